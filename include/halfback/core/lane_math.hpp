@@ -1,0 +1,56 @@
+// Lane primitives used by the generic parameterization kernels.
+//
+// Every kernel in param.hpp is written once, as a template over a lane type T: a scalar (float,
+// double) or a SIMD pack (xsimd::batch; its LaneOps specialization lives in
+// src/core/batch_simd.hpp). Kernels reach math through LaneOps<T> only, so the single-pair API and
+// the SIMD batch path run the same formulas. Kernels are branch-free: both sides of a select() are
+// evaluated, and masks are combined with mask_and / mask_or.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <type_traits>
+
+namespace halfback {
+
+template <class T>
+struct LaneOps;
+
+template <class T>
+  requires std::is_floating_point_v<T>
+struct LaneOps<T> {
+  using Scalar = T;
+  using Mask = bool;
+  static T select(bool c, T a, T b) { return c ? a : b; }
+  static T sqrt(T x) { return std::sqrt(x); }
+  static T atan2(T y, T x) { return std::atan2(y, x); }
+  static T abs(T x) { return std::abs(x); }
+  static T min(T a, T b) { return std::fmin(a, b); }
+  static T max(T a, T b) { return std::fmax(a, b); }
+  static void sincos(T x, T& s, T& c) {
+    s = std::sin(x);
+    c = std::cos(x);
+  }
+  static bool mask_and(bool a, bool b) { return a && b; }
+  static bool mask_or(bool a, bool b) { return a || b; }
+  static bool mask_not(bool a) { return !a; }
+};
+
+template <class T>
+using ScalarOf = typename LaneOps<T>::Scalar;
+template <class T>
+using MaskOf = typename LaneOps<T>::Mask;
+
+// Tolerance of the domain predicates, in units of the parameter computations' rounding. A tuple
+// whose reconstructed elevations are below the horizon by less than this is valid, and the
+// inverse map clamps it onto the horizon (see docs/math.md, "Valid domain").
+template <class S>
+inline constexpr S kDomainTolerance = S(64) * std::numeric_limits<S>::epsilon();
+
+template <class S>
+inline constexpr S kTwoPi = S(2) * std::numbers::pi_v<S>;
+template <class S>
+inline constexpr S kHalfPi = std::numbers::pi_v<S> / S(2);
+
+}  // namespace halfback

@@ -1,0 +1,91 @@
+// Row-wise decode (form -> direction pair) and encode (direction pair -> form) on lane types.
+// Shared by convert_one(), the batch engine's kernels and the reference implementation.
+#pragma once
+
+#include <cmath>
+
+#include "halfback/core/space.hpp"
+
+namespace halfback::detail {
+
+// Validity of a user-given pair, in the precision of T (see check_pair()).
+template <class T>
+inline MaskOf<T> pair_is_valid(const DirPair<T>& p) {
+  using L = LaneOps<T>;
+  using S = ScalarOf<T>;
+  const T unit_tol(static_cast<S>(kUnitTolerance)), horizon_tol(kDomainTolerance<S>);
+  auto unit = [&](const Vec3<T>& w) {
+    const T e = dot(w, w) - T(1);
+    return L::mask_and(e <= unit_tol, e >= -unit_tol);  // false for NaN and ±inf
+  };
+  return L::mask_and(L::mask_and(unit(p.wi), unit(p.wo)),
+                     L::mask_and(p.wi.z >= -horizon_tol, p.wo.z >= -horizon_tol));
+}
+
+// Decodes coordinates `in` (dimension(from) values) into a pair; the mask says whether valid.
+// Invalid pairs are NaN.
+template <class P, class T>
+inline Solved<T> decode_param(bool isotropic, const T* in) {
+  if (isotropic) return inverse_iso<P>(Tuple3<T>{in[0], in[1], in[2]});
+  return inverse<P>(Tuple4<T>{in[0], in[1], in[2], in[3]});
+}
+
+template <class P, class T>
+inline void encode_param(bool isotropic, const DirPair<T>& p, T* out) {
+  if (isotropic) {
+    const Tuple3<T> q = P::forward_iso(p);
+    for (int i = 0; i < 3; ++i) out[i] = q[i];
+  } else {
+    const Tuple4<T> q = P::forward(p);
+    for (int i = 0; i < 4; ++i) out[i] = q[i];
+  }
+}
+
+template <class P, class T>
+inline T jacobian_of(bool isotropic, const T* q) {
+  if (isotropic) return jacobian_iso<P>(Tuple3<T>{q[0], q[1], q[2]});
+  return P::jacobian(Tuple4<T>{q[0], q[1], q[2], q[3]});
+}
+
+inline constexpr int kMaxDim = 6;
+
+// One row, scalar T: the reference semantics of convert().
+template <class T>
+inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
+  DirPair<T> pair;
+  bool ok;
+  if (from.space == Space::dirs) {
+    pair = {{in[0], in[1], in[2]}, {in[3], in[4], in[5]}};
+    ok = pair_is_valid(pair);
+  } else {
+    const Solved<T> s = visit_parameterization(
+        from.space, [&](auto p) { return decode_param<decltype(p)>(from.isotropic, in); });
+    pair = s.pair;
+    ok = s.in_domain;
+  }
+  const int dim_out = static_cast<int>(dimension(to));
+  if (!ok) {
+    for (int i = 0; i < dim_out; ++i) out[i] = std::numeric_limits<T>::quiet_NaN();
+    if (jacobian) *jacobian = std::numeric_limits<T>::quiet_NaN();
+    return false;
+  }
+  if (to.space == Space::dirs) {
+    const T v[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
+    for (int i = 0; i < 6; ++i) out[i] = v[i];
+  } else {
+    visit_parameterization(to.space,
+                           [&](auto p) { encode_param<decltype(p)>(to.isotropic, pair, out); });
+  }
+  if (jacobian) {
+    const Form side = to.space != Space::dirs ? to : from;
+    const T* q = to.space != Space::dirs ? out : in;
+    *jacobian = side.space == Space::dirs
+                    ? T(1)
+                    : visit_parameterization(side.space, [&](auto p) {
+                        return jacobian_of<decltype(p)>(side.isotropic, q);
+                      });
+  }
+  return true;
+}
+
+}  // namespace halfback::detail
