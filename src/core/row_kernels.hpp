@@ -79,11 +79,9 @@ inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
   if (jacobian) {
     const Form side = to.space != Space::dirs ? to : from;
     const T* q = to.space != Space::dirs ? out : in;
-    *jacobian = side.space == Space::dirs
-                    ? T(1)
-                    : visit_parameterization(side.space, [&](auto p) {
-                        return jacobian_of<decltype(p)>(side.isotropic, q);
-                      });
+    *jacobian = side.space == Space::dirs ? T(1) : visit_parameterization(side.space, [&](auto p) {
+      return jacobian_of<decltype(p)>(side.isotropic, q);
+    });
   }
   return true;
 }

@@ -11,7 +11,9 @@ constexpr std::array<std::string_view, 6> kDirColumns{"wi_x", "wi_y", "wi_z",
                                                       "wo_x", "wo_y", "wo_z"};
 }  // namespace
 
-std::string_view name_of(Space space) { return kNames[static_cast<std::size_t>(space)]; }
+std::string_view name_of(Space space) {
+  return kNames[static_cast<std::size_t>(space)];
+}
 
 std::optional<Space> space_from_name(std::string_view name) {
   for (std::size_t i = 0; i < kNames.size(); ++i)
@@ -55,12 +57,18 @@ PairStatus check_pair(const DirPair<double>& p) {
 
 std::string_view describe(PairStatus status) {
   switch (status) {
-    case PairStatus::ok: return "valid";
-    case PairStatus::not_finite: return "a direction component is not a finite number";
-    case PairStatus::wi_not_unit: return "wi is not a unit vector";
-    case PairStatus::wo_not_unit: return "wo is not a unit vector";
-    case PairStatus::wi_below_horizon: return "wi is below the horizon (wi_z < 0)";
-    case PairStatus::wo_below_horizon: return "wo is below the horizon (wo_z < 0)";
+    case PairStatus::ok:
+      return "valid";
+    case PairStatus::not_finite:
+      return "a direction component is not a finite number";
+    case PairStatus::wi_not_unit:
+      return "wi is not a unit vector";
+    case PairStatus::wo_not_unit:
+      return "wo is not a unit vector";
+    case PairStatus::wi_below_horizon:
+      return "wi is below the horizon (wi_z < 0)";
+    case PairStatus::wo_below_horizon:
+      return "wo is below the horizon (wo_z < 0)";
   }
   return "unknown";
 }

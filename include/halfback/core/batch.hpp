@@ -50,13 +50,13 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
 
 extern template void convert<float>(Form, Form, std::span<const ConstColumn<float>>, std::size_t,
                                     const ConvertOutput<float>&, const BatchOptions&);
-extern template void convert<double>(Form, Form, std::span<const ConstColumn<double>>,
-                                     std::size_t, const ConvertOutput<double>&,
-                                     const BatchOptions&);
+extern template void convert<double>(Form, Form, std::span<const ConstColumn<double>>, std::size_t,
+                                     const ConvertOutput<double>&, const BatchOptions&);
 
 // Single row through the same code path, for callers that hold one tuple (values in, values out).
 // Returns whether the input was valid. `jacobian` may be null.
 template <class T>
-bool convert_one(Form from, Form to, std::span<const T> in, std::span<T> out, T* jacobian = nullptr);
+bool convert_one(Form from, Form to, std::span<const T> in, std::span<T> out,
+                 T* jacobian = nullptr);
 
 }  // namespace halfback

@@ -18,7 +18,7 @@ template <class T>
 struct LaneOps;
 
 template <class T>
-  requires std::is_floating_point_v<T>
+requires std::is_floating_point_v<T>
 struct LaneOps<T> {
   using Scalar = T;
   using Mask = bool;
@@ -35,6 +35,7 @@ struct LaneOps<T> {
   static bool mask_and(bool a, bool b) { return a && b; }
   static bool mask_or(bool a, bool b) { return a || b; }
   static bool mask_not(bool a) { return !a; }
+  static bool select_mask(bool c, bool a, bool b) { return c ? a : b; }
 };
 
 template <class T>
@@ -47,6 +48,17 @@ using MaskOf = typename LaneOps<T>::Mask;
 // inverse map clamps it onto the horizon (see docs/math.md, "Valid domain").
 template <class S>
 inline constexpr S kDomainTolerance = S(64) * std::numeric_limits<S>::epsilon();
+
+// Newton's iteration, for compile-time constants only.
+template <class S>
+constexpr S constexpr_sqrt(S x) {
+  S r = x > S(1) ? x : S(1);
+  for (int i = 0; i < 200; ++i) r = S(0.5) * (r + x / r);
+  return r;
+}
+
+template <class S>
+inline constexpr S kSqrtDomainTolerance = constexpr_sqrt(kDomainTolerance<S>);
 
 template <class S>
 inline constexpr S kTwoPi = S(2) * std::numbers::pi_v<S>;

@@ -91,6 +91,15 @@ inline T elevation(T x, T y, T z) {
   return LaneOps<T>::atan2(LaneOps<T>::sqrt(x * x + y * y), z);
 }
 
+// Tolerance on a reconstructed elevation whose rounding error grows like ε / cond: the domain
+// predicates accept z >= -tol / max(cond, √tol) (docs/math.md, "Valid domain").
+template <class T>
+inline T conditioned_tolerance(T cond) {
+  using S = ScalarOf<T>;
+  const S tol = kDomainTolerance<S>;
+  return T(tol) / LaneOps<T>::max(cond, T(kSqrtDomainTolerance<S>));
+}
+
 template <class T>
 inline T dot(const Vec3<T>& a, const Vec3<T>& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
@@ -150,8 +159,8 @@ struct Spherical {
     const Tuple4<T> q = forward(p);
     const auto vertical_i = L::mask_and(p.wi.x == T(0), p.wi.y == T(0));
     const auto vertical_o = L::mask_and(p.wo.x == T(0), p.wo.y == T(0));
-    const T dphi = L::select(L::mask_or(vertical_i, vertical_o), T(0),
-                             detail::wrap_two_pi(q[3] - q[1]));
+    const T dphi =
+        L::select(L::mask_or(vertical_i, vertical_o), T(0), detail::wrap_two_pi(q[3] - q[1]));
     return {q[0], q[2], dphi};
   }
 
@@ -166,9 +175,12 @@ struct Spherical {
     using L = LaneOps<T>;
     Solved<T> r = inverse_raw(lift_iso(q));
     // Rotate by -φh so that h̄ lies on +x (nothing to do when h̄ = 0: ωi is already at azimuth 0).
+    // The pose is discontinuous at h̄ = 0, so an h̄ at the rounding level of its two terms (an
+    // exact mirror configuration, Δφ = π) counts as zero rather than picking a random rotation.
     const T hx = r.pair.wi.x + r.pair.wo.x, hy = r.pair.wi.y + r.pair.wo.y;
     const T len = L::sqrt(hx * hx + hy * hy);
-    const auto zero = len == T(0);
+    const T scale = L::abs(r.pair.wi.x) + L::abs(r.pair.wo.x) + L::abs(r.pair.wo.y);
+    const auto zero = len <= T(8 * std::numeric_limits<ScalarOf<T>>::epsilon()) * scale;
     const T c = L::select(zero, T(1), hx / len), s = L::select(zero, T(0), -hy / len);
     r.pair.wi = detail::rotate_z(r.pair.wi, c, s);
     r.pair.wo = detail::rotate_z(r.pair.wo, c, s);
@@ -223,11 +235,17 @@ struct HalfDiff {
     const T cp = L::select(flat, T(1), sx / rxy), sp = L::select(flat, T(0), sy / rxy);
     const T ct = L::select(null, T(1), sz / len), st = L::select(null, T(0), rxy / len);
     const T theta_h = L::select(null, T(0), L::atan2(rxy, sz));
-    // d = R_y(-θh) R_z(-φh) ωi
-    const T a = cp * p.wi.x + sp * p.wi.y;
-    const T dy = cp * p.wi.y - sp * p.wi.x;
-    const T dx = ct * a - st * p.wi.z;
-    const T dz = L::max(st * a + ct * p.wi.z, T(0));  // = |h| >= 0; rounding may dip below
+    // d = R_y(-θh) R_z(-φh) ωi, computed symmetrically in ωi and ωo: R⁻¹h = (0, 0, ‖h‖) exactly,
+    // so d = (R⁻¹k)_xy + ‖h‖ n. Rotating ωi alone would make the inverse reflect ωi about ĥ, and
+    // amplify the inputs' unit-norm rounding (‖ωi‖ ≠ ‖ωo‖ by an ulp) by 1/‖h‖ near h = 0; with
+    // the symmetric form the inverse reproduces the pair up to one common scale (docs/math.md).
+    const T half(0.5);
+    const T kx = half * (p.wi.x - p.wo.x), ky = half * (p.wi.y - p.wo.y),
+            kz = half * (p.wi.z - p.wo.z);
+    const T a = cp * kx + sp * ky;
+    const T dy = cp * ky - sp * kx;
+    const T dx = ct * a - st * kz;
+    const T dz = half * len;
     return {theta_h, detail::azimuth(sy, sx), detail::elevation(dx, dy, dz),
             detail::azimuth(dy, dx)};
   }
@@ -247,12 +265,13 @@ struct HalfDiff {
     Solved<T> r;
     r.pair.wi = {cp * ai - sp * dy, sp * ai + cp * dy, ch * dz - sh * dx};
     r.pair.wo = {cp * ao + sp * dy, sp * ao - cp * dy, ch * dz + sh * dx};
-    const T half_pi(kHalfPi<S>), tol(kDomainTolerance<S>);
-    r.in_domain = L::mask_and(
-        L::mask_and(
-            L::mask_and(detail::in_range(q[0], T(0), half_pi), detail::in_range(q[2], T(0), half_pi)),
-            L::mask_and(detail::is_azimuth(q[1]), detail::is_azimuth(q[3]))),
-        L::mask_and(r.pair.wi.z >= -tol, r.pair.wo.z >= -tol));
+    // The elevations inherit the inputs' unit-norm rounding amplified by 1/‖h‖ = 1/cos θd.
+    const T half_pi(kHalfPi<S>), tol = detail::conditioned_tolerance(cd);
+    r.in_domain =
+        L::mask_and(L::mask_and(L::mask_and(detail::in_range(q[0], T(0), half_pi),
+                                            detail::in_range(q[2], T(0), half_pi)),
+                                L::mask_and(detail::is_azimuth(q[1]), detail::is_azimuth(q[3]))),
+                    L::mask_and(r.pair.wi.z >= -tol, r.pair.wo.z >= -tol));
     return r;
   }
 
@@ -269,8 +288,7 @@ struct HalfDiff {
   static Tuple3<T> forward_iso(const DirPair<T>& p) {
     using L = LaneOps<T>;
     const Tuple4<T> q = forward(p);
-    const auto flat =
-        L::mask_and(p.wi.x + p.wo.x == T(0), p.wi.y + p.wo.y == T(0));  // h̄ = 0
+    const auto flat = L::mask_and(p.wi.x + p.wo.x == T(0), p.wi.y + p.wo.y == T(0));  // h̄ = 0
     return {q[0], q[2], L::select(flat, T(0), q[3])};
   }
   template <class T>
@@ -383,8 +401,9 @@ struct Ortho {
     r.pair.wo = {xo, yo, L::sqrt(L::max(zo2, T(0)))};
     const T tol(kDomainTolerance<S>);
     r.in_domain = L::mask_and(
-        L::mask_and(L::mask_and(detail::in_range(q[0], T(0), T(1)), detail::in_range(q[2], T(0), T(1))),
-                    L::mask_and(detail::is_azimuth(q[1]), detail::is_azimuth(q[3]))),
+        L::mask_and(
+            L::mask_and(detail::in_range(q[0], T(0), T(1)), detail::in_range(q[2], T(0), T(1))),
+            L::mask_and(detail::is_azimuth(q[1]), detail::is_azimuth(q[3]))),
         L::mask_and(zi2 >= -tol, zo2 >= -tol));
     return r;
   }
@@ -429,6 +448,9 @@ struct Ortho {
 
 struct Hybrid {
   static constexpr std::string_view name = "hybrid";
+  // hz² below this is at the rounding level of 1 − ‖h̄‖² − ‖k‖²: both directions graze.
+  template <class S>
+  static constexpr S kNoisyHz2 = S(16) * std::numeric_limits<S>::epsilon();
   static constexpr std::array<std::string_view, 4> columns{"hbar", "phi_h", "k", "phi_k"};
   static constexpr std::array<std::string_view, 3> iso_columns{"hbar", "k", "dphi"};
 
@@ -478,23 +500,29 @@ struct Hybrid {
     // Both elevations hz ± kz are >= 0 iff |kz| <= hz. When hz is at rounding level (both
     // directions grazing) the raw kz can jump to the wrong branch (±‖k‖); clamping it, and
     // taking ‖k̄‖ from ‖k‖² = ‖k̄‖² + kz², keeps the error at the representation's own limit.
+    // Outside that regime the clamp only moves kz by rounding, and ‖k‖ sin θk stays the
+    // accurate ‖k̄‖ (√(‖k‖² − kz²) is not, when k is nearly vertical).
     const T kz_raw = q[2] * cos_tk;
     const T kz = L::max(-g.hz, L::min(kz_raw, g.hz));
-    const T kbar = L::select(kz == kz_raw, q[2] * sin_tk,
-                             L::sqrt(L::max(q[2] * q[2] - kz * kz, T(0))));
+    const auto noisy = g.hz2 < T(kNoisyHz2<S>);
+    const T zi_raw = g.hz + kz_raw, zo_raw = g.hz - kz_raw;
+    const T kbar = L::select(noisy, L::sqrt(L::max(q[2] * q[2] - kz * kz, T(0))), q[2] * sin_tk);
     const T kx = kbar * g.ck, ky = kbar * g.sk;
     Solved<T> r;
     r.pair.wi = {g.hx + kx, g.hy + ky, g.hz + kz};
     r.pair.wo = {g.hx - kx, g.hy - ky, g.hz - kz};
-    // Domain: hz² >= 0 and zi zo >= 0, the latter as the polynomial margin
-    // zi zo (hz² + c²) = hz² (hz² + c²) - ‖k‖² c², which is accurate to a few ulps even where the
-    // reconstructed elevations are not (docs/math.md).
+    // Domain: hz² >= 0, and both elevations >= 0 within their rounding error (~ε/hz). Where hz is
+    // itself at rounding level the elevations are meaningless and the test is the polynomial
+    // margin zi zo (hz² + c²) = hz² (hz² + c²) - ‖k‖² c², accurate to a few ulps (docs/math.md).
     const T margin = g.hz2 * (g.hz2 + g.c * g.c) - q[2] * q[2] * g.c * g.c;
-    const T tol(kDomainTolerance<S>);
+    const T tol(kDomainTolerance<S>), ztol = detail::conditioned_tolerance(g.hz);
+    const auto elevations_ok =
+        L::select_mask(noisy, margin >= -tol, L::mask_and(zi_raw >= -ztol, zo_raw >= -ztol));
     r.in_domain = L::mask_and(
-        L::mask_and(L::mask_and(detail::in_range(q[0], T(0), T(1)), detail::in_range(q[2], T(0), T(1))),
-                    L::mask_and(detail::is_azimuth(q[1]), detail::is_azimuth(q[3]))),
-        L::mask_and(g.hz2 >= -tol, margin >= -tol));
+        L::mask_and(
+            L::mask_and(detail::in_range(q[0], T(0), T(1)), detail::in_range(q[2], T(0), T(1))),
+            L::mask_and(detail::is_azimuth(q[1]), detail::is_azimuth(q[3]))),
+        L::mask_and(g.hz2 >= -tol, elevations_ok));
     return r;
   }
 

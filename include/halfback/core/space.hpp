@@ -30,11 +30,16 @@ struct Form {
 template <class F>
 decltype(auto) visit_parameterization(Space space, F&& f) {
   switch (space) {
-    case Space::spherical: return f(Spherical{});
-    case Space::halfdiff: return f(HalfDiff{});
-    case Space::ortho: return f(Ortho{});
-    case Space::hybrid: break;
-    case Space::dirs: break;
+    case Space::spherical:
+      return f(Spherical{});
+    case Space::halfdiff:
+      return f(HalfDiff{});
+    case Space::ortho:
+      return f(Ortho{});
+    case Space::hybrid:
+      break;
+    case Space::dirs:
+      break;
   }
   return f(Hybrid{});  // dirs is rejected by callers before dispatch
 }
@@ -51,7 +56,14 @@ std::span<const std::string_view> column_names(Form form);
 
 // Checks a direction pair given by the user. Directions must be finite, unit within
 // kUnitTolerance (on ‖ω‖² - 1), and not below the horizon by more than kDomainTolerance.
-enum class PairStatus { ok, not_finite, wi_not_unit, wo_not_unit, wi_below_horizon, wo_below_horizon };
+enum class PairStatus {
+  ok,
+  not_finite,
+  wi_not_unit,
+  wo_not_unit,
+  wi_below_horizon,
+  wo_below_horizon
+};
 inline constexpr double kUnitTolerance = 1e-6;
 PairStatus check_pair(const DirPair<double>& p);
 std::string_view describe(PairStatus status);

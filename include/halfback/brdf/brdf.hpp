@@ -1,0 +1,43 @@
+// The BRDF interface: ρ(ωi, ωo) in sr⁻¹, RGB, without the cosine factor.
+//
+// Directions follow the core conventions (halfback/core/param.hpp): ωi is the incoming (light)
+// direction, ωo the outgoing (view) direction, unit vectors in the frame n = +z, t = +x, b = +y.
+// Analytic models, the paper's test functions and measured data (MERL, RGL, ALTA) all implement it.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+
+#include "halfback/core/param.hpp"
+
+namespace halfback {
+
+struct Rgb {
+  double r = 0, g = 0, b = 0;
+  friend bool operator==(const Rgb&, const Rgb&) = default;
+};
+
+class Brdf {
+ public:
+  virtual ~Brdf() = default;
+
+  // Short identifier, e.g. "ggx" or "merl:gold-metallic-paint"; and one line for humans.
+  virtual std::string name() const = 0;
+  virtual std::string description() const = 0;
+
+  // Whether ρ is invariant under rotations about n, and under ωi <-> ωo.
+  virtual bool isotropic() const = 0;
+  virtual bool reciprocal() const = 0;
+
+  // ρ(ωi, ωo). A pair with a direction below the horizon (z < 0) gives 0.
+  virtual Rgb eval(const DirPair<double>& pair) const = 0;
+
+  // Batch evaluation (out.size() == pairs.size()). The default runs eval() over all threads;
+  // formats with a faster batched path override it.
+  virtual void eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const;
+};
+
+using BrdfPtr = std::shared_ptr<const Brdf>;
+
+}  // namespace halfback
