@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <limits>
 
 #include "core/test_util.hpp"
@@ -57,7 +58,7 @@ void check_round_trip(std::size_t n) {
   auto pairs = test::random_pairs(n, 20261122);
   const auto edges = test::edge_pairs();
   pairs.insert(pairs.end(), edges.begin(), edges.end());
-  double worst_ratio = 0, worst_well_conditioned = 0;
+  double worst_ratio = 0, worst_well_conditioned = 0, worst_above_001 = 0;
   std::size_t failures = 0;
   for (const auto& p64 : pairs) {
     const DirPair<T> p = test::cast_pair<T>(p64);
@@ -71,19 +72,34 @@ void check_round_trip(std::size_t n) {
     const double cond = condition(P{}, exact);
     const double bound = round_trip_bound<T>(cond);
     worst_ratio = std::max(worst_ratio, err / bound);
-    if (std::min(exact.wi.z, exact.wo.z) >= 0.01 && cond >= 0.05)
-      worst_well_conditioned = std::max(worst_well_conditioned, err);
+    if (std::min(exact.wi.z, exact.wo.z) >= 0.01) {
+      worst_above_001 = std::max(worst_above_001, err);
+      if (cond >= 0.05) worst_well_conditioned = std::max(worst_well_conditioned, err);
+    }
     if (err > bound && failures++ < 5)
       ADD_FAILURE() << P::name << ": round trip error " << err << " > bound " << bound << " (cond "
                     << cond << ") for wi=(" << exact.wi.x << "," << exact.wi.y << "," << exact.wi.z
                     << ") wo=(" << exact.wo.x << "," << exact.wo.y << "," << exact.wo.z << ")";
   }
-  // The absolute targets of the issue, where the conditioning allows them.
-  const double target = std::is_same_v<T, double> ? 1e-12 : 1e-5;
-  EXPECT_LE(worst_well_conditioned, target) << P::name;
-  ::testing::Test::RecordProperty("worst_error_over_bound", std::to_string(worst_ratio));
-  ::testing::Test::RecordProperty("worst_error_well_conditioned",
-                                  std::to_string(worst_well_conditioned));
+  // The absolute targets, where the conditioning allows them (docs/math.md, "Accuracy"): double
+  // ≤ 1e-12 wherever both z ≥ 0.01. Float ≤ 1e-5 there for spherical and halfdiff; ortho and
+  // hybrid store ‖h̄‖, ‖k̄‖ / ‖k‖ with 6e-8 relative rounding, which alone moves z by ~ε/z, so
+  // for them 1e-5 holds where the conditioning number is ≥ 0.05 and the bound above elsewhere.
+  if constexpr (std::is_same_v<T, double>) {
+    EXPECT_LE(worst_above_001, 1e-12) << P::name;
+  } else if constexpr (std::is_same_v<P, Spherical> || std::is_same_v<P, HalfDiff>) {
+    EXPECT_LE(worst_above_001, 1e-5) << P::name;
+  } else {
+    EXPECT_LE(worst_well_conditioned, 1e-5) << P::name;
+  }
+  auto sci = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return std::string(buf);
+  };
+  ::testing::Test::RecordProperty("worst_error_over_bound", sci(worst_ratio));
+  ::testing::Test::RecordProperty("worst_error_well_conditioned", sci(worst_well_conditioned));
+  ::testing::Test::RecordProperty("worst_error_both_z_above_0.01", sci(worst_above_001));
 }
 
 TYPED_TEST(ParamTest, RoundTripOrderedPairDouble) {
