@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Quickstart step 1: install halfback's dependencies (Debian 12, as root or with sudo), build it,
+# and run the main job on the data embedded in the project.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=$(grep -v '^\s*#' scripts/debian-packages.txt | tr '\n' ' ')
+if command -v apt-get >/dev/null; then
+  sudo=""
+  [ "$(id -u)" = 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends $packages
+else
+  echo "setup: apt-get not found; install these packages yourself: $packages" >&2
+fi
+
+cmake --preset release
+cmake --build --preset release
+
+bash scripts/main-job.sh
