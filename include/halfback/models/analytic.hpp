@@ -1,0 +1,112 @@
+// Analytic BRDF models, for testing, comparison and figures. Formulas and their sources:
+// docs/models.md. All return ρ in sr⁻¹ without the cosine factor, and 0 below the horizon.
+// Constructors validate their parameters and throw std::invalid_argument naming the bad one.
+#pragma once
+
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/models/fresnel.hpp"
+
+namespace halfback::models {
+
+// ρ = albedo / π.
+class Lambert final : public Brdf {
+ public:
+  explicit Lambert(Rgb albedo);
+  std::string name() const override { return "lambert"; }
+  std::string description() const override;
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return true; }
+  Rgb eval(const DirPair<double>& pair) const override;
+
+ private:
+  Rgb albedo_;
+};
+
+// Microfacet reflection (Cook–Torrance form with Walter et al. 2007 / Heitz 2014 conventions):
+// ρ = F(ωi·m) D(m) G2(ωi, ωo) / (4 cos θi cos θo), m = ĥ, with the anisotropic GGX or Beckmann
+// distribution and the height-correlated Smith masking-shadowing G2 = 1 / (1 + Λ(ωi) + Λ(ωo)).
+struct MicrofacetParams {
+  enum class Distribution { ggx, beckmann };
+  Distribution distribution = Distribution::ggx;
+  double alpha_x = 0.2, alpha_y = 0.2;  // roughness along t and b
+  Fresnel fresnel;
+};
+
+class Microfacet final : public Brdf {
+ public:
+  explicit Microfacet(const MicrofacetParams& params);
+  std::string name() const override;
+  std::string description() const override;
+  bool isotropic() const override { return params_.alpha_x == params_.alpha_y; }
+  bool reciprocal() const override { return true; }
+  Rgb eval(const DirPair<double>& pair) const override;
+
+  // The distribution of normals D(m) (∫ D(m) (m·n) dm = 1) and Smith's Λ(ω).
+  double distribution(const Vec3<double>& m) const;
+  double lambda(const Vec3<double>& w) const;
+  const MicrofacetParams& params() const { return params_; }
+
+ private:
+  MicrofacetParams params_;
+};
+
+// The ABC model in the orthographic form of Löw et al. 2012: ρ = kd/π + F(θd) S(f) with the
+// K-correlation spectrum S(f) = A / (1 + B f²)^((C+1)/2) of the distance f = ‖β − β0‖ = 2‖h̄‖
+// between the projected view direction and the projected mirror direction.
+struct AbcParams {
+  double a = 1.0, b = 400.0, c = 1.5;
+  double eta = 1.5;  // dielectric Fresnel at θd
+  Rgb kd{0, 0, 0};
+};
+
+class Abc final : public Brdf {
+ public:
+  explicit Abc(const AbcParams& params);
+  std::string name() const override { return "abc"; }
+  std::string description() const override;
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return true; }
+  Rgb eval(const DirPair<double>& pair) const override;
+
+ private:
+  AbcParams params_;
+};
+
+// A sheen lobe for cloth-like grazing retro-reflection: the "Charlie" distribution of Estevez
+// and Kulla 2017, D(m) = (2 + 1/α) sin(θm)^(1/α) / (2π), with the Ashikhmin–Premoze visibility
+// V = 1 / (4 (cos θi + cos θo − cos θi cos θo)); ρ = color · D(ĥ) · V.
+struct SheenParams {
+  Rgb color{1, 1, 1};
+  double alpha = 0.3;
+};
+
+class Sheen final : public Brdf {
+ public:
+  explicit Sheen(const SheenParams& params);
+  std::string name() const override { return "sheen"; }
+  std::string description() const override;
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return true; }
+  Rgb eval(const DirPair<double>& pair) const override;
+
+ private:
+  SheenParams params_;
+};
+
+// The sum of several BRDFs (e.g. a diffuse base with a sheen or a glossy layer on top).
+class Sum final : public Brdf {
+ public:
+  explicit Sum(std::vector<BrdfPtr> terms);
+  std::string name() const override;
+  std::string description() const override;
+  bool isotropic() const override;
+  bool reciprocal() const override;
+  Rgb eval(const DirPair<double>& pair) const override;
+
+ private:
+  std::vector<BrdfPtr> terms_;
+};
+
+}  // namespace halfback::models
