@@ -1,0 +1,98 @@
+// The analytic models' entries in the model registry: names, parameters (defaults, ranges) and
+// factories, so that "ggx:alpha=0.2,f0=0.9" works everywhere a BRDF SPEC is accepted.
+#include "halfback/models/register.hpp"
+
+#include "halfback/models/analytic.hpp"
+
+namespace halfback::models {
+
+namespace {
+
+// Colour parameters: a grey value plus optional per-channel overrides (−1 = use the grey value),
+// because registry parameters are scalars.
+std::vector<ModelParam> colour_params(const std::string& name, const std::string& what,
+                                      double default_value, double max) {
+  return {{name, what + " (grey)", default_value, 0, max},
+          {name + "_r", what + ", red channel (default: " + name + ")", -1, -1, max},
+          {name + "_g", what + ", green channel (default: " + name + ")", -1, -1, max},
+          {name + "_b", what + ", blue channel (default: " + name + ")", -1, -1, max}};
+}
+
+Rgb colour(const ModelArgs& a, const std::string& name) {
+  const double grey = a[name];
+  auto channel = [&](const char* suffix) {
+    const double v = a[name + suffix];
+    return v < 0 ? grey : v;
+  };
+  return {channel("_r"), channel("_g"), channel("_b")};
+}
+
+std::vector<ModelParam> concat(std::vector<ModelParam> a, const std::vector<ModelParam>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+ModelInfo microfacet_info(MicrofacetParams::Distribution d, std::string name, std::string title) {
+  std::vector<ModelParam> params{
+      {"alpha", "roughness (both directions)", 0.2, 1e-3, 10},
+      {"alpha_x", "roughness along t (default: alpha)", -1, -1, 10},
+      {"alpha_y", "roughness along b (default: alpha)", -1, -1, 10},
+      {"eta", "index of refraction; > 0 selects exact Fresnel instead of Schlick", 0, 0, 100},
+      {"k", "extinction coefficient (conductor when > 0; needs eta)", 0, 0, 100},
+  };
+  params = concat(params, colour_params("f0", "Schlick reflectance at normal incidence", 0.04, 1));
+  return {std::move(name), std::move(title), std::move(params), [d](const ModelArgs& a) {
+            MicrofacetParams p;
+            p.distribution = d;
+            p.alpha_x = a["alpha_x"] < 0 ? a["alpha"] : a["alpha_x"];
+            p.alpha_y = a["alpha_y"] < 0 ? a["alpha"] : a["alpha_y"];
+            if (a["eta"] > 0) {
+              p.fresnel.kind = a["k"] > 0 ? Fresnel::Kind::conductor : Fresnel::Kind::dielectric;
+              p.fresnel.eta = {a["eta"], a["eta"], a["eta"]};
+              p.fresnel.k = {a["k"], a["k"], a["k"]};
+            } else {
+              if (a["k"] > 0) throw std::invalid_argument(std::string("k needs eta > 0"));
+              p.fresnel.kind = Fresnel::Kind::schlick;
+              p.fresnel.f0 = colour(a, "f0");
+            }
+            return std::make_shared<Microfacet>(p);
+          }};
+}
+
+}  // namespace
+
+void register_analytic_models(ModelRegistry& registry) {
+  registry.add({"lambert", "Lambertian diffuse reflection, rho = albedo / pi",
+                colour_params("albedo", "albedo", 0.5, 1), [](const ModelArgs& a) {
+                  return std::make_shared<Lambert>(colour(a, "albedo"));
+                }});
+  registry.add(microfacet_info(MicrofacetParams::Distribution::ggx, "ggx",
+                               "GGX microfacet reflection, anisotropic, Smith G2, Fresnel"));
+  registry.add(microfacet_info(MicrofacetParams::Distribution::beckmann, "beckmann",
+                               "Beckmann microfacet reflection, anisotropic, Smith G2, Fresnel"));
+  registry.add({"abc",
+                "ABC smooth-surface model of Low et al. 2012: F(theta_d) A/(1+B f^2)^((C+1)/2), "
+                "f = 2|h_bar|, plus kd/pi",
+                {{"a", "A: specular scale", 1, 0, 1e6},
+                 {"b", "B: inverse squared width in f = 2|h_bar|", 400, 0, 1e9},
+                 {"c", "C: fall-off exponent", 1.5, 0, 100},
+                 {"eta", "index of refraction of the dielectric Fresnel factor", 1.5, 1e-3, 100},
+                 {"kd", "diffuse albedo", 0, 0, 1}},
+                [](const ModelArgs& a) {
+                  AbcParams p;
+                  p.a = a["a"];
+                  p.b = a["b"];
+                  p.c = a["c"];
+                  p.eta = a["eta"];
+                  p.kd = {a["kd"], a["kd"], a["kd"]};
+                  return std::make_shared<Abc>(p);
+                }});
+  registry.add({"sheen", "Charlie sheen lobe (Estevez & Kulla 2017) for cloth-like grazing reflection",
+                concat({{"alpha", "roughness of the sheen distribution", 0.3, 1e-3, 1}},
+                       colour_params("color", "sheen colour", 1, 1)),
+                [](const ModelArgs& a) {
+                  return std::make_shared<Sheen>(SheenParams{colour(a, "color"), a["alpha"]});
+                }});
+}
+
+}  // namespace halfback::models
