@@ -1,0 +1,165 @@
+"""Tests of the Python module against independent NumPy formulas, the CLI, and bad input."""
+
+import os
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import halfback
+
+PARAMS = ["spherical", "halfdiff", "ortho", "hybrid"]
+
+
+def random_dirs(n, seed=1, zmin=0.0):
+    rng = np.random.default_rng(seed)
+    z = zmin + (1 - zmin) * rng.random((n, 2))
+    phi = 2 * np.pi * rng.random((n, 2))
+    s = np.sqrt(1 - z * z)
+    return np.stack([s[:, 0] * np.cos(phi[:, 0]), s[:, 0] * np.sin(phi[:, 0]), z[:, 0],
+                     s[:, 1] * np.cos(phi[:, 1]), s[:, 1] * np.sin(phi[:, 1]), z[:, 1]], axis=1)
+
+
+def numpy_hybrid(x):
+    """The hybrid forward map, written here with NumPy (what a researcher would write)."""
+    h = (x[:, 0:3] + x[:, 3:6]) / 2
+    k = (x[:, 0:3] - x[:, 3:6]) / 2
+    hbar = np.hypot(h[:, 0], h[:, 1])
+    phi_h = np.mod(np.arctan2(h[:, 1], h[:, 0]), 2 * np.pi)
+    knorm = np.linalg.norm(k, axis=1)
+    phi_k = np.mod(np.arctan2(k[:, 1], k[:, 0]), 2 * np.pi)
+    return np.stack([hbar, phi_h, knorm, phi_k], axis=1)
+
+
+def angle_diff(a, b):
+    d = np.mod(np.abs(a - b), 2 * np.pi)
+    return np.minimum(d, 2 * np.pi - d)
+
+
+def test_hybrid_matches_numpy_formula():
+    x = random_dirs(10000, zmin=0.01)
+    q = halfback.convert(x, "dirs", "hybrid")
+    ref = numpy_hybrid(x)
+    np.testing.assert_allclose(q[:, [0, 2]], ref[:, [0, 2]], atol=1e-14)
+    assert angle_diff(q[:, [1, 3]], ref[:, [1, 3]]).max() < 1e-12
+
+
+@pytest.mark.parametrize("param", PARAMS)
+@pytest.mark.parametrize("isotropic", [False, True])
+def test_round_trip_float64(param, isotropic):
+    x = random_dirs(20000, seed=2, zmin=0.05)
+    q = halfback.convert(x, "dirs", param, isotropic=isotropic)
+    assert q.shape == (len(x), 3 if isotropic else 4) and q.dtype == np.float64
+    back = halfback.convert(q, param, "dirs", isotropic=isotropic)
+    if not isotropic:
+        np.testing.assert_allclose(back, x, atol=1e-12)
+    else:  # the canonical pose: same isotropic coordinates again
+        q2 = halfback.convert(back, "dirs", param, isotropic=True)
+        np.testing.assert_allclose(q2[:, :2], q[:, :2], atol=1e-12)
+        assert angle_diff(q2[:, 2], q[:, 2]).max() < 1e-9
+
+
+@pytest.mark.parametrize("param", PARAMS)
+def test_float32_stays_float32(param):
+    x = random_dirs(5000, seed=3, zmin=0.1).astype(np.float32)
+    q = halfback.convert(x, "dirs", param)
+    assert q.dtype == np.float32
+    back = halfback.convert(q, param, "dirs")
+    assert back.dtype == np.float32
+    assert np.abs(back - x).max() < 1e-4
+
+
+def test_non_contiguous_and_fortran_inputs_give_the_same_result():
+    x = random_dirs(3000, seed=4)
+    ref = halfback.convert(x, "dirs", "ortho")
+    wide = np.zeros((3000, 12))
+    wide[:, ::2] = x  # column stride 2
+    np.testing.assert_array_equal(halfback.convert(wide[:, ::2], "dirs", "ortho"), ref)
+    np.testing.assert_array_equal(halfback.convert(np.asfortranarray(x), "dirs", "ortho"), ref)
+    np.testing.assert_array_equal(halfback.convert(x[::-1], "dirs", "ortho"), ref[::-1])
+    np.testing.assert_array_equal(halfback.convert(x.tolist(), "dirs", "ortho"), ref)
+
+
+def test_valid_and_nan_handling():
+    x = random_dirs(10, seed=5)
+    x[1, 2] = np.nan
+    x[2, 5] = -0.5  # below the horizon (and not unit)
+    x[3, 0] *= 1.1  # not unit
+    mask = halfback.valid(x, "dirs")
+    assert mask.dtype == np.bool_
+    assert mask.tolist() == [True, False, False, False] + [True] * 6
+    q = halfback.convert(x, "dirs", "hybrid")
+    assert np.isnan(q[1:4]).all() and not np.isnan(q[[0, 4]]).any()
+
+
+def test_domain_mask_for_tuples():
+    q = np.array([[0.6, 0.0, 0.6, 0.0], [0.6, 0.0, 0.6, np.pi / 2], [0.5, 0.0, 0.5, 7.0]])
+    assert halfback.valid(q, "ortho").tolist() == [False, True, False]
+    d = halfback.convert(q, "ortho", "dirs")
+    assert np.isnan(d[[0, 2]]).all() and (d[1, [2, 5]] >= 0).all()
+
+
+def test_jacobian_integrates_to_the_measure_of_pairs():
+    # ∫ J over the box of hybrid coordinates (with the validity mask) = (2π)².
+    rng = np.random.default_rng(6)
+    n = 400000
+    q = np.stack([rng.random(n), 2 * np.pi * rng.random(n), rng.random(n),
+                  2 * np.pi * rng.random(n)], axis=1)
+    j = np.nan_to_num(halfback.jacobian(q, "hybrid"), nan=0.0) * (2 * np.pi) ** 2
+    mean, se = j.mean(), j.std() / np.sqrt(n)
+    assert abs(mean - 4 * np.pi ** 2) < 3 * se and se < 0.01 * 4 * np.pi ** 2
+
+
+def test_columns():
+    assert halfback.columns("hybrid") == ["hbar", "phi_h", "k", "phi_k"]
+    assert halfback.columns("ortho", isotropic=True) == ["hbar", "kbar", "dphi"]
+
+
+@pytest.mark.parametrize("call,exc,text", [
+    (lambda: halfback.convert(np.zeros((3, 5)), "dirs", "hybrid"), ValueError, "shape (N, 6)"),
+    (lambda: halfback.convert(np.zeros(6), "dirs", "hybrid"), ValueError, "shape (N, 6)"),
+    (lambda: halfback.convert(np.zeros((3, 6)), "dirs", "hybird"), ValueError, "unknown parameterization 'hybird'"),
+    (lambda: halfback.convert(np.zeros((3, 6), dtype=complex), "dirs", "hybrid"), TypeError, "float32 or float64"),
+    (lambda: halfback.convert(np.array([["a"] * 6]), "dirs", "hybrid"), TypeError, "float32 or float64"),
+    (lambda: halfback.jacobian(np.zeros((3, 6)), "dirs"), ValueError, "not dirs"),
+    (lambda: halfback.convert(np.zeros((3, 4)), "hybrid", "dirs", isotropic=True), ValueError, "shape (N, 3)"),
+])
+def test_bad_input_raises_clear_errors(call, exc, text):
+    with pytest.raises(exc, match=None) as info:
+        call()
+    assert text in str(info.value)
+
+
+def test_thread_safety():
+    x = random_dirs(200000, seed=7)
+    ref = halfback.convert(x, "dirs", "halfdiff")
+    results = [None] * 4
+
+    def work(i):
+        results[i] = halfback.convert(x, "dirs", "halfdiff")
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        np.testing.assert_array_equal(r, ref)
+
+
+def test_agrees_with_the_cli(tmp_path):
+    cli = os.environ.get("HALFBACK_CLI")
+    if not cli or not os.path.exists(cli):
+        pytest.skip("HALFBACK_CLI not set (run through ctest)")
+    x = random_dirs(50, seed=8)
+    src = tmp_path / "in.csv"
+    np.savetxt(src, x, delimiter=",", header="wi_x,wi_y,wi_z,wo_x,wo_y,wo_z", comments="",
+               fmt="%.17g")
+    done = subprocess.run([cli, "convert", "--from", "dirs", "--to", "hybrid", "-i", str(src)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.strip().splitlines()
+    assert lines[0].split(",")[:4] == ["hbar", "phi_h", "k", "phi_k"]
+    cli_q = np.array([[float(v) for v in line.split(",")[:4]] for line in lines[1:]])
+    np.testing.assert_array_equal(cli_q, halfback.convert(x, "dirs", "hybrid"))
