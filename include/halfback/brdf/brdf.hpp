@@ -10,6 +10,7 @@
 #include <string>
 
 #include "halfback/core/param.hpp"
+#include "halfback/core/space.hpp"
 
 namespace halfback {
 
@@ -39,5 +40,12 @@ class Brdf {
 };
 
 using BrdfPtr = std::shared_ptr<const Brdf>;
+
+// ρ at the coordinates `coords` of any form (dimension(form) values): the pair is reconstructed
+// with the core's checked inverse (convert_one), so coordinates outside the parameterization's
+// domain, or a dirs row that check_pair() rejects, give NaN in all three channels. Throws
+// std::invalid_argument when coords.size() != dimension(form). Isotropic coordinates stand for
+// their canonical pose (param.hpp), which is what an anisotropic ρ is evaluated at.
+Rgb eval_at(const Brdf& brdf, Form form, std::span<const double> coords);
 
 }  // namespace halfback

@@ -1,0 +1,25 @@
+// One entry point for every BRDF source: a file (MERL .binary, RGL .bsdf, ALTA text), recognized
+// by its content, or an analytic model spec "name:key=value,..." from the model registry.
+#pragma once
+
+#include <filesystem>
+#include <string_view>
+
+#include "halfback/brdf/brdf.hpp"
+
+namespace halfback {
+
+enum class BrdfFileFormat { unknown, merl, rgl, alta };
+
+// The format of a file from its content: MERL by its size and 90/90/180 header, RGL by the
+// "tensor_file\0" magic, ALTA by its `#` header lines (a #DIM line before the first data line).
+// Throws FormatError when the file cannot be read.
+BrdfFileFormat detect_brdf_format(const std::filesystem::path& path);
+
+// If `spec` names an existing file, reads it with the reader its content calls for (the file's
+// extension only picks the reader whose error to report when the content matches no format).
+// Otherwise `spec` is a model spec for ModelRegistry::global(). Throws FormatError for file
+// problems and std::invalid_argument for a spec that is neither a file nor a valid model spec.
+BrdfPtr load_brdf(std::string_view spec);
+
+}  // namespace halfback

@@ -1,0 +1,68 @@
+// The registry of analytic BRDF models, addressed by a spec "name" or "name:key=value,...":
+// each model declares a name, a description, its parameters (default and range) and a factory.
+// Models register themselves with ModelRegistry::global().add(...) (see load.hpp for how a spec
+// reaches it); the registry validates every spec before the factory sees it.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+
+namespace halfback {
+
+struct ModelParam {
+  std::string name;         // [a-z][a-z0-9_]*
+  std::string description;  // one line
+  double default_value = 0;
+  double min = 0, max = 0;  // inclusive range; default_value must lie in it
+};
+
+// The parameter values a factory receives: every declared parameter, defaults filled in.
+class ModelArgs {
+ public:
+  double operator[](std::string_view name) const;  // throws std::out_of_range if undeclared
+  const std::map<std::string, double, std::less<>>& values() const { return values_; }
+  void set(std::string name, double value) { values_[std::move(name)] = value; }
+
+ private:
+  std::map<std::string, double, std::less<>> values_;
+};
+
+struct ModelInfo {
+  std::string name;  // [a-z][a-z0-9_-]*
+  std::string description;
+  std::vector<ModelParam> params;
+  std::function<BrdfPtr(const ModelArgs&)> factory;
+};
+
+class ModelRegistry {
+ public:
+  // The process-wide registry used by load_brdf().
+  static ModelRegistry& global();
+
+  // Registers a model; throws std::invalid_argument on a malformed entry (bad or duplicate name,
+  // default outside its range, no factory).
+  void add(ModelInfo info);
+  // Removes a model (for tests); returns whether it was registered.
+  bool remove(std::string_view name);
+
+  // nullptr when unknown. The pointer stays valid until the model is removed.
+  const ModelInfo* find(std::string_view name) const;
+  std::vector<std::string> names() const;  // sorted
+
+  // Parses "name" or "name:key=value,key=value" and creates the model. Throws
+  // std::invalid_argument with a message for users: unknown model (listing the known ones),
+  // unknown or repeated parameter, a value that is not a number or is out of range.
+  BrdfPtr create(std::string_view spec) const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, ModelInfo, std::less<>> models_;
+};
+
+}  // namespace halfback

@@ -1,0 +1,43 @@
+#include "halfback/brdf/brdf.hpp"
+
+#include <array>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "halfback/core/batch.hpp"
+#include "parallel_for.hpp"
+
+namespace halfback {
+
+void Brdf::eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
+  if (out.size() != pairs.size())
+    throw std::invalid_argument("Brdf::eval: " + std::to_string(pairs.size()) + " pairs but " +
+                                std::to_string(out.size()) + " outputs");
+  // One virtual call per pair is negligible next to a measured BRDF lookup (~100 ns); blocks of
+  // 1024 pairs keep thread start-up (~20 µs) below a few percent.
+  detail::parallel_for(pairs.size(), 1024, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) out[i] = eval(pairs[i]);
+  });
+}
+
+Rgb eval_at(const Brdf& brdf, Form form, std::span<const double> coords) {
+  if (coords.size() != dimension(form))
+    throw std::invalid_argument("eval_at: " + std::string(name_of(form.space)) +
+                                (form.isotropic ? " (isotropic)" : "") + " takes " +
+                                std::to_string(dimension(form)) + " coordinates, got " +
+                                std::to_string(coords.size()));
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  std::array<double, 6> d{};
+  bool ok;
+  if (form.space == Space::dirs) {
+    std::copy(coords.begin(), coords.end(), d.begin());
+    ok = check_pair({{d[0], d[1], d[2]}, {d[3], d[4], d[5]}}) == PairStatus::ok;
+  } else {
+    ok = convert_one<double>(form, Form{Space::dirs, false}, coords, d);
+  }
+  if (!ok) return {nan, nan, nan};
+  return brdf.eval(DirPair<double>{{d[0], d[1], d[2]}, {d[3], d[4], d[5]}});
+}
+
+}  // namespace halfback

@@ -1,0 +1,101 @@
+#include "halfback/brdf/load.hpp"
+
+#include <array>
+#include <fstream>
+#include <string>
+#include <system_error>
+
+#include "halfback/brdf/registry.hpp"
+#include "halfback/io/alta.hpp"
+#include "halfback/io/format_error.hpp"
+#include "halfback/io/merl.hpp"
+#include "halfback/io/rgl.hpp"
+
+namespace halfback {
+
+namespace {
+
+bool is_merl_header(const char* head, std::size_t n) {
+  if (n < 12) return false;
+  const unsigned char* p = reinterpret_cast<const unsigned char*>(head);
+  auto i32 = [&](int k) {
+    return std::int32_t(std::uint32_t(p[4 * k]) | std::uint32_t(p[4 * k + 1]) << 8 |
+                        std::uint32_t(p[4 * k + 2]) << 16 | std::uint32_t(p[4 * k + 3]) << 24);
+  };
+  return i32(0) == merl::kThetaH && i32(1) == merl::kThetaD && i32(2) == merl::kPhiD;
+}
+
+// ALTA: text whose first non-blank line is a `#` line, with a #DIM line before any data line.
+bool looks_like_alta(const std::string& head) {
+  std::size_t pos = 0;
+  bool first = true;
+  while (pos < head.size()) {
+    std::size_t eol = head.find('\n', pos);
+    if (eol == std::string::npos) eol = head.size();
+    std::string_view line(head.data() + pos, eol - pos);
+    pos = eol + 1;
+    while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+    if (line.empty() || line == "\r") continue;
+    if (line.front() != '#') return false;  // data (or anything else) before #DIM
+    if (first && line.size() < 2) return false;
+    first = false;
+    if (line.substr(0, 5) == "#DIM " || line.substr(0, 5) == "#DIM\t") return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+BrdfFileFormat detect_brdf_format(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw FormatError(path.string(), "file", "cannot get its size: " + ec.message());
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FormatError(path.string(), "file", "cannot open for reading");
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (size == merl::kFileBytes && is_merl_header(head.data(), head.size()))
+    return BrdfFileFormat::merl;
+  if (head.size() >= 12 && head.compare(0, 12, std::string("tensor_file\0", 12)) == 0)
+    return BrdfFileFormat::rgl;
+  if (looks_like_alta(head)) return BrdfFileFormat::alta;
+  return BrdfFileFormat::unknown;
+}
+
+BrdfPtr load_brdf(std::string_view spec) {
+  const std::filesystem::path path{std::string(spec)};
+  std::error_code ec;
+  if (!spec.empty() && std::filesystem::exists(path, ec)) {
+    if (!std::filesystem::is_regular_file(path, ec))
+      throw FormatError(path.string(), "file", "not a regular file");
+    BrdfFileFormat format = detect_brdf_format(path);
+    if (format == BrdfFileFormat::unknown) {
+      // The content matches no format: let the reader the extension names say what is wrong.
+      const std::string ext = path.extension().string();
+      if (ext == ".binary")
+        format = BrdfFileFormat::merl;
+      else if (ext == ".bsdf")
+        format = BrdfFileFormat::rgl;
+      else if (ext == ".dat" || ext == ".alta")
+        format = BrdfFileFormat::alta;
+      else
+        throw FormatError(path.string(), "format",
+                          "not a MERL .binary (34992012 bytes, 90 90 180 header), RGL .bsdf "
+                          "(\"tensor_file\" magic) or ALTA text file (#DIM header)");
+    }
+    switch (format) {
+      case BrdfFileFormat::merl:
+        return load_merl(path);
+      case BrdfFileFormat::rgl:
+        return load_rgl(path);
+      case BrdfFileFormat::alta:
+        return load_alta(path);
+      case BrdfFileFormat::unknown:
+        break;
+    }
+  }
+  return ModelRegistry::global().create(spec);
+}
+
+}  // namespace halfback
