@@ -77,9 +77,14 @@ inline void write_file_atomically(const std::filesystem::path& path,
   namespace fs = std::filesystem;
   const std::string name = path.string();
   static std::atomic<std::uint64_t> counter{0};  // distinct names within a process
-  const fs::path tmp =
-      path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) +
-                            "-" + std::to_string(++counter));
+  // (Built with += : GCC 12 warns falsely (-Wrestrict) on "literal" + std::string&&.)
+  std::string tmp_name(1, '.');
+  tmp_name += path.filename().string();
+  tmp_name += ".tmp-";
+  tmp_name += std::to_string(::getpid());
+  tmp_name += '-';
+  tmp_name += std::to_string(++counter);
+  const fs::path tmp = path.parent_path() / tmp_name;
   std::error_code ec;
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);

@@ -192,6 +192,18 @@ struct Warp {
   }
   double M(const Slices& s, std::size_t j) const { return blend(marginal, h, s, j); }
 
+  // Density on the unit square at p (the blended, normalized grid values, bilinear).
+  double density(const Slices& s, RglWarpPoint p) const {
+    const double x = std::clamp(p.x, 0.0, 1.0) * double(w - 1);
+    const double y = std::clamp(p.y, 0.0, 1.0) * double(h - 1);
+    const std::size_t i = std::min(static_cast<std::size_t>(x), w - 2);
+    const std::size_t j = std::min(static_cast<std::size_t>(y), h - 2);
+    const double sx = x - double(i), ty = y - double(j);
+    const double c0 = (1 - ty) * F(s, j, i) + ty * F(s, j + 1, i);
+    const double c1 = (1 - ty) * F(s, j, i + 1) + ty * F(s, j + 1, i + 1);
+    return ((1 - sx) * c0 + sx * c1) * double(w - 1) * double(h - 1);
+  }
+
   // Point p of the unit square -> sample (the CDFs at p): the inverse of the warp.
   RglWarpPoint inverse(const Slices& s, RglWarpPoint p) const {
     const double x = std::clamp(p.x, 0.0, 1.0) * double(w - 1);
@@ -429,6 +441,40 @@ RglWarpPoint RglBrdf::vndf_inverse(RglWarpPoint p, double theta_i, double phi_i)
 
 RglWarpPoint RglBrdf::vndf_forward(RglWarpPoint u, double theta_i, double phi_i) const {
   return impl_->vndf.forward(impl_->slices(phi_i, theta_i), u);
+}
+
+double RglBrdf::vndf_density(RglWarpPoint p, double theta_i, double phi_i) const {
+  return impl_->vndf.density(impl_->slices(phi_i, theta_i), p);
+}
+
+RglSample RglBrdf::sample(const Vec3<double>& wi_in, double u1, double u2) const {
+  const Impl& m = *impl_;
+  if (!(wi_in.z > 0)) return {{0, 0, 1}, 0};
+  Vec3<double> wi = wi_in;
+  bool fx = false, fy = false;
+  if (m.reduction >= 2) {
+    const double sy = wi.y, sx = m.reduction == 4 ? wi.x : sy;
+    fx = negative_sign(sx);
+    fy = negative_sign(sy);
+    if (fx) wi.x = -wi.x;
+    if (fy) wi.y = -wi.y;
+  }
+  const double theta_i = std::atan2(std::hypot(wi.x, wi.y), wi.z);
+  const double phi_i = std::atan2(wi.y, wi.x);
+  const Slices s = m.slices(phi_i, theta_i);
+  const RglWarpPoint um = m.vndf.forward(s, {u1, u2});
+  const double pdf_u = m.vndf.density(s, um);
+  const double theta_m = um.x * um.x * (kPi / 2);
+  const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_i : 0.0);
+  const Vec3<double> n{std::sin(theta_m) * std::cos(phi_m), std::sin(theta_m) * std::sin(phi_m),
+                       std::cos(theta_m)};
+  const double dot = wi.x * n.x + wi.y * n.y + wi.z * n.z;
+  Vec3<double> wo{2 * dot * n.x - wi.x, 2 * dot * n.y - wi.y, 2 * dot * n.z - wi.z};
+  if (fx) wo.x = -wo.x;
+  if (fy) wo.y = -wo.y;
+  // dωm = sin θm dθm dφm = 2π² u sin θm du dv, and dωo = 4 |ωi·m| dωm (reflection).
+  const double jacobian = 2 * kPi * kPi * um.x * std::sin(theta_m) * 4 * std::abs(dot);
+  return {wo, jacobian > 0 ? pdf_u / jacobian : 0.0};
 }
 
 Rgb RglBrdf::eval_cosine(const DirPair<double>& pair) const {

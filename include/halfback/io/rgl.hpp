@@ -86,6 +86,12 @@ struct RglWarpPoint {
   double x, y;
 };
 
+// A direction drawn by RglBrdf::sample and its density per unit solid angle.
+struct RglSample {
+  Vec3<double> wo;
+  double pdf;
+};
+
 class RglBrdf final : public Brdf {
  public:
   // Validates the material fields of a parsed tensor file (names, dtypes, shapes, values: finite,
@@ -116,6 +122,13 @@ class RglBrdf final : public Brdf {
   // tests.
   RglWarpPoint vndf_inverse(RglWarpPoint normal_coords, double theta_i, double phi_i) const;
   RglWarpPoint vndf_forward(RglWarpPoint sample, double theta_i, double phi_i) const;
+  // Density of the VNDF warp's output on the unit square at a point.
+  double vndf_density(RglWarpPoint normal_coords, double theta_i, double phi_i) const;
+
+  // Importance sampling as in the paper: a uniform (u1, u2) through the VNDF warp gives a
+  // microfacet normal m, and ωo is ωi reflected about m. pdf is the density of ωo per unit solid
+  // angle (0 when ωi is at or below the horizon; ωo may fall below the horizon, where ρ is 0).
+  RglSample sample(const Vec3<double>& wi, double u1, double u2) const;
 
   struct Impl;
 
