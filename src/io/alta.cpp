@@ -378,17 +378,22 @@ Rgb AltaBrdf::eval_coords(double theta_l, double px, double py) const {
     return true;
   };
 
-  // Linear in θl between the two measured incidences around it; no extrapolation.
+  // Linear in θl between the two measured incidences around it; no extrapolation. The tolerance
+  // covers angles written with 8 decimals (0.26179939 for 15°).
   const auto& sl = m.slices;
-  const double tol = 1e-12;
+  const double tol = 1e-6;
   if (theta_l < sl.front().theta_l - tol || theta_l > sl.back().theta_l + tol) return none;
   std::size_t j = 0;
   while (j + 1 < sl.size() && sl[j + 1].theta_l <= theta_l) ++j;
   std::array<double, 3> a{}, b{};
-  if (j + 1 == sl.size() || theta_l <= sl[j].theta_l + tol) {
-    if (!in_slice(sl[j], a)) return none;
-    return {a[0], a[1], a[2]};
+  // On a measured incidence (within the tolerance): that slice alone.
+  for (std::size_t k : {j, j + 1}) {
+    if (k < sl.size() && std::abs(theta_l - sl[k].theta_l) <= tol) {
+      if (!in_slice(sl[k], a)) return none;
+      return {a[0], a[1], a[2]};
+    }
   }
+  if (j + 1 == sl.size()) return none;  // unreachable: θl beyond the last slice was rejected
   const double t = (theta_l - sl[j].theta_l) / (sl[j + 1].theta_l - sl[j].theta_l);
   if (!in_slice(sl[j], a) || !in_slice(sl[j + 1], b)) return none;
   return {(1 - t) * a[0] + t * b[0], (1 - t) * a[1] + t * b[1], (1 - t) * a[2] + t * b[2]};

@@ -15,6 +15,10 @@
 #include "halfback/core/param.hpp"
 #include "halfback/io/format_error.hpp"
 
+#ifndef HALFBACK_SOURCE_DIR
+#define HALFBACK_SOURCE_DIR "."  // the tests' CMake targets define it; CTest sets the variable
+#endif
+
 namespace halfback::test {
 
 // ../shared/data/SUB (from HALFBACK_SHARED_DIR, set by CTest), or "" when absent.
