@@ -1,13 +1,145 @@
+// The batch conversion engine.
+//
+// Rows are processed in tiles of kTileBytes per column (512 float or 256 double rows). For each
+// tile: input columns with stride 1 are read in place, others are gathered into SoA scratch; the
+// stage kernels of batch_engine.hpp (check or decode, then encode) run on the tile; outputs with
+// stride 1 are written in place, others scattered from scratch. Tiles are grouped into chunks run
+// by oneTBB on up to BatchOptions::threads threads. Every row is computed by the same vector
+// code, in the same lane, whatever the chunking (tiles are whole multiples of every vector
+// width), so the result does not depend on the thread count.
 #include "halfback/core/batch.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdlib>
+#include <memory>
+#include <new>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
+#include "batch_engine.hpp"
 #include "row_kernels.hpp"
 
 namespace halfback {
 
+// ---------------------------------------------------------------------------------------------
+// Instruction-set dispatch
+// ---------------------------------------------------------------------------------------------
+namespace detail {
+
+static_assert(static_cast<int>(Space::spherical) == 1 && static_cast<int>(Space::halfdiff) == 2 &&
+                  static_cast<int>(Space::ortho) == 3 && static_cast<int>(Space::hybrid) == 4,
+              "the kernel tables are indexed by Space - 1");
+
+std::string_view isa_name(SimdIsa isa) {
+  switch (isa) {
+    case SimdIsa::scalar:
+      return "scalar";
+    case SimdIsa::sse2:
+      return "sse2";
+    case SimdIsa::avx2:
+      return "avx2";
+    case SimdIsa::avx512:
+      return "avx512";
+  }
+  return "unknown";
+}
+
+std::optional<SimdIsa> isa_from_name(std::string_view name) {
+  for (SimdIsa isa : kAllIsas)
+    if (isa_name(isa) == name) return isa;
+  return std::nullopt;
+}
+
 namespace {
+
+#if defined(HALFBACK_X86_KERNELS)
+bool cpu_supports(SimdIsa isa) {
+  // __builtin_cpu_supports also checks that the OS saves the YMM/ZMM state (XGETBV).
+  __builtin_cpu_init();
+  switch (isa) {
+    case SimdIsa::scalar:
+    case SimdIsa::sse2:
+      return true;  // x86-64 baseline
+    case SimdIsa::avx2:
+      return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    case SimdIsa::avx512:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2") &&
+             __builtin_cpu_supports("fma");
+  }
+  return false;
+}
+#endif
+
+const KernelSet* best_kernels() {
+  for (auto it = std::rbegin(kAllIsas); it != std::rend(kAllIsas); ++it)
+    if (const KernelSet* k = kernels_for(*it)) return k;
+  return &kernels_scalar();
+}
+
+const KernelSet& default_kernels() {
+  static const KernelSet* const chosen = [] {
+    if (const char* env = std::getenv("HALFBACK_ISA")) {
+      if (const auto isa = isa_from_name(env))
+        if (const KernelSet* k = kernels_for(*isa)) return k;
+    }
+    return best_kernels();
+  }();
+  return *chosen;
+}
+
+std::atomic<const KernelSet*> g_override{nullptr};
+
+}  // namespace
+
+const KernelSet* kernels_for(SimdIsa isa) {
+#if defined(HALFBACK_X86_KERNELS)
+  if (!cpu_supports(isa)) return nullptr;
+  switch (isa) {
+    case SimdIsa::scalar:
+      return &kernels_scalar();
+    case SimdIsa::sse2:
+      return &kernels_sse2();
+    case SimdIsa::avx2:
+      return &kernels_avx2();
+    case SimdIsa::avx512:
+      return &kernels_avx512();
+  }
+  return nullptr;
+#else
+  return isa == SimdIsa::scalar ? &kernels_scalar() : nullptr;
+#endif
+}
+
+const KernelSet& active_kernels() {
+  const KernelSet* k = g_override.load(std::memory_order_acquire);
+  return k ? *k : default_kernels();
+}
+
+bool set_batch_isa(std::optional<SimdIsa> isa) {
+  if (!isa) {
+    g_override.store(nullptr, std::memory_order_release);
+    return true;
+  }
+  const KernelSet* k = kernels_for(*isa);
+  if (!k) return false;
+  g_override.store(k, std::memory_order_release);
+  return true;
+}
+
+}  // namespace detail
+
+// ---------------------------------------------------------------------------------------------
+// The tiled engine
+// ---------------------------------------------------------------------------------------------
+namespace {
+
 void check_shapes(Form from, Form to, std::size_t n_in, std::size_t n_out) {
   if (n_in != dimension(from))
     throw std::invalid_argument("convert: " + std::string(name_of(from.space)) + " needs " +
@@ -20,24 +152,159 @@ void check_shapes(Form from, Form to, std::size_t n_in, std::size_t n_out) {
   if ((from.space == Space::dirs && from.isotropic) || (to.space == Space::dirs && to.isotropic))
     throw std::invalid_argument("convert: dirs has no isotropic form");
 }
+
+constexpr std::size_t kTileBytes = 2048;  // per column: a tile's ~20 columns stay in L1
+// A thread is worth starting only for this many tiles (~10^4 rows, tens of microseconds).
+constexpr std::size_t kMinTilesPerThread = 32;
+
+template <class T>
+constexpr std::size_t kTileRows = kTileBytes / sizeof(T);
+
+// The kernels and the column layout of one convert() call.
+template <class T>
+struct Plan {
+  using Stages = detail::StageKernels<T>;
+  Form from, to;
+  std::size_t dim_in, dim_out;
+  std::span<const ConstColumn<T>> in;
+  const ConvertOutput<T>* out;
+  bool want_jac;
+  typename Stages::CheckFn check = nullptr;
+  typename Stages::DecodeFn decode = nullptr;
+  typename Stages::EncodeFn encode = nullptr;
+
+  Plan(const Stages& k, Form f, Form t, std::span<const ConstColumn<T>> i,
+       const ConvertOutput<T>& o)
+      : from(f), to(t), dim_in(dimension(f)), dim_out(dimension(t)), in(i), out(&o) {
+    want_jac = o.jacobian.data != nullptr;
+    const bool to_dirs = t.space == Space::dirs;
+    // The jacobian comes from the output coordinates, or from the input ones when `to` is dirs.
+    const int jac_at_input = want_jac && to_dirs ? 1 : 0;
+    const int jac_at_output = want_jac && !to_dirs ? 1 : 0;
+    if (f.space == Space::dirs)
+      check = k.check[to_dirs ? 1 : 0][jac_at_input];
+    else
+      decode = k.decode[static_cast<int>(f.space) - 1][f.isotropic ? 1 : 0][jac_at_input];
+    if (!to_dirs)
+      encode = k.encode[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0][jac_at_output];
+  }
+};
+
+template <class T>
+struct AlignedDelete {
+  void operator()(T* p) const { ::operator delete[](p, std::align_val_t{64}); }
+};
+
+// Scratch and loop over the tiles of one chunk.
+template <class T>
+class TileRunner {
+ public:
+  TileRunner(const Plan<T>& plan, std::size_t rows) : plan_(plan), rows_(rows) {
+    // Columns: 6 gathered inputs, 6 outputs to scatter, 6 directions, mask, jacobian.
+    const std::size_t count = kColumns * rows_;
+    scratch_.reset(static_cast<T*>(::operator new[](count * sizeof(T), std::align_val_t{64})));
+  }
+
+  void run(std::size_t r0, std::size_t m) {
+    const Plan<T>& p = plan_;
+    const auto base = static_cast<std::ptrdiff_t>(r0);
+    const T* in[detail::kMaxDim];
+    for (std::size_t c = 0; c < p.dim_in; ++c) {
+      const ConstColumn<T>& col = p.in[c];
+      if (col.stride == 1) {
+        in[c] = col.data + base;
+      } else {
+        T* s = column(kInput + c);
+        const T* src = col.data + base * col.stride;
+        for (std::size_t i = 0; i < m; ++i) s[i] = src[static_cast<std::ptrdiff_t>(i) * col.stride];
+        in[c] = s;
+      }
+    }
+    T* out[detail::kMaxDim];
+    for (std::size_t c = 0; c < p.dim_out; ++c) {
+      const Column<T>& col = p.out->columns[c];
+      out[c] = col.stride == 1 ? col.data + base : column(kOutput + c);
+    }
+    const Column<T>& jcol = p.out->jacobian;
+    T* jac = p.want_jac ? (jcol.stride == 1 ? jcol.data + base : column(kJacobian)) : nullptr;
+    T* mask = column(kMask);
+
+    if (p.check) {
+      p.check(in, out, mask, p.encode ? nullptr : jac, m);
+      if (p.encode) p.encode(in, mask, out, jac, m);
+    } else if (!p.encode) {
+      p.decode(in, out, mask, jac, m);
+    } else {
+      T* dirs[6];
+      for (int c = 0; c < 6; ++c) dirs[c] = column(kDirs + c);
+      p.decode(in, dirs, mask, nullptr, m);
+      p.encode(dirs, mask, out, jac, m);
+    }
+
+    for (std::size_t c = 0; c < p.dim_out; ++c) {
+      const Column<T>& col = p.out->columns[c];
+      if (col.stride == 1) continue;
+      T* dst = col.data + base * col.stride;
+      for (std::size_t i = 0; i < m; ++i)
+        dst[static_cast<std::ptrdiff_t>(i) * col.stride] = out[c][i];
+    }
+    if (jac && jcol.stride != 1) {
+      T* dst = jcol.data + base * jcol.stride;
+      for (std::size_t i = 0; i < m; ++i)
+        dst[static_cast<std::ptrdiff_t>(i) * jcol.stride] = jac[i];
+    }
+    if (std::uint8_t* valid = p.out->valid) {
+      for (std::size_t i = 0; i < m; ++i) valid[r0 + i] = mask[i] > T(0) ? 1 : 0;
+    }
+  }
+
+ private:
+  static constexpr std::size_t kInput = 0, kOutput = 6, kDirs = 12, kMask = 18, kJacobian = 19,
+                               kColumns = 20;
+  T* column(std::size_t c) { return scratch_.get() + c * rows_; }
+
+  const Plan<T>& plan_;
+  std::size_t rows_;
+  std::unique_ptr<T[], AlignedDelete<T>> scratch_;
+};
+
+unsigned hardware_threads() {
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw == 0 ? 1 : hw;
+}
+
 }  // namespace
 
 template <class T>
 void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t n,
-             const ConvertOutput<T>& out, const BatchOptions& /*options*/) {
+             const ConvertOutput<T>& out, const BatchOptions& options) {
   check_shapes(from, to, in.size(), out.columns.size());
-  T row_in[detail::kMaxDim], row_out[detail::kMaxDim];
-  for (std::size_t r = 0; r < n; ++r) {
-    const auto ir = static_cast<std::ptrdiff_t>(r);
-    for (std::size_t c = 0; c < in.size(); ++c) row_in[c] = in[c].data[ir * in[c].stride];
-    T jac;
-    const bool ok =
-        detail::convert_row(from, to, row_in, row_out, out.jacobian.data ? &jac : nullptr);
-    for (std::size_t c = 0; c < out.columns.size(); ++c)
-      out.columns[c].data[ir * out.columns[c].stride] = row_out[c];
-    if (out.jacobian.data) out.jacobian.data[ir * out.jacobian.stride] = jac;
-    if (out.valid) out.valid[r] = ok ? 1 : 0;
+  if (n == 0) return;
+  const Plan<T> plan(detail::active_kernels().stages<T>(), from, to, in, out);
+
+  constexpr std::size_t tile = kTileRows<T>;
+  const std::size_t tiles = (n + tile - 1) / tile;
+  auto run_tiles = [&](std::size_t t0, std::size_t t1) {
+    const std::size_t rows = std::min(tile, n - t0 * tile);
+    TileRunner<T> runner(plan, (rows + 63) / 64 * 64);
+    for (std::size_t t = t0; t < t1; ++t) runner.run(t * tile, std::min(tile, n - t * tile));
+  };
+
+  const std::size_t requested = options.threads == 0 ? hardware_threads() : options.threads;
+  const std::size_t threads = std::min(requested, tiles / kMinTilesPerThread);
+  if (threads <= 1) {
+    run_tiles(0, tiles);
+    return;
   }
+  // Several chunks per thread, so that a thread slowed down by other work is compensated.
+  const std::size_t grain = std::max<std::size_t>(tiles / (threads * 8), 4);
+  tbb::task_arena arena(static_cast<int>(threads));
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, tiles, grain),
+        [&](const tbb::blocked_range<std::size_t>& r) { run_tiles(r.begin(), r.end()); },
+        tbb::simple_partitioner());
+  });
 }
 
 template <class T>
@@ -51,7 +318,6 @@ template void convert<float>(Form, Form, std::span<const ConstColumn<float>>, st
 template void convert<double>(Form, Form, std::span<const ConstColumn<double>>, std::size_t,
                               const ConvertOutput<double>&, const BatchOptions&);
 template bool convert_one<float>(Form, Form, std::span<const float>, std::span<float>, float*);
-template bool convert_one<double>(Form, Form, std::span<const double>, std::span<double>,
-                                  double*);
+template bool convert_one<double>(Form, Form, std::span<const double>, std::span<double>, double*);
 
 }  // namespace halfback

@@ -1,0 +1,72 @@
+// Internals of the batch conversion engine (batch.cpp): the per-instruction-set kernel tables and
+// the run-time choice between them. No xsimd here: the tables hold plain function pointers, and
+// each instruction set's table is built in its own translation unit (batch_kernels_<isa>.cpp)
+// compiled with that set's -m flags.
+//
+// A conversion runs in tiles of rows, in up to three stages on SoA columns:
+//   check  (dirs input)   6 direction columns -> mask [, NaN-masked copy] [, J = 1]
+//   decode (P input)      dim(P) columns -> 6 direction columns (NaN if invalid), mask [, J(q)]
+//   encode (P output)     6 direction columns + mask -> dim(P) columns (NaN if invalid) [, J(q)]
+// Masks are stored as T: 1 for a valid row, 0 otherwise.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string_view>
+
+namespace halfback::detail {
+
+enum class SimdIsa { scalar, sse2, avx2, avx512 };
+
+inline constexpr SimdIsa kAllIsas[] = {SimdIsa::scalar, SimdIsa::sse2, SimdIsa::avx2,
+                                       SimdIsa::avx512};
+
+template <class T>
+struct StageKernels {
+  using CheckFn = void (*)(const T* const* in, T* const* copy, T* mask, T* jac, std::size_t m);
+  using DecodeFn = void (*)(const T* const* in, T* const* dirs, T* mask, T* jac, std::size_t m);
+  using EncodeFn = void (*)(const T* const* dirs, const T* mask, T* const* out, T* jac,
+                            std::size_t m);
+  std::size_t width;         // lanes per vector
+  CheckFn check[2][2];       // [copy][jacobian]
+  DecodeFn decode[4][2][2];  // [space - 1][isotropic][jacobian]
+  EncodeFn encode[4][2][2];  // [space - 1][isotropic][jacobian]
+};
+
+struct KernelSet {
+  SimdIsa isa;
+  std::string_view name;
+  StageKernels<float> f32;
+  StageKernels<double> f64;
+
+  template <class T>
+  const StageKernels<T>& stages() const {
+    if constexpr (sizeof(T) == sizeof(float))
+      return f32;
+    else
+      return f64;
+  }
+};
+
+// One table per instruction set; the SIMD ones exist only in x86-64 builds.
+const KernelSet& kernels_scalar();
+const KernelSet& kernels_sse2();
+const KernelSet& kernels_avx2();    // AVX2 + FMA
+const KernelSet& kernels_avx512();  // AVX-512F (+ AVX2, FMA)
+
+std::string_view isa_name(SimdIsa isa);
+std::optional<SimdIsa> isa_from_name(std::string_view name);
+
+// The table of `isa` when it is compiled in and this CPU (and OS) can run it, else nullptr.
+const KernelSet* kernels_for(SimdIsa isa);
+
+// The table convert() uses: the override if set, else HALFBACK_ISA from the environment (read
+// once; scalar, sse2, avx2 or avx512; an unsupported one falls back to the best), else the best
+// the CPU supports.
+const KernelSet& active_kernels();
+
+// For tests and benchmarks: forces an instruction set (nullopt: back to the default). Returns
+// false, changing nothing, when `isa` is not available here. Not meant to race with convert().
+bool set_batch_isa(std::optional<SimdIsa> isa);
+
+}  // namespace halfback::detail

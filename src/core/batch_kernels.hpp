@@ -1,0 +1,187 @@
+// The stage kernels of the batch engine, generic over a lane type B: a scalar (float, double) or
+// an xsimd batch (include batch_simd.hpp first). They run the formulas of param.hpp through the
+// row helpers of row_kernels.hpp, exactly as convert_one() does, one vector of rows at a time.
+//
+// Include this only from the batch_kernels_<isa>.cpp translation units. Everything here has
+// internal linkage (anonymous namespace), and the param.hpp templates are instantiated only on
+// the TU's own batch types, so code compiled with one TU's -m flags cannot be picked by the
+// linker for another (one-definition-rule hazard of multi-ISA builds).
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <type_traits>
+
+#include "batch_engine.hpp"
+#include "row_kernels.hpp"
+
+namespace halfback::detail {
+namespace {
+
+template <class B>
+struct Lanes {
+  using S = ScalarOf<B>;
+  static constexpr std::size_t size = [] {
+    if constexpr (std::is_floating_point_v<B>)
+      return std::size_t{1};
+    else
+      return B::size;
+  }();
+  static B load(const S* p) {
+    if constexpr (std::is_floating_point_v<B>)
+      return *p;
+    else
+      return B::load_unaligned(p);
+  }
+  static void store(S* p, const B& v) {
+    if constexpr (std::is_floating_point_v<B>)
+      *p = v;
+    else
+      v.store_unaligned(p);
+  }
+};
+
+// Runs f(x, y) on every vector of rows: x[c] holds rows [i, i + W) of in[c], and y[c] is stored
+// to out[c]. The last m % W rows go through a zero-padded buffer; lanes are independent, so the
+// padding never changes a real row's result.
+template <class B, int NI, int NO, class F>
+inline void for_rows(const ScalarOf<B>* const* in, ScalarOf<B>* const* out, std::size_t m, F&& f) {
+  using S = ScalarOf<B>;
+  using L = Lanes<B>;
+  constexpr std::size_t W = L::size;
+  B x[NI], y[NO];
+  std::size_t i = 0;
+  for (; i + W <= m; i += W) {
+    for (int c = 0; c < NI; ++c) x[c] = L::load(in[c] + i);
+    f(x, y);
+    for (int c = 0; c < NO; ++c) L::store(out[c] + i, y[c]);
+  }
+  if constexpr (W > 1) {
+    if (i == m) return;
+    const std::size_t r = m - i;
+    alignas(64) S buf[NI > NO ? NI : NO][W];
+    for (int c = 0; c < NI; ++c) {
+      for (std::size_t k = 0; k < W; ++k) buf[c][k] = k < r ? in[c][i + k] : S(0);
+      x[c] = L::load(buf[c]);
+    }
+    f(x, y);
+    for (int c = 0; c < NO; ++c) {
+      L::store(buf[c], y[c]);
+      for (std::size_t k = 0; k < r; ++k) out[c][i + k] = buf[c][k];
+    }
+  }
+}
+
+template <class B>
+inline B nan_lanes() {
+  return B(std::numeric_limits<ScalarOf<B>>::quiet_NaN());
+}
+
+template <class B>
+inline B mask_to_lanes(const MaskOf<B>& m) {
+  using S = ScalarOf<B>;
+  return LaneOps<B>::select(m, B(S(1)), B(S(0)));
+}
+
+// dirs input: the pair_is_valid() mask; with Copy, the pair itself (NaN where invalid).
+template <class B, bool Copy, bool Jac>
+void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy, ScalarOf<B>* mask,
+                 ScalarOf<B>* jac, std::size_t m) {
+  using S = ScalarOf<B>;
+  using L = LaneOps<B>;
+  constexpr int kCopy = Copy ? 6 : 0;
+  constexpr int NO = kCopy + 1 + (Jac ? 1 : 0);
+  S* outs[NO];
+  for (int c = 0; c < kCopy; ++c) outs[c] = copy[c];
+  outs[kCopy] = mask;
+  if constexpr (Jac) outs[kCopy + 1] = jac;
+  for_rows<B, 6, NO>(in, outs, m, [](const B* x, B* y) {
+    const DirPair<B> p{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
+    const auto ok = pair_is_valid(p);
+    for (int c = 0; c < kCopy; ++c) y[c] = L::select(ok, x[c], nan_lanes<B>());
+    y[kCopy] = mask_to_lanes<B>(ok);
+    if constexpr (Jac) y[kCopy + 1] = L::select(ok, B(S(1)), nan_lanes<B>());
+  });
+}
+
+// P input: the pair (NaN where invalid), the domain mask and, with Jac, the measure of q.
+template <class B, class P, bool Iso, bool Jac>
+void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, ScalarOf<B>* mask,
+                  ScalarOf<B>* jac, std::size_t m) {
+  using S = ScalarOf<B>;
+  using L = LaneOps<B>;
+  constexpr int NI = Iso ? 3 : 4;
+  constexpr int NO = 6 + 1 + (Jac ? 1 : 0);
+  S* outs[NO];
+  for (int c = 0; c < 6; ++c) outs[c] = dirs[c];
+  outs[6] = mask;
+  if constexpr (Jac) outs[7] = jac;
+  for_rows<B, NI, NO>(in, outs, m, [](const B* q, B* y) {
+    const Solved<B> s = decode_param<P, B>(Iso, q);
+    y[0] = s.pair.wi.x;
+    y[1] = s.pair.wi.y;
+    y[2] = s.pair.wi.z;
+    y[3] = s.pair.wo.x;
+    y[4] = s.pair.wo.y;
+    y[5] = s.pair.wo.z;
+    y[6] = mask_to_lanes<B>(s.in_domain);
+    if constexpr (Jac) y[7] = L::select(s.in_domain, jacobian_of<P, B>(Iso, q), nan_lanes<B>());
+  });
+}
+
+// P output: the coordinates of the pair (NaN where the mask is 0) and, with Jac, their measure.
+template <class B, class P, bool Iso, bool Jac>
+void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask, ScalarOf<B>* const* out,
+                  ScalarOf<B>* jac, std::size_t m) {
+  using S = ScalarOf<B>;
+  using L = LaneOps<B>;
+  constexpr int kDim = Iso ? 3 : 4;
+  constexpr int NO = kDim + (Jac ? 1 : 0);
+  const S* ins[7] = {dirs[0], dirs[1], dirs[2], dirs[3], dirs[4], dirs[5], mask};
+  S* outs[NO];
+  for (int c = 0; c < kDim; ++c) outs[c] = out[c];
+  if constexpr (Jac) outs[kDim] = jac;
+  for_rows<B, 7, NO>(ins, outs, m, [](const B* x, B* y) {
+    const auto ok = x[6] > B(S(0));
+    const DirPair<B> p{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
+    encode_param<P, B>(Iso, p, y);
+    if constexpr (Jac) y[kDim] = jacobian_of<P, B>(Iso, y);
+    for (int c = 0; c < NO; ++c) y[c] = L::select(ok, y[c], nan_lanes<B>());
+  });
+}
+
+template <class B, class P, int Space>
+constexpr void fill_param(StageKernels<ScalarOf<B>>& k) {
+  k.decode[Space][0][0] = &decode_stage<B, P, false, false>;
+  k.decode[Space][0][1] = &decode_stage<B, P, false, true>;
+  k.decode[Space][1][0] = &decode_stage<B, P, true, false>;
+  k.decode[Space][1][1] = &decode_stage<B, P, true, true>;
+  k.encode[Space][0][0] = &encode_stage<B, P, false, false>;
+  k.encode[Space][0][1] = &encode_stage<B, P, false, true>;
+  k.encode[Space][1][0] = &encode_stage<B, P, true, false>;
+  k.encode[Space][1][1] = &encode_stage<B, P, true, true>;
+}
+
+template <class B>
+constexpr StageKernels<ScalarOf<B>> make_stages() {
+  StageKernels<ScalarOf<B>> k{};
+  k.width = Lanes<B>::size;
+  k.check[0][0] = &check_stage<B, false, false>;
+  k.check[0][1] = &check_stage<B, false, true>;
+  k.check[1][0] = &check_stage<B, true, false>;
+  k.check[1][1] = &check_stage<B, true, true>;
+  // Indices follow Space: spherical = 1, halfdiff = 2, ortho = 3, hybrid = 4.
+  fill_param<B, Spherical, 0>(k);
+  fill_param<B, HalfDiff, 1>(k);
+  fill_param<B, Ortho, 2>(k);
+  fill_param<B, Hybrid, 3>(k);
+  return k;
+}
+
+template <class BF, class BD>
+constexpr KernelSet make_kernel_set(SimdIsa isa, std::string_view name) {
+  return KernelSet{isa, name, make_stages<BF>(), make_stages<BD>()};
+}
+
+}  // namespace
+}  // namespace halfback::detail
