@@ -1,0 +1,366 @@
+#include "halfback/figure/slices.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include "halfback/figure/coordinates.hpp"
+
+namespace halfback::figure {
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+const Color kSliceBackground{0.10, 0.10, 0.13};
+
+Color test_function_colour(TestFunction f) {
+  switch (f) {
+    case TestFunction::specular:
+      return {1.0, 0.22, 0.18};
+    case TestFunction::grazing:
+      return {0.30, 0.62, 1.0};
+    case TestFunction::fresnel:
+      break;
+  }
+  return kWhite;
+}
+
+std::string colour_name(TestFunction f) {
+  switch (f) {
+    case TestFunction::specular:
+      return "red";
+    case TestFunction::grazing:
+      return "blue";
+    case TestFunction::fresnel:
+      break;
+  }
+  return "white";
+}
+
+std::string formula(TestFunction f) {
+  switch (f) {
+    case TestFunction::specular:
+      return "S = 1 − ‖h\u0304‖";
+    case TestFunction::grazing:
+      return "G = 1 − (ωi·n)(ωo·n)";
+    case TestFunction::fresnel:
+      break;
+  }
+  return "F = 1 − cos θ_d";
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return kNan;
+  const std::size_t k = std::min(v.size() - 1, std::size_t(p * double(v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+  return v[k];
+}
+
+std::string power_of_ten_label(double log10_value) {
+  const long e = std::lround(std::floor(log10_value + 1e-9));
+  const double m = std::pow(10.0, log10_value - double(e));
+  const long mi = std::lround(m);
+  const std::string exp = e < 0 ? fmt::format("−{}", -e) : fmt::format("{}", e);
+  if (mi == 1) return fmt::format("10^{{{}}}", exp);
+  return fmt::format("{}·10^{{{}}}", mi, exp);
+}
+
+}  // namespace
+
+SliceSample sample_slice(Space space, double azimuth, const Grid& grid, unsigned threads) {
+  if (space == Space::dirs) throw std::invalid_argument("slice: dirs is not a parameterization");
+  SliceSample s;
+  s.grid = grid;
+  s.valid.assign(grid.size(), 0);
+  s.pairs.resize(grid.size());
+  visit_parameterization(space, [&](auto p) {
+    using P = decltype(p);
+    parallel_rows(grid.ny, threads, [&](std::size_t j) {
+      for (std::size_t i = 0; i < grid.nx; ++i) {
+        const Tuple3<double> q{grid.x(i), grid.y(j), azimuth};
+        const Solved<double> r = inverse_iso<P>(q);
+        const std::size_t k = grid.index(i, j);
+        s.valid[k] = valid_iso<P>(q) ? 1 : 0;
+        s.pairs[k] = r.pair;
+      }
+    });
+  });
+  return s;
+}
+
+ScalarField test_function_field(const SliceSample& slice, TestFunction f) {
+  ScalarField out(slice.grid);
+  out.valid = slice.valid;
+  for (std::size_t k = 0; k < out.values.size(); ++k)
+    out.values[k] = slice.valid[k] ? test_function_value(f, slice.pairs[k]) : kNan;
+  return out;
+}
+
+std::vector<double> log_levels(double lo, double hi, std::size_t max_count) {
+  std::vector<double> best;
+  static const std::vector<std::vector<double>> steps{{1}, {1, 2, 5}, {1, 2, 3, 4, 5, 6, 7, 8, 9}};
+  for (const auto& mantissas : steps) {
+    std::vector<double> levels;
+    for (long e = long(std::floor(lo)) - 1; e <= long(std::ceil(hi)); ++e)
+      for (double m : mantissas) {
+        const double l = double(e) + std::log10(m);
+        if (l > lo + 1e-9 && l < hi - 1e-9) levels.push_back(l);
+      }
+    if (levels.size() <= max_count && levels.size() >= best.size()) best = levels;
+    if (levels.size() > max_count) break;
+  }
+  if (best.empty() && max_count > 0 && hi > lo) {
+    // Less than one level per decade fits: every n-th decade.
+    const long n = long(std::ceil((hi - lo) / double(max_count)));
+    for (long e = long(std::ceil(lo)); e < hi; ++e)
+      if (e % n == 0) best.push_back(double(e));
+  }
+  return best;
+}
+
+SliceFigure slice_figure(const SliceOptions& o) {
+  if (o.params.empty()) throw std::invalid_argument("slice figure: no parameterization given");
+  if (o.azimuths_deg.empty()) throw std::invalid_argument("slice figure: no azimuth given");
+  if (!o.brdf && o.test_functions.empty())
+    throw std::invalid_argument("slice figure: no test function and no BRDF given");
+  for (Space s : o.params)
+    if (s == Space::dirs)
+      throw std::invalid_argument(
+          "slice figure: 'dirs' is not a parameterization (use spherical, halfdiff, ortho or "
+          "hybrid)");
+  for (double a : o.azimuths_deg)
+    if (!std::isfinite(a))
+      throw std::invalid_argument("slice figure: the azimuths must be finite numbers");
+  if (!(o.panel_size > 10) || !(o.pixels_per_point > 0))
+    throw std::invalid_argument("slice figure: bad panel size or pixel density");
+
+  SliceFigure fig;
+  Scene& sc = fig.scene;
+  const bool generic = o.brdf != nullptr;
+  const double P = snap(o.panel_size), gap = 26, vgap = 56;
+  const double left = 84, top = 70, right = generic ? 96 : 24, bottom = 64;
+  const std::size_t rows = o.params.size(), cols = o.azimuths_deg.size();
+  sc.width = snap(left + double(cols) * P + double(cols - 1) * gap + right);
+  sc.height = snap(top + double(rows) * P + double(rows - 1) * vgap + bottom);
+
+  // Sample every panel first (the colour scale is shared).
+  for (std::size_t r = 0; r < rows; ++r) {
+    const auto coords = iso_coordinates(o.params[r]);
+    for (std::size_t c = 0; c < cols; ++c) {
+      SliceFigure::Panel p;
+      p.param = o.params[r];
+      p.azimuth_deg = o.azimuths_deg[c];
+      p.map = PanelMap{{left + double(c) * (P + gap), top + double(r) * (P + vgap), P, P},
+                       0,
+                       coords[0].max,
+                       0,
+                       coords[1].max};
+      // Reduce the azimuth to [0°, 360°) for the core, which wants [0, 2π).
+      double a = std::fmod(p.azimuth_deg, 360.0);
+      if (a < 0) a += 360.0;
+      double rad = a * kDeg;
+      if (rad >= 2 * kPi) rad = 0;
+      p.sample = sample_slice(p.param, rad, p.map.raster_grid(o.pixels_per_point), o.threads);
+      fig.panels.push_back(std::move(p));
+    }
+  }
+
+  // Generic mode: evaluate the BRDF on every valid pair of every panel.
+  std::vector<std::vector<Rgb>> rgb(fig.panels.size());
+  std::vector<ScalarField> log_lum;
+  double exposure = 1;
+  if (generic) {
+    std::vector<double> all;
+    for (std::size_t n = 0; n < fig.panels.size(); ++n) {
+      const SliceSample& s = fig.panels[n].sample;
+      std::vector<DirPair<double>> pairs;
+      std::vector<std::size_t> where;
+      for (std::size_t k = 0; k < s.valid.size(); ++k)
+        if (s.valid[k]) {
+          pairs.push_back(s.pairs[k]);
+          where.push_back(k);
+        }
+      std::vector<Rgb> values(pairs.size());
+      o.brdf->eval(pairs, values);
+      rgb[n].assign(s.valid.size(), Rgb{kNan, kNan, kNan});
+      ScalarField f(s.grid);
+      f.valid = s.valid;
+      std::fill(f.values.begin(), f.values.end(), kNan);
+      for (std::size_t m = 0; m < where.size(); ++m) {
+        rgb[n][where[m]] = values[m];
+        const double l = luminance(values[m]);
+        if (l > 0 && std::isfinite(l)) {
+          f.values[where[m]] = std::log10(l);
+          all.push_back(f.values[where[m]]);
+        }
+      }
+      log_lum.push_back(std::move(f));
+    }
+    if (all.empty()) {
+      fig.log_lo = -1;
+      fig.log_hi = 0;
+    } else {
+      fig.log_hi = *std::max_element(all.begin(), all.end());
+      fig.log_lo = std::max(percentile(all, 0.01), fig.log_hi - 6.0);
+      if (!(fig.log_hi - fig.log_lo > 1e-6)) fig.log_lo = fig.log_hi - 1;
+    }
+    // Luminance 0 (or below the scale) sits at the bottom of the scale, and contours as such.
+    for (ScalarField& f : log_lum)
+      for (std::size_t k = 0; k < f.values.size(); ++k)
+        if (f.valid[k] && !std::isfinite(f.values[k])) f.values[k] = fig.log_lo - 1;
+    fig.log_levels = log_levels(fig.log_lo, fig.log_hi, o.luminance_levels);
+    if (o.colouring == SliceColouring::rgb) {
+      std::vector<double> lin;
+      for (double v : all) lin.push_back(std::pow(10.0, v));
+      const double median = percentile(lin, 0.5);
+      exposure = median > 0 ? 1.0 / median : 1.0;
+    }
+  }
+
+  // Title.
+  if (generic) {
+    sc.title = fmt::format("Slices of the isotropic forms: {}", o.brdf->name());
+    sc.text(
+        {left, 20},
+        fmt::format("Slices of the isotropic forms at fixed relative azimuth: {}", o.brdf->name()),
+        12, HAlign::left, VAlign::baseline, kBlack, 0, true);
+    sc.text({left, 36},
+            fmt::format("{}; {}; isolines of luminance at log-spaced levels (shared scale)",
+                        o.brdf->description(),
+                        o.colouring == SliceColouring::rgb ? "tone-mapped RGB"
+                                                           : "false colour of log₁₀ luminance"),
+            9);
+  } else {
+    std::string names;
+    for (std::size_t k = 0; k < o.test_functions.size(); ++k)
+      names += (k ? ", " : "") + std::string(letter_of(o.test_functions[k]));
+    sc.title = fmt::format("Slices of the isotropic forms: test functions {}", names);
+    sc.text(
+        {left, 20},
+        fmt::format("Slices of the isotropic forms at fixed relative azimuth: test functions {}",
+                    names),
+        12, HAlign::left, VAlign::baseline, kBlack, 0, true);
+    std::string levels;
+    if (!o.levels.empty())
+      levels = fmt::format("isolines at {:g} … {:g}", o.levels.front(), o.levels.back());
+    if (o.levels.size() == 9 && o.levels.front() == 0.1) levels += " (step 0.1; 0.5 thicker)";
+    sc.text({left, 36}, levels + "; hatched: outside the valid domain", 9);
+  }
+
+  const double fs = 8.5;
+  for (std::size_t n = 0; n < fig.panels.size(); ++n) {
+    const SliceFigure::Panel& p = fig.panels[n];
+    const std::size_t r = n / cols, c = n % cols;
+    const auto coords = iso_coordinates(p.param);
+    const SliceSample& s = p.sample;
+    const Grid& g = s.grid;
+    // Background raster.
+    sc.add(raster(p.map, g, [&](std::size_t i, std::size_t j) -> Color {
+      const std::size_t k = g.index(i, j);
+      if (!s.valid[k]) return hatch(i, j, kInvalidLight, kInvalidDark);
+      if (!generic) return kSliceBackground;
+      if (o.colouring == SliceColouring::rgb) return tonemap(rgb[n][k], exposure);
+      const double v = log_lum[n].values[k];
+      return viridis((v - fig.log_lo) / (fig.log_hi - fig.log_lo));
+    }));
+    // Isolines.
+    if (generic) {
+      for (double level : fig.log_levels) {
+        const bool decade = std::abs(level - std::round(level)) < 1e-9;
+        const Color lc =
+            o.colouring == SliceColouring::rgb ? Color{0, 0, 0, 0.7} : Color{1, 1, 1, 0.8};
+        draw_polylines(sc, p.map, contour(log_lum[n], level), Stroke{lc, decade ? 0.9 : 0.5});
+      }
+    } else {
+      for (TestFunction f : o.test_functions) {
+        const ScalarField field = test_function_field(s, f);
+        for (double level : o.levels) {
+          const double w = std::abs(level - 0.5) < 1e-12 ? 1.3 : 0.75;
+          draw_polylines(sc, p.map, contour(field, level), Stroke{test_function_colour(f), w});
+        }
+      }
+    }
+    // The domain boundary, exactly.
+    const double az = std::fmod(std::fmod(p.azimuth_deg, 360.0) + 360.0, 360.0) * kDeg;
+    auto inside = [&](double x, double y) {
+      return visit_parameterization(p.param, [&](auto q) {
+        return bool(valid_iso<decltype(q)>(Tuple3<double>{x, y, az < 2 * kPi ? az : 0.0}));
+      });
+    };
+    draw_polylines(sc, p.map, region_boundary(g, s.valid, inside), Stroke{kBlack, 0.8});
+    // Axes.
+    AxisSpec ax{coords[0].label, ticks(0, coords[0].max, coords[0].angle ? 15 * kDeg : 0.2), {}};
+    AxisSpec ay{coords[1].label, ticks(0, coords[1].max, coords[1].angle ? 15 * kDeg : 0.2), {}};
+    for (double t : ax.ticks) ax.labels.push_back(format_coordinate(coords[0], t));
+    for (double t : ay.ticks) ay.labels.push_back(format_coordinate(coords[1], t));
+    draw_axes(sc, p.map, ax, ay, true, c == 0, fs);
+    sc.text({p.map.rect.x + 0.5 * P, p.map.rect.y - 5},
+            fmt::format("{} = {:g}°", relative_azimuth_label(p.param), p.azimuth_deg), 9.5,
+            HAlign::centre, VAlign::bottom);
+    if (c == 0)
+      sc.text({14, p.map.rect.y + 0.5 * P}, std::string(name_of(p.param)), 11, HAlign::centre,
+              VAlign::middle, kBlack, 90, true);
+    (void)r;
+  }
+
+  // Legend or colour bar.
+  const double ly = top + double(rows) * P + double(rows - 1) * vgap + 46;
+  if (!generic) {
+    // Legend on a dark strip (the white swatch needs it); item widths from the label lengths.
+    std::vector<std::string> labels;
+    std::vector<double> widths;
+    double total = 0;
+    for (TestFunction f : o.test_functions) {
+      labels.push_back(formula(f) + " (" + colour_name(f) + ")");
+      widths.push_back(40 + approx_text_width(labels.back(), 9));
+      total += widths.back();
+    }
+    sc.rect(left - 8, ly - 9, total + 4, 18, kSliceBackground, std::nullopt);
+    double x = left;
+    for (std::size_t k = 0; k < o.test_functions.size(); ++k) {
+      draw_legend_line(sc, {x, ly}, Stroke{test_function_colour(o.test_functions[k]), 1.6},
+                       labels[k], 9, kWhite);
+      x += widths[k];
+    }
+  } else {
+    const double bar_x = left + double(cols) * P + double(cols - 1) * gap + 22;
+    const Rect bar{bar_x, top + 10, 14, double(rows) * P + double(rows - 1) * vgap - 20};
+    std::vector<double> tick_t;
+    std::vector<std::string> labels;
+    const std::vector<double> label_levels = log_levels(fig.log_lo - 1e-6, fig.log_hi + 1e-6, 8);
+    const double span = fig.log_hi - fig.log_lo;
+    if (o.colouring == SliceColouring::luminance) {
+      for (double l : label_levels) {
+        tick_t.push_back((l - fig.log_lo) / span);
+        labels.push_back(power_of_ten_label(l));
+      }
+      draw_colour_bar(
+          sc, bar, [](double t) { return viridis(t); }, tick_t, labels, "luminance",
+          o.pixels_per_point);
+    } else {
+      for (double l : label_levels) {
+        const double e = exposure * std::pow(10.0, l);
+        tick_t.push_back(e / (1 + e));
+        labels.push_back(power_of_ten_label(l));
+      }
+      draw_colour_bar(
+          sc, bar,
+          [](double t) {
+            const double v = srgb_encode(t);
+            return Color{v, v, v};
+          },
+          tick_t, labels, "luminance", o.pixels_per_point);
+    }
+    sc.text({left, ly},
+            "Luminance isolines at the levels marked on the colour bar (decades thicker).", 9);
+  }
+  return fig;
+}
+
+}  // namespace halfback::figure
