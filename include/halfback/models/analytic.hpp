@@ -1,17 +1,33 @@
 // Analytic BRDF models, for testing, comparison and figures. Formulas and their sources:
 // docs/models.md. All return ρ in sr⁻¹ without the cosine factor, and 0 below the horizon.
 // Constructors validate their parameters and throw std::invalid_argument naming the bad one.
+//
+// Every model also samples itself (SamplableBrdf, models/sampling.hpp; docs/render.md): Lambert and
+// sheen by the cosine, GGX by its visible normals (Heitz 2018), Beckmann by D(m) cos θm, ABC by its
+// lobe in the projected disk plus the cosine for kd, and Sum by a mixture of its terms' samplers
+// weighted by their directional albedos at θo. The sampling code is in src/models/sampling.cpp.
 #pragma once
 
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
 #include "halfback/models/fresnel.hpp"
+#include "halfback/models/sampling.hpp"
 
 namespace halfback::models {
 
+namespace detail {
+class MixtureWeights;  // lobe weights as a function of cos θo (src/models/sampling_detail.hpp)
+struct MixtureWeightsDeleter {
+  void operator()(MixtureWeights* p) const;
+};
+using MixtureWeightsPtr = std::unique_ptr<MixtureWeights, MixtureWeightsDeleter>;
+}  // namespace detail
+
 // ρ = albedo / π.
-class Lambert final : public Brdf {
+class Lambert final : public Brdf, public SamplableBrdf {
  public:
   explicit Lambert(Rgb albedo);
   std::string name() const override { return "lambert"; }
@@ -19,6 +35,8 @@ class Lambert final : public Brdf {
   bool isotropic() const override { return true; }
   bool reciprocal() const override { return true; }
   Rgb eval(const DirPair<double>& pair) const override;
+  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
+  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
 
  private:
   Rgb albedo_;
@@ -34,7 +52,7 @@ struct MicrofacetParams {
   Fresnel fresnel;
 };
 
-class Microfacet final : public Brdf {
+class Microfacet final : public Brdf, public SamplableBrdf {
  public:
   explicit Microfacet(const MicrofacetParams& params);
   std::string name() const override;
@@ -42,6 +60,8 @@ class Microfacet final : public Brdf {
   bool isotropic() const override { return params_.alpha_x == params_.alpha_y; }
   bool reciprocal() const override { return true; }
   Rgb eval(const DirPair<double>& pair) const override;
+  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
+  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
 
   // The distribution of normals D(m) (∫ D(m) (m·n) dm = 1) and Smith's Λ(ω).
   double distribution(const Vec3<double>& m) const;
@@ -61,7 +81,7 @@ struct AbcParams {
   Rgb kd{0, 0, 0};
 };
 
-class Abc final : public Brdf {
+class Abc final : public Brdf, public SamplableBrdf {
  public:
   explicit Abc(const AbcParams& params);
   std::string name() const override { return "abc"; }
@@ -69,9 +89,15 @@ class Abc final : public Brdf {
   bool isotropic() const override { return true; }
   bool reciprocal() const override { return true; }
   Rgb eval(const DirPair<double>& pair) const override;
+  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
+  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
 
  private:
   AbcParams params_;
+  // Sampling: the weights of the specular lobe and of kd, computed on first use.
+  const detail::MixtureWeights& mixture() const;
+  mutable std::once_flag mixture_once_;
+  mutable detail::MixtureWeightsPtr mixture_;
 };
 
 // A sheen lobe for cloth-like grazing retro-reflection: the "Charlie" distribution of Estevez
@@ -82,7 +108,7 @@ struct SheenParams {
   double alpha = 0.3;
 };
 
-class Sheen final : public Brdf {
+class Sheen final : public Brdf, public SamplableBrdf {
  public:
   explicit Sheen(const SheenParams& params);
   std::string name() const override { return "sheen"; }
@@ -90,13 +116,15 @@ class Sheen final : public Brdf {
   bool isotropic() const override { return true; }
   bool reciprocal() const override { return true; }
   Rgb eval(const DirPair<double>& pair) const override;
+  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
+  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
 
  private:
   SheenParams params_;
 };
 
 // The sum of several BRDFs (e.g. a diffuse base with a sheen or a glossy layer on top).
-class Sum final : public Brdf {
+class Sum final : public Brdf, public SamplableBrdf {
  public:
   explicit Sum(std::vector<BrdfPtr> terms);
   std::string name() const override;
@@ -104,9 +132,15 @@ class Sum final : public Brdf {
   bool isotropic() const override;
   bool reciprocal() const override;
   Rgb eval(const DirPair<double>& pair) const override;
+  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
+  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
 
  private:
   std::vector<BrdfPtr> terms_;
+  // Sampling: the terms' weights (their albedos at θo), computed on first use.
+  const detail::MixtureWeights& mixture() const;
+  mutable std::once_flag mixture_once_;
+  mutable detail::MixtureWeightsPtr mixture_;
 };
 
 }  // namespace halfback::models

@@ -1,0 +1,88 @@
+// BRDF importance sampling for the renderer: a BRDF's own sampler when it has one (the analytic
+// models, SamplableBrdf), else a tabulation of ρ cos θi in a parameterization of ωi given ωo,
+// sampled with piecewise-constant distributions (docs/render.md, "Sampling tabulated BRDFs").
+//
+// Directions are in the local frame (n = +z); ωo is the view direction, ωi the sampled light
+// direction; pdfs are per unit solid angle. All samplers are immutable and thread-safe.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/models/sampling.hpp"
+#include "halfback/render/distribution.hpp"
+
+namespace halfback::render {
+
+class BrdfSampler {
+ public:
+  virtual ~BrdfSampler() = default;
+  virtual BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const = 0;
+  virtual double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const = 0;
+  virtual std::string describe() const = 0;
+};
+
+// The 2D parameterization of ωi, for a fixed ωo, that a tabulated sampler's cells live in:
+//  spherical: (θi, φi − φo), dωi = sin θi dθi dφ;
+//  halfdiff:  (θh, φh) of the half vector ĥ, ωi = 2(ωo·ĥ)ĥ − ωo, dωi = 4 (ωo·ĥ) sin θh dθh dφh;
+//  hybrid:    (‖h̄‖, φh) of the projected half vector, ωi_xy = 2h̄ − ωo_xy: the first two
+//             coordinates of the hybrid (and ortho) parameterizations; dωi = 4‖h̄‖ d‖h̄‖ dφh / cos
+//             θi, so ρ cos θi dωi = 4 ρ ‖h̄‖ d‖h̄‖ dφh: the cosine cancels.
+enum class TableParam { spherical, halfdiff, hybrid };
+const char* name_of(TableParam p);
+TableParam table_param_from_name(const std::string& name);  // throws std::invalid_argument
+
+struct TabulationOptions {
+  TableParam param = TableParam::hybrid;
+  // The radial coordinate (θi, θh or ‖h̄‖) as r = r_max s², s uniform over the cells: cells are
+  // finer near the lobe's peak (the normal for spherical, the mirror direction for the others).
+  bool warp = true;
+  int radial = 64, azimuthal = 128;                    // cells of one slice
+  int theta_slices = 32;                               // slices in θo (isotropic BRDFs)
+  int aniso_theta_slices = 16, aniso_phi_slices = 16;  // anisotropic BRDFs: slices in θo × φo,
+                                                       // each of radial/2 × azimuthal/2 cells
+  int supersample = 2;      // ρ cos θi |J| per cell: mean over supersample² points
+  double defensive = 0.05;  // probability of a cosine-weighted sample instead (never 0 where ρ ≠ 0)
+  int threads = 0;          // for building the tables; 0: all cores
+};
+
+// The sampler to render `brdf` with: its own (SamplableBrdf) unless `force_tabulated`, else a
+// TabulatedSampler. The BRDF must outlive the sampler.
+std::shared_ptr<const BrdfSampler> make_brdf_sampler(const Brdf& brdf,
+                                                     const TabulationOptions& options = {},
+                                                     bool force_tabulated = false);
+
+// Cosine-weighted hemisphere sampling (for comparisons).
+std::shared_ptr<const BrdfSampler> make_cosine_sampler();
+
+class TabulatedSampler final : public BrdfSampler {
+ public:
+  TabulatedSampler(const Brdf& brdf, const TabulationOptions& options = {});
+  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
+  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
+  std::string describe() const override;
+
+  // Table size and build time, for reports.
+  std::size_t cells() const;
+  double build_seconds() const { return build_seconds_; }
+
+ private:
+  struct Blend {  // up to four slices and their weights
+    int index[4];
+    double weight[4];
+    int count;
+  };
+  Blend blend(const Vec3<double>& wo_canonical) const;
+  double table_pdf(const Vec3<double>& wo, const Vec3<double>& wi, const Blend& b) const;
+
+  std::string name_;
+  TabulationOptions options_;
+  bool isotropic_;
+  int n_theta_, n_phi_, n_radial_, n_azimuthal_;
+  std::vector<Distribution2D> slices_;  // [theta][phi]
+  double build_seconds_ = 0;
+};
+
+}  // namespace halfback::render

@@ -1,0 +1,57 @@
+// Piecewise-constant 1D and 2D distributions over cells, for importance sampling of environment
+// maps and tabulated BRDFs. Weights are non-negative; a cell of weight 0 is never sampled.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace halfback::render {
+
+class Distribution1D {
+ public:
+  Distribution1D() = default;
+  // Throws std::invalid_argument for an empty list or a negative or non-finite weight.
+  explicit Distribution1D(std::span<const double> weights);
+
+  struct Sample {
+    std::size_t index = 0;   // the cell
+    double probability = 0;  // its probability; 0 only when every weight is 0
+    double remapped = 0;     // u rescaled within the cell, in [0, 1): reusable as a fresh number
+  };
+  // u in [0, 1).
+  Sample sample(double u) const;
+  double probability(std::size_t index) const { return total_ > 0 ? weights_[index] / total_ : 0; }
+  double total() const { return total_; }
+  std::size_t size() const { return weights_.size(); }
+
+ private:
+  std::vector<double> weights_;
+  std::vector<double> cdf_;  // size() + 1 entries, cdf_[0] = 0, cdf_.back() = 1
+  double total_ = 0;
+};
+
+// rows × cols cells, weights row-major: a marginal over rows and one conditional per row.
+class Distribution2D {
+ public:
+  Distribution2D() = default;
+  Distribution2D(std::size_t rows, std::size_t cols, std::span<const double> weights);
+
+  struct Sample {
+    std::size_t row = 0, col = 0;
+    double probability = 0;                     // of the cell
+    double remapped_row = 0, remapped_col = 0;  // in [0, 1), the position inside the cell
+  };
+  Sample sample(double u1, double u2) const;
+  double probability(std::size_t row, std::size_t col) const;
+  double total() const { return marginal_.total(); }
+  std::size_t rows() const { return rows_; }
+  std::size_t cols() const { return cols_; }
+
+ private:
+  std::size_t rows_ = 0, cols_ = 0;
+  Distribution1D marginal_;
+  std::vector<Distribution1D> conditional_;
+};
+
+}  // namespace halfback::render

@@ -1,0 +1,86 @@
+// Environment maps: latitude–longitude radiance maps (Radiance .hdr or OpenEXR files, a built-in
+// procedural sky, or a constant), looked up and importance sampled in world directions.
+//
+// World frame of the renderer (docs/render.md): +y is up, the camera looks along −z from +z, +x is
+// to the right in the image. A map pixel (column c, row r) of a W×H map covers
+//   φ ∈ [2π c/W − π, 2π (c+1)/W − π),   θ ∈ [π r/H, π (r+1)/H),
+// θ the polar angle from +y (row 0 is the zenith) and φ the azimuth about +y, with
+//   direction(θ, φ) = (sin θ sin φ, cos θ, −sin θ cos φ).
+// So the centre of the map (φ = 0, θ = π/2) is −z, the direction the camera looks in, and is what
+// the background shows behind the sphere; the left and right edges are +z, behind the camera; the
+// map's right half (φ > 0) is to the right (+x). Lookups are nearest-pixel: the map is piecewise
+// constant in direction, which is exactly the function the sampler importance samples.
+#pragma once
+
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/render/distribution.hpp"
+
+namespace halfback::render {
+
+struct EnvOptions {
+  double rotation_deg = 0;  // turns the environment about +y (counter-clockwise seen from above)
+  double exposure = 0;      // radiance scale 2^exposure
+};
+
+class EnvMap {
+ public:
+  // `rgb` holds width × height × 3 linear radiance values, row 0 at the top (the zenith). Throws
+  // std::invalid_argument when a dimension is 0, the size does not match, or a value is negative,
+  // NaN or infinite (the message names `name`, the pixel and the channel).
+  EnvMap(int width, int height, std::vector<float> rgb, std::string name, EnvOptions options = {});
+
+  // "default" (the built-in sky), "constant:V" or "constant:R,G,B", or a file name.
+  static EnvMap from_spec(std::string_view spec, EnvOptions options = {});
+  // A Radiance .hdr or OpenEXR file, recognized by its content. Throws FormatError naming the file
+  // and the problem: unreadable, not an HDR image, zero size, not 2:1, NaN/Inf/negative pixels.
+  static EnvMap load(const std::filesystem::path& path, EnvOptions options = {});
+  static EnvMap constant(const Rgb& radiance, EnvOptions options = {});
+  // The built-in procedural environment (1024 × 512): a blue sky gradient, a small bright sun
+  // disk (radius 1.5°, 40° above the horizon, behind the camera on its left) and a darker ground.
+  static EnvMap default_sky(EnvOptions options = {});
+
+  // Radiance arriving from world direction `dir` (unit), scaled by the exposure.
+  Rgb eval(const Vec3<double>& dir) const;
+
+  struct Sample {
+    Vec3<double> dir;  // world direction towards the light
+    Rgb radiance;
+    double pdf = 0;  // per unit solid angle; 0 when the map is black (no sample)
+  };
+  // A direction with probability proportional to the luminance of its pixel (times the pixel's
+  // solid angle), uniform in solid angle within the pixel. u1, u2 in [0, 1).
+  Sample sample(double u1, double u2) const;
+  // The density of sample() at `dir`, per unit solid angle.
+  double pdf(const Vec3<double>& dir) const;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const std::string& name() const { return name_; }
+  const EnvOptions& options() const { return options_; }
+  std::span<const float> pixels() const { return rgb_; }  // without the exposure scale
+
+  // The map frame: direction of map coordinates (u, v) ∈ [0, 1]² and back (u ∈ [0, 1)).
+  static Vec3<double> map_direction(double u, double v);
+  static void map_coordinates(const Vec3<double>& dir, double& u, double& v);
+
+ private:
+  Vec3<double> to_map(const Vec3<double>& world) const;
+  Vec3<double> to_world(const Vec3<double>& map) const;
+  std::size_t pixel_of(const Vec3<double>& map_dir, std::size_t& row, std::size_t& col) const;
+
+  int width_ = 0, height_ = 0;
+  std::vector<float> rgb_;
+  std::string name_;
+  EnvOptions options_;
+  double scale_ = 1, cos_rot_ = 1, sin_rot_ = 0;
+  std::vector<double> row_solid_angle_;  // of one pixel of each row
+  Distribution2D distribution_;
+};
+
+}  // namespace halfback::render

@@ -1,0 +1,66 @@
+// A unit sphere of any BRDF under an environment map: direct lighting only (the sphere is convex,
+// so nothing else reaches it), estimated by multiple importance sampling of the environment and
+// the BRDF (docs/render.md). The image is returned as an array; image.hpp writes it to files.
+//
+// Scene: the sphere of radius 1 at the origin; +y up, the camera on +z looking along −z (the
+// world frame of envmap.hpp). Orthographic view: the image spans [−1.25, 1.25] vertically, and the
+// background shows the environment as seen by a perspective camera of `background_fov_deg`.
+// Perspective view: the camera at (0, 0, 4.5) with a vertical field of view of 30°.
+// Shading frame at a point of normal n: t = normalize(+y × n) (along the parallels, +x at the
+// front), b = n × t; directions are expressed in (t, b, n) before calling the BRDF, with ωi
+// towards the light and ωo towards the camera.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/render/brdf_sampler.hpp"
+#include "halfback/render/envmap.hpp"
+#include "halfback/render/image.hpp"
+
+namespace halfback::render {
+
+enum class Projection { orthographic, perspective };
+// mis: one environment and one BRDF sample per pixel sample, weighted by the heuristic;
+// brdf, env: two samples of that strategy alone (the same number of light samples as mis).
+enum class Strategy { mis, brdf, env };
+enum class Heuristic { balance, power };
+enum class Sequence { sobol, random };  // scrambled Sobol (0,2) points per pixel, or independent
+
+struct RenderSettings {
+  int width = 512, height = 512;
+  int spp = 64;            // pixel samples
+  std::uint64_t seed = 1;  // the image is a function of the seed (not of the thread count)
+  double time_budget = 0;  // seconds; 0: none. Stops after the last pass that fits (>= 1 spp)
+  Projection projection = Projection::orthographic;
+  double background_fov_deg = 60;  // orthographic view: the background's field of view
+  Strategy strategy = Strategy::mis;
+  Heuristic heuristic = Heuristic::power;
+  Sequence sequence = Sequence::sobol;
+  int threads = 0;               // 0: all cores
+  bool progress = false;         // a progress bar on stderr, only when stderr is a terminal
+  bool variance = false;         // also return the per-pixel variance of the mean (luminance)
+  TabulationOptions tabulation;  // for BRDFs without a sampler of their own
+};
+
+struct RenderResult {
+  Image image;
+  std::vector<float> variance;  // width × height when settings.variance, else empty
+  int spp = 0;                  // pixel samples taken (fewer than asked if the budget ran out)
+  double seconds = 0;           // rendering time, without building the BRDF sampler
+  double sampler_seconds = 0;   // building the BRDF sampler (tabulation)
+  bool budget_exhausted = false;
+  std::uint64_t nonfinite = 0;  // sample values that were NaN or infinite, dropped
+  std::string sampler;          // which BRDF sampler was used
+};
+
+// Throws std::invalid_argument for invalid settings (sizes, spp, fov).
+RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings);
+// With a given BRDF sampler (e.g. a tabulated one for a BRDF that has its own).
+RenderResult render(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& env,
+                    const RenderSettings& settings);
+
+}  // namespace halfback::render

@@ -1,0 +1,291 @@
+// Importance sampling of the analytic models (SamplableBrdf, models/sampling.hpp). The formulas
+// and their sources are in docs/render.md.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "halfback/models/analytic.hpp"
+#include "sampling_detail.hpp"
+
+namespace halfback::models {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double luminance(const Rgb& c) {
+  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+}
+
+double dot(const Vec3<double>& a, const Vec3<double>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+Vec3<double> normalize(const Vec3<double>& v) {
+  const double l = std::sqrt(dot(v, v));
+  return {v.x / l, v.y / l, v.z / l};
+}
+
+// Mirror of wo about the unit normal m.
+Vec3<double> reflect(const Vec3<double>& wo, const Vec3<double>& m) {
+  const double c = 2 * dot(wo, m);
+  return {c * m.x - wo.x, c * m.y - wo.y, c * m.z - wo.z};
+}
+
+BrdfSample finish(const SamplableBrdf& s, const Vec3<double>& wo, const Vec3<double>& wi) {
+  if (!(wi.z > 0)) return {};
+  return {wi, s.pdf(wo, wi)};
+}
+
+// The cosine sampler, for terms of a Sum that have no sampler of their own.
+struct CosineSampler final : SamplableBrdf {
+  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override {
+    if (!(wo.z > 0)) return {};
+    const Vec3<double> wi = sample_cosine_hemisphere(u1, u2);
+    return {wi, cosine_hemisphere_pdf(wi)};
+  }
+  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override {
+    return wo.z > 0 ? cosine_hemisphere_pdf(wi) : 0;
+  }
+};
+const CosineSampler kCosine;
+
+const SamplableBrdf& sampler_of(const Brdf& b) {
+  const auto* s = dynamic_cast<const SamplableBrdf*>(&b);
+  return s ? *s : kCosine;
+}
+
+}  // namespace
+
+// --- mixture weights --------------------------------------------------------------------------
+
+namespace detail {
+
+void MixtureWeightsDeleter::operator()(MixtureWeights* p) const {
+  delete p;
+}
+
+MixtureWeights::MixtureWeights(
+    std::size_t lobes, const std::function<double(std::size_t, const Vec3<double>&)>& albedo)
+    : lobes_(lobes), table_(std::size_t(kNodes) * lobes) {
+  for (int k = 0; k < kNodes; ++k) {
+    const double c = (k + 0.5) / kNodes, s = std::sqrt(1 - c * c);
+    // At φo = π/4, between the two roughness axes of an anisotropic lobe.
+    const Vec3<double> wo{s * std::sqrt(0.5), s * std::sqrt(0.5), c};
+    double sum = 0;
+    for (std::size_t j = 0; j < lobes; ++j) {
+      const double a = std::max(0.0, albedo(j, wo));
+      table_[std::size_t(k) * lobes + j] = std::isfinite(a) ? a : 0;
+      sum += table_[std::size_t(k) * lobes + j];
+    }
+    for (std::size_t j = 0; j < lobes; ++j) {
+      double& w = table_[std::size_t(k) * lobes + j];
+      w = sum > 0 ? w / sum : 1.0 / double(lobes);
+    }
+  }
+}
+
+void MixtureWeights::weights(double cos_o, std::span<double> out) const {
+  const double x = std::clamp(cos_o * kNodes - 0.5, 0.0, double(kNodes - 1));
+  const int k0 = std::min(int(x), kNodes - 2);
+  const double t = std::clamp(x - k0, 0.0, 1.0);
+  for (std::size_t j = 0; j < lobes_; ++j)
+    out[j] = (1 - t) * table_[std::size_t(k0) * lobes_ + j] +
+             t * table_[std::size_t(k0 + 1) * lobes_ + j];
+}
+
+double MixtureWeights::albedo(const Brdf& brdf, const SamplableBrdf& sampler,
+                              const Vec3<double>& wo) {
+  double sum = 0;
+  for (int i = 0; i < kStrata; ++i)
+    for (int j = 0; j < kStrata; ++j) {
+      const BrdfSample s = sampler.sample(wo, (i + 0.5) / kStrata, (j + 0.5) / kStrata);
+      if (s.pdf > 0) sum += luminance(brdf.eval({s.wi, wo})) * s.wi.z / s.pdf;
+    }
+  return sum / (kStrata * kStrata);
+}
+
+}  // namespace detail
+
+// --- Lambert and sheen: the cosine ------------------------------------------------------------
+
+BrdfSample Lambert::sample(const Vec3<double>& wo, double u1, double u2) const {
+  return kCosine.sample(wo, u1, u2);
+}
+double Lambert::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  return kCosine.pdf(wo, wi);
+}
+
+BrdfSample Sheen::sample(const Vec3<double>& wo, double u1, double u2) const {
+  return kCosine.sample(wo, u1, u2);
+}
+double Sheen::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  return kCosine.pdf(wo, wi);
+}
+
+// --- Microfacet ---------------------------------------------------------------------------------
+// GGX: the distribution of visible normals D_ωo(m) = G1(ωo) max(0, ωo·m) D(m) / cos θo, sampled
+// exactly (Heitz 2018, "Sampling the GGX Distribution of Visible Normals"); ωi = reflect(ωo, m),
+// pdf(ωi) = D_ωo(m) / (4 ωo·m) = G1(ωo) D(m) / (4 cos θo).
+// Beckmann: m with density D(m) cos θm (a Gaussian in slope space), pdf(ωi) = D(m) cos θm /
+// (4 ωo·m).
+
+BrdfSample Microfacet::sample(const Vec3<double>& wo, double u1, double u2) const {
+  if (!(wo.z > 0)) return {};
+  const double ax = params_.alpha_x, ay = params_.alpha_y;
+  Vec3<double> m;
+  if (params_.distribution == MicrofacetParams::Distribution::ggx) {
+    // The view direction in the hemisphere configuration (roughness stretched to 1).
+    const Vec3<double> vh = normalize({ax * wo.x, ay * wo.y, wo.z});
+    const double len2 = vh.x * vh.x + vh.y * vh.y;
+    const Vec3<double> t1 = len2 > 0
+                                ? Vec3<double>{-vh.y / std::sqrt(len2), vh.x / std::sqrt(len2), 0}
+                                : Vec3<double>{1, 0, 0};
+    const Vec3<double> t2{vh.y * t1.z - vh.z * t1.y, vh.z * t1.x - vh.x * t1.z,
+                          vh.x * t1.y - vh.y * t1.x};
+    // A point on the projected hemisphere: a disk, half of it squashed by the view's slope.
+    const double r = std::sqrt(u1), phi = 2 * kPi * u2;
+    const double p1 = r * std::cos(phi);
+    double p2 = r * std::sin(phi);
+    const double s = 0.5 * (1 + vh.z);
+    p2 = (1 - s) * std::sqrt(std::max(0.0, 1 - p1 * p1)) + s * p2;
+    const double pz = std::sqrt(std::max(0.0, 1 - p1 * p1 - p2 * p2));
+    const Vec3<double> nh{p1 * t1.x + p2 * t2.x + pz * vh.x, p1 * t1.y + p2 * t2.y + pz * vh.y,
+                          p1 * t1.z + p2 * t2.z + pz * vh.z};
+    m = normalize({ax * nh.x, ay * nh.y, std::max(1e-300, nh.z)});
+  } else {
+    const double r = std::sqrt(-std::log1p(-u1)), phi = 2 * kPi * u2;
+    m = normalize({-ax * r * std::cos(phi), -ay * r * std::sin(phi), 1});
+  }
+  if (!(dot(wo, m) > 0)) return {};
+  return finish(*this, wo, reflect(wo, m));
+}
+
+double Microfacet::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  if (!(wo.z > 0 && wi.z > 0)) return 0;
+  const Vec3<double> m = normalize({wi.x + wo.x, wi.y + wo.y, wi.z + wo.z});
+  const double d = distribution(m);
+  if (params_.distribution == MicrofacetParams::Distribution::ggx)
+    return d / ((1 + lambda(wo)) * 4 * wo.z);
+  return d * m.z / (4 * dot(wo, m));
+}
+
+// --- ABC
+// ------------------------------------------------------------------------------------------ The
+// specular lobe is S(f), f = ‖ωi_xy + ωo_xy‖: in the plane of projected directions it is a radial
+// function around the projected mirror direction −ωo_xy. It is sampled there with density q(x) ∝ (1
+// + B f²)^(−a), a = (C+1)/2, truncated to f ≤ 2 (the largest possible f); a point outside the unit
+// disk is no sample. dA = cos θi dωi, so pdf(ωi) = q(ωi_xy) cos θi. kd is sampled by the cosine;
+// the two are mixed with weights from their albedos at θo.
+
+namespace {
+
+// ∫_0^f r (1 + B r²)^(−a) dr, and the inverse of its normalized form.
+struct AbcRadial {
+  double b, e;  // e = 1 − a
+  double integral(double f) const {
+    if (b <= 0) return 0.5 * f * f;
+    const double l = std::log1p(b * f * f);
+    if (std::abs(e) < 1e-9) return l / (2 * b);
+    return std::expm1(e * l) / (2 * b * e);
+  }
+  double invert(double u) const {  // f with integral(f) = u · integral(2)
+    if (b <= 0) return 2 * std::sqrt(u);
+    const double l2 = std::log1p(4 * b);
+    double f2;
+    if (std::abs(e) < 1e-9) {
+      f2 = std::expm1(u * l2) / b;
+    } else {
+      f2 = std::expm1(std::log1p(u * std::expm1(e * l2)) / e) / b;
+    }
+    return std::sqrt(std::max(0.0, f2));
+  }
+};
+
+}  // namespace
+
+const detail::MixtureWeights& Abc::mixture() const {
+  std::call_once(mixture_once_, [this] {
+    const double kd = luminance(params_.kd);
+    const AbcRadial radial{params_.b, 1 - 0.5 * (params_.c + 1)};
+    mixture_.reset(new detail::MixtureWeights(2, [&](std::size_t lobe, const Vec3<double>& wo) {
+      if (lobe == 1) return kd;
+      // The specular albedo, sampled with the specular lobe's own density.
+      double sum = 0;
+      const int n = detail::MixtureWeights::kStrata;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const double f = radial.invert((i + 0.5) / n), phi = 2 * kPi * (j + 0.5) / n;
+          const double x = f * std::cos(phi) - wo.x, y = f * std::sin(phi) - wo.y;
+          const double r2 = x * x + y * y;
+          if (r2 >= 1) continue;
+          const Vec3<double> wi{x, y, std::sqrt(1 - r2)};
+          const double q = std::pow(1 + params_.b * f * f, -0.5 * (params_.c + 1)) /
+                           (2 * kPi * radial.integral(2));
+          const double spec = luminance(eval({wi, wo})) - kd / kPi;
+          sum += std::max(0.0, spec) * wi.z / (q * wi.z);
+        }
+      return sum / (n * n);
+    }));
+  });
+  return *mixture_;
+}
+
+BrdfSample Abc::sample(const Vec3<double>& wo, double u1, double u2) const {
+  if (!(wo.z > 0)) return {};
+  std::array<double, 2> w;
+  mixture().weights(wo.z, w);
+  if (detail::pick_lobe(w, u1) == 1) return finish(*this, wo, sample_cosine_hemisphere(u1, u2));
+  const AbcRadial radial{params_.b, 1 - 0.5 * (params_.c + 1)};
+  const double f = radial.invert(u1), phi = 2 * kPi * u2;
+  const double x = f * std::cos(phi) - wo.x, y = f * std::sin(phi) - wo.y;
+  const double r2 = x * x + y * y;
+  if (!(r2 < 1)) return {};
+  return finish(*this, wo, {x, y, std::sqrt(1 - r2)});
+}
+
+double Abc::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  if (!(wo.z > 0 && wi.z > 0)) return 0;
+  std::array<double, 2> w;
+  mixture().weights(wo.z, w);
+  const AbcRadial radial{params_.b, 1 - 0.5 * (params_.c + 1)};
+  const double fx = wi.x + wo.x, fy = wi.y + wo.y, f2 = fx * fx + fy * fy;
+  const double q =
+      std::pow(1 + params_.b * f2, -0.5 * (params_.c + 1)) / (2 * kPi * radial.integral(2));
+  return w[0] * q * wi.z + w[1] * cosine_hemisphere_pdf(wi);
+}
+
+// --- Sum: a mixture of the terms' samplers --------------------------------------------------
+
+const detail::MixtureWeights& Sum::mixture() const {
+  std::call_once(mixture_once_, [this] {
+    mixture_.reset(
+        new detail::MixtureWeights(terms_.size(), [this](std::size_t j, const Vec3<double>& wo) {
+          return detail::MixtureWeights::albedo(*terms_[j], sampler_of(*terms_[j]), wo);
+        }));
+  });
+  return *mixture_;
+}
+
+BrdfSample Sum::sample(const Vec3<double>& wo, double u1, double u2) const {
+  if (!(wo.z > 0)) return {};
+  std::vector<double> w(terms_.size());
+  mixture().weights(wo.z, w);
+  const std::size_t j = detail::pick_lobe(w, u1);
+  const BrdfSample s = sampler_of(*terms_[j]).sample(wo, u1, u2);
+  if (!(s.pdf > 0)) return {};
+  return finish(*this, wo, s.wi);
+}
+
+double Sum::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  if (!(wo.z > 0 && wi.z > 0)) return 0;
+  std::vector<double> w(terms_.size());
+  mixture().weights(wo.z, w);
+  double p = 0;
+  for (std::size_t j = 0; j < terms_.size(); ++j)
+    if (w[j] > 0) p += w[j] * sampler_of(*terms_[j]).pdf(wo, wi);
+  return p;
+}
+
+}  // namespace halfback::models

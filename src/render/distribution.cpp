@@ -1,0 +1,86 @@
+#include "halfback/render/distribution.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace halfback::render {
+
+namespace {
+// The largest double below 1: remapped numbers must stay in [0, 1).
+constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
+}  // namespace
+
+Distribution1D::Distribution1D(std::span<const double> weights)
+    : weights_(weights.begin(), weights.end()) {
+  if (weights_.empty()) throw std::invalid_argument("Distribution1D: no cells");
+  cdf_.resize(weights_.size() + 1);
+  cdf_[0] = 0;
+  for (std::size_t i = 0; i < weights_.size(); ++i) {
+    const double w = weights_[i];
+    if (!std::isfinite(w) || w < 0)
+      throw std::invalid_argument("Distribution1D: weight " + std::to_string(i) +
+                                  " is negative or not finite");
+    cdf_[i + 1] = cdf_[i] + w;
+  }
+  total_ = cdf_.back();
+  if (!std::isfinite(total_)) throw std::invalid_argument("Distribution1D: weights overflow");
+  if (total_ > 0) {
+    for (double& c : cdf_) c /= total_;
+  } else {
+    for (std::size_t i = 0; i < cdf_.size(); ++i) cdf_[i] = double(i) / double(weights_.size());
+  }
+  cdf_.back() = 1;
+}
+
+Distribution1D::Sample Distribution1D::sample(double u) const {
+  Sample s;
+  if (total_ <= 0 || weights_.empty()) return s;
+  u = std::clamp(u, 0.0, kOneMinusEpsilon);
+  // The first cell whose upper bound exceeds u: cells of weight 0 have an empty interval.
+  const auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), u);
+  std::size_t i = std::size_t(it - cdf_.begin()) - 1;
+  i = std::min(i, weights_.size() - 1);
+  while (weights_[i] == 0 && i > 0) --i;  // rounding at the last cell: step back to a live cell
+  s.index = i;
+  s.probability = weights_[i] / total_;
+  const double width = cdf_[i + 1] - cdf_[i];
+  s.remapped = width > 0 ? std::clamp((u - cdf_[i]) / width, 0.0, kOneMinusEpsilon) : 0.5;
+  return s;
+}
+
+Distribution2D::Distribution2D(std::size_t rows, std::size_t cols, std::span<const double> weights)
+    : rows_(rows), cols_(cols) {
+  if (rows == 0 || cols == 0 || weights.size() != rows * cols)
+    throw std::invalid_argument("Distribution2D: " + std::to_string(weights.size()) +
+                                " weights for " + std::to_string(rows) + " x " +
+                                std::to_string(cols) + " cells");
+  std::vector<double> row_weights(rows);
+  conditional_.reserve(rows);
+  for (std::size_t r = 0; r < rows; ++r) {
+    conditional_.emplace_back(weights.subspan(r * cols, cols));
+    row_weights[r] = conditional_.back().total();
+  }
+  marginal_ = Distribution1D(row_weights);
+}
+
+Distribution2D::Sample Distribution2D::sample(double u1, double u2) const {
+  Sample s;
+  const auto r = marginal_.sample(u1);
+  if (r.probability <= 0) return s;
+  const auto c = conditional_[r.index].sample(u2);
+  s.row = r.index;
+  s.col = c.index;
+  s.probability = r.probability * c.probability;
+  s.remapped_row = r.remapped;
+  s.remapped_col = c.remapped;
+  return s;
+}
+
+double Distribution2D::probability(std::size_t row, std::size_t col) const {
+  if (row >= rows_ || col >= cols_) return 0;
+  return marginal_.probability(row) * conditional_[row].probability(col);
+}
+
+}  // namespace halfback::render

@@ -1,0 +1,455 @@
+#include "halfback/render/envmap.hpp"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfEnvmap.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfStandardAttributes.h>
+#include <stb_image.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "halfback/io/format_error.hpp"
+
+namespace halfback::render {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr long long kMaxPixels = 1LL << 28;  // 268 M pixels: 3 GiB of floats
+
+double luminance(float r, float g, float b) {
+  return 0.2126 * r + 0.7152 * g + 0.0722 * b;
+}
+
+std::string describe_value(float v) {
+  if (std::isnan(v)) return "NaN";
+  if (std::isinf(v)) return v > 0 ? "+Inf" : "-Inf";
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// The first bad pixel and the number of bad values, or an empty string when all are valid.
+std::string check_pixels(int width, std::span<const float> rgb) {
+  std::size_t bad = 0, first = 0;
+  for (std::size_t i = 0; i < rgb.size(); ++i) {
+    const float v = rgb[i];
+    if (!(std::isfinite(v) && v >= 0)) {
+      if (bad++ == 0) first = i;
+    }
+  }
+  if (bad == 0) return {};
+  const std::size_t pixel = first / 3;
+  const char channel = "RGB"[first % 3];
+  std::ostringstream s;
+  s << bad << " invalid value" << (bad > 1 ? "s" : "") << " (radiance must be finite and >= 0); "
+    << "first at pixel (x=" << pixel % std::size_t(width) << ", y=" << pixel / std::size_t(width)
+    << ") channel " << channel << ": " << describe_value(rgb[first]);
+  return s.str();
+}
+
+std::vector<unsigned char> read_bytes(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw FormatError(path.string(), "file", "is a directory, not an image");
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw FormatError(path.string(), "file", std::string("cannot open: ") + std::strerror(errno));
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                   std::istreambuf_iterator<char>());
+  if (in.bad()) throw FormatError(path.string(), "file", "read error");
+  return bytes;
+}
+
+bool is_exr(std::span<const unsigned char> b) {
+  return b.size() >= 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01;
+}
+
+bool is_radiance(std::span<const unsigned char> b) {
+  return b.size() >= 2 && b[0] == '#' && b[1] == '?';
+}
+
+// Walks the scanlines of Radiance pixel data (flat RGBE, or the run-length encoding of each
+// channel) and checks that they are complete: stb_image reads past a truncated file as zeros.
+void check_radiance_data(const std::string& file, std::span<const unsigned char> d,
+                         std::size_t width, std::size_t height) {
+  auto truncated = [&](std::size_t y) {
+    throw FormatError(file, "Radiance data",
+                      "truncated: the pixel data ends in scanline " + std::to_string(y) + " of " +
+                          std::to_string(height));
+  };
+  std::size_t pos = 0;
+  for (std::size_t y = 0; y < height; ++y) {
+    const bool rle = width >= 8 && width < 32768 && pos + 4 <= d.size() && d[pos] == 2 &&
+                     d[pos + 1] == 2 && !(d[pos + 2] & 0x80);
+    if (!rle) {  // flat pixels from here to the end of the image
+      if (d.size() - std::min(pos, d.size()) < 4 * width * (height - y)) truncated(y);
+      return;
+    }
+    if ((std::size_t(d[pos + 2]) << 8 | d[pos + 3]) != width)
+      throw FormatError(file, "Radiance data",
+                        "scanline " + std::to_string(y) + " has the wrong length");
+    pos += 4;
+    for (int channel = 0; channel < 4; ++channel)
+      for (std::size_t x = 0; x < width;) {
+        if (pos >= d.size()) truncated(y);
+        std::size_t count = d[pos++];
+        if (count > 128) {
+          count -= 128;
+          pos += 1;
+        } else {
+          pos += count;
+        }
+        if (count == 0 || x + count > width)
+          throw FormatError(file, "Radiance data",
+                            "bad run-length encoding in scanline " + std::to_string(y));
+        if (pos > d.size()) truncated(y);
+        x += count;
+      }
+  }
+}
+
+// The resolution line of a Radiance file ("-Y H +X W" after the blank line ending the header), so
+// that a zero-size image gets its own message rather than stb's generic one.
+void check_radiance_resolution(const std::string& file, std::span<const unsigned char> b) {
+  std::size_t i = 0;
+  bool blank = false;
+  while (i < b.size() && !blank) {  // header lines up to an empty one
+    const std::size_t start = i;
+    while (i < b.size() && b[i] != '\n') ++i;
+    blank = (i == start);
+    ++i;
+  }
+  if (!blank) throw FormatError(file, "Radiance header", "no blank line ends the header");
+  std::string line;
+  while (i < b.size() && b[i] != '\n' && line.size() < 100) line.push_back(char(b[i++]));
+  ++i;  // the data starts after the resolution line
+  std::istringstream s(line);
+  std::string a1, a2;
+  long long n1 = -1, n2 = -1;
+  s >> a1 >> n1 >> a2 >> n2;
+  if (!s || a1.size() != 2 || a2.size() != 2)
+    throw FormatError(file, "Radiance resolution line", "cannot parse '" + line + "'");
+  if (n1 <= 0 || n2 <= 0)
+    throw FormatError(file, "Radiance resolution line",
+                      "zero-size image ('" + line + "'): an environment map needs pixels");
+  if (a1 != "-Y" || a2 != "+X")
+    throw FormatError(file, "Radiance resolution line",
+                      "unsupported orientation '" + line + "' (expected -Y H +X W)");
+  if (n1 * n2 > kMaxPixels) throw FormatError(file, "Radiance resolution line", "image too large");
+  check_radiance_data(file, b.subspan(std::min(i, b.size())), std::size_t(n2), std::size_t(n1));
+}
+
+struct Loaded {
+  int width = 0, height = 0;
+  std::vector<float> rgb;
+};
+
+Loaded load_radiance(const std::string& file, std::span<const unsigned char> bytes) {
+  check_radiance_resolution(file, bytes);
+  if (!stbi_is_hdr_from_memory(bytes.data(), int(bytes.size())))
+    throw FormatError(file, "Radiance header",
+                      "not a Radiance HDR file (expected '#?RADIANCE' or '#?RGBE')");
+  if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
+    throw FormatError(file, "file", "too large");
+  int w = 0, h = 0, comp = 0;
+  float* data = stbi_loadf_from_memory(bytes.data(), int(bytes.size()), &w, &h, &comp, 3);
+  if (!data) {
+    const char* why = stbi_failure_reason();
+    throw FormatError(file, "Radiance data",
+                      std::string("cannot decode: ") + (why ? why : "unknown error"));
+  }
+  Loaded out;
+  out.width = w;
+  out.height = h;
+  out.rgb.assign(data, data + std::size_t(w) * std::size_t(h) * 3);
+  stbi_image_free(data);
+  return out;
+}
+
+Loaded load_openexr(const std::string& file) {
+  try {
+    Imf::InputFile in(file.c_str());
+    const Imf::Header& header = in.header();
+    if (Imf::hasEnvmap(header) && Imf::envmap(header) == Imf::ENVMAP_CUBE)
+      throw FormatError(file, "envmap attribute",
+                        "a cube map; only latitude-longitude maps are supported");
+    const Imath::Box2i dw = header.dataWindow();
+    const long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
+    if (w <= 0 || h <= 0)
+      throw FormatError(file, "dataWindow", "zero-size image: an environment map needs pixels");
+    if (w * h > kMaxPixels)
+      throw FormatError(file, "dataWindow",
+                        "image too large (" + std::to_string(w) + " x " + std::to_string(h) + ")");
+    const Imf::ChannelList& channels = header.channels();
+    const bool rgb =
+        channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
+    const bool grey = !rgb && channels.findChannel("Y");
+    if (!rgb && !grey) {
+      std::string names;
+      for (auto it = channels.begin(); it != channels.end(); ++it)
+        names += (names.empty() ? "" : ", ") + std::string(it.name());
+      throw FormatError(file, "channels",
+                        "needs R, G, B (or Y) channels; the file has: " +
+                            (names.empty() ? std::string("none") : names));
+    }
+    Loaded out;
+    out.width = int(w);
+    out.height = int(h);
+    out.rgb.assign(std::size_t(w * h * 3), 0.0f);
+    // The frame buffer's base points at pixel (0, 0) of the coordinate system, so that the data
+    // window's first pixel lands at index 0.
+    char* base = reinterpret_cast<char*>(out.rgb.data()) -
+                 (std::ptrdiff_t(dw.min.x) + std::ptrdiff_t(dw.min.y) * w) * 3 * sizeof(float);
+    const std::size_t xs = 3 * sizeof(float), ys = std::size_t(w) * xs;
+    Imf::FrameBuffer fb;
+    if (rgb) {
+      fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+      fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+      fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    } else {
+      fb.insert("Y", Imf::Slice(Imf::FLOAT, base, xs, ys));
+    }
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+    if (grey)
+      for (std::size_t i = 0; i < out.rgb.size(); i += 3)
+        out.rgb[i + 1] = out.rgb[i + 2] = out.rgb[i];
+    return out;
+  } catch (const FormatError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw FormatError(file, "OpenEXR", e.what());
+  }
+}
+
+}  // namespace
+
+// --------------------------------------------------------------------------------------------
+
+EnvMap::EnvMap(int width, int height, std::vector<float> rgb, std::string name, EnvOptions options)
+    : width_(width),
+      height_(height),
+      rgb_(std::move(rgb)),
+      name_(std::move(name)),
+      options_(options) {
+  if (width <= 0 || height <= 0)
+    throw std::invalid_argument(name_ + ": zero-size image (" + std::to_string(width) + " x " +
+                                std::to_string(height) + ")");
+  if ((long long)width * height > kMaxPixels)
+    throw std::invalid_argument(name_ + ": image too large");
+  if (rgb_.size() != std::size_t(width) * std::size_t(height) * 3)
+    throw std::invalid_argument(name_ + ": " + std::to_string(rgb_.size()) + " values for " +
+                                std::to_string(width) + " x " + std::to_string(height) +
+                                " RGB pixels");
+  if (const std::string bad = check_pixels(width, rgb_); !bad.empty())
+    throw std::invalid_argument(name_ + ": " + bad);
+  if (!std::isfinite(options.exposure) || std::abs(options.exposure) > 64)
+    throw std::invalid_argument(name_ + ": exposure must be a finite number of stops in [-64, 64]");
+  if (!std::isfinite(options.rotation_deg))
+    throw std::invalid_argument(name_ + ": rotation must be finite");
+  scale_ = std::exp2(options.exposure);
+  const double rot = options.rotation_deg * kPi / 180;
+  cos_rot_ = std::cos(rot);
+  sin_rot_ = std::sin(rot);
+
+  // Pixel probability ∝ luminance × solid angle; within a pixel, uniform in solid angle.
+  row_solid_angle_.resize(std::size_t(height));
+  const double dphi = 2 * kPi / width;
+  for (int r = 0; r < height; ++r) {
+    const double c0 = std::cos(kPi * r / height), c1 = std::cos(kPi * (r + 1) / height);
+    row_solid_angle_[std::size_t(r)] = dphi * (c0 - c1);
+  }
+  std::vector<double> weights(std::size_t(width) * std::size_t(height));
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    const float* p = &rgb_[3 * i];
+    weights[i] = luminance(p[0], p[1], p[2]) * row_solid_angle_[i / std::size_t(width)];
+  }
+  distribution_ = Distribution2D(std::size_t(height), std::size_t(width), weights);
+}
+
+EnvMap EnvMap::constant(const Rgb& radiance, EnvOptions options) {
+  std::ostringstream name;
+  name << "constant:" << radiance.r << "," << radiance.g << "," << radiance.b;
+  return EnvMap(1, 1, {float(radiance.r), float(radiance.g), float(radiance.b)}, name.str(),
+                options);
+}
+
+EnvMap EnvMap::from_spec(std::string_view spec, EnvOptions options) {
+  if (spec == "default") return default_sky(options);
+  constexpr std::string_view prefix = "constant:";
+  if (spec.substr(0, prefix.size()) == prefix) {
+    std::vector<double> v;
+    std::string_view rest = spec.substr(prefix.size());
+    while (true) {
+      const std::size_t comma = rest.find(',');
+      const std::string_view item = rest.substr(0, comma);
+      double x = 0;
+      const auto r = std::from_chars(item.data(), item.data() + item.size(), x);
+      if (item.empty() || r.ec != std::errc() || r.ptr != item.data() + item.size())
+        throw std::invalid_argument("environment '" + std::string(spec) + "': '" +
+                                    std::string(item) + "' is not a number");
+      if (!std::isfinite(x) || x < 0)
+        throw std::invalid_argument("environment '" + std::string(spec) +
+                                    "': radiance must be finite and >= 0");
+      v.push_back(x);
+      if (comma == std::string_view::npos) break;
+      rest = rest.substr(comma + 1);
+    }
+    if (v.size() != 1 && v.size() != 3)
+      throw std::invalid_argument("environment '" + std::string(spec) +
+                                  "': expected constant:V or constant:R,G,B");
+    return v.size() == 1 ? constant({v[0], v[0], v[0]}, options)
+                         : constant({v[0], v[1], v[2]}, options);
+  }
+  return load(std::filesystem::path(std::string(spec)), options);
+}
+
+EnvMap EnvMap::load(const std::filesystem::path& path, EnvOptions options) {
+  const std::string file = path.string();
+  const std::vector<unsigned char> bytes = read_bytes(path);
+  if (bytes.empty()) throw FormatError(file, "file", "empty file, not an HDR image");
+  Loaded img;
+  if (is_exr(bytes)) {
+    img = load_openexr(file);
+  } else if (is_radiance(bytes)) {
+    img = load_radiance(file, bytes);
+  } else {
+    throw FormatError(file, "content",
+                      "not an HDR image: expected a Radiance .hdr ('#?RADIANCE' header) or an "
+                      "OpenEXR file");
+  }
+  if (img.width <= 0 || img.height <= 0)
+    throw FormatError(file, "size", "zero-size image: an environment map needs pixels");
+  if (std::abs(img.width - 2 * img.height) > 1)
+    throw FormatError(file, "size",
+                      std::to_string(img.width) + " x " + std::to_string(img.height) +
+                          " is not a latitude-longitude map (width must be twice the height)");
+  if (const std::string bad = check_pixels(img.width, img.rgb); !bad.empty())
+    throw FormatError(file, "pixels", bad);
+  return EnvMap(img.width, img.height, std::move(img.rgb), file, options);
+}
+
+// --------------------------------------------------------------------------------------------
+
+Vec3<double> EnvMap::map_direction(double u, double v) {
+  const double theta = kPi * v, phi = 2 * kPi * u - kPi;
+  const double st = std::sin(theta);
+  return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
+}
+
+void EnvMap::map_coordinates(const Vec3<double>& d, double& u, double& v) {
+  const double theta = std::atan2(std::sqrt(d.x * d.x + d.z * d.z), d.y);
+  const double phi = std::atan2(d.x, -d.z);  // (−π, π]
+  u = (phi + kPi) / (2 * kPi);
+  if (!(u < 1)) u = 0;  // φ = π is the left edge again
+  v = theta / kPi;
+}
+
+// The map is turned by +rotation about +y, so a world direction is looked up turned by −rotation.
+Vec3<double> EnvMap::to_map(const Vec3<double>& w) const {
+  return {cos_rot_ * w.x - sin_rot_ * w.z, w.y, sin_rot_ * w.x + cos_rot_ * w.z};
+}
+Vec3<double> EnvMap::to_world(const Vec3<double>& m) const {
+  return {cos_rot_ * m.x + sin_rot_ * m.z, m.y, -sin_rot_ * m.x + cos_rot_ * m.z};
+}
+
+std::size_t EnvMap::pixel_of(const Vec3<double>& map_dir, std::size_t& row,
+                             std::size_t& col) const {
+  double u, v;
+  map_coordinates(map_dir, u, v);
+  col = std::min(std::size_t(u * width_), std::size_t(width_ - 1));
+  row = std::min(std::size_t(v * height_), std::size_t(height_ - 1));
+  return row * std::size_t(width_) + col;
+}
+
+Rgb EnvMap::eval(const Vec3<double>& dir) const {
+  std::size_t row, col;
+  const std::size_t i = pixel_of(to_map(dir), row, col);
+  const float* p = &rgb_[3 * i];
+  return {p[0] * scale_, p[1] * scale_, p[2] * scale_};
+}
+
+EnvMap::Sample EnvMap::sample(double u1, double u2) const {
+  Sample s;
+  const auto cell = distribution_.sample(u1, u2);
+  if (cell.probability <= 0) return s;
+  const double c0 = std::cos(kPi * double(cell.row) / height_);
+  const double c1 = std::cos(kPi * double(cell.row + 1) / height_);
+  const double cos_theta = std::clamp(c0 + (c1 - c0) * cell.remapped_row, -1.0, 1.0);
+  const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
+  const double phi = 2 * kPi * (double(cell.col) + cell.remapped_col) / width_ - kPi;
+  const Vec3<double> m{sin_theta * std::sin(phi), cos_theta, -sin_theta * std::cos(phi)};
+  s.dir = to_world(m);
+  const float* p = &rgb_[3 * (cell.row * std::size_t(width_) + cell.col)];
+  s.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
+  s.pdf = cell.probability / row_solid_angle_[cell.row];
+  return s;
+}
+
+double EnvMap::pdf(const Vec3<double>& dir) const {
+  std::size_t row, col;
+  pixel_of(to_map(dir), row, col);
+  return distribution_.probability(row, col) / row_solid_angle_[row];
+}
+
+// --------------------------------------------------------------------------------------------
+// The built-in environment.
+
+EnvMap EnvMap::default_sky(EnvOptions options) {
+  constexpr int W = 1024, H = 512;
+  const double sun_elev = 40 * kPi / 180, sun_azim = 35 * kPi / 180;  // from +z towards −x
+  const Vec3<double> sun{-std::cos(sun_elev) * std::sin(sun_azim), std::sin(sun_elev),
+                         std::cos(sun_elev) * std::cos(sun_azim)};
+  const double sun_radius = 1.5 * kPi / 180, cos_sun = std::cos(sun_radius);
+  const Rgb sun_radiance{1000, 940, 840};
+  auto background = [&](const Vec3<double>& d) -> Rgb {
+    if (d.y >= 0) {
+      // Sky: a saturated blue at the zenith fading to a pale horizon, brighter towards the sun.
+      const double t = std::pow(1 - d.y, 4);
+      const double glow = std::pow(std::max(0.0, d.x * sun.x + d.y * sun.y + d.z * sun.z), 8);
+      return {0.09 + 0.31 * t + 0.25 * glow, 0.16 + 0.29 * t + 0.22 * glow,
+              0.38 + 0.17 * t + 0.17 * glow};
+    }
+    // Ground: warm grey, darker towards the nadir.
+    const double t = 0.55 + 0.45 * std::pow(1 + d.y, 2);
+    return {0.13 * t, 0.115 * t, 0.095 * t};
+  };
+  std::vector<float> rgb(std::size_t(W) * H * 3);
+  for (int r = 0; r < H; ++r)
+    for (int c = 0; c < W; ++c) {
+      const Vec3<double> d = map_direction((c + 0.5) / W, (r + 0.5) / H);
+      Rgb v = background(d);
+      // The sun disk, supersampled near its edge.
+      const double cs = d.x * sun.x + d.y * sun.y + d.z * sun.z;
+      if (cs > std::cos(sun_radius + 2 * kPi / H)) {
+        constexpr int n = 8;
+        int inside = 0;
+        for (int i = 0; i < n; ++i)
+          for (int j = 0; j < n; ++j) {
+            const Vec3<double> e = map_direction((c + (i + 0.5) / n) / W, (r + (j + 0.5) / n) / H);
+            inside += (e.x * sun.x + e.y * sun.y + e.z * sun.z) >= cos_sun;
+          }
+        const double f = double(inside) / (n * n);
+        v = {v.r + f * sun_radiance.r, v.g + f * sun_radiance.g, v.b + f * sun_radiance.b};
+      }
+      float* p = &rgb[3 * (std::size_t(r) * W + std::size_t(c))];
+      p[0] = float(v.r);
+      p[1] = float(v.g);
+      p[2] = float(v.b);
+    }
+  return EnvMap(W, H, std::move(rgb), "default", options);
+}
+
+}  // namespace halfback::render

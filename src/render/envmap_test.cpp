@@ -1,0 +1,272 @@
+// Environment maps: the lat-long convention, lookups, rotation and exposure, importance sampling
+// (pdf integrates to 1, sample/pdf/eval agree, χ²), the real maps of shared/, and bad input.
+#include "halfback/render/envmap.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <string>
+
+#include "halfback/io/format_error.hpp"
+#include "halfback/render/distribution.hpp"
+#include "halfback/render/image.hpp"
+#include "render/test_stats.hpp"
+
+namespace halfback::render {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+std::filesystem::path shared_envmaps() {
+  const char* dir = std::getenv("HALFBACK_SHARED_DIR");
+  return dir ? std::filesystem::path(dir) / "data" / "envmaps" : std::filesystem::path();
+}
+
+#define REQUIRE_SHARED(path)                                             \
+  if (!std::filesystem::exists(path)) {                                  \
+    const char* ci = std::getenv("CI");                                  \
+    if (ci && std::string(ci) == "true") FAIL() << "missing " << (path); \
+    GTEST_SKIP() << "shared data not found: " << (path)                  \
+                 << " (set HALFBACK_SHARED_DIR to the shared/ folder)";  \
+  }
+
+std::filesystem::path temp_file(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / "halfback_envmap_test";
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+void write_text(const std::filesystem::path& p, const std::string& s) {
+  std::ofstream(p, std::ios::binary) << s;
+}
+
+// A small map with random non-negative values and a few bright pixels.
+EnvMap random_map(int w, int h, EnvOptions o = {}, std::uint64_t seed = 1) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<float> rgb(std::size_t(w * h * 3));
+  for (float& v : rgb) v = u(rng) < 0.1f ? 20 * u(rng) : u(rng);
+  rgb[0] = rgb[1] = rgb[2] = 0;  // a black pixel is never sampled
+  return EnvMap(w, h, std::move(rgb), "random", o);
+}
+
+Vec3<double> unit(double x, double y, double z) {
+  const double l = std::sqrt(x * x + y * y + z * z);
+  return {x / l, y / l, z / l};
+}
+
+TEST(Distribution, SamplesFollowTheWeights) {
+  const std::vector<double> w{1, 0, 3, 0, 4};
+  const Distribution1D d(w);
+  EXPECT_DOUBLE_EQ(d.probability(2), 3.0 / 8);
+  std::vector<int> count(5, 0);
+  constexpr int n = 80000;
+  for (int i = 0; i < n; ++i) {
+    const auto s = d.sample((i + 0.5) / n);
+    ++count[s.index];
+    EXPECT_GE(s.remapped, 0);
+    EXPECT_LT(s.remapped, 1);
+  }
+  EXPECT_EQ(count[1], 0);
+  EXPECT_EQ(count[3], 0);
+  EXPECT_NEAR(count[2], n * 3 / 8, 2);
+  EXPECT_NEAR(count[4], n / 2, 2);
+  EXPECT_THROW(Distribution1D(std::vector<double>{1, -1}), std::invalid_argument);
+  EXPECT_THROW(Distribution1D(std::vector<double>{}), std::invalid_argument);
+  EXPECT_EQ(Distribution1D(std::vector<double>{0, 0}).sample(0.5).probability, 0);
+}
+
+TEST(EnvMap, LatLongConvention) {
+  auto near = [](const Vec3<double>& a, const Vec3<double>& b) {
+    return std::abs(a.x - b.x) < 1e-12 && std::abs(a.y - b.y) < 1e-12 &&
+           std::abs(a.z - b.z) < 1e-12;
+  };
+  EXPECT_TRUE(near(EnvMap::map_direction(0.5, 0.5), {0, 0, -1}));  // centre: where the camera looks
+  EXPECT_TRUE(near(EnvMap::map_direction(0.75, 0.5), {1, 0, 0}));  // right half: +x
+  EXPECT_TRUE(near(EnvMap::map_direction(0.25, 0.5), {-1, 0, 0}));
+  EXPECT_TRUE(near(EnvMap::map_direction(0.0, 0.5), {0, 0, 1}));  // edges: behind the camera
+  EXPECT_NEAR(EnvMap::map_direction(0.3, 0).y, 1, 1e-12);         // top row: zenith, +y
+  double u, v;
+  EnvMap::map_coordinates(unit(0.3, -0.4, 0.5), u, v);
+  const auto d = EnvMap::map_direction(u, v);
+  EXPECT_TRUE(near(d, unit(0.3, -0.4, 0.5)));
+
+  // A 4 × 2 map with one distinct pixel per quadrant of directions.
+  std::vector<float> rgb(24, 0);
+  for (int i = 0; i < 8; ++i) rgb[std::size_t(3 * i)] = float(i + 1);
+  const EnvMap m(4, 2, rgb, "quadrants");
+  EXPECT_EQ(m.eval({0, 0.5, -0.8}).r, 2 + 1);  // upper row, column 2 (φ in [0, π/2))
+  EXPECT_EQ(m.eval(unit(0.1, -0.5, -0.8)).r, 6 + 1);
+  EXPECT_EQ(m.eval(unit(-0.1, 0.5, -0.8)).r, 1 + 1);
+  EXPECT_EQ(m.eval(unit(0.1, 0.5, 0.8)).r, 3 + 1);
+}
+
+TEST(EnvMap, RotationAndExposure) {
+  const EnvMap a = random_map(64, 32);
+  const EnvMap b = random_map(64, 32, {90, 2});
+  // Turning by +90° about +y moves what was at −z to −x (counter-clockwise seen from above).
+  const Vec3<double> d = unit(0.2, 0.3, -0.9);
+  const Vec3<double> turned{d.z, d.y, -d.x};  // R_y(+90°) d
+  const Rgb x = a.eval(d), y = b.eval(turned);
+  EXPECT_NEAR(y.r, 4 * x.r, 1e-5);
+  EXPECT_NEAR(y.g, 4 * x.g, 1e-5);
+  EXPECT_NEAR(b.pdf(turned), a.pdf(d), 1e-9 * a.pdf(d));
+}
+
+TEST(EnvMap, ConstantIsUniform) {
+  const EnvMap c = EnvMap::from_spec("constant:0.5,1,2");
+  EXPECT_EQ(c.eval(unit(1, 2, 3)).g, 1);
+  EXPECT_EQ(c.eval(unit(1, 2, 3)).b, 2);
+  for (const auto& d : {unit(0, 1, 0), unit(1, 0, 0), unit(0.2, -0.9, 0.1)})
+    EXPECT_NEAR(c.pdf(d), 1 / (4 * kPi), 1e-12);
+  const auto s = c.sample(0.3, 0.8);
+  EXPECT_NEAR(s.pdf, 1 / (4 * kPi), 1e-12);
+  EXPECT_EQ(EnvMap::from_spec("constant:3").eval({0, 0, 1}).r, 3);
+  const EnvMap black = EnvMap::from_spec("constant:0");
+  EXPECT_EQ(black.sample(0.5, 0.5).pdf, 0);
+  EXPECT_EQ(black.pdf({0, 0, 1}), 0);
+}
+
+TEST(EnvMap, SampleAgreesWithPdfAndEval) {
+  for (const EnvMap& m : {random_map(64, 32, {37, 0}), EnvMap::default_sky({-20, 1})}) {
+    std::mt19937_64 rng(2);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int i = 0; i < 5000; ++i) {
+      const auto s = m.sample(u(rng), u(rng));
+      ASSERT_GT(s.pdf, 0);
+      EXPECT_NEAR(std::hypot(s.dir.x, s.dir.y, s.dir.z), 1, 1e-12);
+      // Away from pixel borders the direction maps back to its own pixel.
+      const double p = m.pdf(s.dir);
+      if (std::abs(p - s.pdf) > 1e-9 * s.pdf) {
+        double uu, vv;
+        EnvMap::map_coordinates(s.dir, uu, vv);
+        const double fu = uu * m.width() - std::floor(uu * m.width());
+        const double fv = vv * m.height() - std::floor(vv * m.height());
+        EXPECT_TRUE(std::min(fu, 1 - fu) < 1e-6 || std::min(fv, 1 - fv) < 1e-6) << i;
+      } else {
+        const Rgb e = m.eval(s.dir);
+        EXPECT_EQ(e.r, s.radiance.r);
+        EXPECT_EQ(e.b, s.radiance.b);
+      }
+    }
+  }
+}
+
+TEST(EnvMap, PdfIntegratesToOneAndChiSquare) {
+  // The sphere's (cos, φ) cells do not line up with the map's pixels (the map is rotated).
+  const EnvMap m = random_map(32, 16, {23, 0}, 5);
+  // Directions in the test's frame: z is the map's up axis (+y).
+  auto to_world = [](const Vec3<double>& d) { return Vec3<double>{d.x, d.z, -d.y}; };
+  auto from_world = [](const Vec3<double>& d) { return Vec3<double>{d.x, -d.z, d.y}; };
+  const auto r = testing::chi2_test(
+      [&](double u1, double u2) {
+        const auto s = m.sample(u1, u2);
+        return testing::DirSample{from_world(s.dir), s.pdf};
+      },
+      [&](const Vec3<double>& d) { return m.pdf(to_world(d)); }, 300000, true, 48, 96, 16);
+  EXPECT_NEAR(r.integral, 1, 2e-3);
+  EXPECT_EQ(r.valid_fraction, 1);
+  EXPECT_LT(r.z, 4.5) << "chi2 " << r.chi2 << " dof " << r.dof;
+}
+
+TEST(EnvMap, DefaultSkyHasASun) {
+  const EnvMap d = EnvMap::from_spec("default");
+  EXPECT_EQ(d.width(), 1024);
+  EXPECT_EQ(d.height(), 512);
+  // The sun: 40° up, 35° from +z towards −x.
+  const double e = 40 * kPi / 180, a = 35 * kPi / 180;
+  const Vec3<double> sun{-std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)};
+  EXPECT_GT(d.eval(sun).r, 500);
+  EXPECT_LT(d.eval({0, 1, 0}).r, 1);
+  EXPECT_LT(d.eval({0, -1, 0}).r, d.eval({0, 1, 0}).b);  // ground darker than the sky
+  EXPECT_GT(d.pdf(sun), 100 * d.pdf({0, 1, 0}));
+}
+
+TEST(EnvMap, RealMaps) {
+  const auto dir = shared_envmaps();
+  REQUIRE_SHARED(dir / "uffizi.hdr");
+  for (const char* name : {"uffizi", "grace", "pisa", "ennis", "wells", "venice_sunset_1k"}) {
+    const EnvMap m = EnvMap::load(dir / (std::string(name) + ".hdr"));
+    EXPECT_EQ(m.width(), 2 * m.height()) << name;
+    EXPECT_GT(m.pdf(m.sample(0.5, 0.5).dir), 0) << name;
+  }
+  const EnvMap u = EnvMap::load(dir / "uffizi.hdr");
+  EXPECT_EQ(u.width(), 256);
+  // The uffizi probe has its bright sky at the top: the zenith outshines the floor.
+  EXPECT_GT(u.eval({0, 1, 0}).r, 4 * u.eval({0, -1, 0}).r);
+}
+
+TEST(EnvMap, OpenExrRoundTrip) {
+  Image img{8, 4, {}};
+  for (int i = 0; i < 32 * 3; ++i) img.rgb.push_back(float(i) * 0.25f);
+  const auto p = temp_file("ok.exr");
+  write_exr(p, img);
+  const EnvMap m = EnvMap::load(p);
+  EXPECT_EQ(m.width(), 8);
+  EXPECT_EQ(m.pixels()[5], img.rgb[5]);
+  EXPECT_EQ(EnvMap::from_spec(p.string()).pixels()[95], img.rgb[95]);
+}
+
+// Every bad input gets a FormatError naming the file and the problem.
+void expect_error(const std::filesystem::path& p, const std::string& words) {
+  try {
+    EnvMap::load(p);
+    ADD_FAILURE() << "no error for " << p;
+  } catch (const FormatError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(p.string()), std::string::npos) << what;
+    EXPECT_NE(what.find(words), std::string::npos) << what;
+  }
+}
+
+TEST(EnvMap, BadInput) {
+  expect_error(temp_file("does_not_exist.hdr"), "cannot open");
+  expect_error(std::filesystem::temp_directory_path(), "directory");
+  const auto empty = temp_file("empty.hdr");
+  write_text(empty, "");
+  expect_error(empty, "empty file");
+  const auto png = temp_file("ldr.hdr");
+  write_text(png, std::string("\x89PNG\r\n\x1a\n", 8) + "not really");
+  expect_error(png, "not an HDR image");
+  const auto zero = temp_file("zero.hdr");
+  write_text(zero, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n");
+  expect_error(zero, "zero-size");
+  const auto truncated = temp_file("truncated.hdr");
+  write_text(truncated, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n\x01\x02");
+  expect_error(truncated, "truncated");
+  const auto noheader = temp_file("noheader.hdr");
+  write_text(noheader, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n");
+  expect_error(noheader, "header");
+
+  auto exr_with = [](const std::string& name, float bad, int w = 8, int h = 4) {
+    Image img{w, h, std::vector<float>(std::size_t(w * h * 3), 0.5f)};
+    img.rgb[std::size_t(3 * (w + 2) + 1)] = bad;  // pixel (2, 1), channel G
+    const auto p = temp_file(name);
+    write_exr(p, img);
+    return p;
+  };
+  expect_error(exr_with("nan.exr", std::nanf("")), "NaN");
+  expect_error(exr_with("nan.exr", std::nanf("")), "pixel (x=2, y=1) channel G");
+  expect_error(exr_with("inf.exr", INFINITY), "Inf");
+  expect_error(exr_with("neg.exr", -1.0f), "-1");
+  expect_error(exr_with("square.exr", 1.0f, 4, 4), "not a latitude-longitude map");
+  const auto bad_exr = temp_file("bad.exr");
+  write_text(bad_exr, std::string("\x76\x2f\x31\x01", 4) + "garbage");
+  expect_error(bad_exr, "OpenEXR");
+
+  // Built-ins and in-memory maps.
+  EXPECT_THROW(EnvMap::from_spec("constant:abc"), std::invalid_argument);
+  EXPECT_THROW(EnvMap::from_spec("constant:1,2"), std::invalid_argument);
+  EXPECT_THROW(EnvMap::from_spec("constant:-1"), std::invalid_argument);
+  EXPECT_THROW(EnvMap::from_spec("constant:nan"), std::invalid_argument);
+  EXPECT_THROW(EnvMap(0, 0, {}, "empty"), std::invalid_argument);
+  EXPECT_THROW(EnvMap(2, 1, {1, 1, 1, 1, 1, NAN}, "nan"), std::invalid_argument);
+  EXPECT_THROW(EnvMap(2, 1, {1, 1, 1}, "short"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace halfback::render

@@ -1,0 +1,365 @@
+#include "halfback/render/renderer.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <mutex>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "sequence.hpp"
+
+namespace halfback::render {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kOrthoHalfHeight = 1.25;
+constexpr double kCameraDistance = 4.5, kPerspectiveFov = 30;
+constexpr int kTile = 16;
+
+using V3 = Vec3<double>;
+using Clock = std::chrono::steady_clock;
+
+V3 normalize(const V3& v) {
+  const double l = std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  return {v.x / l, v.y / l, v.z / l};
+}
+double dot(const V3& a, const V3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+V3 cross(const V3& a, const V3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+double luminance(const Rgb& c) {
+  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+}
+
+struct Frame {
+  V3 t, b, n;
+  V3 to_local(const V3& w) const { return {dot(w, t), dot(w, b), dot(w, n)}; }
+  V3 to_world(const V3& w) const {
+    return {w.x * t.x + w.y * b.x + w.z * n.x, w.x * t.y + w.y * b.y + w.z * n.y,
+            w.x * t.z + w.y * b.z + w.z * n.z};
+  }
+};
+
+// t along the parallels (+y × n), b = n × t; at the poles, where +y × n vanishes, t = +x.
+Frame shading_frame(const V3& n) {
+  V3 t{n.z, 0, -n.x};
+  const double l = std::sqrt(t.x * t.x + t.z * t.z);
+  t = l > 1e-12 ? V3{t.x / l, 0, t.z / l} : V3{1, 0, 0};
+  return {t, cross(n, t), n};
+}
+
+double weight(Heuristic h, double a, double b) {
+  if (!(b > 0)) return 1;
+  const double r = b / a;
+  return h == Heuristic::balance ? 1 / (1 + r) : 1 / (1 + r * r);
+}
+
+struct Accum {
+  std::vector<double> rgb, y, y2;
+  void reset(std::size_t n, bool variance) {
+    rgb.assign(3 * n, 0.0);
+    y.assign(variance ? n : 0, 0.0);
+    y2.assign(variance ? n : 0, 0.0);
+  }
+};
+
+class Progress {
+ public:
+  Progress(bool enabled, std::uint64_t total)
+      : enabled_(enabled && isatty(fileno(stderr))), total_(total), start_(Clock::now()) {}
+  ~Progress() {
+    if (enabled_ && drawn_) std::fputc('\n', stderr);
+  }
+  void add(std::uint64_t n) {
+    const std::uint64_t done = done_.fetch_add(n) + n;
+    if (!enabled_) return;
+    std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock) return;
+    const auto now = Clock::now();
+    if (drawn_ && done < total_ && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    drawn_ = true;
+    const double f = total_ ? std::min(1.0, double(done) / double(total_)) : 1.0;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    constexpr int width = 40;
+    const int filled = int(f * width);
+    char bar[width + 1];
+    for (int i = 0; i < width; ++i) bar[i] = i < filled ? '#' : '-';
+    bar[width] = 0;
+    const double eta = f > 0 ? elapsed * (1 - f) / f : 0;
+    std::fprintf(stderr, "\rrender [%s] %5.1f%%  %.1f s, %.1f s left ", bar, 100 * f, elapsed, eta);
+    std::fflush(stderr);
+  }
+
+ private:
+  bool enabled_;
+  std::uint64_t total_;
+  std::atomic<std::uint64_t> done_{0};
+  Clock::time_point start_, last_;
+  std::mutex mutex_;
+  bool drawn_ = false;
+};
+
+class Renderer {
+ public:
+  Renderer(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& env, const RenderSettings& s)
+      : brdf_(brdf),
+        sampler_(sampler),
+        env_(env),
+        s_(s),
+        kind_(s.sequence == Sequence::sobol ? detail::SequenceKind::sobol
+                                            : detail::SequenceKind::random),
+        aspect_(double(s.width) / s.height),
+        tan_bg_(std::tan(0.5 * s.background_fov_deg * kPi / 180)),
+        tan_persp_(std::tan(0.5 * kPerspectiveFov * kPi / 180)) {}
+
+  // The radiance of one pixel sample.
+  Rgb pixel_sample(int px, int py, std::uint64_t pixel, std::uint32_t index) const {
+    double jx, jy;
+    detail::sample_2d(kind_, s_.seed, pixel, index, 0, jx, jy);
+    const double ndc_x = (2 * (px + jx) / s_.width - 1) * aspect_;
+    const double ndc_y = 1 - 2 * (py + jy) / s_.height;
+    V3 n, wo;
+    if (s_.projection == Projection::orthographic) {
+      const double x = ndc_x * kOrthoHalfHeight, y = ndc_y * kOrthoHalfHeight;
+      const double r2 = x * x + y * y;
+      if (r2 >= 1) return env_.eval(normalize({ndc_x * tan_bg_, ndc_y * tan_bg_, -1}));
+      n = {x, y, std::sqrt(1 - r2)};
+      wo = {0, 0, 1};
+    } else {
+      const V3 d = normalize({ndc_x * tan_persp_, ndc_y * tan_persp_, -1});
+      const V3 o{0, 0, kCameraDistance};
+      const double b = dot(o, d), c = dot(o, o) - 1, disc = b * b - c;
+      if (disc <= 0) return env_.eval(d);
+      const double t = -b - std::sqrt(disc);
+      n = normalize({o.x + t * d.x, o.y + t * d.y, o.z + t * d.z});
+      wo = {-d.x, -d.y, -d.z};
+    }
+    return shade(n, wo, pixel, index);
+  }
+
+  Rgb shade(const V3& n, const V3& wo_world, std::uint64_t pixel, std::uint32_t index) const {
+    const Frame f = shading_frame(n);
+    const V3 wo = f.to_local(wo_world);
+    Rgb sum;
+    if (!(wo.z > 0)) return sum;
+    auto add = [&](const Rgb& fr, const Rgb& li, double factor) {
+      sum.r += fr.r * li.r * factor;
+      sum.g += fr.g * li.g * factor;
+      sum.b += fr.b * li.b * factor;
+    };
+    auto env_sample = [&](std::uint32_t dim, double share) {
+      double u1, u2;
+      detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
+      const EnvMap::Sample es = env_.sample(u1, u2);
+      if (!(es.pdf > 0)) return;
+      const V3 wi = f.to_local(es.dir);
+      if (!(wi.z > 0)) return;
+      const Rgb fr = brdf_.eval({wi, wo});
+      const double w =
+          s_.strategy == Strategy::mis ? weight(s_.heuristic, es.pdf, sampler_.pdf(wo, wi)) : 1;
+      add(fr, es.radiance, share * w * wi.z / es.pdf);
+    };
+    auto brdf_sample = [&](std::uint32_t dim, double share) {
+      double u1, u2;
+      detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
+      const BrdfSample bs = sampler_.sample(wo, u1, u2);
+      if (!(bs.pdf > 0 && bs.wi.z > 0)) return;
+      const V3 dir = f.to_world(bs.wi);
+      const Rgb li = env_.eval(dir);
+      if (li.r == 0 && li.g == 0 && li.b == 0) return;
+      const Rgb fr = brdf_.eval({bs.wi, wo});
+      const double w =
+          s_.strategy == Strategy::mis ? weight(s_.heuristic, bs.pdf, env_.pdf(dir)) : 1;
+      add(fr, li, share * w * bs.wi.z / bs.pdf);
+    };
+    switch (s_.strategy) {
+      case Strategy::mis:
+        env_sample(1, 1);
+        brdf_sample(2, 1);
+        break;
+      case Strategy::env:
+        env_sample(1, 0.5);
+        env_sample(2, 0.5);
+        break;
+      case Strategy::brdf:
+        brdf_sample(1, 0.5);
+        brdf_sample(2, 0.5);
+        break;
+    }
+    return sum;
+  }
+
+  // Adds samples [first, first + count) of the pixels of one tile to `acc`.
+  void tile(int tx, int ty, std::uint32_t first, std::uint32_t count, Accum& acc,
+            std::atomic<std::uint64_t>& nonfinite) const {
+    const int x1 = std::min(tx + kTile, s_.width), y1 = std::min(ty + kTile, s_.height);
+    for (int py = ty; py < y1; ++py)
+      for (int px = tx; px < x1; ++px) {
+        const std::size_t p = std::size_t(py) * std::size_t(s_.width) + std::size_t(px);
+        double r = 0, g = 0, b = 0, y = 0, y2 = 0;
+        std::uint64_t bad = 0;
+        for (std::uint32_t i = first; i < first + count; ++i) {
+          const Rgb v = pixel_sample(px, py, p, i);
+          if (!(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b))) {
+            ++bad;
+            continue;
+          }
+          r += v.r;
+          g += v.g;
+          b += v.b;
+          const double l = luminance(v);
+          y += l;
+          y2 += l * l;
+        }
+        acc.rgb[3 * p] += r;
+        acc.rgb[3 * p + 1] += g;
+        acc.rgb[3 * p + 2] += b;
+        if (!acc.y.empty()) {
+          acc.y[p] += y;
+          acc.y2[p] += y2;
+        }
+        if (bad) nonfinite += bad;
+      }
+  }
+
+ private:
+  const Brdf& brdf_;
+  const BrdfSampler& sampler_;
+  const EnvMap& env_;
+  const RenderSettings& s_;
+  detail::SequenceKind kind_;
+  double aspect_, tan_bg_, tan_persp_;
+};
+
+void validate(const RenderSettings& s) {
+  if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
+    throw std::invalid_argument("render: width and height must be in [1, 16384]");
+  if (s.spp < 1 || s.spp > (1 << 24))
+    throw std::invalid_argument("render: samples per pixel must be in [1, 16777216]");
+  if (!(s.time_budget >= 0) || !std::isfinite(s.time_budget))
+    throw std::invalid_argument("render: the time budget must be >= 0 seconds");
+  if (!(s.background_fov_deg > 0 && s.background_fov_deg < 179))
+    throw std::invalid_argument("render: the background field of view must be in (0, 179) degrees");
+  if (s.threads < 0) throw std::invalid_argument("render: threads must be >= 0");
+}
+
+}  // namespace
+
+RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings) {
+  validate(settings);
+  const auto start = Clock::now();
+  TabulationOptions tab = settings.tabulation;
+  if (tab.threads == 0) tab.threads = settings.threads;
+  const auto sampler = make_brdf_sampler(brdf, tab);
+  const double build = std::chrono::duration<double>(Clock::now() - start).count();
+  RenderResult r = render(brdf, *sampler, env, settings);
+  r.sampler_seconds = build;
+  return r;
+}
+
+RenderResult render(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& env,
+                    const RenderSettings& s) {
+  validate(s);
+  const auto start = Clock::now();
+  const Renderer renderer(brdf, sampler, env, s);
+  const std::size_t pixels = std::size_t(s.width) * std::size_t(s.height);
+  const int tiles_x = (s.width + kTile - 1) / kTile, tiles_y = (s.height + kTile - 1) / kTile;
+  const int tiles = tiles_x * tiles_y;
+  const int threads = std::max(
+      1, std::min(tiles, s.threads > 0 ? s.threads
+                                       : int(std::max(1u, std::thread::hardware_concurrency()))));
+
+  Accum total, pass;
+  total.reset(pixels, s.variance);
+  std::atomic<std::uint64_t> nonfinite{0};
+  Progress progress(s.progress, std::uint64_t(pixels) * std::uint64_t(s.spp));
+  bool exhausted = false;
+  int done = 0;
+  // Passes: the whole count at once without a budget; with one, 1, 1, 2, 4, ... pixel samples,
+  // and a pass that the budget interrupts is dropped (every pixel keeps the same sample count).
+  int pass_size = s.time_budget > 0 ? 1 : s.spp;
+  while (done < s.spp) {
+    const int count = std::min(pass_size, s.spp - done);
+    pass.reset(pixels, s.variance);
+    std::atomic<int> next{0};
+    std::atomic<bool> abort{false};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    auto worker = [&] {
+      for (int t; !abort && (t = next.fetch_add(1)) < tiles;) {
+        if (s.time_budget > 0 && done > 0 &&
+            std::chrono::duration<double>(Clock::now() - start).count() > s.time_budget) {
+          abort = true;
+          break;
+        }
+        try {
+          renderer.tile((t % tiles_x) * kTile, (t / tiles_x) * kTile, std::uint32_t(done),
+                        std::uint32_t(count), pass, nonfinite);
+        } catch (...) {
+          std::lock_guard lock(error_mutex);
+          if (!error) error = std::current_exception();
+          abort = true;
+        }
+        const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
+        progress.add(std::uint64_t(std::min(kTile, s.width - x0)) *
+                     std::uint64_t(std::min(kTile, s.height - y0)) * std::uint64_t(count));
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+    if (abort) {
+      exhausted = true;
+      break;
+    }
+    for (std::size_t i = 0; i < total.rgb.size(); ++i) total.rgb[i] += pass.rgb[i];
+    for (std::size_t i = 0; i < total.y.size(); ++i) {
+      total.y[i] += pass.y[i];
+      total.y2[i] += pass.y2[i];
+    }
+    done += count;
+    pass_size = std::min(2 * pass_size, 1 << 20);
+    if (s.time_budget > 0 && done < s.spp &&
+        std::chrono::duration<double>(Clock::now() - start).count() > s.time_budget) {
+      exhausted = true;
+      break;
+    }
+  }
+
+  RenderResult r;
+  r.spp = done;
+  r.budget_exhausted = exhausted;
+  r.nonfinite = nonfinite;
+  r.sampler = sampler.describe();
+  r.image.width = s.width;
+  r.image.height = s.height;
+  r.image.rgb.resize(3 * pixels);
+  for (std::size_t i = 0; i < 3 * pixels; ++i) r.image.rgb[i] = float(total.rgb[i] / done);
+  if (s.variance) {
+    r.variance.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) {
+      const double m = total.y[i] / done;
+      const double var =
+          done > 1 ? std::max(0.0, total.y2[i] / done - m * m) * done / (done - 1) : 0.0;
+      r.variance[i] = float(var / done);
+    }
+  }
+  r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return r;
+}
+
+}  // namespace halfback::render

@@ -1,0 +1,78 @@
+// Per-pixel sample sequences for the renderer: 2D points from a scrambled, shuffled Sobol (0,2)
+// sequence, one independent scramble per pixel and per pair of dimensions ("padding"), after
+// Burley 2020, "Practical Hash-based Owen Scrambling"; or independent uniform numbers. Both are
+// pure functions of (seed, pixel, sample index, dimension pair), so an image does not depend on
+// the number of threads or on how the work was split.
+#pragma once
+
+#include <cstdint>
+
+namespace halfback::render::detail {
+
+inline std::uint64_t mix64(std::uint64_t x) {  // splitmix64's finalizer
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  x ^= x >> 31;
+  return x;
+}
+
+inline std::uint32_t hash32(std::uint64_t a, std::uint64_t b, std::uint64_t c) {
+  return std::uint32_t(mix64(mix64(mix64(a) ^ b) ^ c) >> 32);
+}
+
+inline std::uint32_t reverse_bits(std::uint32_t x) {
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+  return (x >> 16) | (x << 16);
+}
+
+// A hash that only lets a bit depend on the bits below it (Laine and Karras 2011), applied to the
+// reversed bits: a nested uniform (Owen) scramble of a 32-bit fraction.
+inline std::uint32_t owen_scramble(std::uint32_t x, std::uint32_t seed) {
+  x = reverse_bits(x);
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return reverse_bits(x);
+}
+
+// The first two dimensions of Sobol's sequence: van der Corput, and the dimension with the
+// primitive polynomial x + 1 (direction numbers v_k = v_{k-1} ^ (v_{k-1} >> 1)).
+inline std::uint32_t sobol_dim0(std::uint32_t i) {
+  return reverse_bits(i);
+}
+inline std::uint32_t sobol_dim1(std::uint32_t i) {
+  std::uint32_t v = 1u << 31, r = 0;
+  for (; i; i >>= 1, v ^= v >> 1)
+    if (i & 1) r ^= v;
+  return r;
+}
+
+inline double to_unit(std::uint32_t x) {
+  return double(x) * 0x1p-32;  // in [0, 1)
+}
+
+enum class SequenceKind { sobol, random };
+
+// Point `index` of the 2D sequence `dim` (a dimension pair) of one pixel.
+inline void sample_2d(SequenceKind kind, std::uint64_t seed, std::uint64_t pixel,
+                      std::uint32_t index, std::uint32_t dim, double& u1, double& u2) {
+  const std::uint64_t key = (seed << 8) ^ dim;
+  if (kind == SequenceKind::random) {
+    const std::uint64_t h = mix64(mix64(mix64(key) ^ pixel) ^ index);
+    u1 = double(h >> 11) * 0x1p-53;
+    u2 = double(mix64(h) >> 11) * 0x1p-53;
+    return;
+  }
+  const std::uint32_t shuffled = owen_scramble(index, hash32(key, pixel, 0x5bd1e995));
+  u1 = to_unit(owen_scramble(sobol_dim0(shuffled), hash32(key, pixel, 0x68e31da4)));
+  u2 = to_unit(owen_scramble(sobol_dim1(shuffled), hash32(key, pixel, 0xb5297a4d)));
+}
+
+}  // namespace halfback::render::detail
