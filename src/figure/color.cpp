@@ -49,13 +49,13 @@ double luminance(const Rgb& c) {
   return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
 }
 
-Color tonemap(const Rgb& c, double exposure) {
-  const Rgb p{std::max(c.r, 0.0) * exposure, std::max(c.g, 0.0) * exposure,
-              std::max(c.b, 0.0) * exposure};
+Color tonemap_log(const Rgb& c, double log_lo, double log_hi) {
+  const Rgb p{std::max(c.r, 0.0), std::max(c.g, 0.0), std::max(c.b, 0.0)};
   const double l = luminance(p);
-  if (!(l > 0.0)) return {0, 0, 0, 1};
-  const double s = 1.0 / (1.0 + l);  // L/(1+L) applied to the channels in proportion
-  return {srgb_encode(p.r * s), srgb_encode(p.g * s), srgb_encode(p.b * s), 1};
+  if (!(l > 0.0) || !std::isfinite(l)) return {0, 0, 0, 1};
+  const double t = std::clamp((std::log10(l) - log_lo) / (log_hi - log_lo), 0.0, 1.0);
+  const double s = t / l;
+  return {std::min(p.r * s, 1.0), std::min(p.g * s, 1.0), std::min(p.b * s, 1.0), 1};
 }
 
 }  // namespace halfback::figure

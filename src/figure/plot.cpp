@@ -135,6 +135,27 @@ double approx_text_width(std::string_view markup, double fs) {
   return w;
 }
 
+std::vector<std::string> wrap_text(std::string_view text, double width, double fs) {
+  std::vector<std::string> lines;
+  std::string line;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const std::size_t space = text.find(' ', i);
+    const std::size_t end = space == std::string_view::npos ? text.size() : space;
+    const std::string_view word = text.substr(i, end - i);
+    const std::string candidate = line.empty() ? std::string(word) : line + " " + std::string(word);
+    if (!line.empty() && approx_text_width(candidate, fs) > width) {
+      lines.push_back(line);
+      line = std::string(word);
+    } else {
+      line = candidate;
+    }
+    i = end + 1;
+  }
+  if (!line.empty() || lines.empty()) lines.push_back(line);
+  return lines;
+}
+
 void draw_legend_line(Scene& scene, Point at, const Stroke& stroke, const std::string& label,
                       double fs, const Color& text_colour) {
   scene.line({at.x, at.y}, {at.x + 22, at.y}, stroke);

@@ -144,9 +144,36 @@ SliceFigure slice_figure(const SliceOptions& o) {
   Scene& sc = fig.scene;
   const bool generic = o.brdf != nullptr;
   const double P = snap(o.panel_size), gap = 26, vgap = 56;
-  const double left = 84, top = 70, right = generic ? 96 : 24, bottom = 64;
+  const double left = 84, right = generic ? 96 : 24, bottom = 64;
   const std::size_t rows = o.params.size(), cols = o.azimuths_deg.size();
   sc.width = snap(left + double(cols) * P + double(cols - 1) * gap + right);
+
+  std::string heading, sub;
+  if (generic) {
+    sc.title = fmt::format("Slices of the isotropic forms: {}", o.brdf->name());
+    heading =
+        fmt::format("Slices of the isotropic forms at fixed relative azimuth: {}", o.brdf->name());
+    sub = fmt::format(
+        "{}. Colour: {}; isolines of luminance at log-spaced levels; one scale "
+        "for all panels, clipped at the 0.5 % and 99.5 % percentiles; hatched: outside "
+        "the valid domain.",
+        o.brdf->description(),
+        o.colouring == SliceColouring::rgb ? "RGB tone-mapped on the log-luminance scale"
+                                           : "false colour (viridis) of log₁₀ luminance");
+  } else {
+    std::string names;
+    for (std::size_t k = 0; k < o.test_functions.size(); ++k)
+      names += (k ? ", " : "") + std::string(letter_of(o.test_functions[k]));
+    sc.title = fmt::format("Slices of the isotropic forms: test functions {}", names);
+    heading = fmt::format(
+        "Slices of the isotropic forms at fixed relative azimuth: test functions {}", names);
+    if (!o.levels.empty())
+      sub = fmt::format("Isolines at {:g} … {:g}", o.levels.front(), o.levels.back());
+    if (o.levels.size() == 9 && o.levels.front() == 0.1) sub += " (step 0.1; 0.5 thicker)";
+    sub += "; hatched: outside the valid domain.";
+  }
+  const std::vector<std::string> subtitle = wrap_text(sub, sc.width - left - 12, 9);
+  const double top = 58 + 12 * double(subtitle.size());
   sc.height = snap(top + double(rows) * P + double(rows - 1) * vgap + bottom);
 
   // Sample every panel first (the colour scale is shared).
@@ -174,7 +201,6 @@ SliceFigure slice_figure(const SliceOptions& o) {
   // Generic mode: evaluate the BRDF on every valid pair of every panel.
   std::vector<std::vector<Rgb>> rgb(fig.panels.size());
   std::vector<ScalarField> log_lum;
-  double exposure = 1;
   if (generic) {
     std::vector<double> all;
     for (std::size_t n = 0; n < fig.panels.size(); ++n) {
@@ -206,8 +232,10 @@ SliceFigure slice_figure(const SliceOptions& o) {
       fig.log_lo = -1;
       fig.log_hi = 0;
     } else {
-      fig.log_hi = *std::max_element(all.begin(), all.end());
-      fig.log_lo = std::max(percentile(all, 0.01), fig.log_hi - 6.0);
+      // Percentiles, not extremes: grazing spikes (1/cos θ factors) would otherwise take the
+      // whole scale. At most 7 decades.
+      fig.log_hi = percentile(all, 0.995);
+      fig.log_lo = std::max(percentile(all, 0.005), fig.log_hi - 7.0);
       if (!(fig.log_hi - fig.log_lo > 1e-6)) fig.log_lo = fig.log_hi - 1;
     }
     // Luminance 0 (or below the scale) sits at the bottom of the scale, and contours as such.
@@ -215,43 +243,12 @@ SliceFigure slice_figure(const SliceOptions& o) {
       for (std::size_t k = 0; k < f.values.size(); ++k)
         if (f.valid[k] && !std::isfinite(f.values[k])) f.values[k] = fig.log_lo - 1;
     fig.log_levels = log_levels(fig.log_lo, fig.log_hi, o.luminance_levels);
-    if (o.colouring == SliceColouring::rgb) {
-      std::vector<double> lin;
-      for (double v : all) lin.push_back(std::pow(10.0, v));
-      const double median = percentile(lin, 0.5);
-      exposure = median > 0 ? 1.0 / median : 1.0;
-    }
   }
 
-  // Title.
-  if (generic) {
-    sc.title = fmt::format("Slices of the isotropic forms: {}", o.brdf->name());
-    sc.text(
-        {left, 20},
-        fmt::format("Slices of the isotropic forms at fixed relative azimuth: {}", o.brdf->name()),
-        12, HAlign::left, VAlign::baseline, kBlack, 0, true);
-    sc.text({left, 36},
-            fmt::format("{}; {}; isolines of luminance at log-spaced levels (shared scale)",
-                        o.brdf->description(),
-                        o.colouring == SliceColouring::rgb ? "tone-mapped RGB"
-                                                           : "false colour of log₁₀ luminance"),
-            9);
-  } else {
-    std::string names;
-    for (std::size_t k = 0; k < o.test_functions.size(); ++k)
-      names += (k ? ", " : "") + std::string(letter_of(o.test_functions[k]));
-    sc.title = fmt::format("Slices of the isotropic forms: test functions {}", names);
-    sc.text(
-        {left, 20},
-        fmt::format("Slices of the isotropic forms at fixed relative azimuth: test functions {}",
-                    names),
-        12, HAlign::left, VAlign::baseline, kBlack, 0, true);
-    std::string levels;
-    if (!o.levels.empty())
-      levels = fmt::format("isolines at {:g} … {:g}", o.levels.front(), o.levels.back());
-    if (o.levels.size() == 9 && o.levels.front() == 0.1) levels += " (step 0.1; 0.5 thicker)";
-    sc.text({left, 36}, levels + "; hatched: outside the valid domain", 9);
-  }
+  // Title and subtitle (wrapped to the figure's width).
+  sc.text({left, 20}, heading, 12, HAlign::left, VAlign::baseline, kBlack, 0, true);
+  for (std::size_t k = 0; k < subtitle.size(); ++k)
+    sc.text({left, 36 + 12 * double(k)}, subtitle[k], 9);
 
   const double fs = 8.5;
   for (std::size_t n = 0; n < fig.panels.size(); ++n) {
@@ -265,7 +262,7 @@ SliceFigure slice_figure(const SliceOptions& o) {
       const std::size_t k = g.index(i, j);
       if (!s.valid[k]) return hatch(i, j, kInvalidLight, kInvalidDark);
       if (!generic) return kSliceBackground;
-      if (o.colouring == SliceColouring::rgb) return tonemap(rgb[n][k], exposure);
+      if (o.colouring == SliceColouring::rgb) return tonemap_log(rgb[n][k], fig.log_lo, fig.log_hi);
       const double v = log_lum[n].values[k];
       return viridis((v - fig.log_lo) / (fig.log_hi - fig.log_lo));
     }));
@@ -273,8 +270,9 @@ SliceFigure slice_figure(const SliceOptions& o) {
     if (generic) {
       for (double level : fig.log_levels) {
         const bool decade = std::abs(level - std::round(level)) < 1e-9;
+        // White on viridis; orange on the grey levels of tone-mapped RGB.
         const Color lc =
-            o.colouring == SliceColouring::rgb ? Color{0, 0, 0, 0.7} : Color{1, 1, 1, 0.8};
+            o.colouring == SliceColouring::rgb ? Color{1.0, 0.55, 0.1, 0.9} : Color{1, 1, 1, 0.8};
         draw_polylines(sc, p.map, contour(log_lum[n], level), Stroke{lc, decade ? 0.9 : 0.5});
       }
     } else {
@@ -335,28 +333,21 @@ SliceFigure slice_figure(const SliceOptions& o) {
     std::vector<std::string> labels;
     const std::vector<double> label_levels = log_levels(fig.log_lo - 1e-6, fig.log_hi + 1e-6, 8);
     const double span = fig.log_hi - fig.log_lo;
-    if (o.colouring == SliceColouring::luminance) {
-      for (double l : label_levels) {
-        tick_t.push_back((l - fig.log_lo) / span);
-        labels.push_back(power_of_ten_label(l));
-      }
+    for (double l : label_levels) {
+      tick_t.push_back((l - fig.log_lo) / span);
+      labels.push_back(power_of_ten_label(l));
+    }
+    if (o.colouring == SliceColouring::luminance)
       draw_colour_bar(
           sc, bar, [](double t) { return viridis(t); }, tick_t, labels, "luminance",
           o.pixels_per_point);
-    } else {
-      for (double l : label_levels) {
-        const double e = exposure * std::pow(10.0, l);
-        tick_t.push_back(e / (1 + e));
-        labels.push_back(power_of_ten_label(l));
-      }
+    else  // tonemap_log: luminance t on the same scale, drawn as grey t
       draw_colour_bar(
           sc, bar,
           [](double t) {
-            const double v = srgb_encode(t);
-            return Color{v, v, v};
+            return Color{t, t, t};
           },
           tick_t, labels, "luminance", o.pixels_per_point);
-    }
     sc.text({left, ly},
             "Luminance isolines at the levels marked on the colour bar (decades thicker).", 9);
   }

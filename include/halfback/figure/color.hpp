@@ -34,9 +34,11 @@ double srgb_encode(double linear);
 // Rec. 709 / sRGB luminance of linear RGB.
 double luminance(const Rgb& c);
 
-// Tone mapping of linear RGB for display: Reinhard's L/(1+L) on exposure·luminance, applied to
-// the three channels in proportion, then sRGB-encoded. Negative channels are clamped to 0.
-Color tonemap(const Rgb& c, double exposure);
+// Tone mapping of linear RGB for display on a logarithmic scale: the colour is scaled so that its
+// luminance L becomes t = (log10 L − log_lo) / (log_hi − log_lo), clamped to [0, 1], keeping its
+// chromaticity (channels clamped to 1). So the grey levels follow the same scale as the false
+// colour of log luminance, and a colour bar of t in [0, 1] labels both. L <= 0 gives black.
+Color tonemap_log(const Rgb& c, double log_lo, double log_hi);
 
 // Colours used by the figures for things that are not data.
 inline constexpr Color kInvalidLight{0.80, 0.80, 0.80};  // hatching of invalid regions

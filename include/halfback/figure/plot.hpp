@@ -78,6 +78,10 @@ void draw_colour_bar(Scene& scene, const Rect& rect, const std::function<Color(d
 // the font is not at hand; DejaVu Sans averages about 0.55–0.6 em.
 double approx_text_width(std::string_view markup, double font_size);
 
+// Splits a text at spaces into lines of at most `width` points (by approx_text_width); a word
+// longer than the width gets a line of its own.
+std::vector<std::string> wrap_text(std::string_view markup, double width, double font_size);
+
 // A short horizontal line sample followed by a label (legends).
 void draw_legend_line(Scene& scene, Point at, const Stroke& stroke, const std::string& label,
                       double font_size = 9, const Color& text_colour = kBlack);
