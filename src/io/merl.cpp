@@ -100,7 +100,7 @@ std::array<double, 3> bin_centre(int theta_h, int theta_d, int phi_d) {
 
 }  // namespace merl
 
-MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name_view) {
+MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name_view, bool identify) {
   const std::string name(name_view);
   check_header(bytes.first(std::min(bytes.size(), merl::kHeaderBytes)), bytes.size(), name);
   MerlData data;
@@ -115,12 +115,15 @@ MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name_view
       data.values[c * merl::kBins + i] = v;
     }
   }
-  data.sha256 = sha256_hex(bytes);
-  if (const MerlMaterial* m = find_merl_material(data.sha256)) data.material = std::string(m->name);
+  if (identify) {
+    data.sha256 = sha256_hex(bytes);
+    if (const MerlMaterial* m = find_merl_material(data.sha256))
+      data.material = std::string(m->name);
+  }
   return data;
 }
 
-MerlData read_merl(const std::filesystem::path& path) {
+MerlData read_merl(const std::filesystem::path& path, bool identify) {
   const std::string name = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
@@ -135,7 +138,7 @@ MerlData read_merl(const std::filesystem::path& path) {
     check_header(std::span(head).first(static_cast<std::size_t>(in.gcount())), size, name);
   }
   const std::string bytes = io_detail::read_file_bytes(path, merl::kFileBytes);
-  return parse_merl(io_detail::as_bytes(bytes), name);
+  return parse_merl(io_detail::as_bytes(bytes), name, identify);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -21,6 +21,11 @@ using io_detail::load_le;
 constexpr double kPi = std::numbers::pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Clamp to [0, 1], NaN to 0 (std::clamp would pass NaN through to an index computation).
+double unit(double x) {
+  return x > 0 ? (x < 1 ? x : 1) : 0;
+}
+
 double theta_to_u(double theta) {
   return std::sqrt(theta * (2 / kPi));
 }
@@ -126,8 +131,8 @@ struct Table {
   std::vector<double> v;  // slices of h·w values
 
   double eval(const Slices& s, double x, double y) const {
-    x = std::clamp(x, 0.0, 1.0) * double(w - 1);
-    y = std::clamp(y, 0.0, 1.0) * double(h - 1);
+    x = unit(x) * double(w - 1);
+    y = unit(y) * double(h - 1);
     const std::size_t i = std::min(static_cast<std::size_t>(x), w - 2);
     const std::size_t j = std::min(static_cast<std::size_t>(y), h - 2);
     const double tx = x - double(i), ty = y - double(j);
@@ -194,8 +199,8 @@ struct Warp {
 
   // Density on the unit square at p (the blended, normalized grid values, bilinear).
   double density(const Slices& s, RglWarpPoint p) const {
-    const double x = std::clamp(p.x, 0.0, 1.0) * double(w - 1);
-    const double y = std::clamp(p.y, 0.0, 1.0) * double(h - 1);
+    const double x = unit(p.x) * double(w - 1);
+    const double y = unit(p.y) * double(h - 1);
     const std::size_t i = std::min(static_cast<std::size_t>(x), w - 2);
     const std::size_t j = std::min(static_cast<std::size_t>(y), h - 2);
     const double sx = x - double(i), ty = y - double(j);
@@ -206,8 +211,8 @@ struct Warp {
 
   // Point p of the unit square -> sample (the CDFs at p): the inverse of the warp.
   RglWarpPoint inverse(const Slices& s, RglWarpPoint p) const {
-    const double x = std::clamp(p.x, 0.0, 1.0) * double(w - 1);
-    const double y = std::clamp(p.y, 0.0, 1.0) * double(h - 1);
+    const double x = unit(p.x) * double(w - 1);
+    const double y = unit(p.y) * double(h - 1);
     const std::size_t i = std::min(static_cast<std::size_t>(x), w - 2);
     const std::size_t j = std::min(static_cast<std::size_t>(y), h - 2);
     const double sx = x - double(i), ty = y - double(j);
@@ -218,15 +223,15 @@ struct Warp {
     const double r0 = C(s, j, w - 1), r1 = C(s, j + 1, w - 1);
     const double row = (1 - ty) * r0 + ty * r1;
     RglWarpPoint u;
-    u.x = row > 0 ? std::clamp(num / row, 0.0, 1.0) : std::clamp(p.x, 0.0, 1.0);
-    u.y = std::clamp(M(s, j) + ty * r0 + 0.5 * ty * ty * (r1 - r0), 0.0, 1.0);
+    u.x = row > 0 ? unit(num / row) : unit(p.x);
+    u.y = unit(M(s, j) + ty * r0 + 0.5 * ty * ty * (r1 - r0));
     return u;
   }
 
   // Sample -> point: inverts the marginal CDF in y, then the conditional CDF in x.
   RglWarpPoint forward(const Slices& s, RglWarpPoint u) const {
-    u.x = std::clamp(u.x, 0.0, 1.0);
-    u.y = std::clamp(u.y, 0.0, 1.0);
+    u.x = unit(u.x);
+    u.y = unit(u.y);
     // Row: the last j in [0, h-2] with M(j) < u.y.
     std::size_t lo = 0, hi = h - 2;
     while (lo < hi) {
@@ -265,7 +270,7 @@ struct Warp {
     const double disc = std::max(a * a + 2 * (b - a) * area, 0.0);
     const double den = a + std::sqrt(disc);
     if (!(den > 0)) return 0;
-    return std::clamp(2 * area / den, 0.0, 1.0);
+    return unit(2 * area / den);
   }
 };
 

@@ -310,6 +310,21 @@ TEST(RglEval, ReturnsFrNotFrCos) {
   EXPECT_TRUE(b.isotropic());
 }
 
+// Found by fuzz/rgl_fuzz.cpp: a NaN warp coordinate reached a float-to-index conversion (undefined
+// behaviour, reported by UBSan). Non-finite input must give clamped or NaN results, never UB.
+TEST(RglEval, NonFiniteInputIsSafe) {
+  const RglBrdf b = Synthetic{}.brdf();
+  const double nan = std::nan(""), inf = INFINITY;
+  const RglWarpPoint s = b.vndf_inverse({nan, nan}, nan, nan);
+  EXPECT_TRUE(s.x >= 0 && s.x <= 1 && s.y >= 0 && s.y <= 1);
+  const RglWarpPoint f = b.vndf_forward({nan, inf}, inf, -inf);
+  EXPECT_TRUE(f.x >= 0 && f.x <= 1 && f.y >= 0 && f.y <= 1);
+  EXPECT_TRUE(std::isfinite(b.vndf_density({-inf, nan}, 0.5, 0)));
+  const Rgb v = b.eval({{inf, 0, 1}, {-inf, 0, 1}});  // h = NaN
+  EXPECT_TRUE(std::isnan(v.r) || v.r >= 0);
+  (void)b.sample({inf, inf, 1}, nan, 0.5);
+}
+
 TEST(RglEval, NegativeRgbIsClampedByDefault) {
   Synthetic s;
   s.rgb = [](auto, std::size_t c, auto, auto) { return c == 0 ? -0.05f : 0.2f; };

@@ -64,11 +64,11 @@ struct MerlData {
 
 // Reads and validates a MERL file: size exactly kFileBytes, dimensions 90 90 180, every value
 // finite. Throws FormatError naming the file, the field and the problem. Negative values are
-// accepted and counted (MerlData::missing). Computes the file's SHA-256 and identifies the
-// published material it matches, if any.
-MerlData read_merl(const std::filesystem::path& path);
+// accepted and counted (MerlData::missing). With `identify`, computes the file's SHA-256 (~0.1 s)
+// and names the published material it matches, if any.
+MerlData read_merl(const std::filesystem::path& path, bool identify = true);
 // The same from bytes in memory; `name` stands for the file in messages.
-MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name);
+MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name, bool identify = true);
 
 // The 100 published materials: name, SHA-256 (lowercase hex) and size, from
 // src/io/merl_sha256.tsv (embedded at build time).

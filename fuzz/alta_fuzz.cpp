@@ -1,0 +1,30 @@
+// libFuzzer target for the ALTA text reader and its scattered-data evaluation (see fuzz/run.sh).
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <string_view>
+
+#include "halfback/io/alta.hpp"
+#include "halfback/io/format_error.hpp"
+
+using namespace halfback;
+
+namespace {
+volatile double sink;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  try {
+    const AltaData d = parse_alta(text, "fuzz.dat");
+    const AltaBrdf brdf(d, "fuzz.dat", "fuzz");
+    double v[6] = {0.3, 0.1, 0.9, -0.2, 0.4, 0.8};
+    if (size >= 48) std::memcpy(v, data, sizeof v);
+    const Rgb a = brdf.eval({{v[0], v[1], v[2]}, {v[3], v[4], v[5]}});
+    const Rgb b = brdf.eval_coords(v[0], v[1], v[2]);
+    const Rgb c = brdf.eval({{0.3, 0.1, 0.9}, {-0.2, 0.4, 0.8}});
+    sink = a.r + b.g + c.b;
+  } catch (const FormatError&) {
+  }
+  return 0;
+}

@@ -1,0 +1,93 @@
+// Writes small valid inputs for the fuzzers into DIR/{merl,rgl,alta}/ (see fuzz/run.sh): a
+// synthetic RGL material with tiny grids, ALTA files, and MERL headers.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "halfback/io/rgl.hpp"
+
+using namespace halfback;
+namespace fs = std::filesystem;
+
+namespace {
+
+template <class T>
+std::vector<std::byte> le(const std::vector<T>& v) {  // the fuzzers run on little-endian hosts
+  std::vector<std::byte> b(v.size() * sizeof(T));
+  if (!v.empty()) std::memcpy(b.data(), v.data(), b.size());
+  return b;
+}
+
+void write(const fs::path& p, const void* data, std::size_t n) {
+  std::ofstream(p, std::ios::binary)
+      .write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
+}
+
+std::vector<std::byte> rgl_material(std::size_t n_theta, std::size_t w, std::size_t r,
+                                    std::vector<float> phi_i) {
+  std::vector<float> theta(n_theta);
+  for (std::size_t i = 0; i < n_theta; ++i) theta[i] = float(1.5 * double(i) / double(n_theta));
+  const std::size_t np = phi_i.size(), slices = np * n_theta;
+  std::vector<float> vndf, lum, rgb;
+  for (std::size_t s = 0; s < slices; ++s) {
+    for (std::size_t k = 0; k < w * w; ++k) vndf.push_back(float(1 + (k * 7 + s) % 5));
+    for (std::size_t k = 0; k < r * r; ++k) lum.push_back(1.0f);
+    for (std::size_t k = 0; k < 3 * r * r; ++k) rgb.push_back(float(0.1 * double(k % 7)));
+  }
+  const std::string desc = "seed";
+  std::vector<std::byte> d(desc.size());
+  std::memcpy(d.data(), desc.data(), desc.size());
+  const std::vector<TensorFieldData> fields{
+      {"description", TensorDtype::uint8, {desc.size()}, d},
+      {"phi_i", TensorDtype::float32, {np}, le(phi_i)},
+      {"theta_i", TensorDtype::float32, {n_theta}, le(theta)},
+      {"sigma", TensorDtype::float32, {2, w}, le(std::vector<float>(2 * w, 0.8f))},
+      {"ndf", TensorDtype::float32, {2, w}, le(std::vector<float>(2 * w, 0.5f))},
+      {"vndf", TensorDtype::float32, {np, n_theta, w, w}, le(vndf)},
+      {"luminance", TensorDtype::float32, {np, n_theta, r, r}, le(lum)},
+      {"rgb", TensorDtype::float32, {np, n_theta, 3, r, r}, le(rgb)},
+      {"jacobian", TensorDtype::uint8, {1}, {std::byte{1}}},
+  };
+  return serialize_tensor_file(fields);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::cerr << "usage: make_fuzz_seeds DIR\n";
+    return 2;
+  }
+  const fs::path dir = argv[1];
+  for (const char* sub : {"merl", "rgl", "alta"}) fs::create_directories(dir / sub);
+
+  const auto iso = rgl_material(3, 4, 2, {0.0f});
+  write(dir / "rgl" / "iso.bsdf", iso.data(), iso.size());
+  const auto aniso = rgl_material(2, 3, 2, {-3.14159265f, -1.5707963f, 0.0f});
+  write(dir / "rgl" / "aniso.bsdf", aniso.data(), aniso.size());
+
+  const std::string alta =
+      "#DIM 3 1\n#VS 0\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT "
+      "INV_STERADIAN_COSINE_FACTOR\n"
+      "0.5 0 0 1\n0.5 0.1 0 2\n0.5 0 0.1 3\n0.5 0.1 0.1 4\n1.0 0 0 1\n1.0 0.2 0 2\n1.0 0 -0.2 3\n";
+  write(dir / "alta" / "small.dat", alta.data(), alta.size());
+  const std::string alta_vs =
+      "#DIM 3 3\n#VS 2\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN\n"
+      "0.2 0 0 1 2 3 0.5 1.5\n0.2 1e-1 0 1 2 3 0.5 1.5\n0.2 0 0.1 1 2 3 0.5 1.5\n";
+  write(dir / "alta" / "rgb_vs.dat", alta_vs.data(), alta_vs.size());
+
+  // MERL: a valid header followed by a few values.
+  std::vector<unsigned char> merl(12 + 64);
+  const std::int32_t dims[3] = {90, 90, 180};
+  std::memcpy(merl.data(), dims, 12);
+  for (std::size_t i = 12; i < merl.size(); ++i) merl[i] = static_cast<unsigned char>(i * 37);
+  write(dir / "merl" / "header.bin", merl.data(), merl.size());
+  const double pair[6] = {0.3, 0.1, 0.948683, -0.2, 0.4, 0.894427};
+  write(dir / "merl" / "pair.bin", pair, sizeof pair);
+  return 0;
+}
