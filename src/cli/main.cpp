@@ -1,1 +1,108 @@
-int main() { return 0; }
+// The `halfback` command-line tool: builds the CLI11 app from the command table (commands.cpp),
+// parses, runs the selected command and turns every error into a message and an exit status
+// (command.hpp). Nothing escapes as an uncaught exception.
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "command.hpp"
+
+#ifndef HALFBACK_VERSION
+#define HALFBACK_VERSION "unknown"
+#endif
+
+namespace halfback::cli {
+namespace {
+
+constexpr const char* kDescription =
+    "halfback: parameterizations of BRDF direction pairs (Barla et al. 2015): convert between\n"
+    "directions and the spherical, half/difference, orthographic and hybrid coordinates.\n";
+
+constexpr const char* kFooter =
+    "Run 'halfback COMMAND --help' for the options and examples of a command.\n"
+    "Exit status: 0 on success, 1 for bad input data or a file that cannot be read or written,\n"
+    "2 for a bad command line. Errors are reported on stderr as 'halfback COMMAND: error: ...'.";
+
+void report_error(const std::string& who, std::string_view message) {
+  fmt::print(stderr, "{}: error: {}\n", who, message);
+}
+
+void usage_hint(const std::string& who) {
+  fmt::print(stderr, "Run '{} --help' for more information.\n", who);
+}
+
+std::string command_names(const std::vector<Command>& commands) {
+  std::string s;
+  for (const Command& c : commands) s += (s.empty() ? "" : ", ") + c.app->get_name();
+  return s;
+}
+
+int run_command(const std::string& who, const Command& command) {
+  try {
+    return command.run();
+  } catch (const UsageError& e) {
+    report_error(who, e.what());
+    usage_hint(who);
+    return kExitUsageError;
+  } catch (const std::bad_alloc&) {
+    report_error(who, "out of memory");
+  } catch (const std::exception& e) {
+    report_error(who, e.what());
+  } catch (...) {
+    report_error(who, "unknown error");
+  }
+  return kExitDataError;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app(kDescription, "halfback");
+  app.set_version_flag("--version", "halfback " HALFBACK_VERSION, "Print the version and exit");
+  app.set_help_flag("-h,--help", "Print this help and exit");
+  app.require_subcommand(0, 1);
+  app.footer(kFooter);
+  app.get_formatter()->column_width(28);
+
+  std::vector<Command> commands;
+  for (RegisterCommand add : command_table()) commands.push_back(add(app));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help, --version
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string who = "halfback";
+    for (const CLI::App* sub : app.get_subcommands()) who += " " + sub->get_name();
+    if (who == "halfback" && dynamic_cast<const CLI::ExtrasError*>(&e) && !app.remaining().empty())
+      report_error(who, fmt::format("unknown command '{}' (the commands are: {})",
+                                    app.remaining().front(), command_names(commands)));
+    else
+      report_error(who, e.what());
+    usage_hint(who);
+    return kExitUsageError;
+  }
+  for (const Command& command : commands)
+    if (command.app->parsed()) return run_command("halfback " + command.app->get_name(), command);
+  report_error("halfback",
+               fmt::format("a command is required (one of: {})", command_names(commands)));
+  usage_hint("halfback");
+  return kExitUsageError;
+}
+
+}  // namespace
+}  // namespace halfback::cli
+
+int main(int argc, char** argv) {
+  try {
+    return halfback::cli::run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "halfback: error: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "halfback: error: unknown error\n");
+  }
+  return halfback::cli::kExitDataError;
+}

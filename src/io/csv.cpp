@@ -220,17 +220,20 @@ CsvReader::CsvReader(std::string_view text, std::string source)
   std::deque<std::string> scratch;
   if (std::string problem = split_fields(line, fields, scratch); !problem.empty())
     throw CsvError(source_, header_line_, "", "header: " + problem);
-  std::unordered_set<std::string_view> seen;
-  for (std::size_t i = 0; i < fields.size(); ++i) {
-    if (fields[i].empty())
-      throw CsvError(source_, header_line_, "",
-                     fmt::format("header: the name of column {} is empty", i + 1));
-    if (!seen.insert(fields[i]).second)
-      throw CsvError(source_, header_line_, "",
-                     fmt::format("header: duplicate column name '{}'", shown(fields[i])));
-  }
   header_.assign(fields.begin(), fields.end());
   pos_ = cursor.pos;
+}
+
+void CsvReader::check_names() const {
+  std::unordered_set<std::string_view> seen;
+  for (std::size_t i = 0; i < header_.size(); ++i) {
+    if (header_[i].empty())
+      throw CsvError(source_, header_line_, "",
+                     fmt::format("header: the name of column {} is empty", i + 1));
+    if (!seen.insert(header_[i]).second)
+      throw CsvError(source_, header_line_, "",
+                     fmt::format("header: duplicate column name '{}'", shown(header_[i])));
+  }
 }
 
 void CsvReader::require_header(std::span<const std::string_view> expected,
@@ -245,6 +248,7 @@ void CsvReader::require_header(std::span<const std::string_view> expected,
 }
 
 CsvTable CsvReader::read_rows(const CsvReadOptions& options) {
+  check_names();
   const std::size_t ncols = header_.size();
   CsvTable table;
   table.header = header_;

@@ -85,10 +85,14 @@ TEST(CsvRead, HeaderOnlyIsAnEmptyTable) {
 }
 
 TEST(CsvRead, MalformedHeader) {
-  EXPECT_STREQ(csv_error([] { CsvReader r("a,,c\n", "h.csv"); }).what(),
+  EXPECT_STREQ(csv_error([] { read_csv("a,,c\n", "h.csv"); }).what(),
                "h.csv:1: header: the name of column 2 is empty");
-  EXPECT_STREQ(csv_error([] { CsvReader r("a,b,a\n", "h.csv"); }).what(),
+  EXPECT_STREQ(csv_error([] { read_csv("a,b,a\n", "h.csv"); }).what(),
                "h.csv:1: header: duplicate column name 'a'");
+  // require_header() comes first: a header-less file is reported as a header mismatch.
+  CsvReader r("1,1,2\n", "h.csv");
+  EXPECT_EQ(csv_error([&] { r.require_header(kAbc); }).problem(),
+            "header does not match: expected 'a,b,c', found '1,1,2'");
   EXPECT_STREQ(csv_error([] { CsvReader r("a,\"b\n", "h.csv"); }).what(),
                "h.csv:1: header: unterminated quoted field");
 }

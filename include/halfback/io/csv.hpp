@@ -73,7 +73,9 @@ struct CsvTable {
 class CsvReader {
  public:
   // `text` must outlive the reader; `source` names it in messages (a file name, "<stdin>").
-  // Reads the header; throws CsvError when there is none or it is malformed.
+  // Reads the header; throws CsvError when there is none or a quoted name is malformed. (Empty
+  // and duplicate names are reported by read_rows(), so that require_header() can say first
+  // that the header is not the expected one.)
   CsvReader(std::string_view text, std::string source);
 
   const std::vector<std::string>& header() const noexcept { return header_; }
@@ -84,11 +86,13 @@ class CsvReader {
   // does not match: expected 'a,b,c', found 'a,c'" followed by `note` when given.
   void require_header(std::span<const std::string_view> expected, std::string_view note = {}) const;
 
-  // Reads every row (one column per header entry). Throws CsvError on the first bad row unless
-  // options.keep_bad_rows. Call once.
+  // Reads every row (one column per header entry). Throws CsvError for an empty or duplicate
+  // column name, and on the first bad row unless options.keep_bad_rows. Call once.
   CsvTable read_rows(const CsvReadOptions& options = {});
 
  private:
+  void check_names() const;
+
   std::string_view text_;
   std::string source_;
   std::vector<std::string> header_;

@@ -1,0 +1,84 @@
+// The pieces shared by the subcommands of the `halfback` tool.
+//
+// Each subcommand lives in its own file (convert_command.cpp, ...) and exposes a registration
+// function that adds its CLI::App to the main app and returns a Command; main.cpp calls the
+// functions listed in command_table() (commands.cpp), parses, and runs the selected command.
+//
+// Errors: a command throws. UsageError (a command line that parses but makes no sense) exits
+// with code 2, like the CLI11 parse errors; any other exception (bad data, a file that cannot be
+// read or written) exits with code 1. main.cpp prints "halfback NAME: error: MESSAGE" on stderr.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "halfback/io/atomic_file.hpp"
+#include "halfback/io/csv.hpp"
+
+namespace halfback::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitDataError = 1;
+inline constexpr int kExitUsageError = 2;
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A registered subcommand: its CLI11 app, and what runs it after a successful parse (returns the
+// exit code, or throws).
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+using RegisterCommand = Command (*)(CLI::App& parent);
+
+// The subcommands, in the order of `halfback --help` (commands.cpp).
+std::span<const RegisterCommand> command_table();
+
+Command register_convert(CLI::App& parent);
+
+// "halfback COMMAND: warning: MESSAGE" on stderr.
+void warn(std::string_view command, std::string_view message);
+
+// The text of an input given as a path, or "-" for standard input, and its name for messages.
+struct InputText {
+  std::string text;
+  std::string name;  // the path, or "<stdin>"
+};
+// Throws std::system_error ("cannot read 'PATH': REASON").
+InputText read_input(const std::string& path);
+
+// An output given as a path, or "-" for standard output. A file is written through an
+// AtomicFile, created by the constructor (so an unwritable destination fails before any work)
+// and renamed into place by commit(): on error, nothing is left and an existing file is kept.
+// Standard output is written directly; commands write only once their input is fully read and
+// checked, so that a data error prints nothing there.
+class Output {
+ public:
+  explicit Output(const std::string& path);
+  void write(std::string_view data);
+  void commit();
+  CsvSink sink() {
+    return [this](std::string_view s) { write(s); };
+  }
+  bool is_stdout() const noexcept { return !file_; }
+
+ private:
+  std::unique_ptr<AtomicFile> file_;
+};
+
+// A CLI11 validator for parameterization names ("dirs", "hybrid", ...), with a message listing
+// the names.
+CLI::Validator space_name_validator();
+
+}  // namespace halfback::cli

@@ -1,0 +1,19 @@
+// The table of subcommands: add a command by writing NAME_command.cpp with a register_NAME()
+// function (declared in command.hpp) and listing it here.
+#include <array>
+
+#include "command.hpp"
+
+namespace halfback::cli {
+
+namespace {
+constexpr std::array<RegisterCommand, 1> kCommands{
+    &register_convert,
+};
+}  // namespace
+
+std::span<const RegisterCommand> command_table() {
+  return kCommands;
+}
+
+}  // namespace halfback::cli

@@ -1,0 +1,301 @@
+// `halfback figure`: the figures of Barla et al. 2015 (docs/figures.md).
+//
+//   halfback figure hemisphere  Figure 1: ωi over the hemisphere for fixed ωo, coloured by the
+//                               pair's coordinates
+//   halfback figure slices      Figure 2: slices of the isotropic forms, with the test functions
+//                               S, G, F as isolines, or any BRDF in false colour
+//   halfback figure paper       Figures 1 and 2 on their defaults, PNG + SVG + PDF, into a folder
+//
+// All the work is in the library (include/halfback/figure/); this file parses options. Every
+// file is written atomically (the library's save(), through AtomicFile): an unwritable
+// destination fails before any drawing, and no partial file is left behind.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "command.hpp"
+#include "halfback/brdf/load.hpp"
+#include "halfback/brdf/test_functions.hpp"
+#include "halfback/core/space.hpp"
+#include "halfback/figure/hemisphere.hpp"
+#include "halfback/figure/paper.hpp"
+#include "halfback/figure/render.hpp"
+#include "halfback/figure/slices.hpp"
+#include "halfback/io/atomic_file.hpp"
+
+namespace halfback::cli {
+
+namespace {
+
+using figure::Format;
+
+struct HemisphereArgs {
+  std::vector<std::string> params{"halfdiff", "ortho", "hybrid"};
+  std::vector<double> elevations{0, 40, 80};
+  std::string projection = "equal-area";
+  std::string centre = "normal";
+  double scale = 2;
+  bool no_markers = false, no_isolines = false;
+  unsigned threads = 0;
+  std::string out = "hemisphere.png";
+};
+
+struct SliceArgs {
+  std::string brdf = "test:S,G,F";
+  std::vector<std::string> params{"halfdiff", "ortho", "hybrid"};
+  std::vector<double> azimuths{0, 45, 90};
+  std::vector<double> levels{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
+  std::string colour = "luminance";
+  double scale = 2;
+  unsigned threads = 0;
+  std::string out = "slices.png";
+};
+
+struct PaperArgs {
+  std::string out;
+  std::vector<std::string> formats{"png", "svg", "pdf"};
+  unsigned threads = 0;
+};
+
+std::vector<Space> parameterizations(const std::vector<std::string>& names) {
+  if (names.empty()) throw UsageError("--param: no parameterization given");
+  std::vector<Space> spaces;
+  for (const std::string& n : names) {
+    const auto s = space_from_name(n);
+    if (!s || *s == Space::dirs)
+      throw UsageError(fmt::format(
+          "--param: unknown parameterization '{}' (expected spherical, halfdiff, ortho or hybrid)",
+          n));
+    spaces.push_back(*s);
+  }
+  return spaces;
+}
+
+// The output's format, checked before any work.
+void check_output(const std::string& out) {
+  if (out.empty()) throw UsageError("--out: no file name given");
+  if (!figure::format_from_path(out))
+    throw UsageError(fmt::format(
+        "--out '{}': cannot tell the figure format: use a .png, .svg or .pdf file name", out));
+}
+
+void check_scale(double scale) {
+  if (!(scale >= 0.25 && scale <= 8))
+    throw UsageError(fmt::format("--scale {}: must be between 0.25 and 8 pixels per point", scale));
+}
+
+void finish(const figure::Scene& scene, const std::string& out, double scale, double seconds) {
+  figure::save(scene, out, {scale});
+  fmt::print("wrote {} ({:.2f} s)\n", out, seconds);
+}
+
+double since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int run_hemisphere(const HemisphereArgs& a) {
+  check_output(a.out);
+  check_scale(a.scale);
+  figure::HemisphereOptions o;
+  o.params = parameterizations(a.params);
+  if (a.elevations.empty()) throw UsageError("--elevations: no elevation given");
+  for (double e : a.elevations)
+    if (!(e >= 0 && e <= 90))
+      throw UsageError(fmt::format(
+          "--elevations: {}° is outside [0°, 90°] (the polar angle θo of ωo from the normal)", e));
+  o.elevations_deg = a.elevations;
+  const auto projection = figure::projection_from_name(a.projection);
+  if (!projection)
+    throw UsageError(fmt::format(
+        "--projection: unknown projection '{}' (expected equal-area, orthographic or equidistant)",
+        a.projection));
+  o.projection = *projection;
+  const auto centre = figure::view_centre_from_name(a.centre);
+  if (!centre)
+    throw UsageError(
+        fmt::format("--centre: unknown centre '{}' (expected normal, mirror or back)", a.centre));
+  o.centre = *centre;
+  o.pixels_per_point = a.scale;
+  o.markers = !a.no_markers;
+  o.isolines = !a.no_isolines;
+  o.threads = a.threads;
+  AtomicFile probe(a.out);  // an unwritable destination fails before any work
+  probe.discard();
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto fig = figure::hemisphere_figure(o);
+  finish(fig.scene, a.out, a.scale, since(t0));
+  return kExitOk;
+}
+
+int run_slices(const SliceArgs& a) {
+  check_output(a.out);
+  check_scale(a.scale);
+  figure::SliceOptions o;
+  o.params = parameterizations(a.params);
+  if (a.azimuths.empty()) throw UsageError("--azimuths: no azimuth given");
+  for (double az : a.azimuths)
+    if (!std::isfinite(az)) throw UsageError("--azimuths: the azimuths must be finite numbers");
+  o.azimuths_deg = a.azimuths;
+  if (a.colour == "luminance")
+    o.colouring = figure::SliceColouring::luminance;
+  else if (a.colour == "rgb")
+    o.colouring = figure::SliceColouring::rgb;
+  else
+    throw UsageError(
+        fmt::format("--colour: unknown colouring '{}' (expected luminance or rgb)", a.colour));
+  o.pixels_per_point = a.scale;
+  o.threads = a.threads;
+
+  const std::string prefix = "test:";
+  if (a.brdf.rfind(prefix, 0) == 0) {
+    // The paper's test functions, as isolines: test:S,G,F (any subset, any order).
+    o.test_functions.clear();
+    const std::string list = a.brdf.substr(prefix.size());
+    std::size_t start = 0;
+    while (start <= list.size()) {
+      const std::size_t comma = std::min(list.find(',', start), list.size());
+      const std::string name = list.substr(start, comma - start);
+      const auto f = test_function_from_name(name);
+      if (!f)
+        throw UsageError(fmt::format(
+            "--brdf '{}': unknown test function '{}' (expected S, G or F, e.g. test:S,G,F)", a.brdf,
+            name));
+      o.test_functions.push_back(*f);
+      start = comma + 1;
+    }
+    if (a.levels.empty()) throw UsageError("--levels: no level given");
+    o.levels = a.levels;
+  }
+  AtomicFile probe(a.out);  // an unwritable destination fails before loading and drawing
+  probe.discard();
+  if (a.brdf.rfind(prefix, 0) != 0) o.brdf = load_brdf(a.brdf);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto fig = figure::slice_figure(o);
+  finish(fig.scene, a.out, a.scale, since(t0));
+  return kExitOk;
+}
+
+int run_paper(const PaperArgs& a) {
+  if (a.out.empty()) throw UsageError("--out: no folder given");
+  figure::PaperFigureOptions o;
+  o.png = o.svg = o.pdf = false;
+  if (a.formats.empty()) throw UsageError("--formats: no format given");
+  for (const std::string& f : a.formats) {
+    if (f == "png")
+      o.png = true;
+    else if (f == "svg")
+      o.svg = true;
+    else if (f == "pdf")
+      o.pdf = true;
+    else
+      throw UsageError(fmt::format("--formats: unknown format '{}' (expected png, svg, pdf)", f));
+  }
+  o.threads = a.threads;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto written = figure::write_paper_figures(a.out, o);
+  for (const auto& w : written) {
+    fmt::print("{}:\n", w.description);
+    for (const auto& p : w.files) fmt::print("  {}\n", p.string());
+  }
+  fmt::print(
+      "{} files in {:.2f} s\n",
+      [&] {
+        std::size_t n = 0;
+        for (const auto& w : written) n += w.files.size();
+        return n;
+      }(),
+      since(t0));
+  return kExitOk;
+}
+
+}  // namespace
+
+Command register_figure(CLI::App& parent) {
+  CLI::App* app = parent.add_subcommand(
+      "figure", "Draw the figures of Barla et al. 2015 (hemisphere views, slices) as PNG/SVG/PDF");
+  app->require_subcommand(1, 1);
+  app->footer(
+      "Examples:\n"
+      "  halfback figure paper --out figures\n"
+      "  halfback figure hemisphere --param halfdiff,hybrid --elevations 0,60 --out fig1.pdf\n"
+      "  halfback figure slices --brdf test:S,G,F --azimuths 0,45,90 --out fig2.svg\n"
+      "  halfback figure slices --brdf ggx:alpha=0.1 --colour rgb --out ggx.png\n"
+      "See docs/figures.md.");
+
+  auto hemi = std::make_shared<HemisphereArgs>();
+  CLI::App* h = app->add_subcommand(
+      "hemisphere",
+      "Figure 1: every incoming direction of the hemisphere for fixed outgoing directions, "
+      "coloured by the pair's two non-azimuthal coordinates (red, green)");
+  h->add_option("--param", hemi->params,
+                "Parameterizations, one row each (spherical, halfdiff, ortho, hybrid)")
+      ->delimiter(',')
+      ->capture_default_str();
+  h->add_option("--elevations", hemi->elevations,
+                "Polar angles θo of ωo from the normal, in degrees, one column each")
+      ->delimiter(',')
+      ->capture_default_str();
+  h->add_option("--projection", hemi->projection,
+                "Disk projection: equal-area, orthographic or equidistant")
+      ->capture_default_str();
+  h->add_option("--centre", hemi->centre,
+                "Disk centre: normal, mirror (the mirror direction of ωo) or back (ωo)")
+      ->capture_default_str();
+  h->add_option("--scale", hemi->scale, "Pixels per point of the PNG (and of the rasters)")
+      ->capture_default_str();
+  h->add_flag("--no-markers", hemi->no_markers, "Do not mark ωo and its mirror direction");
+  h->add_flag("--no-isolines", hemi->no_isolines, "Colours only");
+  h->add_option("--threads", hemi->threads, "Sampling threads (0: all cores)")
+      ->capture_default_str();
+  h->add_option("-o,--out", hemi->out, "Output file: .png, .svg or .pdf")->capture_default_str();
+
+  auto sl = std::make_shared<SliceArgs>();
+  CLI::App* s = app->add_subcommand(
+      "slices",
+      "Figure 2: slices of the isotropic forms at fixed relative azimuths, with the test "
+      "functions as isolines or any BRDF in false colour");
+  s->add_option("--brdf", sl->brdf,
+                "test:S,G,F (any of the paper's test functions, as isolines), or a BRDF: a "
+                "file (MERL, RGL, ALTA) or a model spec such as ggx:alpha=0.2")
+      ->capture_default_str();
+  s->add_option("--param", sl->params, "Parameterizations, one row each")
+      ->delimiter(',')
+      ->capture_default_str();
+  s->add_option("--azimuths", sl->azimuths,
+                "Relative azimuths in degrees (φd for halfdiff, φk − φh for ortho and hybrid), "
+                "one column each")
+      ->delimiter(',')
+      ->capture_default_str();
+  s->add_option("--levels", sl->levels, "Isoline levels of the test functions")
+      ->delimiter(',')
+      ->capture_default_str();
+  s->add_option("--colour", sl->colour,
+                "For a BRDF: luminance (viridis of log luminance) or rgb (tone-mapped)")
+      ->capture_default_str();
+  s->add_option("--scale", sl->scale, "Pixels per point of the PNG (and of the rasters)")
+      ->capture_default_str();
+  s->add_option("--threads", sl->threads, "Sampling threads (0: all cores)")->capture_default_str();
+  s->add_option("-o,--out", sl->out, "Output file: .png, .svg or .pdf")->capture_default_str();
+
+  auto pa = std::make_shared<PaperArgs>();
+  CLI::App* p = app->add_subcommand(
+      "paper",
+      "Figures 1 (three views) and 2 on their default settings, into a folder, and print "
+      "where they are");
+  p->add_option("-o,--out", pa->out, "Output folder (created if missing)")->required();
+  p->add_option("--formats", pa->formats, "Formats to write: png, svg, pdf")
+      ->delimiter(',')
+      ->capture_default_str();
+  p->add_option("--threads", pa->threads, "Sampling threads (0: all cores)")->capture_default_str();
+
+  return {app, [=]() -> int {
+            if (h->parsed()) return run_hemisphere(*hemi);
+            if (s->parsed()) return run_slices(*sl);
+            return run_paper(*pa);
+          }};
+}
+
+}  // namespace halfback::cli

@@ -1,0 +1,133 @@
+// halfback render: a unit sphere of any BRDF under an environment map, direct lighting by
+// multiple importance sampling (docs/render.md).
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "command.hpp"
+#include "halfback/brdf/load.hpp"
+#include "halfback/render/renderer.hpp"
+
+namespace halfback::cli {
+
+namespace {
+
+struct RenderOptions {
+  std::string brdf, env = "default", output, strategy = "mis", heuristic = "power",
+                    sampling = "hybrid";
+  int width = 512, height = 512, spp = 64, threads = 0;
+  std::uint64_t seed = 1;
+  double time_budget = 0, exposure = 0, env_rotation = 0, env_exposure = 0;
+  bool filmic = false, perspective = false, quiet = false;
+};
+
+std::string lower_extension(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+int run_render(const RenderOptions& o) {
+  const std::string ext = lower_extension(o.output);
+  if (ext != ".png" && ext != ".exr")
+    throw UsageError("the output must be a .png (tone-mapped sRGB) or .exr (linear) file: '" +
+                     o.output + "'");
+  {
+    // Fail before rendering when the destination cannot be written.
+    AtomicFile probe(o.output);
+    probe.discard();
+  }
+  render::RenderSettings s;
+  s.width = o.width;
+  s.height = o.height;
+  s.spp = o.spp;
+  s.seed = o.seed;
+  s.time_budget = o.time_budget;
+  s.threads = o.threads;
+  s.projection = o.perspective ? render::Projection::perspective : render::Projection::orthographic;
+  s.strategy = o.strategy == "brdf"  ? render::Strategy::brdf
+               : o.strategy == "env" ? render::Strategy::env
+                                     : render::Strategy::mis;
+  s.heuristic = o.heuristic == "balance" ? render::Heuristic::balance : render::Heuristic::power;
+  s.tabulation.param = render::table_param_from_name(o.sampling);
+  s.progress = !o.quiet;  // drawn only when stderr is a terminal
+
+  const BrdfPtr brdf = load_brdf(o.brdf);
+  const render::EnvMap env = render::EnvMap::from_spec(o.env, {o.env_rotation, o.env_exposure});
+  const render::RenderResult r = render::render(*brdf, env, s);
+  render::write_image(o.output, r.image, {o.exposure, o.filmic});
+
+  if (r.budget_exhausted)
+    warn("render", "the time budget ran out after " + std::to_string(r.spp) + " of " +
+                       std::to_string(o.spp) + " samples per pixel");
+  if (r.nonfinite)
+    warn("render", std::to_string(r.nonfinite) + " samples were NaN or infinite and were dropped");
+  if (!o.quiet && isatty(fileno(stderr)))
+    std::fprintf(stderr, "%s: %d x %d, %d spp, %.2f s (+%.2f s sampler setup), %s\n",
+                 o.output.c_str(), o.width, o.height, r.spp, r.seconds, r.sampler_seconds,
+                 r.sampler.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+Command register_render(CLI::App& parent) {
+  auto o = std::make_shared<RenderOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "render",
+      "Render a unit sphere of a BRDF under an environment map (direct lighting, multiple "
+      "importance sampling of the environment and the BRDF)");
+  app->add_option("--brdf", o->brdf,
+                  "BRDF SPEC: a MERL, RGL or ALTA file, or a model such as ggx:alpha=0.2")
+      ->required();
+  app->add_option("--env", o->env,
+                  "environment: a latitude-longitude .hdr or .exr file, constant:V, "
+                  "constant:R,G,B, or default (a built-in sky with a sun)")
+      ->capture_default_str();
+  app->add_option("-o,--output", o->output, "output image: .exr (linear) or .png (sRGB)")
+      ->required();
+  app->add_option("--width", o->width, "image width in pixels")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  app->add_option("--height", o->height, "image height in pixels")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  app->add_option("--spp", o->spp, "samples per pixel (each: one environment + one BRDF sample)")
+      ->check(CLI::Range(1, 1 << 24))
+      ->capture_default_str();
+  app->add_option("--seed", o->seed, "random seed (the image does not depend on --threads)")
+      ->capture_default_str();
+  app->add_option("--time-budget", o->time_budget,
+                  "stop after about SEC seconds, keeping the finished passes (0: no limit)")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
+  app->add_option("--exposure", o->exposure, "PNG exposure in stops")->capture_default_str();
+  app->add_flag("--filmic", o->filmic, "PNG: ACES filmic tone curve instead of a plain clamp");
+  app->add_flag("--perspective", o->perspective, "perspective camera (default: orthographic)");
+  app->add_option("--env-rotation", o->env_rotation,
+                  "turn the environment about the up axis, in degrees")
+      ->capture_default_str();
+  app->add_option("--env-exposure", o->env_exposure, "scale the environment by 2^E")
+      ->capture_default_str();
+  app->add_option("--strategy", o->strategy, "mis, or one strategy alone: brdf or env")
+      ->check(CLI::IsMember({"mis", "brdf", "env"}))
+      ->capture_default_str();
+  app->add_option("--heuristic", o->heuristic, "MIS weights: power or balance")
+      ->check(CLI::IsMember({"power", "balance"}))
+      ->capture_default_str();
+  app->add_option("--sampling-param", o->sampling,
+                  "parameterization of the tabulated sampler of measured BRDFs: hybrid, "
+                  "halfdiff or spherical")
+      ->check(CLI::IsMember({"hybrid", "halfdiff", "spherical"}))
+      ->capture_default_str();
+  app->add_option("--threads", o->threads, "worker threads (0: all cores)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  app->add_flag("-q,--quiet", o->quiet, "no progress bar or summary");
+  return {app, [o] { return run_render(*o); }};
+}
+
+}  // namespace halfback::cli
