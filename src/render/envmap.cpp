@@ -277,6 +277,19 @@ EnvMap::EnvMap(int width, int height, std::vector<float> rgb, std::string name, 
     weights[i] = luminance(p[0], p[1], p[2]) * row_solid_angle_[i / std::size_t(width)];
   }
   distribution_ = Distribution2D(std::size_t(height), std::size_t(width), weights);
+  // MIS compensation: the luminance above its solid-angle mean.
+  double mean = 0;
+  for (double w : weights) mean += w;
+  mean /= 4 * kPi;
+  std::vector<double> compensated(weights.size());
+  double total = 0;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    const double omega = row_solid_angle_[i / std::size_t(width)];
+    compensated[i] = std::max(0.0, weights[i] - mean * omega);
+    total += compensated[i];
+  }
+  compensated_ = total > 0 ? Distribution2D(std::size_t(height), std::size_t(width), compensated)
+                           : distribution_;
 }
 
 EnvMap EnvMap::constant(const Rgb& radiance, EnvOptions options) {
@@ -381,9 +394,9 @@ Rgb EnvMap::eval(const Vec3<double>& dir) const {
   return {p[0] * scale_, p[1] * scale_, p[2] * scale_};
 }
 
-EnvMap::Sample EnvMap::sample(double u1, double u2) const {
+EnvMap::Sample EnvMap::sample(double u1, double u2, bool compensated) const {
   Sample s;
-  const auto cell = distribution_.sample(u1, u2);
+  const auto cell = (compensated ? compensated_ : distribution_).sample(u1, u2);
   if (cell.probability <= 0) return s;
   const double c0 = std::cos(kPi * double(cell.row) / height_);
   const double c1 = std::cos(kPi * double(cell.row + 1) / height_);
@@ -398,10 +411,10 @@ EnvMap::Sample EnvMap::sample(double u1, double u2) const {
   return s;
 }
 
-double EnvMap::pdf(const Vec3<double>& dir) const {
+double EnvMap::pdf(const Vec3<double>& dir, bool compensated) const {
   std::size_t row, col;
   pixel_of(to_map(dir), row, col);
-  return distribution_.probability(row, col) / row_solid_angle_[row];
+  return (compensated ? compensated_ : distribution_).probability(row, col) / row_solid_angle_[row];
 }
 
 // --------------------------------------------------------------------------------------------

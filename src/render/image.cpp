@@ -7,16 +7,14 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStdIO.h>
 #include <stb_image_write.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
+
+#include "halfback/io/atomic_file.hpp"
 
 namespace halfback::render {
 
@@ -26,31 +24,6 @@ void check_image(const Image& image, const std::filesystem::path& path) {
   if (image.width <= 0 || image.height <= 0 ||
       image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
     throw std::invalid_argument(path.string() + ": the image is empty or its size is inconsistent");
-}
-
-// Writes `bytes` to a temporary file beside `path`, flushes it to disk and renames it over `path`.
-void write_atomically(const std::filesystem::path& path, const void* data, std::size_t size) {
-  static std::atomic<unsigned> counter{0};
-  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
-  std::string name(".");
-  name.append(path.filename().string())
-      .append(".tmp-")
-      .append(std::to_string(getpid()))
-      .append("-")
-      .append(std::to_string(counter++));
-  const std::filesystem::path tmp = dir / name;
-  auto fail = [&](const std::string& what) {
-    const std::string reason = std::strerror(errno);
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(path.string() + ": " + what + ": " + reason);
-  };
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) fail("cannot create a temporary file in " + dir.string());
-  const bool ok =
-      std::fwrite(data, 1, size, f) == size && std::fflush(f) == 0 && fsync(fileno(f)) == 0;
-  if (std::fclose(f) != 0 || !ok) fail("cannot write");
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail("cannot rename the temporary file");
 }
 
 double srgb_encode(double v) {
@@ -96,7 +69,8 @@ void write_png(const std::filesystem::path& path, const Image& image, const Tone
   if (!stbi_write_png_to_func(sink, &bytes, image.width, image.height, 3, pixels.data(),
                               image.width * 3))
     throw std::runtime_error(path.string() + ": PNG encoding failed");
-  write_atomically(path, bytes.data(), bytes.size());
+  write_file_atomically(
+      path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 void write_exr(const std::filesystem::path& path, const Image& image) {
@@ -120,8 +94,7 @@ void write_exr(const std::filesystem::path& path, const Image& image) {
   } catch (const std::exception& e) {
     throw std::runtime_error(path.string() + ": OpenEXR: " + e.what());
   }
-  const std::string bytes = buffer.str();
-  write_atomically(path, bytes.data(), bytes.size());
+  write_file_atomically(path, buffer.str());
 }
 
 void write_image(const std::filesystem::path& path, const Image& image, const ToneMapOptions& o) {

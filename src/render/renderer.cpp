@@ -162,7 +162,8 @@ class Renderer {
     auto env_sample = [&](std::uint32_t dim, double share) {
       double u1, u2;
       detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
-      const EnvMap::Sample es = env_.sample(u1, u2);
+      const bool comp = s_.strategy == Strategy::mis && s_.compensation;
+      const EnvMap::Sample es = env_.sample(u1, u2, comp);
       if (!(es.pdf > 0)) return;
       const V3 wi = f.to_local(es.dir);
       if (!(wi.z > 0)) return;
@@ -180,8 +181,9 @@ class Renderer {
       const Rgb li = env_.eval(dir);
       if (li.r == 0 && li.g == 0 && li.b == 0) return;
       const Rgb fr = brdf_.eval({bs.wi, wo});
-      const double w =
-          s_.strategy == Strategy::mis ? weight(s_.heuristic, bs.pdf, env_.pdf(dir)) : 1;
+      const double w = s_.strategy == Strategy::mis
+                           ? weight(s_.heuristic, bs.pdf, env_.pdf(dir, s_.compensation))
+                           : 1;
       add(fr, li, share * w * bs.wi.z / bs.pdf);
     };
     switch (s_.strategy) {

@@ -1,0 +1,355 @@
+// The renderer: white furnace (constant environment of radiance 1: each pixel is the BRDF's
+// directional albedo), black environment, convergence rate, MIS against each strategy alone,
+// determinism, time budget, camera conventions, image files and bad input.
+#include "halfback/render/renderer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <numbers>
+
+#include "halfback/brdf/albedo.hpp"
+#include "halfback/brdf/load.hpp"
+#include "halfback/brdf/registry.hpp"
+#include "halfback/models/analytic.hpp"
+#include "halfback/models/register.hpp"
+
+namespace halfback::render {
+namespace {
+
+constexpr double kOrthoHalfHeight = 1.25;
+
+class Opaque final : public Brdf {  // hides the model's own sampler
+ public:
+  explicit Opaque(BrdfPtr b) : b_(std::move(b)) {}
+  std::string name() const override { return "opaque"; }
+  std::string description() const override { return b_->description(); }
+  bool isotropic() const override { return b_->isotropic(); }
+  bool reciprocal() const override { return b_->reciprocal(); }
+  Rgb eval(const DirPair<double>& p) const override { return b_->eval(p); }
+
+ private:
+  BrdfPtr b_;
+};
+
+double luminance(const Rgb& c) {
+  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+}
+
+BrdfPtr ggx(double alpha, double f0 = 1) {
+  models::MicrofacetParams p;
+  p.alpha_x = p.alpha_y = alpha;
+  p.fresnel.kind = models::Fresnel::Kind::schlick;
+  p.fresnel.f0 = {f0, f0, f0};
+  return std::make_shared<models::Microfacet>(p);
+}
+
+RenderSettings small(int size, int spp) {
+  RenderSettings s;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.variance = true;
+  s.tabulation.radial = 32;
+  s.tabulation.azimuthal = 64;
+  s.tabulation.theta_slices = 16;
+  return s;
+}
+
+// The pixel's footprint lies entirely on the sphere (orthographic view).
+bool fully_on_sphere(const RenderSettings& s, int x, int y, Vec3<double>* normal = nullptr) {
+  for (int cx = 0; cx < 2; ++cx)
+    for (int cy = 0; cy < 2; ++cy) {
+      const double px = (2.0 * (x + cx) / s.width - 1) * kOrthoHalfHeight;
+      const double py = (1 - 2.0 * (y + cy) / s.height) * kOrthoHalfHeight;
+      if (px * px + py * py >= 0.999) return false;
+    }
+  if (normal) {
+    const double px = (2.0 * (x + 0.5) / s.width - 1) * kOrthoHalfHeight;
+    const double py = (1 - 2.0 * (y + 0.5) / s.height) * kOrthoHalfHeight;
+    *normal = {px, py, std::sqrt(1 - px * px - py * py)};
+  }
+  return true;
+}
+
+std::filesystem::path shared_dir() {
+  const char* d = std::getenv("HALFBACK_SHARED_DIR");
+  return d ? std::filesystem::path(d) : std::filesystem::path();
+}
+
+// Lambert in a white furnace: every pixel is the albedo; the deviation is within the estimator's
+// own standard error, and the background is exactly the environment.
+TEST(Renderer, WhiteFurnaceLambert) {
+  const models::Lambert lambert({0.7, 0.7, 0.7});
+  const EnvMap white = EnvMap::constant({1, 1, 1});
+  for (const bool tabulated : {false, true}) {
+    const Opaque opaque(std::make_shared<models::Lambert>(Rgb{0.7, 0.7, 0.7}));
+    const Brdf& b = tabulated ? static_cast<const Brdf&>(opaque) : lambert;
+    const RenderSettings s = small(32, 64);
+    const RenderResult r = render(b, white, s);
+    EXPECT_EQ(r.spp, 64);
+    int n = 0, outliers = 0;
+    double sum = 0, worst = 0;
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        const float* p = r.image.pixel(x, y);
+        const float sd = std::sqrt(r.variance[std::size_t(y * s.width + x)]);
+        if (fully_on_sphere(s, x, y)) {
+          ++n;
+          sum += p[1];
+          worst = std::max(worst, std::abs(p[1] - 0.7) / std::max(sd, 1e-6f));
+          outliers += std::abs(p[1] - 0.7) > 4 * sd + 1e-6;
+        } else if (!(p[0] > 0.6f && p[0] <= 1.000001f)) {  // sphere and background mixed
+          ADD_FAILURE() << "pixel " << x << "," << y << " = " << p[0];
+        }
+      }
+    EXPECT_LE(outliers, 1) << "worst deviation " << worst << " sd";
+    EXPECT_NEAR(sum / n, 0.7, 2e-3) << (tabulated ? "tabulated" : "own sampler");
+    // Corner pixels show the environment exactly.
+    EXPECT_EQ(r.image.pixel(0, 0)[2], 1.0f);
+  }
+}
+
+// A glossy GGX (F = 1) in a white furnace: each pixel is its directional albedo at θo.
+TEST(Renderer, WhiteFurnaceGgx) {
+  const auto g = ggx(0.3);
+  const RenderSettings s = small(24, 128);
+  const RenderResult r = render(*g, EnvMap::constant({1, 1, 1}), s);
+  int checked = 0;
+  for (int y = 0; y < s.height; y += 3)
+    for (int x = 0; x < s.width; x += 3) {
+      Vec3<double> n;
+      if (!fully_on_sphere(s, x, y, &n)) continue;
+      // ωo = +z in the local frame is (0, 0, n.z) up to an azimuth, which GGX ignores.
+      const Vec3<double> wo{std::sqrt(1 - n.z * n.z), 0, n.z};
+      const AlbedoEstimate a = directional_albedo(*g, wo, 256, 9);
+      const double sd = std::sqrt(r.variance[std::size_t(y * s.width + x)]);
+      // The pixel integrates over its footprint, the reference is at its centre.
+      const double spread = std::abs(
+          directional_albedo(*g, {std::sqrt(1 - std::pow(n.z * 0.98, 2)), 0, n.z * 0.98}, 64, 9)
+              .mean.r -
+          a.mean.r);
+      EXPECT_NEAR(r.image.pixel(x, y)[0], a.mean.r, 5 * sd + 4 * a.standard_error.r + spread + 1e-3)
+          << "pixel " << x << "," << y << " cos θo " << n.z;
+      ++checked;
+    }
+  EXPECT_GT(checked, 20);
+}
+
+TEST(Renderer, BlackEnvironmentIsBlack) {
+  const RenderResult r = render(*ggx(0.2), EnvMap::from_spec("constant:0"), small(16, 4));
+  for (float v : r.image.rgb) EXPECT_EQ(v, 0.0f);
+}
+
+double rmse(const Image& a, const Image& b) {
+  double s = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) s += std::pow(double(a.rgb[i]) - b.rgb[i], 2);
+  return std::sqrt(s / double(a.rgb.size()));
+}
+
+// The slope of log RMSE against log N, by least squares.
+double slope(const std::vector<double>& n, const std::vector<double>& e) {
+  double mx = 0, my = 0;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    mx += std::log(n[i]);
+    my += std::log(e[i]);
+  }
+  mx /= double(n.size());
+  my /= double(n.size());
+  double sxy = 0, sxx = 0;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    sxy += (std::log(n[i]) - mx) * (std::log(e[i]) - my);
+    sxx += std::pow(std::log(n[i]) - mx, 2);
+  }
+  return sxy / sxx;
+}
+
+TEST(Renderer, ConvergesAsOneOverSqrtN) {
+  const auto g = ggx(0.2, 0.9);
+  const EnvMap env = EnvMap::default_sky();
+  RenderSettings ref = small(16, 8192);
+  ref.seed = 99;
+  ref.variance = false;
+  const Image reference = render(*g, env, ref).image;
+  for (const Sequence seq : {Sequence::random, Sequence::sobol}) {
+    std::vector<double> ns, errs;
+    for (int spp : {4, 16, 64, 256}) {
+      double e2 = 0;
+      for (int seed = 1; seed <= 4; ++seed) {  // average the squared error over seeds
+        RenderSettings s = small(16, spp);
+        s.sequence = seq;
+        s.seed = std::uint64_t(seed);
+        s.variance = false;
+        e2 += std::pow(rmse(render(*g, env, s).image, reference), 2);
+      }
+      ns.push_back(spp);
+      errs.push_back(std::sqrt(e2 / 4));
+    }
+    const double k = slope(ns, errs);
+    RecordProperty(seq == Sequence::random ? "slope_random" : "slope_sobol", std::to_string(k));
+    if (seq == Sequence::random)
+      EXPECT_NEAR(k, -0.5, 0.08) << "independent samples: 1/sqrt(N)";
+    else
+      EXPECT_LT(k, -0.45) << "stratified samples: at least as fast as 1/sqrt(N)";
+    for (std::size_t i = 1; i < errs.size(); ++i) EXPECT_LT(errs[i], errs[i - 1]);
+  }
+}
+
+double mean_variance(const Brdf& b, const EnvMap& env, Strategy st) {
+  RenderSettings s = small(48, 32);
+  s.strategy = st;
+  s.sequence = Sequence::random;
+  const RenderResult r = render(b, env, s);
+  double v = 0;
+  int n = 0;
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x)
+      if (fully_on_sphere(s, x, y)) {
+        v += r.variance[std::size_t(y * s.width + x)];
+        ++n;
+      }
+  return v / n;
+}
+
+// MIS (with compensation) beats both strategies alone, at the same number of light samples, on a
+// glossy and a diffuse material under an environment with a small bright source (the built-in
+// sky), and under a real map (grace: bright windows in a dim church).
+TEST(Renderer, MisHasLowerVarianceThanEitherStrategy) {
+  const EnvMap env = EnvMap::default_sky();
+  const models::Lambert lambert({0.8, 0.8, 0.8});
+  const auto glossy = ggx(0.15, 0.9);
+  for (const Brdf* b : {static_cast<const Brdf*>(&lambert), glossy.get()}) {
+    const double mis = mean_variance(*b, env, Strategy::mis);
+    const double brdf = mean_variance(*b, env, Strategy::brdf);
+    const double light = mean_variance(*b, env, Strategy::env);
+    EXPECT_LT(mis, brdf) << b->name();
+    EXPECT_LT(mis, light) << b->name();
+    RecordProperty(b->name() + "_variance_ratio_brdf", std::to_string(brdf / mis));
+    RecordProperty(b->name() + "_variance_ratio_env", std::to_string(light / mis));
+  }
+}
+
+TEST(Renderer, MisOnRealMap) {
+  const auto path = shared_dir() / "data" / "envmaps" / "grace.hdr";
+  if (!std::filesystem::exists(path)) {
+    const char* ci = std::getenv("CI");
+    if (ci && std::string(ci) == "true") FAIL() << "missing " << path;
+    GTEST_SKIP() << "shared data not found: " << path;
+  }
+  const EnvMap env = EnvMap::load(path);
+  const models::Lambert lambert({0.8, 0.8, 0.8});
+  const auto glossy = ggx(0.3, 0.9);
+  for (const Brdf* b : {static_cast<const Brdf*>(&lambert), glossy.get()}) {
+    const double mis = mean_variance(*b, env, Strategy::mis);
+    EXPECT_LT(mis, mean_variance(*b, env, Strategy::brdf)) << b->name();
+    EXPECT_LT(mis, mean_variance(*b, env, Strategy::env)) << b->name();
+  }
+}
+
+TEST(Renderer, DeterministicAcrossThreadCounts) {
+  const auto g = ggx(0.2);
+  const EnvMap env = EnvMap::default_sky();
+  RenderSettings s = small(40, 4);
+  s.threads = 1;
+  const Image a = render(*g, env, s).image;
+  s.threads = 3;
+  const Image b = render(*g, env, s).image;
+  EXPECT_EQ(a.rgb, b.rgb);
+  s.seed = 2;
+  EXPECT_NE(render(*g, env, s).image.rgb, a.rgb);
+}
+
+TEST(Renderer, TimeBudgetStopsEarly) {
+  RenderSettings s = small(64, 1 << 16);
+  s.time_budget = 0.3;
+  const RenderResult r = render(*ggx(0.2), EnvMap::default_sky(), s);
+  EXPECT_TRUE(r.budget_exhausted);
+  EXPECT_GE(r.spp, 1);
+  EXPECT_LT(r.spp, 1 << 16);
+  EXPECT_LT(r.seconds, 5);
+  for (float v : r.image.rgb) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(Renderer, CameraConventions) {
+  // A map whose right half (+x) is red and left half blue, the sky brighter than the ground.
+  std::vector<float> rgb(8 * 4 * 3, 0);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x) {
+      float* p = &rgb[std::size_t(3 * (y * 8 + x))];
+      (x >= 4 ? p[0] : p[2]) = y < 2 ? 1.0f : 0.25f;
+    }
+  const EnvMap env(8, 4, rgb, "halves");
+  for (const Projection proj : {Projection::orthographic, Projection::perspective}) {
+    RenderSettings s = small(33, 2);
+    s.projection = proj;
+    const Image img = render(models::Lambert({1, 1, 1}), env, s).image;
+    // The background: red on the right, blue on the left, brighter at the top.
+    EXPECT_GT(img.pixel(32, 16)[0], 0.2f);
+    EXPECT_EQ(img.pixel(32, 16)[2], 0.0f);
+    EXPECT_GT(img.pixel(0, 16)[2], 0.2f);
+    EXPECT_GT(img.pixel(32, 0)[0], img.pixel(32, 32)[0]);
+    // The sphere: its right side faces the red half, its left side the blue one.
+    const float* right = img.pixel(24, 16);
+    const float* left = img.pixel(8, 16);
+    EXPECT_GT(right[0], right[2]);
+    EXPECT_GT(left[2], left[0]);
+  }
+}
+
+TEST(Renderer, ImageFiles) {
+  const RenderResult r =
+      render(models::Lambert({0.5, 0.5, 0.5}), EnvMap::default_sky(), small(8, 2));
+  const auto dir = std::filesystem::temp_directory_path() / "halfback_render_test";
+  std::filesystem::create_directories(dir);
+  write_image(dir / "a.exr", r.image, {});
+  EXPECT_EQ(read_exr(dir / "a.exr").rgb, r.image.rgb);
+  write_image(dir / "a.PNG", r.image, {1, true});
+  std::ifstream png(dir / "a.PNG", std::ios::binary);
+  char magic[4] = {};
+  png.read(magic, 4);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "left a temp file";
+  EXPECT_THROW(write_image(dir / "a.jpg", r.image, {}), std::invalid_argument);
+  try {
+    write_image(dir / "no" / "such" / "dir.png", r.image, {});
+    ADD_FAILURE();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("dir.png"), std::string::npos) << e.what();
+  }
+  // Tone mapping: 0 → 0, 1 → 255, exposure doubles, filmic compresses.
+  const Image grey{3, 1, {0, 0, 0, 1, 1, 1, 0.25f, 0.25f, 0.25f}};
+  const auto plain = tonemap_srgb8(grey, {});
+  EXPECT_EQ(plain[0], 0);
+  EXPECT_EQ(plain[3], 255);
+  EXPECT_EQ(tonemap_srgb8(grey, {1, false})[6], tonemap_srgb8({1, 1, {0.5f, 0.5f, 0.5f}}, {})[0]);
+  EXPECT_LT(tonemap_srgb8(grey, {0, true})[3], 255);
+}
+
+TEST(Renderer, BadInput) {
+  const models::Lambert l({0.5, 0.5, 0.5});
+  const EnvMap env = EnvMap::constant({1, 1, 1});
+  RenderSettings s = small(8, 1);
+  s.width = 0;
+  EXPECT_THROW(render(l, env, s), std::invalid_argument);
+  s = small(8, 0);
+  EXPECT_THROW(render(l, env, s), std::invalid_argument);
+  s = small(8, 1);
+  s.time_budget = -1;
+  EXPECT_THROW(render(l, env, s), std::invalid_argument);
+  // Unknown BRDFs are refused by load_brdf with a message naming them.
+  if (!ModelRegistry::global().find("ggx"))
+    models::register_analytic_models(ModelRegistry::global());
+  try {
+    load_brdf("no_such_model:alpha=1");
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_model"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(load_brdf("ggx:alpha=0.2"));
+}
+
+}  // namespace
+}  // namespace halfback::render

@@ -55,9 +55,14 @@ class EnvMap {
   };
   // A direction with probability proportional to the luminance of its pixel (times the pixel's
   // solid angle), uniform in solid angle within the pixel. u1, u2 in [0, 1).
-  Sample sample(double u1, double u2) const;
+  //
+  // `compensated`: proportional to max(0, luminance − mean luminance) instead (MIS compensation,
+  // Karlík et al. 2019): for use only beside a BRDF sampler in MIS, which covers the dim
+  // directions that this density leaves out (pdf 0). The same as the plain density when the map
+  // is constant.
+  Sample sample(double u1, double u2, bool compensated = false) const;
   // The density of sample() at `dir`, per unit solid angle.
-  double pdf(const Vec3<double>& dir) const;
+  double pdf(const Vec3<double>& dir, bool compensated = false) const;
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -80,7 +85,7 @@ class EnvMap {
   EnvOptions options_;
   double scale_ = 1, cos_rot_ = 1, sin_rot_ = 0;
   std::vector<double> row_solid_angle_;  // of one pixel of each row
-  Distribution2D distribution_;
+  Distribution2D distribution_, compensated_;
 };
 
 }  // namespace halfback::render

@@ -1,6 +1,6 @@
 // Rendered images: linear RGB float arrays, tone mapping, and the file writers (linear OpenEXR,
-// tone-mapped 8-bit sRGB PNG). Files are written safely: to a temporary file beside the target,
-// then renamed over it, so a reader never sees a partial image.
+// tone-mapped 8-bit sRGB PNG). Files are written safely through halfback::AtomicFile (a temporary
+// file beside the target, renamed over it), so a reader never sees a partial image.
 #pragma once
 
 #include <cstdint>
@@ -24,8 +24,9 @@ struct ToneMapOptions {
 // 8-bit sRGB, width × height × 3. NaN becomes 0.
 std::vector<std::uint8_t> tonemap_srgb8(const Image& image, const ToneMapOptions& options);
 
-// Throw std::runtime_error naming the file on failure. write_image picks the format from the
-// extension (.exr or .png, case-insensitive) and throws std::invalid_argument for any other.
+// Throw std::runtime_error (std::system_error for I/O) naming the file on failure. write_image
+// picks the format from the extension (.exr or .png, case-insensitive) and throws
+// std::invalid_argument for any other.
 void write_exr(const std::filesystem::path& path, const Image& image);
 void write_png(const std::filesystem::path& path, const Image& image,
                const ToneMapOptions& options);

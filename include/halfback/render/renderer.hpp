@@ -39,6 +39,9 @@ struct RenderSettings {
   double background_fov_deg = 60;  // orthographic view: the background's field of view
   Strategy strategy = Strategy::mis;
   Heuristic heuristic = Heuristic::power;
+  // MIS: sample the environment in proportion to its luminance above the mean (EnvMap::sample),
+  // leaving the dim directions to the BRDF sampler.
+  bool compensation = true;
   Sequence sequence = Sequence::sobol;
   int threads = 0;               // 0: all cores
   bool progress = false;         // a progress bar on stderr, only when stderr is a terminal
