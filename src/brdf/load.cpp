@@ -2,14 +2,18 @@
 
 #include <array>
 #include <fstream>
+#include <mutex>
 #include <string>
 #include <system_error>
 
 #include "halfback/brdf/registry.hpp"
+#include "halfback/brdf/test_functions.hpp"
 #include "halfback/io/alta.hpp"
 #include "halfback/io/format_error.hpp"
 #include "halfback/io/merl.hpp"
 #include "halfback/io/rgl.hpp"
+#include "halfback/models/analytic.hpp"
+#include "halfback/models/register.hpp"
 
 namespace halfback {
 
@@ -63,7 +67,65 @@ BrdfFileFormat detect_brdf_format(const std::filesystem::path& path) {
   return BrdfFileFormat::unknown;
 }
 
+namespace {
+
+// The paper's test functions as the model "test" with one named argument: "test:S".
+void register_test_functions(ModelRegistry& registry) {
+  registry.add({"test",
+                "the paper's test functions: F = 1 - cos(theta_d), S = 1 - |h_bar|, "
+                "G = 1 - (wi.n)(wo.n)",
+                {{"fn",
+                  "which function: F (Fresnel-like), S (specular) or G (grazing)",
+                  1,
+                  0,
+                  2,
+                  {"F", "S", "G"}}},
+                [](const ModelArgs& a) {
+                  const TestFunction fns[] = {TestFunction::fresnel, TestFunction::specular,
+                                              TestFunction::grazing};
+                  return std::make_shared<TestFunctionBrdf>(fns[int(a["fn"])]);
+                }});
+}
+
+// The separators of a sum "lambert:albedo=0.3+sheen:alpha=0.4": '+' followed by a model name
+// (a number's exponent sign, as in 1e+3, is followed by a digit).
+std::vector<std::string_view> split_sum(std::string_view spec) {
+  std::vector<std::string_view> parts;
+  std::size_t start = 0;
+  for (std::size_t i = 0; i + 1 < spec.size(); ++i)
+    if (spec[i] == '+' && spec[i + 1] >= 'a' && spec[i + 1] <= 'z') {
+      parts.push_back(spec.substr(start, i - start));
+      start = i + 1;
+    }
+  parts.push_back(spec.substr(start));
+  return parts;
+}
+
+BrdfPtr load_one(std::string_view spec);
+
+}  // namespace
+
+ModelRegistry& ModelRegistry::global() {
+  static ModelRegistry registry;
+  static std::once_flag builtins;
+  std::call_once(builtins, [] {
+    models::register_analytic_models(registry);
+    register_test_functions(registry);
+  });
+  return registry;
+}
+
 BrdfPtr load_brdf(std::string_view spec) {
+  const auto parts = split_sum(spec);
+  if (parts.size() == 1) return load_one(spec);
+  std::vector<BrdfPtr> terms;
+  for (const auto part : parts) terms.push_back(load_one(part));
+  return std::make_shared<models::Sum>(std::move(terms));
+}
+
+namespace {
+
+BrdfPtr load_one(std::string_view spec) {
   const std::filesystem::path path{std::string(spec)};
   std::error_code ec;
   if (!spec.empty() && std::filesystem::exists(path, ec)) {
@@ -98,4 +160,5 @@ BrdfPtr load_brdf(std::string_view spec) {
   return ModelRegistry::global().create(spec);
 }
 
+}  // namespace
 }  // namespace halfback

@@ -197,7 +197,9 @@ TEST(Registry, SpecErrors) {
   r.add(constant_model("other"));
   expect_invalid(r, "nope:x=1", {"'nope:x=1'", "models: other, test-constant"});
   expect_invalid(r, "test-constant:alpha=1", {"no parameter 'alpha'", "parameters: value, blue"});
-  expect_invalid(r, "test-constant:value", {"'value' is not key=value"});
+  // A bare value sets the first parameter, and must then be a number (or one of its choices).
+  expect_invalid(r, "test-constant:value", {"'value' of 'value' is not a finite number"});
+  expect_invalid(r, "test-constant:blue=1,0.5", {"'0.5' is not key=value"});
   expect_invalid(r, "test-constant:value=1,", {"empty parameter"});
   expect_invalid(r, "test-constant:value=abc", {"value 'abc' of 'value' is not a finite number"});
   expect_invalid(r, "test-constant:value=nan", {"not a finite number"});
@@ -305,6 +307,45 @@ TEST(LoadBrdf, PublishedFiles) {
   HALFBACK_REQUIRE_SHARED(alta, "alta");
   EXPECT_EQ(load_brdf((rgl / "cardboard_rgb.bsdf").string())->name(), "rgl:cardboard_rgb");
   EXPECT_EQ(load_brdf((alta / "retro-3M-jaune.dat").string())->name(), "alta:retro-3M-jaune");
+}
+
+}  // namespace
+}  // namespace halfback
+
+// --- Built-in models, named choices, positional values, sums -----------------------------------
+namespace halfback {
+namespace {
+
+TEST(BuiltinModels, GlobalRegistryKnowsTheAnalyticModelsAndTestFunctions) {
+  for (const char* name : {"lambert", "ggx", "beckmann", "abc", "sheen", "test"})
+    EXPECT_NE(ModelRegistry::global().find(name), nullptr) << name;
+}
+
+TEST(BuiltinModels, TestFunctionByPositionalName) {
+  const DirPair<double> p{{0.6, 0, 0.8}, {-0.6, 0, 0.8}};  // mirror pair: ‖h̄‖ = 0
+  EXPECT_EQ(load_brdf("test:S")->eval(p).r, 1.0);          // S = 1 − ‖h̄‖
+  EXPECT_NEAR(load_brdf("test:fn=G")->eval(p).g, 1 - 0.64, 1e-15);
+  EXPECT_EQ(load_brdf("test")->name(), "test:S");  // default
+  try {
+    load_brdf("test:X");
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fn=X is not one of: F, S, G"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(load_brdf("ggx:alpha=0.1,0.3"), std::invalid_argument);  // bare value not first
+}
+
+TEST(BuiltinModels, SumOfSpecs) {
+  const DirPair<double> p{{0.3, 0.2, std::sqrt(0.87)}, {-0.5, 0.1, std::sqrt(0.74)}};
+  const BrdfPtr sum = load_brdf("lambert:albedo=0.25+ggx:alpha=0.3,f0=0.5");
+  const double expected =
+      load_brdf("lambert:albedo=0.25")->eval(p).r + load_brdf("ggx:alpha=0.3,f0=0.5")->eval(p).r;
+  EXPECT_NEAR(sum->eval(p).r, expected, 1e-15);
+  EXPECT_EQ(sum->name(), "lambert+ggx");
+  // An exponent's sign is not a separator.
+  EXPECT_NO_THROW(load_brdf("abc:b=1e+3"));
+  EXPECT_THROW(load_brdf("lambert+nosuchmodel"), std::invalid_argument);
 }
 
 }  // namespace

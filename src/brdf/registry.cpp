@@ -1,5 +1,6 @@
 #include "halfback/brdf/registry.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <set>
@@ -37,12 +38,12 @@ double ModelArgs::operator[](std::string_view name) const {
   return it->second;
 }
 
-ModelRegistry& ModelRegistry::global() {
-  static ModelRegistry registry;
-  return registry;
-}
-
 void ModelRegistry::add(ModelInfo info) {
+  for (auto& p : info.params)
+    if (!p.choices.empty()) {
+      p.min = 0;
+      p.max = double(p.choices.size() - 1);
+    }
   if (!valid_identifier(info.name, true))
     throw std::invalid_argument("model name '" + info.name + "' must match [a-z][a-z0-9_-]*");
   if (!info.factory) throw std::invalid_argument("model '" + info.name + "' has no factory");
@@ -109,10 +110,14 @@ BrdfPtr ModelRegistry::create(std::string_view spec) const {
       const std::string_view item = trim(rest.substr(0, comma));
       const std::size_t eq = item.find('=');
       if (item.empty()) throw std::invalid_argument("model spec '" + spec_s + "': empty parameter");
-      if (eq == std::string_view::npos)
+      // A bare value sets the first parameter ("test:S" is "test:fn=S").
+      const bool positional = eq == std::string_view::npos;
+      if (positional && (info->params.empty() || !given.empty()))
         throw std::invalid_argument("model spec '" + spec_s + "': '" + std::string(item) +
                                     "' is not key=value");
-      const std::string_view key = trim(item.substr(0, eq)), text = trim(item.substr(eq + 1));
+      const std::string_view key =
+          positional ? std::string_view(info->params.front().name) : trim(item.substr(0, eq));
+      const std::string_view text = positional ? item : trim(item.substr(eq + 1));
       const ModelParam* param = nullptr;
       for (const auto& p : info->params)
         if (p.name == key) param = &p;
@@ -127,15 +132,26 @@ BrdfPtr ModelRegistry::create(std::string_view spec) const {
         throw std::invalid_argument("model spec '" + spec_s + "': '" + std::string(key) +
                                     "' given twice");
       double v = 0;
-      const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
-      if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() ||
-          !std::isfinite(v))
-        throw std::invalid_argument("model '" + info->name + "': value '" + std::string(text) +
-                                    "' of '" + param->name + "' is not a finite number");
-      if (v < param->min || v > param->max)
-        throw std::invalid_argument(
-            "model '" + info->name + "': " + param->name + "=" + std::string(text) +
-            " is outside [" + format_number(param->min) + ", " + format_number(param->max) + "]");
+      if (!param->choices.empty()) {
+        const auto it = std::find(param->choices.begin(), param->choices.end(), text);
+        if (it == param->choices.end()) {
+          std::string list;
+          for (const auto& c : param->choices) list += (list.empty() ? "" : ", ") + c;
+          throw std::invalid_argument("model '" + info->name + "': " + param->name + "=" +
+                                      std::string(text) + " is not one of: " + list);
+        }
+        v = double(it - param->choices.begin());
+      } else {
+        const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() ||
+            !std::isfinite(v))
+          throw std::invalid_argument("model '" + info->name + "': value '" + std::string(text) +
+                                      "' of '" + param->name + "' is not a finite number");
+        if (v < param->min || v > param->max)
+          throw std::invalid_argument(
+              "model '" + info->name + "': " + param->name + "=" + std::string(text) +
+              " is outside [" + format_number(param->min) + ", " + format_number(param->max) + "]");
+      }
       args.set(param->name, v);
       if (comma == std::string_view::npos) break;
       rest.remove_prefix(comma + 1);

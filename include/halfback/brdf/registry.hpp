@@ -20,6 +20,9 @@ struct ModelParam {
   std::string description;  // one line
   double default_value = 0;
   double min = 0, max = 0;  // inclusive range; default_value must lie in it
+  // Named values (e.g. {"F", "S", "G"}): the spec gives a name, the factory receives its index.
+  // For such a parameter min and max are set by add() to 0 and choices.size() − 1.
+  std::vector<std::string> choices = {};
 };
 
 // The parameter values a factory receives: every declared parameter, defaults filled in.
@@ -42,7 +45,8 @@ struct ModelInfo {
 
 class ModelRegistry {
  public:
-  // The process-wide registry used by load_brdf().
+  // The process-wide registry used by load_brdf(), with every built-in model registered
+  // (defined in src/brdf/load.cpp, the layer that knows them all).
   static ModelRegistry& global();
 
   // Registers a model; throws std::invalid_argument on a malformed entry (bad or duplicate name,
@@ -55,7 +59,8 @@ class ModelRegistry {
   const ModelInfo* find(std::string_view name) const;
   std::vector<std::string> names() const;  // sorted
 
-  // Parses "name" or "name:key=value,key=value" and creates the model. Throws
+  // Parses "name", "name:key=value,key=value" or "name:value,key=value" (a value without a key
+  // sets the model's first parameter, so "test:S" is "test:fn=S") and creates the model. Throws
   // std::invalid_argument with a message for users: unknown model (listing the known ones),
   // unknown or repeated parameter, a value that is not a number or is out of range.
   BrdfPtr create(std::string_view spec) const;
