@@ -10,6 +10,7 @@
 #include "halfback/core/batch.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
@@ -21,7 +22,6 @@
 #include <new>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "batch_engine.hpp"
 #include "row_kernels.hpp"
@@ -268,9 +268,9 @@ class TileRunner {
   std::unique_ptr<T[], AlignedDelete<T>> scratch_;
 };
 
-unsigned hardware_threads() {
-  const unsigned hw = std::thread::hardware_concurrency();
-  return hw == 0 ? 1 : hw;
+// Threads available to this process (TBB reads the affinity mask); more would only oversubscribe.
+std::size_t hardware_threads() {
+  return static_cast<std::size_t>(std::max(1, tbb::info::default_concurrency()));
 }
 
 }  // namespace
@@ -290,7 +290,9 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
     for (std::size_t t = t0; t < t1; ++t) runner.run(t * tile, std::min(tile, n - t * tile));
   };
 
-  const std::size_t requested = options.threads == 0 ? hardware_threads() : options.threads;
+  const std::size_t hw = hardware_threads();
+  const std::size_t requested =
+      options.threads == 0 ? hw : std::min<std::size_t>(options.threads, hw);
   const std::size_t threads = std::min(requested, tiles / kMinTilesPerThread);
   if (threads <= 1) {
     run_tiles(0, tiles);

@@ -1,0 +1,917 @@
+// Tests of the batch engine (batch.cpp): the SIMD/tiled/threaded convert() against the scalar
+// reference convert_one() (std math, one row at a time), for every pair of forms, float and
+// double, and every instruction set this CPU can run; layouts (strided AoS vs SoA), invalid rows,
+// thread counts, sizes; and the xsimd LaneOps mapping itself (batch_simd.hpp).
+#include "halfback/core/batch.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/batch_engine.hpp"
+#include "core/batch_simd.hpp"
+#include "core/row_kernels.hpp"
+#include "core/test_util.hpp"
+
+namespace halfback {
+namespace {
+
+using detail::SimdIsa;
+
+std::vector<Form> all_forms() {
+  std::vector<Form> forms{{Space::dirs, false}};
+  for (Space s : kParameterizations) {
+    forms.push_back({s, false});
+    forms.push_back({s, true});
+  }
+  return forms;
+}
+
+std::string form_name(Form f) {
+  return std::string(name_of(f.space)) + (f.isotropic ? "_iso" : "");
+}
+
+std::string pair_name(Form from, Form to) {
+  return form_name(from) + "->" + form_name(to);
+}
+
+// The instruction sets to test: every one this build and CPU can run (scalar and sse2 at least
+// on x86-64).
+std::vector<SimdIsa> available_isas() {
+  std::vector<SimdIsa> isas;
+  for (SimdIsa isa : detail::kAllIsas)
+    if (detail::kernels_for(isa)) isas.push_back(isa);
+  return isas;
+}
+
+// Forces an instruction set for the lifetime of the guard.
+class IsaGuard {
+ public:
+  explicit IsaGuard(SimdIsa isa) { ok_ = detail::set_batch_isa(isa); }
+  ~IsaGuard() { detail::set_batch_isa(std::nullopt); }
+  IsaGuard(const IsaGuard&) = delete;
+  IsaGuard& operator=(const IsaGuard&) = delete;
+  bool ok() const { return ok_; }
+
+ private:
+  bool ok_;
+};
+
+template <class T>
+using Table = std::vector<std::vector<T>>;  // [column][row]
+
+template <class T>
+struct Result {
+  Table<T> cols;
+  std::vector<T> jac;
+  std::vector<std::uint8_t> valid;
+};
+
+template <class T>
+Table<T> make_table(std::size_t dim, std::size_t n) {
+  return Table<T>(dim, std::vector<T>(n));
+}
+
+// Inputs of form `from` in precision T: the pairs encoded by the scalar path in double, rounded.
+template <class T>
+Table<T> inputs_for(Form from, const std::vector<DirPair<double>>& pairs) {
+  const std::size_t dim = dimension(from);
+  Table<T> t = make_table<T>(dim, pairs.size());
+  for (std::size_t r = 0; r < pairs.size(); ++r) {
+    const auto& p = pairs[r];
+    const double v[6] = {p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z};
+    double q[6];
+    if (from.space == Space::dirs)
+      std::copy(v, v + 6, q);
+    else
+      convert_one<double>({Space::dirs, false}, from, v, std::span<double>(q, dim));
+    for (std::size_t c = 0; c < dim; ++c) t[c][r] = static_cast<T>(q[c]);
+  }
+  return t;
+}
+
+template <class T>
+Result<T> run_batch(Form from, Form to, const Table<T>& in, bool jac, unsigned threads = 1) {
+  const std::size_t n = in.empty() ? 0 : in[0].size();
+  Result<T> r{make_table<T>(dimension(to), n), std::vector<T>(jac ? n : 0),
+              std::vector<std::uint8_t>(n, 7)};
+  std::vector<ConstColumn<T>> ic;
+  for (const auto& c : in) ic.push_back({c.data(), 1});
+  std::vector<Column<T>> oc;
+  for (auto& c : r.cols) oc.push_back({c.data(), 1});
+  ConvertOutput<T> out{oc, jac ? Column<T>{r.jac.data(), 1} : Column<T>{}, r.valid.data()};
+  convert<T>(from, to, ic, n, out, {threads});
+  return r;
+}
+
+template <class T>
+Result<T> run_scalar(Form from, Form to, const Table<T>& in) {
+  const std::size_t n = in.empty() ? 0 : in[0].size();
+  const std::size_t din = dimension(from), dout = dimension(to);
+  Result<T> r{make_table<T>(dout, n), std::vector<T>(n), std::vector<std::uint8_t>(n)};
+  T a[6], b[6];
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t c = 0; c < din; ++c) a[c] = in[c][i];
+    r.valid[i] =
+        convert_one<T>(from, to, std::span<const T>(a, din), std::span<T>(b, dout), &r.jac[i]) ? 1
+                                                                                               : 0;
+    for (std::size_t c = 0; c < dout; ++c) r.cols[c][i] = b[c];
+  }
+  return r;
+}
+
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+template <class T>
+bool same_bits(const Result<T>& a, const Result<T>& b) {
+  if (a.cols.size() != b.cols.size() || a.valid != b.valid || !same_bits(a.jac, b.jac))
+    return false;
+  for (std::size_t c = 0; c < a.cols.size(); ++c)
+    if (!same_bits(a.cols[c], b.cols[c])) return false;
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Batch == scalar reference
+// ---------------------------------------------------------------------------------------------
+//
+// The batch kernels evaluate the same param.hpp formulas with the same arithmetic as the scalar
+// reference (the kernel TUs are compiled with -ffp-contract=off): only atan2, sin and cos differ,
+// xsimd against libm. Measured (BatchLaneOps tests below): xsimd's atan2 is within 2.5 ulp of the
+// exact value and its sin/cos within 1.5 ulp; libm is within 0.5 (double) or 1.5 (float) ulp.
+// The tolerances, per valid row (ε of the precision T):
+//
+// - dirs -> P (encode only; the two sides see the same input and the same arithmetic up to the
+//   atan2 results): every coordinate within kUlps·ε·max(|x|, 1), azimuths compared on the
+//   circle. The error is absolute on the scale of 1 because of at most one cancellation against
+//   a quantity of order 1 (Δφ = φo − φi of the isotropic forms).
+// - P -> dirs and P -> Q (a decode is involved): a sin or cos one ulp off is amplified by the
+//   conditioning of the inverse map, up to √ε for ortho and hybrid at grazing, where
+//   z = √(1 − r²), and like ε/‖h̄‖ for the canonical pose of the isotropic forms when h̄ ≈ 0.
+//   No two implementations agree in ulps there. The check uses the error model of docs/math.md
+//   ("Accuracy") that param_test.cpp verifies for the round trip, bound(p) = ε / max(cond, √ε)
+//   with cond = 1 (spherical), ‖h‖ = cos θd (halfdiff), min(zi, zo) (ortho), (zi + zo)/2
+//   (hybrid), and for isotropic forms also ‖h̄‖ (the pose's rotation). P -> dirs: the pairs
+//   within kPair·bound_P; P -> Q: both outputs decoded by the reference within
+//   kPair·(bound_P + bound_Q) (each decode adds one round trip of Q).
+// - Jacobian: the batch's J against the reference formula at the same coordinates (the batch's
+//   own output, or the input when `to` is dirs), relative error within kUlps·ε·cond_J: 1 for
+//   spherical, 1 + 1/cos θd for halfdiff, 1 + 1/zi² + 1/zo² for ortho (zi from √(1 − r²)),
+//   1 + 2/√(hz² + c²) for hybrid (hz² + c² from the sincos of the azimuths).
+// - The valid flag must match exactly, and invalid rows must be NaN everywhere.
+constexpr double kUlps = 8;
+constexpr double kPair = 16;
+
+bool is_azimuth_column(Form f, std::size_t c) {
+  if (f.space == Space::dirs) return false;
+  return f.isotropic ? c == 2 : (c == 1 || c == 3);
+}
+
+double distance(Form f, std::size_t c, double a, double b) {
+  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b) ? 0 : INFINITY;
+  if (a == b) return 0;  // equal infinities too
+  const double d = std::abs(a - b);
+  return is_azimuth_column(f, c) ? std::min(d, test::kTwoPiD - d) : d;
+}
+
+// Error model of the inverse map of `form` at pair p (docs/math.md, "Accuracy"): the shape of
+// the pair is reproduced within ε / max(cond, √ε), cond = 1 (spherical), ‖h‖ = cos θd
+// (halfdiff), min(zi, zo) (ortho), (zi + zo)/2 (hybrid); the canonical pose of the isotropic
+// forms adds a rotation about n known to ε / ‖h̄‖.
+double shape_bound(Form form, const DirPair<double>& p, double eps) {
+  double cond = 1;
+  switch (form.space) {
+    case Space::dirs:
+    case Space::spherical:
+      break;
+    case Space::halfdiff:
+      cond = std::sqrt(std::max(0.0, 0.5 * (1 + detail::dot(p.wi, p.wo))));
+      break;
+    case Space::ortho:
+      cond = std::min(p.wi.z, p.wo.z);
+      break;
+    case Space::hybrid:
+      cond = 0.5 * (p.wi.z + p.wo.z);
+      break;
+  }
+  return eps / std::max(cond, std::sqrt(eps));
+}
+
+double pose_bound(Form form, const DirPair<double>& p, double eps) {
+  if (!form.isotropic) return 0;
+  const double hbar = 0.5 * std::hypot(p.wi.x + p.wo.x, p.wi.y + p.wo.y);
+  return hbar == 0 ? 0 : eps / hbar;
+}
+
+// Functions of a pair that do not depend on its rotation about n.
+std::array<double, 4> invariants(const DirPair<double>& p) {
+  return {p.wi.z, p.wo.z, detail::dot(p.wi, p.wo), p.wi.x * p.wo.y - p.wi.y * p.wo.x};
+}
+
+double max_abs_diff(const std::array<double, 4>& a, const std::array<double, 4>& b) {
+  double m = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double d = std::abs(a[i] - b[i]);
+    m = std::isnan(d) ? INFINITY : std::max(m, d);
+  }
+  return m;
+}
+
+// Relative error of the jacobian formula of `form` at coordinates q caused by sin/cos results one
+// ulp off, in units of ε (see above). The quantities the kernel computes identically on both
+// sides (hz², zi², zo² from the same products) are evaluated in the precision T, as the kernel
+// does: where they are at rounding level the jacobian has no significant digit.
+template <class T>
+double jacobian_condition(Form form, const T* q) {
+  const T q4[4] = {q[0], form.isotropic ? T(0) : q[1], form.isotropic ? q[1] : q[2],
+                   form.isotropic ? q[2] : q[3]};
+  switch (form.space) {
+    case Space::dirs:
+    case Space::spherical:
+      return 1;
+    case Space::halfdiff:
+      return 1 + 1 / std::abs(std::cos(double(q4[2])));
+    case Space::ortho: {
+      const T hx = q4[0] * std::cos(q4[1]), hy = q4[0] * std::sin(q4[1]);
+      const T kx = q4[2] * std::cos(q4[3]), ky = q4[2] * std::sin(q4[3]);
+      const T xi = hx + kx, yi = hy + ky, xo = hx - kx, yo = hy - ky;
+      const T zi2 = T(1) - (xi * xi + yi * yi), zo2 = T(1) - (xo * xo + yo * yo);
+      return 1 + 2 / std::abs(double(zi2)) + 2 / std::abs(double(zo2));
+    }
+    case Space::hybrid: {
+      const T hz2 = T(1) - q4[0] * q4[0] - q4[2] * q4[2];
+      const double hz = std::sqrt(std::max(double(hz2), 0.0));
+      const double c = double(q4[0]) * std::cos(double(q4[3]) - double(q4[1]));
+      return 1 + 4 * std::abs(c) * double(q4[0]) / (hz * hz + c * c);
+    }
+  }
+  return 1;
+}
+
+// The reference jacobian formula (scalar, precision T) at coordinates q of `form`.
+template <class T>
+T reference_jacobian(Form form, const T* q) {
+  if (form.space == Space::dirs) return T(1);
+  return visit_parameterization(
+      form.space, [&](auto p) { return detail::jacobian_of<decltype(p), T>(form.isotropic, q); });
+}
+
+template <class T>
+DirPair<double> pair_of(const T* v) {
+  return {{double(v[0]), double(v[1]), double(v[2])}, {double(v[3]), double(v[4]), double(v[5])}};
+}
+
+// The reference decode of a T tuple of `form` into a pair (the identity for dirs).
+template <class T>
+bool decode_reference(Form form, const T* q, DirPair<double>& p) {
+  T d[6];
+  if (form.space == Space::dirs) {
+    std::copy(q, q + 6, d);
+  } else if (!convert_one<T>(form, {Space::dirs, false}, std::span<const T>(q, dimension(form)),
+                             d)) {
+    return false;
+  }
+  p = pair_of(d);
+  return true;
+}
+
+struct Stats {
+  double raw = 0;      // worst difference in ε (of max(|x|, 1) for coordinates, of pairs)
+  double raw_jac = 0;  // worst relative jacobian difference, in ε
+  double ratio = 0;    // worst difference / tolerance
+  std::size_t invalid = 0;
+  void merge(const Stats& o) {
+    raw = std::max(raw, o.raw);
+    raw_jac = std::max(raw_jac, o.raw_jac);
+    ratio = std::max(ratio, o.ratio);
+    invalid = std::max(invalid, o.invalid);
+  }
+};
+
+template <class T>
+std::string row_text(const Table<T>& in, std::size_t i) {
+  std::string s;
+  char buf[40];
+  for (const auto& c : in) {
+    std::snprintf(buf, sizeof buf, " %.9g", static_cast<double>(c[i]));
+    s += buf;
+  }
+  return s;
+}
+
+// Compares a batch result with the scalar reference under the tolerances above.
+template <class T>
+Stats compare(Form from, Form to, const Table<T>& in, const Result<T>& got, const Result<T>& ref,
+              bool check_jac, const std::string& label) {
+  const double eps = std::numeric_limits<T>::epsilon();
+  const std::size_t n = in.empty() ? 0 : in[0].size(), din = dimension(from), dout = dimension(to);
+  const Form dirs{Space::dirs, false};
+  Stats st;
+  int reported = 0;
+  auto fail = [&](std::size_t i, const std::string& what) {
+    if (reported++ < 5)
+      ADD_FAILURE() << label << " row " << i << " (in:" << row_text(in, i) << "): " << what;
+  };
+  auto check = [&](std::size_t i, const char* what, double err, double tol, double unit) {
+    st.raw = std::max(st.raw, err / unit);
+    st.ratio = std::max(st.ratio, err / tol);
+    if (!(err <= tol)) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%s differ by %.3g ε (tolerance %.3g ε)", what, err / eps,
+                    tol / eps);
+      fail(i, buf);
+    }
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (got.valid[i] != ref.valid[i]) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "valid flag %d, reference %d", got.valid[i], ref.valid[i]);
+      fail(i, buf);
+      continue;
+    }
+    if (!ref.valid[i]) {
+      ++st.invalid;
+      for (std::size_t c = 0; c < dout; ++c)
+        if (!std::isnan(got.cols[c][i])) fail(i, "invalid row with a non-NaN output");
+      if (check_jac && !std::isnan(got.jac[i])) fail(i, "invalid row with a non-NaN jacobian");
+      continue;
+    }
+    T x[6], qb[6], qs[6];
+    for (std::size_t c = 0; c < din; ++c) x[c] = in[c][i];
+    for (std::size_t c = 0; c < dout; ++c) {
+      qb[c] = got.cols[c][i];
+      qs[c] = ref.cols[c][i];
+    }
+    if (from.space == Space::dirs) {
+      for (std::size_t c = 0; c < dout; ++c) {
+        const double unit = eps * std::max(std::abs(double(qs[c])), 1.0);
+        check(i, "coordinates", distance(to, c, qb[c], qs[c]), kUlps * unit, unit);
+      }
+    } else {
+      DirPair<double> p;  // the pair the reference decodes from the input
+      if (!decode_reference<T>(from, x, p)) {
+        fail(i, "reference decode failed");
+        continue;
+      }
+      const double shape = kPair * (shape_bound(from, p, eps) + shape_bound(to, p, eps));
+      const double pose = kPair * (pose_bound(from, p, eps) + pose_bound(to, p, eps));
+      DirPair<double> pb, ps;
+      if (!decode_reference<T>(to, qb, pb) || !decode_reference<T>(to, qs, ps)) {
+        fail(i, "an output does not decode");
+        continue;
+      }
+      check(i, "pairs", test::max_abs_diff(pb, ps), shape + pose, eps);
+      check(i, "rotation invariants", max_abs_diff(invariants(pb), invariants(ps)), 2 * shape, eps);
+    }
+    if (check_jac) {
+      const Form side = to.space != Space::dirs ? to : from;
+      const T* q = to.space != Space::dirs ? qb : x;
+      const double jb = got.jac[i], js = reference_jacobian<T>(side, q);
+      const double err = distance(dirs, 0, jb, js);
+      if (err == 0) continue;
+      const double rel_tol = kUlps * eps * jacobian_condition<T>(side, q);
+      if (rel_tol >= 1) continue;  // no significant digit (a singular configuration)
+      const double unit = eps * std::abs(js);
+      const double ratio = err / (rel_tol * std::abs(js));
+      st.raw_jac = std::max(st.raw_jac, err / unit);
+      st.ratio = std::max(st.ratio, ratio);
+      if (!(ratio <= 1)) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "jacobian %.9g vs reference %.9g (%.3g × tolerance)", jb, js,
+                      ratio);
+        fail(i, buf);
+      }
+    }
+  }
+  return st;
+}
+
+std::vector<DirPair<double>> test_pairs(std::size_t n_random, std::uint64_t seed) {
+  auto pairs = test::random_pairs(n_random, seed);
+  const auto edges = test::edge_pairs();
+  pairs.insert(pairs.end(), edges.begin(), edges.end());
+  // Azimuths just above 0 and just below 2π (the wrap of azimuth()), normal incidence.
+  for (double d : {1e-7, 1e-12, 1e-16}) {
+    pairs.push_back({test::direction(0.5, -d), test::direction(0.2, test::kTwoPiD - d)});
+    pairs.push_back({test::direction(0.5, d), test::direction(0.5, test::kPi + d)});
+    pairs.push_back({test::direction(1.0, 0.0), test::direction(0.5, -d)});
+  }
+  return pairs;
+}
+
+template <class T>
+class BatchTest : public ::testing::Test {};
+using Precisions = ::testing::Types<float, double>;
+class PrecisionNames {
+ public:
+  template <class T>
+  static std::string GetName(int) {
+    return sizeof(T) == 4 ? "float" : "double";
+  }
+};
+TYPED_TEST_SUITE(BatchTest, Precisions, PrecisionNames);
+
+TYPED_TEST(BatchTest, MatchesScalarReferenceForEveryPairOfForms) {
+  using T = TypeParam;
+  const auto pairs = test_pairs(10000, 77);
+  const auto isas = available_isas();
+  ASSERT_GE(isas.size(), 1u);
+  std::printf("  instruction sets:");
+  for (SimdIsa isa : isas) std::printf(" %s", std::string(detail::isa_name(isa)).c_str());
+  std::printf("\n  %-28s %10s %10s %8s %7s\n", "from -> to", "diff (ε)", "J diff (ε)", "diff/tol",
+              "invalid");
+  for (Form from : all_forms()) {
+    const Table<T> in = inputs_for<T>(from, pairs);
+    for (Form to : all_forms()) {
+      const Result<T> ref = run_scalar<T>(from, to, in);
+      Stats worst;
+      for (SimdIsa isa : isas) {
+        IsaGuard guard(isa);
+        ASSERT_TRUE(guard.ok());
+        const std::string label =
+            pair_name(from, to) + " [" + std::string(detail::isa_name(isa)) + "]";
+        const Result<T> got = run_batch<T>(from, to, in, true);
+        worst.merge(compare<T>(from, to, in, got, ref, true, label));
+        // Without the jacobian: the same coordinates and flags.
+        Result<T> plain = run_batch<T>(from, to, in, false);
+        plain.jac = got.jac;
+        EXPECT_TRUE(same_bits(plain, got)) << label << ": the jacobian changes the coordinates";
+      }
+      // The inputs are images of valid pairs: nearly all are valid (rounding a grazing tuple to
+      // float may leave the domain; the reference decides, and the batch must agree).
+      EXPECT_LE(worst.invalid, pairs.size() / 100) << pair_name(from, to);
+      std::printf("  %-28s %10.3g %10.3g %8.3f %7zu\n", pair_name(from, to).c_str(), worst.raw,
+                  worst.raw_jac, worst.ratio, worst.invalid);
+    }
+  }
+}
+
+// P -> Q is decode then encode through the same pair, bit for bit: the engine's composition of
+// stages (scratch, masks, tiles) adds nothing.
+TYPED_TEST(BatchTest, ParameterToParameterIsDecodeThenEncode) {
+  using T = TypeParam;
+  const auto pairs = test_pairs(3000, 5);
+  const Form dirs{Space::dirs, false};
+  for (SimdIsa isa : available_isas()) {
+    IsaGuard guard(isa);
+    for (Form from : all_forms()) {
+      if (from.space == Space::dirs) continue;
+      const Table<T> in = inputs_for<T>(from, pairs);
+      const Result<T> mid = run_batch<T>(from, dirs, in, false);
+      for (Form to : all_forms()) {
+        if (to.space == Space::dirs) continue;
+        const std::string label =
+            pair_name(from, to) + " [" + std::string(detail::isa_name(isa)) + "]";
+        const Result<T> direct = run_batch<T>(from, to, in, true);
+        const Result<T> composed = run_batch<T>(dirs, to, mid.cols, true);
+        std::size_t mismatches = 0;
+        for (std::size_t i = 0; i < pairs.size(); ++i) {
+          ASSERT_EQ(direct.valid[i], mid.valid[i]) << label << " row " << i;
+          if (!direct.valid[i]) continue;
+          ASSERT_TRUE(composed.valid[i]) << label << ": decoded pair rejected, row " << i;
+          bool same = std::memcmp(&direct.jac[i], &composed.jac[i], sizeof(T)) == 0;
+          for (std::size_t c = 0; c < dimension(to); ++c)
+            same = same && std::memcmp(&direct.cols[c][i], &composed.cols[c][i], sizeof(T)) == 0;
+          if (!same) ++mismatches;
+        }
+        EXPECT_EQ(mismatches, 0u) << label;
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Layouts
+// ---------------------------------------------------------------------------------------------
+
+// Row-major (AoS) input and output, strides 6/4/3 (and the jacobian interleaved with the
+// outputs), and a mix of strides including a reversed column, give the same bits as SoA.
+TYPED_TEST(BatchTest, StridedLayoutsGiveTheSameBitsAsSoa) {
+  using T = TypeParam;
+  auto pairs = test_pairs(1000, 9);
+  pairs.push_back({{0, 0, 2}, {0, 0, 1}});  // an invalid row (dirs input; wi not unit)
+  const std::size_t n = pairs.size();
+  for (SimdIsa isa : available_isas()) {
+    IsaGuard guard(isa);
+    for (Form from : all_forms()) {
+      const Table<T> in = inputs_for<T>(from, pairs);
+      const std::size_t din = dimension(from);
+      // AoS input.
+      std::vector<T> aos_in(n * din);
+      for (std::size_t r = 0; r < n; ++r)
+        for (std::size_t c = 0; c < din; ++c) aos_in[r * din + c] = in[c][r];
+      // Mixed input: column 0 reversed in memory (stride -1), column 1 with stride 3, rest SoA.
+      std::vector<T> rev(in[0].rbegin(), in[0].rend()), spaced(3 * n);
+      for (std::size_t r = 0; r < n; ++r) spaced[3 * r] = in[1][r];
+      for (Form to : all_forms()) {
+        const std::size_t dout = dimension(to);
+        const std::string label =
+            pair_name(from, to) + " [" + std::string(detail::isa_name(isa)) + "]";
+        const Result<T> soa = run_batch<T>(from, to, in, true);
+
+        std::vector<ConstColumn<T>> ic(din);
+        for (std::size_t c = 0; c < din; ++c)
+          ic[c] = {aos_in.data() + c, static_cast<std::ptrdiff_t>(din)};
+        const std::size_t row = dout + 1;  // outputs then the jacobian, row-major
+        std::vector<T> aos_out(n * row);
+        std::vector<Column<T>> oc(dout);
+        for (std::size_t c = 0; c < dout; ++c)
+          oc[c] = {aos_out.data() + c, static_cast<std::ptrdiff_t>(row)};
+        std::vector<std::uint8_t> valid(n, 7);
+        convert<T>(from, to, ic, n,
+                   {oc, {aos_out.data() + dout, static_cast<std::ptrdiff_t>(row)}, valid.data()});
+        Result<T> aos{make_table<T>(dout, n), std::vector<T>(n), valid};
+        for (std::size_t r = 0; r < n; ++r) {
+          for (std::size_t c = 0; c < dout; ++c) aos.cols[c][r] = aos_out[r * row + c];
+          aos.jac[r] = aos_out[r * row + dout];
+        }
+        EXPECT_TRUE(same_bits(aos, soa))
+            << label << ": AoS (stride " << din << " -> " << row << ")";
+
+        ic.clear();
+        for (std::size_t c = 0; c < din; ++c) ic.push_back({in[c].data(), 1});
+        ic[0] = {rev.data() + (n - 1), -1};
+        ic[1] = {spaced.data(), 3};
+        Result<T> mixed{make_table<T>(dout, n), std::vector<T>(2 * n),
+                        std::vector<std::uint8_t>(n)};
+        std::vector<T> out0(2 * n);
+        oc.clear();
+        for (std::size_t c = 0; c < dout; ++c) oc.push_back({mixed.cols[c].data(), 1});
+        oc[0] = {out0.data(), 2};
+        convert<T>(from, to, ic, n, {oc, {mixed.jac.data(), 2}, mixed.valid.data()});
+        for (std::size_t r = 0; r < n; ++r) {
+          mixed.cols[0][r] = out0[2 * r];
+          mixed.jac[r] = mixed.jac[2 * r];
+        }
+        mixed.jac.resize(n);
+        EXPECT_TRUE(same_bits(mixed, soa)) << label << ": mixed strides";
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Invalid rows
+// ---------------------------------------------------------------------------------------------
+
+// Rows the reference rejects, for each input form: not finite, not unit, below the horizon,
+// coordinates out of range, and in-range tuples whose directions would be below the horizon.
+template <class T>
+std::vector<std::vector<T>> invalid_rows(Form from) {
+  const T nan = std::numeric_limits<T>::quiet_NaN(), inf = std::numeric_limits<T>::infinity();
+  std::vector<std::vector<T>> rows;
+  if (from.space == Space::dirs) {
+    const std::vector<T> ok{0.6f, 0, 0.8f, 0, -0.28f, 0.96f};
+    for (std::size_t c = 0; c < 6; ++c)
+      for (T bad : {nan, inf, -inf}) {
+        rows.push_back(ok);
+        rows.back()[c] = bad;
+      }
+    rows.push_back({0.6f * 1.001f, 0, 0.8f * 1.001f, 0, -0.28f, 0.96f});  // |ωi|² − 1 = 2e-3
+    rows.push_back({0.6f, 0, 0.8f, 0, -0.28f * 0.5f, 0.96f * 0.5f});
+    rows.push_back({0, 0, 0, 0, 0, 1});
+    rows.push_back({0.6f, 0, -0.8f, 0, 0, 1});          // below the horizon
+    rows.push_back({0, 1, 0, 0, 0.9999995f, -0.001f});  // just below
+    const T tol = kDomainTolerance<T>;
+    rows.push_back({1, 0, T(-2) * tol, 0, 0, 1});  // beyond the horizon tolerance
+    return rows;
+  }
+  const std::size_t dim = dimension(from);
+  const bool angular = from.space == Space::spherical || from.space == Space::halfdiff;
+  // A valid tuple, and per column its upper limit (π/2 or 1 for magnitudes, 2π excluded).
+  std::vector<T> ok =
+      from.isotropic ? std::vector<T>{0.3f, 0.4f, 1.0f} : std::vector<T>{0.3f, 1.0f, 0.4f, 2.0f};
+  for (std::size_t c = 0; c < dim; ++c) {
+    const T upper = is_azimuth_column(from, c) ? T(kTwoPi<T>)
+                    : angular                  ? std::nextafter(T(kHalfPi<T>), T(4))
+                                               : std::nextafter(T(1), T(2));
+    for (T bad : {nan, inf, -inf, T(-0.1f), T(-1e-30f), upper, T(1e30f)}) {
+      rows.push_back(ok);
+      rows.back()[c] = bad;
+    }
+  }
+  // In range, outside the domain.
+  auto push = [&](std::vector<T> q4) {
+    if (from.isotropic) q4 = {q4[0], q4[2], q4[3]};  // φh = 0
+    rows.push_back(q4);
+  };
+  switch (from.space) {
+    case Space::spherical:
+      break;  // its domain is the box
+    case Space::halfdiff:
+      push({1.2f, 0, 1.2f, 0});        // ωi.z = cos 2.4 < 0
+      push({1.2f, 0, 1.2f, 3.1416f});  // ωo.z < 0
+      break;
+    case Space::ortho:
+      push({0.8f, 0, 0.8f, 0});      // |h̄ + k̄| = 1.6
+      push({0.8f, 0, 0.8f, 3.14f});  // |h̄ − k̄| > 1
+      push({0.9f, 0, 0.2f, 0.1f});
+      break;
+    case Space::hybrid:
+      push({0.8f, 0, 0.8f, 1.0f});  // ‖h̄‖² + ‖k‖² > 1
+      push({0.1f, 0, 0.99f, 0});    // k along h̄ with |kz| > hz
+      break;
+    case Space::dirs:
+      break;
+  }
+  return rows;
+}
+
+TYPED_TEST(BatchTest, InvalidRowsAreNanWithValidZero) {
+  using T = TypeParam;
+  const auto pairs = test_pairs(300, 21);
+  std::mt19937_64 rng(4);
+  for (SimdIsa isa : available_isas()) {
+    IsaGuard guard(isa);
+    for (Form from : all_forms()) {
+      const std::size_t din = dimension(from);
+      const Table<T> good = inputs_for<T>(from, pairs);
+      const auto bad = invalid_rows<T>(from);
+      // Interleave: every invalid row lands at a random place between valid ones, so vectors mix
+      // valid and invalid lanes.
+      Table<T> in = make_table<T>(din, 0);
+      std::vector<int> source;  // -1: invalid, else index in `good`
+      std::size_t next_bad = 0, next_good = 0;
+      while (next_bad < bad.size() || next_good < pairs.size()) {
+        const bool take_bad =
+            next_bad < bad.size() && (next_good == pairs.size() || rng() % 3 == 0);
+        for (std::size_t c = 0; c < din; ++c)
+          in[c].push_back(take_bad ? bad[next_bad][c] : good[c][next_good]);
+        source.push_back(take_bad ? -1 : static_cast<int>(next_good));
+        take_bad ? ++next_bad : ++next_good;
+      }
+      for (Form to : all_forms()) {
+        const std::string label =
+            pair_name(from, to) + " [" + std::string(detail::isa_name(isa)) + "]";
+        const Result<T> got = run_batch<T>(from, to, in, true);
+        const Result<T> ref = run_scalar<T>(from, to, in);
+        const Result<T> alone = run_batch<T>(from, to, good, true);
+        for (std::size_t i = 0; i < source.size(); ++i) {
+          ASSERT_EQ(got.valid[i], ref.valid[i]) << label << " row" << row_text(in, i);
+          if (source[i] < 0) {
+            ASSERT_EQ(ref.valid[i], 0) << label << ": test row is valid:" << row_text(in, i);
+            for (std::size_t c = 0; c < dimension(to); ++c)
+              ASSERT_TRUE(std::isnan(got.cols[c][i])) << label << row_text(in, i);
+            ASSERT_TRUE(std::isnan(got.jac[i])) << label << row_text(in, i);
+            continue;
+          }
+          // A valid row's result does not depend on its neighbours in the vector.
+          const auto g = static_cast<std::size_t>(source[i]);
+          bool same = std::memcmp(&got.jac[i], &alone.jac[g], sizeof(T)) == 0 &&
+                      got.valid[i] == alone.valid[g];
+          for (std::size_t c = 0; c < dimension(to); ++c)
+            same = same && std::memcmp(&got.cols[c][i], &alone.cols[c][g], sizeof(T)) == 0;
+          ASSERT_TRUE(same) << label << ": row" << row_text(in, i)
+                            << " changes with its neighbours";
+        }
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Threads and sizes
+// ---------------------------------------------------------------------------------------------
+
+template <class T>
+Table<T> big_input(Form from, std::size_t n) {
+  const auto pairs = test_pairs(5000, 31);
+  const Table<T> base = inputs_for<T>(from, pairs);
+  Table<T> t = make_table<T>(base.size(), n);
+  for (std::size_t r = 0; r < n; ++r)
+    for (std::size_t c = 0; c < base.size(); ++c)
+      t[c][r] = r % 1001 == 500 ? std::numeric_limits<T>::quiet_NaN() : base[c][r % pairs.size()];
+  return t;
+}
+
+const std::pair<Form, Form> kSampleConversions[] = {
+    {{Space::dirs, false}, {Space::halfdiff, false}},
+    {{Space::spherical, false}, {Space::hybrid, true}},
+    {{Space::ortho, false}, {Space::dirs, false}},
+    {{Space::halfdiff, true}, {Space::spherical, false}},
+};
+
+TYPED_TEST(BatchTest, ThreadCountsGiveIdenticalBits) {
+  using T = TypeParam;
+  const std::size_t n = 1000003;
+  for (const auto& [from, to] : kSampleConversions) {
+    const Table<T> in = big_input<T>(from, n);
+    const Result<T> one = run_batch<T>(from, to, in, true, 1);
+    for (unsigned threads : {2u, 7u, 0u}) {
+      const Result<T> many = run_batch<T>(from, to, in, true, threads);
+      EXPECT_TRUE(same_bits(many, one)) << pair_name(from, to) << ", " << threads << " threads";
+    }
+  }
+}
+
+TYPED_TEST(BatchTest, SizesIncludingEmptyAndTails) {
+  using T = TypeParam;
+  // n = 0 touches nothing, even through null columns.
+  {
+    std::vector<ConstColumn<T>> ic(6);
+    std::vector<Column<T>> oc(4);
+    EXPECT_NO_THROW(convert<T>({Space::dirs, false}, {Space::ortho, false}, ic, 0, {oc}));
+    T sentinel = T(42);
+    std::uint8_t valid = 9;
+    std::vector<ConstColumn<T>> ic4(4, ConstColumn<T>{&sentinel, 1});
+    std::vector<Column<T>> oc6(6, Column<T>{&sentinel, 1});
+    convert<T>({Space::hybrid, false}, {Space::dirs, false}, ic4, 0, {oc6, {&sentinel, 1}, &valid});
+    EXPECT_EQ(sentinel, T(42));
+    EXPECT_EQ(valid, 9);
+  }
+  // Small sizes (one partial vector) through every pair of forms and instruction set.
+  const auto pairs = test_pairs(0, 0);
+  for (std::size_t n : {std::size_t{1}, std::size_t{7}}) {
+    const std::vector<DirPair<double>> some(pairs.begin() + 40, pairs.begin() + 40 + n);
+    for (SimdIsa isa : available_isas()) {
+      IsaGuard guard(isa);
+      for (Form from : all_forms()) {
+        const Table<T> in = inputs_for<T>(from, some);
+        for (Form to : all_forms()) {
+          const std::string label = pair_name(from, to) + " n=" + std::to_string(n) + " [" +
+                                    std::string(detail::isa_name(isa)) + "]";
+          compare<T>(from, to, in, run_batch<T>(from, to, in, true), run_scalar<T>(from, to, in),
+                     true, label);
+        }
+      }
+    }
+  }
+  // A large size with a tail, threaded, against the reference.
+  for (const auto& [from, to] : kSampleConversions) {
+    const Table<T> in = big_input<T>(from, 1000003);
+    const Stats s = compare<T>(from, to, in, run_batch<T>(from, to, in, true, 0),
+                               run_scalar<T>(from, to, in), true, pair_name(from, to));
+    EXPECT_GE(s.invalid, 1000003u / 1001) << pair_name(from, to);
+  }
+}
+
+TEST(Batch, RejectsWrongShapes) {
+  std::vector<ConstColumn<double>> in6(6), in4(4);
+  std::vector<Column<double>> out4(4), out3(3), out6(6);
+  const Form dirs{Space::dirs, false}, sph{Space::spherical, false};
+  EXPECT_THROW(convert<double>(dirs, sph, in4, 1, {out4}), std::invalid_argument);
+  EXPECT_THROW(convert<double>(dirs, sph, in6, 1, {out3}), std::invalid_argument);
+  EXPECT_THROW(convert<double>(sph, {Space::dirs, true}, in4, 1, {out6}), std::invalid_argument);
+  EXPECT_THROW(convert<double>({Space::dirs, true}, sph, in6, 1, {out4}), std::invalid_argument);
+}
+
+TEST(Batch, DispatchPicksTheBestAvailableInstructionSet) {
+  const auto isas = available_isas();
+  ASSERT_FALSE(isas.empty());
+  EXPECT_EQ(isas.front(), SimdIsa::scalar);
+#if defined(__x86_64__)
+  EXPECT_NE(detail::kernels_for(SimdIsa::sse2), nullptr);  // the x86-64 baseline
+#endif
+  if (std::getenv("HALFBACK_ISA") == nullptr) {
+    EXPECT_EQ(detail::active_kernels().isa, isas.back());
+  }
+  for (SimdIsa isa : detail::kAllIsas) {
+    EXPECT_EQ(detail::isa_from_name(detail::isa_name(isa)), isa);
+    const bool available = detail::kernels_for(isa) != nullptr;
+    EXPECT_EQ(detail::set_batch_isa(isa), available);
+    if (available) {
+      EXPECT_EQ(detail::active_kernels().isa, isa);
+    }
+  }
+  detail::set_batch_isa(std::nullopt);
+  std::printf("  active: %s\n", std::string(detail::active_kernels().name).c_str());
+}
+
+// ---------------------------------------------------------------------------------------------
+// The xsimd LaneOps mapping (batch_simd.hpp), on the SSE2 batches this TU can run everywhere
+// ---------------------------------------------------------------------------------------------
+
+template <class S>
+using Sse2 = xsimd::batch<S, xsimd::sse2>;
+
+template <class S>
+std::vector<S> lanes(const Sse2<S>& b) {
+  std::vector<S> v(Sse2<S>::size);
+  b.store_unaligned(v.data());
+  return v;
+}
+
+template <class S>
+Sse2<S> make(std::initializer_list<S> v) {
+  std::vector<S> a(v);
+  a.resize(Sse2<S>::size, a.back());
+  return Sse2<S>::load_unaligned(a.data());
+}
+
+template <class S>
+double ulps(S got, long double exact) {
+  const S r = static_cast<S>(exact);
+  const S up = std::nextafter(std::abs(r), std::numeric_limits<S>::infinity());
+  const long double ulp = static_cast<long double>(up) - std::abs(r);
+  return static_cast<double>(std::abs(static_cast<long double>(got) - exact) / ulp);
+}
+
+template <class S>
+class BatchLaneOps : public ::testing::Test {};
+TYPED_TEST_SUITE(BatchLaneOps, Precisions, PrecisionNames);
+
+TYPED_TEST(BatchLaneOps, Atan2SpecialValuesMatchStd) {
+  using S = TypeParam;
+  using L = LaneOps<Sse2<S>>;
+  const S inf = std::numeric_limits<S>::infinity(), nan = std::numeric_limits<S>::quiet_NaN();
+  const S ys[] = {0, -S(0), 1, -1, inf, -inf, S(1e-30), nan};
+  const S xs[] = {0, -S(0), 1, -1, inf, -inf, S(1e-30), nan};
+  for (S y : ys)
+    for (S x : xs) {
+      const S got = lanes(L::atan2(make<S>({y}), make<S>({x})))[0];
+      const S want = std::atan2(y, x);
+      if (std::isnan(want)) {
+        EXPECT_TRUE(std::isnan(got)) << "atan2(" << y << ", " << x << ")";
+      } else {
+        EXPECT_LE(ulps<S>(got, want), 2.5) << "atan2(" << y << ", " << x << ")";
+        EXPECT_EQ(std::signbit(got), std::signbit(want)) << "atan2(" << y << ", " << x << ")";
+      }
+    }
+}
+
+TYPED_TEST(BatchLaneOps, MinMaxIgnoreNanLikeFminFmax) {
+  using S = TypeParam;
+  using L = LaneOps<Sse2<S>>;
+  const S nan = std::numeric_limits<S>::quiet_NaN();
+  const S vals[] = {nan, 1, -2, 0, -S(0)};
+  for (S a : vals)
+    for (S b : vals) {
+      const S mn = lanes(L::min(make<S>({a}), make<S>({b})))[0];
+      const S mx = lanes(L::max(make<S>({a}), make<S>({b})))[0];
+      const S fmn = std::fmin(a, b), fmx = std::fmax(a, b);
+      EXPECT_TRUE((std::isnan(mn) && std::isnan(fmn)) || mn == fmn) << a << " " << b;
+      EXPECT_TRUE((std::isnan(mx) && std::isnan(fmx)) || mx == fmx) << a << " " << b;
+    }
+}
+
+TYPED_TEST(BatchLaneOps, SincosLanesDoNotDependOnTheirNeighbours) {
+  using S = TypeParam;
+  using L = LaneOps<Sse2<S>>;
+  constexpr std::size_t W = Sse2<S>::size;
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<S> u(0, 7);
+  const S odd[] = {S(1e30), std::numeric_limits<S>::quiet_NaN(), S(1e5), S(100),
+                   std::numeric_limits<S>::infinity()};
+  for (int it = 0; it < 20000; ++it) {
+    std::vector<S> a(W), b(W);
+    for (auto& v : a) v = u(rng);
+    b = a;
+    b[W - 1] = odd[it % 5];  // a neighbour that needs another range reduction
+    Sse2<S> sa, ca, sb, cb;
+    L::sincos(Sse2<S>::load_unaligned(a.data()), sa, ca);
+    L::sincos(Sse2<S>::load_unaligned(b.data()), sb, cb);
+    const auto vsa = lanes(sa), vca = lanes(ca), vsb = lanes(sb), vcb = lanes(cb);
+    for (std::size_t k = 0; k + 1 < W; ++k) {
+      ASSERT_EQ(std::memcmp(&vsa[k], &vsb[k], sizeof(S)), 0) << a[k] << " next to " << b[W - 1];
+      ASSERT_EQ(std::memcmp(&vca[k], &vcb[k], sizeof(S)), 0) << a[k] << " next to " << b[W - 1];
+    }
+  }
+}
+
+// The accuracy the batch tolerances rely on (see the comment on kUlps).
+TYPED_TEST(BatchLaneOps, MathFunctionsAreAccurate) {
+  using S = TypeParam;
+  using L = LaneOps<Sse2<S>>;
+  constexpr std::size_t W = Sse2<S>::size;
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(-1, 1);
+  double worst_atan2 = 0, worst_sin = 0, worst_cos = 0;
+  for (int it = 0; it < 200000; ++it) {
+    std::vector<S> y(W), x(W), a(W);
+    for (std::size_t k = 0; k < W; ++k) {
+      y[k] = static_cast<S>(u(rng) * std::pow(10.0, 4 * u(rng)));
+      x[k] = static_cast<S>(u(rng) * std::pow(10.0, 4 * u(rng)));
+      a[k] = static_cast<S>((u(rng) + 1) * (it % 2 ? 3.2 : 0.8));  // [0, 6.4) and [0, 1.6)
+    }
+    const auto r =
+        lanes(L::atan2(Sse2<S>::load_unaligned(y.data()), Sse2<S>::load_unaligned(x.data())));
+    Sse2<S> s, c;
+    L::sincos(Sse2<S>::load_unaligned(a.data()), s, c);
+    const auto vs = lanes(s), vc = lanes(c);
+    for (std::size_t k = 0; k < W; ++k) {
+      worst_atan2 = std::max(worst_atan2, ulps<S>(r[k], atan2l(y[k], x[k])));
+      worst_sin = std::max(worst_sin, ulps<S>(vs[k], sinl(a[k])));
+      worst_cos = std::max(worst_cos, ulps<S>(vc[k], cosl(a[k])));
+    }
+  }
+  std::printf("  xsimd accuracy (ulp): atan2 %.2f, sin %.2f, cos %.2f\n", worst_atan2, worst_sin,
+              worst_cos);
+  EXPECT_LE(worst_atan2, 3.0);
+  EXPECT_LE(worst_sin, 2.0);
+  EXPECT_LE(worst_cos, 2.0);
+}
+
+}  // namespace
+}  // namespace halfback
