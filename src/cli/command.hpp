@@ -46,6 +46,7 @@ using RegisterCommand = Command (*)(CLI::App& parent);
 std::span<const RegisterCommand> command_table();
 
 Command register_convert(CLI::App& parent);
+Command register_render(CLI::App& parent);
 
 // "halfback COMMAND: warning: MESSAGE" on stderr.
 void warn(std::string_view command, std::string_view message);

@@ -7,8 +7,9 @@
 namespace halfback::cli {
 
 namespace {
-constexpr std::array<RegisterCommand, 1> kCommands{
+constexpr std::array<RegisterCommand, 2> kCommands{
     &register_convert,
+    &register_render,
 };
 }  // namespace
 
