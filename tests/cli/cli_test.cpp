@@ -1,0 +1,673 @@
+// Tests of the `halfback` binary (its path is HALFBACK_CLI_PATH): runs it with arguments and
+// standard input, and checks its standard output, standard error, exit status and files.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "halfback/core/batch.hpp"
+#include "halfback/core/space.hpp"
+#include "halfback/io/csv.hpp"
+
+extern char** environ;
+
+namespace halfback {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::string_literals;
+
+constexpr double kPi = std::numbers::pi;
+constexpr const char* kDirsHeader = "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n";
+
+struct Result {
+  int status = -1;  // exit status, or -1 when killed by a signal
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void put(const fs::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+class CliTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(testing::TempDir()) /
+           ("halfback_cli_test_" + std::to_string(getpid()) + "_" +
+            testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::permissions(dir_ / "ro", fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(dir_, ec);
+  }
+
+  fs::path path(const std::string& name) const { return dir_ / name; }
+
+  // Runs halfback with `args` in the test's directory, `input` on stdin.
+  Result run(const std::vector<std::string>& args, const std::string& input = "") const {
+    const fs::path in = path(".stdin"), out = path(".stdout"), err = path(".stderr");
+    put(in, input);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, in.c_str(), O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    std::vector<std::string> argv_storage{HALFBACK_CLI_PATH};
+    argv_storage.insert(argv_storage.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : argv_storage) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    const fs::path cwd = fs::current_path();
+    fs::current_path(dir_);
+    pid_t pid = 0;
+    const int rc = posix_spawn(&pid, HALFBACK_CLI_PATH, &actions, nullptr, argv.data(), environ);
+    fs::current_path(cwd);
+    posix_spawn_file_actions_destroy(&actions);
+    Result r;
+    if (rc != 0) {
+      ADD_FAILURE() << "cannot run " << HALFBACK_CLI_PATH << ": " << std::strerror(rc);
+      return r;
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    fs::remove(in);
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+  // The files of the test's directory, sorted (no leftover temporary files).
+  std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  fs::path dir_;
+};
+
+// Parses the tool's output (nan allowed).
+CsvTable parse(const std::string& text) {
+  CsvReadOptions options;
+  options.allow_non_finite = true;
+  return read_csv(text, "output", {}, options);
+}
+
+std::vector<std::string> header_of(std::span<const std::string_view> names,
+                                   std::vector<std::string> extra = {}) {
+  std::vector<std::string> h(names.begin(), names.end());
+  h.insert(h.end(), extra.begin(), extra.end());
+  return h;
+}
+
+// Well-conditioned pairs: away from the pole, the horizon, and the mirror and retro
+// configurations, where some coordinates are ill-defined.
+std::vector<DirPair<double>> well_conditioned_pairs(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> z(0.15, 0.95), phi(0, 2 * kPi);
+  std::vector<DirPair<double>> pairs;
+  while (pairs.size() < n) {
+    auto dir = [&] {
+      const double c = z(rng), s = std::sqrt((1 - c) * (1 + c)), p = phi(rng);
+      return Vec3<double>{s * std::cos(p), s * std::sin(p), c};
+    };
+    const DirPair<double> p{dir(), dir()};
+    const double hx = p.wi.x + p.wo.x, hy = p.wi.y + p.wo.y;
+    const double kx = p.wi.x - p.wo.x, ky = p.wi.y - p.wo.y;
+    if (std::hypot(hx, hy) < 0.1 || std::hypot(kx, ky) < 0.1) continue;
+    pairs.push_back(p);
+  }
+  return pairs;
+}
+
+std::string dirs_csv(const std::vector<DirPair<double>>& pairs) {
+  std::vector<std::vector<double>> c(6);
+  for (const auto& p : pairs) {
+    const double v[6] = {p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z};
+    for (int i = 0; i < 6; ++i) c[i].push_back(v[i]);
+  }
+  const auto names = column_names({Space::dirs, false});
+  const std::vector<std::string> header(names.begin(), names.end());
+  const std::vector<std::span<const double>> cols(c.begin(), c.end());
+  return to_csv(header, cols);
+}
+
+// Distance between two angles on the circle.
+double angle_diff(double a, double b) {
+  const double d = std::fmod(std::abs(a - b), 2 * kPi);
+  return std::min(d, 2 * kPi - d);
+}
+
+bool is_angle_column(std::string_view name) {
+  return name.rfind("phi", 0) == 0 || name == "dphi";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Help, version, usage errors
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(CliTest, HelpAndVersion) {
+  Result r = run({"--help"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("convert"), std::string::npos);
+  EXPECT_NE(r.out.find("Exit status"), std::string::npos);
+  r = run({"convert", "--help"});
+  EXPECT_EQ(r.status, 0);
+  for (const char* s : {"--from", "--to", "--isotropic", "--jacobian", "--skip-invalid", "--input",
+                        "--output", "Examples:", "hbar,phi_h,k,phi_k", "isotropic: hbar,k,dphi",
+                        "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  r = run({"--version"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, "halfback 0.1.0\n");
+}
+
+TEST_F(CliTest, UsageErrorsExitWithTwo) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::string hint = "Run 'halfback convert --help' for more information.\n";
+  const Case cases[] = {
+      {{"convert", "--from", "hybird", "--to", "dirs"},
+       "halfback convert: error: --from: unknown coordinates 'hybird' (expected one of: dirs, "
+       "spherical, halfdiff, ortho, hybrid)\n" +
+           hint},
+      {{"convert", "--from", "dirs", "--to", "polar"},
+       "halfback convert: error: --to: unknown coordinates 'polar' (expected one of: dirs, "
+       "spherical, halfdiff, ortho, hybrid)\n" +
+           hint},
+      {{"convert", "--from", "dirs"}, "halfback convert: error: --to is required\n" + hint},
+      {{"convert", "--from", "dirs", "--to", "hybrid", "--bogus"},
+       "halfback convert: error: The following argument was not expected: --bogus\n" + hint},
+      {{"convert", "--from", "dirs", "--to", "dirs", "--isotropic"},
+       "halfback convert: error: --isotropic needs a parameterization on one side (--from or "
+       "--to)\n" +
+           hint},
+      {{"convert", "--from", "dirs", "--to", "dirs", "--jacobian"},
+       "halfback convert: error: --jacobian needs a parameterization on one side (--from or "
+       "--to)\n" +
+           hint},
+  };
+  // (The list of commands grows: only its start is checked.)
+  Result r = run({});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err.rfind("halfback: error: a command is required (one of: convert", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(")\nRun 'halfback --help' for more information.\n"), std::string::npos);
+  r = run({"frobnicate"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(
+      r.err.rfind("halfback: error: unknown command 'frobnicate' (the commands are: convert", 0),
+      0u)
+      << r.err;
+  for (const Case& c : cases) {
+    r = run(c.args);
+    EXPECT_EQ(r.status, 2) << c.message;
+    EXPECT_EQ(r.err, c.message);
+    EXPECT_EQ(r.out, "");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Round trips
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(CliTest, RoundTripThroughEveryParameterization) {
+  const auto pairs = well_conditioned_pairs(500, 1);
+  put(path("pairs.csv"), dirs_csv(pairs));
+  for (Space space : kParameterizations) {
+    const std::string name(name_of(space));
+    SCOPED_TRACE(name);
+    Result r = run({"convert", "--from", "dirs", "--to", name, "-i", "pairs.csv", "-o", "p.csv"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(r.err, "");
+    const CsvTable q = parse(slurp(path("p.csv")));
+    EXPECT_EQ(q.header, header_of(column_names({space, false})));  // dirs input: no valid column
+    ASSERT_EQ(q.rows(), pairs.size());
+
+    r = run({"convert", "--from", name, "--to", "dirs", "-i", "p.csv", "-o", "back.csv"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const CsvTable back = parse(slurp(path("back.csv")));
+    EXPECT_EQ(back.header, header_of(column_names({Space::dirs, false}), {"valid"}));
+    ASSERT_EQ(back.rows(), pairs.size());
+    double worst = 0;
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const auto& p = pairs[i];
+      const double v[6] = {p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z};
+      for (int c = 0; c < 6; ++c) worst = std::max(worst, std::abs(back.columns[c][i] - v[c]));
+      EXPECT_EQ(back.columns[6][i], 1.0);
+    }
+    EXPECT_LE(worst, 1e-12);
+  }
+}
+
+TEST_F(CliTest, IsotropicRoundTrip) {
+  const auto pairs = well_conditioned_pairs(500, 2);
+  put(path("pairs.csv"), dirs_csv(pairs));
+  for (Space space : kParameterizations) {
+    const std::string name(name_of(space));
+    SCOPED_TRACE(name);
+    Result r = run({"convert", "--from", "dirs", "--to", name, "--isotropic", "-i", "pairs.csv",
+                    "-o", "q.csv"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const CsvTable q = parse(slurp(path("q.csv")));
+    ASSERT_EQ(q.header, header_of(column_names({space, true})));
+    ASSERT_EQ(q.rows(), pairs.size());
+
+    // The canonical pose: the same pair up to a rotation about n.
+    r = run({"convert", "--from", name, "--to", "dirs", "--isotropic", "-i", "q.csv", "-o",
+             "pose.csv"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const CsvTable pose = parse(slurp(path("pose.csv")));
+    ASSERT_EQ(pose.rows(), pairs.size());
+    double worst = 0;
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const auto& p = pairs[i];
+      const auto& c = pose.columns;
+      const double dot_in = p.wi.x * p.wo.x + p.wi.y * p.wo.y + p.wi.z * p.wo.z;
+      const double dot_out = c[0][i] * c[3][i] + c[1][i] * c[4][i] + c[2][i] * c[5][i];
+      worst = std::max({worst, std::abs(c[2][i] - p.wi.z), std::abs(c[5][i] - p.wo.z),
+                        std::abs(dot_out - dot_in)});
+      EXPECT_EQ(c[6][i], 1.0);
+    }
+    EXPECT_LE(worst, 1e-12);
+
+    // And back to the same isotropic coordinates.
+    r = run({"convert", "--from", "dirs", "--to", name, "--isotropic", "-i", "pose.csv", "-o",
+             "q2.csv"});
+    EXPECT_EQ(r.status, 1);  // pose.csv has a valid column: not a dirs header
+    EXPECT_NE(r.err.find("header does not match"), std::string::npos);
+    std::vector<std::string> six(pose.header.begin(), pose.header.begin() + 6);
+    std::vector<std::span<const double>> cols(pose.columns.begin(), pose.columns.begin() + 6);
+    put(path("pose6.csv"), to_csv(six, cols));
+    r = run({"convert", "--from", "dirs", "--to", name, "--isotropic", "-i", "pose6.csv"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const CsvTable q2 = parse(r.out);
+    ASSERT_EQ(q2.rows(), pairs.size());
+    worst = 0;
+    for (std::size_t c = 0; c < 3; ++c)
+      for (std::size_t i = 0; i < pairs.size(); ++i)
+        worst = std::max(worst, is_angle_column(q.header[c])
+                                    ? angle_diff(q2.columns[c][i], q.columns[c][i])
+                                    : std::abs(q2.columns[c][i] - q.columns[c][i]));
+    EXPECT_LE(worst, 1e-12);
+  }
+}
+
+TEST_F(CliTest, ParameterizationToParameterization) {
+  // hybrid -> halfdiff equals dirs -> halfdiff, 4D and isotropic.
+  const auto pairs = well_conditioned_pairs(200, 3);
+  put(path("pairs.csv"), dirs_csv(pairs));
+  for (bool iso : {false, true}) {
+    std::vector<std::string> extra;
+    if (iso) extra.push_back("--isotropic");
+    auto args = [&](std::vector<std::string> a) {
+      a.insert(a.end(), extra.begin(), extra.end());
+      return a;
+    };
+    ASSERT_EQ(run(args({"convert", "--from", "dirs", "--to", "hybrid", "-i", "pairs.csv", "-o",
+                        "hy.csv"}))
+                  .status,
+              0);
+    const Result direct =
+        run(args({"convert", "--from", "dirs", "--to", "halfdiff", "-i", "pairs.csv"}));
+    const Result via =
+        run(args({"convert", "--from", "hybrid", "--to", "halfdiff", "-i", "hy.csv"}));
+    ASSERT_EQ(direct.status, 0);
+    ASSERT_EQ(via.status, 0) << via.err;
+    const CsvTable a = parse(direct.out), b = parse(via.out);
+    EXPECT_EQ(b.header, header_of(column_names({Space::halfdiff, iso}), {"valid"}));
+    ASSERT_EQ(b.rows(), a.rows());
+    for (std::size_t c = 0; c < a.header.size(); ++c)
+      for (std::size_t i = 0; i < a.rows(); ++i) {
+        const double d = is_angle_column(a.header[c]) ? angle_diff(a.columns[c][i], b.columns[c][i])
+                                                      : std::abs(a.columns[c][i] - b.columns[c][i]);
+        ASSERT_LE(d, 1e-12) << a.header[c] << " row " << i;
+      }
+  }
+}
+
+TEST_F(CliTest, StdinStdoutAndDash) {
+  const std::string in = std::string(kDirsHeader) + "0,0,1,0.6,0,0.8\n";
+  const Result a = run({"convert", "--from", "dirs", "--to", "halfdiff"}, in);
+  const Result b = run({"convert", "--from", "dirs", "--to", "halfdiff", "-i", "-", "-o", "-"}, in);
+  put(path("in.csv"), in);
+  const Result c = run({"convert", "--from", "dirs", "--to", "halfdiff", "--input", "in.csv"});
+  ASSERT_EQ(a.status, 0);
+  EXPECT_EQ(a.out,
+            "theta_h,phi_h,theta_d,phi_d\n"
+            "0.32175055439664219,0,0.32175055439664224,3.1415926535897931\n");
+  EXPECT_EQ(b.out, a.out);
+  EXPECT_EQ(c.out, a.out);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"in.csv"}));
+}
+
+TEST_F(CliTest, CrlfBlanksAndTrailingLines) {
+  const std::string in =
+      "\xEF\xBB\xBF wi_x , wi_y,wi_z,wo_x,wo_y,wo_z\r\n 0 , 0 "
+      ",1,0.6,0,0.8\r\n0,0,1,0.6,0,0.8\r\n\r\n";
+  const Result r = run({"convert", "--from", "dirs", "--to", "halfdiff"}, in);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(parse(r.out).rows(), 2u);
+}
+
+TEST_F(CliTest, HeaderOnlyInputGivesHeaderOnlyOutput) {
+  Result r = run({"convert", "--from", "dirs", "--to", "hybrid", "--jacobian"}, kDirsHeader);
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, "hbar,phi_h,k,phi_k,jacobian\n");
+  r = run({"convert", "--from", "ortho", "--to", "dirs", "--isotropic"}, "hbar,kbar,dphi");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z,valid\n");
+}
+
+TEST_F(CliTest, InputAndOutputMayBeTheSameFile) {
+  put(path("data.csv"), std::string(kDirsHeader) + "0,0,1,0.6,0,0.8\n");
+  const Result r =
+      run({"convert", "--from", "dirs", "--to", "ortho", "-i", "data.csv", "-o", "data.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(
+      slurp(path("data.csv")),
+      "hbar,phi_h,kbar,phi_k\n0.29999999999999999,0,0.29999999999999999,3.1415926535897931\n");
+  EXPECT_EQ(entries(), (std::vector<std::string>{"data.csv"}));
+}
+
+TEST_F(CliTest, ManyRows) {
+  const auto pairs = well_conditioned_pairs(30000, 4);  // several tiles: the threaded path
+  const Result q = run({"convert", "--from", "dirs", "--to", "hybrid"}, dirs_csv(pairs));
+  ASSERT_EQ(q.status, 0) << q.err;
+  const Result back = run({"convert", "--from", "hybrid", "--to", "dirs"}, q.out);
+  ASSERT_EQ(back.status, 0) << back.err;
+  const CsvTable t = parse(back.out);
+  ASSERT_EQ(t.rows(), pairs.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    worst = std::max(worst, std::abs(t.columns[0][i] - pairs[i].wi.x));
+    worst = std::max(worst, std::abs(t.columns[5][i] - pairs[i].wo.z));
+  }
+  EXPECT_LE(worst, 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------------
+// valid and jacobian columns
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(CliTest, JacobianColumnMatchesTheLibraryAndTheSphericalFormula) {
+  const auto pairs = well_conditioned_pairs(100, 5);
+  put(path("pairs.csv"), dirs_csv(pairs));
+  for (Space space : kParameterizations) {
+    for (bool iso : {false, true}) {
+      const std::string name(name_of(space));
+      SCOPED_TRACE(name + (iso ? " isotropic" : ""));
+      std::vector<std::string> args{"convert",    "--from", "dirs",      "--to", name,
+                                    "--jacobian", "-i",     "pairs.csv", "-o",   "q.csv"};
+      if (iso) args.push_back("--isotropic");
+      Result r = run(args);
+      ASSERT_EQ(r.status, 0) << r.err;
+      const CsvTable q = parse(slurp(path("q.csv")));
+      ASSERT_EQ(q.header, header_of(column_names({space, iso}), {"jacobian"}));
+      // And from the parameterization back to dirs: the jacobian of the input tuple.
+      args = {"convert", "--from", name, "--to", "dirs", "--jacobian", "-i", "q.csv"};
+      if (iso) args.push_back("--isotropic");
+      std::vector<std::string> coords(q.header.begin(), q.header.end() - 1);
+      std::vector<std::span<const double>> cols(q.columns.begin(), q.columns.end() - 1);
+      put(path("q.csv"), to_csv(coords, cols));
+      r = run(args);
+      ASSERT_EQ(r.status, 0) << r.err;
+      const CsvTable back = parse(r.out);
+      ASSERT_EQ(back.header, header_of(column_names({Space::dirs, false}), {"valid", "jacobian"}));
+
+      const Form to{space, iso};
+      const std::size_t dim = dimension(to);
+      for (std::size_t i = 0; i < pairs.size(); ++i) {
+        const auto& p = pairs[i];
+        const double in[6] = {p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z};
+        double out[4], jac = 0;
+        ASSERT_TRUE(convert_one<double>({Space::dirs, false}, to, in, std::span(out, dim), &jac));
+        const double j = q.columns[dim][i];
+        EXPECT_NEAR(j, jac, 1e-12 * std::abs(jac)) << i;
+        EXPECT_NEAR(back.columns[7][i], jac, 1e-10 * std::abs(jac)) << i;
+        EXPECT_EQ(back.columns[6][i], 1.0);
+        if (space == Space::spherical) {  // dwi dwo = sin(theta_i) sin(theta_o) dq
+          const double expected = std::sqrt(1 - p.wi.z * p.wi.z) * std::sqrt(1 - p.wo.z * p.wo.z) *
+                                  (iso ? 2 * kPi : 1.0);
+          EXPECT_NEAR(j, expected, 1e-12 * expected) << i;
+        }
+      }
+    }
+  }
+}
+
+TEST_F(CliTest, OutOfDomainTuplesAreValidZeroRows) {
+  const std::string in =
+      "hbar,phi_h,k,phi_k\n"
+      "0.3,0,0.3,0\n"   // valid
+      "0.9,0,0.9,0\n"   // outside the domain
+      "0.3,7,0.3,0\n"   // azimuth out of range
+      "0.3,1,0.2,2\n";  // valid
+  const Result r = run({"convert", "--from", "hybrid", "--to", "dirs", "--jacobian"}, in);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");  // not an error, not a warning
+  const CsvTable t = parse(r.out);
+  ASSERT_EQ(t.header, header_of(column_names({Space::dirs, false}), {"valid", "jacobian"}));
+  ASSERT_EQ(t.rows(), 4u);
+  EXPECT_EQ(t.columns[6], (std::vector<double>{1, 0, 0, 1}));
+  for (std::size_t row : {1u, 2u})
+    for (std::size_t c : {0u, 1u, 2u, 3u, 4u, 5u, 7u}) EXPECT_TRUE(std::isnan(t.columns[c][row]));
+  for (std::size_t row : {0u, 3u})
+    for (std::size_t c : {0u, 1u, 2u, 3u, 4u, 5u, 7u})
+      EXPECT_TRUE(std::isfinite(t.columns[c][row]));
+  // The invalid rows print `nan` (not -nan).
+  EXPECT_NE(r.out.find("\nnan,nan,nan,nan,nan,nan,0,nan\n"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input
+// ---------------------------------------------------------------------------------------------
+
+struct BadInput {
+  std::string name;
+  std::vector<std::string> args;
+  std::string input;
+  std::string message;  // stderr after "halfback convert: error: "
+};
+
+TEST_F(CliTest, BadInputIsAnErrorNamingTheLine) {
+  const std::string h = kDirsHeader, ok = "0,0,1,0.6,0,0.8\n";
+  const std::vector<std::string> d2h{"convert", "--from", "dirs", "--to", "hybrid", "-i", "in.csv"};
+  const BadInput cases[] = {
+      {"wrong column count", d2h, h + ok + ok + "0,0,1,0.6,0\n",
+       "in.csv:4: expected 6 fields (wi_x,wi_y,wi_z,wo_x,wo_y,wo_z), found 5"},
+      {"trailing comma", d2h, h + ok + "0,0,1,0.6,0,0.8,\n",
+       "in.csv:3: expected 6 fields (wi_x,wi_y,wi_z,wo_x,wo_y,wo_z), found 7 (a trailing comma?)"},
+      {"not a number", d2h, h + ok + "0,0,1,0.6,zero,0.8\n",
+       "in.csv:3: column wo_y: 'zero' is not a number"},
+      {"empty field", d2h, h + "0,0,1,,0,0.8\n", "in.csv:2: column wo_x: empty field"},
+      {"nan", d2h, h + ok + "0,0,1,0.6,nan,0.8\n",
+       "in.csv:3: column wo_y: 'nan' is not a finite number"},
+      {"inf", d2h, h + "0,0,inf,0.6,0,0.8\n",
+       "in.csv:2: column wi_z: 'inf' is not a finite number"},
+      {"out of range", d2h, h + "0,0,1e999,0.6,0,0.8\n",
+       "in.csv:2: column wi_z: '1e999' is out of the range of a double"},
+      {"not unit", d2h, h + ok + ok + ok + "0,0,1,0.6,0,0.8002\n",
+       "in.csv:5: wo is not a unit vector (|wo|^2 - 1 = 3.2e-04)"},
+      {"wi not unit", d2h, h + "0,0,0.5,0.6,0,0.8\n",
+       "in.csv:2: wi is not a unit vector (|wi|^2 - 1 = -7.5e-01)"},
+      {"below horizon", d2h, h + ok + "0.6,0,-0.8,0,0,1\n",
+       "in.csv:3: wi is below the horizon (wi_z < 0): wi_z = -0.8"},
+      {"wo below horizon", d2h, h + "0,0,1,0.6,0,-0.8\n",
+       "in.csv:2: wo is below the horizon (wo_z < 0): wo_z = -0.8"},
+      {"blank line inside", d2h, h + ok + "\n" + ok,
+       "in.csv:3: empty line inside the data (blank lines are allowed only at the end)"},
+      {"empty file", d2h, "", "in.csv: the input is empty (expected a header row)"},
+      {"no header", d2h, ok + ok,
+       "in.csv:1: header does not match: expected 'wi_x,wi_y,wi_z,wo_x,wo_y,wo_z', found "
+       "'0,0,1,0.6,0,0.8'; the first line looks like data: the input needs a header row"},
+      {"header of another form", d2h, "theta_h,phi_h,theta_d,phi_d\n0.1,0,0.1,0\n",
+       "in.csv:1: header does not match: expected 'wi_x,wi_y,wi_z,wo_x,wo_y,wo_z', found "
+       "'theta_h,phi_h,theta_d,phi_d'; these are the columns of '--from halfdiff'"},
+      {"isotropic header without --isotropic",
+       {"convert", "--from", "ortho", "--to", "dirs", "-i", "in.csv"},
+       "hbar,kbar,dphi\n",
+       "in.csv:1: header does not match: expected 'hbar,phi_h,kbar,phi_k', found "
+       "'hbar,kbar,dphi'; these are the columns of '--from ortho --isotropic'"},
+      {"4D header with --isotropic",
+       {"convert", "--from", "ortho", "--to", "dirs", "--isotropic", "-i", "in.csv"},
+       "hbar,phi_h,kbar,phi_k\n",
+       "in.csv:1: header does not match: expected 'hbar,kbar,dphi', found "
+       "'hbar,phi_h,kbar,phi_k'; these are the columns of '--from ortho' (without --isotropic)"},
+      {"columns reordered", d2h, "wi_x,wi_y,wi_z,wo_y,wo_x,wo_z\n" + ok,
+       "in.csv:1: header does not match: expected 'wi_x,wi_y,wi_z,wo_x,wo_y,wo_z', found "
+       "'wi_x,wi_y,wi_z,wo_y,wo_x,wo_z'"},
+      {"nan in a parameterization",
+       {"convert", "--from", "halfdiff", "--to", "dirs", "-i", "in.csv"},
+       "theta_h,phi_h,theta_d,phi_d\n0.1,0,0.1,0\n0.1,NaN,0.1,0\n",
+       "in.csv:3: column phi_h: 'NaN' is not a finite number"},
+      {"unterminated quote", d2h, h + "0,0,1,\"0.6,0,0.8\n", "in.csv:2: unterminated quoted field"},
+  };
+  for (const BadInput& c : cases) {
+    SCOPED_TRACE(c.name);
+    put(path("in.csv"), c.input);
+    const Result r = run(c.args);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.err, "halfback convert: error: " + c.message + "\n");
+    EXPECT_EQ(r.out, "");  // nothing on stdout
+  }
+}
+
+TEST_F(CliTest, StdinIsNamedInMessages) {
+  const Result r = run({"convert", "--from", "dirs", "--to", "ortho"},
+                       std::string(kDirsHeader) + "1,0,0,0,1,0.5\n");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err,
+            "halfback convert: error: <stdin>:2: wo is not a unit vector (|wo|^2 - 1 = 2.5e-01)\n");
+}
+
+TEST_F(CliTest, SkipInvalidWritesValidZeroRows) {
+  const std::string in = std::string(kDirsHeader) +
+                         "0,0,1,0.6,0,0.8\n"     // 2 ok
+                         "0,0,1,0.6,0,0.8002\n"  // 3 not unit
+                         "0,0,1,0.6,nan,0.8\n"   // 4 nan
+                         "0,0,1,0.6,0\n"         // 5 wrong count
+                         "0,0,1,x,0,0.8\n"       // 6 not a number
+                         "0.6,0,-0.8,0,0,1\n"    // 7 below the horizon
+                         "0,0,1,0,0,1\n";        // 8 ok
+  const Result r =
+      run({"convert", "--from", "dirs", "--to", "halfdiff", "--jacobian", "--skip-invalid"}, in);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err,
+            "halfback convert: warning: 5 invalid input rows written with valid = 0; the first: "
+            "<stdin>:3: wo is not a unit vector (|wo|^2 - 1 = 3.2e-04)\n");
+  const CsvTable t = parse(r.out);
+  ASSERT_EQ(t.header, header_of(column_names({Space::halfdiff, false}), {"valid", "jacobian"}));
+  ASSERT_EQ(t.rows(), 7u);
+  EXPECT_EQ(t.columns[4], (std::vector<double>{1, 0, 0, 0, 0, 0, 1}));
+  for (std::size_t row = 1; row <= 5; ++row)
+    for (std::size_t c : {0u, 1u, 2u, 3u, 5u}) EXPECT_TRUE(std::isnan(t.columns[c][row]));
+  EXPECT_TRUE(std::isfinite(t.columns[0][0]));
+  EXPECT_TRUE(std::isfinite(t.columns[0][6]));
+
+  // A parameterization input: a NaN row becomes a valid = 0 row, like an out-of-domain one.
+  const Result p = run({"convert", "--from", "hybrid", "--to", "dirs", "--skip-invalid"},
+                       "hbar,phi_h,k,phi_k\n0.3,0,0.3,0\nnan,0,0.3,0\n0.9,0,0.9,0\n");
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_EQ(p.err,
+            "halfback convert: warning: 1 invalid input row written with valid = 0; the first: "
+            "<stdin>:3: column hbar: 'nan' is not a finite number\n");
+  EXPECT_EQ(parse(p.out).columns[6], (std::vector<double>{1, 0, 0}));
+}
+
+TEST_F(CliTest, MissingInputFile) {
+  const Result r = run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "missing.csv"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err,
+            "halfback convert: error: cannot read 'missing.csv': No such file or directory\n");
+  EXPECT_EQ(r.out, "");
+}
+
+TEST_F(CliTest, UnwritableOutput) {
+  put(path("in.csv"), std::string(kDirsHeader) + "0,0,1,0.6,0,0.8\n");
+  put(path("file"), "x");
+  Result r =
+      run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "in.csv", "-o", "nodir/out.csv"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err,
+            "halfback convert: error: cannot write 'nodir/out.csv': No such file or directory\n");
+  r = run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "in.csv", "-o", "file/out.csv"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "halfback convert: error: cannot write 'file/out.csv': Not a directory\n");
+  r = run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "in.csv", "-o", "."});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "halfback convert: error: cannot write '.': Is a directory\n");
+  if (geteuid() != 0) {  // root ignores directory permissions
+    fs::create_directory(path("ro"));
+    fs::permissions(path("ro"), fs::perms::owner_read | fs::perms::owner_exec);
+    r = run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "in.csv", "-o", "ro/out.csv"});
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.err, "halfback convert: error: cannot write 'ro/out.csv': Permission denied\n");
+  }
+  EXPECT_EQ(entries(), (std::vector<std::string>{"file", "in.csv"}));
+}
+
+TEST_F(CliTest, ExistingOutputIsKeptWhenTheInputIsBad) {
+  put(path("out.csv"), "precious\n");
+  const std::vector<std::string> bad_inputs = {
+      std::string(kDirsHeader) + "0,0,1,0.6,0,0.8\n0,0,1,0.6,0,0.9\n",  // not unit (line 3)
+      std::string(kDirsHeader) + "0,0,1,0.6\n",                         // column count
+      "theta_h,phi_h,theta_d,phi_d\n",                                  // header
+      "",                                                               // empty
+  };
+  for (const auto& bad : bad_inputs) {
+    put(path("in.csv"), bad);
+    const Result r =
+        run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "in.csv", "-o", "out.csv"});
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(slurp(path("out.csv")), "precious\n");
+    EXPECT_EQ(entries(), (std::vector<std::string>{"in.csv", "out.csv"}));
+  }
+  // A missing input and a usage error leave it too.
+  EXPECT_EQ(run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "nope.csv", "-o", "out.csv"})
+                .status,
+            1);
+  EXPECT_EQ(
+      run({"convert", "--from", "dirs", "--to", "dirs", "--isotropic", "-o", "out.csv"}).status, 2);
+  EXPECT_EQ(slurp(path("out.csv")), "precious\n");
+  EXPECT_EQ(entries(), (std::vector<std::string>{"in.csv", "out.csv"}));
+
+  // A good input replaces it.
+  put(path("in.csv"), std::string(kDirsHeader) + "0,0,1,0,0,1\n");
+  const Result r =
+      run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "in.csv", "-o", "out.csv"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(path("out.csv")), "hbar,phi_h,k,phi_k\n0,0,0,0\n");
+}
+
+}  // namespace
+}  // namespace halfback
