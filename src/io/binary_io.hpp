@@ -1,10 +1,7 @@
-// Little-endian decoding/encoding and an atomic whole-file write, shared by the binary readers and
-// writers in src/io (private header).
+// Little-endian decoding/encoding and whole-file reading, shared by the binary readers and writers
+// in src/io (private header).
 #pragma once
 
-#include <unistd.h>
-
-#include <atomic>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -68,42 +65,6 @@ inline std::string read_file_bytes(const std::filesystem::path& path, std::uintm
 
 inline std::span<const std::byte> as_bytes(const std::string& s) {
   return {reinterpret_cast<const std::byte*>(s.data()), s.size()};
-}
-
-// Writes `bytes` to a temporary file beside `path` and renames it over `path`: readers never see a
-// partial file, and nothing is left behind on error. Throws FormatError.
-inline void write_file_atomically(const std::filesystem::path& path,
-                                  std::span<const std::byte> bytes) {
-  namespace fs = std::filesystem;
-  const std::string name = path.string();
-  static std::atomic<std::uint64_t> counter{0};  // distinct names within a process
-  // (Built with += : GCC 12 warns falsely (-Wrestrict) on "literal" + std::string&&.)
-  std::string tmp_name(1, '.');
-  tmp_name += path.filename().string();
-  tmp_name += ".tmp-";
-  tmp_name += std::to_string(::getpid());
-  tmp_name += '-';
-  tmp_name += std::to_string(++counter);
-  const fs::path tmp = path.parent_path() / tmp_name;
-  std::error_code ec;
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw FormatError(name, "write", "cannot create temporary file " + tmp.string());
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(tmp, ec);
-      throw FormatError(name, "write", "write error (disk full?) on " + tmp.string());
-    }
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignore;
-    fs::remove(tmp, ignore);
-    throw FormatError(name, "write", "cannot rename temporary file into place: " + ec.message());
-  }
 }
 
 }  // namespace halfback::io_detail

@@ -5,10 +5,12 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <system_error>
 
 #include "../brdf/parallel_for.hpp"
 #include "binary_io.hpp"
 #include "halfback/core/param.hpp"
+#include "halfback/io/atomic_file.hpp"
 #include "halfback/io/format_error.hpp"
 
 namespace halfback {
@@ -304,7 +306,13 @@ void write_merl(const std::filesystem::path& path, const MerlData& data) {
   for (int i = 0; i < 3; ++i) store_le<std::int32_t>(bytes.data() + 4 * i, kDims[i]);
   for (std::size_t i = 0; i < data.values.size(); ++i)
     store_le<double>(bytes.data() + merl::kHeaderBytes + 8 * i, data.values[i]);
-  io_detail::write_file_atomically(path, bytes);
+  try {
+    AtomicFile file(path);  // temporary file + rename: no partial file on error
+    file.write(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+    file.commit();
+  } catch (const std::system_error& e) {
+    throw FormatError(path.string(), "write", e.what());
+  }
 }
 
 void write_merl(const std::filesystem::path& path, const Brdf& brdf) {
