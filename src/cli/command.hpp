@@ -47,6 +47,7 @@ std::span<const RegisterCommand> command_table();
 
 Command register_convert(CLI::App& parent);
 Command register_render(CLI::App& parent);
+Command register_figure(CLI::App& parent);
 
 // "halfback COMMAND: warning: MESSAGE" on stderr.
 void warn(std::string_view command, std::string_view message);

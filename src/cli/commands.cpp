@@ -7,9 +7,10 @@
 namespace halfback::cli {
 
 namespace {
-constexpr std::array<RegisterCommand, 2> kCommands{
+constexpr std::array<RegisterCommand, 3> kCommands{
     &register_convert,
     &register_render,
+    &register_figure,
 };
 }  // namespace
 

@@ -11,6 +11,7 @@
 // destination fails before any drawing, and no partial file is left behind.
 #include <fmt/format.h>
 
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -32,9 +33,11 @@ namespace {
 
 using figure::Format;
 
+// Lists are taken as one comma-separated string each and split here, so that an empty list or a
+// bad item gets a message naming the option.
 struct HemisphereArgs {
-  std::vector<std::string> params{"halfdiff", "ortho", "hybrid"};
-  std::vector<double> elevations{0, 40, 80};
+  std::string params = "halfdiff,ortho,hybrid";
+  std::string elevations = "0,40,80";
   std::string projection = "equal-area";
   std::string centre = "normal";
   double scale = 2;
@@ -45,9 +48,9 @@ struct HemisphereArgs {
 
 struct SliceArgs {
   std::string brdf = "test:S,G,F";
-  std::vector<std::string> params{"halfdiff", "ortho", "hybrid"};
-  std::vector<double> azimuths{0, 45, 90};
-  std::vector<double> levels{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
+  std::string params = "halfdiff,ortho,hybrid";
+  std::string azimuths = "0,45,90";
+  std::string levels = "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9";
   std::string colour = "luminance";
   double scale = 2;
   unsigned threads = 0;
@@ -56,14 +59,46 @@ struct SliceArgs {
 
 struct PaperArgs {
   std::string out;
-  std::vector<std::string> formats{"png", "svg", "pdf"};
+  std::string formats = "png,svg,pdf";
   unsigned threads = 0;
 };
 
-std::vector<Space> parameterizations(const std::vector<std::string>& names) {
-  if (names.empty()) throw UsageError("--param: no parameterization given");
+// "a,b,c" -> {"a", "b", "c"}, items trimmed of spaces; an empty list or item is a usage error.
+std::vector<std::string> split_list(const std::string& list, const char* option, const char* what) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  const auto trimmed = [](std::string t) {
+    const auto b = t.find_first_not_of(' ');
+    if (b == std::string::npos) return std::string();
+    return t.substr(b, t.find_last_not_of(' ') - b + 1);
+  };
+  if (trimmed(list).empty()) throw UsageError(fmt::format("{}: no {} given", option, what));
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    std::string item = trimmed(list.substr(start, comma - start));
+    if (item.empty())
+      throw UsageError(fmt::format("{} '{}': empty item in the list", option, list));
+    items.push_back(std::move(item));
+    start = comma + 1;
+  }
+  return items;
+}
+
+std::vector<double> number_list(const std::string& list, const char* option, const char* what) {
+  std::vector<double> values;
+  for (const std::string& item : split_list(list, option, what)) {
+    double v = 0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (ec != std::errc() || end != item.data() + item.size() || !std::isfinite(v))
+      throw UsageError(fmt::format("{}: '{}' is not a number", option, item));
+    values.push_back(v);
+  }
+  return values;
+}
+
+std::vector<Space> parameterizations(const std::string& list) {
   std::vector<Space> spaces;
-  for (const std::string& n : names) {
+  for (const std::string& n : split_list(list, "--param", "parameterization")) {
     const auto s = space_from_name(n);
     if (!s || *s == Space::dirs)
       throw UsageError(fmt::format(
@@ -101,12 +136,11 @@ int run_hemisphere(const HemisphereArgs& a) {
   check_scale(a.scale);
   figure::HemisphereOptions o;
   o.params = parameterizations(a.params);
-  if (a.elevations.empty()) throw UsageError("--elevations: no elevation given");
-  for (double e : a.elevations)
+  o.elevations_deg = number_list(a.elevations, "--elevations", "elevation");
+  for (double e : o.elevations_deg)
     if (!(e >= 0 && e <= 90))
       throw UsageError(fmt::format(
           "--elevations: {}° is outside [0°, 90°] (the polar angle θo of ωo from the normal)", e));
-  o.elevations_deg = a.elevations;
   const auto projection = figure::projection_from_name(a.projection);
   if (!projection)
     throw UsageError(fmt::format(
@@ -135,10 +169,7 @@ int run_slices(const SliceArgs& a) {
   check_scale(a.scale);
   figure::SliceOptions o;
   o.params = parameterizations(a.params);
-  if (a.azimuths.empty()) throw UsageError("--azimuths: no azimuth given");
-  for (double az : a.azimuths)
-    if (!std::isfinite(az)) throw UsageError("--azimuths: the azimuths must be finite numbers");
-  o.azimuths_deg = a.azimuths;
+  o.azimuths_deg = number_list(a.azimuths, "--azimuths", "azimuth");
   if (a.colour == "luminance")
     o.colouring = figure::SliceColouring::luminance;
   else if (a.colour == "rgb")
@@ -149,29 +180,28 @@ int run_slices(const SliceArgs& a) {
   o.pixels_per_point = a.scale;
   o.threads = a.threads;
 
+  // test:LIST of the paper's test functions (S, G, F, or their names) draws them as isolines;
+  // anything else, "test:fn=G" included, is a BRDF for load_brdf(), drawn in colour.
+  bool isolines = false;
   const std::string prefix = "test:";
   if (a.brdf.rfind(prefix, 0) == 0) {
-    // The paper's test functions, as isolines: test:S,G,F (any subset, any order).
-    o.test_functions.clear();
-    const std::string list = a.brdf.substr(prefix.size());
-    std::size_t start = 0;
-    while (start <= list.size()) {
-      const std::size_t comma = std::min(list.find(',', start), list.size());
-      const std::string name = list.substr(start, comma - start);
+    std::vector<TestFunction> fns;
+    bool all = true;
+    for (const std::string& name :
+         split_list(a.brdf.substr(prefix.size()), "--brdf", "test function")) {
       const auto f = test_function_from_name(name);
-      if (!f)
-        throw UsageError(fmt::format(
-            "--brdf '{}': unknown test function '{}' (expected S, G or F, e.g. test:S,G,F)", a.brdf,
-            name));
-      o.test_functions.push_back(*f);
-      start = comma + 1;
+      if (!f) all = false;
+      if (f) fns.push_back(*f);
     }
-    if (a.levels.empty()) throw UsageError("--levels: no level given");
-    o.levels = a.levels;
+    if (all) {
+      isolines = true;
+      o.test_functions = fns;
+      o.levels = number_list(a.levels, "--levels", "level");
+    }
   }
   AtomicFile probe(a.out);  // an unwritable destination fails before loading and drawing
   probe.discard();
-  if (a.brdf.rfind(prefix, 0) != 0) o.brdf = load_brdf(a.brdf);
+  if (!isolines) o.brdf = load_brdf(a.brdf);
   const auto t0 = std::chrono::steady_clock::now();
   const auto fig = figure::slice_figure(o);
   finish(fig.scene, a.out, a.scale, since(t0));
@@ -182,8 +212,7 @@ int run_paper(const PaperArgs& a) {
   if (a.out.empty()) throw UsageError("--out: no folder given");
   figure::PaperFigureOptions o;
   o.png = o.svg = o.pdf = false;
-  if (a.formats.empty()) throw UsageError("--formats: no format given");
-  for (const std::string& f : a.formats) {
+  for (const std::string& f : split_list(a.formats, "--formats", "format")) {
     if (f == "png")
       o.png = true;
     else if (f == "svg")
@@ -232,11 +261,9 @@ Command register_figure(CLI::App& parent) {
       "coloured by the pair's two non-azimuthal coordinates (red, green)");
   h->add_option("--param", hemi->params,
                 "Parameterizations, one row each (spherical, halfdiff, ortho, hybrid)")
-      ->delimiter(',')
       ->capture_default_str();
   h->add_option("--elevations", hemi->elevations,
                 "Polar angles θo of ωo from the normal, in degrees, one column each")
-      ->delimiter(',')
       ->capture_default_str();
   h->add_option("--projection", hemi->projection,
                 "Disk projection: equal-area, orthographic or equidistant")
@@ -261,16 +288,12 @@ Command register_figure(CLI::App& parent) {
                 "test:S,G,F (any of the paper's test functions, as isolines), or a BRDF: a "
                 "file (MERL, RGL, ALTA) or a model spec such as ggx:alpha=0.2")
       ->capture_default_str();
-  s->add_option("--param", sl->params, "Parameterizations, one row each")
-      ->delimiter(',')
-      ->capture_default_str();
+  s->add_option("--param", sl->params, "Parameterizations, one row each")->capture_default_str();
   s->add_option("--azimuths", sl->azimuths,
                 "Relative azimuths in degrees (φd for halfdiff, φk − φh for ortho and hybrid), "
                 "one column each")
-      ->delimiter(',')
       ->capture_default_str();
   s->add_option("--levels", sl->levels, "Isoline levels of the test functions")
-      ->delimiter(',')
       ->capture_default_str();
   s->add_option("--colour", sl->colour,
                 "For a BRDF: luminance (viridis of log luminance) or rgb (tone-mapped)")
@@ -286,9 +309,7 @@ Command register_figure(CLI::App& parent) {
       "Figures 1 (three views) and 2 on their default settings, into a folder, and print "
       "where they are");
   p->add_option("-o,--out", pa->out, "Output folder (created if missing)")->required();
-  p->add_option("--formats", pa->formats, "Formats to write: png, svg, pdf")
-      ->delimiter(',')
-      ->capture_default_str();
+  p->add_option("--formats", pa->formats, "Formats to write: png, svg, pdf")->capture_default_str();
   p->add_option("--threads", pa->threads, "Sampling threads (0: all cores)")->capture_default_str();
 
   return {app, [=]() -> int {

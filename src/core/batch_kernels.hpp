@@ -15,6 +15,12 @@
 #include "batch_engine.hpp"
 #include "row_kernels.hpp"
 
+#if defined(__GNUC__)
+#define HALFBACK_FLATTEN [[gnu::flatten]]
+#else
+#define HALFBACK_FLATTEN
+#endif
+
 namespace halfback::detail {
 namespace {
 
@@ -84,9 +90,12 @@ inline B mask_to_lanes(const MaskOf<B>& m) {
 }
 
 // dirs input: the pair_is_valid() mask; with Copy, the pair itself (NaN where invalid).
+// The stages are flattened: everything they call, down to the xsimd intrinsics, is inlined into
+// one loop (GCC otherwise keeps the larger param.hpp functions and xsimd's sincos out of line,
+// passing 512-bit vectors through memory, which costs 2-3x).
 template <class B, bool Copy, bool Jac>
-void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy, ScalarOf<B>* mask,
-                 ScalarOf<B>* jac, std::size_t m) {
+HALFBACK_FLATTEN void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy,
+                                  ScalarOf<B>* mask, ScalarOf<B>* jac, std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int kCopy = Copy ? 6 : 0;
@@ -106,8 +115,8 @@ void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy, ScalarO
 
 // P input: the pair (NaN where invalid), the domain mask and, with Jac, the measure of q.
 template <class B, class P, bool Iso, bool Jac>
-void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, ScalarOf<B>* mask,
-                  ScalarOf<B>* jac, std::size_t m) {
+HALFBACK_FLATTEN void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs,
+                                   ScalarOf<B>* mask, ScalarOf<B>* jac, std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int NI = Iso ? 3 : 4;
@@ -131,8 +140,8 @@ void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, Scalar
 
 // P output: the coordinates of the pair (NaN where the mask is 0) and, with Jac, their measure.
 template <class B, class P, bool Iso, bool Jac>
-void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask, ScalarOf<B>* const* out,
-                  ScalarOf<B>* jac, std::size_t m) {
+HALFBACK_FLATTEN void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask,
+                                   ScalarOf<B>* const* out, ScalarOf<B>* jac, std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int kDim = Iso ? 3 : 4;

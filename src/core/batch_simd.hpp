@@ -58,15 +58,20 @@ struct LaneOps<xsimd::batch<S, A>> {
     const T limit(S(20) * std::numbers::pi_v<S>);
     const auto large = !(xsimd::abs(x) <= limit);  // NaN included
     if (xsimd::any(large)) [[unlikely]] {
-      const auto small = xsimd::sincos(xsimd::select(large, T(S(0)), x));
-      const auto big = xsimd::sincos(xsimd::select(large, x, T(S(0))));
-      s = xsimd::select(large, big.first, small.first);
-      c = xsimd::select(large, big.second, small.second);
+      sincos_with_large_lanes(x, large, s, c);
       return;
     }
     const auto r = xsimd::sincos(x);
     s = r.first;
     c = r.second;
+  }
+
+  // Out of line, so that the kernels inline only the common path.
+  [[gnu::noinline]] static void sincos_with_large_lanes(const T& x, const Mask& large, T& s, T& c) {
+    const auto small = xsimd::sincos(xsimd::select(large, T(S(0)), x));
+    const auto big = xsimd::sincos(xsimd::select(large, x, T(S(0))));
+    s = xsimd::select(large, big.first, small.first);
+    c = xsimd::select(large, big.second, small.second);
   }
 
   static Mask mask_and(const Mask& a, const Mask& b) { return a && b; }

@@ -301,7 +301,7 @@ HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
 
   HemisphereFigure fig;
   const double D = snap(o.disk_size), gap = 18, vgap = 22;
-  const double left = 92, top = 58, key_gap = 62, key = snap(0.62 * D), right = 24, bottom = 64;
+  const double left = 92, top = 64, key_gap = 62, key = snap(0.62 * D), right = 24, bottom = 64;
   const std::size_t rows = o.params.size(), cols = o.elevations_deg.size();
   Scene& sc = fig.scene;
   sc.width = snap(left + double(cols) * D + double(cols - 1) * gap + key_gap + key + right);

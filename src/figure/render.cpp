@@ -1,23 +1,18 @@
 #include "halfback/figure/render.hpp"
 
+#include "halfback/io/atomic_file.hpp"
+
 #include <cairo-pdf.h>
 #include <cairo.h>
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
+#include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <memory>
 #include <numbers>
-#include <random>
 #include <stdexcept>
-#include <system_error>
-
-#include <unistd.h>
 
 namespace halfback::figure {
 namespace {
@@ -452,38 +447,16 @@ Raster decode_png(std::string_view png) {
   return raster_of(s.get());
 }
 
-void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
-  namespace fs = std::filesystem;
-  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  static std::atomic<unsigned> counter{0};
-  const fs::path tmp =
-      dir / fmt::format(".{}.tmp-{}-{}", path.filename().string(), ::getpid(), counter++);
-  auto fail = [&](const std::string& why) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw std::runtime_error(fmt::format("cannot write '{}': {}", path.string(), why));
-  };
-  {
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) fail(std::strerror(errno));
-    const bool written = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-    const int saved = errno;
-    const bool closed = std::fclose(f) == 0;
-    if (!written || !closed) fail(std::strerror(written ? errno : saved));
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) fail(ec.message());
-}
-
 void save(const Scene& scene, const std::filesystem::path& path, const RenderOptions& options) {
   const auto format = format_from_path(path);
   if (!format)
     throw std::invalid_argument(
         fmt::format("cannot tell the figure format of '{}': use a .png, .svg or .pdf file name",
                     path.string()));
-  const std::string bytes = render(scene, *format, options);
-  write_file_atomically(path, bytes);
+  // Fail on an unwritable destination before rendering; nothing is left behind on error.
+  AtomicFile out(path);
+  out.write(render(scene, *format, options));
+  out.commit();
 }
 
 }  // namespace halfback::figure

@@ -113,9 +113,9 @@ TEST(TabulatedSampler, ChiSquareAndIntegral) {
               const BrdfSample x = t.sample(wo, u1, u2);
               return testing::DirSample{x.wi, x.pdf};
             },
-            [&](const Vec3<double>& wi) { return t.pdf(wo, wi); }, 100000, false, 16, 32, 24,
-            7, s.param == TableParam::spherical ? Vec3<double>{0, 0, 1}
-                                                : Vec3<double>{-wo.x, -wo.y, wo.z},
+            [&](const Vec3<double>& wi) { return t.pdf(wo, wi); }, 100000, false, 16, 32, 24, 7,
+            s.param == TableParam::spherical ? Vec3<double>{0, 0, 1}
+                                             : Vec3<double>{-wo.x, -wo.y, wo.z},
             10);
         // The quadrature is least accurate at the pdf's integrable singularity.
         EXPECT_LE(r.integral, 1.02) << t.describe();

@@ -45,8 +45,8 @@ struct Chi2Result {
 inline Chi2Result chi2_test(const std::function<DirSample(double, double)>& sample,
                             const std::function<double(const Vec3<double>&)>& pdf, int n,
                             bool sphere = false, int theta_bins = 16, int phi_bins = 32,
-                            int sub = 12, std::uint64_t seed = 7,
-                            Vec3<double> singular = {0, 0, 1}, double cap_deg = 0) {
+                            int sub = 12, std::uint64_t seed = 7, Vec3<double> singular = {0, 0, 1},
+                            double cap_deg = 0) {
   const double pi = std::numbers::pi;
   const double z_lo = sphere ? -1 : 0;
   auto cell_of = [&](const Vec3<double>& d) {

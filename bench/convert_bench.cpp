@@ -1,0 +1,334 @@
+// halfback_bench: batch conversion throughput (docs/performance.md).
+//
+// For every parameterization P, float and double, over kPairs (10^7 by default) SoA rows:
+//   forward/P/T/threads:k   convert(dirs -> P), the engine, k = 1 or all hardware threads
+//   inverse/P/T/threads:k   convert(P -> dirs)
+//   scalar_forward/P/T      a straightforward per-pair loop through a virtual, parameterization-
+//   scalar_inverse/P/T      generic interface with std math (the baseline of the speed-up)
+//   stream/6to4/T/threads:k a plain triad moving the same bytes per pair as forward (6 columns
+//   stream/4to6/T/threads:k in, 4 out) or inverse, over arrays of the same size: the memory bound
+// plus, for one conversion, every instruction set (isa/...), and a strided AoS input (aos/...).
+// Counters: s_per_pair (displayed with an SI prefix, e.g. 2.1n = 2.1 ns per pair) and
+// bytes_per_second (input + output bytes per pair). HALFBACK_BENCH_PAIRS overrides the size.
+#include <benchmark/benchmark.h>
+#include <tbb/blocked_range.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/batch_engine.hpp"
+#include "core/row_kernels.hpp"
+#include "halfback/core/batch.hpp"
+
+namespace halfback {
+namespace {
+
+std::size_t pair_count() {
+  if (const char* env = std::getenv("HALFBACK_BENCH_PAIRS")) return std::strtoull(env, nullptr, 10);
+  return 10'000'000;
+}
+
+template <class T>
+using Columns = std::vector<std::vector<T>>;
+
+// The data of one precision: random valid pairs (uniform in solid angle), their coordinates in
+// every parameterization (to time the inverse on valid input), and an output buffer.
+template <class T>
+struct Data {
+  std::size_t n;
+  Columns<T> dirs, out;
+  std::vector<std::uint8_t> valid;
+  std::vector<Columns<T>> coords;  // [space - 1]
+
+  explicit Data(std::size_t rows) : n(rows), dirs(6, std::vector<T>(rows)), out(6), valid(rows) {
+    for (auto& c : out) c.assign(rows, T(0));
+    std::mt19937_64 rng(2024);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (std::size_t r = 0; r < rows; ++r) {
+      double w[6];
+      for (int k = 0; k < 2; ++k) {
+        const double z = u(rng), phi = 2 * std::numbers::pi * u(rng);
+        const double s = std::sqrt((1 - z) * (1 + z));
+        w[3 * k] = s * std::cos(phi);
+        w[3 * k + 1] = s * std::sin(phi);
+        w[3 * k + 2] = z;
+      }
+      for (int c = 0; c < 6; ++c) dirs[c][r] = static_cast<T>(w[c]);
+    }
+    for (Space s : kParameterizations) {
+      Columns<T> q(4, std::vector<T>(rows));
+      std::vector<ConstColumn<T>> ic;
+      for (const auto& c : dirs) ic.push_back({c.data(), 1});
+      std::vector<Column<T>> oc;
+      for (auto& c : q) oc.push_back({c.data(), 1});
+      convert<T>({Space::dirs, false}, {s, false}, ic, rows, {oc, {}, valid.data()});
+      coords.push_back(std::move(q));
+    }
+  }
+
+  static Data& get() {
+    static Data data(pair_count());
+    return data;
+  }
+};
+
+std::string type_name(float) {
+  return "float";
+}
+std::string type_name(double) {
+  return "double";
+}
+
+unsigned all_threads() {
+  return static_cast<unsigned>(tbb::info::default_concurrency());
+}
+
+template <class T>
+void set_counters(benchmark::State& state, std::size_t n, std::size_t columns) {
+  const double pairs = static_cast<double>(n) * static_cast<double>(state.iterations());
+  state.counters["s_per_pair"] =
+      benchmark::Counter(pairs, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.SetBytesProcessed(static_cast<std::int64_t>(pairs * columns * sizeof(T)));
+}
+
+// --- the engine ---------------------------------------------------------------------------
+
+template <class T>
+void bm_convert(benchmark::State& state, Space space, bool forward, unsigned threads) {
+  Data<T>& d = Data<T>::get();
+  const Form dirs{Space::dirs, false}, param{space, false};
+  const Columns<T>& src = forward ? d.dirs : d.coords[static_cast<int>(space) - 1];
+  std::vector<ConstColumn<T>> ic;
+  for (const auto& c : src) ic.push_back({c.data(), 1});
+  std::vector<Column<T>> oc;
+  for (std::size_t c = 0; c < (forward ? 4u : 6u); ++c) oc.push_back({d.out[c].data(), 1});
+  const ConvertOutput<T> out{oc, {}, d.valid.data()};
+  for (auto _ : state) {
+    convert<T>(forward ? dirs : param, forward ? param : dirs, ic, d.n, out, {threads});
+    benchmark::ClobberMemory();
+  }
+  set_counters<T>(state, d.n, 10);
+}
+
+// dirs given as one row-major (N, 6) array: the gather path.
+template <class T>
+void bm_convert_aos(benchmark::State& state, Space space) {
+  Data<T>& d = Data<T>::get();
+  std::vector<T> aos(6 * d.n);
+  for (std::size_t r = 0; r < d.n; ++r)
+    for (int c = 0; c < 6; ++c) aos[6 * r + c] = d.dirs[c][r];
+  std::vector<ConstColumn<T>> ic;
+  for (int c = 0; c < 6; ++c) ic.push_back({aos.data() + c, 6});
+  std::vector<Column<T>> oc;
+  for (std::size_t c = 0; c < 4; ++c) oc.push_back({d.out[c].data(), 1});
+  for (auto _ : state) {
+    convert<T>({Space::dirs, false}, {space, false}, ic, d.n, {oc, {}, d.valid.data()}, {1});
+    benchmark::ClobberMemory();
+  }
+  set_counters<T>(state, d.n, 10);
+}
+
+template <class T>
+void bm_isa(benchmark::State& state, detail::SimdIsa isa, Space space, bool forward) {
+  if (!detail::set_batch_isa(isa)) {
+    state.SkipWithError("instruction set not available");
+    return;
+  }
+  bm_convert<T>(state, space, forward, 1);
+  detail::set_batch_isa(std::nullopt);
+}
+
+// --- the scalar baseline: per pair, virtual, std math ------------------------------------------
+
+template <class T>
+class Parameterization {
+ public:
+  virtual ~Parameterization() = default;
+  // Coordinates of a pair (NaN and false when the pair is not a valid one).
+  virtual bool forward(const DirPair<T>& p, T* q) const = 0;
+  // The pair with coordinates q (NaN and false outside the domain).
+  virtual bool inverse(const T* q, DirPair<T>& p) const = 0;
+};
+
+template <class P, class T>
+class ParameterizationOf final : public Parameterization<T> {
+ public:
+  bool forward(const DirPair<T>& p, T* q) const override {
+    if (!detail::pair_is_valid(p)) {
+      for (int i = 0; i < 4; ++i) q[i] = std::numeric_limits<T>::quiet_NaN();
+      return false;
+    }
+    const Tuple4<T> t = P::forward(p);
+    for (int i = 0; i < 4; ++i) q[i] = t[i];
+    return true;
+  }
+  bool inverse(const T* q, DirPair<T>& p) const override {
+    const Solved<T> s = halfback::inverse<P>(Tuple4<T>{q[0], q[1], q[2], q[3]});
+    p = s.pair;
+    return s.in_domain;
+  }
+};
+
+template <class T>
+std::unique_ptr<Parameterization<T>> make_parameterization(Space space) {
+  return visit_parameterization(space, [](auto p) -> std::unique_ptr<Parameterization<T>> {
+    return std::make_unique<ParameterizationOf<decltype(p), T>>();
+  });
+}
+
+template <class T>
+void bm_scalar(benchmark::State& state, Space space, bool forward) {
+  Data<T>& d = Data<T>::get();
+  std::unique_ptr<Parameterization<T>> param = make_parameterization<T>(space);
+  const Parameterization<T>* pp = param.get();
+  benchmark::DoNotOptimize(pp);  // keep the call virtual
+  const Columns<T>& q = d.coords[static_cast<int>(space) - 1];
+  for (auto _ : state) {
+    for (std::size_t i = 0; i < d.n; ++i) {
+      if (forward) {
+        const DirPair<T> p{{d.dirs[0][i], d.dirs[1][i], d.dirs[2][i]},
+                           {d.dirs[3][i], d.dirs[4][i], d.dirs[5][i]}};
+        T r[4];
+        d.valid[i] = pp->forward(p, r);
+        for (int c = 0; c < 4; ++c) d.out[c][i] = r[c];
+      } else {
+        const T in[4] = {q[0][i], q[1][i], q[2][i], q[3][i]};
+        DirPair<T> p;
+        d.valid[i] = pp->inverse(in, p);
+        d.out[0][i] = p.wi.x;
+        d.out[1][i] = p.wi.y;
+        d.out[2][i] = p.wi.z;
+        d.out[3][i] = p.wo.x;
+        d.out[4][i] = p.wo.y;
+        d.out[5][i] = p.wo.z;
+      }
+    }
+    benchmark::ClobberMemory();
+  }
+  set_counters<T>(state, d.n, 10);
+}
+
+// --- the streaming bound ------------------------------------------------------------------
+
+// A triad that reads the `in` columns and writes the `out` columns once per pair, like convert():
+// 6 -> 4 (forward) or 4 -> 6 (inverse).
+template <class T>
+void stream_rows(const Columns<T>& a, Columns<T>& o, std::size_t nin, std::size_t nout,
+                 std::size_t begin, std::size_t end) {
+  const T s = T(0.5);
+  if (nin == 6) {
+    const T *a0 = a[0].data(), *a1 = a[1].data(), *a2 = a[2].data(), *a3 = a[3].data(),
+            *a4 = a[4].data(), *a5 = a[5].data();
+    T *o0 = o[0].data(), *o1 = o[1].data(), *o2 = o[2].data(), *o3 = o[3].data();
+    for (std::size_t i = begin; i < end; ++i) {
+      o0[i] = a0[i] + s * a4[i];
+      o1[i] = a1[i] + s * a5[i];
+      o2[i] = a2[i] * s;
+      o3[i] = a3[i] * s;
+    }
+  } else {
+    const T *a0 = a[0].data(), *a1 = a[1].data(), *a2 = a[2].data(), *a3 = a[3].data();
+    T *o0 = o[0].data(), *o1 = o[1].data(), *o2 = o[2].data(), *o3 = o[3].data(), *o4 = o[4].data(),
+      *o5 = o[5].data();
+    for (std::size_t i = begin; i < end; ++i) {
+      o0[i] = a0[i] * s;
+      o1[i] = a1[i] * s;
+      o2[i] = a2[i] * s;
+      o3[i] = a3[i] * s;
+      o4[i] = a0[i] + a1[i];
+      o5[i] = a2[i] + a3[i];
+    }
+  }
+  (void)nout;
+}
+
+template <class T>
+void bm_stream(benchmark::State& state, bool forward, unsigned threads) {
+  Data<T>& d = Data<T>::get();
+  const Columns<T>& src = forward ? d.dirs : d.coords[0];
+  const std::size_t nin = forward ? 6 : 4, nout = forward ? 4 : 6;
+  tbb::task_arena arena(static_cast<int>(threads));
+  for (auto _ : state) {
+    if (threads == 1) {
+      stream_rows(src, d.out, nin, nout, 0, d.n);
+    } else {
+      arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, d.n, 1 << 16),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                            stream_rows(src, d.out, nin, nout, r.begin(), r.end());
+                          });
+      });
+    }
+    benchmark::ClobberMemory();
+  }
+  set_counters<T>(state, d.n, 10);
+}
+
+template <class T>
+void register_all() {
+  const std::string t = type_name(T{});
+  const unsigned all = all_threads();
+  std::vector<unsigned> thread_counts{1};
+  if (all > 1) thread_counts.push_back(all);
+  for (bool forward : {true, false}) {
+    const std::string dir = forward ? "forward" : "inverse";
+    for (Space s : kParameterizations) {
+      const std::string p(name_of(s));
+      for (unsigned k : thread_counts)
+        benchmark::RegisterBenchmark(
+            (dir + "/" + p + "/" + t + "/threads:" + std::to_string(k)).c_str(),
+            [=](benchmark::State& st) { bm_convert<T>(st, s, forward, k); })
+            ->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("scalar_" + dir + "/" + p + "/" + t).c_str(),
+                                   [=](benchmark::State& st) { bm_scalar<T>(st, s, forward); })
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+    }
+    for (unsigned k : thread_counts)
+      benchmark::RegisterBenchmark(
+          ((forward ? "stream/6to4/" : "stream/4to6/") + t + "/threads:" + std::to_string(k))
+              .c_str(),
+          [=](benchmark::State& st) { bm_stream<T>(st, forward, k); })
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+  }
+  for (detail::SimdIsa isa : detail::kAllIsas)
+    for (bool forward : {true, false})
+      benchmark::RegisterBenchmark(
+          (std::string("isa/") + (forward ? "forward" : "inverse") + "/halfdiff/" + t + "/" +
+           std::string(detail::isa_name(isa)))
+              .c_str(),
+          [=](benchmark::State& st) { bm_isa<T>(st, isa, Space::halfdiff, forward); })
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark(("aos/forward/halfdiff/" + t + "/threads:1").c_str(),
+                               [](benchmark::State& st) { bm_convert_aos<T>(st, Space::halfdiff); })
+      ->UseRealTime()
+      ->Unit(benchmark::kMillisecond);
+}
+
+}  // namespace
+}  // namespace halfback
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  halfback::register_all<float>();
+  halfback::register_all<double>();
+  benchmark::AddCustomContext("halfback_isa", std::string(halfback::detail::active_kernels().name));
+  benchmark::AddCustomContext("pairs", std::to_string(halfback::pair_count()));
+  benchmark::AddCustomContext("threads_all", std::to_string(halfback::all_threads()));
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
