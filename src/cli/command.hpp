@@ -48,6 +48,11 @@ std::span<const RegisterCommand> command_table();
 Command register_convert(CLI::App& parent);
 Command register_render(CLI::App& parent);
 Command register_figure(CLI::App& parent);
+Command register_info(CLI::App& parent);
+Command register_eval(CLI::App& parent);
+Command register_resample(CLI::App& parent);
+Command register_export_merl(CLI::App& parent);
+Command register_models(CLI::App& parent);
 
 // "halfback COMMAND: warning: MESSAGE" on stderr.
 void warn(std::string_view command, std::string_view message);

@@ -7,10 +7,9 @@
 namespace halfback::cli {
 
 namespace {
-constexpr std::array<RegisterCommand, 3> kCommands{
-    &register_convert,
-    &register_render,
-    &register_figure,
+constexpr std::array<RegisterCommand, 8> kCommands{
+    &register_convert,     &register_info,   &register_eval,   &register_resample,
+    &register_export_merl, &register_models, &register_render, &register_figure,
 };
 }  // namespace
 

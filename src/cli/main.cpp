@@ -21,7 +21,9 @@ namespace {
 
 constexpr const char* kDescription =
     "halfback: parameterizations of BRDF direction pairs (Barla et al. 2015): convert between\n"
-    "directions and the spherical, half/difference, orthographic and hybrid coordinates.\n";
+    "directions and the spherical, half/difference, orthographic and hybrid coordinates;\n"
+    "inspect, evaluate, resample and export BRDFs (analytic models, MERL, RGL, ALTA); render\n"
+    "them on a sphere; draw the paper's figures.\n";
 
 constexpr const char* kFooter =
     "Run 'halfback COMMAND --help' for the options and examples of a command.\n"

@@ -1,5 +1,7 @@
 #include "halfback/io/alta.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -314,6 +316,23 @@ std::string AltaBrdf::description() const {
   d += " (" + std::to_string(impl_->samples) + " samples at " +
        std::to_string(impl_->slices.size()) + " incidence angles, " + impl_->param_out + ")";
   return d;
+}
+
+std::vector<Brdf::Fact> AltaBrdf::facts() const {
+  const Impl& m = *impl_;
+  std::vector<Fact> f;
+  f.push_back(
+      {"format", "ALTA text data, #PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI, #PARAM_OUT " + m.param_out});
+  if (!m.sample.empty()) f.push_back({"sample", m.sample});
+  f.push_back({"samples", fmt::format("{} used, {} dropped at grazing view (see docs/formats.md)",
+                                      m.samples, m.dropped)});
+  std::string angles;
+  for (const double a : incidence_angles())
+    angles +=
+        fmt::format("{}{:.4g}°", angles.empty() ? "" : ", ", a * 180 / 3.14159265358979323846);
+  f.push_back({"incidence angles θl", angles});
+  f.push_back({"channels", m.dim_out == 3 ? "RGB" : "one (gray, copied to R, G, B)"});
+  return f;
 }
 
 std::size_t AltaBrdf::samples() const {

@@ -1,5 +1,7 @@
 #include "halfback/io/merl.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -165,6 +167,26 @@ std::string MerlBrdf::description() const {
   const std::size_t missing = std::max({data_.missing[0], data_.missing[1], data_.missing[2]});
   if (missing > 0) d += ", " + std::to_string(missing) + " unmeasured bins";
   return d;
+}
+
+std::vector<Brdf::Fact> MerlBrdf::facts() const {
+  std::vector<Fact> f;
+  f.push_back({"format", "MERL .binary: 90 θh × 90 θd × 180 φd bins, RGB float64"});
+  f.push_back({"lookup", options_.lookup == MerlLookup::nearest
+                             ? "nearest bin (the reference reader's)"
+                             : "trilinear in the stored coordinates"});
+  f.push_back({"unmeasured bins", fmt::format("R {}, G {}, B {} of {}", data_.missing[0],
+                                              data_.missing[1], data_.missing[2], merl::kBins)});
+  std::array<double, 3> max{};
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < merl::kBins; ++i)
+      max[c] = std::max(max[c], data_.values[c * merl::kBins + i] * merl::kScale[c]);
+  f.push_back(
+      {"max stored ρ", fmt::format("R {:.6g}, G {:.6g}, B {:.6g} sr⁻¹", max[0], max[1], max[2])});
+  if (!data_.sha256.empty()) f.push_back({"sha256", data_.sha256});
+  f.push_back({"MERL material", data_.material ? *data_.material + " (one of the 100 published)"
+                                               : std::string("not one of the 100 published")});
+  return f;
 }
 
 Rgb MerlBrdf::bin_value(int th, int td, int pd) const {

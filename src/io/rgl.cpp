@@ -4,6 +4,8 @@
 // linearly between the slices at the incidence grid values (clamped at the ends).
 #include "halfback/io/rgl.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -425,6 +427,25 @@ std::string RglBrdf::name() const {
 std::string RglBrdf::description() const {
   return "RGL measured BRDF: " + impl_->description + " (" + std::to_string(impl_->n_slices) +
          " incidence slices, " + (impl_->isotropic ? "isotropic" : "anisotropic") + ")";
+}
+
+std::vector<Brdf::Fact> RglBrdf::facts() const {
+  const Impl& m = *impl_;
+  std::vector<Fact> f;
+  f.push_back({"format", "RGL tensor_file (Dupuy & Jakob 2018), RGB variant"});
+  f.push_back({"material", m.description});
+  f.push_back({"incidence grid",
+               fmt::format("{} θi × {} φi{}", m.theta_i_raw.size(), m.phi_i_raw.size(),
+                           m.reduction > 1 ? fmt::format(" (1/{} of the azimuths, the rest "
+                                                         "by symmetry)",
+                                                         m.reduction)
+                                           : std::string())});
+  f.push_back({"spectral slices",
+               fmt::format("{} × {} samples per incidence, 3 channels", m.rgb.h, m.rgb.w)});
+  f.push_back({"VNDF / NDF tables",
+               fmt::format("{} × {} / {} × {}", m.vndf.h, m.vndf.w, m.ndf.h, m.ndf.w)});
+  f.push_back({"symmetry", m.isotropic ? "isotropic" : "anisotropic"});
+  return f;
 }
 
 bool RglBrdf::isotropic() const {

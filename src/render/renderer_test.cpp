@@ -35,10 +35,6 @@ class Opaque final : public Brdf {  // hides the model's own sampler
   BrdfPtr b_;
 };
 
-double luminance(const Rgb& c) {
-  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
-}
-
 BrdfPtr ggx(double alpha, double f0 = 1) {
   models::MicrofacetParams p;
   p.alpha_x = p.alpha_y = alpha;

@@ -159,6 +159,16 @@ std::string dirs_csv(const std::vector<DirPair<double>>& pairs) {
   return to_csv(header, cols);
 }
 
+// One CSV row of six numbers, %.17g.
+std::string fmt_row(const std::array<double, 6>& v) {
+  std::string s;
+  for (double x : v) {
+    if (!s.empty()) s += ',';
+    s += format_csv_number(x);
+  }
+  return s;
+}
+
 // Distance between two angles on the circle.
 double angle_diff(double a, double b) {
   const double d = std::fmod(std::abs(a - b), 2 * kPi);
@@ -667,6 +677,147 @@ TEST_F(CliTest, ExistingOutputIsKeptWhenTheInputIsBad) {
       run({"convert", "--from", "dirs", "--to", "hybrid", "-i", "in.csv", "-o", "out.csv"});
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(slurp(path("out.csv")), "hbar,phi_h,k,phi_k\n0,0,0,0\n");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The BRDF commands: models, eval, info, export-merl, resample
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(CliTest, ModelsListsEveryModelWithItsParameters) {
+  const Result r = run({"models"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* s : {"lambert", "ggx", "beckmann", "abc", "sheen", "test", "albedo", "alpha_x",
+                        "default 0.2, in [0.001, 10]", "one of F | S | G"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+}
+
+// Lambert is ρ = albedo/π; GGX at normal incidence and normal view is D(0) F0 G / (4 cos²) with
+// D(0) = 1/(π α²) and G = 1 (Smith at normal incidence): values computed here.
+TEST_F(CliTest, EvalGivesClosedFormValuesAndZeroBelowTheHorizon) {
+  const std::string input = std::string(kDirsHeader) +
+                            "0,0,1,0,0,1\n"
+                            "0.6,0,0.8,-0.6,0,0.8\n"
+                            "0,0,1,0.6,0,-0.8\n";
+  Result r = run({"eval", "--brdf", "lambert:albedo=0.5"}, input);
+  ASSERT_EQ(r.status, 0) << r.err;
+  CsvTable t = parse(r.out);
+  ASSERT_EQ(t.header, (std::vector<std::string>{"r", "g", "b"}));
+  ASSERT_EQ(t.rows(), 3u);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_DOUBLE_EQ(t.columns[c][0], 0.5 / kPi);
+    EXPECT_DOUBLE_EQ(t.columns[c][1], 0.5 / kPi);
+    EXPECT_EQ(t.columns[c][2], 0.0);
+  }
+  r = run({"eval", "--brdf", "ggx:alpha=0.3,f0=0.9", "-i", "in.csv", "-o", "out.csv"});
+  EXPECT_NE(r.status, 0);  // no such input file
+  put(path("in.csv"), std::string(kDirsHeader) + "0,0,1,0,0,1\n");
+  r = run({"eval", "--brdf", "ggx:alpha=0.3,f0=0.9", "-i", "in.csv", "-o", "out.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  t = parse(slurp(path("out.csv")));
+  EXPECT_NEAR(t.columns[0][0], 0.9 / (kPi * 0.09) / 4, 1e-12);
+}
+
+TEST_F(CliTest, EvalBadInput) {
+  Result r = run({"eval", "--brdf", "lambert"}, std::string(kDirsHeader) + "0,0,1,0,0.5,0.5\n");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("<stdin>:2: wo is not a unit vector"), std::string::npos) << r.err;
+  r = run({"eval", "--brdf", "lambert"}, "a,b\n1,2\n");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("header does not match"), std::string::npos) << r.err;
+  r = run({"eval", "--brdf", "glossy:alpha=2"}, std::string(kDirsHeader));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("'glossy:alpha=2' is neither an existing file nor a known BRDF model"),
+            std::string::npos)
+      << r.err;
+  r = run({"eval", "--brdf", "ggx:alpha=-1"}, std::string(kDirsHeader));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("alpha"), std::string::npos) << r.err;
+  put(path("out.csv"), "keep me\n");
+  r = run({"eval", "--brdf", "lambert", "-o", "out.csv"}, std::string(kDirsHeader) + "1,2,3\n");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(slurp(path("out.csv")), "keep me\n");
+  EXPECT_EQ(entries(), (std::vector<std::string>{"out.csv"}));
+}
+
+TEST_F(CliTest, InfoOfAModelAndOfAMerlFileItWrote) {
+  Result r = run({"info", "lambert:albedo=0.25"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("isotropic:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("albedo at θi = 60°:    0.25, 0.25, 0.25"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0.0795775"), std::string::npos) << r.out;  // max ρ = 0.25/π
+
+  r = run({"export-merl", "--brdf", "ggx:alpha=0.3,f0=0.5", "-o", "ggx.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(fs::file_size(path("ggx.binary")), 34992012u);
+  r = run({"info", "ggx.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* s :
+       {"merl:ggx", "MERL .binary", "unmeasured bins:", "sha256:", "not one of the 100 published"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+  // The file evaluates like the model at a bin centre away from any bin edge.
+  const double th = std::pow(40.5 / 90, 2) * kPi / 2, td = 30.5 / 90 * kPi / 2,
+               pd = 60.5 / 180 * kPi;
+  std::array<double, 6> d{};
+  ASSERT_TRUE(convert_one<double>({Space::halfdiff, true}, {Space::dirs, false},
+                                  std::array<double, 3>{th, td, pd}, d));
+  const std::string input = std::string(kDirsHeader) + fmt_row(d) + "\n";
+  const Result a = run({"eval", "--brdf", "ggx.binary"}, input);
+  const Result b = run({"eval", "--brdf", "ggx:alpha=0.3,f0=0.5"}, input);
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  const CsvTable ta = parse(a.out), tb = parse(b.out);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(ta.columns[c][0], tb.columns[c][0], 1e-9 * tb.columns[c][0]);
+}
+
+TEST_F(CliTest, ExportMerlBadInputKeepsTheOutput) {
+  put(path("x.binary"), "old");
+  Result r = run({"export-merl", "--brdf", "nope", "-o", "x.binary"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(slurp(path("x.binary")), "old");
+  r = run({"export-merl", "--brdf", "lambert", "-o", "missing/x.binary"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("cannot write"), std::string::npos) << r.err;
+  r = run({"info", "x.binary"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("x.binary"), std::string::npos) << r.err;
+  EXPECT_EQ(entries(), (std::vector<std::string>{"x.binary"}));
+}
+
+TEST_F(CliTest, ResampleWritesEachFormatAndRejectsBadGrids) {
+  for (const char* f : {"t.exr", "t.npz", "t.npy"}) {
+    const Result r = run({"resample", "--brdf", "test:S", "--param", "hybrid", "--kind", "slice",
+                          "--azimuth", "45", "--size", "16,8", "-o", f});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("128 grid points"), std::string::npos) << r.err;
+    EXPECT_GT(fs::file_size(path(f)), 16u * 8 * 3 * 4);
+  }
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const Case cases[] = {
+      {{"--param", "dirs"}, "expected a parameterization"},
+      {{"--size", "16,0"}, "'0' is not a positive whole number"},
+      {{"--size", "4,4"}, "has 3 axes, got 2 sample counts"},
+      {{"--azimuth", "30"}, "needs --kind slice"},
+      {{"--range", "theta_h=0:1"}, "no axis 'theta_h' (its axes: hbar, k, dphi)"},
+      {{"--range", "k=1:0"}, "lo <= hi"},
+      {{"--range", "k=0:x"}, "'x' is not a number"},
+      {{"--range", "k"}, "expected NAME=LO:HI"},
+      {{"--kind", "cube"}, "cube"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"resample", "--brdf", "lambert", "-o", "bad.npz"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const Result r = run(args);
+    EXPECT_EQ(r.status, 2) << c.message << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+  }
+  Result r = run({"resample", "--brdf", "lambert", "-o", "t.csv"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find(".exr, .npz or .npy"), std::string::npos) << r.err;
+  EXPECT_EQ(entries(), (std::vector<std::string>{"t.exr", "t.npy", "t.npz"}));
 }
 
 }  // namespace

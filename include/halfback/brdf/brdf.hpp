@@ -8,6 +8,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "halfback/core/param.hpp"
 #include "halfback/core/space.hpp"
@@ -33,6 +34,14 @@ class Brdf {
 
   // ρ(ωi, ωo). A pair with a direction below the horizon (z < 0) gives 0.
   virtual Rgb eval(const DirPair<double>& pair) const = 0;
+
+  // What a user inspecting the data wants to know beyond name() and description() (`halfback
+  // info`): format, dimensions, unmeasured bins, identity... as (label, value) lines. Empty for
+  // analytic models, which their spec describes.
+  struct Fact {
+    std::string label, value;
+  };
+  virtual std::vector<Fact> facts() const { return {}; }
 
   // Batch evaluation (out.size() == pairs.size()). The default runs eval() over all threads;
   // formats with a faster batched path override it.

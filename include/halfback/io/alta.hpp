@@ -66,6 +66,7 @@ class AltaBrdf final : public Brdf {
   bool reciprocal() const override { return false; }
   Rgb eval(const DirPair<double>& pair) const override;
   using Brdf::eval;
+  std::vector<Fact> facts() const override;
 
   // ρ at the data's own coordinates (θl, θv·cos Δφ, θv·sin Δφ).
   Rgb eval_coords(double theta_l, double px, double py) const;

@@ -109,6 +109,7 @@ class MerlBrdf final : public Brdf {
   // 0 when a direction is below the horizon (z < 0), NaN when the pair has a NaN.
   Rgb eval(const DirPair<double>& pair) const override;
   using Brdf::eval;
+  std::vector<Fact> facts() const override;
 
   // The value stored in a bin, times the channel scale (what the reference returns for it).
   Rgb bin_value(int theta_h, int theta_d, int phi_d) const;

@@ -108,6 +108,7 @@ class RglBrdf final : public Brdf {
   // below the horizon (z <= 0), NaN when the pair has a NaN.
   Rgb eval(const DirPair<double>& pair) const override;
   using Brdf::eval;
+  std::vector<Fact> facts() const override;
 
   // fr·cos θo: what the reference loader's eval(wi, wo) returns.
   Rgb eval_cosine(const DirPair<double>& pair) const;

@@ -1,0 +1,96 @@
+// Resampling: a BRDF tabulated on a regular grid of any parameterization, with a validity mask.
+//
+// Three kinds of grid over a parameterization P (docs/formats.md, "Resampled tables"):
+//   full       the 4D coordinates of P                   (e.g. hbar, phi_h, k, phi_k)
+//   isotropic  the 3D isotropic form of P                (e.g. hbar, k, dphi), canonical pose
+//   slice      the isotropic form at a fixed relative azimuth: the two non-azimuthal coordinates
+//              (e.g. hbar, k at dphi = 90°), the slices of the paper's Figures 2-5
+// Each axis is a range [lo, hi] with `count` samples, either at the centres of `count` equal cells
+// (the default, as MERL does: no sample on a singular boundary such as θ = π/2) or at `count`
+// equally spaced nodes including both ends. A grid point outside the parameterization's domain
+// (no pair of directions in the upper hemisphere has those coordinates) is invalid: its values are
+// NaN and its mask 0. The table is row-major, the last axis fastest.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/core/space.hpp"
+
+namespace halfback {
+
+enum class GridKind { full, isotropic, slice };
+enum class GridSampling { centres, nodes };
+
+std::string_view name_of(GridKind kind);
+std::string_view name_of(GridSampling sampling);
+
+struct GridAxis {
+  std::string name;  // the coordinate's column name (space.hpp), e.g. "theta_h"
+  double lo = 0, hi = 1;
+  std::size_t count = 1;
+  // The i-th sample position.
+  double position(std::size_t i, GridSampling sampling) const;
+};
+
+struct GridSpec {
+  Space space = Space::hybrid;  // a parameterization, not dirs
+  GridKind kind = GridKind::isotropic;
+  GridSampling sampling = GridSampling::centres;
+  double slice_azimuth = 0;    // kind == slice: the relative azimuth, radians
+  std::vector<GridAxis> axes;  // 4, 3 or 2 axes (full, isotropic, slice)
+
+  std::size_t points() const;
+  // The form whose coordinates a grid point is evaluated at (the slice's is the isotropic one).
+  Form form() const { return {space, kind != GridKind::full}; }
+};
+
+// The grid of a kind over `space`, each axis on the range that bounds the domain (angles θ in
+// [0, π/2], azimuths in [0, 2π), ‖h̄‖, ‖k̄‖, ‖k‖ in [0, 1]), with counts[i] samples on axis i (a
+// single count applies to every axis). Throws std::invalid_argument for dirs, a wrong number of
+// counts or a count of 0.
+GridSpec default_grid(Space space, GridKind kind, std::vector<std::size_t> counts,
+                      double slice_azimuth = 0);
+
+// Checks a grid (the right axes for its kind, finite ranges with lo < hi, counts >= 1, nodes
+// need counts >= 2 only when lo != hi, at most 2^31 points); throws std::invalid_argument.
+void validate(const GridSpec& grid);
+
+struct ResampledTable {
+  GridSpec grid;
+  std::string brdf_name, brdf_description;
+  std::vector<double> rgb;          // points() × 3; NaN where invalid
+  std::vector<std::uint8_t> valid;  // points(); 1 inside the domain, 0 outside
+  std::size_t valid_count() const;
+};
+
+struct ResampleOptions {
+  unsigned threads = 0;  // 1: the calling thread only; otherwise all hardware threads
+};
+
+// Tabulates `brdf` on `grid` (validated first). A valid point whose ρ is not finite keeps that
+// value; the mask only says whether the coordinates are those of a pair of directions.
+ResampledTable resample(const Brdf& brdf, const GridSpec& grid,
+                        const ResampleOptions& options = {});
+
+// Writes a table, the format chosen by the extension (docs/formats.md, "Resampled tables"):
+//   .exr  OpenEXR, float channels R, G, B and `valid`; the table as an image whose width is the
+//         last axis and whose rows run over the other axes (row-major); string attributes
+//         `halfback:*` state the parameterization, kind, sampling, shape, and each axis's name,
+//         range, count and sample positions
+//   .npz  NumPy archive (np.load): `rho` float64 (shape..., 3), `valid` bool (shape...),
+//         `axis0`... float64 sample positions, `axis_names` and `metadata` (JSON) strings
+//   .npy  NumPy array `rho` only, float64 (shape..., 3), NaN where invalid (no room for
+//         metadata in that format: use .npz or .exr to keep the axes)
+// The file is written to a temporary file and renamed into place. Throws std::invalid_argument
+// for another extension and std::runtime_error (naming the file) on I/O errors.
+void write_table(const std::filesystem::path& path, const ResampledTable& table);
+
+// The metadata of a table as a JSON object (what .npz and .exr carry).
+std::string table_metadata_json(const ResampledTable& table);
+
+}  // namespace halfback

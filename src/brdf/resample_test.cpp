@@ -1,0 +1,287 @@
+// Resampling onto grids of the parameterizations, and the table files (.exr, .npy; the .npz is
+// read back by NumPy itself in tests/python/test_brdf_cli.py).
+#include "halfback/brdf/resample.hpp"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "halfback/brdf/test_functions.hpp"
+#include "halfback/core/batch.hpp"
+#include "io/test_support.hpp"
+
+namespace halfback {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Smooth, anisotropic and non-reciprocal: a resampling that mixes up coordinates shows.
+class Smooth final : public Brdf {
+ public:
+  std::string name() const override { return "smooth"; }
+  std::string description() const override { return "smooth test function"; }
+  bool isotropic() const override { return false; }
+  bool reciprocal() const override { return false; }
+  Rgb eval(const DirPair<double>& p) const override {
+    if (p.wi.z < 0 || p.wo.z < 0) return {};
+    return {1 + p.wi.x + 0.5 * p.wo.y, 2 + p.wi.z * p.wo.z, 0.5 + 0.1 * p.wo.x - 0.2 * p.wi.y};
+  }
+  using Brdf::eval;
+};
+
+// The coordinates of grid point `flat` (row-major, last axis fastest), the slice azimuth added.
+std::vector<double> coords_of(const GridSpec& g, std::size_t flat) {
+  std::vector<double> x(g.axes.size());
+  for (std::size_t a = g.axes.size(); a-- > 0;) {
+    x[a] = g.axes[a].position(flat % g.axes[a].count, g.sampling);
+    flat /= g.axes[a].count;
+  }
+  if (g.kind == GridKind::slice) x.push_back(g.slice_azimuth);
+  return x;
+}
+
+TEST(Resample, EveryPointIsTheBrdfAtTheCheckedInverse) {
+  const Smooth brdf;
+  for (Space s : kParameterizations) {
+    for (GridKind kind : {GridKind::full, GridKind::isotropic, GridKind::slice}) {
+      const std::size_t n = kind == GridKind::full ? 7 : kind == GridKind::isotropic ? 11 : 23;
+      GridSpec g = default_grid(s, kind, {n}, 1.1);
+      for (GridSampling sampling : {GridSampling::centres, GridSampling::nodes}) {
+        g.sampling = sampling;
+        const ResampledTable t = resample(brdf, g);
+        ASSERT_EQ(t.rgb.size(), 3 * g.points());
+        std::size_t valid = 0;
+        for (std::size_t p = 0; p < g.points(); ++p) {
+          const auto x = coords_of(g, p);
+          std::array<double, 6> d{};
+          const bool ok = convert_one<double>(g.form(), {Space::dirs, false}, x, d);
+          ASSERT_EQ(bool(t.valid[p]), ok) << name_of(s) << " " << name_of(kind) << " point " << p;
+          if (!ok) {
+            EXPECT_TRUE(std::isnan(t.rgb[3 * p]) && std::isnan(t.rgb[3 * p + 2]));
+            continue;
+          }
+          ++valid;
+          const Rgb ref = brdf.eval(DirPair<double>{{d[0], d[1], d[2]}, {d[3], d[4], d[5]}});
+          // The batch inverse (SIMD math) and convert_one agree to a few ulps, except for ortho
+          // at the horizon, where z = √(1 − ‖ω̄‖²) is known to √ε only (docs/math.md).
+          const double tol = std::min(d[2], d[5]) < 1e-7 ? 1e-7 : 1e-12;
+          EXPECT_NEAR(t.rgb[3 * p], ref.r, tol) << name_of(s) << " " << name_of(kind);
+          EXPECT_NEAR(t.rgb[3 * p + 1], ref.g, tol) << name_of(s) << " " << name_of(kind);
+          EXPECT_NEAR(t.rgb[3 * p + 2], ref.b, tol) << name_of(s) << " " << name_of(kind);
+        }
+        EXPECT_EQ(valid, t.valid_count());
+        // Every grid has points on both sides of the domain boundary.
+        EXPECT_GT(valid, 0u) << name_of(s) << " " << name_of(kind);
+        if (s != Space::spherical) {
+          EXPECT_LT(valid, g.points()) << name_of(s);
+        }
+      }
+    }
+  }
+}
+
+// Closed forms on the paper's slices, computed here from the coordinates alone:
+// S = 1 − ‖h̄‖ on ortho and hybrid slices; F = 1 − cos θd on halfdiff slices.
+TEST(Resample, SlicesOfTheTestFunctionsMatchTheirClosedForms) {
+  const TestFunctionBrdf specular(TestFunction::specular), fresnel(TestFunction::fresnel);
+  for (double az_deg : {0.0, 45.0, 90.0}) {
+    for (Space s : {Space::ortho, Space::hybrid}) {
+      const GridSpec g = default_grid(s, GridKind::slice, {64}, az_deg * kPi / 180);
+      const ResampledTable t = resample(specular, g);
+      for (std::size_t p = 0; p < g.points(); ++p) {
+        if (!t.valid[p]) continue;
+        const double hbar = g.axes[0].position(p / 64, g.sampling);
+        EXPECT_NEAR(t.rgb[3 * p], 1 - hbar, 1e-12);
+      }
+    }
+    const GridSpec g = default_grid(Space::halfdiff, GridKind::slice, {64}, az_deg * kPi / 180);
+    const ResampledTable t = resample(fresnel, g);
+    for (std::size_t p = 0; p < g.points(); ++p) {
+      if (!t.valid[p]) continue;
+      const double theta_d = g.axes[1].position(p % 64, g.sampling);
+      EXPECT_NEAR(t.rgb[3 * p], 1 - std::cos(theta_d), 1e-12);
+    }
+  }
+}
+
+// A halfdiff slice at φd = 90° is valid exactly where θh ≤ π/2 and θd ≤ π/2 with
+// cos θi, cos θo ≥ 0: at φd = 90° the difference vector is along b, so z = cos θh cos θd for both
+// directions and the whole square is valid; at φd = 0, z = cos(θh ± θd), valid iff θh + θd ≤ π/2.
+TEST(Resample, HalfdiffSliceDomainsHaveTheirClosedForm) {
+  const TestFunctionBrdf g_fn(TestFunction::grazing);
+  const GridSpec g90 = default_grid(Space::halfdiff, GridKind::slice, {40}, kPi / 2);
+  EXPECT_EQ(resample(g_fn, g90).valid_count(), g90.points());
+  const GridSpec g0 = default_grid(Space::halfdiff, GridKind::slice, {40}, 0);
+  const ResampledTable t0 = resample(g_fn, g0);
+  for (std::size_t p = 0; p < g0.points(); ++p) {
+    const double th = g0.axes[0].position(p / 40, g0.sampling);
+    const double td = g0.axes[1].position(p % 40, g0.sampling);
+    if (std::abs(th + td - kPi / 2) < 1e-9) continue;  // on the boundary: either way by rounding
+    EXPECT_EQ(bool(t0.valid[p]), th + td < kPi / 2) << th << " " << td;
+  }
+}
+
+TEST(Resample, SamplePositions) {
+  GridAxis a{"x", 0, 1, 4};
+  EXPECT_DOUBLE_EQ(a.position(0, GridSampling::centres), 0.125);
+  EXPECT_DOUBLE_EQ(a.position(3, GridSampling::centres), 0.875);
+  EXPECT_EQ(a.position(0, GridSampling::nodes), 0);
+  EXPECT_EQ(a.position(3, GridSampling::nodes), 1);
+  GridAxis phi{"phi", 0, 2 * kPi, 7};
+  EXPECT_EQ(phi.position(6, GridSampling::nodes), 2 * kPi);
+  GridAxis one{"x", 0.3, 0.3, 1};
+  EXPECT_EQ(one.position(0, GridSampling::nodes), 0.3);
+}
+
+TEST(Resample, DefaultGridsAndValidation) {
+  const GridSpec g = default_grid(Space::hybrid, GridKind::isotropic, {4, 5, 6});
+  ASSERT_EQ(g.axes.size(), 3u);
+  EXPECT_EQ(g.axes[0].name, "hbar");
+  EXPECT_EQ(g.axes[1].name, "k");
+  EXPECT_EQ(g.axes[2].name, "dphi");
+  EXPECT_EQ(g.axes[2].hi, 2 * kPi);
+  EXPECT_EQ(g.points(), 120u);
+  const GridSpec f = default_grid(Space::halfdiff, GridKind::full, {3});
+  EXPECT_EQ(f.axes[0].name, "theta_h");
+  EXPECT_EQ(f.axes[0].hi, kPi / 2);
+  EXPECT_EQ(f.axes[1].name, "phi_h");
+  EXPECT_EQ(f.points(), 81u);
+  const GridSpec s = default_grid(Space::ortho, GridKind::slice, {8});
+  ASSERT_EQ(s.axes.size(), 2u);
+  EXPECT_EQ(s.axes[1].name, "kbar");
+
+  auto message = [](auto f) {
+    try {
+      f();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message([] { default_grid(Space::dirs, GridKind::full, {4}); }).find("dirs"),
+            std::string::npos);
+  EXPECT_NE(message([] {
+              default_grid(Space::hybrid, GridKind::full, {4, 4});
+            }).find("4 axes"),
+            std::string::npos);
+  EXPECT_NE(message([] { default_grid(Space::hybrid, GridKind::slice, {0}); }).find("no samples"),
+            std::string::npos);
+  GridSpec bad = g;
+  bad.axes[1].lo = 2, bad.axes[1].hi = 1;
+  EXPECT_NE(message([&] { validate(bad); }).find("lo <= hi"), std::string::npos);
+  bad = g;
+  bad.axes[0].hi = NAN;
+  EXPECT_NE(message([&] { validate(bad); }).find("finite"), std::string::npos);
+  bad = g;
+  bad.axes[0].name = "theta_h";
+  EXPECT_NE(message([&] { validate(bad); }).find("'theta_h'"), std::string::npos);
+  EXPECT_NE(message([] { default_grid(Space::hybrid, GridKind::full, {400}); }).find("2^31"),
+            std::string::npos);
+}
+
+TEST(Resample, ThreadCountDoesNotChangeTheBits) {
+  const Smooth brdf;
+  const GridSpec g = default_grid(Space::ortho, GridKind::isotropic, {33, 17, 29});
+  const ResampledTable a = resample(brdf, g, {1}), b = resample(brdf, g, {0});
+  EXPECT_EQ(a.valid, b.valid);
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  EXPECT_EQ(std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(double)), 0);
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(TableFile, NpyHeaderAndData) {
+  test::TempDir dir;
+  const GridSpec g = default_grid(Space::hybrid, GridKind::slice, {3, 5}, 0.5);
+  const ResampledTable t = resample(Smooth(), g);
+  write_table(dir.path() / "t.npy", t);
+  const std::string b = slurp(dir.path() / "t.npy");
+  ASSERT_GE(b.size(), 10u);
+  EXPECT_EQ(b.substr(0, 8), std::string("\x93NUMPY\x01\x00", 8));
+  const std::size_t header_len = std::size_t(std::uint8_t(b[8])) | std::size_t(std::uint8_t(b[9]))
+                                                                       << 8;
+  EXPECT_EQ((10 + header_len) % 64, 0u);
+  const std::string header = b.substr(10, header_len);
+  EXPECT_NE(header.find("'descr': '<f8'"), std::string::npos) << header;
+  EXPECT_NE(header.find("'shape': (3, 5, 3)"), std::string::npos) << header;
+  EXPECT_EQ(header.back(), '\n');
+  ASSERT_EQ(b.size(), 10 + header_len + 8 * t.rgb.size());
+  for (std::size_t i = 0; i < t.rgb.size(); ++i) {
+    double v;
+    std::memcpy(&v, b.data() + 10 + header_len + 8 * i, 8);
+    if (std::isnan(t.rgb[i]))
+      EXPECT_TRUE(std::isnan(v));
+    else
+      EXPECT_EQ(v, t.rgb[i]);
+  }
+}
+
+TEST(TableFile, ExrChannelsAndAttributes) {
+  test::TempDir dir;
+  GridSpec g = default_grid(Space::halfdiff, GridKind::isotropic, {4, 6, 8});
+  g.axes[0].hi = 1.0;  // a custom range shows in the attributes
+  const ResampledTable t = resample(Smooth(), g);
+  const auto path = dir.path() / "t.exr";
+  write_table(path, t);
+  Imf::InputFile in(path.c_str());
+  const auto dw = in.header().dataWindow();
+  const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+  ASSERT_EQ(w, 8);
+  ASSERT_EQ(h, 24);
+  for (const char* c : {"R", "G", "B", "valid"})
+    EXPECT_NE(in.header().channels().findChannel(c), nullptr) << c;
+  auto attr = [&](const char* name) {
+    const auto* a = in.header().findTypedAttribute<Imf::StringAttribute>(name);
+    return a ? a->value() : std::string("(missing)");
+  };
+  EXPECT_EQ(attr("halfback:parameterization"), "halfdiff");
+  EXPECT_EQ(attr("halfback:kind"), "isotropic");
+  EXPECT_EQ(attr("halfback:shape"), "4 6 8");
+  EXPECT_EQ(attr("halfback:axis0"), "theta_h [0, 1] 4 centres");
+  EXPECT_EQ(attr("halfback:brdf"), "smooth");
+  EXPECT_NE(attr("halfback:metadata").find("\"axes\""), std::string::npos);
+  std::vector<float> px(std::size_t(w) * h * 4);
+  Imf::FrameBuffer fb;
+  char* base = reinterpret_cast<char*>(px.data());
+  const char* names[] = {"R", "G", "B", "valid"};
+  for (int c = 0; c < 4; ++c)
+    fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float),
+                                   4 * sizeof(float) * w));
+  in.setFrameBuffer(fb);
+  in.readPixels(dw.min.y, dw.max.y);
+  for (std::size_t p = 0; p < g.points(); ++p) {
+    EXPECT_EQ(px[4 * p + 3], t.valid[p] ? 1.f : 0.f);
+    if (t.valid[p]) {
+      EXPECT_EQ(px[4 * p], float(t.rgb[3 * p]));
+    }
+  }
+}
+
+TEST(TableFile, BadNamesAndDestinations) {
+  test::TempDir dir;
+  const ResampledTable t = resample(Smooth(), default_grid(Space::hybrid, GridKind::slice, {2}));
+  EXPECT_THROW(write_table(dir.path() / "t.csv", t), std::invalid_argument);
+  EXPECT_ANY_THROW(write_table(dir.path() / "missing" / "t.npz", t));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "missing"));
+  ResampledTable broken = t;
+  broken.rgb.pop_back();
+  EXPECT_THROW(write_table(dir.path() / "t.npz", broken), std::invalid_argument);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "t.npz"));
+}
+
+}  // namespace
+}  // namespace halfback

@@ -1,0 +1,160 @@
+// `halfback resample`: a BRDF tabulated on a regular grid of a parameterization (4D, isotropic
+// 3D, or a 2D slice at a fixed relative azimuth), written as OpenEXR, .npz or .npy
+// (brdf/resample.hpp).
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "command.hpp"
+#include "halfback/brdf/load.hpp"
+#include "halfback/brdf/resample.hpp"
+
+namespace halfback::cli {
+
+namespace {
+
+struct ResampleOptions {
+  std::string brdf, param = "hybrid", kind = "isotropic", size = "64", output;
+  std::vector<std::string> ranges;
+  double azimuth_deg = 0;
+  bool azimuth_given = false;
+  bool nodes = false;
+  unsigned threads = 0;
+};
+
+double parse_number(std::string_view text, const std::string& what) {
+  double v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
+    throw UsageError(fmt::format("{}: '{}' is not a number", what, text));
+  return v;
+}
+
+std::vector<std::size_t> parse_counts(const std::string& list) {
+  std::vector<std::size_t> counts;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string item = list.substr(start, comma - start);
+    std::size_t v = 0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (item.empty() || ec != std::errc() || end != item.data() + item.size() || v == 0)
+      throw UsageError(
+          fmt::format("--size '{}': '{}' is not a positive whole number of samples", list, item));
+    counts.push_back(v);
+    start = comma + 1;
+  }
+  return counts;
+}
+
+int run_resample(const ResampleOptions& o) {
+  const auto space = space_from_name(o.param);
+  if (!space || *space == Space::dirs)
+    throw UsageError(fmt::format(
+        "--param '{}': expected a parameterization: spherical, halfdiff, ortho or hybrid",
+        o.param));
+  const GridKind kind = o.kind == "full"        ? GridKind::full
+                        : o.kind == "isotropic" ? GridKind::isotropic
+                                                : GridKind::slice;
+  if (o.azimuth_given && kind != GridKind::slice)
+    throw UsageError("--azimuth fixes the relative azimuth of a slice: it needs --kind slice");
+  GridSpec grid;
+  try {
+    grid = default_grid(*space, kind, parse_counts(o.size), o.azimuth_deg * std::numbers::pi / 180);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("--size: {}", e.what()));
+  }
+  grid.sampling = o.nodes ? GridSampling::nodes : GridSampling::centres;
+  for (const std::string& r : o.ranges) {
+    const std::size_t eq = r.find('='), colon = r.find(':', eq == std::string::npos ? 0 : eq);
+    if (eq == std::string::npos || colon == std::string::npos)
+      throw UsageError(fmt::format("--range '{}': expected NAME=LO:HI, e.g. theta_h=0:0.5", r));
+    const std::string name = r.substr(0, eq);
+    GridAxis* axis = nullptr;
+    std::string names;
+    for (GridAxis& a : grid.axes) {
+      if (a.name == name) axis = &a;
+      names += (names.empty() ? "" : ", ") + a.name;
+    }
+    if (!axis)
+      throw UsageError(
+          fmt::format("--range '{}': this grid has no axis '{}' (its axes: {})", r, name, names));
+    axis->lo = parse_number(std::string_view(r).substr(eq + 1, colon - eq - 1), "--range " + r);
+    axis->hi = parse_number(std::string_view(r).substr(colon + 1), "--range " + r);
+  }
+  try {
+    validate(grid);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  {
+    std::string ext = std::filesystem::path(o.output).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".exr" && ext != ".npz" && ext != ".npy")
+      throw UsageError(
+          fmt::format("-o '{}': the table is written as .exr, .npz or .npy", o.output));
+    AtomicFile probe(o.output);  // an unwritable destination fails before any work
+    probe.discard();
+  }
+  const BrdfPtr brdf = load_brdf(o.brdf);
+  halfback::ResampleOptions ro;
+  ro.threads = o.threads;
+  const ResampledTable t = resample(*brdf, grid, ro);
+  write_table(o.output, t);
+  fmt::print(stderr, "halfback resample: {} written: {} grid points ({} inside the domain)\n",
+             o.output, grid.points(), t.valid_count());
+  return kExitOk;
+}
+
+}  // namespace
+
+Command register_resample(CLI::App& parent) {
+  auto o = std::make_shared<ResampleOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "resample", "Tabulate a BRDF on a regular grid of a parameterization (.exr, .npz, .npy)");
+  app->add_option("--brdf", o->brdf, "BRDF SPEC: a MERL, RGL or ALTA file, or a model")->required();
+  app->add_option("--param", o->param, "Parameterization: spherical, halfdiff, ortho or hybrid")
+      ->capture_default_str();
+  app->add_option("--kind", o->kind,
+                  "full (4D), isotropic (3D, phi_h = 0) or slice (2D, at --azimuth)")
+      ->check(CLI::IsMember({"full", "isotropic", "slice"}))
+      ->capture_default_str();
+  app->add_option("--azimuth", o->azimuth_deg,
+                  "Slice: the relative azimuth in degrees (phi_d, or phi_k - phi_h, or phi_o - "
+                  "phi_i)")
+      ->each([o](const std::string&) { o->azimuth_given = true; });
+  app->add_option("--size", o->size, "Samples per axis: N (every axis) or N1,N2,...")
+      ->capture_default_str();
+  app->add_option("--range", o->ranges,
+                  "NAME=LO:HI, the range of an axis in its own units (radians, or unitless "
+                  "lengths); repeatable")
+      ->take_all();
+  app->add_flag("--nodes", o->nodes,
+                "Sample at N nodes including both ends (default: at the centres of N cells)");
+  app->add_option("--threads", o->threads, "1: one thread; otherwise all cores")
+      ->capture_default_str();
+  app->add_option("-o,--output", o->output, "Output: .exr, .npz or .npy, replaced only on success")
+      ->required()
+      ->type_name("FILE");
+  app->footer(
+      "Axes (the last one is the fastest in the table):\n"
+      "  full:      the 4 columns of the parameterization (see 'halfback convert --help')\n"
+      "  isotropic: its 3 isotropic columns, the pair rotated to phi_h = 0\n"
+      "  slice:     the first 2 isotropic columns, at a fixed relative azimuth\n"
+      "Default ranges bound the domain: theta in [0, pi/2], phi in [0, 2 pi), hbar, kbar, k in\n"
+      "[0, 1]. Points outside the domain have NaN values and valid = 0.\n"
+      "Files: .exr (float R, G, B, valid; halfback:* attributes give the grid), .npz (rho,\n"
+      "valid, axis0..., axis_names, metadata), .npy (rho only).\n"
+      "\n"
+      "Examples:\n"
+      "  halfback resample --brdf ggx:alpha=0.2 --param hybrid --size 90,90,180 -o ggx.npz\n"
+      "  halfback resample --brdf paper.bsdf --param ortho --kind slice --azimuth 90 --size 256 "
+      "-o s.exr");
+  return {app, [o] { return run_resample(*o); }};
+}
+
+}  // namespace halfback::cli
