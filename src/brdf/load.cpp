@@ -14,6 +14,7 @@
 #include "halfback/io/rgl.hpp"
 #include "halfback/models/analytic.hpp"
 #include "halfback/models/register.hpp"
+#include "io/embedded.hpp"
 
 namespace halfback {
 
@@ -115,6 +116,12 @@ ModelRegistry& ModelRegistry::global() {
   return registry;
 }
 
+std::vector<std::string> embedded_material_names() {
+  std::vector<std::string> names;
+  for (const detail::EmbeddedFile& f : detail::embedded_files()) names.emplace_back(f.name);
+  return names;
+}
+
 BrdfPtr load_brdf(std::string_view spec) {
   const auto parts = split_sum(spec);
   if (parts.size() == 1) return load_one(spec);
@@ -125,7 +132,25 @@ BrdfPtr load_brdf(std::string_view spec) {
 
 namespace {
 
+// "embedded:NAME": a measured material compiled into the library (data/README.md).
+BrdfPtr load_embedded(std::string_view name) {
+  for (const detail::EmbeddedFile& f : detail::embedded_files()) {
+    if (f.name != name) continue;
+    const auto* b = reinterpret_cast<const std::byte*>(f.bytes.data());
+    const std::string label = "embedded:" + std::string(name);
+    return std::make_shared<RglBrdf>(
+        parse_tensor_file(std::vector<std::byte>(b, b + f.bytes.size()), label),
+        std::string(name) + "_rgb");
+  }
+  std::string known;
+  for (const std::string& n : embedded_material_names()) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("'embedded:" + std::string(name) +
+                              "': no such embedded material (embedded: " + known + ")");
+}
+
 BrdfPtr load_one(std::string_view spec) {
+  constexpr std::string_view embedded = "embedded:";
+  if (spec.substr(0, embedded.size()) == embedded) return load_embedded(spec.substr(embedded.size()));
   const std::filesystem::path path{std::string(spec)};
   std::error_code ec;
   if (!spec.empty() && std::filesystem::exists(path, ec)) {

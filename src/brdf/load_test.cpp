@@ -348,5 +348,32 @@ TEST(BuiltinModels, SumOfSpecs) {
   EXPECT_THROW(load_brdf("lambert+nosuchmodel"), std::invalid_argument);
 }
 
+// The embedded materials are the files of data/rgl/ (same bytes, so the same values), and an
+// unknown name lists the known ones.
+TEST(Embedded, MaterialsAreTheDataFiles) {
+  const auto names = embedded_material_names();
+  ASSERT_EQ(names.size(), 3u);
+  const auto pairs = random_pairs(500, 17);
+  for (const std::string& n : names) {
+    const BrdfPtr e = load_brdf("embedded:" + n);
+    EXPECT_EQ(e->name(), "rgl:" + n + "_rgb");
+    const BrdfPtr f = load_brdf(std::string(HALFBACK_SOURCE_DIR) + "/data/rgl/" + n + "_rgb.bsdf");
+    for (const auto& p : pairs) {
+      const Rgb a = e->eval(p), b = f->eval(p);
+      ASSERT_EQ(a, b) << n;
+    }
+    EXPECT_FALSE(e->facts().empty());
+  }
+  try {
+    load_brdf("embedded:gold");
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& ex) {
+    EXPECT_NE(std::string(ex.what()).find("no such embedded material (embedded: "),
+              std::string::npos)
+        << ex.what();
+    EXPECT_NE(std::string(ex.what()).find("acrylic_felt_green"), std::string::npos);
+  }
+}
+
 }  // namespace
 }  // namespace halfback

@@ -11,6 +11,7 @@
 // destination fails before any drawing, and no partial file is left behind.
 #include <fmt/format.h>
 
+#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -22,7 +23,9 @@
 #include "halfback/brdf/test_functions.hpp"
 #include "halfback/core/space.hpp"
 #include "halfback/figure/hemisphere.hpp"
+#include "halfback/figure/material.hpp"
 #include "halfback/figure/paper.hpp"
+#include "halfback/render/envmap.hpp"
 #include "halfback/figure/render.hpp"
 #include "halfback/figure/slices.hpp"
 #include "halfback/io/atomic_file.hpp"
@@ -60,7 +63,23 @@ struct SliceArgs {
 struct PaperArgs {
   std::string out;
   std::string formats = "png,svg,pdf";
+  std::vector<std::string> materials;  // replace the default Figures 3-5
+  std::string envs = "default,studio,sunset";
+  bool no_materials = false;
+  int render_pixels = 176, spp = 48;
   unsigned threads = 0;
+};
+
+struct MaterialArgs {
+  std::string brdf, heading;
+  std::string envs = "default,studio,sunset";
+  std::string params = "halfdiff,ortho,hybrid";
+  std::string azimuths = "0,45,90";
+  std::string colour = "rgb";
+  int render_pixels = 176, spp = 48;
+  double scale = 2;
+  unsigned threads = 0;
+  std::string out = "material.png";
 };
 
 // "a,b,c" -> {"a", "b", "c"}, items trimmed of spaces; an empty list or item is a usage error.
@@ -208,6 +227,45 @@ int run_slices(const SliceArgs& a) {
   return kExitOk;
 }
 
+// Each environment spec is checked (built-in, constant or readable file) before any work.
+std::vector<std::string> environment_list(const std::string& list) {
+  std::vector<std::string> envs = split_list(list, "--env", "environment");
+  for (const std::string& e : envs) {
+    try {
+      (void)render::EnvMap::from_spec(e);
+    } catch (const std::exception& ex) {
+      throw UsageError(fmt::format("--env '{}': {}", e, ex.what()));
+    }
+  }
+  return envs;
+}
+
+int run_material(const MaterialArgs& a) {
+  check_scale(a.scale);
+  figure::MaterialFigureOptions o;
+  o.environments = environment_list(a.envs);
+  o.slices.params = parameterizations(a.params);
+  o.slices.azimuths_deg = number_list(a.azimuths, "--azimuths", "azimuth");
+  if (a.colour == "luminance")
+    o.slices.colouring = figure::SliceColouring::luminance;
+  else if (a.colour == "rgb")
+    o.slices.colouring = figure::SliceColouring::rgb;
+  else
+    throw UsageError(fmt::format("--colour '{}': expected luminance or rgb", a.colour));
+  o.slices.pixels_per_point = a.scale;
+  o.slices.threads = a.threads;
+  o.render_pixels = a.render_pixels;
+  o.spp = a.spp;
+  o.heading = a.heading;
+  AtomicFile probe(a.out);  // an unwritable destination fails before loading and drawing
+  probe.discard();
+  o.brdf = load_brdf(a.brdf);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto fig = figure::material_figure(o);
+  finish(fig.scene, a.out, a.scale, since(t0));
+  return kExitOk;
+}
+
 int run_paper(const PaperArgs& a) {
   if (a.out.empty()) throw UsageError("--out: no folder given");
   figure::PaperFigureOptions o;
@@ -223,6 +281,24 @@ int run_paper(const PaperArgs& a) {
       throw UsageError(fmt::format("--formats: unknown format '{}' (expected png, svg, pdf)", f));
   }
   o.threads = a.threads;
+  o.environments = environment_list(a.envs);
+  o.render_pixels = a.render_pixels;
+  o.spp = a.spp;
+  if (a.no_materials) {
+    if (!a.materials.empty()) throw UsageError("--no-materials and --material contradict");
+    o.materials.clear();
+  } else if (!a.materials.empty()) {
+    // Each SPEC must load before any figure is drawn.
+    o.materials.clear();
+    for (std::size_t k = 0; k < a.materials.size(); ++k) {
+      const BrdfPtr b = load_brdf(a.materials[k]);
+      std::string stem = fmt::format("fig{}-", 3 + k);
+      for (const char c : b->name()) stem += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
+      o.materials.push_back(
+          {stem, a.materials[k], fmt::format("Figure {} ({}): {}", 3 + k, a.materials[k],
+                                             b->description())});
+    }
+  }
   const auto t0 = std::chrono::steady_clock::now();
   const auto written = figure::write_paper_figures(a.out, o);
   for (const auto& w : written) {
@@ -244,7 +320,9 @@ int run_paper(const PaperArgs& a) {
 
 Command register_figure(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand(
-      "figure", "Draw the figures of Barla et al. 2015 (hemisphere views, slices) as PNG/SVG/PDF");
+      "figure",
+      "Draw the figures of Barla et al. 2015 (hemisphere views, slices, materials) as "
+      "PNG/SVG/PDF");
   app->require_subcommand(1, 1);
   app->footer(
       "Examples:\n"
@@ -252,6 +330,7 @@ Command register_figure(CLI::App& parent) {
       "  halfback figure hemisphere --param halfdiff,hybrid --elevations 0,60 --out fig1.pdf\n"
       "  halfback figure slices --brdf test:S,G,F --azimuths 0,45,90 --out fig2.svg\n"
       "  halfback figure slices --brdf ggx:alpha=0.1 --colour rgb --out ggx.png\n"
+      "  halfback figure material --brdf embedded:acrylic_felt_green --env studio --out felt.pdf\n"
       "See docs/figures.md.");
 
   auto hemi = std::make_shared<HemisphereArgs>();
@@ -306,15 +385,58 @@ Command register_figure(CLI::App& parent) {
   auto pa = std::make_shared<PaperArgs>();
   CLI::App* p = app->add_subcommand(
       "paper",
-      "Figures 1 (three views) and 2 on their default settings, into a folder, and print "
-      "where they are");
+      "Figures 1 (three views), 2 and 3-5 (measured and analytic materials) on their default "
+      "settings, into a folder, and print where they are");
   p->add_option("-o,--out", pa->out, "Output folder (created if missing)")->required();
   p->add_option("--formats", pa->formats, "Formats to write: png, svg, pdf")->capture_default_str();
+  p->add_option("--material", pa->materials,
+                "A BRDF SPEC for Figures 3, 4, 5... (repeatable; replaces the default measured "
+                "and analytic materials)")
+      ->take_all();
+  p->add_flag("--no-materials", pa->no_materials, "Figures 1 and 2 only");
+  p->add_option("--env", pa->envs,
+                "Environments of the sphere renderings: default, studio, sunset, constant:V or "
+                ".hdr/.exr files, comma-separated")
+      ->capture_default_str();
+  p->add_option("--render-size", pa->render_pixels, "Pixels of each sphere rendering")
+      ->check(CLI::Range(16, 2048))
+      ->capture_default_str();
+  p->add_option("--spp", pa->spp, "Samples per pixel of the renderings")
+      ->check(CLI::Range(1, 1 << 16))
+      ->capture_default_str();
   p->add_option("--threads", pa->threads, "Sampling threads (0: all cores)")->capture_default_str();
+
+  auto ma = std::make_shared<MaterialArgs>();
+  CLI::App* m = app->add_subcommand(
+      "material",
+      "Figures 3-5 for any BRDF: sphere renderings under environments, then its slices");
+  m->add_option("--brdf", ma->brdf, "BRDF SPEC: a file (MERL, RGL, ALTA) or a model")->required();
+  m->add_option("--title", ma->heading, "Figure title (default: the BRDF's name)");
+  m->add_option("--env", ma->envs,
+                "Environments: default, studio, sunset, constant:V or .hdr/.exr files, "
+                "comma-separated")
+      ->capture_default_str();
+  m->add_option("--param", ma->params, "Parameterizations, one row of slices each")
+      ->capture_default_str();
+  m->add_option("--azimuths", ma->azimuths, "Relative azimuths of the slices, in degrees")
+      ->capture_default_str();
+  m->add_option("--colour", ma->colour, "Slices: rgb (tone-mapped) or luminance (viridis)")
+      ->capture_default_str();
+  m->add_option("--render-size", ma->render_pixels, "Pixels of each sphere rendering")
+      ->check(CLI::Range(16, 2048))
+      ->capture_default_str();
+  m->add_option("--spp", ma->spp, "Samples per pixel of the renderings")
+      ->check(CLI::Range(1, 1 << 16))
+      ->capture_default_str();
+  m->add_option("--scale", ma->scale, "Pixels per point of the PNG (and of the rasters)")
+      ->capture_default_str();
+  m->add_option("--threads", ma->threads, "Threads (0: all cores)")->capture_default_str();
+  m->add_option("-o,--out", ma->out, "Output file: .png, .svg or .pdf")->capture_default_str();
 
   return {app, [=]() -> int {
             if (h->parsed()) return run_hemisphere(*hemi);
             if (s->parsed()) return run_slices(*sl);
+            if (m->parsed()) return run_material(*ma);
             return run_paper(*pa);
           }};
 }

@@ -90,7 +90,7 @@ Command register_render(CLI::App& parent) {
       ->required();
   app->add_option("--env", o->env,
                   "environment: a latitude-longitude .hdr or .exr file, constant:V, "
-                  "constant:R,G,B, or default (a built-in sky with a sun)")
+                  "constant:R,G,B, or a built-in: default (a sky with a sun), studio, sunset")
       ->capture_default_str();
   app->add_option("-o,--output", o->output, "output image: .exr (linear) or .png (sRGB)")
       ->required();

@@ -15,7 +15,9 @@
 #include "batch_engine.hpp"
 #include "row_kernels.hpp"
 
-#if defined(__GNUC__)
+// Sanitizer builds (HALFBACK_NO_FLATTEN, set by CMake) keep the calls: flattening instrumented
+// code takes the compiler minutes and gigabytes per kernel file, for no benefit to the checks.
+#if defined(__GNUC__) && !defined(HALFBACK_NO_FLATTEN)
 #define HALFBACK_FLATTEN [[gnu::flatten]]
 #else
 #define HALFBACK_FLATTEN

@@ -7,7 +7,9 @@
 #include <tuple>
 #include <utility>
 
+#include "halfback/brdf/load.hpp"
 #include "halfback/figure/hemisphere.hpp"
+#include "halfback/figure/material.hpp"
 #include "halfback/figure/render.hpp"
 #include "halfback/figure/slices.hpp"
 
@@ -27,6 +29,26 @@ std::vector<std::filesystem::path> save_all(const Scene& scene, const std::files
   return out;
 }
 }  // namespace
+
+std::vector<PaperMaterial> default_paper_materials() {
+  return {
+      {"fig3-metallic", "embedded:ilm_l3_37_metallic",
+       "Figure 3, a glossy metallic: metallic paint, measured (RGL ilm_l3_37_metallic)"},
+      {"fig4-paint", "embedded:colodur_azure_4e",
+       "Figure 4, a diffuse: wall paint, measured (RGL colodur_azure_4e)"},
+      {"fig5-felt", "embedded:acrylic_felt_green",
+       "Figure 5, a textile: felt, measured (RGL acrylic_felt_green)"},
+      {"fig3-analytic-gold", "ggx:alpha=0.15,f0_r=1,f0_g=0.78,f0_b=0.34",
+       "Figure 3, analytic: glossy gold (GGX, Schlick Fresnel)"},
+      {"fig4-analytic-sheen",
+       "lambert:albedo_r=0.55,albedo_g=0.22,albedo_b=0.18+sheen:alpha=0.4,color=0.6",
+       "Figure 4, analytic: a diffuse with sheen (Lambert + Charlie sheen)"},
+      {"fig5-analytic-textile",
+       "sheen:alpha=0.25,color_r=0.35,color_g=0.8,color_b=0.35+lambert:albedo_r=0.04,"
+       "albedo_g=0.18,albedo_b=0.05",
+       "Figure 5, analytic: a textile-like grazing lobe (Charlie sheen over a dark diffuse)"},
+  };
+}
 
 std::vector<WrittenFigure> write_paper_figures(const std::filesystem::path& dir,
                                                const PaperFigureOptions& o) {
@@ -53,6 +75,17 @@ std::vector<WrittenFigure> write_paper_figures(const std::filesystem::path& dir,
   s.threads = o.threads;
   written.push_back({"Figure 2, test functions S, G, F on slices",
                      save_all(slice_figure(s).scene, dir, "fig2-slices", o)});
+  for (const PaperMaterial& m : o.materials) {
+    MaterialFigureOptions mo;
+    mo.brdf = load_brdf(m.spec);
+    mo.heading = m.description;
+    mo.environments = o.environments;
+    mo.render_pixels = o.render_pixels;
+    mo.spp = o.spp;
+    mo.slices.threads = o.threads;
+    mo.slices.colouring = SliceColouring::rgb;
+    written.push_back({m.description, save_all(material_figure(mo).scene, dir, m.stem, o)});
+  }
   return written;
 }
 

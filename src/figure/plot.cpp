@@ -74,6 +74,10 @@ std::vector<double> ticks(double lo, double hi, double step) {
   return t;
 }
 
+void draw_frame(Scene& scene, const Rect& r, double width) {
+  scene.rect(r.x, r.y, r.w, r.h, std::nullopt, Stroke{kBlack, width});
+}
+
 void draw_axes(Scene& scene, const PanelMap& panel, const AxisSpec& x, const AxisSpec& y,
                bool x_labels, bool y_labels, double fs) {
   const Rect& r = panel.rect;

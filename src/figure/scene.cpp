@@ -53,6 +53,35 @@ std::string plain_text(std::string_view text) {
   return out;
 }
 
+std::string escape_markup(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '_' || c == '^') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+void Scene::add(Item item) { items.push_back(std::move(item)); }
+
+void append_scene(Scene& dst, const Scene& src, Point offset) {
+  auto move = [&](Point& p) {
+    p.x += offset.x;
+    p.y += offset.y;
+  };
+  for (Item item : src.items) {
+    if (auto* path = std::get_if<PathItem>(&item))
+      for (Point& p : path->points) move(p);
+    else if (auto* circle = std::get_if<CircleItem>(&item))
+      move(circle->centre);
+    else if (auto* image = std::get_if<ImageItem>(&item))
+      image->x += offset.x, image->y += offset.y;
+    else if (auto* text = std::get_if<TextItem>(&item))
+      move(text->at);
+    dst.add(std::move(item));
+  }
+}
+
 double baseline_offset(VAlign v) {
   switch (v) {
     case VAlign::middle:

@@ -152,12 +152,13 @@ SliceFigure slice_figure(const SliceOptions& o) {
   if (generic) {
     sc.title = fmt::format("Slices of the isotropic forms: {}", o.brdf->name());
     heading =
-        fmt::format("Slices of the isotropic forms at fixed relative azimuth: {}", o.brdf->name());
+        fmt::format("Slices of the isotropic forms at fixed relative azimuth: {}",
+                    escape_markup(o.brdf->name()));
     sub = fmt::format(
         "{}. Colour: {}; isolines of luminance at log-spaced levels; one scale "
         "for all panels, clipped at the 0.5 % and 99.5 % percentiles; hatched: outside "
         "the valid domain.",
-        o.brdf->description(),
+        escape_markup(o.brdf->description()),
         o.colouring == SliceColouring::rgb ? "RGB tone-mapped on the log-luminance scale"
                                            : "false colour (viridis) of log₁₀ luminance");
   } else {

@@ -300,7 +300,9 @@ EnvMap EnvMap::constant(const Rgb& radiance, EnvOptions options) {
 }
 
 EnvMap EnvMap::from_spec(std::string_view spec, EnvOptions options) {
-  if (spec == "default") return default_sky(options);
+  if (spec == "default" || spec == "sky") return default_sky(options);
+  if (spec == "studio") return studio(options);
+  if (spec == "sunset") return sunset(options);
   constexpr std::string_view prefix = "constant:";
   if (spec.substr(0, prefix.size()) == prefix) {
     std::vector<double> v;
@@ -464,5 +466,104 @@ EnvMap EnvMap::default_sky(EnvOptions options) {
     }
   return EnvMap(W, H, std::move(rgb), "default", options);
 }
+
+namespace {
+
+// A procedural map: `radiance(d)` at the centre of every pixel, averaged over 4 × 4 sub-pixel
+// samples where `edge(d)` says the pixel may straddle the boundary of a light.
+template <class Radiance, class Edge>
+std::vector<float> procedural_map(int W, int H, Radiance radiance, Edge edge) {
+  std::vector<float> rgb(std::size_t(W) * H * 3);
+  for (int r = 0; r < H; ++r)
+    for (int c = 0; c < W; ++c) {
+      const Vec3<double> d = EnvMap::map_direction((c + 0.5) / W, (r + 0.5) / H);
+      Rgb v{};
+      const int n = edge(d) ? 4 : 1;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const Rgb x = radiance(EnvMap::map_direction((c + (i + 0.5) / n) / W,
+                                                       (r + (j + 0.5) / n) / H));
+          v = {v.r + x.r, v.g + x.g, v.b + x.b};
+        }
+      float* p = &rgb[3 * (std::size_t(r) * W + std::size_t(c))];
+      p[0] = float(v.r / (n * n));
+      p[1] = float(v.g / (n * n));
+      p[2] = float(v.b / (n * n));
+    }
+  return rgb;
+}
+
+// Elevation above the horizon and azimuth from +z (the camera's side) towards +x, in radians.
+void elevation_azimuth(const Vec3<double>& d, double& elev, double& azim) {
+  elev = std::asin(std::clamp(d.y, -1.0, 1.0));
+  azim = std::atan2(d.x, d.z);
+}
+
+// Whether (elev, azim) is inside a rectangle of half-sizes (he, ha) around (e0, a0), with the
+// azimuth difference wrapped to (−π, π].
+bool in_rectangle(double elev, double azim, double e0, double a0, double he, double ha,
+                  double margin = 0) {
+  const double da = std::remainder(azim - a0, 2 * kPi);
+  return std::abs(elev - e0) <= he + margin && std::abs(da) <= ha + margin;
+}
+
+}  // namespace
+
+EnvMap EnvMap::studio(EnvOptions options) {
+  constexpr int W = 512, H = 256;
+  constexpr double deg = kPi / 180, margin = 2 * kPi / H;
+  struct Light {
+    double e0, a0, he, ha;
+    Rgb radiance;
+  };
+  // A key softbox above the camera, to its left; a strip light behind the sphere, to the right.
+  const Light lights[] = {{40 * deg, -40 * deg, 14 * deg, 20 * deg, {9.0, 8.2, 7.0}},
+                          {15 * deg, 150 * deg, 25 * deg, 5 * deg, {3.0, 4.0, 6.0}}};
+  auto radiance = [&](const Vec3<double>& d) -> Rgb {
+    double e, a;
+    elevation_azimuth(d, e, a);
+    for (const Light& l : lights)
+      if (in_rectangle(e, a, l.e0, l.a0, l.he, l.ha)) return l.radiance;
+    // Walls: a dim neutral grey, a little lighter above; the floor darker.
+    const double t = d.y >= 0 ? 0.05 + 0.03 * d.y : 0.03 + 0.01 * (1 + d.y);
+    return {t, t, t};
+  };
+  auto edge = [&](const Vec3<double>& d) {
+    double e, a;
+    elevation_azimuth(d, e, a);
+    for (const Light& l : lights)
+      if (in_rectangle(e, a, l.e0, l.a0, l.he, l.ha, margin)) return true;
+    return false;
+  };
+  return EnvMap(W, H, procedural_map(W, H, radiance, edge), "studio", options);
+}
+
+EnvMap EnvMap::sunset(EnvOptions options) {
+  constexpr int W = 512, H = 256;
+  constexpr double deg = kPi / 180;
+  const double sun_elev = 4 * deg, sun_azim = 110 * deg, sun_radius = 2 * deg;
+  const Vec3<double> sun{std::cos(sun_elev) * std::sin(sun_azim), std::sin(sun_elev),
+                         std::cos(sun_elev) * std::cos(sun_azim)};
+  const double cos_sun = std::cos(sun_radius), cos_edge = std::cos(sun_radius + 2 * kPi / H);
+  auto radiance = [&](const Vec3<double>& d) -> Rgb {
+    const double cs = d.x * sun.x + d.y * sun.y + d.z * sun.z;
+    if (cs >= cos_sun) return {400, 190, 70};
+    if (d.y >= 0) {
+      // From orange at the horizon to a deep blue at the zenith, with a glow around the sun.
+      const double t = std::pow(std::max(0.0, d.y), 0.5);
+      const double glow = std::pow(std::max(0.0, cs), 16);
+      return {(1 - t) * 0.9 + t * 0.05 + 1.5 * glow, (1 - t) * 0.38 + t * 0.09 + 0.6 * glow,
+              (1 - t) * 0.12 + t * 0.30 + 0.15 * glow};
+    }
+    const double t = 0.5 + 0.5 * std::pow(1 + d.y, 3);  // dark ground, lit near the horizon
+    return {0.06 * t, 0.045 * t, 0.04 * t};
+  };
+  auto edge = [&](const Vec3<double>& d) {
+    return d.x * sun.x + d.y * sun.y + d.z * sun.z >= cos_edge;
+  };
+  return EnvMap(W, H, procedural_map(W, H, radiance, edge), "sunset", options);
+}
+
+std::vector<std::string> EnvMap::builtin_names() { return {"default", "sky", "studio", "sunset"}; }
 
 }  // namespace halfback::render

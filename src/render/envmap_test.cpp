@@ -173,6 +173,39 @@ TEST(EnvMap, PdfIntegratesToOneAndChiSquare) {
   EXPECT_LT(r.z, 4.5) << "chi2 " << r.chi2 << " dof " << r.dof;
 }
 
+// The brightest pixel's direction, in the map's world frame.
+Vec3<double> brightest(const EnvMap& m) {
+  std::size_t best = 0;
+  const auto px = m.pixels();
+  for (std::size_t p = 0; p < px.size() / 3; ++p)
+    if (px[3 * p] + px[3 * p + 1] + px[3 * p + 2] > px[3 * best] + px[3 * best + 1] + px[3 * best + 2])
+      best = p;
+  const int c = int(best % std::size_t(m.width())), r = int(best / std::size_t(m.width()));
+  return EnvMap::map_direction((c + 0.5) / m.width(), (r + 0.5) / m.height());
+}
+
+TEST(EnvMap, BuiltInStudioAndSunset) {
+  for (const std::string& name : EnvMap::builtin_names()) {
+    const EnvMap m = EnvMap::from_spec(name);
+    EXPECT_EQ(m.width(), 2 * m.height()) << name;
+    for (float v : m.pixels()) ASSERT_TRUE(std::isfinite(v) && v >= 0) << name;
+  }
+  const double deg = kPi / 180;
+  // Sunset: the sun 4° above the horizon, 110° from +z towards +x (to the right, behind).
+  const Vec3<double> s = brightest(EnvMap::sunset());
+  EXPECT_NEAR(std::asin(s.y), 4 * deg, 2.5 * deg);
+  EXPECT_NEAR(std::atan2(s.x, s.z), 110 * deg, 2.5 * deg);
+  EXPECT_GT(EnvMap::sunset().eval(s).r, 100);
+  // Studio: the key softbox (40° up, 40° to the left of +z) at radiance (9, 8.2, 7); the walls dim.
+  const EnvMap st = EnvMap::studio();
+  const Vec3<double> key{-std::cos(40 * deg) * std::sin(40 * deg), std::sin(40 * deg),
+                         std::cos(40 * deg) * std::cos(40 * deg)};
+  EXPECT_NEAR(st.eval(key).r, 9.0, 1e-6);
+  EXPECT_NEAR(st.eval(key).b, 7.0, 1e-6);
+  EXPECT_LT(st.eval({0, 0, -1}).r, 0.1);
+  EXPECT_THROW(EnvMap::from_spec("studio2"), std::exception);
+}
+
 TEST(EnvMap, DefaultSkyHasASun) {
   const EnvMap d = EnvMap::from_spec("default");
   EXPECT_EQ(d.width(), 1024);

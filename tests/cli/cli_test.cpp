@@ -820,5 +820,43 @@ TEST_F(CliTest, ResampleWritesEachFormatAndRejectsBadGrids) {
   EXPECT_EQ(entries(), (std::vector<std::string>{"t.exr", "t.npy", "t.npz"}));
 }
 
+// ---------------------------------------------------------------------------------------------
+// halfback figure
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(CliTest, FigurePaperWritesEveryFigure) {
+  const Result r = run({"figure", "paper", "--out", "figs", "--formats", "png", "--material",
+                        "lambert:albedo=0.4", "--render-size", "16", "--spp", "2"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"fig1-hemisphere.png", "fig1-hemisphere-mirror.png",
+                        "fig1-hemisphere-back.png", "fig2-slices.png", "fig3-lambert.png"}) {
+    EXPECT_TRUE(fs::is_regular_file(path("figs") / f)) << f;
+    EXPECT_NE(r.out.find(f), std::string::npos) << r.out;
+  }
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(path("figs"))) n += e.is_regular_file();
+  EXPECT_EQ(n, 5u);
+}
+
+TEST_F(CliTest, FigureBadInputLeavesNothing) {
+  Result r = run({"figure", "paper", "--out", "figs", "--material", "nope"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("'nope' is neither an existing file nor a known BRDF model"),
+            std::string::npos)
+      << r.err;
+  r = run({"figure", "paper", "--out", "figs", "--env", "default,missing.hdr"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--env 'missing.hdr'"), std::string::npos) << r.err;
+  r = run({"figure", "material", "--brdf", "lambert", "--azimuths", "", "-o", "m.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--azimuths: no azimuth given"), std::string::npos) << r.err;
+  r = run({"figure", "material", "--brdf", "lambert", "-o", "missing/m.png"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("cannot write"), std::string::npos) << r.err;
+  r = run({"figure", "paper", "--out", "figs", "--no-materials", "--material", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(entries(), std::vector<std::string>{});
+}
+
 }  // namespace
 }  // namespace halfback

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "halfback/brdf/brdf.hpp"
 
@@ -20,6 +22,12 @@ BrdfFileFormat detect_brdf_format(const std::filesystem::path& path);
 // extension only picks the reader whose error to report when the content matches no format).
 // Otherwise `spec` is a model spec for ModelRegistry::global(). Throws FormatError for file
 // problems and std::invalid_argument for a spec that is neither a file nor a valid model spec.
+//
+// "embedded:NAME" loads one of the measured materials compiled into the library (CC0 RGL
+// measurements, data/README.md), so that the default figures need no file.
 BrdfPtr load_brdf(std::string_view spec);
+
+// The NAMEs of "embedded:NAME": ilm_l3_37_metallic, colodur_azure_4e, acrylic_felt_green.
+std::vector<std::string> embedded_material_names();
 
 }  // namespace halfback

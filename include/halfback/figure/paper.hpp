@@ -1,4 +1,4 @@
-// The paper's Figures 1 and 2 on their default settings, written as PNG, SVG and PDF.
+// The paper's Figures 1-5 on their default settings, written as PNG, SVG and PDF.
 #pragma once
 
 #include <filesystem>
@@ -7,9 +7,22 @@
 
 namespace halfback::figure {
 
+// A material of Figures 3-5: the file stem, a BRDF SPEC and what it shows.
+struct PaperMaterial {
+  std::string stem, spec, description;
+};
+
+// The defaults: three measured materials embedded in the library (a metallic paint, a wall paint,
+// a felt: data/README.md) standing for the paper's three MERL materials, and three analytic models
+// with comparable behaviour (a glossy metal, a diffuse with sheen, a textile-like grazing lobe).
+std::vector<PaperMaterial> default_paper_materials();
+
 struct PaperFigureOptions {
   unsigned threads = 0;
   bool png = true, svg = true, pdf = true;
+  std::vector<PaperMaterial> materials = default_paper_materials();  // empty: Figures 1-2 only
+  std::vector<std::string> environments{"default", "studio", "sunset"};
+  int render_pixels = 176, spp = 48;
 };
 
 struct WrittenFigure {
@@ -22,6 +35,7 @@ struct WrittenFigure {
 //   fig1-hemisphere-mirror.{png,svg,pdf}  the same, centred on the mirror direction
 //   fig1-hemisphere-back.{png,svg,pdf}    the same, centred on the back direction ωo
 //   fig2-slices.{png,svg,pdf}             Figure 2, S, G, F on slices at 0°, 45°, 90°
+//   STEM.{png,svg,pdf}                    Figures 3-5, one per material (material.hpp)
 // Each file is written atomically. Throws std::runtime_error when the directory cannot be
 // created or a file cannot be written.
 std::vector<WrittenFigure> write_paper_figures(const std::filesystem::path& dir,

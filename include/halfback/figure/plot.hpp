@@ -63,6 +63,9 @@ struct AxisSpec {
 
 // Frame, ticks (outside the panel), tick labels and axis titles. `x_labels` / `y_labels` say
 // whether this panel shows the tick labels and title of that axis.
+// A black frame around a rectangle.
+void draw_frame(Scene& scene, const Rect& rect, double width = 0.7);
+
 void draw_axes(Scene& scene, const PanelMap& panel, const AxisSpec& x, const AxisSpec& y,
                bool x_labels = true, bool y_labels = true, double font_size = 8.5);
 

@@ -74,7 +74,8 @@ struct Scene {
   std::string title;  // document metadata (PDF title, SVG <title>)
   std::vector<Item> items;
 
-  void add(Item item) { items.push_back(std::move(item)); }
+  // Out of line: GCC 12 reports false -Wmaybe-uninitialized in the inlined vector growth.
+  void add(Item item);
   void line(Point a, Point b, const Stroke& s) { add(PathItem{{a, b}, false, std::nullopt, s}); }
   void rect(double x, double y, double w, double h, std::optional<Color> fill,
             std::optional<Stroke> stroke) {
@@ -86,6 +87,9 @@ struct Scene {
   }
 };
 
+// Appends every item of `src` to `dst`, moved by `offset` (to compose figures from figures).
+void append_scene(Scene& dst, const Scene& src, Point offset);
+
 // A run of text at one script level: 0 normal, −1 subscript, +1 superscript.
 struct TextRun {
   std::string text;
@@ -95,6 +99,9 @@ struct TextRun {
 std::vector<TextRun> parse_markup(std::string_view text);
 // The text without markup (for SVG <title>s, alt texts, tests).
 std::string plain_text(std::string_view text);
+// Text from outside (a BRDF's name, a file name) made literal: every '_' and '^' escaped, so
+// that "ilm_l3_37" is drawn as written, not with subscripts.
+std::string escape_markup(std::string_view text);
 
 // Font metrics shared by the backends: a script run is drawn at kScriptScale of the size, shifted
 // by kSubShift / kSuperShift of the size; vertical alignment offsets the baseline by these

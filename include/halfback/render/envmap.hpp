@@ -35,7 +35,8 @@ class EnvMap {
   // NaN or infinite (the message names `name`, the pixel and the channel).
   EnvMap(int width, int height, std::vector<float> rgb, std::string name, EnvOptions options = {});
 
-  // "default" (the built-in sky), "constant:V" or "constant:R,G,B", or a file name.
+  // A built-in ("default" or "sky", "studio", "sunset"), "constant:V" or "constant:R,G,B", or a
+  // file name.
   static EnvMap from_spec(std::string_view spec, EnvOptions options = {});
   // A Radiance .hdr or OpenEXR file, recognized by its content. Throws FormatError naming the file
   // and the problem: unreadable, not an HDR image, zero size, not 2:1, NaN/Inf/negative pixels.
@@ -44,6 +45,14 @@ class EnvMap {
   // The built-in procedural environment (1024 × 512): a blue sky gradient, a small bright sun
   // disk (radius 1.5°, 40° above the horizon, behind the camera on its left) and a darker ground.
   static EnvMap default_sky(EnvOptions options = {});
+  // Two more built-in environments (512 × 256), so that a material can be shown under three
+  // lightings with no files (the paper's Figures 3-5): a dark studio with a large warm softbox
+  // above the camera's left and a cool strip light behind the sphere on the right; and a sunset, a
+  // low orange sun to the right under a sky going from orange at the horizon to deep blue.
+  static EnvMap studio(EnvOptions options = {});
+  static EnvMap sunset(EnvOptions options = {});
+  // The names of the built-in environments that from_spec() takes.
+  static std::vector<std::string> builtin_names();
 
   // Radiance arriving from world direction `dir` (unit), scaled by the exposure.
   Rgb eval(const Vec3<double>& dir) const;
