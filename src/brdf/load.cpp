@@ -150,7 +150,8 @@ BrdfPtr load_embedded(std::string_view name) {
 
 BrdfPtr load_one(std::string_view spec) {
   constexpr std::string_view embedded = "embedded:";
-  if (spec.substr(0, embedded.size()) == embedded) return load_embedded(spec.substr(embedded.size()));
+  if (spec.substr(0, embedded.size()) == embedded)
+    return load_embedded(spec.substr(embedded.size()));
   const std::filesystem::path path{std::string(spec)};
   std::error_code ec;
   if (!spec.empty() && std::filesystem::exists(path, ec)) {

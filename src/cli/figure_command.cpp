@@ -25,10 +25,10 @@
 #include "halfback/figure/hemisphere.hpp"
 #include "halfback/figure/material.hpp"
 #include "halfback/figure/paper.hpp"
-#include "halfback/render/envmap.hpp"
 #include "halfback/figure/render.hpp"
 #include "halfback/figure/slices.hpp"
 #include "halfback/io/atomic_file.hpp"
+#include "halfback/render/envmap.hpp"
 
 namespace halfback::cli {
 
@@ -295,8 +295,8 @@ int run_paper(const PaperArgs& a) {
       std::string stem = fmt::format("fig{}-", 3 + k);
       for (const char c : b->name()) stem += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
       o.materials.push_back(
-          {stem, a.materials[k], fmt::format("Figure {} ({}): {}", 3 + k, a.materials[k],
-                                             b->description())});
+          {stem, a.materials[k],
+           fmt::format("Figure {} ({}): {}", 3 + k, a.materials[k], b->description())});
     }
   }
   const auto t0 = std::chrono::steady_clock::now();

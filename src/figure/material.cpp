@@ -57,11 +57,11 @@ MaterialFigure material_figure(const MaterialFigureOptions& o) {
   const std::string name = escape_markup(o.brdf->name());
   sc.text({left, 26}, o.heading.empty() ? name : escape_markup(o.heading), 15, HAlign::left,
           VAlign::baseline, kBlack, 0, true);
-  const std::vector<std::string> sub = wrap_text(
-      fmt::format("Top: a unit sphere rendered under {} environment{} ({}×{} pixels, {} "
-                  "samples per pixel, multiple importance sampling); below: slices.",
-                  n, n == 1 ? "" : "s", o.render_pixels, o.render_pixels, o.spp),
-      sc.width - left - 12, 9.5);
+  const std::vector<std::string> sub =
+      wrap_text(fmt::format("Top: a unit sphere rendered under {} environment{} ({}×{} pixels, {} "
+                            "samples per pixel, multiple importance sampling); below: slices.",
+                            n, n == 1 ? "" : "s", o.render_pixels, o.render_pixels, o.spp),
+                sc.width - left - 12, 9.5);
   for (std::size_t k = 0; k < sub.size(); ++k) sc.text({left, 44 + 12 * double(k)}, sub[k], 9.5);
   const double top = snap(52 + 12 * double(sub.size()));
   sc.height = snap(top + size + caption + 16 + slices.height);

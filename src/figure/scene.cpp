@@ -62,7 +62,9 @@ std::string escape_markup(std::string_view text) {
   return out;
 }
 
-void Scene::add(Item item) { items.push_back(std::move(item)); }
+void Scene::add(Item item) {
+  items.push_back(std::move(item));
+}
 
 void append_scene(Scene& dst, const Scene& src, Point offset) {
   auto move = [&](Point& p) {

@@ -481,8 +481,8 @@ std::vector<float> procedural_map(int W, int H, Radiance radiance, Edge edge) {
       const int n = edge(d) ? 4 : 1;
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
-          const Rgb x = radiance(EnvMap::map_direction((c + (i + 0.5) / n) / W,
-                                                       (r + (j + 0.5) / n) / H));
+          const Rgb x =
+              radiance(EnvMap::map_direction((c + (i + 0.5) / n) / W, (r + (j + 0.5) / n) / H));
           v = {v.r + x.r, v.g + x.g, v.b + x.b};
         }
       float* p = &rgb[3 * (std::size_t(r) * W + std::size_t(c))];
@@ -564,6 +564,8 @@ EnvMap EnvMap::sunset(EnvOptions options) {
   return EnvMap(W, H, procedural_map(W, H, radiance, edge), "sunset", options);
 }
 
-std::vector<std::string> EnvMap::builtin_names() { return {"default", "sky", "studio", "sunset"}; }
+std::vector<std::string> EnvMap::builtin_names() {
+  return {"default", "sky", "studio", "sunset"};
+}
 
 }  // namespace halfback::render

@@ -178,7 +178,8 @@ Vec3<double> brightest(const EnvMap& m) {
   std::size_t best = 0;
   const auto px = m.pixels();
   for (std::size_t p = 0; p < px.size() / 3; ++p)
-    if (px[3 * p] + px[3 * p + 1] + px[3 * p + 2] > px[3 * best] + px[3 * best + 1] + px[3 * best + 2])
+    if (px[3 * p] + px[3 * p + 1] + px[3 * p + 2] >
+        px[3 * best] + px[3 * best + 1] + px[3 * best + 2])
       best = p;
   const int c = int(best % std::size_t(m.width())), r = int(best / std::size_t(m.width()));
   return EnvMap::map_direction((c + 0.5) / m.width(), (r + 0.5) / m.height());
