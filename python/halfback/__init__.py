@@ -4,8 +4,11 @@ Parameterization names: "dirs" (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z), "spherical"
 (theta_i, phi_i, theta_o, phi_o), "halfdiff" (theta_h, phi_h, theta_d, phi_d), "ortho"
 (hbar, phi_h, kbar, phi_k) and "hybrid" (hbar, phi_h, k, phi_k). With isotropic=True, phi_h is
 dropped and the second azimuth is relative. Conventions and derivations: docs/math.md.
+
+BRDFs: load(spec) gives a Brdf (analytic models, MERL, RGL, ALTA files, embedded materials) with
+vectorized eval(wi, wo), info, albedo() and resample().
 """
 
-from ._core import columns, convert, jacobian, valid
+from ._core import Brdf, columns, convert, jacobian, load, models, valid
 
-__all__ = ["columns", "convert", "jacobian", "valid"]
+__all__ = ["Brdf", "columns", "convert", "jacobian", "load", "models", "valid"]

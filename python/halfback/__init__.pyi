@@ -1,4 +1,5 @@
-from typing import Literal
+from collections.abc import Mapping, Sequence
+from typing import Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -17,3 +18,40 @@ def jacobian(x: npt.ArrayLike, param: Param, isotropic: bool = False) -> FloatAr
 
 def columns(name: Param, isotropic: bool = False) -> list[str]:
     """Column names of a form, in order."""
+
+Kind = Literal["full", "isotropic", "slice"]
+
+class Brdf:
+    @property
+    def name(self) -> str: ...
+    @property
+    def description(self) -> str: ...
+    @property
+    def isotropic(self) -> bool: ...
+    @property
+    def reciprocal(self) -> bool: ...
+    @property
+    def info(self) -> dict[str, object]:
+        """Name, description, symmetries and data facts."""
+    def eval(self, wi: npt.ArrayLike, wo: npt.ArrayLike | None = None) -> npt.NDArray[np.float64]:
+        """rho(wi, wo) in 1/sr, (N, 3); wi, wo (N, 3) unit vectors, or wi alone (N, 6)."""
+    def albedo(
+        self, theta_i: float, n: int = 256
+    ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """Directional albedo at theta_i (radians) and its standard errors."""
+    def resample(
+        self,
+        param: Param = "hybrid",
+        kind: Kind = "isotropic",
+        size: int | Sequence[int] = 64,
+        azimuth: float = 0.0,
+        nodes: bool = False,
+        ranges: Mapping[str, tuple[float, float]] = ...,
+    ) -> dict[str, Any]:
+        """rho, valid, axes, axis_names, metadata of the BRDF on a grid of `param`."""
+
+def load(spec: str) -> Brdf:
+    """A BRDF from a file, a model spec ("ggx:alpha=0.2"), a sum or "embedded:NAME"."""
+
+def models() -> list[str]:
+    """The analytic models' names."""

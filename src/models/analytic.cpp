@@ -196,13 +196,19 @@ Sum::Sum(std::vector<BrdfPtr> terms) : terms_(std::move(terms)) {
 
 std::string Sum::name() const {
   std::string s;
-  for (const auto& t : terms_) s += (s.empty() ? "" : "+") + t->name();
+  for (const auto& t : terms_) {
+    if (!s.empty()) s += '+';  // (not "+" + name(): GCC 12 warns -Wrestrict falsely there)
+    s += t->name();
+  }
   return s;
 }
 
 std::string Sum::description() const {
   std::string s;
-  for (const auto& t : terms_) s += (s.empty() ? "" : " + ") + t->description();
+  for (const auto& t : terms_) {
+    if (!s.empty()) s += " + ";
+    s += t->description();
+  }
   return s;
 }
 

@@ -1,15 +1,23 @@
-// The Python module `halfback._core`: NumPy front end of the batch conversion engine.
+// The Python module `halfback._core`: NumPy front end of the batch conversion engine and of the
+// BRDF layer (load, eval, resample).
 //
 // Arrays are passed to the engine as strided columns pointing into NumPy's own buffer (any
-// strides, no copy); the GIL is released while the engine runs on all threads.
+// strides, no copy); the GIL is released while the engine runs on all threads. C++ exceptions
+// become Python ones: std::invalid_argument -> ValueError, file and format errors -> RuntimeError.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "halfback/brdf/albedo.hpp"
+#include "halfback/brdf/load.hpp"
+#include "halfback/brdf/registry.hpp"
+#include "halfback/brdf/resample.hpp"
 #include "halfback/core/batch.hpp"
 
 namespace py = pybind11;
@@ -106,6 +114,141 @@ Outputs dispatch(const py::object& obj, Form from, Form to, bool want_result, bo
                        std::string(py::str(x.dtype())) + ")");
 }
 
+// A loaded BRDF (the C++ object is immutable and shared).
+struct PyBrdf {
+  BrdfPtr brdf;
+};
+
+// (N, 3) float64 copies of wi and wo (or of the halves of an (N, 6) array).
+std::vector<DirPair<double>> pairs_of(const py::object& wi_obj, const py::object& wo_obj) {
+  auto np = py::module_::import("numpy");
+  auto as_f64 = [&](const py::object& o, const char* name) {
+    py::array a = np.attr("asarray")(o);
+    if (a.dtype().kind() != 'f' && a.dtype().kind() != 'i' && a.dtype().kind() != 'u')
+      throw py::type_error(std::string(name) + " must be a float array (got dtype " +
+                           std::string(py::str(a.dtype())) + ")");
+    return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  };
+  std::vector<DirPair<double>> pairs;
+  if (wo_obj.is_none()) {
+    const auto x = as_f64(wi_obj, "pairs");
+    if (x.ndim() != 2 || x.shape(1) != 6)
+      throw py::value_error(
+          "pairs must have shape (N, 6) (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z), "
+          "got " +
+          shape_text(x));
+    const double* d = x.data();
+    pairs.resize(std::size_t(x.shape(0)));
+    for (std::size_t i = 0; i < pairs.size(); ++i, d += 6)
+      pairs[i] = {{d[0], d[1], d[2]}, {d[3], d[4], d[5]}};
+  } else {
+    const auto a = as_f64(wi_obj, "wi"), b = as_f64(wo_obj, "wo");
+    for (const auto& [arr, name] : {std::pair{&a, "wi"}, std::pair{&b, "wo"}})
+      if (arr->ndim() != 2 || arr->shape(1) != 3)
+        throw py::value_error(std::string(name) + " must have shape (N, 3), got " +
+                              shape_text(*arr));
+    if (a.shape(0) != b.shape(0))
+      throw py::value_error("wi and wo must have the same number of rows, got " +
+                            std::to_string(a.shape(0)) + " and " + std::to_string(b.shape(0)));
+    pairs.resize(std::size_t(a.shape(0)));
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const double *p = a.data() + 3 * i, *q = b.data() + 3 * i;
+      pairs[i] = {{p[0], p[1], p[2]}, {q[0], q[1], q[2]}};
+    }
+  }
+  // Unit vectors are required (a typo in a direction is a bug, not a query); NaN rows and
+  // directions below the horizon are answered (NaN, 0).
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const PairStatus st = check_pair(pairs[i]);
+    if (st == PairStatus::wi_not_unit || st == PairStatus::wo_not_unit)
+      throw py::value_error("row " + std::to_string(i) + ": " + std::string(describe(st)));
+  }
+  return pairs;
+}
+
+py::array_t<double> eval_brdf(const PyBrdf& b, const py::object& wi, const py::object& wo) {
+  const std::vector<DirPair<double>> pairs = pairs_of(wi, wo);
+  std::vector<Rgb> rho(pairs.size());
+  {
+    py::gil_scoped_release release;
+    b.brdf->eval(pairs, rho);
+  }
+  py::array_t<double> out({py::ssize_t(pairs.size()), py::ssize_t(3)});
+  double* o = out.mutable_data();
+  for (std::size_t i = 0; i < rho.size(); ++i) {
+    o[3 * i] = rho[i].r;
+    o[3 * i + 1] = rho[i].g;
+    o[3 * i + 2] = rho[i].b;
+  }
+  return out;
+}
+
+GridKind parse_kind(const std::string& kind) {
+  if (kind == "full") return GridKind::full;
+  if (kind == "isotropic") return GridKind::isotropic;
+  if (kind == "slice") return GridKind::slice;
+  throw py::value_error("kind: expected 'full', 'isotropic' or 'slice', got '" + kind + "'");
+}
+
+py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::string& kind,
+                       const py::object& size, double azimuth_deg, bool nodes,
+                       const py::dict& ranges) {
+  const Space space = parse_space(param, "param");
+  std::vector<std::size_t> counts;
+  if (py::isinstance<py::int_>(size)) {
+    const long v = size.cast<long>();
+    if (v <= 0) throw py::value_error("size must be positive");
+    counts.push_back(std::size_t(v));
+  } else {
+    for (const auto& v : size) {
+      const long c = v.cast<long>();
+      if (c <= 0) throw py::value_error("size must be positive");
+      counts.push_back(std::size_t(c));
+    }
+  }
+  GridSpec g =
+      default_grid(space, parse_kind(kind), counts, azimuth_deg * 3.14159265358979323846 / 180);
+  g.sampling = nodes ? GridSampling::nodes : GridSampling::centres;
+  for (const auto& [key, value] : ranges) {
+    const std::string name = key.cast<std::string>();
+    GridAxis* axis = nullptr;
+    for (GridAxis& a : g.axes)
+      if (a.name == name) axis = &a;
+    if (!axis) throw py::value_error("ranges: this grid has no axis '" + name + "'");
+    const auto lohi = value.cast<std::pair<double, double>>();
+    axis->lo = lohi.first;
+    axis->hi = lohi.second;
+  }
+  validate(g);
+  ResampledTable t;
+  {
+    py::gil_scoped_release release;
+    t = resample(*b.brdf, g);
+  }
+  std::vector<py::ssize_t> shape;
+  for (const GridAxis& a : g.axes) shape.push_back(py::ssize_t(a.count));
+  std::vector<py::ssize_t> rgb_shape = shape;
+  rgb_shape.push_back(3);
+  py::array_t<double> rho(rgb_shape);
+  std::copy(t.rgb.begin(), t.rgb.end(), rho.mutable_data());
+  py::array_t<bool> valid(shape);
+  std::copy(t.valid.begin(), t.valid.end(), valid.mutable_data());
+  py::list axes, names;
+  for (const GridAxis& a : g.axes) {
+    py::array_t<double> p(py::ssize_t(a.count));
+    for (std::size_t i = 0; i < a.count; ++i) p.mutable_data()[i] = a.position(i, g.sampling);
+    axes.append(p);
+    names.append(a.name);
+  }
+  py::dict d;
+  d["rho"] = rho;
+  d["valid"] = valid;
+  d["axes"] = axes;
+  d["axis_names"] = names;
+  d["metadata"] = py::module_::import("json").attr("loads")(table_metadata_json(t));
+  return d;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -158,4 +301,63 @@ forms, the measure of the 3 coordinates: 2*pi times the 4D J of the canonical po
         return cols;
       },
       py::arg("name"), py::arg("isotropic") = false, "Column names of a form, in order.");
+
+  py::class_<PyBrdf>(m, "Brdf", "A BRDF: an analytic model or measured data (MERL, RGL, ALTA).")
+      .def_property_readonly("name", [](const PyBrdf& b) { return b.brdf->name(); })
+      .def_property_readonly("description", [](const PyBrdf& b) { return b.brdf->description(); })
+      .def_property_readonly("isotropic", [](const PyBrdf& b) { return b.brdf->isotropic(); })
+      .def_property_readonly("reciprocal", [](const PyBrdf& b) { return b.brdf->reciprocal(); })
+      .def_property_readonly(
+          "info",
+          [](const PyBrdf& b) {
+            py::dict d;
+            d["name"] = b.brdf->name();
+            d["description"] = b.brdf->description();
+            d["isotropic"] = b.brdf->isotropic();
+            d["reciprocal"] = b.brdf->reciprocal();
+            for (const auto& f : b.brdf->facts()) d[py::str(f.label)] = f.value;
+            return d;
+          },
+          "The BRDF's name, description, symmetries and data facts (format, dimensions, ...).")
+      .def("eval", &eval_brdf, py::arg("wi"), py::arg("wo") = py::none(),
+           R"doc(rho(wi, wo) in 1/sr (RGB, no cosine factor) as an (N, 3) float64 array.
+
+wi, wo: (N, 3) arrays of unit directions (wi: light, wo: view; frame n = +z), or wi alone as an
+(N, 6) array of pairs. A pair with a direction below the horizon gives 0, a row with NaN gives NaN;
+a direction that is not a unit vector raises ValueError naming the row.)doc")
+      .def(
+          "albedo",
+          [](const PyBrdf& b, double theta_i, int n) {
+            if (n < 1) throw py::value_error("n must be positive");
+            AlbedoEstimate a;
+            {
+              py::gil_scoped_release release;
+              a = directional_albedo(*b.brdf, {std::sin(theta_i), 0, std::cos(theta_i)}, n);
+            }
+            return py::make_tuple(
+                py::make_tuple(a.mean.r, a.mean.g, a.mean.b),
+                py::make_tuple(a.standard_error.r, a.standard_error.g, a.standard_error.b));
+          },
+          py::arg("theta_i"), py::arg("n") = 256,
+          "Directional albedo at incidence theta_i (radians): ((r, g, b), (standard errors)), by "
+          "n x n stratified cosine sampling.")
+      .def("resample", &resample_brdf, py::arg("param") = "hybrid", py::arg("kind") = "isotropic",
+           py::arg("size") = 64, py::arg("azimuth") = 0.0, py::arg("nodes") = false,
+           py::arg("ranges") = py::dict(),
+           R"doc(The BRDF on a regular grid of a parameterization (as `halfback resample`).
+
+kind: "full" (4 axes), "isotropic" (3 axes, phi_h = 0) or "slice" (2 axes at relative azimuth
+`azimuth`, in degrees). size: samples per axis, an int or one per axis. Samples at cell centres,
+or at nodes including both ends with nodes=True. ranges: {axis name: (lo, hi)}.
+Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape...) bool, axes
+(sample positions), axis_names, metadata.)doc")
+      .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; });
+
+  m.def(
+      "load", [](const std::string& spec) { return PyBrdf{load_brdf(spec)}; }, py::arg("spec"),
+      R"doc(Loads a BRDF from a SPEC: a MERL/RGL/ALTA file, a model such as "ggx:alpha=0.2" or
+"lambert:albedo=0.5", a sum "a+b", or "embedded:NAME" (as on the command line).)doc");
+  m.def(
+      "models", [] { return ModelRegistry::global().names(); },
+      "The names of the analytic models (see `halfback models` for their parameters).");
 }

@@ -1,0 +1,115 @@
+"""halfback.load / Brdf: values against closed forms and the CLI, shapes, dtypes, errors."""
+
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import halfback
+
+
+def unit_rows(n, seed=3, zmin=0.05):
+    rng = np.random.default_rng(seed)
+    z = zmin + (1 - zmin) * rng.random(n)
+    phi = 2 * np.pi * rng.random(n)
+    s = np.sqrt(1 - z * z)
+    return np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
+
+
+def test_lambert_is_albedo_over_pi_and_zero_below_the_horizon():
+    b = halfback.load("lambert:albedo=0.5")
+    wi, wo = unit_rows(1000, 1), unit_rows(1000, 2)
+    rho = b.eval(wi, wo)
+    assert rho.shape == (1000, 3) and rho.dtype == np.float64
+    np.testing.assert_allclose(rho, 0.5 / np.pi, rtol=1e-15)
+    below = wo.copy()
+    below[:, 2] *= -1
+    assert (b.eval(wi, below) == 0).all()
+    # One (N, 6) array is the same as two (N, 3) ones; float32 and lists are accepted.
+    np.testing.assert_array_equal(b.eval(np.hstack([wi, wo])), rho)
+    np.testing.assert_allclose(b.eval(wi.astype(np.float32), wo.tolist()), rho, rtol=1e-6)
+
+
+def test_ggx_at_normal_incidence_matches_its_closed_form():
+    # D(0) = 1/(pi alpha^2), G = 1 and F = f0 at normal incidence and view: rho = D F / 4.
+    b = halfback.load("ggx:alpha=0.3,f0=0.9")
+    n = np.array([[0.0, 0.0, 1.0]])
+    np.testing.assert_allclose(b.eval(n, n)[0], 0.9 / (np.pi * 0.09) / 4, rtol=1e-12)
+
+
+def test_non_contiguous_and_nan_rows():
+    b = halfback.load("ggx:alpha=0.2")
+    pairs = np.hstack([unit_rows(100, 4), unit_rows(100, 5)])
+    wide = np.zeros((100, 12))
+    wide[:, ::2] = pairs  # strided columns
+    np.testing.assert_array_equal(b.eval(wide[:, ::2]), b.eval(pairs))
+    pairs[7, 0] = np.nan
+    rho = b.eval(pairs)
+    assert np.isnan(rho[7]).all() and np.isfinite(np.delete(rho, 7, axis=0)).all()
+
+
+def test_bad_input_raises_clear_errors():
+    b = halfback.load("lambert")
+    with pytest.raises(ValueError, match=r"wi must have shape \(N, 3\), got \(4, 2\)"):
+        b.eval(np.zeros((4, 2)), np.zeros((4, 3)))
+    with pytest.raises(ValueError, match="same number of rows"):
+        b.eval(unit_rows(3), unit_rows(4))
+    with pytest.raises(ValueError, match=r"row 1: wo is not a unit vector"):
+        b.eval(unit_rows(2), np.array([[0, 0, 1.0], [0, 0, 2.0]]))
+    with pytest.raises(TypeError, match="float array"):
+        b.eval(np.array([["a", "b", "c"]]), unit_rows(1))
+    with pytest.raises(ValueError, match="neither an existing file nor a known BRDF model"):
+        halfback.load("glossy")
+    with pytest.raises(ValueError, match="alpha"):
+        halfback.load("ggx:alpha=-1")
+    with pytest.raises(ValueError, match="no such embedded material"):
+        halfback.load("embedded:gold")
+
+
+def test_info_albedo_and_models():
+    b = halfback.load("embedded:acrylic_felt_green")
+    info = b.info
+    assert info["name"] == "rgl:acrylic_felt_green_rgb" and info["isotropic"] is True
+    assert "RGL tensor_file" in info["format"]
+    (mean, err) = halfback.load("lambert:albedo=0.25").albedo(0.3, 64)
+    np.testing.assert_allclose(mean, 0.25, rtol=1e-6)
+    assert set(["lambert", "ggx", "beckmann", "abc", "sheen", "test"]) <= set(halfback.models())
+    assert repr(b) == "<halfback.Brdf rgl:acrylic_felt_green_rgb>"
+
+
+def test_resample_slice_matches_the_closed_form_and_the_cli(tmp_path):
+    t = halfback.load("test:S").resample("hybrid", "slice", (20, 10), azimuth=30)
+    assert t["rho"].shape == (20, 10, 3) and t["valid"].shape == (20, 10)
+    assert t["axis_names"] == ["hbar", "k"]
+    hbar = t["axes"][0][:, None]
+    np.testing.assert_allclose(np.broadcast_to(1 - hbar, (20, 10))[t["valid"]],
+                               t["rho"][..., 0][t["valid"]], atol=1e-12)
+    assert t["metadata"]["slice_azimuth"] == pytest.approx(np.radians(30))
+    cli = os.environ.get("HALFBACK_CLI")
+    if cli:
+        out = tmp_path / "s.npz"
+        subprocess.run([cli, "resample", "--brdf", "test:S", "--param", "hybrid", "--kind",
+                        "slice", "--azimuth", "30", "--size", "20,10", "-o", str(out)], check=True,
+                       capture_output=True)
+        with np.load(out) as z:
+            np.testing.assert_array_equal(z["rho"], t["rho"])
+            np.testing.assert_array_equal(z["valid"], t["valid"])
+    with pytest.raises(ValueError, match="kind"):
+        halfback.load("lambert").resample("hybrid", "cube")
+    with pytest.raises(ValueError, match="no axis 'theta_h'"):
+        halfback.load("lambert").resample("hybrid", ranges={"theta_h": (0, 1)})
+
+
+def test_eval_agrees_with_the_cli(tmp_path):
+    cli = os.environ.get("HALFBACK_CLI")
+    if not cli:
+        pytest.skip("HALFBACK_CLI not set (run through ctest)")
+    pairs = np.hstack([unit_rows(50, 8), unit_rows(50, 9)])
+    path = tmp_path / "p.csv"
+    np.savetxt(path, pairs, delimiter=",", header="wi_x,wi_y,wi_z,wo_x,wo_y,wo_z", comments="",
+               fmt="%.17g")
+    out = subprocess.run([cli, "eval", "--brdf", "embedded:colodur_azure_4e", "-i", str(path)],
+                         check=True, capture_output=True, text=True).stdout
+    ref = np.loadtxt(out.splitlines()[1:], delimiter=",")
+    np.testing.assert_array_equal(halfback.load("embedded:colodur_azure_4e").eval(pairs), ref)
