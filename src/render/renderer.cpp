@@ -289,7 +289,8 @@ RenderResult render(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& 
   Progress progress(s.progress, std::uint64_t(pixels) * std::uint64_t(s.spp));
   bool exhausted = false;
   int done = 0;
-  // Passes: the whole count at once without a budget; with one, 1, 1, 2, 4, ... pixel samples,
+  // Passes: the whole count at once without a budget; with one, passes of 1, 2, 4, ... pixel
+  // samples (1, 3, 7, ... in all),
   // and a pass that the budget interrupts is dropped (every pixel keeps the same sample count).
   int pass_size = s.time_budget > 0 ? 1 : s.spp;
   while (done < s.spp) {

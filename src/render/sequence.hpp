@@ -63,7 +63,8 @@ enum class SequenceKind { sobol, random };
 // Point `index` of the 2D sequence `dim` (a dimension pair) of one pixel.
 inline void sample_2d(SequenceKind kind, std::uint64_t seed, std::uint64_t pixel,
                       std::uint32_t index, std::uint32_t dim, double& u1, double& u2) {
-  const std::uint64_t key = (seed << 8) ^ dim;
+  // Every bit of the seed matters (a shift would drop the top ones), and dimensions differ.
+  const std::uint64_t key = mix64(seed ^ mix64(std::uint64_t(dim) + 0x9e3779b97f4a7c15ull));
   if (kind == SequenceKind::random) {
     const std::uint64_t h = mix64(mix64(mix64(key) ^ pixel) ^ index);
     u1 = double(h >> 11) * 0x1p-53;

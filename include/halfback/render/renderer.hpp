@@ -56,7 +56,7 @@ struct RenderResult {
   double seconds = 0;           // rendering time, without building the BRDF sampler
   double sampler_seconds = 0;   // building the BRDF sampler (tabulation)
   bool budget_exhausted = false;
-  std::uint64_t nonfinite = 0;  // sample values that were NaN or infinite, dropped
+  std::uint64_t nonfinite = 0;  // sample values that were NaN or infinite, counted as 0
   std::string sampler;          // which BRDF sampler was used
 };
 
