@@ -1,0 +1,28 @@
+# Installs the build tree BUILD_DIR into WORK_DIR/prefix, then configures, builds and runs the
+# consumer project SOURCE_DIR against it. Fails on any step.
+file(REMOVE_RECURSE ${WORK_DIR})
+function(step)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed: ${ARGN}\n${out}\n${err}")
+  endif()
+  message("${out}")
+endfunction()
+step(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
+foreach(f include/halfback/core/param.hpp bin/halfback share/man/man1/halfback.1)
+  if(NOT EXISTS ${WORK_DIR}/prefix/${f})
+    message(FATAL_ERROR "not installed: ${f}")
+  endif()
+endforeach()
+step(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -G ${GENERATOR}
+     -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release)
+step(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
+step(${WORK_DIR}/build/consumer)
+step(${WORK_DIR}/prefix/bin/halfback --version)
+# The installed Python package, when the module was built.
+set(pydir ${WORK_DIR}/prefix/lib/python3/dist-packages)
+if(PYTHON AND EXISTS ${pydir}/halfback/__init__.py)
+  step(${CMAKE_COMMAND} -E env PYTHONPATH=${pydir} ${PYTHON} -c
+       "print(__import__('halfback').load('lambert').eval([[0, 0, 1]], [[0, 0, 1]]))")
+  # (no ';' in the code: step() passes its arguments as a CMake list)
+endif()
