@@ -10,10 +10,14 @@
 //    sampling only — with the same time budget; relative RMSE over the sphere's pixels, scaled to
 //    exactly the budget (RMSE ∝ 1/√time). The reference's own error (MIS at 4096 spp) is below
 //    the MIS figure by √(4096/spp): a floor, not a bias, of the comparison.
-// --quick shrinks both parts (for a smoke run).
+// 3. Which parameterization the tabulated sampler of measured data should use: equal-time error of
+//    MIS with the table in hybrid, halfdiff and spherical coordinates, for measured materials
+//    and a tabulated glossy model (forced tabulation).
+// --quick shrinks every part (for a smoke run); --part N runs part N only.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -22,6 +26,7 @@
 
 #include "halfback/brdf/load.hpp"
 #include "halfback/io/merl.hpp"
+#include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
 
@@ -55,7 +60,12 @@ double relative_rmse(const render::Image& a, const render::Image& ref) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  bool quick = false;
+  int only = 0;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quick") == 0) quick = true;
+    if (std::strcmp(argv[i], "--part") == 0 && i + 1 < argc) only = std::atoi(argv[++i]);
+  }
   const unsigned all = std::max(1u, std::thread::hardware_concurrency());
   const render::EnvMap sky = render::EnvMap::default_sky();
 
@@ -68,55 +78,97 @@ int main(int argc, char** argv) {
                                     {"MERL table (Lambert + GGX, tabulated)", merl},
                                     {"RGL metallic paint (measured)", rgl}};
 
-  std::printf("## Time for a %d × %d sphere at %d spp (built-in sky)\n\n", quick ? 128 : 512,
-              quick ? 128 : 512, quick ? 16 : 256);
-  std::printf("| material | sampler | 1 thread | %u threads | sampler set-up |\n|---|---|---|---|---|\n",
-              all);
-  for (const Material& m : timed) {
-    render::RenderSettings s;
-    s.width = s.height = quick ? 128 : 512;
-    s.spp = quick ? 16 : 256;
-    double t[2] = {0, 0};
-    render::RenderResult r;
-    for (int k = 0; k < 2; ++k) {
-      s.threads = k == 0 ? 1 : int(all);
-      r = render::render(*m.brdf, sky, s);
-      t[k] = r.seconds;
+  if (only == 0 || only == 1) {
+    std::printf("## Time for a %d × %d sphere at %d spp (built-in sky)\n\n", quick ? 128 : 512,
+                quick ? 128 : 512, quick ? 16 : 256);
+    std::printf(
+        "| material | sampler | 1 thread | %u threads | sampler set-up |\n|---|---|---|---|---|\n",
+        all);
+    for (const Material& m : timed) {
+      render::RenderSettings s;
+      s.width = s.height = quick ? 128 : 512;
+      s.spp = quick ? 16 : 256;
+      double t[2] = {0, 0};
+      render::RenderResult r;
+      for (int k = 0; k < 2; ++k) {
+        s.threads = k == 0 ? 1 : int(all);
+        r = render::render(*m.brdf, sky, s);
+        t[k] = r.seconds;
+      }
+      std::printf("| %s | %s | %.1f s | %.1f s | %.2f s |\n", m.label.c_str(), r.sampler.c_str(),
+                  t[0], t[1], r.sampler_seconds);
+      std::fflush(stdout);
     }
-    std::printf("| %s | %s | %.1f s | %.1f s | %.2f s |\n", m.label.c_str(), r.sampler.c_str(), t[0],
-                t[1], r.sampler_seconds);
-    std::fflush(stdout);
   }
 
-  const std::vector<Material> compared{{"glossy: GGX α = 0.05", load_brdf("ggx:alpha=0.05,f0=0.9")},
-                                       {"diffuse: Lambert 0.5", load_brdf("lambert:albedo=0.5")},
-                                       {"measured: RGL metallic paint", rgl}};
   const double budget = quick ? 0.3 : 2.0;
-  std::printf("\n## Error at equal time (%.1f s, 128 × 128, built-in sky, %u threads)\n\n", budget,
-              all);
-  std::printf("| material | MIS: spp, rel. RMSE | BRDF only | environment only |\n|---|---|---|---|\n");
-  for (const Material& m : compared) {
-    render::RenderSettings ref;
-    ref.width = ref.height = 128;
-    ref.spp = quick ? 256 : 4096;
-    ref.seed = 977;
-    const render::Image reference = render::render(*m.brdf, sky, ref).image;
-    std::printf("| %s |", m.label.c_str());
-    for (render::Strategy st : {render::Strategy::mis, render::Strategy::brdf,
-                                render::Strategy::env}) {
-      render::RenderSettings s;
-      s.width = s.height = 128;
-      s.spp = 1 << 20;
-      s.time_budget = budget;
-      s.strategy = st;
-      const render::RenderResult r = render::render(*m.brdf, sky, s);
-      // The budget stops after whole passes (1, 2, 4, ... samples), so the time used differs a
-      // little between strategies: the error is scaled to the budget by RMSE ∝ 1/√time.
-      const double e = relative_rmse(r.image, reference) * std::sqrt(r.seconds / budget);
-      std::printf(" %d spp, %.4f |", r.spp, e);
+  if (only == 0 || only == 2) {
+    const std::vector<Material> compared{
+        {"glossy: GGX α = 0.05", load_brdf("ggx:alpha=0.05,f0=0.9")},
+        {"diffuse: Lambert 0.5", load_brdf("lambert:albedo=0.5")},
+        {"measured: RGL metallic paint", rgl}};
+    std::printf("\n## Error at equal time (%.1f s, 128 × 128, built-in sky, %u threads)\n\n",
+                budget, all);
+    std::printf(
+        "| material | MIS: spp, rel. RMSE | BRDF only | environment only |\n|---|---|---|---|\n");
+    for (const Material& m : compared) {
+      render::RenderSettings ref;
+      ref.width = ref.height = 128;
+      ref.spp = quick ? 256 : 4096;
+      ref.seed = 977;
+      const render::Image reference = render::render(*m.brdf, sky, ref).image;
+      std::printf("| %s |", m.label.c_str());
+      for (render::Strategy st :
+           {render::Strategy::mis, render::Strategy::brdf, render::Strategy::env}) {
+        render::RenderSettings s;
+        s.width = s.height = 128;
+        s.spp = 1 << 20;
+        s.time_budget = budget;
+        s.strategy = st;
+        const render::RenderResult r = render::render(*m.brdf, sky, s);
+        // The budget stops after whole passes (1, 2, 4, ... samples), so the time used differs a
+        // little between strategies: the error is scaled to the budget by RMSE ∝ 1/√time.
+        const double e = relative_rmse(r.image, reference) * std::sqrt(r.seconds / budget);
+        std::printf(" %d spp, %.4f |", r.spp, e);
+      }
+      std::printf("\n");
+      std::fflush(stdout);
     }
-    std::printf("\n");
-    std::fflush(stdout);
+  }
+
+  if (only == 0 || only == 3) {
+    const std::vector<Material> measured{
+        {"RGL metallic paint", rgl},
+        {"RGL felt", load_brdf("embedded:acrylic_felt_green")},
+        {"RGL wall paint", load_brdf("embedded:colodur_azure_4e")},
+        {"GGX α = 0.05, tabulated", load_brdf("ggx:alpha=0.05,f0=0.9")}};
+    std::printf(
+        "\n## Tabulated sampler: parameterization of the table (MIS, %.1f s, 128 × 128, "
+        "built-in sky; relative RMSE at equal time)\n\n",
+        budget);
+    std::printf("| material | hybrid | halfdiff | spherical |\n|---|---|---|---|\n");
+    for (const Material& m : measured) {
+      render::RenderSettings ref;
+      ref.width = ref.height = 128;
+      ref.spp = quick ? 256 : 4096;
+      ref.seed = 977;
+      const render::Image reference = render::render(*m.brdf, sky, ref).image;
+      std::printf("| %s |", m.label.c_str());
+      for (render::TableParam tp : {render::TableParam::hybrid, render::TableParam::halfdiff,
+                                    render::TableParam::spherical}) {
+        render::RenderSettings s;
+        s.width = s.height = 128;
+        s.spp = 1 << 20;
+        s.time_budget = budget;
+        s.tabulation.param = tp;
+        const auto sampler = render::make_brdf_sampler(*m.brdf, s.tabulation, true);
+        const render::RenderResult r = render::render(*m.brdf, *sampler, sky, s);
+        const double e = relative_rmse(r.image, reference) * std::sqrt(r.seconds / budget);
+        std::printf(" %d spp, %.4f |", r.spp, e);
+      }
+      std::printf("\n");
+      std::fflush(stdout);
+    }
   }
   return 0;
 }

@@ -11,10 +11,12 @@
 // destination fails before any drawing, and no partial file is left behind.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -64,6 +66,7 @@ struct PaperArgs {
   std::string out;
   std::string formats = "png,svg,pdf";
   std::vector<std::string> materials;  // replace the default Figures 3-5
+  std::string merl_dir;                // every MERL file in it: Figures 3, 4, 5...
   std::string envs = "default,studio,sunset";
   bool no_materials = false;
   int render_pixels = 176, spp = 48;
@@ -284,19 +287,33 @@ int run_paper(const PaperArgs& a) {
   o.environments = environment_list(a.envs);
   o.render_pixels = a.render_pixels;
   o.spp = a.spp;
+  std::vector<std::string> specs = a.materials;
+  if (!a.merl_dir.empty()) {
+    // The MERL files of the folder (by content, whatever their names), in name order: give it
+    // the paper's three materials to get its Figures 3-5.
+    std::error_code ec;
+    std::vector<std::string> found;
+    for (const auto& e : std::filesystem::directory_iterator(a.merl_dir, ec))
+      if (e.is_regular_file() && detect_brdf_format(e.path()) == BrdfFileFormat::merl)
+        found.push_back(e.path().string());
+    if (ec) throw UsageError(fmt::format("--merl-dir '{}': {}", a.merl_dir, ec.message()));
+    if (found.empty())
+      throw UsageError(fmt::format("--merl-dir '{}': no MERL .binary file in it", a.merl_dir));
+    std::sort(found.begin(), found.end());
+    specs.insert(specs.end(), found.begin(), found.end());
+  }
   if (a.no_materials) {
-    if (!a.materials.empty()) throw UsageError("--no-materials and --material contradict");
+    if (!specs.empty()) throw UsageError("--no-materials contradicts --material and --merl-dir");
     o.materials.clear();
-  } else if (!a.materials.empty()) {
+  } else if (!specs.empty()) {
     // Each SPEC must load before any figure is drawn.
     o.materials.clear();
-    for (std::size_t k = 0; k < a.materials.size(); ++k) {
-      const BrdfPtr b = load_brdf(a.materials[k]);
+    for (std::size_t k = 0; k < specs.size(); ++k) {
+      const BrdfPtr b = load_brdf(specs[k]);
       std::string stem = fmt::format("fig{}-", 3 + k);
       for (const char c : b->name()) stem += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
       o.materials.push_back(
-          {stem, a.materials[k],
-           fmt::format("Figure {} ({}): {}", 3 + k, a.materials[k], b->description())});
+          {stem, specs[k], fmt::format("Figure {} ({}): {}", 3 + k, b->name(), b->description())});
     }
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -393,6 +410,9 @@ Command register_figure(CLI::App& parent) {
                 "A BRDF SPEC for Figures 3, 4, 5... (repeatable; replaces the default measured "
                 "and analytic materials)")
       ->take_all();
+  p->add_option("--merl-dir", pa->merl_dir,
+                "A folder of MERL .binary files (e.g. the paper's three materials): one figure "
+                "each, in name order, instead of the default materials");
   p->add_flag("--no-materials", pa->no_materials, "Figures 1 and 2 only");
   p->add_option("--env", pa->envs,
                 "Environments of the sphere renderings: default, studio, sunset, constant:V or "

@@ -838,6 +838,21 @@ TEST_F(CliTest, FigurePaperWritesEveryFigure) {
   EXPECT_EQ(n, 5u);
 }
 
+TEST_F(CliTest, FigurePaperTakesTheMerlFilesOfAFolder) {
+  fs::create_directories(path("merl"));
+  Result r = run({"export-merl", "--brdf", "lambert:albedo=0.2", "-o", "merl/b.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  put(path("merl/notes.txt"), "not a MERL file\n");
+  r = run({"figure", "paper", "--out", "figs", "--formats", "png", "--merl-dir", "merl",
+           "--render-size", "16", "--spp", "1"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(path("figs") / "fig3-merl-b.png")) << r.out;
+  EXPECT_FALSE(fs::exists(path("figs") / "fig4-felt.png"));
+  r = run({"figure", "paper", "--out", "figs2", "--merl-dir", "figs"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no MERL .binary file in it"), std::string::npos) << r.err;
+}
+
 TEST_F(CliTest, FigureBadInputLeavesNothing) {
   Result r = run({"figure", "paper", "--out", "figs", "--material", "nope"});
   EXPECT_EQ(r.status, 1);
