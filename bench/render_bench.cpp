@@ -57,6 +57,32 @@ double relative_rmse(const render::Image& a, const render::Image& ref) {
   return std::sqrt(se / sr);
 }
 
+// The reference image of part 2 and 3: MIS at many samples, another seed than the estimates.
+render::Image reference_image(const Brdf& brdf, const render::EnvMap& env, bool quick) {
+  render::RenderSettings ref;
+  ref.width = ref.height = 128;
+  ref.spp = quick ? 256 : 4096;
+  ref.seed = 977;
+  return render::render(brdf, env, ref).image;
+}
+
+// Settings of an estimate with a time budget (128 × 128, as many samples as the budget allows).
+render::RenderSettings budgeted(double budget) {
+  render::RenderSettings s;
+  s.width = s.height = 128;
+  s.spp = 1 << 20;
+  s.time_budget = budget;
+  return s;
+}
+
+// The budget stops after whole passes (1, 2, 4, ... samples), so the time used differs a little
+// between runs: the error is scaled to the budget by RMSE ∝ 1/√time. Printed as a table cell.
+void print_equal_time_error(const render::RenderResult& r, const render::Image& reference,
+                            double budget) {
+  const double e = relative_rmse(r.image, reference) * std::sqrt(r.seconds / budget);
+  std::printf(" %d spp, %.4f |", r.spp, e);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -112,24 +138,13 @@ int main(int argc, char** argv) {
     std::printf(
         "| material | MIS: spp, rel. RMSE | BRDF only | environment only |\n|---|---|---|---|\n");
     for (const Material& m : compared) {
-      render::RenderSettings ref;
-      ref.width = ref.height = 128;
-      ref.spp = quick ? 256 : 4096;
-      ref.seed = 977;
-      const render::Image reference = render::render(*m.brdf, sky, ref).image;
+      const render::Image reference = reference_image(*m.brdf, sky, quick);
       std::printf("| %s |", m.label.c_str());
       for (render::Strategy st :
            {render::Strategy::mis, render::Strategy::brdf, render::Strategy::env}) {
-        render::RenderSettings s;
-        s.width = s.height = 128;
-        s.spp = 1 << 20;
-        s.time_budget = budget;
+        render::RenderSettings s = budgeted(budget);
         s.strategy = st;
-        const render::RenderResult r = render::render(*m.brdf, sky, s);
-        // The budget stops after whole passes (1, 2, 4, ... samples), so the time used differs a
-        // little between strategies: the error is scaled to the budget by RMSE ∝ 1/√time.
-        const double e = relative_rmse(r.image, reference) * std::sqrt(r.seconds / budget);
-        std::printf(" %d spp, %.4f |", r.spp, e);
+        print_equal_time_error(render::render(*m.brdf, sky, s), reference, budget);
       }
       std::printf("\n");
       std::fflush(stdout);
@@ -148,23 +163,14 @@ int main(int argc, char** argv) {
         budget);
     std::printf("| material | hybrid | halfdiff | spherical |\n|---|---|---|---|\n");
     for (const Material& m : measured) {
-      render::RenderSettings ref;
-      ref.width = ref.height = 128;
-      ref.spp = quick ? 256 : 4096;
-      ref.seed = 977;
-      const render::Image reference = render::render(*m.brdf, sky, ref).image;
+      const render::Image reference = reference_image(*m.brdf, sky, quick);
       std::printf("| %s |", m.label.c_str());
       for (render::TableParam tp : {render::TableParam::hybrid, render::TableParam::halfdiff,
                                     render::TableParam::spherical}) {
-        render::RenderSettings s;
-        s.width = s.height = 128;
-        s.spp = 1 << 20;
-        s.time_budget = budget;
+        render::RenderSettings s = budgeted(budget);
         s.tabulation.param = tp;
         const auto sampler = render::make_brdf_sampler(*m.brdf, s.tabulation, true);
-        const render::RenderResult r = render::render(*m.brdf, *sampler, sky, s);
-        const double e = relative_rmse(r.image, reference) * std::sqrt(r.seconds / budget);
-        std::printf(" %d spp, %.4f |", r.spp, e);
+        print_equal_time_error(render::render(*m.brdf, *sampler, sky, s), reference, budget);
       }
       std::printf("\n");
       std::fflush(stdout);

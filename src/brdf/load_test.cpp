@@ -10,6 +10,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "brdf/test_brdfs.hpp"
 #include "halfback/brdf/registry.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/io/alta.hpp"
@@ -23,21 +24,7 @@ namespace {
 
 using test::TempDir;
 
-// A smooth anisotropic, non-reciprocal test BRDF.
-class Smooth final : public Brdf {
- public:
-  std::string name() const override { return "smooth"; }
-  std::string description() const override { return "smooth test function"; }
-  bool isotropic() const override { return false; }
-  bool reciprocal() const override { return false; }
-  Rgb eval(const DirPair<double>& p) const override {
-    ++calls;
-    if (p.wi.z < 0 || p.wo.z < 0) return {};
-    return {1 + p.wi.x + 0.5 * p.wo.y, 2 + p.wi.z * p.wo.z, 0.5 + 0.1 * p.wo.x};
-  }
-  using Brdf::eval;
-  mutable std::atomic<long> calls{0};
-};
+using test::Smooth;
 
 class Throwing final : public Brdf {
  public:

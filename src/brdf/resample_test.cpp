@@ -15,6 +15,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "brdf/test_brdfs.hpp"
 #include "halfback/brdf/test_functions.hpp"
 #include "halfback/core/batch.hpp"
 #include "io/test_support.hpp"
@@ -24,19 +25,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// Smooth, anisotropic and non-reciprocal: a resampling that mixes up coordinates shows.
-class Smooth final : public Brdf {
- public:
-  std::string name() const override { return "smooth"; }
-  std::string description() const override { return "smooth test function"; }
-  bool isotropic() const override { return false; }
-  bool reciprocal() const override { return false; }
-  Rgb eval(const DirPair<double>& p) const override {
-    if (p.wi.z < 0 || p.wo.z < 0) return {};
-    return {1 + p.wi.x + 0.5 * p.wo.y, 2 + p.wi.z * p.wo.z, 0.5 + 0.1 * p.wo.x - 0.2 * p.wi.y};
-  }
-  using Brdf::eval;
-};
+using test::Smooth;
 
 // The coordinates of grid point `flat` (row-major, last axis fastest), the slice azimuth added.
 std::vector<double> coords_of(const GridSpec& g, std::size_t flat) {
