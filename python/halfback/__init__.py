@@ -6,9 +6,10 @@ Parameterization names: "dirs" (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z), "spherical"
 dropped and the second azimuth is relative. Conventions and derivations: docs/math.md.
 
 BRDFs: load(spec) gives a Brdf (analytic models, MERL, RGL, ALTA files, embedded materials) with
-vectorized eval(wi, wo), info, albedo() and resample().
+vectorized eval(wi, wo), info, albedo(), resample() and render(); hemisphere() gives the data of
+the paper's Figure 1.
 """
 
-from ._core import Brdf, columns, convert, jacobian, load, models, valid
+from ._core import Brdf, columns, convert, hemisphere, jacobian, load, models, valid
 
-__all__ = ["Brdf", "columns", "convert", "jacobian", "load", "models", "valid"]
+__all__ = ["Brdf", "columns", "convert", "hemisphere", "jacobian", "load", "models", "valid"]

@@ -49,6 +49,26 @@ class Brdf:
         ranges: Mapping[str, tuple[float, float]] = ...,
     ) -> dict[str, Any]:
         """rho, valid, axes, axis_names, metadata of the BRDF on a grid of `param`."""
+    def render(
+        self,
+        env: str = "default",
+        width: int = 256,
+        height: int = 256,
+        spp: int = 64,
+        seed: int = 1,
+        strategy: Literal["mis", "brdf", "env"] = "mis",
+        threads: int = 0,
+    ) -> npt.NDArray[np.float32]:
+        """A sphere of the BRDF under `env`: (height, width, 3) linear radiance."""
+
+def hemisphere(
+    param: Param,
+    theta_o: float,
+    pixels: int = 256,
+    projection: Literal["equal-area", "orthographic", "equidistant"] = "equal-area",
+    centre: Literal["normal", "mirror", "back"] = "normal",
+) -> dict[str, Any]:
+    """first, second, region (pixels x pixels), u, v, wo: Figure 1's data for one disk."""
 
 def load(spec: str) -> Brdf:
     """A BRDF from a file, a model spec ("ggx:alpha=0.2"), a sum or "embedded:NAME"."""

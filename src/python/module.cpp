@@ -19,6 +19,9 @@
 #include "halfback/brdf/registry.hpp"
 #include "halfback/brdf/resample.hpp"
 #include "halfback/core/batch.hpp"
+#include "halfback/figure/hemisphere.hpp"
+#include "halfback/render/envmap.hpp"
+#include "halfback/render/renderer.hpp"
 
 namespace py = pybind11;
 using namespace halfback;
@@ -249,6 +252,71 @@ py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::str
   return d;
 }
 
+py::dict hemisphere_view(const std::string& param, double theta_o, std::size_t pixels,
+                         const std::string& projection, const std::string& centre) {
+  const Space space = parse_space(param, "param");
+  if (space == Space::dirs) throw py::value_error("param: a parameterization, not dirs");
+  if (!(theta_o >= 0 && theta_o <= 1.5707963267948966))
+    throw py::value_error("theta_o must be in [0, pi/2] (radians), got " + std::to_string(theta_o));
+  if (pixels < 2 || pixels > 8192) throw py::value_error("pixels must be in [2, 8192]");
+  const auto proj = figure::projection_from_name(projection);
+  if (!proj)
+    throw py::value_error("projection: expected 'equal-area', 'orthographic' or 'equidistant'");
+  const auto c = figure::view_centre_from_name(centre);
+  if (!c) throw py::value_error("centre: expected 'normal', 'mirror' or 'back'");
+  const Vec3<double> wo = figure::outgoing_direction(theta_o);
+  const figure::HemisphereView view = figure::HemisphereView::make(*c, wo, *proj);
+  figure::HemisphereSample hs;
+  {
+    py::gil_scoped_release release;
+    hs = figure::sample_hemisphere(space, view, wo, pixels);
+  }
+  const auto ny = py::ssize_t(hs.grid.ny), nx = py::ssize_t(hs.grid.nx);
+  py::array_t<double> first({ny, nx}), second({ny, nx}), u(nx), v(ny);
+  py::array_t<std::uint8_t> region({ny, nx});
+  std::copy(hs.first.values.begin(), hs.first.values.end(), first.mutable_data());
+  std::copy(hs.second.values.begin(), hs.second.values.end(), second.mutable_data());
+  std::copy(hs.region.begin(), hs.region.end(), region.mutable_data());
+  for (py::ssize_t i = 0; i < nx; ++i) u.mutable_data()[i] = hs.grid.x(std::size_t(i));
+  for (py::ssize_t j = 0; j < ny; ++j) v.mutable_data()[j] = hs.grid.y(std::size_t(j));
+  py::dict d;
+  d["first"] = first;
+  d["second"] = second;
+  d["region"] = region;
+  d["u"] = u;
+  d["v"] = v;
+  d["wo"] = py::make_tuple(wo.x, wo.y, wo.z);
+  return d;
+}
+
+py::array_t<float> render_brdf(const PyBrdf& b, const std::string& env, int width, int height,
+                               int spp, std::uint64_t seed, const std::string& strategy,
+                               int threads) {
+  render::RenderSettings s;
+  s.width = width;
+  s.height = height;
+  s.spp = spp;
+  s.seed = seed;
+  s.threads = threads;
+  if (strategy == "mis")
+    s.strategy = render::Strategy::mis;
+  else if (strategy == "brdf")
+    s.strategy = render::Strategy::brdf;
+  else if (strategy == "env")
+    s.strategy = render::Strategy::env;
+  else
+    throw py::value_error("strategy: expected 'mis', 'brdf' or 'env', got '" + strategy + "'");
+  const render::EnvMap map = render::EnvMap::from_spec(env);
+  render::RenderResult r;
+  {
+    py::gil_scoped_release release;
+    r = render::render(*b.brdf, map, s);
+  }
+  py::array_t<float> img({py::ssize_t(r.image.height), py::ssize_t(r.image.width), py::ssize_t(3)});
+  std::copy(r.image.rgb.begin(), r.image.rgb.end(), img.mutable_data());
+  return img;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -351,7 +419,23 @@ kind: "full" (4 axes), "isotropic" (3 axes, phi_h = 0) or "slice" (2 axes at rel
 or at nodes including both ends with nodes=True. ranges: {axis name: (lo, hi)}.
 Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape...) bool, axes
 (sample positions), axis_names, metadata.)doc")
+      .def("render", &render_brdf, py::arg("env") = "default", py::arg("width") = 256,
+           py::arg("height") = 256, py::arg("spp") = 64, py::arg("seed") = 1,
+           py::arg("strategy") = "mis", py::arg("threads") = 0,
+           R"doc(A unit sphere of the BRDF under an environment (as `halfback render`): an (H, W, 3)
+float32 array of linear radiance, row 0 at the top. env: "default", "studio", "sunset",
+"constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".)doc")
       .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; });
+
+  m.def("hemisphere", &hemisphere_view, py::arg("param"), py::arg("theta_o"),
+        py::arg("pixels") = 256, py::arg("projection") = "equal-area",
+        py::arg("centre") = "normal",
+        R"doc(Figure 1's data: for wo = (-sin theta_o, 0, cos theta_o), every wi of a disk view of the
+hemisphere. Returns a dict: first, second (pixels x pixels) the pair's two non-azimuthal
+coordinates in `param` (NaN where there is no valid pair), region (0 outside the disk, 1 wi below
+the horizon, 2 valid), u (columns) and v (rows) the disk coordinates of the pixel centres (v up),
+and wo; row j of the arrays is at v = v[j] (row 0 is the bottom). projection: "equal-area", "orthographic" or "equidistant"; centre: "normal", "mirror" or
+"back".)doc");
 
   m.def(
       "load", [](const std::string& spec) { return PyBrdf{load_brdf(spec)}; }, py::arg("spec"),

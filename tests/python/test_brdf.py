@@ -113,3 +113,74 @@ def test_eval_agrees_with_the_cli(tmp_path):
                          check=True, capture_output=True, text=True).stdout
     ref = np.loadtxt(out.splitlines()[1:], delimiter=",")
     np.testing.assert_array_equal(halfback.load("embedded:colodur_azure_4e").eval(pairs), ref)
+
+
+def test_hemisphere_view_is_figure_1s_data():
+    h = halfback.hemisphere("hybrid", np.radians(40), 65)
+    first, second, region = h["first"], h["second"], h["region"]
+    assert first.shape == second.shape == region.shape == (65, 65)
+    inside = region == 2
+    assert np.isnan(first[~inside]).all() and np.isfinite(first[inside]).all()
+    # The centre pixel (u = v = 0) is wi = n: hbar = |(n + wo)/2| projected = sin(40°)/2.
+    assert abs(h["u"][32]) < 1e-12 and abs(h["v"][32]) < 1e-12
+    assert first[32, 32] == pytest.approx(np.sin(np.radians(40)) / 2, abs=1e-12)
+    # The same pair through convert(): hybrid's second coordinate |k| at the centre.
+    wo = np.array(h["wo"])
+    q = halfback.convert(np.hstack([[0, 0, 1], wo])[None, :], "dirs", "hybrid")
+    assert second[32, 32] == pytest.approx(q[0, 2], abs=1e-12)
+    with pytest.raises(ValueError, match="theta_o"):
+        halfback.hemisphere("hybrid", 2.0)
+    with pytest.raises(ValueError, match="projection"):
+        halfback.hemisphere("hybrid", 0.1, projection="mercator")
+
+
+def test_render_furnace_and_errors():
+    img = halfback.load("lambert:albedo=0.3").render("constant:1", 24, 24, 16, threads=2)
+    assert img.shape == (24, 24, 3) and img.dtype == np.float32
+    assert img[12, 12] == pytest.approx([0.3, 0.3, 0.3], abs=0.02)
+    assert (img[0, 0] == 1).all()
+    assert (halfback.load("ggx").render("constant:0", 8, 8, 2) == 0).all()
+    with pytest.raises(ValueError, match="strategy"):
+        halfback.load("lambert").render(strategy="path")
+    with pytest.raises(RuntimeError, match="missing.hdr"):
+        halfback.load("lambert").render("missing.hdr")
+
+
+def test_brdf_eval_from_several_threads():
+    import threading
+
+    b = halfback.load("embedded:ilm_l3_37_metallic")
+    pairs = np.hstack([unit_rows(5000, 11), unit_rows(5000, 12)])
+    ref = b.eval(pairs)
+    results = [None] * 4
+
+    def work(i):
+        results[i] = b.eval(pairs)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        np.testing.assert_array_equal(r, ref)
+
+
+def test_figure2_example_draws_the_nine_panels(tmp_path):
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    import importlib.util
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    path = os.path.join(here, "..", "..", "examples", "figure2_matplotlib.py")
+    spec = importlib.util.spec_from_file_location("figure2_matplotlib", path)
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    out = tmp_path / "fig2.png"
+    example.main(str(out), size=61)
+    image = matplotlib.image.imread(str(out))
+    assert image.shape[0] > 500 and image.shape[1] > 500
+    # The invalid region is drawn light grey (0.8) and the valid one black: both are present.
+    rgb = image[..., :3]
+    assert (np.abs(rgb - 0.8).max(axis=2) < 0.02).mean() > 0.05
+    assert (rgb.max(axis=2) < 0.05).mean() > 0.2
