@@ -7,7 +7,13 @@ import numpy.typing as npt
 Param = Literal["dirs", "spherical", "halfdiff", "ortho", "hybrid"]
 FloatArray = npt.NDArray[np.float32] | npt.NDArray[np.float64]
 
-def convert(x: npt.ArrayLike, src: Param, dst: Param, isotropic: bool = False) -> FloatArray:
+def convert(
+    x: npt.ArrayLike,
+    src: Param,
+    dst: Param,
+    isotropic: bool = False,
+    out: FloatArray | None = None,
+) -> FloatArray:
     """Converts rows of x (N, 6 | 4 | 3) from `src` to `dst`; invalid rows become NaN."""
 
 def valid(x: npt.ArrayLike, param: Param, isotropic: bool = False) -> npt.NDArray[np.bool_]:

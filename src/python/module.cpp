@@ -71,7 +71,8 @@ struct Outputs {
 };
 
 template <class T>
-Outputs run(const py::array& x_any, Form from, Form to, bool want_result, bool want_jacobian) {
+Outputs run(const py::array& x_any, Form from, Form to, bool want_result, bool want_jacobian,
+            const py::object& out_obj = py::none()) {
   // A view when x is already an aligned array of T with element-multiple strides; else one copy.
   const auto x = py::array_t<T>::ensure(x_any);
   if (!x) throw py::type_error("x must be convertible to a floating-point array");
@@ -79,7 +80,25 @@ Outputs run(const py::array& x_any, Form from, Form to, bool want_result, bool w
     throw py::value_error("x has strides that are not a multiple of its item size");
   const auto n = static_cast<std::size_t>(x.shape(0));
   const auto dim_out = static_cast<py::ssize_t>(dimension(to));
-  py::array_t<T> result({static_cast<py::ssize_t>(n), want_result ? dim_out : py::ssize_t(0)});
+  // The result: a new array, or `out` (any strides), whose pages are already there: for large N,
+  // the first touch of a fresh array costs as much as the conversion itself.
+  py::array_t<T> result;
+  if (!out_obj.is_none()) {
+    if (!py::isinstance<py::array_t<T>>(out_obj) ||
+        !py::array(out_obj).dtype().is(py::dtype::of<T>()))
+      throw py::type_error(std::string("out must be a numpy array of dtype ") +
+                           (sizeof(T) == 4 ? "float32" : "float64") + ", the dtype of the result");
+    result = py::reinterpret_borrow<py::array_t<T>>(out_obj);
+    if (result.ndim() != 2 || result.shape(0) != py::ssize_t(n) || result.shape(1) != dim_out)
+      throw py::value_error("out must have shape (" + std::to_string(n) + ", " +
+                            std::to_string(dim_out) + "), got " + shape_text(result));
+    if (!result.writeable()) throw py::value_error("out is read-only");
+    if (result.strides(0) % py::ssize_t(sizeof(T)) != 0 ||
+        result.strides(1) % py::ssize_t(sizeof(T)) != 0)
+      throw py::value_error("out has strides that are not a multiple of its item size");
+  } else {
+    result = py::array_t<T>({static_cast<py::ssize_t>(n), want_result ? dim_out : py::ssize_t(0)});
+  }
   py::array_t<bool> valid(static_cast<py::ssize_t>(n));
   py::array_t<T> jacobian(want_jacobian ? static_cast<py::ssize_t>(n) : py::ssize_t(0));
   // When only the mask or J is wanted, the engine still needs somewhere to put the tuples.
@@ -89,7 +108,8 @@ Outputs run(const py::array& x_any, Form from, Form to, bool want_result, bool w
   std::vector<Column<T>> out;
   for (py::ssize_t c = 0; c < dim_out; ++c) {
     if (want_result)
-      out.push_back({result.mutable_data() + c, dim_out});
+      out.push_back({result.mutable_data() + c * (result.strides(1) / py::ssize_t(sizeof(T))),
+                     result.strides(0) / py::ssize_t(sizeof(T))});
     else
       out.push_back({scratch.data() + c, dim_out});
   }
@@ -105,14 +125,15 @@ Outputs run(const py::array& x_any, Form from, Form to, bool want_result, bool w
           want_jacobian ? py::object(jacobian) : py::none()};
 }
 
-Outputs dispatch(const py::object& obj, Form from, Form to, bool want_result, bool want_jacobian) {
+Outputs dispatch(const py::object& obj, Form from, Form to, bool want_result, bool want_jacobian,
+                 const py::object& out = py::none()) {
   // Anything np.asarray accepts (lists, array-likes); arrays pass through untouched.
   const py::array x = py::module_::import("numpy").attr("asarray")(obj);
   check_input(x, from);
   if (x.dtype().is(py::dtype::of<float>()))
-    return run<float>(x, from, to, want_result, want_jacobian);
+    return run<float>(x, from, to, want_result, want_jacobian, out);
   if (x.dtype().kind() == 'f' || x.dtype().kind() == 'i' || x.dtype().kind() == 'u')
-    return run<double>(x, from, to, want_result, want_jacobian);
+    return run<double>(x, from, to, want_result, want_jacobian, out);
   throw py::type_error("x must be a float32 or float64 array (got dtype " +
                        std::string(py::str(x.dtype())) + ")");
 }
@@ -324,18 +345,22 @@ PYBIND11_MODULE(_core, m) {
 
   m.def(
       "convert",
-      [](const py::object& x, const std::string& src, const std::string& dst, bool isotropic) {
+      [](const py::object& x, const std::string& src, const std::string& dst, bool isotropic,
+         const py::object& out) {
         const Form from = parse_form(src, isotropic, "src"), to = parse_form(dst, isotropic, "dst");
-        return dispatch(x, from, to, true, false).result;
+        return dispatch(x, from, to, true, false, out).result;
       },
       py::arg("x"), py::arg("src"), py::arg("dst"), py::arg("isotropic") = false,
+      py::arg("out") = py::none(),
       R"doc(Converts N tuples from one parameterization to another.
 
 x: array of shape (N, 6) for "dirs" (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z) or (N, 4) / (N, 3) for a
 parameterization ("spherical", "halfdiff", "ortho", "hybrid"), columns in the CLI's order.
 isotropic: use the 3-coordinate isotropic form of every parameterization side.
 Returns an array of the same dtype (float32 stays float32, anything else becomes float64); rows
-whose input is invalid (not unit, below the horizon, outside the domain, NaN) are NaN.)doc");
+whose input is invalid (not unit, below the horizon, outside the domain, NaN) are NaN.
+out: an existing (N, dim) array of the result's dtype to write into (and return), e.g. to convert
+many batches without allocating.)doc");
 
   m.def(
       "valid",
@@ -427,10 +452,10 @@ float32 array of linear radiance, row 0 at the top. env: "default", "studio", "s
 "constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".)doc")
       .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; });
 
-  m.def("hemisphere", &hemisphere_view, py::arg("param"), py::arg("theta_o"),
-        py::arg("pixels") = 256, py::arg("projection") = "equal-area",
-        py::arg("centre") = "normal",
-        R"doc(Figure 1's data: for wo = (-sin theta_o, 0, cos theta_o), every wi of a disk view of the
+  m.def(
+      "hemisphere", &hemisphere_view, py::arg("param"), py::arg("theta_o"), py::arg("pixels") = 256,
+      py::arg("projection") = "equal-area", py::arg("centre") = "normal",
+      R"doc(Figure 1's data: for wo = (-sin theta_o, 0, cos theta_o), every wi of a disk view of the
 hemisphere. Returns a dict: first, second (pixels x pixels) the pair's two non-azimuthal
 coordinates in `param` (NaN where there is no valid pair), region (0 outside the disk, 1 wi below
 the horizon, 2 valid), u (columns) and v (rows) the disk coordinates of the pixel centres (v up),

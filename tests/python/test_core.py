@@ -163,3 +163,26 @@ def test_agrees_with_the_cli(tmp_path):
     assert lines[0].split(",")[:4] == ["hbar", "phi_h", "k", "phi_k"]
     cli_q = np.array([[float(v) for v in line.split(",")[:4]] for line in lines[1:]])
     np.testing.assert_array_equal(cli_q, halfback.convert(x, "dirs", "hybrid"))
+
+
+def test_convert_into_out():
+    x = random_dirs(1000, seed=21, zmin=0.05)
+    ref = halfback.convert(x, "dirs", "hybrid")
+    out = np.full((1000, 4), -1.0)
+    r = halfback.convert(x, "dirs", "hybrid", out=out)
+    assert r is out
+    np.testing.assert_array_equal(out, ref)
+    # Any strides: a column-major array, and a view into a wider one.
+    f = np.asfortranarray(np.zeros((1000, 4)))
+    np.testing.assert_array_equal(halfback.convert(x, "dirs", "hybrid", out=f), ref)
+    wide = np.zeros((1000, 8))
+    halfback.convert(x, "dirs", "hybrid", out=wide[:, ::2])
+    np.testing.assert_array_equal(wide[:, ::2], ref)
+    with pytest.raises(ValueError, match=r"out must have shape \(1000, 4\), got \(1000, 3\)"):
+        halfback.convert(x, "dirs", "hybrid", out=np.zeros((1000, 3)))
+    with pytest.raises(TypeError, match="dtype float64"):
+        halfback.convert(x, "dirs", "hybrid", out=np.zeros((1000, 4), np.float32))
+    ro = np.zeros((1000, 4))
+    ro.flags.writeable = False
+    with pytest.raises(ValueError, match="read-only"):
+        halfback.convert(x, "dirs", "hybrid", out=ro)
