@@ -873,5 +873,47 @@ TEST_F(CliTest, FigureBadInputLeavesNothing) {
   EXPECT_EQ(entries(), std::vector<std::string>{});
 }
 
+// ---------------------------------------------------------------------------------------------
+// halfback study
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
+  const Result r = run({"study", "--quick", "-o", "st", "test:S", "test:G"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string az = slurp(path("st") / "azimuthal.csv");
+  EXPECT_EQ(az.substr(0, az.find('\n')), "brdf,parameterization,error");
+  // S = 1 − ‖h̄‖ = 1 − sin θh cos θd has no azimuthal dependence in halfdiff, ortho and hybrid;
+  // G = 1 − cos θi cos θo none in spherical, some in the others.
+  auto error_of = [&](const std::string& key) {
+    const std::size_t at = az.find(key + ",");
+    if (at == std::string::npos) return -1.0;
+    return std::stod(az.substr(at + key.size() + 1));
+  };
+  for (const char* key : {"test:S,halfdiff", "test:S,ortho", "test:S,hybrid", "test:G,spherical"}) {
+    EXPECT_GE(error_of(key), 0) << key << "\n" << az;
+    EXPECT_LT(error_of(key), 1e-12) << key << "\n" << az;
+  }
+  for (const char* key : {"test:S,spherical", "test:G,halfdiff", "test:G,ortho", "test:G,hybrid"})
+    EXPECT_GT(error_of(key), 1e-3) << key << "\n" << az;
+  const std::string sep = slurp(path("st") / "separability.csv");
+  EXPECT_EQ(sep.substr(0, sep.find('\n')), "brdf,parameterization,rank,error");
+  EXPECT_NE(sep.find("test:S,hybrid-2d,8,"), std::string::npos);
+  EXPECT_NE(slurp(path("st") / "report.md").find("## Azimuthal dependence"), std::string::npos);
+}
+
+TEST_F(CliTest, StudyBadInput) {
+  Result r = run({"study", "-o", "st", "nope"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("'nope' is neither"), std::string::npos) << r.err;
+  r = run({"study", "--space", "sqrt", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--space 'sqrt'"), std::string::npos) << r.err;
+  fs::create_directories(path("empty"));
+  r = run({"study", "-o", "st", "empty"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no MERL, RGL or ALTA file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("st")));
+}
+
 }  // namespace
 }  // namespace halfback

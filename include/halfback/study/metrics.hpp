@@ -1,0 +1,57 @@
+// The quantitative comparison of the parameterizations (issue 6; docs/study.md): metrics of how
+// well a BRDF is represented in each parameterization, all computed under one measure on the
+// space of direction pairs, so that the parameterizations are compared on the same footing.
+//
+// Measure: dμ = cos θi cos θo dωi dωo (the projected solid angles: the weight of a pair in
+// rendering), written in each parameterization's isotropic coordinates (a, b, φ) with the core's
+// Jacobian, dωi dωo = J₃(a, b, φ) da db dφ (batch.hpp, jacobian of an isotropic form).
+// Values: the luminance Y = 0.2126 r + 0.7152 g + 0.0722 b of ρ, in an error space:
+// linear (Y), log (log(1 + Y), the log-relative space of Nielsen et al. 2015) or cube root (Y^⅓).
+// Quadrature: the midpoint rule on a regular grid of cell centres of (a, b, φ) over the ranges of
+// resample.hpp's default grids; cells outside the domain have weight 0.
+#pragma once
+
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/core/space.hpp"
+
+namespace halfback::study {
+
+enum class ErrorSpace { linear, log, cbrt };
+std::string_view name_of(ErrorSpace s);
+
+struct IsoGrid {
+  std::size_t a = 64, b = 64, phi = 64;  // cells of the two magnitudes and of the azimuth
+};
+
+// An isotropic BRDF sampled on the isotropic grid of one parameterization.
+struct IsoSamples {
+  Space space = Space::hybrid;
+  IsoGrid grid;
+  std::vector<double> value;  // a.b.phi values (φ fastest) in the error space; 0 where invalid
+  std::vector<double> weight;  // dμ of each cell: J₃ cos θi cos θo Δa Δb Δφ; 0 where invalid
+  double total_weight() const;
+};
+
+// Throws std::invalid_argument for Space::dirs or an empty grid.
+IsoSamples sample_isotropic(const Brdf& brdf, Space space, const IsoGrid& grid, ErrorSpace es);
+
+// Azimuthal dependence: the relative error of replacing the BRDF by its μ-weighted average over
+// the relative azimuth φ of the parameterization, ρ̄(a, b) = ∫ρ dμ(φ | a, b):
+//   E = ( ∫ (ρ − ρ̄)² dμ / ∫ ρ² dμ )^½.
+// 0 when the BRDF depends on (a, b) only; how "2D" the BRDF is in this parameterization.
+double azimuthal_error(const IsoSamples& s);
+
+// Separability, relative errors of the best rank-r approximations (r = each of `ranks`) in the
+// μ-weighted L² norm, E_r = min ( Σ w (M − U Vᵀ)² / Σ w M² )^½ over U, V of r columns (weighted
+// alternating least squares from the SVD of √w ∘ M; cells outside the domain have w = 0):
+//   of the 2D projection ρ̄(a, b) (weights ∫dμ over φ), a matrix over a × b;
+//   of the 3D table unfolded along its azimuth, a matrix over (a, b) × φ.
+// A table of rank r on the domain has E_r = 0 whatever the domain's shape.
+std::vector<double> separability_2d(const IsoSamples& s, const std::vector<int>& ranks);
+std::vector<double> separability_unfolded(const IsoSamples& s, const std::vector<int>& ranks);
+
+}  // namespace halfback::study

@@ -1,0 +1,128 @@
+// The study's metrics on functions whose answers are known exactly.
+#include "halfback/study/metrics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <numbers>
+
+#include "halfback/brdf/load.hpp"
+
+namespace halfback::study {
+namespace {
+
+// A scalar "BRDF" from a function of the pair.
+class Fn final : public Brdf {
+ public:
+  explicit Fn(std::function<double(const DirPair<double>&)> f) : f_(std::move(f)) {}
+  std::string name() const override { return "fn"; }
+  std::string description() const override { return "test function"; }
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return true; }
+  Rgb eval(const DirPair<double>& p) const override {
+    const double v = f_(p);
+    return {v, v, v};
+  }
+  using Brdf::eval;
+
+ private:
+  std::function<double(const DirPair<double>&)> f_;
+};
+
+double hbar_of(const DirPair<double>& p) {
+  return std::hypot(p.wi.x + p.wo.x, p.wi.y + p.wo.y) / 2;
+}
+double k_of(const DirPair<double>& p) {
+  return std::sqrt((p.wi.x - p.wo.x) * (p.wi.x - p.wo.x) + (p.wi.y - p.wo.y) * (p.wi.y - p.wo.y) +
+                   (p.wi.z - p.wo.z) * (p.wi.z - p.wo.z)) /
+         2;
+}
+double theta_h_of(const DirPair<double>& p) {
+  return std::atan2(hbar_of(p), (p.wi.z + p.wo.z) / 2);
+}
+
+const IsoGrid kGrid{24, 24, 32};
+
+TEST(Azimuthal, ZeroWhereTheBrdfDependsOnTheTwoMagnitudesOnly) {
+  // A function of (‖h̄‖, ‖k‖): no azimuthal dependence in hybrid, some in the others.
+  const Fn f([](const DirPair<double>& p) { return 1 + 3 * hbar_of(p) * hbar_of(p) + k_of(p); });
+  EXPECT_LT(azimuthal_error(sample_isotropic(f, Space::hybrid, kGrid, ErrorSpace::linear)), 1e-12);
+  EXPECT_GT(azimuthal_error(sample_isotropic(f, Space::ortho, kGrid, ErrorSpace::linear)), 1e-3);
+  // A function of θh alone: none in halfdiff, and none in hybrid either (θh is a function of
+  // ‖h̄‖ and ‖k‖: h_z = √(1 − ‖k‖² − ‖h̄‖²)); some in ortho, whose ‖k̄‖ leaves h_z to φ.
+  const Fn g([](const DirPair<double>& p) { return std::exp(-8 * theta_h_of(p)); });
+  for (ErrorSpace es : {ErrorSpace::linear, ErrorSpace::log, ErrorSpace::cbrt}) {
+    EXPECT_LT(azimuthal_error(sample_isotropic(g, Space::halfdiff, kGrid, es)), 1e-12);
+    EXPECT_LT(azimuthal_error(sample_isotropic(g, Space::hybrid, kGrid, es)), 1e-12);
+    EXPECT_GT(azimuthal_error(sample_isotropic(g, Space::ortho, kGrid, es)), 1e-3);
+  }
+}
+
+TEST(Azimuthal, DependsOnTheAzimuthWhenTheBrdfDoes) {
+  // ρ ∝ (1 + ωi·ωo)² depends on θd alone (cos θd = ‖h‖): halfdiff sees no azimuthal dependence.
+  const Fn f([](const DirPair<double>& p) {
+    const double c = p.wi.x * p.wo.x + p.wi.y * p.wo.y + p.wi.z * p.wo.z;
+    return (1 + c) * (1 + c);
+  });
+  EXPECT_LT(azimuthal_error(sample_isotropic(f, Space::halfdiff, kGrid, ErrorSpace::linear)),
+            1e-12);
+  // ‖k‖² = (1 − ωi·ωo)/2: a function of ‖k‖ alone, so none in hybrid either.
+  EXPECT_LT(azimuthal_error(sample_isotropic(f, Space::hybrid, kGrid, ErrorSpace::linear)), 1e-12);
+  // The product cos θi cos θo does depend on φ in every parameterization.
+  const Fn g([](const DirPair<double>& p) { return p.wi.z * p.wo.z; });
+  for (Space s : {Space::halfdiff, Space::ortho, Space::hybrid})
+    EXPECT_GT(azimuthal_error(sample_isotropic(g, s, kGrid, ErrorSpace::linear)), 1e-2)
+        << name_of(s);
+}
+
+TEST(Separability, RankOneFunctionsHaveZeroRankOneError) {
+  // f(θh) g(θd) is of rank 1 in halfdiff's (θh, θd), on whatever domain the slice has.
+  const Fn f([](const DirPair<double>& p) {
+    const double c = p.wi.x * p.wo.x + p.wi.y * p.wo.y + p.wi.z * p.wo.z;
+    const double theta_d = std::acos(std::clamp(std::sqrt((1 + c) / 2), -1.0, 1.0));
+    return std::exp(-4 * theta_h_of(p)) * (1 + std::cos(3 * theta_d));
+  });
+  const IsoSamples s = sample_isotropic(f, Space::halfdiff, kGrid, ErrorSpace::linear);
+  const auto e = separability_2d(s, {0, 1, 2});
+  EXPECT_DOUBLE_EQ(e[0], 1.0);
+  EXPECT_LT(e[1], 1e-6);
+  EXPECT_LT(e[2], 1e-6);
+  // The 3D table has no azimuthal dependence: the unfolding is of rank 1 too.
+  EXPECT_LT(separability_unfolded(s, {1})[0], 1e-6);
+  // A sum of two separable terms: rank 2, not 1.
+  const Fn g([](const DirPair<double>& p) {
+    const double c = p.wi.x * p.wo.x + p.wi.y * p.wo.y + p.wi.z * p.wo.z;
+    const double theta_d = std::acos(std::clamp(std::sqrt((1 + c) / 2), -1.0, 1.0));
+    return std::exp(-4 * theta_h_of(p)) + theta_d * theta_d;
+  });
+  const auto e2 =
+      separability_2d(sample_isotropic(g, Space::halfdiff, kGrid, ErrorSpace::linear), {1, 2});
+  EXPECT_GT(e2[0], 1e-3);
+  EXPECT_LT(e2[1], 1e-6);
+}
+
+TEST(Measure, WeightsIntegrateTheProjectedSolidAngleMeasure) {
+  // ∫∫ cos θi cos θo dωi dωo = π²: the weights are a quadrature of that measure in every
+  // parameterization (midpoint rule on a 64³ grid: a few per cent at the integrable
+  // singularities of the Jacobians).
+  const Fn one([](const DirPair<double>&) { return 1.0; });
+  const double pi2 = std::numbers::pi * std::numbers::pi;
+  for (Space s : kParameterizations) {
+    const IsoSamples x = sample_isotropic(one, s, {64, 64, 64}, ErrorSpace::linear);
+    EXPECT_NEAR(x.total_weight() / pi2, 1.0, 0.03) << name_of(s);
+  }
+}
+
+TEST(Metrics, BadInput) {
+  const Fn one([](const DirPair<double>&) { return 1.0; });
+  EXPECT_THROW(sample_isotropic(one, Space::dirs, kGrid, ErrorSpace::linear),
+               std::invalid_argument);
+  EXPECT_THROW(sample_isotropic(one, Space::hybrid, {0, 4, 4}, ErrorSpace::linear),
+               std::invalid_argument);
+  const IsoSamples x = sample_isotropic(one, Space::hybrid, kGrid, ErrorSpace::linear);
+  EXPECT_THROW(separability_2d(x, {-1}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace halfback::study
