@@ -90,20 +90,24 @@ int run_study(const StudyOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < brdfs.size(); ++k) {
     const auto& [spec, brdf] = brdfs[k];
-    fmt::print(stderr, "halfback study: [{}/{}] {}\n", k + 1, brdfs.size(), brdf->name());
+    // Files by their BRDF's name (merl:..., rgl:...), models by their spec, which holds their
+    // parameters (two GGX of different roughness are both named "ggx").
+    std::error_code ec;
+    const std::string label = std::filesystem::exists(spec, ec) ? brdf->name() : spec;
+    fmt::print(stderr, "halfback study: [{}/{}] {}\n", k + 1, brdfs.size(), label);
     if (!brdf->isotropic())
-      warn("study", brdf->name() + " is anisotropic: the isotropic metrics see its canonical pose");
-    std::string az_row = "| " + brdf->name() + " |", sep_row = az_row;
+      warn("study", label + " is anisotropic: the isotropic metrics see its canonical pose");
+    std::string az_row = "| " + label + " |", sep_row = az_row;
     for (Space s : params) {
       const study::IsoSamples x = study::sample_isotropic(*brdf, s, grid, es);
       const double e = study::azimuthal_error(x);
       const auto r2 = study::separability_2d(x, kRanks);
       const auto r3 = study::separability_unfolded(x, kRanks);
-      azimuthal += fmt::format("{},{},{:.6g}\n", csv_field(brdf->name()), name_of(s), e);
+      azimuthal += fmt::format("{},{},{:.6g}\n", csv_field(label), name_of(s), e);
       for (std::size_t i = 0; i < kRanks.size(); ++i) {
-        separability += fmt::format("{},{},{},{:.6g}\n", csv_field(brdf->name()),
+        separability += fmt::format("{},{},{},{:.6g}\n", csv_field(label),
                                     std::string(name_of(s)) + "-2d", kRanks[i], r2[i]);
-        separability += fmt::format("{},{},{},{:.6g}\n", csv_field(brdf->name()),
+        separability += fmt::format("{},{},{},{:.6g}\n", csv_field(label),
                                     std::string(name_of(s)) + "-3d", kRanks[i], r3[i]);
       }
       az_row += fmt::format(" {:.4f} |", e);
