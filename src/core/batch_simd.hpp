@@ -20,7 +20,14 @@
 #pragma once
 
 #include <numbers>
+
+// xsimd 8's large-argument reduction (__kernel_rem_pio2) trips GCC 12's -Wmaybe-uninitialized when
+// it is inlined into our kernels (seen in the sanitizer build): a false positive in a
+// third-party header, silenced for it alone.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <xsimd/xsimd.hpp>
+#pragma GCC diagnostic pop
 
 #include "halfback/core/lane_math.hpp"
 
