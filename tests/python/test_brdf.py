@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import halfback
+from helpers import results_from_threads
 
 
 def unit_rows(n, seed=3, zmin=0.05):
@@ -147,22 +148,10 @@ def test_render_furnace_and_errors():
 
 
 def test_brdf_eval_from_several_threads():
-    import threading
-
     b = halfback.load("embedded:ilm_l3_37_metallic")
     pairs = np.hstack([unit_rows(5000, 11), unit_rows(5000, 12)])
     ref = b.eval(pairs)
-    results = [None] * 4
-
-    def work(i):
-        results[i] = b.eval(pairs)
-
-    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    for r in results:
+    for r in results_from_threads(lambda: b.eval(pairs)):
         np.testing.assert_array_equal(r, ref)
 
 

@@ -2,12 +2,12 @@
 
 import os
 import subprocess
-import threading
 
 import numpy as np
 import pytest
 
 import halfback
+from helpers import results_from_threads
 
 PARAMS = ["spherical", "halfdiff", "ortho", "hybrid"]
 
@@ -134,17 +134,7 @@ def test_bad_input_raises_clear_errors(call, exc, text):
 def test_thread_safety():
     x = random_dirs(200000, seed=7)
     ref = halfback.convert(x, "dirs", "halfdiff")
-    results = [None] * 4
-
-    def work(i):
-        results[i] = halfback.convert(x, "dirs", "halfdiff")
-
-    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    for r in results:
+    for r in results_from_threads(lambda: halfback.convert(x, "dirs", "halfdiff")):
         np.testing.assert_array_equal(r, ref)
 
 
