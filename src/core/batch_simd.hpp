@@ -24,10 +24,15 @@
 // xsimd 8's large-argument reduction (__kernel_rem_pio2) trips GCC 12's -Wmaybe-uninitialized when
 // it is inlined into our kernels (seen in the sanitizer build): a false positive in a
 // third-party header, silenced for it alone.
+// (GCC only: clang has no such warning and would warn about the unknown option.)
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <xsimd/xsimd.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 #include "halfback/core/lane_math.hpp"
 
