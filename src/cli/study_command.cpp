@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <future>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -98,11 +100,24 @@ int run_study(const StudyOptions& o) {
     if (!brdf->isotropic())
       warn("study", label + " is anisotropic: the isotropic metrics see its canonical pose");
     std::string az_row = "| " + label + " |", sep_row = az_row;
-    for (Space s : params) {
-      const study::IsoSamples x = study::sample_isotropic(*brdf, s, grid, es);
-      const double e = study::azimuthal_error(x);
-      const auto r2 = study::separability_2d(x, kRanks);
-      const auto r3 = study::separability_unfolded(x, kRanks);
+    // The parameterizations are independent: one task each (the low-rank fits are serial).
+    struct Result {
+      double azimuthal;
+      std::vector<double> r2, r3;
+    };
+    std::vector<std::future<Result>> tasks;
+    for (Space s : params)
+      tasks.push_back(std::async(std::launch::async, [&, s] {
+        const study::IsoSamples x = study::sample_isotropic(*brdf, s, grid, es);
+        return Result{study::azimuthal_error(x), study::separability_2d(x, kRanks),
+                      study::separability_unfolded(x, kRanks)};
+      }));
+    for (std::size_t pi = 0; pi < std::size(params); ++pi) {
+      const Space s = params[pi];
+      const Result res = tasks[pi].get();
+      const double e = res.azimuthal;
+      const auto& r2 = res.r2;
+      const auto& r3 = res.r3;
       azimuthal += fmt::format("{},{},{:.6g}\n", csv_field(label), name_of(s), e);
       for (std::size_t i = 0; i < kRanks.size(); ++i) {
         separability += fmt::format("{},{},{},{:.6g}\n", csv_field(label),
