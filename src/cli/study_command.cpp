@@ -12,6 +12,8 @@
 
 #include "command.hpp"
 #include "halfback/brdf/load.hpp"
+#include "halfback/figure/chart.hpp"
+#include "halfback/figure/render.hpp"
 #include "halfback/study/metrics.hpp"
 
 namespace halfback::cli {
@@ -89,6 +91,16 @@ int run_study(const StudyOptions& o) {
       "\n## Separability of the 2D projection (relative error of the best rank-r "
       "approximation, r = 1, 2, 4, 8)\n\n| BRDF | halfdiff | ortho | hybrid | spherical |\n"
       "|---|---|---|---|---|\n";
+  figure::BarChart az_chart, sep_chart;
+  for (Space s : params) {
+    az_chart.series.emplace_back(name_of(s));
+    sep_chart.series.emplace_back(name_of(s));
+  }
+  az_chart.title = fmt::format("Azimuthal dependence ({} error space)", study::name_of(es));
+  az_chart.x_label = "relative error of dropping the relative azimuth";
+  sep_chart.title =
+      fmt::format("Separability of the 2D projection, rank 1 ({} error space)", study::name_of(es));
+  sep_chart.x_label = "relative error of the best rank-1 approximation";
   const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < brdfs.size(); ++k) {
     const auto& [spec, brdf] = brdfs[k];
@@ -100,6 +112,10 @@ int run_study(const StudyOptions& o) {
     if (!brdf->isotropic())
       warn("study", label + " is anisotropic: the isotropic metrics see its canonical pose");
     std::string az_row = "| " + label + " |", sep_row = az_row;
+    az_chart.rows.push_back(label);
+    sep_chart.rows.push_back(label);
+    az_chart.values.emplace_back();
+    sep_chart.values.emplace_back();
     // The parameterizations are independent: one task each (the low-rank fits are serial).
     struct Result {
       double azimuthal;
@@ -125,6 +141,8 @@ int run_study(const StudyOptions& o) {
         separability += fmt::format("{},{},{},{:.6g}\n", csv_field(label),
                                     std::string(name_of(s)) + "-3d", kRanks[i], r3[i]);
       }
+      az_chart.values.back().push_back(e);
+      sep_chart.values.back().push_back(r2[0]);
       az_row += fmt::format(" {:.4f} |", e);
       sep_row += fmt::format(" {:.3f} / {:.3f} / {:.3f} / {:.3f} |", r2[0], r2[1], r2[2], r2[3]);
     }
@@ -139,9 +157,17 @@ int run_study(const StudyOptions& o) {
   const std::filesystem::path dir(o.out);
   write_file_atomically(dir / "azimuthal.csv", azimuthal);
   write_file_atomically(dir / "separability.csv", separability);
+  report +=
+      "\n![Azimuthal dependence](azimuthal.png)\n\n![Separability, rank 1](separability.png)\n";
+  for (const char* ext : {".png", ".svg"}) {
+    figure::save(figure::bar_chart(az_chart), dir / (std::string("azimuthal") + ext));
+    figure::save(figure::bar_chart(sep_chart), dir / (std::string("separability") + ext));
+  }
   write_file_atomically(dir / "report.md", report);
-  fmt::print("{}\nwritten: {}, {}, {}\n", report, (dir / "report.md").string(),
-             (dir / "azimuthal.csv").string(), (dir / "separability.csv").string());
+  fmt::print(
+      "{}\nwritten in {}: report.md, azimuthal.csv, separability.csv, "
+      "azimuthal.{{png,svg}}, separability.{{png,svg}}\n",
+      report, dir.string());
   return kExitOk;
 }
 

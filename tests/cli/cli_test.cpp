@@ -899,6 +899,8 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
   EXPECT_EQ(sep.substr(0, sep.find('\n')), "brdf,parameterization,rank,error");
   EXPECT_NE(sep.find("test:S,hybrid-2d,8,"), std::string::npos);
   EXPECT_NE(slurp(path("st") / "report.md").find("## Azimuthal dependence"), std::string::npos);
+  for (const char* f : {"azimuthal.png", "azimuthal.svg", "separability.png", "separability.svg"})
+    EXPECT_GT(fs::file_size(path("st") / f), 1000u) << f;
 }
 
 TEST_F(CliTest, StudyBadInput) {
