@@ -58,6 +58,26 @@ double GridAxis::position(std::size_t i, GridSampling sampling) const {
   return i + 1 == count ? hi : lo + double(i) * (hi - lo) / double(count - 1);
 }
 
+std::array<double, 4> GridSpec::point(std::size_t flat) const {
+  std::array<double, 4> x{};
+  for (std::size_t a = axes.size(); a-- > 0;) {
+    x[a] = axes[a].position(flat % axes[a].count, sampling);
+    flat /= axes[a].count;
+  }
+  if (kind == GridKind::slice) x[axes.size()] = slice_azimuth;
+  return x;
+}
+
+GridAxis& GridSpec::axis(std::string_view name) {
+  std::string names;
+  for (GridAxis& a : axes) {
+    if (a.name == name) return a;
+    names += (names.empty() ? "" : ", ") + a.name;
+  }
+  throw std::invalid_argument(
+      fmt::format("this grid has no axis '{}' (its axes: {})", name, names));
+}
+
 std::size_t GridSpec::points() const {
   std::size_t n = 1;
   for (const GridAxis& a : axes) n *= a.count;
@@ -120,76 +140,66 @@ std::size_t ResampledTable::valid_count() const {
   return std::size_t(std::count(valid.begin(), valid.end(), std::uint8_t{1}));
 }
 
+void grid_pairs(const GridSpec& grid, std::size_t begin, std::span<DirPair<double>> pairs,
+                std::span<std::uint8_t> valid, std::span<double> jacobian) {
+  const std::size_t m = pairs.size();
+  if (valid.size() != m || (!jacobian.empty() && jacobian.size() != m) || begin + m > grid.points())
+    throw std::invalid_argument("grid_pairs: output sizes do not match the points asked for");
+  const Form form = grid.form();
+  const std::size_t dim = dimension(form);
+  std::vector<std::vector<double>> coords(dim, std::vector<double>(m));
+  for (std::size_t j = 0; j < m; ++j) {
+    const std::array<double, 4> x = grid.point(begin + j);
+    for (std::size_t c = 0; c < dim; ++c) coords[c][j] = x[c];
+  }
+  std::vector<ConstColumn<double>> in(dim);
+  for (std::size_t c = 0; c < dim; ++c) in[c] = {coords[c].data(), 1};
+  // The engine writes straight into the pairs: a DirPair<double> is 6 contiguous doubles.
+  static_assert(sizeof(DirPair<double>) == 6 * sizeof(double));
+  double* base = &pairs.data()->wi.x;
+  std::vector<Column<double>> out(6);
+  for (std::size_t c = 0; c < 6; ++c) out[c] = {base + c, 6};
+  ConvertOutput<double> conv;
+  conv.columns = out;
+  conv.valid = valid.data();
+  if (!jacobian.empty()) conv.jacobian = {jacobian.data(), 1};
+  convert<double>(form, Form{Space::dirs, false}, in, m, conv, BatchOptions{1});
+}
+
 ResampledTable resample(const Brdf& brdf, const GridSpec& grid, const ResampleOptions& options) {
   validate(grid);
   ResampledTable t;
   t.grid = grid;
   t.brdf_name = brdf.name();
   t.brdf_description = brdf.description();
-  const std::size_t n = grid.points(), k = grid.axes.size();
+  const std::size_t n = grid.points();
   t.rgb.assign(3 * n, kNaN);
   t.valid.assign(n, 0);
-
-  // Sample positions per axis, computed once.
-  std::vector<std::vector<double>> pos(k);
-  for (std::size_t a = 0; a < k; ++a) {
-    pos[a].resize(grid.axes[a].count);
-    for (std::size_t i = 0; i < grid.axes[a].count; ++i)
-      pos[a][i] = grid.axes[a].position(i, grid.sampling);
-  }
-  const Form form = grid.form();
-  const std::size_t dim = dimension(form);
 
   // Blocks of points: coordinates -> pairs (the core's checked batch inverse) -> ρ.
   constexpr std::size_t kBlock = 4096;
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
-  const unsigned threads = options.threads;
-  detail::parallel_for(blocks, threads == 1 ? blocks + 1 : 1, [&](std::size_t b0, std::size_t b1) {
-    std::vector<std::vector<double>> coords(dim, std::vector<double>(kBlock));
-    std::vector<std::vector<double>> dirs(6, std::vector<double>(kBlock));
+  const auto run_blocks = [&](std::size_t b0, std::size_t b1) {
+    std::vector<DirPair<double>> pairs(kBlock);
     std::vector<std::uint8_t> ok(kBlock);
-    std::vector<DirPair<double>> pairs;
-    std::vector<Rgb> rho;
-    std::vector<std::size_t> index;
     for (std::size_t b = b0; b < b1; ++b) {
       const std::size_t begin = b * kBlock, m = std::min(kBlock, n - begin);
-      for (std::size_t j = 0; j < m; ++j) {
-        std::size_t flat = begin + j;
-        std::array<double, 4> x{};
-        for (std::size_t a = k; a-- > 0;) {
-          x[a] = pos[a][flat % grid.axes[a].count];
-          flat /= grid.axes[a].count;
-        }
-        for (std::size_t c = 0; c < k; ++c) coords[c][j] = x[c];
-        if (grid.kind == GridKind::slice) coords[2][j] = grid.slice_azimuth;
-      }
-      std::vector<ConstColumn<double>> in(dim);
-      for (std::size_t c = 0; c < dim; ++c) in[c] = {coords[c].data(), 1};
-      std::vector<Column<double>> out(6);
-      for (std::size_t c = 0; c < 6; ++c) out[c] = {dirs[c].data(), 1};
-      ConvertOutput<double> conv;
-      conv.columns = out;
-      conv.valid = ok.data();
-      convert<double>(form, Form{Space::dirs, false}, in, m, conv, BatchOptions{1});
-      pairs.clear();
-      index.clear();
+      grid_pairs(grid, begin, std::span(pairs).first(m), std::span(ok).first(m));
       for (std::size_t j = 0; j < m; ++j) {
         if (!ok[j]) continue;
-        pairs.push_back(
-            {{dirs[0][j], dirs[1][j], dirs[2][j]}, {dirs[3][j], dirs[4][j], dirs[5][j]}});
-        index.push_back(begin + j);
-      }
-      rho.resize(pairs.size());
-      for (std::size_t j = 0; j < pairs.size(); ++j) rho[j] = brdf.eval(pairs[j]);
-      for (std::size_t j = 0; j < pairs.size(); ++j) {
-        const std::size_t p = index[j];
+        const Rgb rho = brdf.eval(pairs[j]);
+        const std::size_t p = begin + j;
         t.valid[p] = 1;
-        t.rgb[3 * p] = rho[j].r;
-        t.rgb[3 * p + 1] = rho[j].g;
-        t.rgb[3 * p + 2] = rho[j].b;
+        t.rgb[3 * p] = rho.r;
+        t.rgb[3 * p + 1] = rho.g;
+        t.rgb[3 * p + 2] = rho.b;
       }
     }
-  });
+  };
+  if (options.threads == 1)
+    run_blocks(0, blocks);
+  else
+    detail::parallel_for(blocks, 1, run_blocks);
   return t;
 }
 

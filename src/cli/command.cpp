@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <charconv>
+#include <cmath>
 #include <system_error>
 
 #include "halfback/core/space.hpp"
@@ -49,6 +52,59 @@ void Output::commit() {
   }
   if (std::fflush(stdout) != 0)
     throw std::system_error(errno, std::generic_category(), "cannot write to standard output");
+}
+
+void check_writable(const std::string& path) {
+  AtomicFile probe(path);
+  probe.discard();
+}
+
+std::vector<std::string> split_list(const std::string& list, const char* option, const char* what) {
+  const auto trimmed = [](std::string_view t) {
+    const auto b = t.find_first_not_of(' ');
+    if (b == std::string_view::npos) return std::string();
+    return std::string(t.substr(b, t.find_last_not_of(' ') - b + 1));
+  };
+  if (trimmed(list).empty()) throw UsageError(fmt::format("{}: no {} given", option, what));
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    std::string item = trimmed(std::string_view(list).substr(start, comma - start));
+    if (item.empty())
+      throw UsageError(fmt::format("{} '{}': empty item in the list", option, list));
+    items.push_back(std::move(item));
+    start = comma + 1;
+  }
+  return items;
+}
+
+double parse_number(std::string_view text, const std::string& what) {
+  double v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
+    throw UsageError(fmt::format("{}: '{}' is not a number", what, text));
+  return v;
+}
+
+std::vector<double> number_list(const std::string& list, const char* option, const char* what) {
+  std::vector<double> values;
+  for (const std::string& item : split_list(list, option, what))
+    values.push_back(parse_number(item, option));
+  return values;
+}
+
+std::vector<std::size_t> count_list(const std::string& list, const char* option, const char* what) {
+  std::vector<std::size_t> counts;
+  for (const std::string& item : split_list(list, option, what)) {
+    std::size_t v = 0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (ec != std::errc() || end != item.data() + item.size() || v == 0)
+      throw UsageError(
+          fmt::format("{} '{}': '{}' is not a positive whole number", option, list, item));
+    counts.push_back(v);
+  }
+  return counts;
 }
 
 CLI::Validator space_name_validator() {

@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "halfback/io/atomic_file.hpp"
 #include "halfback/io/csv.hpp"
@@ -84,6 +85,20 @@ class Output {
  private:
   std::unique_ptr<AtomicFile> file_;
 };
+
+// Fails (std::system_error, "cannot write 'PATH': ...") unless `path` can be written, creating
+// and removing a temporary file beside it: commands call it before any long work.
+void check_writable(const std::string& path);
+
+// Option values given as one comma-separated string, so that an empty list or a bad item gets a
+// message naming the option (UsageError):
+//   "a, b,c" -> {"a", "b", "c"} (items trimmed of spaces; an empty list or item is an error);
+//   numbers (finite, any std::from_chars form); positive whole numbers.
+std::vector<std::string> split_list(const std::string& list, const char* option, const char* what);
+std::vector<double> number_list(const std::string& list, const char* option, const char* what);
+std::vector<std::size_t> count_list(const std::string& list, const char* option, const char* what);
+// One finite number; the message names `what` (e.g. "--range k=0:x").
+double parse_number(std::string_view text, const std::string& what);
 
 // A CLI11 validator for parameterization names ("dirs", "hybrid", ...), with a message listing
 // the names.

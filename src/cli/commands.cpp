@@ -8,8 +8,9 @@ namespace halfback::cli {
 
 namespace {
 constexpr std::array<RegisterCommand, 9> kCommands{
-    &register_convert,     &register_info,   &register_eval,   &register_resample,
-    &register_export_merl, &register_models, &register_render, &register_figure, &register_study,
+    &register_convert,  &register_info,        &register_eval,
+    &register_resample, &register_export_merl, &register_models,
+    &register_render,   &register_figure,      &register_study,
 };
 }  // namespace
 

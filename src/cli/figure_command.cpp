@@ -85,39 +85,6 @@ struct MaterialArgs {
   std::string out = "material.png";
 };
 
-// "a,b,c" -> {"a", "b", "c"}, items trimmed of spaces; an empty list or item is a usage error.
-std::vector<std::string> split_list(const std::string& list, const char* option, const char* what) {
-  std::vector<std::string> items;
-  std::size_t start = 0;
-  const auto trimmed = [](std::string t) {
-    const auto b = t.find_first_not_of(' ');
-    if (b == std::string::npos) return std::string();
-    return t.substr(b, t.find_last_not_of(' ') - b + 1);
-  };
-  if (trimmed(list).empty()) throw UsageError(fmt::format("{}: no {} given", option, what));
-  while (start <= list.size()) {
-    const std::size_t comma = std::min(list.find(',', start), list.size());
-    std::string item = trimmed(list.substr(start, comma - start));
-    if (item.empty())
-      throw UsageError(fmt::format("{} '{}': empty item in the list", option, list));
-    items.push_back(std::move(item));
-    start = comma + 1;
-  }
-  return items;
-}
-
-std::vector<double> number_list(const std::string& list, const char* option, const char* what) {
-  std::vector<double> values;
-  for (const std::string& item : split_list(list, option, what)) {
-    double v = 0;
-    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
-    if (ec != std::errc() || end != item.data() + item.size() || !std::isfinite(v))
-      throw UsageError(fmt::format("{}: '{}' is not a number", option, item));
-    values.push_back(v);
-  }
-  return values;
-}
-
 std::vector<Space> parameterizations(const std::string& list) {
   std::vector<Space> spaces;
   for (const std::string& n : split_list(list, "--param", "parameterization")) {
@@ -178,8 +145,7 @@ int run_hemisphere(const HemisphereArgs& a) {
   o.markers = !a.no_markers;
   o.isolines = !a.no_isolines;
   o.threads = a.threads;
-  AtomicFile probe(a.out);  // an unwritable destination fails before any work
-  probe.discard();
+  check_writable(a.out);
   const auto t0 = std::chrono::steady_clock::now();
   const auto fig = figure::hemisphere_figure(o);
   finish(fig.scene, a.out, a.scale, since(t0));
@@ -221,8 +187,7 @@ int run_slices(const SliceArgs& a) {
       o.levels = number_list(a.levels, "--levels", "level");
     }
   }
-  AtomicFile probe(a.out);  // an unwritable destination fails before loading and drawing
-  probe.discard();
+  check_writable(a.out);
   if (!isolines) o.brdf = load_brdf(a.brdf);
   const auto t0 = std::chrono::steady_clock::now();
   const auto fig = figure::slice_figure(o);
@@ -260,8 +225,7 @@ int run_material(const MaterialArgs& a) {
   o.render_pixels = a.render_pixels;
   o.spp = a.spp;
   o.heading = a.heading;
-  AtomicFile probe(a.out);  // an unwritable destination fails before loading and drawing
-  probe.discard();
+  check_writable(a.out);
   o.brdf = load_brdf(a.brdf);
   const auto t0 = std::chrono::steady_clock::now();
   const auto fig = figure::material_figure(o);

@@ -10,7 +10,6 @@
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/brdf/load.hpp"
 #include "halfback/brdf/resample.hpp"
-#include "halfback/core/batch.hpp"
 
 namespace halfback::cli {
 
@@ -45,30 +44,25 @@ int run_info(const InfoOptions& o) {
   const ResampledTable t = resample(*brdf, grid);
   double best = -1;
   std::size_t where = 0;
-  const std::size_t n1 = grid.axes[1].count, n2 = grid.axes[2].count;
-  const double max_theta = 89 * std::numbers::pi / 180;
+  std::vector<DirPair<double>> pairs(grid.points());
+  std::vector<std::uint8_t> ok(grid.points());
+  grid_pairs(grid, 0, pairs, ok);
+  const double min_z = std::cos(89 * std::numbers::pi / 180);
   for (std::size_t p = 0; p < grid.points(); ++p) {
-    if (!t.valid[p]) continue;
     // Grazing pairs (θ > 89°) are left out: there ρ of many models grows without bound while
     // ρ·cos θ stays finite, and no measurement reaches them.
-    const std::array<double, 3> q{grid.axes[0].position(p / (n1 * n2), grid.sampling),
-                                  grid.axes[1].position(p / n2 % n1, grid.sampling),
-                                  grid.axes[2].position(p % n2, grid.sampling)};
-    std::array<double, 4> sph{};
-    if (!convert_one<double>(grid.form(), {Space::spherical, false}, q, sph)) continue;
-    if (sph[0] > max_theta || sph[2] > max_theta) continue;
+    if (!t.valid[p] || pairs[p].wi.z < min_z || pairs[p].wo.z < min_z) continue;
     const double lum = std::max({t.rgb[3 * p], t.rgb[3 * p + 1], t.rgb[3 * p + 2]});
     if (lum > best) best = lum, where = p;
   }
   if (best >= 0) {
     const double deg = 180 / std::numbers::pi;
+    const std::array<double, 4> q = grid.point(where);
     lines.push_back(
         {"max ρ (θ ≤ 89°)",
          fmt::format("{} sr⁻¹ at θh = {:.3g}°, θd = {:.3g}°, φd = {:.3g}° ({} grid points)",
                      rgb_text({t.rgb[3 * where], t.rgb[3 * where + 1], t.rgb[3 * where + 2]}),
-                     grid.axes[0].position(where / (n1 * n2), grid.sampling) * deg,
-                     grid.axes[1].position(where / n2 % n1, grid.sampling) * deg,
-                     grid.axes[2].position(where % n2, grid.sampling) * deg, t.valid_count())});
+                     q[0] * deg, q[1] * deg, q[2] * deg, t.valid_count())});
   }
 
   for (const double theta_deg : {0.0, 30.0, 60.0, 80.0}) {

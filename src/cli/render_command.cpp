@@ -69,7 +69,9 @@ int run_render(const RenderOptions& o) {
     warn("render", "the time budget ran out after " + std::to_string(r.spp) + " of " +
                        std::to_string(o.spp) + " samples per pixel");
   if (r.nonfinite)
-    warn("render", std::to_string(r.nonfinite) + " samples were NaN or infinite and were counted as 0 (those pixels are biased dark)");
+    warn("render",
+         std::to_string(r.nonfinite) +
+             " samples were NaN or infinite and were counted as 0 (those pixels are biased dark)");
   if (!o.quiet && isatty(fileno(stderr)))
     std::fprintf(stderr, "%s: %d x %d, %d spp, %.2f s (+%.2f s sampler setup), %s\n",
                  o.output.c_str(), o.width, o.height, r.spp, r.seconds, r.sampler_seconds,

@@ -26,31 +26,6 @@ struct ResampleOptions {
   unsigned threads = 0;
 };
 
-double parse_number(std::string_view text, const std::string& what) {
-  double v = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
-    throw UsageError(fmt::format("{}: '{}' is not a number", what, text));
-  return v;
-}
-
-std::vector<std::size_t> parse_counts(const std::string& list) {
-  std::vector<std::size_t> counts;
-  std::size_t start = 0;
-  while (start <= list.size()) {
-    const std::size_t comma = std::min(list.find(',', start), list.size());
-    const std::string item = list.substr(start, comma - start);
-    std::size_t v = 0;
-    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
-    if (item.empty() || ec != std::errc() || end != item.data() + item.size() || v == 0)
-      throw UsageError(
-          fmt::format("--size '{}': '{}' is not a positive whole number of samples", list, item));
-    counts.push_back(v);
-    start = comma + 1;
-  }
-  return counts;
-}
-
 int run_resample(const ResampleOptions& o) {
   const auto space = space_from_name(o.param);
   if (!space || *space == Space::dirs)
@@ -64,7 +39,8 @@ int run_resample(const ResampleOptions& o) {
     throw UsageError("--azimuth fixes the relative azimuth of a slice: it needs --kind slice");
   GridSpec grid;
   try {
-    grid = default_grid(*space, kind, parse_counts(o.size), o.azimuth_deg * std::numbers::pi / 180);
+    grid = default_grid(*space, kind, count_list(o.size, "--size", "sample count"),
+                        o.azimuth_deg * std::numbers::pi / 180);
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("--size: {}", e.what()));
   }
@@ -73,16 +49,12 @@ int run_resample(const ResampleOptions& o) {
     const std::size_t eq = r.find('='), colon = r.find(':', eq == std::string::npos ? 0 : eq);
     if (eq == std::string::npos || colon == std::string::npos)
       throw UsageError(fmt::format("--range '{}': expected NAME=LO:HI, e.g. theta_h=0:0.5", r));
-    const std::string name = r.substr(0, eq);
     GridAxis* axis = nullptr;
-    std::string names;
-    for (GridAxis& a : grid.axes) {
-      if (a.name == name) axis = &a;
-      names += (names.empty() ? "" : ", ") + a.name;
+    try {
+      axis = &grid.axis(r.substr(0, eq));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(fmt::format("--range '{}': {}", r, e.what()));
     }
-    if (!axis)
-      throw UsageError(
-          fmt::format("--range '{}': this grid has no axis '{}' (its axes: {})", r, name, names));
     axis->lo = parse_number(std::string_view(r).substr(eq + 1, colon - eq - 1), "--range " + r);
     axis->hi = parse_number(std::string_view(r).substr(colon + 1), "--range " + r);
   }
@@ -91,15 +63,9 @@ int run_resample(const ResampleOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  {
-    std::string ext = std::filesystem::path(o.output).extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".exr" && ext != ".npz" && ext != ".npy")
-      throw UsageError(
-          fmt::format("-o '{}': the table is written as .exr, .npz or .npy", o.output));
-    AtomicFile probe(o.output);  // an unwritable destination fails before any work
-    probe.discard();
-  }
+  if (!table_format_from_path(o.output))
+    throw UsageError(fmt::format("-o '{}': the table is written as .exr, .npz or .npy", o.output));
+  check_writable(o.output);  // an unwritable destination fails before any work
   const BrdfPtr brdf = load_brdf(o.brdf);
   halfback::ResampleOptions ro;
   ro.threads = o.threads;

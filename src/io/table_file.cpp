@@ -155,53 +155,50 @@ struct ZipMember {
   std::string name, data;
 };
 
+// The fields a local file header and its central directory entry share, from "version needed"
+// to the name length: version 2.0, no flags, stored, DOS time and date 1980-01-01 00:00.
+void append_entry_fields(std::string& out, std::uint32_t crc, std::uint32_t size,
+                         std::size_t name_length) {
+  append_le<std::uint16_t>(out, 20);    // version needed to extract
+  append_le<std::uint16_t>(out, 0);     // flags
+  append_le<std::uint16_t>(out, 0);     // method: stored
+  append_le<std::uint16_t>(out, 0);     // time
+  append_le<std::uint16_t>(out, 0x21);  // date
+  append_le<std::uint32_t>(out, crc);
+  append_le<std::uint32_t>(out, size);  // compressed
+  append_le<std::uint32_t>(out, size);  // uncompressed
+  append_le<std::uint16_t>(out, std::uint16_t(name_length));
+}
+
 std::string zip_stored(const std::vector<ZipMember>& members, const std::filesystem::path& path) {
+  std::size_t total = 0;
+  for (const ZipMember& m : members) total += 76 + 2 * m.name.size() + m.data.size();
+  if (total >= 0xFFFFFFFFull)
+    throw std::runtime_error(fmt::format(
+        "cannot write '{}': the table is larger than the 4 GiB a plain zip (.npz) holds; use "
+        ".exr or .npy",
+        path.string()));
   std::string out, central;
+  out.reserve(total);
   for (const ZipMember& m : members) {
-    if (m.data.size() >= 0xFFFFFFFFull || out.size() >= 0xFFFFFFFFull)
-      throw std::runtime_error(fmt::format(
-          "cannot write '{}': the table is larger than the 4 GiB a plain zip (.npz) holds; use "
-          ".exr or .npy",
-          path.string()));
     const std::uint32_t crc = crc32(m.data), size = std::uint32_t(m.data.size());
     const std::uint32_t offset = std::uint32_t(out.size());
-    // Local file header: version 2.0, no flags, stored, DOS time/date of 1980-01-01 00:00.
-    append_le<std::uint32_t>(out, 0x04034b50u);
-    append_le<std::uint16_t>(out, 20);
-    append_le<std::uint16_t>(out, 0);
-    append_le<std::uint16_t>(out, 0);
-    append_le<std::uint16_t>(out, 0);
-    append_le<std::uint16_t>(out, 0x21);
-    append_le<std::uint32_t>(out, crc);
-    append_le<std::uint32_t>(out, size);
-    append_le<std::uint32_t>(out, size);
-    append_le<std::uint16_t>(out, std::uint16_t(m.name.size()));
-    append_le<std::uint16_t>(out, 0);
+    append_le<std::uint32_t>(out, 0x04034b50u);  // local file header
+    append_entry_fields(out, crc, size, m.name.size());
+    append_le<std::uint16_t>(out, 0);  // extra field length
     out += m.name;
     out += m.data;
-    // Its central directory entry.
-    append_le<std::uint32_t>(central, 0x02014b50u);
-    append_le<std::uint16_t>(central, 20);
-    append_le<std::uint16_t>(central, 20);
-    append_le<std::uint16_t>(central, 0);
-    append_le<std::uint16_t>(central, 0);
-    append_le<std::uint16_t>(central, 0);
-    append_le<std::uint16_t>(central, 0x21);
-    append_le<std::uint32_t>(central, crc);
-    append_le<std::uint32_t>(central, size);
-    append_le<std::uint32_t>(central, size);
-    append_le<std::uint16_t>(central, std::uint16_t(m.name.size()));
-    append_le<std::uint16_t>(central, 0);
-    append_le<std::uint16_t>(central, 0);
-    append_le<std::uint16_t>(central, 0);
-    append_le<std::uint16_t>(central, 0);
-    append_le<std::uint32_t>(central, 0);
+    append_le<std::uint32_t>(central, 0x02014b50u);  // central directory entry
+    append_le<std::uint16_t>(central, 20);           // version made by
+    append_entry_fields(central, crc, size, m.name.size());
+    for (int k = 0; k < 4; ++k) append_le<std::uint16_t>(central, 0);  // extra, comment, disk, attr
+    append_le<std::uint32_t>(central, 0);                              // external attributes
     append_le<std::uint32_t>(central, offset);
     central += m.name;
   }
   const std::uint32_t central_offset = std::uint32_t(out.size());
   out += central;
-  append_le<std::uint32_t>(out, 0x06054b50u);
+  append_le<std::uint32_t>(out, 0x06054b50u);  // end of central directory
   append_le<std::uint16_t>(out, 0);
   append_le<std::uint16_t>(out, 0);
   append_le<std::uint16_t>(out, std::uint16_t(members.size()));
@@ -315,25 +312,36 @@ std::string table_metadata_json(const ResampledTable& t) {
   return s;
 }
 
-void write_table(const std::filesystem::path& path, const ResampledTable& t) {
+std::optional<TableFormat> table_format_from_path(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (t.rgb.size() != 3 * t.grid.points() || t.valid.size() != t.grid.points())
-    throw std::invalid_argument("write_table: the table's arrays do not match its grid");
-  std::string bytes;
-  if (ext == ".exr") {
-    AtomicFile probe(path);  // an unwritable destination fails before encoding
-    probe.discard();
-    bytes = exr_of(t, path);
-  } else if (ext == ".npz") {
-    bytes = npz_of(t, path);
-  } else if (ext == ".npy") {
-    bytes = npy_float64(t.rgb, table_shape(t, true));
-  } else {
+  if (ext == ".exr") return TableFormat::exr;
+  if (ext == ".npz") return TableFormat::npz;
+  if (ext == ".npy") return TableFormat::npy;
+  return std::nullopt;
+}
+
+void write_table(const std::filesystem::path& path, const ResampledTable& t) {
+  const auto format = table_format_from_path(path);
+  if (!format)
     throw std::invalid_argument(fmt::format(
         "cannot tell the table format of '{}': use a .exr, .npz or .npy file name", path.string()));
+  if (t.rgb.size() != 3 * t.grid.points() || t.valid.size() != t.grid.points())
+    throw std::invalid_argument("write_table: the table's arrays do not match its grid");
+  // The file is opened first, so that an unwritable destination fails before any encoding.
+  AtomicFile out(path);
+  switch (*format) {
+    case TableFormat::exr:
+      out.write(exr_of(t, path));
+      break;
+    case TableFormat::npz:
+      out.write(npz_of(t, path));
+      break;
+    case TableFormat::npy:
+      out.write(npy_float64(t.rgb, table_shape(t, true)));
+      break;
   }
-  write_file_atomically(path, bytes);
+  out.commit();
 }
 
 }  // namespace halfback

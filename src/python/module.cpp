@@ -234,11 +234,12 @@ py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::str
       default_grid(space, parse_kind(kind), counts, azimuth_deg * 3.14159265358979323846 / 180);
   g.sampling = nodes ? GridSampling::nodes : GridSampling::centres;
   for (const auto& [key, value] : ranges) {
-    const std::string name = key.cast<std::string>();
     GridAxis* axis = nullptr;
-    for (GridAxis& a : g.axes)
-      if (a.name == name) axis = &a;
-    if (!axis) throw py::value_error("ranges: this grid has no axis '" + name + "'");
+    try {
+      axis = &g.axis(key.cast<std::string>());
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(std::string("ranges: ") + e.what());
+    }
     const auto lohi = value.cast<std::pair<double, double>>();
     axis->lo = lohi.first;
     axis->hi = lohi.second;

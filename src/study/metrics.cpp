@@ -7,7 +7,6 @@
 #include <stdexcept>
 
 #include "halfback/brdf/resample.hpp"
-#include "halfback/core/batch.hpp"
 
 namespace halfback::study {
 
@@ -104,30 +103,15 @@ IsoSamples sample_isotropic(const Brdf& brdf, Space space, const IsoGrid& grid, 
     throw std::invalid_argument("study grid: every axis needs at least one cell");
   const GridSpec g = default_grid(space, GridKind::isotropic, {grid.a, grid.b, grid.phi});
   const std::size_t n = g.points();
-  std::vector<std::vector<double>> coords(3, std::vector<double>(n));
-  for (std::size_t p = 0; p < n; ++p) {
-    coords[0][p] = g.axes[0].position(p / (grid.b * grid.phi), g.sampling);
-    coords[1][p] = g.axes[1].position(p / grid.phi % grid.b, g.sampling);
-    coords[2][p] = g.axes[2].position(p % grid.phi, g.sampling);
-  }
-  std::vector<std::vector<double>> dirs(6, std::vector<double>(n));
-  std::vector<double> jac(n);
+  std::vector<DirPair<double>> all(n);
   std::vector<std::uint8_t> ok(n);
-  std::vector<ConstColumn<double>> in;
-  for (const auto& c : coords) in.push_back({c.data(), 1});
-  std::vector<Column<double>> out;
-  for (auto& c : dirs) out.push_back({c.data(), 1});
-  ConvertOutput<double> conv;
-  conv.columns = out;
-  conv.jacobian = {jac.data(), 1};
-  conv.valid = ok.data();
-  convert<double>(g.form(), {Space::dirs, false}, in, n, conv);
-
+  std::vector<double> jac(n);
+  grid_pairs(g, 0, all, ok, jac);
   std::vector<DirPair<double>> pairs;
   std::vector<std::size_t> where;
   for (std::size_t p = 0; p < n; ++p)
     if (ok[p] && std::isfinite(jac[p])) {
-      pairs.push_back({{dirs[0][p], dirs[1][p], dirs[2][p]}, {dirs[3][p], dirs[4][p], dirs[5][p]}});
+      pairs.push_back(all[p]);
       where.push_back(p);
     }
   std::vector<Rgb> rho(pairs.size());

@@ -12,10 +12,14 @@
 // NaN and its mask 0. The table is row-major, the last axis fastest.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
@@ -47,6 +51,11 @@ struct GridSpec {
   std::size_t points() const;
   // The form whose coordinates a grid point is evaluated at (the slice's is the isotropic one).
   Form form() const { return {space, kind != GridKind::full}; }
+  // The coordinates in form() of point `flat` (row-major, last axis fastest): the axes'
+  // positions, then, for a slice, its azimuth; dimension(form()) values are meaningful.
+  std::array<double, 4> point(std::size_t flat) const;
+  // The axis called `name`; throws std::invalid_argument naming the grid's axes otherwise.
+  GridAxis& axis(std::string_view name);
 };
 
 // The grid of a kind over `space`, each axis on the range that bounds the domain (angles θ in
@@ -59,6 +68,13 @@ GridSpec default_grid(Space space, GridKind kind, std::vector<std::size_t> count
 // Checks a grid (the right axes for its kind, finite ranges with lo < hi, counts >= 1, nodes
 // need counts >= 2 only when lo != hi, at most 2^31 points); throws std::invalid_argument.
 void validate(const GridSpec& grid);
+
+// The direction pairs of points [begin, begin + pairs.size()) of a grid, by the core's checked
+// batch inverse of its form: valid[j] is 1 where point begin + j is a pair of directions of the
+// upper hemisphere, 0 elsewhere (pairs[j] is NaN there). With `jacobian` (pairs.size() values),
+// also the measure of the form at each point (batch.hpp). On the calling thread.
+void grid_pairs(const GridSpec& grid, std::size_t begin, std::span<DirPair<double>> pairs,
+                std::span<std::uint8_t> valid, std::span<double> jacobian = {});
 
 struct ResampledTable {
   GridSpec grid;
@@ -89,6 +105,10 @@ ResampledTable resample(const Brdf& brdf, const GridSpec& grid,
 // The file is written to a temporary file and renamed into place. Throws std::invalid_argument
 // for another extension and std::runtime_error (naming the file) on I/O errors.
 void write_table(const std::filesystem::path& path, const ResampledTable& table);
+
+enum class TableFormat { exr, npz, npy };
+// The format write_table() picks for a path (case-insensitive extension), nullopt for another.
+std::optional<TableFormat> table_format_from_path(const std::filesystem::path& path);
 
 // The metadata of a table as a JSON object (what .npz and .exr carry).
 std::string table_metadata_json(const ResampledTable& table);
