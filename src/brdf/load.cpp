@@ -1,5 +1,6 @@
 #include "halfback/brdf/load.hpp"
 
+#include <algorithm>
 #include <array>
 #include <fstream>
 #include <mutex>
@@ -66,6 +67,20 @@ BrdfFileFormat detect_brdf_format(const std::filesystem::path& path) {
     return BrdfFileFormat::rgl;
   if (looks_like_alta(head)) return BrdfFileFormat::alta;
   return BrdfFileFormat::unknown;
+}
+
+std::vector<std::filesystem::path> brdf_files_in(const std::filesystem::path& dir,
+                                                 std::optional<BrdfFileFormat> only) {
+  std::error_code ec;
+  std::vector<std::filesystem::path> files;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    if (!it->is_regular_file(ec)) continue;
+    const BrdfFileFormat f = detect_brdf_format(it->path());
+    if (f != BrdfFileFormat::unknown && (!only || f == *only)) files.push_back(it->path());
+  }
+  if (ec) throw FormatError(dir.string(), "directory", "cannot read: " + ec.message());
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 namespace {

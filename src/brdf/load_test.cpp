@@ -249,6 +249,16 @@ TEST(LoadBrdf, DetectsFormatsByContent) {
   EXPECT_NEAR(m->eval({{0, 0, 1}, {0, 0, 1}}).r, 1.0, 1e-15);
   EXPECT_EQ(load_brdf((tmp / "rgl.binary").string())->name(), "rgl:rgl");
   EXPECT_EQ(load_brdf((tmp / "alta.txt").string())->name(), "alta:alta");
+
+  // The BRDF files of a directory, by content, sorted; other files and directories left out.
+  write_text(tmp / "notes.txt", "not a BRDF\n");
+  std::filesystem::create_directories(tmp / "sub");
+  EXPECT_EQ(
+      brdf_files_in(tmp.path()),
+      (std::vector<std::filesystem::path>{tmp / "alta.txt", tmp / "merl.dat", tmp / "rgl.binary"}));
+  EXPECT_EQ(brdf_files_in(tmp.path(), BrdfFileFormat::rgl),
+            std::vector<std::filesystem::path>{tmp / "rgl.binary"});
+  EXPECT_THROW(brdf_files_in(tmp / "missing"), FormatError);
 }
 
 TEST(LoadBrdf, ErrorsForFiles) {

@@ -195,12 +195,12 @@ int run_slices(const SliceArgs& a) {
   return kExitOk;
 }
 
-// Each environment spec is checked (built-in, constant or readable file) before any work.
-std::vector<std::string> environment_list(const std::string& list) {
-  std::vector<std::string> envs = split_list(list, "--env", "environment");
-  for (const std::string& e : envs) {
+// The environments, each loaded (or built) once; a bad one is a usage error naming it.
+std::vector<figure::NamedEnvironment> environment_list(const std::string& list) {
+  std::vector<figure::NamedEnvironment> envs;
+  for (const std::string& e : split_list(list, "--env", "environment")) {
     try {
-      (void)render::EnvMap::from_spec(e);
+      envs.push_back(figure::load_environment(e));
     } catch (const std::exception& ex) {
       throw UsageError(fmt::format("--env '{}': {}", e, ex.what()));
     }
@@ -255,16 +255,10 @@ int run_paper(const PaperArgs& a) {
   if (!a.merl_dir.empty()) {
     // The MERL files of the folder (by content, whatever their names), in name order: give it
     // the paper's three materials to get its Figures 3-5.
-    std::error_code ec;
-    std::vector<std::string> found;
-    for (const auto& e : std::filesystem::directory_iterator(a.merl_dir, ec))
-      if (e.is_regular_file() && detect_brdf_format(e.path()) == BrdfFileFormat::merl)
-        found.push_back(e.path().string());
-    if (ec) throw UsageError(fmt::format("--merl-dir '{}': {}", a.merl_dir, ec.message()));
+    const auto found = brdf_files_in(a.merl_dir, BrdfFileFormat::merl);
     if (found.empty())
       throw UsageError(fmt::format("--merl-dir '{}': no MERL .binary file in it", a.merl_dir));
-    std::sort(found.begin(), found.end());
-    specs.insert(specs.end(), found.begin(), found.end());
+    for (const auto& f : found) specs.push_back(f.string());
   }
   if (a.no_materials) {
     if (!specs.empty()) throw UsageError("--no-materials contradicts --material and --merl-dir");
@@ -276,8 +270,9 @@ int run_paper(const PaperArgs& a) {
       const BrdfPtr b = load_brdf(specs[k]);
       std::string stem = fmt::format("fig{}-", 3 + k);
       for (const char c : b->name()) stem += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
-      o.materials.push_back(
-          {stem, specs[k], fmt::format("Figure {} ({}): {}", 3 + k, b->name(), b->description())});
+      o.materials.push_back({stem, specs[k],
+                             fmt::format("Figure {} ({}): {}", 3 + k, b->name(), b->description()),
+                             b});
     }
   }
   const auto t0 = std::chrono::steady_clock::now();

@@ -35,13 +35,9 @@ std::vector<std::pair<std::string, BrdfPtr>> load_all(const std::vector<std::str
   for (const std::string& spec : specs) {
     std::error_code ec;
     if (std::filesystem::is_directory(spec, ec)) {
-      std::vector<std::filesystem::path> files;
-      for (const auto& e : std::filesystem::directory_iterator(spec, ec))
-        if (e.is_regular_file() && detect_brdf_format(e.path()) != BrdfFileFormat::unknown)
-          files.push_back(e.path());
+      const auto files = brdf_files_in(spec);
       if (files.empty())
         throw UsageError(fmt::format("'{}': no MERL, RGL or ALTA file in this directory", spec));
-      std::sort(files.begin(), files.end());
       for (const auto& f : files) brdfs.emplace_back(f.string(), load_brdf(f.string()));
     } else {
       brdfs.emplace_back(spec, load_brdf(spec));

@@ -11,17 +11,24 @@
 
 namespace halfback::figure {
 
-namespace {
-
-// The name to print under a rendering: a built-in's name, or a file's stem.
-std::string environment_label(const std::string& spec) {
-  if (spec == "default" || spec == "sky") return "sky (built-in)";
-  if (spec == "studio" || spec == "sunset") return spec + " (built-in)";
-  if (spec.rfind("constant:", 0) == 0) return spec;
-  return std::filesystem::path(spec).stem().string();
+NamedEnvironment load_environment(const std::string& spec) {
+  auto map = std::make_shared<const render::EnvMap>(render::EnvMap::from_spec(spec));
+  const auto builtins = render::EnvMap::builtin_names();
+  std::string label;
+  if (std::find(builtins.begin(), builtins.end(), spec) != builtins.end())
+    label = (spec == "default" ? std::string("sky") : spec) + " (built-in)";
+  else if (spec.rfind("constant:", 0) == 0)
+    label = spec;
+  else
+    label = std::filesystem::path(spec).stem().string();
+  return {label, std::move(map)};
 }
 
-}  // namespace
+const std::vector<NamedEnvironment>& default_environments() {
+  static const std::vector<NamedEnvironment> envs{
+      load_environment("default"), load_environment("studio"), load_environment("sunset")};
+  return envs;
+}
 
 MaterialFigure material_figure(const MaterialFigureOptions& o) {
   if (!o.brdf) throw std::invalid_argument("material figure: no BRDF given");
@@ -38,9 +45,9 @@ MaterialFigure material_figure(const MaterialFigureOptions& o) {
   rs.spp = o.spp;
   rs.seed = o.seed;
   rs.threads = int(so.threads);
-  for (const std::string& spec : o.environments) {
-    const render::EnvMap env = render::EnvMap::from_spec(spec);
-    fig.renders.push_back(render::render(*o.brdf, env, rs).image);
+  for (const NamedEnvironment& env : o.environments) {
+    if (!env.map) throw std::invalid_argument("material figure: an environment without a map");
+    fig.renders.push_back(render::render(*o.brdf, *env.map, rs).image);
   }
 
   // Layout: title, the row of renderings with their captions, then the slice figure.
@@ -84,7 +91,7 @@ MaterialFigure material_figure(const MaterialFigureOptions& o) {
     const double x = x0 + double(k) * (size + gap);
     draw_frame(sc, {x, top, size, size}, 0.6);
     sc.text({x0 + double(k) * (size + gap) + size / 2, top + size + 14},
-            escape_markup(environment_label(o.environments[k])), 9.5, HAlign::centre);
+            escape_markup(o.environments[k].label), 9.5, HAlign::centre);
   }
   append_scene(sc, slices, {0, snap(top + size + caption + 16)});
   return fig;

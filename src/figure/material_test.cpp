@@ -26,7 +26,7 @@ MaterialFigureOptions small(const std::string& spec) {
 // whose relative spread is below 1: a few 0.1 %), and the corners show the background, exactly 1.
 TEST(MaterialFigure, FurnaceRenderingIsTheAlbedo) {
   MaterialFigureOptions o = small("lambert:albedo=0.3");
-  o.environments = {"constant:1", "constant:0"};
+  o.environments = {load_environment("constant:1"), load_environment("constant:0")};
   const MaterialFigure f = material_figure(o);
   ASSERT_EQ(f.renders.size(), 2u);
   const render::Image& white = f.renders[0];
@@ -54,6 +54,13 @@ TEST(MaterialFigure, SceneHoldsTheRenderingsAndTheSlices) {
       heading |= plain_text(t->text) == "Figure 3, a_test";  // markup escaped: '_' kept
   }
   EXPECT_EQ(render_images, 3u);
+  // Each rendering is captioned with its environment.
+  for (const char* caption : {"sky (built-in)", "studio (built-in)", "sunset (built-in)"}) {
+    bool found = false;
+    for (const Item& item : f.scene.items)
+      if (const auto* t = std::get_if<TextItem>(&item)) found |= plain_text(t->text) == caption;
+    EXPECT_TRUE(found) << caption;
+  }
   EXPECT_GE(images, 3u + f.slices.panels.size());
   EXPECT_TRUE(heading);
   EXPECT_EQ(f.slices.panels.size(), 9u);
@@ -64,8 +71,9 @@ TEST(MaterialFigure, BadInput) {
   MaterialFigureOptions o = small("lambert");
   o.environments = {};
   EXPECT_THROW(material_figure(o), std::invalid_argument);
-  o.environments = {"no-such-map.hdr"};
-  EXPECT_ANY_THROW(material_figure(o));
+  EXPECT_ANY_THROW(load_environment("no-such-map.hdr"));
+  o.environments = {{"no map", nullptr}};
+  EXPECT_THROW(material_figure(o), std::invalid_argument);
   o = small("lambert");
   o.brdf = nullptr;
   EXPECT_THROW(material_figure(o), std::invalid_argument);

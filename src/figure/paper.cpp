@@ -75,11 +75,13 @@ std::vector<WrittenFigure> write_paper_figures(const std::filesystem::path& dir,
   s.threads = o.threads;
   written.push_back({"Figure 2, test functions S, G, F on slices",
                      save_all(slice_figure(s).scene, dir, "fig2-slices", o)});
+  const std::vector<NamedEnvironment>& envs =
+      o.environments.empty() ? default_environments() : o.environments;
   for (const PaperMaterial& m : o.materials) {
     MaterialFigureOptions mo;
-    mo.brdf = load_brdf(m.spec);
+    mo.brdf = m.brdf ? m.brdf : load_brdf(m.spec);
     mo.heading = m.description;
-    mo.environments = o.environments;
+    mo.environments = envs;
     mo.render_pixels = o.render_pixels;
     mo.spp = o.spp;
     mo.slices.threads = o.threads;

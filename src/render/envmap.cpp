@@ -422,63 +422,18 @@ double EnvMap::pdf(const Vec3<double>& dir, bool compensated) const {
 // --------------------------------------------------------------------------------------------
 // The built-in environment.
 
-EnvMap EnvMap::default_sky(EnvOptions options) {
-  constexpr int W = 1024, H = 512;
-  const double sun_elev = 40 * kPi / 180, sun_azim = 35 * kPi / 180;  // from +z towards −x
-  const Vec3<double> sun{-std::cos(sun_elev) * std::sin(sun_azim), std::sin(sun_elev),
-                         std::cos(sun_elev) * std::cos(sun_azim)};
-  const double sun_radius = 1.5 * kPi / 180, cos_sun = std::cos(sun_radius);
-  const Rgb sun_radiance{1000, 940, 840};
-  auto background = [&](const Vec3<double>& d) -> Rgb {
-    if (d.y >= 0) {
-      // Sky: a saturated blue at the zenith fading to a pale horizon, brighter towards the sun.
-      const double t = std::pow(1 - d.y, 4);
-      const double glow = std::pow(std::max(0.0, d.x * sun.x + d.y * sun.y + d.z * sun.z), 8);
-      return {0.09 + 0.31 * t + 0.25 * glow, 0.16 + 0.29 * t + 0.22 * glow,
-              0.38 + 0.17 * t + 0.17 * glow};
-    }
-    // Ground: warm grey, darker towards the nadir.
-    const double t = 0.55 + 0.45 * std::pow(1 + d.y, 2);
-    return {0.13 * t, 0.115 * t, 0.095 * t};
-  };
-  std::vector<float> rgb(std::size_t(W) * H * 3);
-  for (int r = 0; r < H; ++r)
-    for (int c = 0; c < W; ++c) {
-      const Vec3<double> d = map_direction((c + 0.5) / W, (r + 0.5) / H);
-      Rgb v = background(d);
-      // The sun disk, supersampled near its edge.
-      const double cs = d.x * sun.x + d.y * sun.y + d.z * sun.z;
-      if (cs > std::cos(sun_radius + 2 * kPi / H)) {
-        constexpr int n = 8;
-        int inside = 0;
-        for (int i = 0; i < n; ++i)
-          for (int j = 0; j < n; ++j) {
-            const Vec3<double> e = map_direction((c + (i + 0.5) / n) / W, (r + (j + 0.5) / n) / H);
-            inside += (e.x * sun.x + e.y * sun.y + e.z * sun.z) >= cos_sun;
-          }
-        const double f = double(inside) / (n * n);
-        v = {v.r + f * sun_radiance.r, v.g + f * sun_radiance.g, v.b + f * sun_radiance.b};
-      }
-      float* p = &rgb[3 * (std::size_t(r) * W + std::size_t(c))];
-      p[0] = float(v.r);
-      p[1] = float(v.g);
-      p[2] = float(v.b);
-    }
-  return EnvMap(W, H, std::move(rgb), "default", options);
-}
-
 namespace {
 
-// A procedural map: `radiance(d)` at the centre of every pixel, averaged over 4 × 4 sub-pixel
+// A procedural map: `radiance(d)` at the centre of every pixel, averaged over n × n sub-pixel
 // samples where `edge(d)` says the pixel may straddle the boundary of a light.
 template <class Radiance, class Edge>
-std::vector<float> procedural_map(int W, int H, Radiance radiance, Edge edge) {
+std::vector<float> procedural_map(int W, int H, Radiance radiance, Edge edge, int n_edge = 4) {
   std::vector<float> rgb(std::size_t(W) * H * 3);
   for (int r = 0; r < H; ++r)
     for (int c = 0; c < W; ++c) {
       const Vec3<double> d = EnvMap::map_direction((c + 0.5) / W, (r + 0.5) / H);
       Rgb v{};
-      const int n = edge(d) ? 4 : 1;
+      const int n = edge(d) ? n_edge : 1;
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
           const Rgb x =
@@ -508,6 +463,38 @@ bool in_rectangle(double elev, double azim, double e0, double a0, double he, dou
 }
 
 }  // namespace
+
+EnvMap EnvMap::default_sky(EnvOptions options) {
+  constexpr int W = 1024, H = 512;
+  const double sun_elev = 40 * kPi / 180, sun_azim = 35 * kPi / 180;  // from +z towards −x
+  const Vec3<double> sun{-std::cos(sun_elev) * std::sin(sun_azim), std::sin(sun_elev),
+                         std::cos(sun_elev) * std::cos(sun_azim)};
+  const double sun_radius = 1.5 * kPi / 180, cos_sun = std::cos(sun_radius);
+  const double cos_edge = std::cos(sun_radius + 2 * kPi / H);
+  const Rgb sun_radiance{1000, 940, 840};
+  auto radiance = [&](const Vec3<double>& d) -> Rgb {
+    const double cs = d.x * sun.x + d.y * sun.y + d.z * sun.z;
+    Rgb v;
+    if (d.y >= 0) {
+      // Sky: a saturated blue at the zenith fading to a pale horizon, brighter towards the sun.
+      const double t = std::pow(1 - d.y, 4);
+      const double glow = std::pow(std::max(0.0, cs), 8);
+      v = {0.09 + 0.31 * t + 0.25 * glow, 0.16 + 0.29 * t + 0.22 * glow,
+           0.38 + 0.17 * t + 0.17 * glow};
+    } else {
+      // Ground: warm grey, darker towards the nadir.
+      const double t = 0.55 + 0.45 * std::pow(1 + d.y, 2);
+      v = {0.13 * t, 0.115 * t, 0.095 * t};
+    }
+    if (cs >= cos_sun) v = {v.r + sun_radiance.r, v.g + sun_radiance.g, v.b + sun_radiance.b};
+    return v;
+  };
+  // The sun disk's edge, supersampled 8 × 8.
+  auto edge = [&](const Vec3<double>& d) {
+    return d.x * sun.x + d.y * sun.y + d.z * sun.z > cos_edge;
+  };
+  return EnvMap(W, H, procedural_map(W, H, radiance, edge, 8), "default", options);
+}
 
 EnvMap EnvMap::studio(EnvOptions options) {
   constexpr int W = 512, H = 256;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -17,6 +18,11 @@ enum class BrdfFileFormat { unknown, merl, rgl, alta };
 // "tensor_file\0" magic, ALTA by its `#` header lines (a #DIM line before the first data line).
 // Throws FormatError when the file cannot be read.
 BrdfFileFormat detect_brdf_format(const std::filesystem::path& path);
+
+// The regular files of a directory whose content is a BRDF format (`only` that one, if given),
+// sorted by path. Throws FormatError when the directory cannot be read.
+std::vector<std::filesystem::path> brdf_files_in(const std::filesystem::path& dir,
+                                                 std::optional<BrdfFileFormat> only = {});
 
 // If `spec` names an existing file, reads it with the reader its content calls for (the file's
 // extension only picks the reader whose error to report when the content matches no format).

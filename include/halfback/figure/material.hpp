@@ -2,6 +2,7 @@
 // environments (top row), then its 2D slices in each parameterization (slices.hpp, generic mode).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,11 +13,23 @@
 
 namespace halfback::figure {
 
+// An environment of the renderings and the caption under its sphere. Maps are shared: a set of
+// figures loads (or builds) each environment once.
+struct NamedEnvironment {
+  std::string label;
+  std::shared_ptr<const render::EnvMap> map;
+};
+
+// EnvMap::from_spec(spec) with its caption: "sky (built-in)", ..., a constant's spec, or a
+// file's stem. Throws what from_spec throws.
+NamedEnvironment load_environment(const std::string& spec);
+// The three built-ins, default (sky), studio and sunset; built once per process.
+const std::vector<NamedEnvironment>& default_environments();
+
 struct MaterialFigureOptions {
   BrdfPtr brdf;
   std::string heading;  // the figure's title ("Figure 3, ..."); empty: the BRDF's name
-  // Environment specs (EnvMap::from_spec): a built-in or a file; one render each.
-  std::vector<std::string> environments{"default", "studio", "sunset"};
+  std::vector<NamedEnvironment> environments = default_environments();  // one rendering each
   int render_pixels = 176;  // width and height of each sphere rendering
   int spp = 48;
   std::uint64_t seed = 1;
@@ -30,8 +43,7 @@ struct MaterialFigure {
   SliceFigure slices;
 };
 
-// Throws std::invalid_argument for a missing BRDF or an empty environment list, and what
-// EnvMap::from_spec throws for a bad environment.
+// Throws std::invalid_argument for a missing BRDF or an empty environment list.
 MaterialFigure material_figure(const MaterialFigureOptions& options);
 
 }  // namespace halfback::figure

@@ -5,11 +5,16 @@
 #include <string>
 #include <vector>
 
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/figure/material.hpp"
+
 namespace halfback::figure {
 
-// A material of Figures 3-5: the file stem, a BRDF SPEC and what it shows.
+// A material of Figures 3-5: the file stem, a BRDF SPEC and what it shows; `brdf`, when set, is
+// the BRDF already loaded from `spec` (so that a caller that checked it does not load it twice).
 struct PaperMaterial {
   std::string stem, spec, description;
+  BrdfPtr brdf = nullptr;
 };
 
 // The defaults: three measured materials embedded in the library (a metallic paint, a wall paint,
@@ -21,7 +26,7 @@ struct PaperFigureOptions {
   unsigned threads = 0;
   bool png = true, svg = true, pdf = true;
   std::vector<PaperMaterial> materials = default_paper_materials();  // empty: Figures 1-2 only
-  std::vector<std::string> environments{"default", "studio", "sunset"};
+  std::vector<NamedEnvironment> environments;  // empty: default_environments()
   int render_pixels = 176, spp = 48;
 };
 
