@@ -328,8 +328,7 @@ std::vector<Brdf::Fact> AltaBrdf::facts() const {
                                       m.samples, m.dropped)});
   std::string angles;
   for (const double a : incidence_angles())
-    angles +=
-        fmt::format("{}{:.4g}°", angles.empty() ? "" : ", ", a * 180 / 3.14159265358979323846);
+    angles += fmt::format("{}{:.4g}°", angles.empty() ? "" : ", ", a * 180 / std::numbers::pi);
   f.push_back({"incidence angles θl", angles});
   f.push_back({"channels", m.dim_out == 3 ? "RGB" : "one (gray, copied to R, G, B)"});
   return f;

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -230,8 +231,7 @@ py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::str
       counts.push_back(std::size_t(c));
     }
   }
-  GridSpec g =
-      default_grid(space, parse_kind(kind), counts, azimuth_deg * 3.14159265358979323846 / 180);
+  GridSpec g = default_grid(space, parse_kind(kind), counts, azimuth_deg * std::numbers::pi / 180);
   g.sampling = nodes ? GridSampling::nodes : GridSampling::centres;
   for (const auto& [key, value] : ranges) {
     GridAxis* axis = nullptr;
@@ -278,7 +278,7 @@ py::dict hemisphere_view(const std::string& param, double theta_o, std::size_t p
                          const std::string& projection, const std::string& centre) {
   const Space space = parse_space(param, "param");
   if (space == Space::dirs) throw py::value_error("param: a parameterization, not dirs");
-  if (!(theta_o >= 0 && theta_o <= 1.5707963267948966))
+  if (!(theta_o >= 0 && theta_o <= std::numbers::pi / 2))
     throw py::value_error("theta_o must be in [0, pi/2] (radians), got " + std::to_string(theta_o));
   if (pixels < 2 || pixels > 8192) throw py::value_error("pixels must be in [2, 8192]");
   const auto proj = figure::projection_from_name(projection);

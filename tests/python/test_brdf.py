@@ -173,3 +173,19 @@ def test_figure2_example_draws_the_nine_panels(tmp_path):
     rgb = image[..., :3]
     assert (np.abs(rgb - 0.8).max(axis=2) < 0.02).mean() > 0.05
     assert (rgb.max(axis=2) < 0.05).mean() > 0.2
+
+
+def test_bad_grids_and_render_settings_raise():
+    b = halfback.load("lambert")
+    with pytest.raises(ValueError, match="size must be positive"):
+        b.resample("hybrid", size=0)
+    with pytest.raises(ValueError, match="4 axes, got 2 sample counts"):
+        b.resample("hybrid", "full", size=(4, 4))
+    with pytest.raises(ValueError, match="finite"):
+        b.resample("hybrid", ranges={"k": (0, float("nan"))})
+    with pytest.raises(ValueError, match="param"):
+        b.resample("spectral")
+    with pytest.raises(ValueError):
+        b.render(width=0)
+    with pytest.raises(ValueError, match="pixels"):
+        halfback.hemisphere("hybrid", 0.1, pixels=1)
