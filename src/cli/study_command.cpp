@@ -1,20 +1,22 @@
 // `halfback study`: the quantitative comparison of the parameterizations on a set of BRDFs
-// (include/halfback/study/metrics.hpp, docs/study.md). Writes CSV files and a Markdown report.
+// (include/halfback/study/, docs/study.md): options to a StudyConfig, progress, the files.
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <future>
 #include <iterator>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include "command.hpp"
 #include "halfback/brdf/load.hpp"
-#include "halfback/figure/chart.hpp"
-#include "halfback/figure/render.hpp"
-#include "halfback/study/metrics.hpp"
+#include "halfback/figure/material.hpp"
+#include "halfback/study/report.hpp"
+#include "halfback/study/study.hpp"
 
 namespace halfback::cli {
 
@@ -24,10 +26,13 @@ struct StudyOptions {
   std::vector<std::string> specs;
   std::string out = "study";
   std::string space = "log";
-  bool quick = false;
+  std::string budgets, budgets_4d, environments;
+  std::size_t test_pairs = 0, image_budget = 0;
+  int image_size = 0, image_spp = 0;
+  double max_theta = 85;
+  std::uint64_t seed = 1;
+  bool quick = false, no_gonio = false, no_images = false;
 };
-
-const std::vector<int> kRanks{1, 2, 4, 8};
 
 // The BRDFs of the specs: files, every BRDF file of a directory (by content), or models.
 std::vector<std::pair<std::string, BrdfPtr>> load_all(const std::vector<std::string>& specs) {
@@ -46,124 +51,112 @@ std::vector<std::pair<std::string, BrdfPtr>> load_all(const std::vector<std::str
   return brdfs;
 }
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
+study::StudyConfig make_config(const StudyOptions& o) {
+  study::StudyConfig c;
+  if (o.space == "linear")
+    c.space = study::ErrorSpace::linear;
+  else if (o.space == "log")
+    c.space = study::ErrorSpace::log;
+  else if (o.space == "cbrt")
+    c.space = study::ErrorSpace::cbrt;
+  else
+    throw UsageError(fmt::format("--space '{}': expected linear, log or cbrt", o.space));
+  if (o.quick) {
+    c.grid = {24, 24, 32};
+    c.full_grid = {8, 16, 8, 16};
+    c.budgets = {1000, 10000};
+    c.budgets_4d = {1000, 10000};
+    c.test_pairs = 20000;
+    c.image_size = 48;
+    c.image_spp = 8;
+  }
+  auto ascending = [](std::vector<std::size_t> v, const char* option) {
+    for (std::size_t i = 1; i < v.size(); ++i)
+      if (v[i] <= v[i - 1]) throw UsageError(fmt::format("{}: budgets must be ascending", option));
+    return v;
+  };
+  if (!o.budgets.empty())
+    c.budgets = ascending(count_list(o.budgets, "--budgets", "sample budget"), "--budgets");
+  if (!o.budgets_4d.empty())
+    c.budgets_4d =
+        ascending(count_list(o.budgets_4d, "--budgets-4d", "sample budget"), "--budgets-4d");
+  if (o.test_pairs) c.test_pairs = o.test_pairs;
+  if (o.image_size) c.image_size = o.image_size;
+  if (o.image_spp) c.image_spp = o.image_spp;
+  c.seed = o.seed;
+  c.max_theta_deg = o.max_theta;
+  // The image budget: as asked, else 10^4 if it is a budget, else the middle budget.
+  if (o.image_budget) {
+    c.image_budget = o.image_budget;
+  } else if (std::find(c.budgets.begin(), c.budgets.end(), c.image_budget) == c.budgets.end()) {
+    c.image_budget = c.budgets[c.budgets.size() / 2];
+  }
+  if (o.no_gonio) c.budgets.clear();
+  if (!o.no_gonio && !o.no_images) {
+    if (o.environments.empty()) {
+      for (const auto& e : figure::default_environments())
+        c.environments.push_back({e.label, e.map});
+    } else {
+      for (const std::string& spec : split_list(o.environments, "--env", "environment")) {
+        const figure::NamedEnvironment e = figure::load_environment(spec);
+        c.environments.push_back({e.label, e.map});
+      }
+    }
+  }
+  try {
+    c.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return c;
 }
 
 int run_study(const StudyOptions& o) {
   if (o.specs.empty()) throw UsageError("no BRDF given (files, directories or model specs)");
-  study::ErrorSpace es;
-  if (o.space == "linear")
-    es = study::ErrorSpace::linear;
-  else if (o.space == "log")
-    es = study::ErrorSpace::log;
-  else if (o.space == "cbrt")
-    es = study::ErrorSpace::cbrt;
-  else
-    throw UsageError(fmt::format("--space '{}': expected linear, log or cbrt", o.space));
+  study::StudyConfig config = make_config(o);
   const auto brdfs = load_all(o.specs);
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec || !std::filesystem::is_directory(o.out))
     throw std::runtime_error(fmt::format("cannot create the output directory '{}': {}", o.out,
                                          ec ? ec.message() : "a file of that name exists"));
-  const study::IsoGrid grid = o.quick ? study::IsoGrid{24, 24, 32} : study::IsoGrid{64, 64, 64};
-  const Space params[] = {Space::halfdiff, Space::ortho, Space::hybrid, Space::spherical};
+  check_writable((std::filesystem::path(o.out) / "report.md").string());
 
-  std::string azimuthal = "brdf,parameterization,error\n";
-  std::string separability = "brdf,parameterization,rank,error\n";
-  std::string report = fmt::format(
-      "# halfback study\n\n"
-      "Measure: cos θi cos θo dωi dωo, through each parameterization's Jacobian. Values: "
-      "luminance of ρ in the {} error space. Grid: {} × {} × {} cells of each isotropic form "
-      "(midpoint rule). Metrics: docs/study.md.\n\n"
-      "## Azimuthal dependence (relative error of dropping the relative azimuth)\n\n"
-      "| BRDF | halfdiff | ortho | hybrid | spherical |\n|---|---|---|---|---|\n",
-      study::name_of(es), grid.a, grid.b, grid.phi);
-  std::string sep_table =
-      "\n## Separability of the 2D projection (relative error of the best rank-r "
-      "approximation, r = 1, 2, 4, 8)\n\n| BRDF | halfdiff | ortho | hybrid | spherical |\n"
-      "|---|---|---|---|---|\n";
-  figure::BarChart az_chart, sep_chart;
-  for (Space s : params) {
-    az_chart.series.emplace_back(name_of(s));
-    sep_chart.series.emplace_back(name_of(s));
-  }
-  az_chart.title = fmt::format("Azimuthal dependence ({} error space)", study::name_of(es));
-  az_chart.x_label = "relative error of dropping the relative azimuth";
-  sep_chart.title =
-      fmt::format("Separability of the 2D projection, rank 1 ({} error space)", study::name_of(es));
-  sep_chart.x_label = "relative error of the best rank-1 approximation";
+  // Progress: a line per BRDF; on a terminal, also the stage each task has reached.
+  const bool tty = isatty(fileno(stderr));
+  std::mutex progress_mutex;
+  std::string current;
   const auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  if (tty)
+    config.progress = [&](std::string_view stage) {
+      const std::lock_guard lock(progress_mutex);
+      fmt::print(stderr, "\r\x1b[K{}: {} ({:.0f} s)", current, stage, elapsed());
+    };
+  std::vector<study::BrdfResult> results;
   for (std::size_t k = 0; k < brdfs.size(); ++k) {
     const auto& [spec, brdf] = brdfs[k];
     // Files by their BRDF's name (merl:..., rgl:...), models by their spec, which holds their
     // parameters (two GGX of different roughness are both named "ggx").
-    std::error_code ec;
     const std::string label = std::filesystem::exists(spec, ec) ? brdf->name() : spec;
-    fmt::print(stderr, "halfback study: [{}/{}] {}\n", k + 1, brdfs.size(), label);
-    if (!brdf->isotropic())
-      warn("study", label + " is anisotropic: the isotropic metrics see its canonical pose");
-    std::string az_row = "| " + label + " |", sep_row = az_row;
-    az_chart.rows.push_back(label);
-    sep_chart.rows.push_back(label);
-    az_chart.values.emplace_back();
-    sep_chart.values.emplace_back();
-    // The parameterizations are independent: one task each (the low-rank fits are serial).
-    struct Result {
-      double azimuthal;
-      std::vector<double> r2, r3;
-    };
-    std::vector<std::future<Result>> tasks;
-    for (Space s : params)
-      tasks.push_back(std::async(std::launch::async, [&, s] {
-        const study::IsoSamples x = study::sample_isotropic(*brdf, s, grid, es);
-        return Result{study::azimuthal_error(x), study::separability_2d(x, kRanks),
-                      study::separability_unfolded(x, kRanks)};
-      }));
-    for (std::size_t pi = 0; pi < std::size(params); ++pi) {
-      const Space s = params[pi];
-      const Result res = tasks[pi].get();
-      const double e = res.azimuthal;
-      const auto& r2 = res.r2;
-      const auto& r3 = res.r3;
-      azimuthal += fmt::format("{},{},{:.6g}\n", csv_field(label), name_of(s), e);
-      for (std::size_t i = 0; i < kRanks.size(); ++i) {
-        separability += fmt::format("{},{},{},{:.6g}\n", csv_field(label),
-                                    std::string(name_of(s)) + "-2d", kRanks[i], r2[i]);
-        separability += fmt::format("{},{},{},{:.6g}\n", csv_field(label),
-                                    std::string(name_of(s)) + "-3d", kRanks[i], r3[i]);
-      }
-      az_chart.values.back().push_back(e);
-      sep_chart.values.back().push_back(r2[0]);
-      az_row += fmt::format(" {:.4f} |", e);
-      sep_row += fmt::format(" {:.3f} / {:.3f} / {:.3f} / {:.3f} |", r2[0], r2[1], r2[2], r2[3]);
+    {
+      const std::lock_guard lock(progress_mutex);
+      current = fmt::format("halfback study: [{}/{}] {}", k + 1, brdfs.size(), label);
     }
-    report += az_row + "\n";
-    sep_table += sep_row + "\n";
+    if (!tty) fmt::print(stderr, "{}\n", current);
+    if (!brdf->isotropic())
+      warn("study", label +
+                        " is anisotropic: its isotropic metrics see its canonical pose, the "
+                        "4D metrics all of it");
+    results.push_back(study::study_brdf(*brdf, label, config));
+    if (tty) fmt::print(stderr, "\r\x1b[K{}: done in {:.1f} s\n", current, results.back().seconds);
   }
-  report += sep_table;
-  report += fmt::format(
-      "\nIn separability.csv, `P-2d` is the 2D projection over (a, b) and `P-3d` the 3D table "
-      "unfolded along its azimuth, (a, b) × φ.\n\n{} BRDFs in {:.1f} s.\n",
-      brdfs.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  const std::filesystem::path dir(o.out);
-  write_file_atomically(dir / "azimuthal.csv", azimuthal);
-  write_file_atomically(dir / "separability.csv", separability);
-  report +=
-      "\n![Azimuthal dependence](azimuthal.png)\n\n![Separability, rank 1](separability.png)\n";
-  for (const char* ext : {".png", ".svg"}) {
-    figure::save(figure::bar_chart(az_chart), dir / (std::string("azimuthal") + ext));
-    figure::save(figure::bar_chart(sep_chart), dir / (std::string("separability") + ext));
-  }
-  write_file_atomically(dir / "report.md", report);
-  fmt::print(
-      "{}\nwritten in {}: report.md, azimuthal.csv, separability.csv, "
-      "azimuthal.{{png,svg}}, separability.{{png,svg}}\n",
-      report, dir.string());
+  const study::StudyOutput out = study::write_study(o.out, results, config, elapsed());
+  std::string files;
+  for (const std::string& f : out.files) files += (files.empty() ? "" : ", ") + f;
+  fmt::print("{}\nwritten in {}: {}\n", out.markdown, o.out, files);
   return kExitOk;
 }
 
@@ -173,22 +166,57 @@ Command register_study(CLI::App& parent) {
   auto o = std::make_shared<StudyOptions>();
   CLI::App* app = parent.add_subcommand(
       "study",
-      "Compare the parameterizations on BRDFs: azimuthal dependence and separability (CSV and "
-      "a Markdown report)");
+      "Compare the parameterizations on BRDFs: azimuthal dependence, separability, a virtual "
+      "gonio-reflectometer and the image-space error of its reconstructions (CSV, plots, "
+      "Markdown and HTML reports)");
   app->add_option("specs", o->specs, "BRDFs: files, directories of files, or model specs")
       ->required();
   app->add_option("-o,--out", o->out, "Output directory (created if missing)")
       ->capture_default_str();
   app->add_option("--space", o->space, "Error space: linear, log (log(1 + Y)) or cbrt (Y^(1/3))")
       ->capture_default_str();
-  app->add_flag("--quick", o->quick, "A coarse grid (24 x 24 x 32 instead of 64^3)");
+  app->add_flag("--quick", o->quick,
+                "A small study: 24 x 24 x 32 grids, budgets 1000,10000, 20000 test pairs, "
+                "48^2 images");
+  app->add_option("--budgets", o->budgets,
+                  "Gonio-reflectometer budgets, ascending (default 1000,3000,10000,30000,100000)");
+  app->add_option("--budgets-4d", o->budgets_4d,
+                  "Budgets of the 4D gonio-reflectometer of anisotropic BRDFs "
+                  "(default 1000,10000,100000,1000000)");
+  app->add_option("--test-pairs", o->test_pairs,
+                  "Pairs the reconstructions are checked at (default 200000)")
+      ->check(CLI::Range(std::size_t(100), std::size_t(1) << 30));
+  app->add_option("--env", o->environments,
+                  "Environments of the image-space error, comma-separated: built-in names "
+                  "(default, sky, studio, sunset) or .hdr/.exr files (default: the built-ins)");
+  app->add_option("--image-budget", o->image_budget,
+                  "The budget whose reconstructions are rendered (one of --budgets; default "
+                  "10000)");
+  app->add_option("--image-size", o->image_size, "Width and height of the renderings (default 96)")
+      ->check(CLI::Range(8, 4096));
+  app->add_option("--image-spp", o->image_spp, "Samples per pixel of the renderings (default 16)")
+      ->check(CLI::Range(1, 1 << 16));
+  app->add_option("--max-theta", o->max_theta,
+                  "The gonio-reflectometer's reach: no measurement where a direction is farther "
+                  "from the normal (degrees)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 90.0));
+  app->add_option("--seed", o->seed, "Seed of the test pairs, stratified designs and renderings")
+      ->capture_default_str();
+  app->add_flag("--no-gonio", o->no_gonio, "Metrics 1-2 only (no gonio-reflectometer, no images)");
+  app->add_flag("--no-images", o->no_images, "No image-space error");
   app->footer(
       "Metrics (docs/study.md), under the measure cos(theta_i) cos(theta_o) dwi dwo:\n"
-      "  azimuthal.csv     brdf,parameterization,error: the error of dropping the relative\n"
-      "                    azimuth (the BRDF replaced by its average over it)\n"
-      "  separability.csv  brdf,parameterization,rank,error: best rank-r approximations of the\n"
-      "                    2D projection (P-2d) and of the 3D table unfolded along the azimuth\n"
-      "                    (P-3d), r = 1, 2, 4, 8\n"
+      "  azimuthal.csv     brdf,parameterization,error,dims: the error of dropping the relative\n"
+      "                    azimuth (dims 3), or the second azimuth of the full form (dims 4)\n"
+      "  separability.csv  brdf,parameterization,rank,error,dims: best rank-r approximations of\n"
+      "                    the 2D projection (dims 2), the 3D table unfolded along the azimuth\n"
+      "                    (3), the 4D table as (a, phi_a) x (b, phi_b) (4)\n"
+      "  gonio.csv         brdf,parameterization,design,samples,error,dims,budget: the virtual\n"
+      "                    gonio-reflectometer (regular and stratified designs)\n"
+      "  budget.csv        the samples each needs to reach errors of 0.05, 0.02, 0.01\n"
+      "  image.csv         brdf,parameterization,design,samples,environment,relative_rmse,\n"
+      "                    mean_delta_e2000,p95_delta_e2000\n"
       "Example:\n"
       "  halfback study --out study ggx:alpha=0.2 ../shared/data/rgl");
   return {app, [o] { return run_study(*o); }};

@@ -78,4 +78,112 @@ Scene bar_chart(const BarChart& c, const BarChartLayout& l) {
   return sc;
 }
 
+namespace {
+
+// Decade bounds [10^lo, 10^hi] around positive values (at least one decade wide).
+std::pair<int, int> decades(double min, double max) {
+  int lo = int(std::floor(std::log10(min) + 1e-9)), hi = int(std::ceil(std::log10(max) - 1e-9));
+  if (hi <= lo) hi = lo + 1;
+  return {lo, hi};
+}
+
+void check_series(const LineSeries& s) {
+  if (s.x.empty() || s.x.size() != s.y.size())
+    throw std::invalid_argument(fmt::format(
+        "log-log chart: series '{}' needs as many x as y values, at least one", s.name));
+  for (std::size_t i = 0; i < s.x.size(); ++i)
+    if (!(std::isfinite(s.x[i]) && s.x[i] > 0 && std::isfinite(s.y[i]) && s.y[i] > 0))
+      throw std::invalid_argument(
+          fmt::format("log-log chart: series '{}' has a point ({}, {}) that is not finite and > 0",
+                      s.name, s.x[i], s.y[i]));
+}
+
+}  // namespace
+
+Scene loglog_chart(const LogLogChart& c) {
+  if (c.panels.empty()) throw std::invalid_argument("log-log chart: no panels");
+  if (c.columns < 1) throw std::invalid_argument("log-log chart: columns must be >= 1");
+  double xmin = INFINITY, xmax = 0;
+  for (const LogLogPanel& p : c.panels)
+    for (const LineSeries& s : p.series) {
+      check_series(s);
+      for (double x : s.x) xmin = std::min(xmin, x), xmax = std::max(xmax, x);
+    }
+  if (xmax <= 0) throw std::invalid_argument("log-log chart: no points");
+  const auto [xlo, xhi] = decades(xmin, xmax);
+
+  const auto cols = std::size_t(c.columns);
+  const std::size_t rows = (c.panels.size() + cols - 1) / cols;
+  const double margin_left = 52, gap_x = 30, gap_y = 58, top = 44;
+  const double cell_w = c.panel_width + gap_x, cell_h = c.panel_height + gap_y;
+  const LogLogPanel& first = c.panels.front();
+  const double legend = 16 * double((first.series.size() + 3) / 4) + 10;
+  Scene sc;
+  sc.title = c.title;
+  sc.width = snap(margin_left + double(std::min(cols, c.panels.size())) * cell_w + 10);
+  sc.height = snap(top + double(rows) * cell_h + legend + 10);
+  sc.text({12, 24}, escape_markup(c.title), 13, HAlign::left, VAlign::baseline, kBlack, 0, true);
+  const Stroke grid{{0.88, 0.88, 0.88}, 0.5}, axis{kBlack, 0.7};
+
+  for (std::size_t k = 0; k < c.panels.size(); ++k) {
+    const LogLogPanel& p = c.panels[k];
+    const double x0 = margin_left + double(k % cols) * cell_w,
+                 y0 = top + 16 + double(k / cols) * cell_h;
+    const double w = c.panel_width, h = c.panel_height;
+    double ymin = INFINITY, ymax = 0;
+    for (const LineSeries& s : p.series)
+      for (double y : s.y) ymin = std::min(ymin, y), ymax = std::max(ymax, y);
+    const auto [ylo, yhi] = p.series.empty() ? std::pair{-1, 0} : decades(ymin, ymax);
+    auto px = [&](double x) { return x0 + w * (std::log10(x) - xlo) / double(xhi - xlo); };
+    auto py = [&](double y) { return y0 + h - h * (std::log10(y) - ylo) / double(yhi - ylo); };
+    sc.text({x0 + w / 2, y0 - 6}, escape_markup(p.title), 8.5, HAlign::centre);
+    // Grid lines at the decades, and at 2 and 5 times them when the axis spans one decade.
+    for (int d = xlo; d <= xhi; ++d) {
+      const double x = px(std::pow(10.0, d));
+      sc.line({x, y0}, {x, y0 + h}, grid);
+      sc.text({x, y0 + h + 11}, fmt::format("10^{{{}}}", d), 7.5, HAlign::centre);
+    }
+    for (int d = ylo; d <= yhi; ++d) {
+      const double y = py(std::pow(10.0, d));
+      sc.line({x0, y}, {x0 + w, y}, grid);
+      sc.text({x0 - 3, y}, fmt::format("10^{{{}}}", d), 7.5, HAlign::right, VAlign::middle);
+      if (yhi - ylo == 1 && d < yhi)
+        for (double m : {2.0, 5.0}) {
+          const double ym = py(m * std::pow(10.0, d));
+          sc.line({x0, ym}, {x0 + w, ym}, grid);
+          sc.text({x0 - 3, ym}, fmt::format("{:g}", m * std::pow(10.0, d)), 6.5, HAlign::right,
+                  VAlign::middle);
+        }
+    }
+    sc.rect(x0, y0, w, h, std::nullopt, axis);
+    for (const LineSeries& s : p.series) {
+      const Color col = kSeries[std::size_t(std::max(s.colour, 0)) % std::size(kSeries)];
+      Stroke line{col, 1.1};
+      if (s.dashed) line.dash = {3.5, 2};
+      PathItem path;
+      for (std::size_t i = 0; i < s.x.size(); ++i) path.points.push_back({px(s.x[i]), py(s.y[i])});
+      path.stroke = line;
+      sc.add(path);
+      for (const Point& q : path.points)
+        sc.add(CircleItem{q, 1.6, s.dashed ? std::optional<Color>(kWhite) : col, Stroke{col, 0.8}});
+    }
+    if (k % cols == 0)
+      sc.text({x0 - 38, y0 + h / 2}, escape_markup(c.y_label), 8, HAlign::centre, VAlign::middle,
+              kBlack, 90);
+    if (k / cols == rows - 1 || k + cols >= c.panels.size())
+      sc.text({x0 + w / 2, y0 + h + 24}, escape_markup(c.x_label), 8, HAlign::centre);
+  }
+  const double ly = top + double(rows) * cell_h + 8;
+  for (std::size_t s = 0; s < first.series.size(); ++s) {
+    const LineSeries& ser = first.series[s];
+    const double x = margin_left + double(s % 4) * 150, y = ly + 16 * double(s / 4);
+    const Color col = kSeries[std::size_t(std::max(ser.colour, 0)) % std::size(kSeries)];
+    Stroke line{col, 1.1};
+    if (ser.dashed) line.dash = {3.5, 2};
+    sc.line({x, y - 3}, {x + 22, y - 3}, line);
+    sc.text({x + 28, y}, escape_markup(ser.name), 8.5);
+  }
+  return sc;
+}
+
 }  // namespace halfback::figure

@@ -1,4 +1,4 @@
-// Bar charts: bar lengths are the values on the drawn axis; bad input is refused.
+// Bar charts and log-log plots: marks are the values on the drawn axes; bad input is refused.
 #include "halfback/figure/chart.hpp"
 
 #include <gtest/gtest.h>
@@ -45,6 +45,44 @@ TEST(BarChart, BadInput) {
   EXPECT_THROW(bar_chart(c), std::invalid_argument);
   c.values = {{1, 2}};
   EXPECT_THROW(bar_chart(c), std::invalid_argument);
+}
+
+TEST(LogLogChart, PointsArePlacedOnTheDecadeAxes) {
+  LogLogChart c;
+  c.title = "errors";
+  c.panels.push_back({"p_1",
+                      {{"hybrid", 0, false, {1e3, 1e4}, {0.1, 0.01}},
+                       {"ortho", 1, true, {1e3, 1e4}, {0.05, 0.02}}}});
+  c.panels.push_back({"p2", {{"hybrid", 0, false, {1e3, 1e5}, {0.3, 0.2}}}});
+  const Scene sc = loglog_chart(c);
+  // The first series of the first panel spans the x decades [3, 4] (panel 2 extends the shared
+  // x axis to 10^5) and its own y decades [-2, -1] corner to corner.
+  std::vector<const PathItem*> lines;
+  for (const Item& item : sc.items)
+    if (const auto* p = std::get_if<PathItem>(&item))
+      if (p->stroke && !p->fill && !p->closed && p->points.size() >= 2 && p->stroke->width == 1.1)
+        lines.push_back(p);
+  ASSERT_GE(lines.size(), 3u);
+  const PathItem& h = *lines[0];
+  EXPECT_NEAR(h.points[1].x - h.points[0].x, c.panel_width / 2, 1e-9);
+  EXPECT_NEAR(h.points[1].y - h.points[0].y, c.panel_height, 1e-9);
+  EXPECT_TRUE(lines[1]->stroke->dash.size() == 2);
+  bool title = false;
+  for (const Item& item : sc.items)
+    if (const auto* t = std::get_if<TextItem>(&item)) title |= plain_text(t->text) == "p_1";
+  EXPECT_TRUE(title);
+  EXPECT_FALSE(render(sc, Format::svg).empty());
+}
+
+TEST(LogLogChart, BadInput) {
+  LogLogChart c;
+  EXPECT_THROW(loglog_chart(c), std::invalid_argument);
+  c.panels.push_back({"p", {{"s", 0, false, {1, 2}, {1}}}});
+  EXPECT_THROW(loglog_chart(c), std::invalid_argument);
+  c.panels[0].series[0].y = {1, 0};
+  EXPECT_THROW(loglog_chart(c), std::invalid_argument);
+  c.panels[0].series[0].y = {1, NAN};
+  EXPECT_THROW(loglog_chart(c), std::invalid_argument);
 }
 
 }  // namespace

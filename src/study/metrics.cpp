@@ -26,7 +26,9 @@ double IsoSamples::total_weight() const {
   return std::accumulate(weight.begin(), weight.end(), 0.0);
 }
 
-namespace {
+double luminance_of(const Rgb& rho) {
+  return 0.2126 * rho.r + 0.7152 * rho.g + 0.0722 * rho.b;
+}
 
 double to_error_space(double y, ErrorSpace es) {
   switch (es) {
@@ -39,6 +41,12 @@ double to_error_space(double y, ErrorSpace es) {
   }
   return std::cbrt(y);
 }
+
+double FullSamples::total_weight() const {
+  return std::accumulate(weight.begin(), weight.end(), 0.0);
+}
+
+namespace {
 
 // The relative error of the best rank-r approximation of M in the weighted norm
 // Σ w_ij (M_ij − (U Vᵀ)_ij)², by alternating weighted least squares started from the SVD of
@@ -55,27 +63,31 @@ double weighted_rank_error(const Eigen::MatrixXd& m, const Eigen::MatrixXd& w, i
   Eigen::MatrixXd u = svd.matrixU().leftCols(r) * svd.singularValues().head(r).asDiagonal();
   Eigen::MatrixXd v = svd.matrixV().leftCols(r);
   auto error = [&] { return (w.array() * (m - u * v.transpose()).array().square()).sum(); };
-  // One side given the other: a small r × r weighted normal system per row (or column).
-  auto solve = [&](const Eigen::MatrixXd& target, const Eigen::MatrixXd& weights,
+  // One side given the other: an r × r weighted normal system per row (or column), all their
+  // matrices from one product W · (v_j v_jᵀ)_j and right-hand sides from (W ∘ M) · V.
+  const Eigen::MatrixXd wm = w.cwiseProduct(m), wt = w.transpose(), wmt = wm.transpose();
+  auto solve = [&](const Eigen::MatrixXd& weights, const Eigen::MatrixXd& weighted_target,
                    const Eigen::MatrixXd& other, Eigen::MatrixXd& side) {
-    for (Eigen::Index i = 0; i < target.rows(); ++i) {
-      const Eigen::VectorXd wi = weights.row(i).transpose();
-      if (wi.sum() <= 0) {
+    Eigen::MatrixXd outer(other.rows(), r * r);
+    for (int a = 0; a < r; ++a)
+      for (int b = 0; b < r; ++b) outer.col(a * r + b) = other.col(a).cwiseProduct(other.col(b));
+    const Eigen::MatrixXd normals = weights * outer;
+    const Eigen::MatrixXd rhs = weighted_target * other;
+    for (Eigen::Index i = 0; i < weights.rows(); ++i) {
+      Eigen::MatrixXd n = normals.row(i).reshaped(r, r);
+      const double trace = n.trace();
+      if (!(trace > 0)) {  // no weight in this row: it does not count
         side.row(i).setZero();
         continue;
       }
-      Eigen::MatrixXd a = other.transpose() * wi.asDiagonal() * other;
-      a.diagonal().array() += 1e-14 * (a.trace() + 1e-300);
-      const Eigen::VectorXd b =
-          other.transpose() * (wi.array() * target.row(i).transpose().array()).matrix();
-      side.row(i) = a.ldlt().solve(b).transpose();
+      n.diagonal().array() += 1e-14 * trace;
+      side.row(i) = n.ldlt().solve(rhs.row(i).transpose()).transpose();
     }
   };
   double last = error();
   for (int it = 0; it < 200 && last > 1e-30 * norm; ++it) {
-    solve(m, w, v, u);
-    const Eigen::MatrixXd mt = m.transpose(), wt = w.transpose();
-    solve(mt, wt, u, v);
+    solve(w, wm, v, u);
+    solve(wt, wmt, u, v);
     const double e = error();
     if (last - e <= 1e-12 * last) {
       last = e;
@@ -96,12 +108,10 @@ std::vector<double> rank_errors(const Eigen::MatrixXd& m, const Eigen::MatrixXd&
   return out;
 }
 
-}  // namespace
-
-IsoSamples sample_isotropic(const Brdf& brdf, Space space, const IsoGrid& grid, ErrorSpace es) {
-  if (grid.a == 0 || grid.b == 0 || grid.phi == 0)
-    throw std::invalid_argument("study grid: every axis needs at least one cell");
-  const GridSpec g = default_grid(space, GridKind::isotropic, {grid.a, grid.b, grid.phi});
+// The BRDF at the cell centres of a grid: values in the error space and dμ weights (0 outside
+// the domain, where the Jacobian is not finite, or where ρ is not finite: no data there).
+void sample_grid(const Brdf& brdf, const GridSpec& g, ErrorSpace es, std::vector<double>& value,
+                 std::vector<double>& weight) {
   const std::size_t n = g.points();
   std::vector<DirPair<double>> all(n);
   std::vector<std::uint8_t> ok(n);
@@ -116,43 +126,89 @@ IsoSamples sample_isotropic(const Brdf& brdf, Space space, const IsoGrid& grid, 
     }
   std::vector<Rgb> rho(pairs.size());
   brdf.eval(pairs, rho);
-
-  IsoSamples s;
-  s.space = space;
-  s.grid = grid;
-  s.value.assign(n, 0.0);
-  s.weight.assign(n, 0.0);
-  const double cell = (g.axes[0].hi - g.axes[0].lo) / double(grid.a) *
-                      (g.axes[1].hi - g.axes[1].lo) / double(grid.b) *
-                      (g.axes[2].hi - g.axes[2].lo) / double(grid.phi);
+  value.assign(n, 0.0);
+  weight.assign(n, 0.0);
+  double cell = 1;
+  for (const GridAxis& a : g.axes) cell *= (a.hi - a.lo) / double(a.count);
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const std::size_t p = where[k];
-    const double y = 0.2126 * rho[k].r + 0.7152 * rho[k].g + 0.0722 * rho[k].b;
-    if (!std::isfinite(y)) continue;  // no data there (e.g. outside a measurement): left out
-    s.value[p] = to_error_space(y, es);
-    s.weight[p] = jac[p] * pairs[k].wi.z * pairs[k].wo.z * cell;
+    const double y = luminance_of(rho[k]);
+    if (!std::isfinite(y)) continue;
+    value[p] = to_error_space(y, es);
+    weight[p] = jac[p] * pairs[k].wi.z * pairs[k].wo.z * cell;
   }
-  return s;
 }
 
-double azimuthal_error(const IsoSamples& s) {
-  const std::size_t ab = s.grid.a * s.grid.b, nphi = s.grid.phi;
+// The relative error of replacing each run of `group` consecutive values by its weighted mean.
+double group_mean_error(const std::vector<double>& value, const std::vector<double>& weight,
+                        std::size_t group) {
   double err = 0, norm = 0;
-  for (std::size_t i = 0; i < ab; ++i) {
+  for (std::size_t i = 0; i + group <= value.size(); i += group) {
     double w = 0, m = 0;
-    for (std::size_t k = 0; k < nphi; ++k) {
-      w += s.weight[i * nphi + k];
-      m += s.weight[i * nphi + k] * s.value[i * nphi + k];
+    for (std::size_t k = i; k < i + group; ++k) {
+      w += weight[k];
+      m += weight[k] * value[k];
     }
     if (w <= 0) continue;
     m /= w;
-    for (std::size_t k = 0; k < nphi; ++k) {
-      const double d = s.value[i * nphi + k] - m;
-      err += s.weight[i * nphi + k] * d * d;
-      norm += s.weight[i * nphi + k] * s.value[i * nphi + k] * s.value[i * nphi + k];
+    for (std::size_t k = i; k < i + group; ++k) {
+      err += weight[k] * (value[k] - m) * (value[k] - m);
+      norm += weight[k] * value[k] * value[k];
     }
   }
   return norm > 0 ? std::sqrt(err / norm) : 0.0;
+}
+
+// The table as a rows × cols matrix (row-major flat index = row · cols + col) and its weights.
+std::vector<double> unfolded_rank_errors(const std::vector<double>& value,
+                                         const std::vector<double>& weight, std::size_t cols,
+                                         const std::vector<int>& ranks) {
+  const auto rows = static_cast<Eigen::Index>(value.size() / cols);
+  const auto c = static_cast<Eigen::Index>(cols);
+  Eigen::MatrixXd m(rows, c), w(rows, c);
+  for (Eigen::Index i = 0; i < rows; ++i)
+    for (Eigen::Index k = 0; k < c; ++k) {
+      m(i, k) = value[std::size_t(i * c + k)];
+      w(i, k) = weight[std::size_t(i * c + k)];
+    }
+  return rank_errors(m, w, ranks);
+}
+
+}  // namespace
+
+IsoSamples sample_isotropic(const Brdf& brdf, Space space, const IsoGrid& grid, ErrorSpace es) {
+  if (grid.a == 0 || grid.b == 0 || grid.phi == 0)
+    throw std::invalid_argument("study grid: every axis needs at least one cell");
+  IsoSamples s;
+  s.space = space;
+  s.grid = grid;
+  sample_grid(brdf, default_grid(space, GridKind::isotropic, {grid.a, grid.b, grid.phi}), es,
+              s.value, s.weight);
+  return s;
+}
+
+FullSamples sample_full(const Brdf& brdf, Space space, const std::array<std::size_t, 4>& counts,
+                        ErrorSpace es) {
+  for (std::size_t c : counts)
+    if (c == 0) throw std::invalid_argument("study grid: every axis needs at least one cell");
+  FullSamples s;
+  s.space = space;
+  s.counts = counts;
+  sample_grid(brdf, default_grid(space, GridKind::full, {counts.begin(), counts.end()}), es,
+              s.value, s.weight);
+  return s;
+}
+
+double azimuthal_error(const FullSamples& s) {
+  return group_mean_error(s.value, s.weight, s.counts[3]);
+}
+
+std::vector<double> separability_4d(const FullSamples& s, const std::vector<int>& ranks) {
+  return unfolded_rank_errors(s.value, s.weight, s.counts[2] * s.counts[3], ranks);
+}
+
+double azimuthal_error(const IsoSamples& s) {
+  return group_mean_error(s.value, s.weight, s.grid.phi);
 }
 
 std::vector<double> separability_2d(const IsoSamples& s, const std::vector<int>& ranks) {
@@ -174,15 +230,7 @@ std::vector<double> separability_2d(const IsoSamples& s, const std::vector<int>&
 }
 
 std::vector<double> separability_unfolded(const IsoSamples& s, const std::vector<int>& ranks) {
-  const std::size_t ab = s.grid.a * s.grid.b, nphi = s.grid.phi;
-  const auto rows = static_cast<Eigen::Index>(ab), cols = static_cast<Eigen::Index>(nphi);
-  Eigen::MatrixXd m(rows, cols), w(rows, cols);
-  for (std::size_t i = 0; i < ab; ++i)
-    for (std::size_t k = 0; k < nphi; ++k) {
-      m(Eigen::Index(i), Eigen::Index(k)) = s.value[i * nphi + k];
-      w(Eigen::Index(i), Eigen::Index(k)) = s.weight[i * nphi + k];
-    }
-  return rank_errors(m, w, ranks);
+  return unfolded_rank_errors(s.value, s.weight, s.grid.phi, ranks);
 }
 
 }  // namespace halfback::study

@@ -11,6 +11,7 @@
 // resample.hpp's default grids; cells outside the domain have weight 0.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <string_view>
 #include <vector>
@@ -22,6 +23,10 @@ namespace halfback::study {
 
 enum class ErrorSpace { linear, log, cbrt };
 std::string_view name_of(ErrorSpace s);
+
+// The value every metric compares: the luminance of ρ mapped to the error space.
+double luminance_of(const Rgb& rho);
+double to_error_space(double luminance, ErrorSpace es);
 
 struct IsoGrid {
   std::size_t a = 64, b = 64, phi = 64;  // cells of the two magnitudes and of the azimuth
@@ -53,5 +58,24 @@ double azimuthal_error(const IsoSamples& s);
 // A table of rank r on the domain has E_r = 0 whatever the domain's shape.
 std::vector<double> separability_2d(const IsoSamples& s, const std::vector<int>& ranks);
 std::vector<double> separability_unfolded(const IsoSamples& s, const std::vector<int>& ranks);
+
+// The 4D versions, for anisotropic BRDFs: the BRDF on a grid of cell centres of the full form
+// (a, φa, b, φb) of a parameterization — (θh, φh, θd, φd), (‖h̄‖, φh, ‖k̄‖, φk), (‖h̄‖, φh, ‖k‖, φk)
+// or (θi, φi, θo, φo) — with dμ = J₄ cos θi cos θo da dφa db dφb (the core's 4D Jacobian).
+struct FullSamples {
+  Space space = Space::hybrid;
+  std::array<std::size_t, 4> counts{16, 32, 16, 32};  // cells of a, φa, b, φb
+  std::vector<double> value;   // row-major (φb fastest), in the error space; 0 where invalid
+  std::vector<double> weight;  // dμ of each cell; 0 where invalid
+  double total_weight() const;
+};
+FullSamples sample_full(const Brdf& brdf, Space space, const std::array<std::size_t, 4>& counts,
+                        ErrorSpace es);
+// Azimuthal dependence in 4D: the error of replacing ρ by its μ-weighted mean over the second
+// azimuth φb (φd, φk or φo) at fixed (a, φa, b), Stark's reduction applied to anisotropic data.
+double azimuthal_error(const FullSamples& s);
+// Separability in 4D: the best rank-r approximations of the table unfolded as (a, φa) × (b, φb),
+// e.g. a function of the half vector times a function of the difference vector in halfdiff.
+std::vector<double> separability_4d(const FullSamples& s, const std::vector<int>& ranks);
 
 }  // namespace halfback::study

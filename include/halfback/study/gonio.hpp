@@ -1,0 +1,122 @@
+// The virtual gonio-reflectometer of the study (issue 6, metric 3; docs/study.md): a BRDF measured
+// at N points laid out in one parameterization, reconstructed everywhere by interpolation in that
+// parameterization, and compared with the ground truth over the whole space of direction pairs.
+//
+// Designs. Both divide the bounding box of the parameterization's isotropic form (a, b, φ) — or
+// of its full form (a, φa, b, φb) for anisotropic BRDFs — into cells, n per magnitude axis and 2n
+// per azimuth (which spans [0, 2π)), n chosen so that the number of cells inside the domain is
+// nearest the budget N (in ratio):
+//   regular     one measurement at the centre of every cell inside the domain;
+//   stratified  one at a uniformly random point of every cell (redrawn up to 8 times until it
+//               falls inside the domain; a cell that never does has no measurement).
+// Pairs beyond the instrument's reach (max_theta_deg) are not measured.
+// No symmetry is assumed (neither reciprocity nor the mirror symmetry φ → −φ): every
+// parameterization measures the same space, so budgets compare like with like.
+//
+// Reconstruction, at the coordinates x of a pair in the same form: from the 2^d cells around x
+// (those whose centres bracket x on every axis; azimuths wrap around, other axes clamp to the
+// outermost centres),
+//   regular     multilinear interpolation of their values;
+//   stratified  the value at x of the affine least-squares fit to their measurements, limited
+//               to the range of those measurements (no overshoot around a narrow peak); like
+//               multilinear interpolation, exact for affine functions (where x is inside the
+//               measurements' range) and second-order accurate for smooth ones.
+// Cells without a measurement (outside the domain, or whose value was not finite) are first filled
+// by dilation: in rounds, each empty cell next to filled ones takes the mean of their values, at
+// its centre. Values are RGB ρ, reconstructed channel by channel in linear space, as a renderer
+// would use a measured table.
+//
+// Error: ( Σ (T(Ŷ) − T(Y))² / Σ T(Y)² )^½ over test pairs drawn from the measure
+// dμ = cos θi cos θo dωi dωo (normalized: independent cosine-weighted directions, uniform
+// azimuths), T the error space of metrics.hpp: a Monte-Carlo estimate of the same μ-weighted
+// relative L² error as the other metrics, over the whole pair space.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/brdf/resample.hpp"
+#include "halfback/core/space.hpp"
+#include "halfback/study/metrics.hpp"
+
+namespace halfback::study {
+
+enum class Design { regular, stratified };
+std::string_view name_of(Design d);
+
+struct GonioSetup {
+  Space space = Space::hybrid;  // a parameterization, not dirs
+  bool isotropic = true;        // measure in the isotropic (3D) form, else in the full (4D) one
+  Design design = Design::regular;
+  std::size_t budget = 10000;  // measurements wanted (>= 1)
+  std::uint64_t seed = 1;      // the stratified design's random points
+  // The instrument's reach: no measurement where ωi or ωo is farther than this from the normal
+  // (those cells are filled by dilation). Real gonio-reflectometers stop short of grazing, and
+  // measured data are least reliable there (RGL's ρ grows like 1/cos θo past ~87°).
+  double max_theta_deg = 90;
+};
+
+// The cells of a setup: default_grid()'s ranges with n cells per magnitude axis and 2n per
+// azimuth, n such that the cells inside the domain are nearest the budget in ratio.
+GridSpec gonio_cells(const GonioSetup& setup);
+
+// A BRDF measured by the virtual gonio-reflectometer and reconstructed (a Brdf, so that it can be
+// evaluated, resampled and rendered like any other).
+class GonioReconstruction final : public Brdf {
+ public:
+  // Measures `truth` (which need not outlive this). Throws std::invalid_argument for dirs or a
+  // budget of 0, std::runtime_error when no measurement has a finite value.
+  GonioReconstruction(const Brdf& truth, const GonioSetup& setup);
+
+  std::string name() const override;
+  std::string description() const override;
+  bool isotropic() const override { return setup_.isotropic; }
+  bool reciprocal() const override { return false; }  // not enforced by the reconstruction
+  Rgb eval(const DirPair<double>& pair) const override;
+  void eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const override;
+
+  const GonioSetup& setup() const { return setup_; }
+  const GridSpec& cells() const { return cells_; }
+  std::size_t samples() const { return samples_; }  // measurements taken (finite values)
+
+ private:
+  Rgb reconstruct(const double* x) const;  // at coordinates x of the form
+
+  GonioSetup setup_;
+  GridSpec cells_;
+  std::string truth_name_;
+  std::size_t dim_ = 3;
+  std::size_t samples_ = 0;
+  std::array<bool, 4> periodic_{};
+  std::array<std::size_t, 4> stride_{};
+  // Per cell: the point of its measurement (or, for a filled cell, its centre) in cell units,
+  // each coordinate in [0, 1) from the cell's lower corner, and the value there.
+  std::vector<std::array<float, 4>> offset_;
+  std::vector<Rgb> value_;
+};
+
+// Test pairs for reconstruction_error(): `count` pairs drawn from the normalized measure
+// cos θi cos θo dωi dωo / π², those where the truth is finite kept, with the truth's value in
+// the error space.
+struct TestPairs {
+  std::vector<DirPair<double>> pairs;
+  std::vector<double> truth;
+  ErrorSpace space = ErrorSpace::log;
+};
+TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es);
+
+// The relative error of a reconstruction over the test pairs (header comment).
+double reconstruction_error(const Brdf& reconstruction, const TestPairs& test);
+
+// The budget at which an error curve (samples ascending, errors) reaches `target`, by linear
+// interpolation of log error against log samples between the two budgets that bracket it;
+// 0 when the smallest budget already reaches it, and +∞ when the largest does not.
+double samples_to_reach(std::span<const double> samples, std::span<const double> errors,
+                        double target);
+
+}  // namespace halfback::study

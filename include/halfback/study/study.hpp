@@ -1,0 +1,97 @@
+// The study of one BRDF in every parameterization (issue 6; docs/study.md): the metrics of
+// metrics.hpp, the virtual gonio-reflectometer of gonio.hpp and the image-space error of its
+// reconstructions (image_metrics.hpp). report.hpp writes the results of a set of BRDFs.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/core/space.hpp"
+#include "halfback/render/envmap.hpp"
+#include "halfback/study/gonio.hpp"
+#include "halfback/study/metrics.hpp"
+
+namespace halfback::study {
+
+// The parameterizations compared, in the order of every table.
+inline constexpr std::array<Space, 4> kStudied{Space::halfdiff, Space::ortho, Space::hybrid,
+                                               Space::spherical};
+
+struct StudyEnvironment {
+  std::string label;
+  std::shared_ptr<const render::EnvMap> map;
+};
+
+struct StudyConfig {
+  ErrorSpace space = ErrorSpace::log;
+  IsoGrid grid{64, 64, 64};                              // metrics 1-2, isotropic form
+  std::array<std::size_t, 4> full_grid{16, 32, 16, 32};  // metrics 1-2, full form (anisotropic)
+  std::vector<int> ranks{1, 2, 4, 8};
+  // Metric 3: budgets of the 3D (isotropic form) and 4D (full form, anisotropic BRDFs only)
+  // gonio-reflectometers, ascending; test pairs drawn from the measure.
+  std::vector<std::size_t> budgets{1000, 3000, 10000, 30000, 100000};
+  std::vector<std::size_t> budgets_4d{1000, 10000, 100000, 1000000};
+  std::size_t test_pairs = 200000;
+  double max_theta_deg = 85;  // the instrument's reach (GonioSetup)
+  std::uint64_t seed = 1;
+  // The 3D gonio-reflectometer runs on isotropic BRDFs, the 4D one on anisotropic BRDFs.
+  // Metric 4: the reconstructions at `image_budget` (one of `budgets`; of `budgets_4d` for an
+  // anisotropic BRDF, if it is one of them) rendered on a sphere
+  // under each environment, against the ground truth. Environment sampling only, with the same
+  // random numbers for every image, so that the reconstructions see the same light directions
+  // and the difference of two images is not drowned in Monte-Carlo noise.
+  std::vector<StudyEnvironment> environments;  // empty: no image-space error
+  std::size_t image_budget = 10000;
+  int image_size = 96, image_spp = 16;
+  // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.
+  std::function<void(std::string_view stage)> progress;
+
+  // Throws std::invalid_argument naming a bad setting (unsorted budgets, an image budget that
+  // is not one of them, sizes of 0). No budgets: no gonio-reflectometer and no images.
+  void validate() const;
+};
+
+struct GonioPoint {
+  Design design = Design::regular;
+  std::size_t budget = 0, samples = 0;
+  double error = 0;
+};
+
+struct ImagePoint {
+  Design design = Design::regular;
+  std::size_t samples = 0;
+  std::string environment;
+  double relative_rmse = 0, mean_delta_e = 0, p95_delta_e = 0;
+};
+
+struct ParamResult {
+  Space space = Space::hybrid;
+  double azimuthal = 0;
+  std::vector<double> separability_2d, separability_3d;  // one per rank
+  std::vector<GonioPoint> gonio;                         // designs × budgets (isotropic)
+  std::vector<ImagePoint> images;                        // designs × environments
+  // Anisotropic BRDFs only: the 4D metrics.
+  double azimuthal_4d = 0;
+  std::vector<double> separability_4d;
+  std::vector<GonioPoint> gonio_4d;
+};
+
+struct BrdfResult {
+  std::string label;
+  bool isotropic = true;
+  std::vector<ParamResult> params;  // in the order of kStudied
+  double seconds = 0;
+};
+
+// Every metric of `brdf` in every parameterization of kStudied (one task each; the renderings
+// then use all cores). Throws what the metrics throw.
+BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyConfig& config);
+
+}  // namespace halfback::study

@@ -1,0 +1,401 @@
+#include "halfback/study/gonio.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include "halfback/core/batch.hpp"
+
+namespace halfback::study {
+
+std::string_view name_of(Design d) {
+  return d == Design::regular ? "regular" : "stratified";
+}
+
+namespace {
+
+constexpr std::size_t kBlock = 1 << 16;
+constexpr int kStratifiedTries = 8;
+
+bool is_azimuth(const GridAxis& a) {
+  return a.name.find("phi") != std::string::npos;
+}
+
+GridSpec cells_for(const GonioSetup& s, std::size_t n) {
+  GridSpec g = default_grid(s.space, s.isotropic ? GridKind::isotropic : GridKind::full, {1});
+  for (GridAxis& a : g.axes) a.count = is_azimuth(a) ? 2 * n : n;
+  return g;
+}
+
+std::size_t cells_inside(const GridSpec& g) {
+  const std::size_t n = g.points();
+  std::vector<DirPair<double>> pairs(std::min(n, kBlock));
+  std::vector<std::uint8_t> ok(pairs.size());
+  std::size_t inside = 0;
+  for (std::size_t begin = 0; begin < n; begin += kBlock) {
+    const std::size_t m = std::min(kBlock, n - begin);
+    grid_pairs(g, begin, std::span(pairs).first(m), std::span(ok).first(m));
+    inside += std::size_t(std::count(ok.begin(), ok.begin() + std::ptrdiff_t(m), 1));
+  }
+  return inside;
+}
+
+// A reproducible uniform number in [0, 1) for (seed, cell, try, axis): SplitMix64 of a hash.
+double uniform(std::uint64_t seed, std::uint64_t cell, std::uint64_t attempt, std::uint64_t axis) {
+  std::uint64_t z = seed * 0x9E3779B97F4A7C15ull ^ (cell * 0xBF58476D1CE4E5B9ull) ^
+                    (attempt << 56) ^ (axis << 60);
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return double(z >> 11) * 0x1.0p-53;
+}
+
+// Coordinates of a form (SoA, dimension(form) columns of n values) -> direction pairs, with the
+// core's checked inverse.
+void to_pairs(Form form, const std::vector<std::vector<double>>& coords, std::size_t n,
+              std::span<DirPair<double>> pairs, std::span<std::uint8_t> valid) {
+  std::vector<ConstColumn<double>> in;
+  for (const auto& c : coords) in.push_back({c.data(), 1});
+  double* base = &pairs.data()->wi.x;
+  std::vector<Column<double>> out(6);
+  for (std::size_t c = 0; c < 6; ++c) out[c] = {base + c, 6};
+  ConvertOutput<double> conv;
+  conv.columns = out;
+  conv.valid = valid.data();
+  convert<double>(form, Form{Space::dirs, false}, in, n, conv, BatchOptions{1});
+}
+
+bool finite(const Rgb& c) {
+  return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
+}
+
+}  // namespace
+
+GridSpec gonio_cells(const GonioSetup& s) {
+  if (s.space == Space::dirs)
+    throw std::invalid_argument("the gonio-reflectometer needs a parameterization, not dirs");
+  if (s.budget == 0) throw std::invalid_argument("the gonio-reflectometer needs a budget >= 1");
+  if (!(s.max_theta_deg > 0 && s.max_theta_deg <= 90))
+    throw std::invalid_argument("the gonio-reflectometer's reach must be in (0, 90] degrees");
+  // A first guess from the fraction of the box inside the domain, then the nearest n.
+  const GridSpec probe = cells_for(s, 8);
+  const double fraction = double(cells_inside(probe)) / double(probe.points());
+  const double per_n = fraction * double(probe.points()) / std::pow(8.0, double(probe.axes.size()));
+  auto n = std::size_t(std::max(
+      1.0, std::round(std::pow(double(s.budget) / per_n, 1.0 / double(probe.axes.size())))));
+  auto inside = [&](std::size_t m) { return cells_inside(cells_for(s, m)); };
+  while (n > 1 && inside(n - 1) >= s.budget) --n;
+  while (inside(n) < s.budget) ++n;
+  if (n > 1) {
+    const double lo = double(inside(n - 1)), hi = double(inside(n));
+    if (lo > 0 && std::log(double(s.budget) / lo) < std::log(hi / double(s.budget))) --n;
+  }
+  return cells_for(s, n);
+}
+
+GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& setup)
+    : setup_(setup), cells_(gonio_cells(setup)), truth_name_(truth.name()) {
+  dim_ = cells_.axes.size();
+  for (std::size_t a = dim_, stride = 1; a-- > 0;) {
+    periodic_[a] = is_azimuth(cells_.axes[a]);
+    stride_[a] = stride;
+    stride *= cells_.axes[a].count;
+  }
+  const std::size_t n = cells_.points();
+  offset_.assign(n, {0.5f, 0.5f, 0.5f, 0.5f});
+  value_.assign(n, Rgb{});
+  std::vector<std::uint8_t> filled(n, 0);
+
+  // Where each cell is measured: its centre, or random points for the stratified design.
+  std::vector<std::size_t> todo(n);
+  for (std::size_t c = 0; c < n; ++c) todo[c] = c;
+  const int tries = setup_.design == Design::regular ? 1 : kStratifiedTries;
+  const Form form = cells_.form();
+  for (int attempt = 0; attempt < tries && !todo.empty(); ++attempt) {
+    std::vector<std::size_t> again;
+    for (std::size_t b = 0; b < todo.size(); b += kBlock) {
+      const std::size_t m = std::min(kBlock, todo.size() - b);
+      std::vector<std::vector<double>> coords(dim_, std::vector<double>(m));
+      std::vector<std::array<float, 4>> offsets(m, {0.5f, 0.5f, 0.5f, 0.5f});
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::size_t cell = todo[b + j];
+        for (std::size_t a = 0; a < dim_; ++a) {
+          const GridAxis& ax = cells_.axes[a];
+          const std::size_t i = cell / stride_[a] % ax.count;
+          if (setup_.design == Design::stratified)
+            offsets[j][a] = std::min(float(uniform(setup_.seed, cell, std::uint64_t(attempt), a)),
+                                     std::nextafter(1.0f, 0.0f));
+          coords[a][j] = ax.lo + (double(i) + offsets[j][a]) * (ax.hi - ax.lo) / double(ax.count);
+        }
+      }
+      std::vector<DirPair<double>> pairs(m);
+      std::vector<std::uint8_t> ok(m);
+      to_pairs(form, coords, m, pairs, ok);
+      std::vector<DirPair<double>> inside;
+      std::vector<std::size_t> which;
+      const double min_z = std::cos(setup_.max_theta_deg * std::numbers::pi / 180);
+      for (std::size_t j = 0; j < m; ++j) {
+        if (ok[j] &&
+            (setup_.max_theta_deg >= 90 || (pairs[j].wi.z >= min_z && pairs[j].wo.z >= min_z))) {
+          inside.push_back(pairs[j]);
+          which.push_back(j);
+        } else {
+          again.push_back(todo[b + j]);
+        }
+      }
+      std::vector<Rgb> rho(inside.size());
+      truth.eval(inside, rho);
+      for (std::size_t k = 0; k < inside.size(); ++k) {
+        if (!finite(rho[k])) continue;  // no data there: the cell is filled below
+        const std::size_t cell = todo[b + which[k]];
+        value_[cell] = rho[k];
+        offset_[cell] = offsets[which[k]];
+        filled[cell] = 1;
+        ++samples_;
+      }
+    }
+    todo = std::move(again);
+  }
+  if (samples_ == 0)
+    throw std::runtime_error(
+        fmt::format("gonio-reflectometer: {} has no finite value at any of the {} cells of {}",
+                    truth_name_, n, name_of(setup_.space)));
+
+  // Dilation: each round, every empty cell next to filled ones takes their mean, at its centre.
+  std::vector<std::size_t> empty;
+  for (std::size_t c = 0; c < n; ++c)
+    if (!filled[c]) empty.push_back(c);
+  while (!empty.empty()) {
+    std::vector<std::pair<std::size_t, Rgb>> round;
+    std::vector<std::size_t> still;
+    for (std::size_t c : empty) {
+      Rgb sum{};
+      int count = 0;
+      for (std::size_t a = 0; a < dim_; ++a) {
+        const std::size_t len = cells_.axes[a].count, i = c / stride_[a] % len;
+        for (int step : {-1, 1}) {
+          std::size_t j;
+          if (step < 0 ? i > 0 : i + 1 < len)
+            j = step < 0 ? i - 1 : i + 1;
+          else if (periodic_[a] && len > 1)
+            j = step < 0 ? len - 1 : 0;
+          else
+            continue;
+          const std::size_t nb = c - i * stride_[a] + j * stride_[a];
+          if (!filled[nb]) continue;
+          sum.r += value_[nb].r;
+          sum.g += value_[nb].g;
+          sum.b += value_[nb].b;
+          ++count;
+        }
+      }
+      if (count == 0) {
+        still.push_back(c);
+      } else {
+        round.push_back({c, Rgb{sum.r / count, sum.g / count, sum.b / count}});
+      }
+    }
+    if (round.empty()) break;  // cannot happen: the cells are connected and one is measured
+    for (const auto& [c, v] : round) {
+      value_[c] = v;
+      filled[c] = 1;
+    }
+    empty = std::move(still);
+  }
+}
+
+std::string GonioReconstruction::name() const {
+  return fmt::format("gonio:{}/{}/{}:{}", name_of(setup_.space), name_of(setup_.design), samples_,
+                     truth_name_);
+}
+
+std::string GonioReconstruction::description() const {
+  std::string counts;
+  for (const GridAxis& a : cells_.axes)
+    counts += fmt::format("{}{} {}", counts.empty() ? "" : " x ", a.count, a.name);
+  return fmt::format(
+      "{} measured at {} points of a {} design in the {} {} form ({} cells), reconstructed by {}",
+      truth_name_, samples_, name_of(setup_.design), setup_.isotropic ? "isotropic" : "full",
+      name_of(setup_.space), counts,
+      setup_.design == Design::regular ? "multilinear interpolation" : "local affine fits");
+}
+
+Rgb GonioReconstruction::reconstruct(const double* x) const {
+  // Cell coordinates of x and the lower corner of the 2^d cells whose centres bracket it.
+  double xn[4], t[4];
+  long lower[4];
+  for (std::size_t a = 0; a < dim_; ++a) {
+    const GridAxis& ax = cells_.axes[a];
+    const auto len = double(ax.count);
+    double u = (x[a] - ax.lo) / (ax.hi - ax.lo) * len;
+    if (periodic_[a]) {
+      u = std::fmod(u, len);
+      if (u < 0) u += len;
+      const double c = u - 0.5, f = std::floor(c);
+      lower[a] = long(f);
+      t[a] = c - f;
+    } else {
+      const double c = std::clamp(u - 0.5, 0.0, len - 1);
+      const double f = ax.count > 1 ? std::min(std::floor(c), len - 2) : 0.0;
+      lower[a] = long(f);
+      t[a] = ax.count > 1 ? c - f : 0.0;
+    }
+    xn[a] = u;
+  }
+  const unsigned corners = 1u << dim_;
+  std::size_t cell[16];
+  for (unsigned k = 0; k < corners; ++k) {
+    std::size_t flat = 0;
+    for (std::size_t a = 0; a < dim_; ++a) {
+      long i = lower[a] + long((k >> a) & 1u);
+      const auto len = long(cells_.axes[a].count);
+      if (periodic_[a]) i = (i % len + len) % len;
+      flat += std::size_t(std::min(i, len - 1)) * stride_[a];
+    }
+    cell[k] = flat;
+  }
+  auto multilinear = [&] {
+    Rgb v{};
+    for (unsigned k = 0; k < corners; ++k) {
+      double w = 1;
+      for (std::size_t a = 0; a < dim_; ++a) w *= (k >> a) & 1u ? t[a] : 1 - t[a];
+      v.r += w * value_[cell[k]].r;
+      v.g += w * value_[cell[k]].g;
+      v.b += w * value_[cell[k]].b;
+    }
+    return v;
+  };
+  if (setup_.design == Design::regular) return multilinear();
+
+  // Affine least squares in cell units about x: the constant term is the value at x.
+  using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;
+  using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 5, 3>;
+  const auto m = Eigen::Index(dim_ + 1);
+  Mat normal = Mat::Zero(m, m);
+  Rhs rhs = Rhs::Zero(m, 3);
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 5, 1> row(m);
+  for (unsigned k = 0; k < corners; ++k) {
+    row(0) = 1;
+    for (std::size_t a = 0; a < dim_; ++a)
+      row(Eigen::Index(a + 1)) =
+          double(lower[a] + long((k >> a) & 1u)) + offset_[cell[k]][a] - xn[a];
+    normal.noalias() += row * row.transpose();
+    const Rgb& v = value_[cell[k]];
+    for (Eigen::Index r = 0; r < m; ++r) {
+      rhs(r, 0) += row(r) * v.r;
+      rhs(r, 1) += row(r) * v.g;
+      rhs(r, 2) += row(r) * v.b;
+    }
+  }
+  const Eigen::LDLT<Mat> ldlt(normal);
+  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-9)) return multilinear();
+  const Rhs c = ldlt.solve(rhs);
+  // Limited to the range of the measurements used: an affine fit through a narrow peak would
+  // otherwise overshoot (and undershoot below 0) around it.
+  Rgb lo = value_[cell[0]], hi = lo;
+  for (unsigned k = 1; k < corners; ++k) {
+    const Rgb& v = value_[cell[k]];
+    lo = {std::min(lo.r, v.r), std::min(lo.g, v.g), std::min(lo.b, v.b)};
+    hi = {std::max(hi.r, v.r), std::max(hi.g, v.g), std::max(hi.b, v.b)};
+  }
+  return Rgb{std::clamp(c(0, 0), lo.r, hi.r), std::clamp(c(0, 1), lo.g, hi.g),
+             std::clamp(c(0, 2), lo.b, hi.b)};
+}
+
+Rgb GonioReconstruction::eval(const DirPair<double>& pair) const {
+  Rgb out;
+  eval(std::span(&pair, 1), std::span(&out, 1));
+  return out;
+}
+
+void GonioReconstruction::eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
+  if (out.size() != pairs.size())
+    throw std::invalid_argument("GonioReconstruction::eval: output size does not match");
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const Form form = cells_.form();
+  constexpr std::size_t kChunk = 1024;
+  std::vector<double> coords(dim_ * kChunk);
+  std::vector<std::uint8_t> ok(kChunk);
+  for (std::size_t b = 0; b < pairs.size(); b += kChunk) {
+    const std::size_t m = std::min(kChunk, pairs.size() - b);
+    const double* base = &pairs[b].wi.x;
+    std::vector<ConstColumn<double>> in(6);
+    for (std::size_t c = 0; c < 6; ++c) in[c] = {base + c, 6};
+    std::vector<Column<double>> cols(dim_);
+    for (std::size_t c = 0; c < dim_; ++c) cols[c] = {coords.data() + c * kChunk, 1};
+    ConvertOutput<double> conv;
+    conv.columns = cols;
+    conv.valid = ok.data();
+    convert<double>(Form{Space::dirs, false}, form, in, m, conv, BatchOptions{1});
+    for (std::size_t j = 0; j < m; ++j) {
+      const DirPair<double>& p = pairs[b + j];
+      if (!ok[j]) {  // below the horizon: 0, as the models; not a pair of directions: NaN
+        const bool number = std::isfinite(p.wi.x + p.wi.y + p.wi.z + p.wo.x + p.wo.y + p.wo.z);
+        out[b + j] = number ? Rgb{} : Rgb{kNaN, kNaN, kNaN};
+        continue;
+      }
+      double x[4];
+      for (std::size_t c = 0; c < dim_; ++c) x[c] = coords[c * kChunk + j];
+      out[b + j] = reconstruct(x);
+    }
+  }
+}
+
+TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es) {
+  // Independent cosine-weighted directions have the density cos θi cos θo / π² on pairs.
+  auto cosine = [&](std::uint64_t i, std::uint64_t which) {
+    const double u = uniform(seed, i, which, 0), v = uniform(seed, i, which, 1);
+    const double r = std::sqrt(u), phi = 2 * std::numbers::pi * v;
+    return Vec3<double>{r * std::cos(phi), r * std::sin(phi), std::sqrt(1 - u)};
+  };
+  std::vector<DirPair<double>> all(count);
+  for (std::size_t i = 0; i < count; ++i) all[i] = {cosine(i, 0), cosine(i, 1)};
+  std::vector<Rgb> rho(count);
+  truth.eval(all, rho);
+  TestPairs t;
+  t.space = es;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double y = luminance_of(rho[i]);
+    if (!std::isfinite(y)) continue;
+    t.pairs.push_back(all[i]);
+    t.truth.push_back(to_error_space(y, es));
+  }
+  return t;
+}
+
+double reconstruction_error(const Brdf& reconstruction, const TestPairs& test) {
+  std::vector<Rgb> rho(test.pairs.size());
+  reconstruction.eval(test.pairs, rho);
+  double err = 0, norm = 0;
+  for (std::size_t i = 0; i < rho.size(); ++i) {
+    const double y = to_error_space(luminance_of(rho[i]), test.space);
+    if (!std::isfinite(y))
+      throw std::runtime_error(reconstruction.name() + ": a reconstructed value is not finite");
+    err += (y - test.truth[i]) * (y - test.truth[i]);
+    norm += test.truth[i] * test.truth[i];
+  }
+  return norm > 0 ? std::sqrt(err / norm) : (err > 0 ? 1.0 : 0.0);
+}
+
+double samples_to_reach(std::span<const double> samples, std::span<const double> errors,
+                        double target) {
+  if (samples.size() != errors.size() || samples.empty())
+    throw std::invalid_argument("samples_to_reach: one error per budget, at least one");
+  if (errors[0] <= target) return 0;
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    if (errors[i] > target) continue;
+    const double x0 = std::log(samples[i - 1]), x1 = std::log(samples[i]);
+    const double y0 = std::log(errors[i - 1]), y1 = std::log(errors[i]);
+    const double y = std::log(target);
+    return std::exp(y0 == y1 ? x1 : x0 + (y - y0) * (x1 - x0) / (y1 - y0));
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+}  // namespace halfback::study

@@ -1,0 +1,112 @@
+// The study's files: CSV columns, the budget table, the report and its HTML version.
+#include "halfback/study/report.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+namespace halfback::study {
+namespace {
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("halfback_report_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// A made-up result whose numbers the files must repeat.
+BrdfResult fake(const std::string& label, bool isotropic) {
+  BrdfResult b;
+  b.label = label;
+  b.isotropic = isotropic;
+  double k = 1;
+  for (Space s : kStudied) {
+    ParamResult p;
+    p.space = s;
+    p.azimuthal = 0.1 * k;
+    p.separability_2d = {0.2 * k, 0.1 * k, 0.05 * k, 0.01 * k};
+    p.separability_3d = p.separability_2d;
+    // E = 0.5 k (N / 1000)^(-2/3): reaches 0.02 (k = 1) at N = 1000 · 25^(3/2) = 125000.
+    for (Design d : {Design::regular, Design::stratified})
+      for (std::size_t n : {1000u, 1000000u})
+        p.gonio.push_back({d, n, n, 0.5 * k * std::pow(n / 1000.0, -2.0 / 3)});
+    p.images.push_back({Design::regular, 1000, "sky", 0.03 * k, 1.5 * k, 3 * k});
+    if (!isotropic) {
+      p.azimuthal_4d = 0.3 * k;
+      p.separability_4d = p.separability_2d;
+      p.gonio_4d = p.gonio;
+    }
+    b.params.push_back(p);
+    k += 1;
+  }
+  return b;
+}
+
+TEST(Report, FilesRepeatTheResults) {
+  const auto dir = fresh_dir("files");
+  StudyConfig c;
+  c.budgets = {1000, 1000000};
+  c.image_budget = 1000;
+  const StudyOutput out = write_study(dir, {fake("a,b", true), fake("aniso", false)}, c, 1.5);
+  for (const char* f :
+       {"azimuthal.csv", "separability.csv", "gonio.csv", "budget.csv", "image.csv", "report.md",
+        "report.html", "gonio.png", "gonio.svg", "gonio4d.png", "image.png", "azimuthal.svg"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  const std::string az = slurp(dir / "azimuthal.csv");
+  EXPECT_EQ(az.rfind("brdf,parameterization,error,dims\n", 0), 0u);
+  EXPECT_NE(az.find("\"a,b\",halfdiff,0.1,3\n"), std::string::npos);  // quoted label
+  EXPECT_NE(az.find("aniso,ortho,0.6,4\n"), std::string::npos);
+  const std::string sep = slurp(dir / "separability.csv");
+  EXPECT_EQ(sep.rfind("brdf,parameterization,rank,error,dims\n", 0), 0u);
+  EXPECT_NE(sep.find("aniso,hybrid,8,0.03,4\n"), std::string::npos);
+  const std::string gon = slurp(dir / "gonio.csv");
+  EXPECT_EQ(gon.rfind("brdf,parameterization,design,samples,error,", 0), 0u);
+  EXPECT_NE(gon.find("aniso,spherical,stratified,1000000,0.02,4,1000000\n"), std::string::npos);
+  const std::string bud = slurp(dir / "budget.csv");
+  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.02,125000,reached\n"), std::string::npos) << bud;
+  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.01,353553,reached\n"), std::string::npos);
+  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.05,31623,reached\n"), std::string::npos);
+  // ortho (k = 2) reaches 0.05 at 1000 · 20^(3/2); spherical (k = 4) is 0.02 at 10^6.
+  EXPECT_NE(bud.find("aniso,ortho,stratified,4,0.05,89443,reached\n"), std::string::npos);
+  EXPECT_NE(bud.find("aniso,spherical,regular,3,0.01,,not_reached\n"), std::string::npos);
+  EXPECT_NE(slurp(dir / "image.csv").find("aniso,ortho,regular,1000,sky,0.06,3,6\n"),
+            std::string::npos);
+  // The report counts halfdiff (the lowest numbers) as the winner everywhere.
+  EXPECT_NE(out.markdown.find("halfdiff 2, ortho 0, hybrid 0, spherical 0"), std::string::npos);
+  EXPECT_NE(out.markdown.find("| a,b | 0.1000 |"), std::string::npos);
+  const std::string html = slurp(dir / "report.html");
+  EXPECT_NE(html.find("<img alt=\"Virtual gonio-reflectometer\" src=\"data:image/png;base64,"),
+            std::string::npos);
+  EXPECT_EQ(html.find("](gonio.png)"), std::string::npos);
+}
+
+TEST(Report, MarkdownToHtml) {
+  const auto dir = fresh_dir("html");
+  {
+    std::ofstream f(dir / "x.png", std::ios::binary);
+    f << "Man";  // base64 "TWFu"
+  }
+  const std::string html = markdown_to_html(
+      "# T <1>\n\nsome `a|b` and **bold**\ntext & more\n\n| h | k |\n|---|---|\n| 1 \\| 2 | 3 |\n\n"
+      "* one\n* two\n\n![pic](x.png)\n\n![gone](missing.png)\n",
+      dir, "t");
+  EXPECT_NE(html.find("<h1>T &lt;1&gt;</h1>"), std::string::npos);
+  EXPECT_NE(html.find("<p>some <code>a|b</code> and <strong>bold</strong> text &amp; more</p>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<tr><th>h</th><th>k</th></tr>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><td>1 | 2</td><td>3</td></tr>"), std::string::npos);
+  EXPECT_NE(html.find("<li>two</li>"), std::string::npos);
+  EXPECT_NE(html.find("src=\"data:image/png;base64,TWFu\""), std::string::npos);
+  EXPECT_NE(html.find("<a href=\"missing.png\">gone</a>"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace halfback::study

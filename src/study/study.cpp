@@ -1,0 +1,128 @@
+#include "halfback/study/study.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <future>
+#include <stdexcept>
+
+#include "halfback/render/brdf_sampler.hpp"
+#include "halfback/render/renderer.hpp"
+#include "halfback/study/image_metrics.hpp"
+
+namespace halfback::study {
+
+void StudyConfig::validate() const {
+  if (grid.a == 0 || grid.b == 0 || grid.phi == 0)
+    throw std::invalid_argument("study: the isotropic grid needs at least one cell per axis");
+  for (std::size_t c : full_grid)
+    if (c == 0) throw std::invalid_argument("study: the 4D grid needs at least one cell per axis");
+  for (const auto* b : {&budgets, &budgets_4d}) {
+    for (std::size_t i = 0; i < b->size(); ++i)
+      if ((*b)[i] == 0 || (i > 0 && (*b)[i] <= (*b)[i - 1]))
+        throw std::invalid_argument("study: sample budgets must be >= 1 and ascending");
+  }
+  if (test_pairs < 100) throw std::invalid_argument("study: at least 100 test pairs");
+  if (!(max_theta_deg > 0 && max_theta_deg <= 90))
+    throw std::invalid_argument(
+        "study: the gonio-reflectometer's reach must be in (0, 90] degrees");
+  if (!environments.empty() && !budgets.empty()) {
+    if (std::find(budgets.begin(), budgets.end(), image_budget) == budgets.end())
+      throw std::invalid_argument(
+          fmt::format("study: the image budget {} is not one of the sample budgets", image_budget));
+    if (image_size < 8 || image_spp < 1)
+      throw std::invalid_argument("study: images need >= 8 pixels and >= 1 sample per pixel");
+    for (const StudyEnvironment& e : environments)
+      if (!e.map) throw std::invalid_argument("study: environment '" + e.label + "' is empty");
+  }
+}
+
+namespace {
+
+constexpr Design kDesigns[] = {Design::regular, Design::stratified};
+
+render::RenderSettings image_settings(const StudyConfig& c) {
+  render::RenderSettings s;
+  s.width = s.height = c.image_size;
+  s.spp = c.image_spp;
+  s.seed = c.seed;
+  s.strategy = render::Strategy::env;  // the same light directions for every BRDF
+  s.threads = 0;
+  return s;
+}
+
+}  // namespace
+
+BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyConfig& config) {
+  config.validate();
+  const auto t0 = std::chrono::steady_clock::now();
+  auto say = [&](const std::string& stage) {
+    if (config.progress) config.progress(stage);
+  };
+  BrdfResult result;
+  result.label = label;
+  result.isotropic = brdf.isotropic();
+  const TestPairs test = draw_test_pairs(brdf, config.test_pairs, config.seed, config.space);
+  const bool gonio = !config.budgets.empty() && !test.pairs.empty();  // empty: metrics 1-2 only
+
+  // One task per parameterization; the reconstructions at the image budget are kept.
+  struct Task {
+    ParamResult r;
+    std::vector<std::unique_ptr<GonioReconstruction>> for_images;  // one per design
+  };
+  std::vector<std::future<Task>> tasks;
+  for (Space s : kStudied)
+    tasks.push_back(std::async(std::launch::async, [&, s] {
+      Task t;
+      t.r.space = s;
+      const IsoSamples x = sample_isotropic(brdf, s, config.grid, config.space);
+      t.r.azimuthal = azimuthal_error(x);
+      t.r.separability_2d = separability_2d(x, config.ranks);
+      t.r.separability_3d = separability_unfolded(x, config.ranks);
+      const bool iso = brdf.isotropic();
+      const auto& budgets = iso ? config.budgets : config.budgets_4d;
+      if (gonio)
+        for (Design d : kDesigns)
+          for (std::size_t budget : budgets) {
+            GonioSetup setup{s, iso, d, budget, config.seed};
+            setup.max_theta_deg = config.max_theta_deg;
+            auto rec = std::make_unique<GonioReconstruction>(brdf, setup);
+            (iso ? t.r.gonio : t.r.gonio_4d)
+                .push_back({d, budget, rec->samples(), reconstruction_error(*rec, test)});
+            if (budget == config.image_budget && !config.environments.empty())
+              t.for_images.push_back(std::move(rec));
+          }
+      if (!iso) {
+        const FullSamples f = sample_full(brdf, s, config.full_grid, config.space);
+        t.r.azimuthal_4d = azimuthal_error(f);
+        t.r.separability_4d = separability_4d(f, config.ranks);
+      }
+      say(fmt::format("{} {}", gonio ? "gonio" : "metrics", name_of(s)));
+      return t;
+    }));
+  std::vector<Task> done;
+  for (auto& f : tasks) done.push_back(f.get());
+
+  if (gonio && !config.environments.empty()) {
+    const render::RenderSettings settings = image_settings(config);
+    const auto cosine = render::make_cosine_sampler();  // unused by environment sampling
+    const std::vector<std::uint8_t> mask = sphere_mask(settings.width, settings.height);
+    for (const StudyEnvironment& env : config.environments) {
+      const render::Image truth = render::render(brdf, *cosine, *env.map, settings).image;
+      for (Task& t : done)
+        for (const auto& rec : t.for_images) {
+          const render::Image img = render::render(*rec, *cosine, *env.map, settings).image;
+          const ImageError e = compare_images(img, truth, mask);
+          t.r.images.push_back({rec->setup().design, rec->samples(), env.label, e.relative_rmse,
+                                e.mean_delta_e, e.p95_delta_e});
+        }
+      say(fmt::format("images {}", env.label));
+    }
+  }
+  for (Task& t : done) result.params.push_back(std::move(t.r));
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace halfback::study
