@@ -367,6 +367,12 @@ void append_name(fmt::memory_buffer& buf, std::string_view name) {
 
 }  // namespace
 
+std::string csv_text_field(std::string_view text) {
+  fmt::memory_buffer buf;
+  append_name(buf, text);
+  return fmt::to_string(buf);
+}
+
 void write_csv(std::span<const std::string> header,
                std::span<const std::span<const double>> columns, const CsvSink& sink,
                std::size_t chunk_bytes) {

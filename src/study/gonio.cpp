@@ -347,10 +347,15 @@ void GonioReconstruction::eval(std::span<const DirPair<double>> pairs, std::span
   }
 }
 
-TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es) {
-  // Independent cosine-weighted directions have the density cos θi cos θo / π² on pairs.
+TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es,
+                          double max_theta_deg) {
+  if (!(max_theta_deg > 0 && max_theta_deg <= 90))
+    throw std::invalid_argument("test pairs: the largest angle must be in (0, 90] degrees");
+  // Independent cosine-weighted directions have the density cos θi cos θo / π² on pairs; with
+  // z = √(1 − u), u uniform in [0, sin² θmax) keeps θ <= θmax.
+  const double s = std::sin(max_theta_deg * std::numbers::pi / 180), u_max = s * s;
   auto cosine = [&](std::uint64_t i, std::uint64_t which) {
-    const double u = uniform(seed, i, which, 0), v = uniform(seed, i, which, 1);
+    const double u = uniform(seed, i, which, 0) * u_max, v = uniform(seed, i, which, 1);
     const double r = std::sqrt(u), phi = 2 * std::numbers::pi * v;
     return Vec3<double>{r * std::cos(phi), r * std::sin(phi), std::sqrt(1 - u)};
   };

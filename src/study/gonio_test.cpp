@@ -131,6 +131,15 @@ TEST(Gonio, TestPairsFollowTheProjectedSolidAngleMeasure) {
   EXPECT_NEAR(zi / 20000, 2.0 / 3, 0.01);
   EXPECT_NEAR(zo / 20000, 2.0 / 3, 0.01);
   EXPECT_NEAR(xy / 20000, 0, 0.01);
+  // Within a reach of 60°: cos θ in [1/2, 1] with density ∝ cos θ sin θ, mean 7/9.
+  const TestPairs near = draw_test_pairs(one, 20000, 3, ErrorSpace::linear, 60);
+  double z_min = 1, z_mean = 0;
+  for (const auto& p : near.pairs) {
+    z_min = std::min({z_min, p.wi.z, p.wo.z});
+    z_mean += p.wi.z / 20000;
+  }
+  EXPECT_GE(z_min, 0.5 - 1e-12);
+  EXPECT_NEAR(z_mean, 7.0 / 9, 0.005);
   // A BRDF without data somewhere keeps only the pairs where it has some.
   const Fn half([](const DirPair<double>& p) {
     return p.wi.x > 0 ? 1.0 : std::numeric_limits<double>::quiet_NaN();

@@ -13,19 +13,13 @@
 #include "halfback/figure/chart.hpp"
 #include "halfback/figure/render.hpp"
 #include "halfback/io/atomic_file.hpp"
+#include "halfback/io/csv.hpp"
 
 namespace halfback::study {
 
 namespace {
 
 constexpr Design kDesigns[] = {Design::regular, Design::stratified};
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
 
 std::string md_cell(const std::string& s) {
   std::string out;
@@ -149,7 +143,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
       "brdf,parameterization,design,samples,environment,relative_rmse,mean_delta_e2000,"
       "p95_delta_e2000\n";
   for (const BrdfResult& b : results) {
-    const std::string brdf = csv_field(b.label);
+    const std::string brdf = csv_text_field(b.label);
     for (const ParamResult& p : b.params) {
       const std::string_view pn = name_of(p.space);
       az += fmt::format("{},{},{:.6g},3\n", brdf, pn, p.azimuthal);
@@ -182,8 +176,8 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
       gonio_rows(p.gonio_4d, 4);
       for (const ImagePoint& i : p.images)
         img += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g}\n", brdf, pn, name_of(i.design),
-                           i.samples, csv_field(i.environment), i.relative_rmse, i.mean_delta_e,
-                           i.p95_delta_e);
+                           i.samples, csv_text_field(i.environment), i.relative_rmse,
+                           i.mean_delta_e, i.p95_delta_e);
     }
   }
   auto csv = [&](const char* name, const std::string& text) {

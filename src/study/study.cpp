@@ -63,7 +63,9 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
   BrdfResult result;
   result.label = label;
   result.isotropic = brdf.isotropic();
-  const TestPairs test = draw_test_pairs(brdf, config.test_pairs, config.seed, config.space);
+  // The reconstructions are checked where the instrument reaches (docs/study.md says why).
+  const TestPairs test =
+      draw_test_pairs(brdf, config.test_pairs, config.seed, config.space, config.max_theta_deg);
   const bool gonio = !config.budgets.empty() && !test.pairs.empty();  // empty: metrics 1-2 only
 
   // One task per parameterization; the reconstructions at the image budget are kept.

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numbers>
 #include <random>
 #include <sstream>
@@ -118,6 +119,14 @@ CsvTable parse(const std::string& text) {
   CsvReadOptions options;
   options.allow_non_finite = true;
   return read_csv(text, "output", {}, options);
+}
+
+// Rows of a CSV text with text fields (quoted fields on one line), for the study's files.
+std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) rows.push_back(split_csv_line(line));
+  return rows;
 }
 
 std::vector<std::string> header_of(std::span<const std::string_view> names,
@@ -878,10 +887,11 @@ TEST_F(CliTest, FigureBadInputLeavesNothing) {
 // ---------------------------------------------------------------------------------------------
 
 TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
-  const Result r = run({"study", "--quick", "-o", "st", "test:S", "test:G"});
+  const Result r = run(
+      {"study", "--quick", "-o", "st", "test:S", "test:G", "ggx:alpha_x=0.2,alpha_y=0.5,f0=0.9"});
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string az = slurp(path("st") / "azimuthal.csv");
-  EXPECT_EQ(az.substr(0, az.find('\n')), "brdf,parameterization,error");
+  EXPECT_EQ(az.substr(0, az.find('\n')), "brdf,parameterization,error,dims");
   // S = 1 − ‖h̄‖ = 1 − sin θh cos θd has no azimuthal dependence in halfdiff, ortho and hybrid;
   // G = 1 − cos θi cos θo none in spherical, some in the others.
   auto error_of = [&](const std::string& key) {
@@ -895,12 +905,51 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
   }
   for (const char* key : {"test:S,spherical", "test:G,halfdiff", "test:G,ortho", "test:G,hybrid"})
     EXPECT_GT(error_of(key), 1e-3) << key << "\n" << az;
+  // The anisotropic model also has its 4D rows.
+  EXPECT_NE(az.find("\"ggx:alpha_x=0.2,alpha_y=0.5,f0=0.9\",hybrid,"), std::string::npos) << az;
+  EXPECT_NE(az.find(",4\n"), std::string::npos) << az;
   const std::string sep = slurp(path("st") / "separability.csv");
-  EXPECT_EQ(sep.substr(0, sep.find('\n')), "brdf,parameterization,rank,error");
-  EXPECT_NE(sep.find("test:S,hybrid-2d,8,"), std::string::npos);
-  EXPECT_NE(slurp(path("st") / "report.md").find("## Azimuthal dependence"), std::string::npos);
-  for (const char* f : {"azimuthal.png", "azimuthal.svg", "separability.png", "separability.svg"})
-    EXPECT_GT(fs::file_size(path("st") / f), 1000u) << f;
+  EXPECT_EQ(sep.substr(0, sep.find('\n')), "brdf,parameterization,rank,error,dims");
+  EXPECT_NE(sep.find("test:S,hybrid,8,"), std::string::npos);
+
+  // The gonio-reflectometer: the smooth S is reconstructed better from 10^4 measurements than
+  // from 10^3, in every parameterization and design.
+  const std::vector<std::vector<std::string>> gonio = csv_rows(slurp(path("st") / "gonio.csv"));
+  ASSERT_FALSE(gonio.empty());
+  EXPECT_EQ(gonio[0], (std::vector<std::string>{"brdf", "parameterization", "design", "samples",
+                                                "error", "dims", "budget"}));
+  std::map<std::string, std::map<std::string, double>> s_error;  // param/design -> budget -> e
+  int four_d = 0;
+  for (std::size_t i = 1; i < gonio.size(); ++i) {
+    ASSERT_EQ(gonio[i].size(), 7u);
+    if (gonio[i][0] == "test:S")
+      s_error[gonio[i][1] + "/" + gonio[i][2]][gonio[i][6]] = std::stod(gonio[i][4]);
+    four_d += gonio[i][5] == "4";
+  }
+  EXPECT_EQ(s_error.size(), 8u);
+  for (const auto& [key, e] : s_error) {
+    ASSERT_EQ(e.size(), 2u) << key;
+    EXPECT_LT(e.at("10000"), 0.7 * e.at("1000")) << key;
+    EXPECT_LT(e.at("10000"), 0.02) << key;
+  }
+  EXPECT_EQ(four_d, 16);  // the anisotropic GGX: 4 parameterizations x 2 designs x 2 budgets
+  const std::vector<std::vector<std::string>> image = csv_rows(slurp(path("st") / "image.csv"));
+  ASSERT_GT(image.size(), 1u);
+  EXPECT_EQ(image[0][5], "relative_rmse");
+  for (std::size_t i = 1; i < image.size(); ++i)
+    if (image[i][0] == "test:S") {
+      EXPECT_LT(std::stod(image[i][5]), 0.05) << image[i][1];
+    }
+
+  const std::string report = slurp(path("st") / "report.md");
+  for (const char* h : {"## 1. Azimuthal dependence", "## 2. Separability",
+                        "## 3. Virtual gonio-reflectometer", "## 4. Image-space error"})
+    EXPECT_NE(report.find(h), std::string::npos) << h;
+  EXPECT_NE(slurp(path("st") / "report.html").find("src=\"data:image/png;base64,"),
+            std::string::npos);
+  for (const char* f : {"azimuthal.png", "azimuthal.svg", "separability.png", "separability.svg",
+                        "gonio.png", "gonio.svg", "gonio4d.png", "image.png", "budget.csv"})
+    EXPECT_GT(fs::file_size(path("st") / f), 100u) << f;
 }
 
 TEST_F(CliTest, StudyBadInput) {
@@ -915,6 +964,18 @@ TEST_F(CliTest, StudyBadInput) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("no MERL, RGL or ALTA file"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("st")));
+  r = run({"study", "--budgets", "1000,100", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("ascending"), std::string::npos) << r.err;
+  r = run({"study", "--budgets", "1000,3000", "--image-budget", "5", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("image budget 5"), std::string::npos) << r.err;
+  r = run({"study", "--max-theta", "0", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  r = run({"study", "--env", "nowhere.hdr", "lambert"});
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("nowhere.hdr"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("study")));
 }
 
 }  // namespace

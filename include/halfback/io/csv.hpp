@@ -118,6 +118,10 @@ std::string parse_csv_number(std::string_view field, double& value, bool allow_n
 // "{:.17g}", except that every NaN prints as `nan`.
 std::string format_csv_number(double value);
 
+// A text field as written in a CSV file: quoted (RFC 4180) when it holds a comma, a quote, a
+// line break or surrounding blanks, as it is otherwise.
+std::string csv_text_field(std::string_view text);
+
 // Receives the written text in chunks.
 using CsvSink = std::function<void(std::string_view)>;
 

@@ -29,7 +29,8 @@
 // Error: ( Σ (T(Ŷ) − T(Y))² / Σ T(Y)² )^½ over test pairs drawn from the measure
 // dμ = cos θi cos θo dωi dωo (normalized: independent cosine-weighted directions, uniform
 // azimuths), T the error space of metrics.hpp: a Monte-Carlo estimate of the same μ-weighted
-// relative L² error as the other metrics, over the whole pair space.
+// relative L² error as the other metrics, over the whole pair space or over the pairs within
+// the instrument's reach (the study's default: docs/study.md says why).
 #pragma once
 
 #include <cstddef>
@@ -100,15 +101,17 @@ class GonioReconstruction final : public Brdf {
   std::vector<Rgb> value_;
 };
 
-// Test pairs for reconstruction_error(): `count` pairs drawn from the normalized measure
-// cos θi cos θo dωi dωo / π², those where the truth is finite kept, with the truth's value in
-// the error space.
+// Test pairs for reconstruction_error(): `count` pairs drawn from the measure
+// cos θi cos θo dωi dωo normalized on the pairs whose directions are both within `max_theta_deg`
+// of the normal (90: the whole pair space), those where the truth is finite kept, with the
+// truth's value in the error space.
 struct TestPairs {
   std::vector<DirPair<double>> pairs;
   std::vector<double> truth;
   ErrorSpace space = ErrorSpace::log;
 };
-TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es);
+TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es,
+                          double max_theta_deg = 90);
 
 // The relative error of a reconstruction over the test pairs (header comment).
 double reconstruction_error(const Brdf& reconstruction, const TestPairs& test);

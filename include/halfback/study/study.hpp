@@ -39,7 +39,7 @@ struct StudyConfig {
   std::vector<std::size_t> budgets{1000, 3000, 10000, 30000, 100000};
   std::vector<std::size_t> budgets_4d{1000, 10000, 100000, 1000000};
   std::size_t test_pairs = 200000;
-  double max_theta_deg = 85;  // the instrument's reach (GonioSetup)
+  double max_theta_deg = 85;  // the instrument's reach (GonioSetup), and of the test pairs
   std::uint64_t seed = 1;
   // The 3D gonio-reflectometer runs on isotropic BRDFs, the 4D one on anisotropic BRDFs.
   // Metric 4: the reconstructions at `image_budget` (one of `budgets`; of `budgets_4d` for an
