@@ -103,14 +103,13 @@ void check_series(const LineSeries& s) {
 Scene loglog_chart(const LogLogChart& c) {
   if (c.panels.empty()) throw std::invalid_argument("log-log chart: no panels");
   if (c.columns < 1) throw std::invalid_argument("log-log chart: columns must be >= 1");
-  double xmin = INFINITY, xmax = 0;
+  bool any = false;
   for (const LogLogPanel& p : c.panels)
     for (const LineSeries& s : p.series) {
       check_series(s);
-      for (double x : s.x) xmin = std::min(xmin, x), xmax = std::max(xmax, x);
+      any = true;
     }
-  if (xmax <= 0) throw std::invalid_argument("log-log chart: no points");
-  const auto [xlo, xhi] = decades(xmin, xmax);
+  if (!any) throw std::invalid_argument("log-log chart: no points");
 
   const auto cols = std::size_t(c.columns);
   const std::size_t rows = (c.panels.size() + cols - 1) / cols;
@@ -120,7 +119,11 @@ Scene loglog_chart(const LogLogChart& c) {
   const double legend = 16 * double((first.series.size() + 3) / 4) + 10;
   Scene sc;
   sc.title = c.title;
-  sc.width = snap(margin_left + double(std::min(cols, c.panels.size())) * cell_w + 10);
+  // Wide enough for the panels, the legend (4 entries a row) and the title (~0.62 em a glyph).
+  const double title_w = 24 + 13 * 0.62 * double(plain_text(c.title).size());
+  const double legend_w = margin_left + 150 * double(std::min<std::size_t>(4, first.series.size()));
+  sc.width = snap(std::max({margin_left + double(std::min(cols, c.panels.size())) * cell_w + 10,
+                            legend_w + 10, title_w}));
   sc.height = snap(top + double(rows) * cell_h + legend + 10);
   sc.text({12, 24}, escape_markup(c.title), 13, HAlign::left, VAlign::baseline, kBlack, 0, true);
   const Stroke grid{{0.88, 0.88, 0.88}, 0.5}, axis{kBlack, 0.7};
@@ -130,9 +133,12 @@ Scene loglog_chart(const LogLogChart& c) {
     const double x0 = margin_left + double(k % cols) * cell_w,
                  y0 = top + 16 + double(k / cols) * cell_h;
     const double w = c.panel_width, h = c.panel_height;
-    double ymin = INFINITY, ymax = 0;
-    for (const LineSeries& s : p.series)
+    double xmin = INFINITY, xmax = 0, ymin = INFINITY, ymax = 0;
+    for (const LineSeries& s : p.series) {
+      for (double x : s.x) xmin = std::min(xmin, x), xmax = std::max(xmax, x);
       for (double y : s.y) ymin = std::min(ymin, y), ymax = std::max(ymax, y);
+    }
+    const auto [xlo, xhi] = p.series.empty() ? std::pair{0, 1} : decades(xmin, xmax);
     const auto [ylo, yhi] = p.series.empty() ? std::pair{-1, 0} : decades(ymin, ymax);
     auto px = [&](double x) { return x0 + w * (std::log10(x) - xlo) / double(xhi - xlo); };
     auto py = [&](double y) { return y0 + h - h * (std::log10(y) - ylo) / double(yhi - ylo); };

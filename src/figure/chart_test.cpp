@@ -52,11 +52,11 @@ TEST(LogLogChart, PointsArePlacedOnTheDecadeAxes) {
   c.title = "errors";
   c.panels.push_back({"p_1",
                       {{"hybrid", 0, false, {1e3, 1e4}, {0.1, 0.01}},
-                       {"ortho", 1, true, {1e3, 1e4}, {0.05, 0.02}}}});
+                       {"ortho", 1, true, {1e3, 1e5}, {0.05, 0.02}}}});
   c.panels.push_back({"p2", {{"hybrid", 0, false, {1e3, 1e5}, {0.3, 0.2}}}});
   const Scene sc = loglog_chart(c);
-  // The first series of the first panel spans the x decades [3, 4] (panel 2 extends the shared
-  // x axis to 10^5) and its own y decades [-2, -1] corner to corner.
+  // The first series of the first panel spans the panel's x decades [3, 5] (the second series
+  // reaches 10^5) and its y decades [-2, -1] corner to corner.
   std::vector<const PathItem*> lines;
   for (const Item& item : sc.items)
     if (const auto* p = std::get_if<PathItem>(&item))

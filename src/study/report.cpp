@@ -39,11 +39,12 @@ std::string table_header(const std::string& first) {
 // The parameterization with the lowest value in each row, counted over the rows.
 struct Wins {
   std::array<int, kStudied.size()> count{};
+  // Ties (within 10^-9 relative) count for each of the tied parameterizations.
   void add(const std::array<double, kStudied.size()>& v) {
-    std::size_t best = 0;
-    for (std::size_t i = 1; i < v.size(); ++i)
-      if (v[i] < v[best]) best = i;
-    if (std::isfinite(v[best])) ++count[best];
+    const double best = *std::min_element(v.begin(), v.end());
+    if (!std::isfinite(best)) return;
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (v[i] <= best + 1e-9 * std::abs(best) + 1e-15) ++count[i];
   }
   std::string text() const {
     std::string s;
@@ -97,9 +98,12 @@ figure::Scene gonio_chart(const std::vector<BrdfResult>& results, bool four_d,
     for (std::size_t i = 0; i < b.params.size(); ++i)
       for (Design d : kDesigns) {
         auto [n, e] = curve(four_d ? b.params[i].gonio_4d : b.params[i].gonio, d);
-        bool positive = !n.empty();
-        for (double v : e) positive &= v > 0 && std::isfinite(v);
-        if (!positive) continue;  // an exact reconstruction has no place on a log axis
+        bool positive = !n.empty(), exact = true;
+        for (double v : e) {
+          positive &= v > 0 && std::isfinite(v);
+          exact &= v < 1e-12;
+        }
+        if (!positive || exact) continue;  // an exact reconstruction has no place on a log axis
         panel.series.push_back({fmt::format("{} {}", name_of(b.params[i].space), name_of(d)),
                                 int(i), d == Design::stratified, n, e});
       }
@@ -240,8 +244,10 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
     az_wins.add(v);
     md += row + "\n";
   }
-  md += fmt::format("\nLowest error (BRDFs): {}.\n\n![Azimuthal dependence](azimuthal.png)\n\n",
-                    az_wins.text());
+  md += fmt::format(
+      "\nLowest error (BRDFs; ties count for each): {}.\n\n![Azimuthal "
+      "dependence](azimuthal.png)\n\n",
+      az_wins.text());
   if (any_aniso) {
     md +=
         "Anisotropic BRDFs, 4D: the error of dropping the second azimuth (φd, φk or φo) at "

@@ -111,7 +111,14 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
     const auto cosine = render::make_cosine_sampler();  // unused by environment sampling
     const std::vector<std::uint8_t> mask = sphere_mask(settings.width, settings.height);
     for (const StudyEnvironment& env : config.environments) {
-      const render::Image truth = render::render(brdf, *cosine, *env.map, settings).image;
+      const render::RenderResult truth_result = render::render(brdf, *cosine, *env.map, settings);
+      // A BRDF without data somewhere (an ALTA file's few incidence angles) has no ground-truth
+      // image to compare with: its reconstructions extrapolate where it has nothing.
+      if (truth_result.nonfinite > 0) {
+        say(fmt::format("images {}: skipped, the BRDF has no value somewhere", env.label));
+        continue;
+      }
+      const render::Image& truth = truth_result.image;
       for (Task& t : done)
         for (const auto& rec : t.for_images) {
           const render::Image img = render::render(*rec, *cosine, *env.map, settings).image;

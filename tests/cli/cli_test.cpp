@@ -887,8 +887,8 @@ TEST_F(CliTest, FigureBadInputLeavesNothing) {
 // ---------------------------------------------------------------------------------------------
 
 TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
-  const Result r = run(
-      {"study", "--quick", "-o", "st", "test:S", "test:G", "ggx:alpha_x=0.2,alpha_y=0.5,f0=0.9"});
+  const Result r = run({"study", "--quick", "-o", "st", "test:S", "test:G",
+                        "ggx:alpha_x=0.2,alpha_y=0.5,f0=0.9", "embedded:acrylic_felt_green"});
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string az = slurp(path("st") / "azimuthal.csv");
   EXPECT_EQ(az.substr(0, az.find('\n')), "brdf,parameterization,error,dims");
@@ -932,7 +932,16 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
     EXPECT_LT(e.at("10000"), 0.7 * e.at("1000")) << key;
     EXPECT_LT(e.at("10000"), 0.02) << key;
   }
-  EXPECT_EQ(four_d, 16);  // the anisotropic GGX: 4 parameterizations x 2 designs x 2 budgets
+  EXPECT_EQ(four_d, 16);
+  // Measured data too: the felt's reconstruction improves with the budget.
+  std::map<std::string, double> felt;
+  for (const auto& row : gonio)
+    if (row[0] == "embedded:acrylic_felt_green" && row[2] == "regular")
+      felt[row[1] + row[6]] = std::stod(row[4]);
+  ASSERT_EQ(felt.size(), 8u);
+  for (const char* p : {"halfdiff", "ortho", "hybrid", "spherical"})
+    EXPECT_LT(felt[std::string(p) + "10000"], felt[std::string(p) + "1000"])
+        << p;  // the anisotropic GGX: 4 parameterizations x 2 designs x 2 budgets
   const std::vector<std::vector<std::string>> image = csv_rows(slurp(path("st") / "image.csv"));
   ASSERT_GT(image.size(), 1u);
   EXPECT_EQ(image[0][5], "relative_rmse");

@@ -44,8 +44,7 @@ struct LogLogChart {
   double panel_width = 170, panel_height = 120;
 };
 
-// The x axis spans the decades around every panel's x values (shared); each panel's y axis spans
-// the decades around its own y values. Throws std::invalid_argument for no panels, a series with
+// Each panel's axes span the decades around its own values. Throws std::invalid_argument for no panels, a series with
 // mismatched or no points, or a value that is not finite and > 0.
 Scene loglog_chart(const LogLogChart& chart);
 
