@@ -344,6 +344,47 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
       }
       md += "\n";
     }
+    // The budget each parameterization needs to match the best one at a reference budget.
+    const std::size_t ref = std::find(config.budgets.begin(), config.budgets.end(),
+                                      config.image_budget) != config.budgets.end()
+                                ? config.image_budget
+                                : config.budgets[config.budgets.size() / 2];
+    md += fmt::format(
+              "\nMeasurements each parameterization needs to reach E*, the lowest error of the "
+              "regular design at N = {} (as a multiple of the best one's samples; log-log "
+              "interpolation; “> ×k” when even the largest budget does not reach E*):\n\n",
+              ref) +
+          table_header("BRDF (E*)");
+    std::array<std::vector<double>, kStudied.size()> ratios;
+    for (const BrdfResult& b : results) {
+      double best = INFINITY, best_samples = 0;
+      for (const ParamResult& p : b.params)
+        if (const GonioPoint* g = find_point(p.gonio, Design::regular, ref); g && g->error < best) {
+          best = g->error;
+          best_samples = double(g->samples);
+        }
+      if (!std::isfinite(best) || best <= 1e-12) continue;  // not measured, or exact everywhere
+      md += fmt::format("| {} ({:.3g}) |", md_cell(b.label), best);
+      for (std::size_t i = 0; i < b.params.size(); ++i) {
+        const auto [n, e] = curve(b.params[i].gonio, Design::regular);
+        const double need = samples_to_reach(n, e, best * (1 + 1e-9));
+        const double ratio = need == 0 ? n.front() / best_samples : need / best_samples;
+        ratios[i].push_back(ratio);
+        md += std::isinf(ratio) ? fmt::format(" > ×{:.3g} |", n.back() / best_samples)
+                                : fmt::format(" ×{:.2f} |", ratio);
+      }
+      md += "\n";
+    }
+    std::string medians;
+    for (std::size_t i = 0; i < kStudied.size(); ++i) {
+      std::vector<double> r = ratios[i];
+      if (r.empty()) continue;
+      std::sort(r.begin(), r.end());
+      const double m =
+          r.size() % 2 ? r[r.size() / 2] : 0.5 * (r[r.size() / 2 - 1] + r[r.size() / 2]);
+      medians += fmt::format("{}{} ×{:.3g}", medians.empty() ? "" : ", ", name_of(kStudied[i]), m);
+    }
+    if (!medians.empty()) md += "\nMedian over the BRDFs: " + medians + ".\n";
     md += "\n![Virtual gonio-reflectometer](gonio.png)\n\n";
     if (any_aniso) {
       md += "Anisotropic BRDFs, 4D (measured in the full form; regular / stratified):\n\n";

@@ -82,6 +82,8 @@ TEST(Report, FilesRepeatTheResults) {
   // The report counts halfdiff (the lowest numbers) as the winner everywhere.
   EXPECT_NE(out.markdown.find("halfdiff 2, ortho 0, hybrid 0, spherical 0"), std::string::npos);
   EXPECT_NE(out.markdown.find("| a,b | 0.1000 |"), std::string::npos);
+  // ortho (k = 2) needs 1000 · 2^(3/2) measurements to reach halfdiff's error at 1000.
+  EXPECT_NE(out.markdown.find("| a,b (0.5) | ×1.00 | ×2.83 |"), std::string::npos) << out.markdown;
   const std::string html = slurp(dir / "report.html");
   EXPECT_NE(html.find("<img alt=\"Virtual gonio-reflectometer\" src=\"data:image/png;base64,"),
             std::string::npos);
