@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include "halfback/core/batch.hpp"
@@ -167,7 +168,22 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
         fmt::format("gonio-reflectometer: {} has no finite value at any of the {} cells of {}",
                     truth_name_, n, name_of(setup_.space)));
 
-  // Dilation: each round, every empty cell next to filled ones takes their mean, at its centre.
+  // Dilation: each round, every empty cell next to filled ones takes the mean of the linear
+  // extrapolations from them (2 v₁ − v₂ along an axis where two filled cells line up; the mean of
+  // the neighbours v₁ where none do), at its centre, clamped to >= 0. Linear extrapolation keeps
+  // affine functions exact up to the domain's edge, where a plain mean would make an O(h) error in
+  // every cell the edge cuts.
+  auto neighbour = [&](std::size_t c, std::size_t a, int step) -> std::optional<std::size_t> {
+    const std::size_t len = cells_.axes[a].count, i = c / stride_[a] % len;
+    std::size_t j;
+    if (step < 0 ? i > 0 : i + 1 < len)
+      j = step < 0 ? i - 1 : i + 1;
+    else if (periodic_[a] && len > 2)
+      j = step < 0 ? len - 1 : 0;
+    else
+      return std::nullopt;
+    return c - i * stride_[a] + j * stride_[a];
+  };
   std::vector<std::size_t> empty;
   for (std::size_t c = 0; c < n; ++c)
     if (!filled[c]) empty.push_back(c);
@@ -175,31 +191,32 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
     std::vector<std::pair<std::size_t, Rgb>> round;
     std::vector<std::size_t> still;
     for (std::size_t c : empty) {
-      Rgb sum{};
-      int count = 0;
-      for (std::size_t a = 0; a < dim_; ++a) {
-        const std::size_t len = cells_.axes[a].count, i = c / stride_[a] % len;
+      // Linear estimates where two filled cells line up, else the filled neighbours' values.
+      Rgb linear{}, near{};
+      int n_linear = 0, n_near = 0;
+      for (std::size_t a = 0; a < dim_; ++a)
         for (int step : {-1, 1}) {
-          std::size_t j;
-          if (step < 0 ? i > 0 : i + 1 < len)
-            j = step < 0 ? i - 1 : i + 1;
-          else if (periodic_[a] && len > 1)
-            j = step < 0 ? len - 1 : 0;
-          else
-            continue;
-          const std::size_t nb = c - i * stride_[a] + j * stride_[a];
-          if (!filled[nb]) continue;
-          sum.r += value_[nb].r;
-          sum.g += value_[nb].g;
-          sum.b += value_[nb].b;
-          ++count;
+          const auto n1 = neighbour(c, a, step);
+          if (!n1 || !filled[*n1]) continue;
+          const Rgb& v1 = value_[*n1];
+          near = {near.r + v1.r, near.g + v1.g, near.b + v1.b};
+          ++n_near;
+          const auto n2 = neighbour(*n1, a, step);
+          if (n2 && filled[*n2] && *n2 != c) {
+            const Rgb& v2 = value_[*n2];
+            linear = {linear.r + 2 * v1.r - v2.r, linear.g + 2 * v1.g - v2.g,
+                      linear.b + 2 * v1.b - v2.b};
+            ++n_linear;
+          }
         }
-      }
-      if (count == 0) {
+      if (n_near == 0) {
         still.push_back(c);
-      } else {
-        round.push_back({c, Rgb{sum.r / count, sum.g / count, sum.b / count}});
+        continue;
       }
+      const Rgb& sum = n_linear ? linear : near;
+      const double count = n_linear ? n_linear : n_near;
+      round.push_back({c, Rgb{std::max(sum.r / count, 0.0), std::max(sum.g / count, 0.0),
+                              std::max(sum.b / count, 0.0)}});
     }
     if (round.empty()) break;  // cannot happen: the cells are connected and one is measured
     for (const auto& [c, v] : round) {
@@ -241,8 +258,10 @@ Rgb GonioReconstruction::reconstruct(const double* x) const {
       lower[a] = long(f);
       t[a] = c - f;
     } else {
-      const double c = std::clamp(u - 0.5, 0.0, len - 1);
-      const double f = ax.count > 1 ? std::min(std::floor(c), len - 2) : 0.0;
+      // Between the box's edge and the outermost centres, t < 0 or t > 1: linear extrapolation
+      // from the two outermost cells (a clamp would make an O(h) error in those half cells).
+      const double c = u - 0.5;
+      const double f = ax.count > 1 ? std::clamp(std::floor(c), 0.0, len - 2) : 0.0;
       lower[a] = long(f);
       t[a] = ax.count > 1 ? c - f : 0.0;
     }
@@ -271,7 +290,10 @@ Rgb GonioReconstruction::reconstruct(const double* x) const {
     }
     return v;
   };
-  if (setup_.design == Design::regular) return multilinear();
+  if (setup_.design == Design::regular) {
+    const Rgb v = multilinear();  // may extrapolate below 0 near the box's edge
+    return {std::max(v.r, 0.0), std::max(v.g, 0.0), std::max(v.b, 0.0)};
+  }
 
   // Affine least squares in cell units about x: the constant term is the value at x.
   using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;

@@ -90,6 +90,22 @@ TEST(Gonio, AffineFunctionsAreReconstructedExactly) {
     }
 }
 
+TEST(Gonio, AffineFunctionsStayExactAtTheDomainsEdgeAndTheReach) {
+  // S = 1 − ‖h̄‖ is affine in the first coordinate of ortho and hybrid, whose domains are not
+  // boxes: cells cut by the domain's edge or beyond the reach are filled by linear extrapolation,
+  // and the box's outer half cells are extrapolated too, so that S is exact everywhere.
+  const Fn s([](const DirPair<double>& p) {
+    return 1 - std::hypot(p.wi.x + p.wo.x, p.wi.y + p.wo.y) / 2;
+  });
+  const TestPairs test = draw_test_pairs(s, 20000, 9, ErrorSpace::linear, 85);
+  for (Space space : {Space::ortho, Space::hybrid}) {
+    GonioSetup setup{space, true, Design::regular, 2000, 1};
+    setup.max_theta_deg = 85;
+    const GonioReconstruction r(s, setup);
+    EXPECT_LT(reconstruction_error(r, test), 1e-12) << name_of(space);
+  }
+}
+
 // The order p of the error in the cell size h ∝ N^(−1/d): E ∝ h^p.
 double order(const Brdf& f, Space s, Design d, std::size_t n0, std::size_t n1,
              const TestPairs& test) {

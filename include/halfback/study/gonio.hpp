@@ -14,16 +14,17 @@
 // parameterization measures the same space, so budgets compare like with like.
 //
 // Reconstruction, at the coordinates x of a pair in the same form: from the 2^d cells around x
-// (those whose centres bracket x on every axis; azimuths wrap around, other axes clamp to the
-// outermost centres),
-//   regular     multilinear interpolation of their values;
+// (those whose centres bracket x on every axis; azimuths wrap around; beyond the outermost
+// centres of another axis, the two outermost cells),
+//   regular     multilinear interpolation of their values (extrapolation beyond the outermost
+//               centres, clamped to >= 0);
 //   stratified  the value at x of the affine least-squares fit to their measurements, limited
 //               to the range of those measurements (no overshoot around a narrow peak); like
 //               multilinear interpolation, exact for affine functions (where x is inside the
 //               measurements' range) and second-order accurate for smooth ones.
-// Cells without a measurement (outside the domain, or whose value was not finite) are first filled
-// by dilation: in rounds, each empty cell next to filled ones takes the mean of their values, at
-// its centre. Values are RGB ρ, reconstructed channel by channel in linear space, as a renderer
+// Cells without a measurement (outside the domain or the reach, or whose value was not finite)
+// are first filled by dilation: in rounds, each empty cell next to filled ones takes the mean of
+// the linear extrapolations from them, at its centre. Values are RGB ρ, reconstructed channel by channel in linear space, as a renderer
 // would use a measured table.
 //
 // Error: ( Σ (T(Ŷ) − T(Y))² / Σ T(Y)² )^½ over test pairs drawn from the measure
