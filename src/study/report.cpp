@@ -356,6 +356,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
               ref) +
           table_header("BRDF (E*)");
     std::array<std::vector<double>, kStudied.size()> ratios;
+    std::string exact;
     for (const BrdfResult& b : results) {
       double best = INFINITY, best_samples = 0;
       for (const ParamResult& p : b.params)
@@ -363,7 +364,11 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
           best = g->error;
           best_samples = double(g->samples);
         }
-      if (!std::isfinite(best) || best <= 1e-12) continue;  // not measured, or exact everywhere
+      if (!std::isfinite(best)) continue;  // not measured
+      if (best <= 1e-12) {                 // reconstructed exactly by some parameterization
+        exact += (exact.empty() ? "" : ", ") + b.label;
+        continue;
+      }
       md += fmt::format("| {} ({:.3g}) |", md_cell(b.label), best);
       for (std::size_t i = 0; i < b.params.size(); ++i) {
         const auto [n, e] = curve(b.params[i].gonio, Design::regular);
@@ -385,6 +390,10 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
       medians += fmt::format("{}{} ×{:.3g}", medians.empty() ? "" : ", ", name_of(kStudied[i]), m);
     }
     if (!medians.empty()) md += "\nMedian over the BRDFs: " + medians + ".\n";
+    if (!exact.empty())
+      md +=
+          "\nLeft out, reconstructed exactly (E* = 0) by at least one parameterization: " + exact +
+          ".\n";
     md += "\n![Virtual gonio-reflectometer](gonio.png)\n\n";
     if (any_aniso) {
       md += "Anisotropic BRDFs, 4D (measured in the full form; regular / stratified):\n\n";
@@ -428,7 +437,14 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
     im_chart.x_label = "relative RMSE of the sphere renderings (regular design, mean over maps)";
     std::array<Wins, 2> rmse_wins, de_wins;
     std::string strat_rows;
+    std::string no_images;
     for (const BrdfResult& b : results) {
+      bool has_images = false;
+      for (const ParamResult& p : b.params) has_images |= !p.images.empty();
+      if (!has_images) {  // no finite ground truth to compare with (an ALTA file's gaps)
+        no_images += (no_images.empty() ? "" : ", ") + b.label;
+        continue;
+      }
       im_chart.rows.push_back(b.label);
       im_chart.values.emplace_back();
       std::array<std::string, 2> row{"| " + md_cell(b.label) + " |",
@@ -465,6 +481,9 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
               "\nLowest relative RMSE (BRDFs): {}; lowest ΔE00: {}.\n\n"
               "![Image-space error](image.png)\n\n",
               rmse_wins[1].text(), de_wins[1].text());
+    if (!no_images.empty())
+      md += "Not rendered (the BRDF has no value somewhere, so there is no ground-truth image): " +
+            no_images + ".\n\n";
   }
   md += "Files: ";
   for (std::size_t i = 0; i < out.files.size(); ++i) md += (i ? ", " : "") + out.files[i];
