@@ -138,8 +138,10 @@ Scene loglog_chart(const LogLogChart& c) {
       for (double x : s.x) xmin = std::min(xmin, x), xmax = std::max(xmax, x);
       for (double y : s.y) ymin = std::min(ymin, y), ymax = std::max(ymax, y);
     }
-    const auto [xlo, xhi] = p.series.empty() ? std::pair{0, 1} : decades(xmin, xmax);
-    const auto [ylo, yhi] = p.series.empty() ? std::pair{-1, 0} : decades(ymin, ymax);
+    // Plain variables, not structured bindings: Clang 14 cannot capture those in the lambdas.
+    const std::pair<int, int> xd = p.series.empty() ? std::pair{0, 1} : decades(xmin, xmax);
+    const std::pair<int, int> yd = p.series.empty() ? std::pair{-1, 0} : decades(ymin, ymax);
+    const int xlo = xd.first, xhi = xd.second, ylo = yd.first, yhi = yd.second;
     auto px = [&](double x) { return x0 + w * (std::log10(x) - xlo) / double(xhi - xlo); };
     auto py = [&](double y) { return y0 + h - h * (std::log10(y) - ylo) / double(yhi - ylo); };
     sc.text({x0 + w / 2, y0 - 6}, escape_markup(p.title), 8.5, HAlign::centre);
