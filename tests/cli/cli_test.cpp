@@ -887,7 +887,9 @@ TEST_F(CliTest, FigureBadInputLeavesNothing) {
 // ---------------------------------------------------------------------------------------------
 
 TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
-  const Result r = run({"study", "--quick", "-o", "st", "test:S", "test:G",
+  // --quick, lighter still: the test runs under the sanitizers too.
+  const Result r = run({"study", "--quick", "--test-pairs", "5000", "--env", "sky", "--image-size",
+                        "32", "--image-spp", "4", "-o", "st", "test:S", "test:G",
                         "ggx:alpha_x=0.2,alpha_y=0.5,f0=0.9", "embedded:acrylic_felt_green"});
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string az = slurp(path("st") / "azimuthal.csv");
