@@ -44,8 +44,8 @@ struct LogLogChart {
   double panel_width = 170, panel_height = 120;
 };
 
-// Each panel's axes span the decades around its own values. Throws std::invalid_argument for no panels, a series with
-// mismatched or no points, or a value that is not finite and > 0.
+// Each panel's axes span the decades around its own values. Throws std::invalid_argument for no
+// panels, a series with mismatched or no points, or a value that is not finite and > 0.
 Scene loglog_chart(const LogLogChart& chart);
 
 }  // namespace halfback::figure

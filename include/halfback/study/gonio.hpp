@@ -24,8 +24,8 @@
 //               measurements' range) and second-order accurate for smooth ones.
 // Cells without a measurement (outside the domain or the reach, or whose value was not finite)
 // are first filled by dilation: in rounds, each empty cell next to filled ones takes the mean of
-// the linear extrapolations from them, at its centre. Values are RGB ρ, reconstructed channel by channel in linear space, as a renderer
-// would use a measured table.
+// the linear extrapolations from them, at its centre. Values are RGB ρ, reconstructed channel by
+// channel in linear space, as a renderer would use a measured table.
 //
 // Error: ( Σ (T(Ŷ) − T(Y))² / Σ T(Y)² )^½ over test pairs drawn from the measure
 // dμ = cos θi cos θo dωi dωo (normalized: independent cosine-weighted directions, uniform
