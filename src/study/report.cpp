@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "halfback/figure/chart.hpp"
+#include "halfback/figure/plot.hpp"
 #include "halfback/figure/render.hpp"
 #include "halfback/io/atomic_file.hpp"
 #include "halfback/io/csv.hpp"
@@ -112,6 +113,56 @@ figure::Scene gonio_chart(const std::vector<BrdfResult>& results, bool four_d,
   if (c.panels.empty()) return {};
   c.columns = int(std::min<std::size_t>(4, c.panels.size()));
   return figure::loglog_chart(c);
+}
+
+// The renderings of the BRDFs and of their regular-design reconstructions under the first
+// environment, side by side (the same tone mapping for a row), for the eye.
+figure::Scene examples_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const double cell = 66, gap = 4, label_w = 250, top = 78;
+  std::size_t rows = 0;
+  for (const BrdfResult& b : results) rows += b.example_images.size() == kStudied.size() + 1;
+  if (rows == 0 || config.environments.empty()) return {};
+  figure::Scene sc;
+  sc.title = "Renderings of the reconstructions";
+  const std::string title = fmt::format(
+      "The BRDF and its reconstructions from {} measurements (regular design), under {}",
+      config.image_budget, config.environments.front().label);
+  const std::string note = fmt::format(
+      "{} environment samples per pixel, the same in every image: the noise is common to a row",
+      config.image_spp);
+  sc.width = figure::snap(std::max(label_w + double(kStudied.size() + 1) * (cell + gap) + 10,
+                                   24 + 13 * 0.62 * double(title.size())));
+  sc.height = figure::snap(top + 14 + double(rows) * (cell + gap) + 10);
+  sc.text({12, 24}, figure::escape_markup(title), 13, figure::HAlign::left,
+          figure::VAlign::baseline, figure::kBlack, 0, true);
+  sc.text({12, 42}, figure::escape_markup(note), 9.5);
+  const char* heads[] = {"BRDF", "halfdiff", "ortho", "hybrid", "spherical"};
+  for (std::size_t k = 0; k < std::size(heads); ++k)
+    sc.text({label_w + double(k) * (cell + gap) + cell / 2, top - 8}, heads[k], 9,
+            figure::HAlign::centre);
+  double y = top;
+  for (const BrdfResult& b : results) {
+    if (b.example_images.size() != kStudied.size() + 1) continue;
+    sc.text({label_w - 8, y + cell / 2}, figure::escape_markup(b.label), 8.5, figure::HAlign::right,
+            figure::VAlign::middle);
+    for (std::size_t k = 0; k < b.example_images.size(); ++k) {
+      const render::Image& img = b.example_images[k];
+      const std::vector<std::uint8_t> rgb = render::tonemap_srgb8(img, {});
+      figure::ImageItem item;
+      item.x = label_w + double(k) * (cell + gap);
+      item.y = y;
+      item.width = item.height = cell;
+      item.px_width = std::size_t(img.width);
+      item.px_height = std::size_t(img.height);
+      item.rgba.reserve(rgb.size() / 3 * 4);
+      for (std::size_t i = 0; i < rgb.size(); i += 3)
+        item.rgba.insert(item.rgba.end(), {rgb[i], rgb[i + 1], rgb[i + 2], 255});
+      item.smooth = true;
+      sc.add(std::move(item));
+    }
+    y += cell + gap;
+  }
+  return sc;
 }
 
 void save_plot(const figure::Scene& sc, const std::filesystem::path& dir, const std::string& stem,
@@ -479,7 +530,8 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
           table_header("BRDF") + strat_rows +
           fmt::format(
               "\nLowest relative RMSE (BRDFs): {}; lowest ΔE00: {}.\n\n"
-              "![Image-space error](image.png)\n\n",
+              "![Image-space error](image.png)\n\n"
+              "![Renderings of the reconstructions](renderings.png)\n\n",
               rmse_wins[1].text(), de_wins[1].text());
     if (!no_images.empty())
       md += "Not rendered (the BRDF has no value somewhere, so there is no ground-truth image): " +
@@ -494,7 +546,10 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
   if (any_gonio) save_plot(gonio_chart(results, false, config), dir, "gonio", out.files);
   if (any_gonio && any_aniso)
     save_plot(gonio_chart(results, true, config), dir, "gonio4d", out.files);
-  if (any_images) save_plot(figure::bar_chart(im_chart), dir, "image", out.files);
+  if (any_images) {
+    save_plot(figure::bar_chart(im_chart), dir, "image", out.files);
+    save_plot(examples_chart(results, config), dir, "renderings", out.files);
+  }
   write_text(dir / "report.md", md);
   write_text(dir / "report.html", markdown_to_html(md, dir, "halfback study"));
   out.files.push_back("report.md");

@@ -55,7 +55,11 @@ TEST(Report, FilesRepeatTheResults) {
   StudyConfig c;
   c.budgets = {1000, 1000000};
   c.image_budget = 1000;
-  const StudyOutput out = write_study(dir, {fake("a,b", true), fake("aniso", false)}, c, 1.5);
+  c.environments.push_back({"sky", nullptr});  // only its label is used by the report
+  BrdfResult with_images = fake("a,b", true);
+  render::Image grey{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
+  with_images.example_images.assign(kStudied.size() + 1, grey);
+  const StudyOutput out = write_study(dir, {with_images, fake("aniso", false)}, c, 1.5);
   for (const char* f :
        {"azimuthal.csv", "separability.csv", "gonio.csv", "budget.csv", "image.csv", "report.md",
         "report.html", "gonio.png", "gonio.svg", "gonio4d.png", "image.png", "azimuthal.svg"})

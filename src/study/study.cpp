@@ -119,9 +119,12 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
         continue;
       }
       const render::Image& truth = truth_result.image;
+      const bool first = &env == &config.environments.front();
+      if (first) result.example_images.push_back(truth);
       for (Task& t : done)
         for (const auto& rec : t.for_images) {
           const render::Image img = render::render(*rec, *cosine, *env.map, settings).image;
+          if (first && rec->setup().design == Design::regular) result.example_images.push_back(img);
           const ImageError e = compare_images(img, truth, mask);
           t.r.images.push_back({rec->setup().design, rec->samples(), env.label, e.relative_rmse,
                                 e.mean_delta_e, e.p95_delta_e});

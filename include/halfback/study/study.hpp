@@ -15,6 +15,7 @@
 #include "halfback/brdf/brdf.hpp"
 #include "halfback/core/space.hpp"
 #include "halfback/render/envmap.hpp"
+#include "halfback/render/image.hpp"
 #include "halfback/study/gonio.hpp"
 #include "halfback/study/metrics.hpp"
 
@@ -87,6 +88,9 @@ struct BrdfResult {
   std::string label;
   bool isotropic = true;
   std::vector<ParamResult> params;  // in the order of kStudied
+  // Under the first environment: the BRDF's rendering, then its regular-design reconstructions
+  // at the image budget in the order of kStudied (empty when there are no images).
+  std::vector<render::Image> example_images;
   double seconds = 0;
 };
 
