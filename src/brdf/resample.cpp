@@ -152,8 +152,22 @@ void grid_pairs(const GridSpec& grid, std::size_t begin, std::span<DirPair<doubl
     const std::array<double, 4> x = grid.point(begin + j);
     for (std::size_t c = 0; c < dim; ++c) coords[c][j] = x[c];
   }
-  std::vector<ConstColumn<double>> in(dim);
-  for (std::size_t c = 0; c < dim; ++c) in[c] = {coords[c].data(), 1};
+  std::vector<std::span<const double>> columns(coords.begin(), coords.end());
+  coordinates_to_pairs(form, columns, pairs, valid, jacobian);
+}
+
+void coordinates_to_pairs(Form form, std::span<const std::span<const double>> columns,
+                          std::span<DirPair<double>> pairs, std::span<std::uint8_t> valid,
+                          std::span<double> jacobian) {
+  const std::size_t m = pairs.size();
+  if (columns.size() != dimension(form) || valid.size() != m ||
+      (!jacobian.empty() && jacobian.size() != m))
+    throw std::invalid_argument("coordinates_to_pairs: column count or sizes do not match");
+  std::vector<ConstColumn<double>> in;
+  for (std::span<const double> c : columns) {
+    if (c.size() != m) throw std::invalid_argument("coordinates_to_pairs: columns differ in size");
+    in.push_back({c.data(), 1});
+  }
   // The engine writes straight into the pairs: a DirPair<double> is 6 contiguous doubles.
   static_assert(sizeof(DirPair<double>) == 6 * sizeof(double));
   double* base = &pairs.data()->wi.x;

@@ -177,6 +177,31 @@ TEST(Resample, DefaultGridsAndValidation) {
             std::string::npos);
 }
 
+TEST(Resample, CoordinatesToPairs) {
+  // Hybrid isotropic (‖h̄‖, ‖k‖, φ): (0, 0.6, 0) is the pair ωi = (0.6, 0, 0.8), ωo = (−0.6, 0,
+  // 0.8); ‖k‖ = 1 with ‖h̄‖ = 0.5 is outside the domain.
+  const std::vector<double> hbar{0, 0.5}, k{0.6, 1}, phi{0, 0};
+  const std::vector<std::span<const double>> columns{hbar, k, phi};
+  std::vector<DirPair<double>> pairs(2);
+  std::vector<std::uint8_t> valid(2);
+  coordinates_to_pairs({Space::hybrid, true}, columns, pairs, valid);
+  ASSERT_EQ(valid[0], 1);
+  EXPECT_EQ(valid[1], 0);
+  EXPECT_NEAR(pairs[0].wi.z, 0.8, 1e-12);
+  EXPECT_NEAR(pairs[0].wo.z, 0.8, 1e-12);
+  EXPECT_NEAR(std::abs(pairs[0].wi.x - pairs[0].wo.x), 1.2, 1e-12);
+  EXPECT_TRUE(std::isnan(pairs[1].wi.z));
+  // Two columns for a 3D form, or columns of the wrong length, are refused.
+  EXPECT_THROW(coordinates_to_pairs({Space::hybrid, true},
+                                    std::vector<std::span<const double>>{hbar, k}, pairs, valid),
+               std::invalid_argument);
+  const std::vector<double> one{0};
+  EXPECT_THROW(
+      coordinates_to_pairs({Space::hybrid, true},
+                           std::vector<std::span<const double>>{hbar, k, one}, pairs, valid),
+      std::invalid_argument);
+}
+
 TEST(Resample, ThreadCountDoesNotChangeTheBits) {
   const Smooth brdf;
   const GridSpec g = default_grid(Space::ortho, GridKind::isotropic, {33, 17, 29});

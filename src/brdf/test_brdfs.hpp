@@ -1,8 +1,10 @@
-// BRDFs for the tests of the BRDF layer (not part of the library).
+// BRDFs for the tests of the BRDF layer and the study (not part of the library).
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <string>
+#include <utility>
 
 #include "halfback/brdf/brdf.hpp"
 
@@ -23,6 +25,27 @@ class Smooth final : public Brdf {
   }
   using Brdf::eval;
   mutable std::atomic<long> calls{0};
+};
+
+// An isotropic "BRDF" from a scalar function of the pair, ρ = f · tint (a tint with unequal
+// channels shows a mixed-up channel; the default's luminance is f itself).
+class FunctionBrdf : public Brdf {
+ public:
+  explicit FunctionBrdf(std::function<double(const DirPair<double>&)> f, Rgb tint = {1, 1, 1})
+      : f_(std::move(f)), tint_(tint) {}
+  std::string name() const override { return "function"; }
+  std::string description() const override { return "test function"; }
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return false; }
+  Rgb eval(const DirPair<double>& p) const override {
+    const double v = f_(p);
+    return {v * tint_.r, v * tint_.g, v * tint_.b};
+  }
+  using Brdf::eval;
+
+ private:
+  std::function<double(const DirPair<double>&)> f_;
+  Rgb tint_;
 };
 
 }  // namespace halfback::test

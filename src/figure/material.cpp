@@ -30,6 +30,23 @@ const std::vector<NamedEnvironment>& default_environments() {
   return envs;
 }
 
+ImageItem rendering_item(const render::Image& image, double x, double y, double size) {
+  const std::vector<std::uint8_t> rgb = render::tonemap_srgb8(image, {});
+  ImageItem item;
+  item.x = x;
+  item.y = y;
+  item.width = item.height = size;
+  item.px_width = std::size_t(image.width);
+  item.px_height = std::size_t(image.height);
+  item.rgba.resize(4 * rgb.size() / 3);
+  for (std::size_t p = 0; p < rgb.size() / 3; ++p) {
+    std::copy_n(&rgb[3 * p], 3, &item.rgba[4 * p]);
+    item.rgba[4 * p + 3] = 255;
+  }
+  item.smooth = true;
+  return item;
+}
+
 MaterialFigure material_figure(const MaterialFigureOptions& o) {
   if (!o.brdf) throw std::invalid_argument("material figure: no BRDF given");
   if (o.environments.empty()) throw std::invalid_argument("material figure: no environment given");
@@ -74,20 +91,7 @@ MaterialFigure material_figure(const MaterialFigureOptions& o) {
   sc.height = snap(top + size + caption + 16 + slices.height);
   for (std::size_t k = 0; k < n; ++k) {
     const render::Image& img = fig.renders[k];
-    const std::vector<std::uint8_t> rgb = render::tonemap_srgb8(img, {});
-    ImageItem item;
-    item.x = x0 + double(k) * (size + gap);
-    item.y = top;
-    item.width = item.height = size;
-    item.px_width = std::size_t(img.width);
-    item.px_height = std::size_t(img.height);
-    item.rgba.resize(4 * rgb.size() / 3);
-    for (std::size_t p = 0; p < rgb.size() / 3; ++p) {
-      std::copy_n(&rgb[3 * p], 3, &item.rgba[4 * p]);
-      item.rgba[4 * p + 3] = 255;
-    }
-    item.smooth = true;
-    sc.add(std::move(item));
+    sc.add(rendering_item(img, x0 + double(k) * (size + gap), top, size));
     const double x = x0 + double(k) * (size + gap);
     draw_frame(sc, {x, top, size, size}, 0.6);
     sc.text({x0 + double(k) * (size + gap) + size / 2, top + size + 14},

@@ -1,6 +1,7 @@
 #include "halfback/figure/render.hpp"
 
 #include "halfback/io/atomic_file.hpp"
+#include "halfback/io/text_encoding.hpp"
 
 #include <cairo-pdf.h>
 #include <cairo.h>
@@ -241,53 +242,6 @@ std::string num(double v) {
   return s;
 }
 
-std::string escape(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-std::string base64(std::string_view in) {
-  static constexpr char k[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((in.size() + 2) / 3 * 4);
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const std::uint32_t v = (std::uint32_t(std::uint8_t(in[i])) << 16) |
-                            (std::uint32_t(std::uint8_t(in[i + 1])) << 8) | std::uint8_t(in[i + 2]);
-    out += k[v >> 18];
-    out += k[(v >> 12) & 63];
-    out += k[(v >> 6) & 63];
-    out += k[v & 63];
-  }
-  if (i < in.size()) {
-    std::uint32_t v = std::uint32_t(std::uint8_t(in[i])) << 16;
-    if (i + 1 < in.size()) v |= std::uint32_t(std::uint8_t(in[i + 1])) << 8;
-    out += k[v >> 18];
-    out += k[(v >> 12) & 63];
-    out += i + 1 < in.size() ? k[(v >> 6) & 63] : '=';
-    out += '=';
-  }
-  return out;
-}
-
 std::string paint_attributes(const std::optional<Color>& fill,
                              const std::optional<Stroke>& stroke) {
   std::string a;
@@ -319,7 +273,7 @@ std::string render_svg(const Scene& scene) {
       "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" "
       "width=\"{0}pt\" height=\"{1}pt\" viewBox=\"0 0 {0} {1}\" version=\"1.1\">\n",
       num(scene.width), num(scene.height));
-  if (!scene.title.empty()) out += fmt::format("<title>{}</title>\n", escape(scene.title));
+  if (!scene.title.empty()) out += fmt::format("<title>{}</title>\n", escape_xml(scene.title));
   out += fmt::format(
       "<g stroke-linejoin=\"round\" stroke-linecap=\"round\" font-family=\"{}, Verdana, "
       "sans-serif\">\n",
@@ -346,7 +300,7 @@ std::string render_svg(const Scene& scene) {
           "<image x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" preserveAspectRatio=\"none\"{} "
           "xlink:href=\"data:image/png;base64,{}\"/>\n",
           num(im->x), num(im->y), num(im->width), num(im->height),
-          im->smooth ? "" : " style=\"image-rendering:pixelated\"", base64(png));
+          im->smooth ? "" : " style=\"image-rendering:pixelated\"", base64_encode(png));
     } else if (const auto* t = std::get_if<TextItem>(&item)) {
       const char* anchor = t->halign == HAlign::left     ? "start"
                            : t->halign == HAlign::centre ? "middle"
@@ -373,8 +327,8 @@ std::string render_svg(const Scene& scene) {
         std::string ta;
         if (dy != 0) ta += fmt::format(" dy=\"{}\"", num(dy));
         if (r.script != 0) ta += fmt::format(" font-size=\"{}\"", num(t->size * kScriptScale));
-        body +=
-            ta.empty() ? escape(r.text) : fmt::format("<tspan{}>{}</tspan>", ta, escape(r.text));
+        body += ta.empty() ? escape_xml(r.text)
+                           : fmt::format("<tspan{}>{}</tspan>", ta, escape_xml(r.text));
       }
       out += fmt::format("<text xml:space=\"preserve\"{}>{}</text>\n", attrs, body);
     }

@@ -10,28 +10,17 @@
 #include <numbers>
 #include <random>
 
+#include "brdf/test_brdfs.hpp"
+
 namespace halfback::study {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-class Fn final : public Brdf {
- public:
-  explicit Fn(std::function<double(const DirPair<double>&)> f, bool iso = true)
-      : f_(std::move(f)), iso_(iso) {}
-  std::string name() const override { return "fn"; }
-  std::string description() const override { return "test function"; }
-  bool isotropic() const override { return iso_; }
-  bool reciprocal() const override { return false; }
-  Rgb eval(const DirPair<double>& p) const override {
-    const double v = f_(p);
-    return {v, 0.5 * v, 2 * v};
-  }
-  using Brdf::eval;
-
- private:
-  std::function<double(const DirPair<double>&)> f_;
-  bool iso_;
+// Unequal channels: a reconstruction that mixes them up shows.
+struct Fn : test::FunctionBrdf {
+  explicit Fn(std::function<double(const DirPair<double>&)> f)
+      : test::FunctionBrdf(std::move(f), {1, 0.5, 2}) {}
 };
 
 Vec3<double> dir(double theta, double phi) {

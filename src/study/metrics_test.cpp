@@ -7,28 +7,13 @@
 #include <functional>
 #include <numbers>
 
+#include "brdf/test_brdfs.hpp"
 #include "halfback/brdf/load.hpp"
 
 namespace halfback::study {
 namespace {
 
-// A scalar "BRDF" from a function of the pair.
-class Fn final : public Brdf {
- public:
-  explicit Fn(std::function<double(const DirPair<double>&)> f) : f_(std::move(f)) {}
-  std::string name() const override { return "fn"; }
-  std::string description() const override { return "test function"; }
-  bool isotropic() const override { return true; }
-  bool reciprocal() const override { return true; }
-  Rgb eval(const DirPair<double>& p) const override {
-    const double v = f_(p);
-    return {v, v, v};
-  }
-  using Brdf::eval;
-
- private:
-  std::function<double(const DirPair<double>&)> f_;
-};
+using Fn = test::FunctionBrdf;
 
 double hbar_of(const DirPair<double>& p) {
   return std::hypot(p.wi.x + p.wo.x, p.wi.y + p.wo.y) / 2;

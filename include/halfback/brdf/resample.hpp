@@ -76,6 +76,13 @@ void validate(const GridSpec& grid);
 void grid_pairs(const GridSpec& grid, std::size_t begin, std::span<DirPair<double>> pairs,
                 std::span<std::uint8_t> valid, std::span<double> jacobian = {});
 
+// The direction pairs at coordinates of a form, given as dimension(form) columns of
+// pairs.size() values each, by the core's checked batch inverse; `valid` and `jacobian` as in
+// grid_pairs(). On the calling thread.
+void coordinates_to_pairs(Form form, std::span<const std::span<const double>> columns,
+                          std::span<DirPair<double>> pairs, std::span<std::uint8_t> valid,
+                          std::span<double> jacobian = {});
+
 struct ResampledTable {
   GridSpec grid;
   std::string brdf_name, brdf_description;

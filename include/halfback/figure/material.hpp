@@ -26,6 +26,10 @@ NamedEnvironment load_environment(const std::string& spec);
 // The three built-ins, default (sky), studio and sunset; built once per process.
 const std::vector<NamedEnvironment>& default_environments();
 
+// A rendering drawn as a size × size image item at (x, y), tone mapped to 8-bit sRGB at exposure
+// 0 (render::tonemap_srgb8), smoothly interpolated.
+ImageItem rendering_item(const render::Image& image, double x, double y, double size);
+
 struct MaterialFigureOptions {
   BrdfPtr brdf;
   std::string heading;  // the figure's title ("Figure 3, ..."); empty: the BRDF's name
