@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
@@ -57,21 +58,6 @@ double uniform(std::uint64_t seed, std::uint64_t cell, std::uint64_t attempt, st
   return double(z >> 11) * 0x1.0p-53;
 }
 
-// Coordinates of a form (SoA, dimension(form) columns of n values) -> direction pairs, with the
-// core's checked inverse.
-void to_pairs(Form form, const std::vector<std::vector<double>>& coords, std::size_t n,
-              std::span<DirPair<double>> pairs, std::span<std::uint8_t> valid) {
-  std::vector<ConstColumn<double>> in;
-  for (const auto& c : coords) in.push_back({c.data(), 1});
-  double* base = &pairs.data()->wi.x;
-  std::vector<Column<double>> out(6);
-  for (std::size_t c = 0; c < 6; ++c) out[c] = {base + c, 6};
-  ConvertOutput<double> conv;
-  conv.columns = out;
-  conv.valid = valid.data();
-  convert<double>(form, Form{Space::dirs, false}, in, n, conv, BatchOptions{1});
-}
-
 bool finite(const Rgb& c) {
   return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
 }
@@ -90,7 +76,12 @@ GridSpec gonio_cells(const GonioSetup& s) {
   const double per_n = fraction * double(probe.points()) / std::pow(8.0, double(probe.axes.size()));
   auto n = std::size_t(std::max(
       1.0, std::round(std::pow(double(s.budget) / per_n, 1.0 / double(probe.axes.size())))));
-  auto inside = [&](std::size_t m) { return cells_inside(cells_for(s, m)); };
+  std::map<std::size_t, std::size_t> counted;  // n -> cells inside: each grid counted once
+  auto inside = [&](std::size_t m) {
+    const auto [it, fresh] = counted.try_emplace(m, 0);
+    if (fresh) it->second = cells_inside(cells_for(s, m));
+    return it->second;
+  };
   while (n > 1 && inside(n - 1) >= s.budget) --n;
   while (inside(n) < s.budget) ++n;
   if (n > 1) {
@@ -117,6 +108,10 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
   std::vector<std::size_t> todo(n);
   for (std::size_t c = 0; c < n; ++c) todo[c] = c;
   const int tries = setup_.design == Design::regular ? 1 : kStratifiedTries;
+  // The instrument's reach (a full reach takes every pair the inverse map accepts).
+  const double min_z = setup_.max_theta_deg >= 90
+                           ? -std::numeric_limits<double>::infinity()
+                           : std::cos(setup_.max_theta_deg * std::numbers::pi / 180);
   const Form form = cells_.form();
   for (int attempt = 0; attempt < tries && !todo.empty(); ++attempt) {
     std::vector<std::size_t> again;
@@ -137,13 +132,12 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
       }
       std::vector<DirPair<double>> pairs(m);
       std::vector<std::uint8_t> ok(m);
-      to_pairs(form, coords, m, pairs, ok);
+      const std::vector<std::span<const double>> columns(coords.begin(), coords.end());
+      coordinates_to_pairs(form, columns, pairs, ok);
       std::vector<DirPair<double>> inside;
       std::vector<std::size_t> which;
-      const double min_z = std::cos(setup_.max_theta_deg * std::numbers::pi / 180);
       for (std::size_t j = 0; j < m; ++j) {
-        if (ok[j] &&
-            (setup_.max_theta_deg >= 90 || (pairs[j].wi.z >= min_z && pairs[j].wo.z >= min_z))) {
+        if (ok[j] && pairs[j].wi.z >= min_z && pairs[j].wo.z >= min_z) {
           inside.push_back(pairs[j]);
           which.push_back(j);
         } else {
@@ -330,40 +324,49 @@ Rgb GonioReconstruction::reconstruct(const double* x) const {
              std::clamp(c(0, 2), lo.b, hi.b)};
 }
 
+Rgb GonioReconstruction::outside(const DirPair<double>& p) {
+  // Below the horizon: 0, as the models; not a pair of directions: NaN.
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const bool number = std::isfinite(p.wi.x + p.wi.y + p.wi.z + p.wo.x + p.wo.y + p.wo.z);
+  return number ? Rgb{} : Rgb{kNaN, kNaN, kNaN};
+}
+
 Rgb GonioReconstruction::eval(const DirPair<double>& pair) const {
-  Rgb out;
-  eval(std::span(&pair, 1), std::span(&out, 1));
-  return out;
+  // One pair (the renderer's calls): the core's single-row path, no scratch buffers.
+  static_assert(sizeof(DirPair<double>) == 6 * sizeof(double));
+  double x[4];
+  if (!convert_one<double>(Form{Space::dirs, false}, cells_.form(),
+                           std::span<const double>(&pair.wi.x, 6), std::span<double>(x, dim_)))
+    return outside(pair);
+  return reconstruct(x);
 }
 
 void GonioReconstruction::eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
   if (out.size() != pairs.size())
     throw std::invalid_argument("GonioReconstruction::eval: output size does not match");
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const Form form = cells_.form();
   constexpr std::size_t kChunk = 1024;
-  std::vector<double> coords(dim_ * kChunk);
-  std::vector<std::uint8_t> ok(kChunk);
-  for (std::size_t b = 0; b < pairs.size(); b += kChunk) {
-    const std::size_t m = std::min(kChunk, pairs.size() - b);
+  const std::size_t chunk = std::min(kChunk, pairs.size());
+  std::vector<double> coords(dim_ * chunk);
+  std::vector<std::uint8_t> ok(chunk);
+  std::vector<Column<double>> cols(dim_);
+  for (std::size_t c = 0; c < dim_; ++c) cols[c] = {coords.data() + c * chunk, 1};
+  ConvertOutput<double> conv;
+  conv.columns = cols;
+  conv.valid = ok.data();
+  std::vector<ConstColumn<double>> in(6);
+  for (std::size_t b = 0; b < pairs.size(); b += chunk) {
+    const std::size_t m = std::min(chunk, pairs.size() - b);
     const double* base = &pairs[b].wi.x;
-    std::vector<ConstColumn<double>> in(6);
     for (std::size_t c = 0; c < 6; ++c) in[c] = {base + c, 6};
-    std::vector<Column<double>> cols(dim_);
-    for (std::size_t c = 0; c < dim_; ++c) cols[c] = {coords.data() + c * kChunk, 1};
-    ConvertOutput<double> conv;
-    conv.columns = cols;
-    conv.valid = ok.data();
     convert<double>(Form{Space::dirs, false}, form, in, m, conv, BatchOptions{1});
     for (std::size_t j = 0; j < m; ++j) {
-      const DirPair<double>& p = pairs[b + j];
-      if (!ok[j]) {  // below the horizon: 0, as the models; not a pair of directions: NaN
-        const bool number = std::isfinite(p.wi.x + p.wi.y + p.wi.z + p.wo.x + p.wo.y + p.wo.z);
-        out[b + j] = number ? Rgb{} : Rgb{kNaN, kNaN, kNaN};
+      if (!ok[j]) {
+        out[b + j] = outside(pairs[b + j]);
         continue;
       }
       double x[4];
-      for (std::size_t c = 0; c < dim_; ++c) x[c] = coords[c * kChunk + j];
+      for (std::size_t c = 0; c < dim_; ++c) x[c] = coords[c * chunk + j];
       out[b + j] = reconstruct(x);
     }
   }

@@ -11,16 +11,16 @@
 #include <sstream>
 
 #include "halfback/figure/chart.hpp"
+#include "halfback/figure/material.hpp"
 #include "halfback/figure/plot.hpp"
 #include "halfback/figure/render.hpp"
 #include "halfback/io/atomic_file.hpp"
 #include "halfback/io/csv.hpp"
+#include "halfback/io/text_encoding.hpp"
 
 namespace halfback::study {
 
 namespace {
-
-constexpr Design kDesigns[] = {Design::regular, Design::stratified};
 
 std::string md_cell(const std::string& s) {
   std::string out;
@@ -61,6 +61,16 @@ const GonioPoint* find_point(const std::vector<GonioPoint>& pts, Design d, std::
   return nullptr;
 }
 
+// " regular / stratified |": the two designs' errors at a budget ("–" where not measured).
+std::string design_cells(const std::vector<GonioPoint>& pts, std::size_t budget) {
+  std::string cell;
+  for (Design d : kDesigns) {
+    const GonioPoint* p = find_point(pts, d, budget);
+    cell += (cell.empty() ? " " : " / ") + (p ? fmt::format("{:.4f}", p->error) : "–");
+  }
+  return cell + " |";
+}
+
 std::pair<std::vector<double>, std::vector<double>> curve(const std::vector<GonioPoint>& pts,
                                                           Design d) {
   std::vector<double> n, e;
@@ -76,12 +86,6 @@ std::string samples_text(double n, double smallest) {
   if (n == 0) return fmt::format("≤ {:.0f}", smallest);
   if (std::isinf(n)) return "not reached";
   return fmt::format("{:.3g}", n);
-}
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  AtomicFile f(path);
-  f.write(text);
-  f.commit();
 }
 
 // The gonio curves as small multiples: one panel per BRDF, a colour per parameterization, the
@@ -145,21 +149,9 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
     if (b.example_images.size() != kStudied.size() + 1) continue;
     sc.text({label_w - 8, y + cell / 2}, figure::escape_markup(b.label), 8.5, figure::HAlign::right,
             figure::VAlign::middle);
-    for (std::size_t k = 0; k < b.example_images.size(); ++k) {
-      const render::Image& img = b.example_images[k];
-      const std::vector<std::uint8_t> rgb = render::tonemap_srgb8(img, {});
-      figure::ImageItem item;
-      item.x = label_w + double(k) * (cell + gap);
-      item.y = y;
-      item.width = item.height = cell;
-      item.px_width = std::size_t(img.width);
-      item.px_height = std::size_t(img.height);
-      item.rgba.reserve(rgb.size() / 3 * 4);
-      for (std::size_t i = 0; i < rgb.size(); i += 3)
-        item.rgba.insert(item.rgba.end(), {rgb[i], rgb[i + 1], rgb[i + 2], 255});
-      item.smooth = true;
-      sc.add(std::move(item));
-    }
+    for (std::size_t k = 0; k < b.example_images.size(); ++k)
+      sc.add(
+          figure::rendering_item(b.example_images[k], label_w + double(k) * (cell + gap), y, cell));
     y += cell + gap;
   }
   return sc;
@@ -184,7 +176,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
   for (const BrdfResult& b : results) {
     any_aniso |= !b.isotropic;
     for (const ParamResult& p : b.params) {
-      any_gonio |= !p.gonio.empty();
+      any_gonio |= !p.gonio.empty() || !p.gonio_4d.empty();
       any_images |= !p.images.empty();
     }
   }
@@ -236,7 +228,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
     }
   }
   auto csv = [&](const char* name, const std::string& text) {
-    write_text(dir / name, text);
+    write_file_atomically(dir / name, text);
     out.files.push_back(name);
   };
   csv("azimuthal.csv", az);
@@ -246,6 +238,18 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
     csv("budget.csv", bud);
   }
   if (any_images) csv("image.csv", img);
+
+  // The plots that may have nothing to draw (every curve exact, no rendering): the report links
+  // only those that are written.
+  const figure::Scene gonio_scene =
+      any_gonio ? gonio_chart(results, false, config) : figure::Scene{};
+  const figure::Scene gonio4d_scene =
+      any_gonio && any_aniso ? gonio_chart(results, true, config) : figure::Scene{};
+  const figure::Scene renderings_scene =
+      any_images ? examples_chart(results, config) : figure::Scene{};
+  auto link = [](const figure::Scene& sc, const char* alt, const char* stem) {
+    return sc.items.empty() ? std::string() : fmt::format("![{}]({}.png)\n\n", alt, stem);
+  };
 
   // The report.
   std::string md = fmt::format(
@@ -364,10 +368,8 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
         md += "| " + md_cell(b.label) + " |";
         std::array<double, kStudied.size()> v{};
         for (std::size_t i = 0; i < b.params.size(); ++i) {
+          md += design_cells(b.params[i].gonio, budget);
           const GonioPoint* r = find_point(b.params[i].gonio, Design::regular, budget);
-          const GonioPoint* s = find_point(b.params[i].gonio, Design::stratified, budget);
-          md += fmt::format(" {} / {} |", r ? fmt::format("{:.4f}", r->error) : "–",
-                            s ? fmt::format("{:.4f}", s->error) : "–");
           v[i] = r ? r->error : INFINITY;
         }
         w.add(v);
@@ -445,7 +447,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
       md +=
           "\nLeft out, reconstructed exactly (E* = 0) by at least one parameterization: " + exact +
           ".\n";
-    md += "\n![Virtual gonio-reflectometer](gonio.png)\n\n";
+    md += "\n" + link(gonio_scene, "Virtual gonio-reflectometer", "gonio");
     if (any_aniso) {
       md += "Anisotropic BRDFs, 4D (measured in the full form; regular / stratified):\n\n";
       md += "| BRDF | budget |";
@@ -455,16 +457,11 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
         if (b.isotropic) continue;
         for (std::size_t budget : config.budgets_4d) {
           md += "| " + md_cell(b.label) + fmt::format(" | {} |", budget);
-          for (const ParamResult& p : b.params) {
-            const GonioPoint* r = find_point(p.gonio_4d, Design::regular, budget);
-            const GonioPoint* s = find_point(p.gonio_4d, Design::stratified, budget);
-            md += fmt::format(" {} / {} |", r ? fmt::format("{:.4f}", r->error) : "–",
-                              s ? fmt::format("{:.4f}", s->error) : "–");
-          }
+          for (const ParamResult& p : b.params) md += design_cells(p.gonio_4d, budget);
           md += "\n";
         }
       }
-      md += "\n![Virtual gonio-reflectometer, 4D](gonio4d.png)\n\n";
+      md += "\n" + link(gonio4d_scene, "Virtual gonio-reflectometer, 4D", "gonio4d");
     }
   }
 
@@ -530,9 +527,9 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
           table_header("BRDF") + strat_rows +
           fmt::format(
               "\nLowest relative RMSE (BRDFs): {}; lowest ΔE00: {}.\n\n"
-              "![Image-space error](image.png)\n\n"
-              "![Renderings of the reconstructions](renderings.png)\n\n",
-              rmse_wins[1].text(), de_wins[1].text());
+              "![Image-space error](image.png)\n\n",
+              rmse_wins[1].text(), de_wins[1].text()) +
+          link(renderings_scene, "Renderings of the reconstructions", "renderings");
     if (!no_images.empty())
       md += "Not rendered (the BRDF has no value somewhere, so there is no ground-truth image): " +
             no_images + ".\n\n";
@@ -543,15 +540,12 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
 
   save_plot(figure::bar_chart(az_chart), dir, "azimuthal", out.files);
   save_plot(figure::bar_chart(sep_chart), dir, "separability", out.files);
-  if (any_gonio) save_plot(gonio_chart(results, false, config), dir, "gonio", out.files);
-  if (any_gonio && any_aniso)
-    save_plot(gonio_chart(results, true, config), dir, "gonio4d", out.files);
-  if (any_images) {
-    save_plot(figure::bar_chart(im_chart), dir, "image", out.files);
-    save_plot(examples_chart(results, config), dir, "renderings", out.files);
-  }
-  write_text(dir / "report.md", md);
-  write_text(dir / "report.html", markdown_to_html(md, dir, "halfback study"));
+  save_plot(gonio_scene, dir, "gonio", out.files);
+  save_plot(gonio4d_scene, dir, "gonio4d", out.files);
+  if (any_images) save_plot(figure::bar_chart(im_chart), dir, "image", out.files);
+  save_plot(renderings_scene, dir, "renderings", out.files);
+  write_file_atomically(dir / "report.md", md);
+  write_file_atomically(dir / "report.html", markdown_to_html(md, dir, "halfback study"));
   out.files.push_back("report.md");
   out.files.push_back("report.html");
   out.markdown = md;
@@ -559,27 +553,6 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
 }
 
 namespace {
-
-std::string escape_html(std::string_view s) {
-  std::string out;
-  for (char c : s) switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  return out;
-}
 
 // `code` and **bold**, the rest escaped.
 std::string inline_html(std::string_view s) {
@@ -597,31 +570,11 @@ std::string inline_html(std::string_view s) {
       out += '|';
       ++i;
     } else {
-      out += escape_html(s.substr(i, 1));
+      out += escape_xml(s.substr(i, 1));
     }
   }
   if (code) out += "</code>";
   if (bold) out += "</strong>";
-  return out;
-}
-
-std::string base64(const std::string& data) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  std::size_t i = 0;
-  for (; i + 2 < data.size(); i += 3) {
-    const auto v = std::uint32_t(std::uint8_t(data[i])) << 16 |
-                   std::uint32_t(std::uint8_t(data[i + 1])) << 8 | std::uint8_t(data[i + 2]);
-    for (int s : {18, 12, 6, 0}) out += k[(v >> s) & 63];
-  }
-  if (i < data.size()) {
-    std::uint32_t v = std::uint32_t(std::uint8_t(data[i])) << 16;
-    if (i + 1 < data.size()) v |= std::uint32_t(std::uint8_t(data[i + 1])) << 8;
-    out += k[(v >> 18) & 63];
-    out += k[(v >> 12) & 63];
-    out += i + 1 < data.size() ? k[(v >> 6) & 63] : '=';
-    out += '=';
-  }
   return out;
 }
 
@@ -661,7 +614,7 @@ std::string markdown_to_html(std::string_view markdown, const std::filesystem::p
       "line-height:1.4}}table{{border-collapse:collapse;font-size:90%;margin:1em 0}}"
       "td,th{{border:1px solid #ccc;padding:2px 6px;text-align:right}}td:first-child{{text-align:"
       "left}}img{{max-width:100%}}code{{background:#f4f4f4}}</style>\n</head>\n<body>\n",
-      escape_html(title));
+      escape_xml(title));
   std::string paragraph;
   auto flush = [&] {
     if (!paragraph.empty()) html += "<p>" + inline_html(paragraph) + "</p>\n";
@@ -683,10 +636,10 @@ std::string markdown_to_html(std::string_view markdown, const std::filesystem::p
       std::ifstream f(image_dir / src, std::ios::binary);
       const std::string data((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
       if (!f.good() && data.empty())
-        html += fmt::format("<p><a href=\"{}\">{}</a></p>\n", escape_html(src), escape_html(alt));
+        html += fmt::format("<p><a href=\"{}\">{}</a></p>\n", escape_xml(src), escape_xml(alt));
       else
         html += fmt::format("<p><img alt=\"{}\" src=\"data:image/png;base64,{}\"></p>\n",
-                            escape_html(alt), base64(data));
+                            escape_xml(alt), base64_encode(data));
     } else if (l[0] == '|') {
       flush();
       html += "<table>\n";

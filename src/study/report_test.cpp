@@ -94,6 +94,27 @@ TEST(Report, FilesRepeatTheResults) {
   EXPECT_EQ(html.find("](gonio.png)"), std::string::npos);
 }
 
+TEST(Report, OnlyWhatWasComputedIsWrittenAndLinked) {
+  // Anisotropic BRDFs only: the 4D gonio-reflectometer still gets its CSV files; no example
+  // renderings: no renderings plot, and no link to one.
+  const auto dir = fresh_dir("aniso_only");
+  StudyConfig c;
+  c.budgets = {1000, 1000000};
+  c.image_budget = 1000;
+  c.environments.push_back({"sky", nullptr});
+  BrdfResult b = fake("aniso", false);
+  for (ParamResult& p : b.params) p.gonio.clear();
+  const StudyOutput out = write_study(dir, {b}, c, 1);
+  EXPECT_TRUE(std::filesystem::exists(dir / "gonio.csv"));
+  EXPECT_NE(slurp(dir / "gonio.csv").find("aniso,hybrid,regular,1000,"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "gonio4d.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "gonio.png"));  // no 3D curve to draw
+  EXPECT_FALSE(std::filesystem::exists(dir / "renderings.png"));
+  EXPECT_EQ(out.markdown.find("](gonio.png)"), std::string::npos);
+  EXPECT_EQ(out.markdown.find("](renderings.png)"), std::string::npos);
+  EXPECT_NE(out.markdown.find("](gonio4d.png)"), std::string::npos);
+}
+
 TEST(Report, MarkdownToHtml) {
   const auto dir = fresh_dir("html");
   {

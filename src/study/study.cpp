@@ -40,8 +40,6 @@ void StudyConfig::validate() const {
 
 namespace {
 
-constexpr Design kDesigns[] = {Design::regular, Design::stratified};
-
 render::RenderSettings image_settings(const StudyConfig& c) {
   render::RenderSettings s;
   s.width = s.height = c.image_size;

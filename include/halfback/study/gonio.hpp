@@ -34,6 +34,7 @@
 // the instrument's reach (the study's default: docs/study.md says why).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -49,6 +50,7 @@
 namespace halfback::study {
 
 enum class Design { regular, stratified };
+inline constexpr std::array<Design, 2> kDesigns{Design::regular, Design::stratified};
 std::string_view name_of(Design d);
 
 struct GonioSetup {
@@ -87,7 +89,8 @@ class GonioReconstruction final : public Brdf {
   std::size_t samples() const { return samples_; }  // measurements taken (finite values)
 
  private:
-  Rgb reconstruct(const double* x) const;  // at coordinates x of the form
+  Rgb reconstruct(const double* x) const;        // at coordinates x of the form
+  static Rgb outside(const DirPair<double>& p);  // at a pair the form does not take
 
   GonioSetup setup_;
   GridSpec cells_;
