@@ -50,9 +50,7 @@ int run_render(const RenderOptions& o) {
   s.time_budget = o.time_budget;
   s.threads = o.threads;
   s.projection = o.perspective ? render::Projection::perspective : render::Projection::orthographic;
-  s.strategy = o.strategy == "brdf"  ? render::Strategy::brdf
-               : o.strategy == "env" ? render::Strategy::env
-                                     : render::Strategy::mis;
+  s.strategy = render::strategy_from_name(o.strategy).value();  // checked by the parser
   s.heuristic = o.heuristic == "balance" ? render::Heuristic::balance : render::Heuristic::power;
   s.tabulation.param = render::table_param_from_name(o.sampling);
   s.progress = !o.quiet;  // drawn only when stderr is a terminal

@@ -320,14 +320,10 @@ py::array_t<float> render_brdf(const PyBrdf& b, const std::string& env, int widt
   s.spp = spp;
   s.seed = seed;
   s.threads = threads;
-  if (strategy == "mis")
-    s.strategy = render::Strategy::mis;
-  else if (strategy == "brdf")
-    s.strategy = render::Strategy::brdf;
-  else if (strategy == "env")
-    s.strategy = render::Strategy::env;
-  else
+  const auto parsed = render::strategy_from_name(strategy);
+  if (!parsed)
     throw py::value_error("strategy: expected 'mis', 'brdf' or 'env', got '" + strategy + "'");
+  s.strategy = *parsed;
   const render::EnvMap map = render::EnvMap::from_spec(env);
   render::RenderResult r;
   {

@@ -259,6 +259,13 @@ void validate(const RenderSettings& s) {
 
 }  // namespace
 
+std::optional<Strategy> strategy_from_name(std::string_view name) {
+  if (name == "mis") return Strategy::mis;
+  if (name == "brdf") return Strategy::brdf;
+  if (name == "env") return Strategy::env;
+  return std::nullopt;
+}
+
 RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings) {
   validate(settings);
   const auto start = Clock::now();

@@ -347,5 +347,13 @@ TEST(Renderer, BadInput) {
   EXPECT_NO_THROW(load_brdf("ggx:alpha=0.2"));
 }
 
+TEST(Renderer, StrategyNames) {
+  EXPECT_EQ(strategy_from_name("mis"), Strategy::mis);
+  EXPECT_EQ(strategy_from_name("brdf"), Strategy::brdf);
+  EXPECT_EQ(strategy_from_name("env"), Strategy::env);
+  EXPECT_FALSE(strategy_from_name("MIS").has_value());
+  EXPECT_FALSE(strategy_from_name("").has_value());
+}
+
 }  // namespace
 }  // namespace halfback::render

@@ -13,7 +13,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
@@ -27,6 +29,8 @@ enum class Projection { orthographic, perspective };
 // mis: one environment and one BRDF sample per pixel sample, weighted by the heuristic;
 // brdf, env: two samples of that strategy alone (the same number of light samples as mis).
 enum class Strategy { mis, brdf, env };
+// "mis", "brdf" or "env"; nullopt for another name.
+std::optional<Strategy> strategy_from_name(std::string_view name);
 enum class Heuristic { balance, power };
 enum class Sequence { sobol, random };  // scrambled Sobol (0,2) points per pixel, or independent
 
