@@ -1,7 +1,7 @@
 // Measured-BRDF evaluation throughput (docs/performance.md, "BRDF evaluation"):
 //   MERL nearest-bin and trilinear lookups, one thread and batched over all threads, against a
 //   straightforward per-pair implementation of the MERL reference lookup (acos-based half/diff
-//   angles, Rodrigues rotations: src/io/merl_reference.hpp) measured in the same run;
+//   angles, Rodrigues rotations: src/formats/merl_reference.hpp) measured in the same run;
 //   RGL evaluations (../shared/data/rgl, skipped when absent); ALTA scattered-data evaluations.
 // Every benchmark processes the same 65536 random direction pairs (fixed seed); items/s counts
 // pairs.
@@ -14,10 +14,10 @@
 #include <random>
 #include <vector>
 
-#include "halfback/io/alta.hpp"
-#include "halfback/io/merl.hpp"
-#include "halfback/io/rgl.hpp"
-#include "io/merl_reference.hpp"
+#include "formats/merl_reference.hpp"
+#include "halfback/formats/alta.hpp"
+#include "halfback/formats/merl.hpp"
+#include "halfback/formats/rgl.hpp"
 
 namespace {
 
@@ -75,7 +75,7 @@ void run_batch(benchmark::State& state, const Brdf& brdf) {
   const auto& p = pairs();
   std::vector<Rgb> out(p.size());
   for (auto _ : state) {
-    brdf.eval(std::span<const DirPair<double>>(p), std::span<Rgb>(out));
+    brdf.eval_batch(p, out);
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));

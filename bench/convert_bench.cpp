@@ -113,7 +113,7 @@ void bm_convert(benchmark::State& state, Space space, bool forward, unsigned thr
   for (std::size_t c = 0; c < (forward ? 4u : 6u); ++c) oc.push_back({d.out[c].data(), 1});
   const ConvertOutput<T> out{oc, {}, d.valid.data()};
   for (auto _ : state) {
-    convert<T>(forward ? dirs : param, forward ? param : dirs, ic, d.n, out, {threads});
+    convert<T>(forward ? dirs : param, forward ? param : dirs, ic, d.n, out, {int(threads)});
     benchmark::ClobberMemory();
   }
   set_counters<T>(state, d.n, 10);

@@ -24,8 +24,8 @@
 #include <thread>
 #include <vector>
 
-#include "halfback/brdf/load.hpp"
-#include "halfback/io/merl.hpp"
+#include "halfback/formats/merl.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
@@ -169,8 +169,8 @@ int main(int argc, char** argv) {
                                     render::TableParam::spherical}) {
         render::RenderSettings s = budgeted(budget);
         s.tabulation.param = tp;
-        const auto sampler = render::make_brdf_sampler(*m.brdf, s.tabulation, true);
-        print_equal_time_error(render::render(*m.brdf, *sampler, sky, s), reference, budget);
+        const auto tabulated = render::with_importance_sampling(*m.brdf, s.tabulation, true);
+        print_equal_time_error(render::render_sampled(*tabulated, sky, s), reference, budget);
       }
       std::printf("\n");
       std::fflush(stdout);

@@ -45,7 +45,7 @@ foreach(line IN LISTS lines)
 endforeach()
 file(WRITE "${OUT}.tmp"
 "// Generated from ${IN} by cmake/embed_merl_table.cmake. Do not edit.
-#include \"halfback/io/merl.hpp\"
+#include \"halfback/formats/merl.hpp\"
 
 namespace halfback::merl_table {
 extern const MerlMaterial kMaterials[];

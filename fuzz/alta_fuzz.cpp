@@ -4,8 +4,8 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "halfback/io/alta.hpp"
-#include "halfback/io/format_error.hpp"
+#include "halfback/formats/alta.hpp"
+#include "halfback/util/format_error.hpp"
 
 using namespace halfback;
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "halfback/io/rgl.hpp"
+#include "halfback/formats/rgl.hpp"
 
 using namespace halfback;
 namespace fs = std::filesystem;

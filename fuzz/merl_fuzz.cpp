@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <cstring>
 
-#include "halfback/io/format_error.hpp"
-#include "halfback/io/merl.hpp"
+#include "halfback/formats/merl.hpp"
+#include "halfback/util/format_error.hpp"
 
 using namespace halfback;
 

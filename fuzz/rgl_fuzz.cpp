@@ -4,8 +4,8 @@
 #include <cstring>
 #include <vector>
 
-#include "halfback/io/format_error.hpp"
-#include "halfback/io/rgl.hpp"
+#include "halfback/formats/rgl.hpp"
+#include "halfback/util/format_error.hpp"
 
 using namespace halfback;
 

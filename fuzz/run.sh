@@ -10,9 +10,7 @@ seconds="${FUZZ_SECONDS:-30}"
 build="${FUZZ_BUILD_DIR:-build/fuzz}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_COMPILER=clang++ -DHALFBACK_BUILD_FUZZ=ON \
-  -DHALFBACK_BUILD_TESTS=OFF -DHALFBACK_BUILD_BENCH=OFF -DHALFBACK_BUILD_PYTHON=OFF >/dev/null
+cmake --preset fuzz -B "$build" >/dev/null
 cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz make_fuzz_seeds
 
 corpus="$build/corpus"

@@ -3,6 +3,8 @@
 # and run the main job on the data embedded in the project.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# ccache (when installed): paths relative to the tree, so that another clone hits the same cache.
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
 
 packages=$(grep -v '^\s*#' scripts/debian-packages.txt | tr '\n' ' ')
 if command -v apt-get >/dev/null; then
@@ -14,7 +16,7 @@ else
   echo "setup: apt-get not found; install these packages yourself: $packages" >&2
 fi
 
-cmake --preset release
+cmake --preset release ${CI:+-DHALFBACK_WERROR=ON}
 cmake --build --preset release
 
 bash scripts/main-job.sh

@@ -3,12 +3,14 @@
 # AddressSanitizer + UndefinedBehaviorSanitizer, then the file-format fuzzers for a bounded time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# ccache (when installed): paths relative to the tree, so that another clone hits the same cache.
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
 
-cmake --preset release
+cmake --preset release ${CI:+-DHALFBACK_WERROR=ON}
 cmake --build --preset release
 ctest --preset release
 
-cmake --preset asan
+cmake --preset asan ${CI:+-DHALFBACK_WERROR=ON}
 cmake --build --preset asan
 ctest --preset asan
 

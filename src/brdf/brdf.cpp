@@ -6,19 +6,33 @@
 #include <string>
 
 #include "halfback/core/batch.hpp"
-#include "parallel_for.hpp"
+#include "halfback/core/parallel.hpp"
 
 namespace halfback {
 
-void Brdf::eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
+void Brdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
   if (out.size() != pairs.size())
-    throw std::invalid_argument("Brdf::eval: " + std::to_string(pairs.size()) + " pairs but " +
-                                std::to_string(out.size()) + " outputs");
+    throw std::invalid_argument("Brdf::eval_batch: " + std::to_string(pairs.size()) +
+                                " pairs but " + std::to_string(out.size()) + " outputs");
   // One virtual call per pair is negligible next to a measured BRDF lookup (~100 ns); blocks of
   // 1024 pairs keep thread start-up (~20 µs) below a few percent.
-  detail::parallel_for(pairs.size(), 1024, [&](std::size_t begin, std::size_t end) {
+  parallel_for(pairs.size(), 1024, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) out[i] = eval(pairs[i]);
   });
+}
+
+BrdfSample Brdf::sample(const Vec3<double>& wo, double u1, double u2) const {
+  if (!(wo.z > 0)) return {};
+  const Vec3<double> wi = sample_cosine_hemisphere(u1, u2);
+  return {wi, cosine_hemisphere_pdf(wi)};
+}
+
+double Brdf::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  return wo.z > 0 ? cosine_hemisphere_pdf(wi) : 0;
+}
+
+std::string Brdf::describe_sampling() const {
+  return has_importance_sampling() ? "own sampler of " + name() : "cosine-weighted hemisphere";
 }
 
 Rgb eval_at(const Brdf& brdf, Form form, std::span<const double> coords) {

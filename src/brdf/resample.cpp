@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "halfback/core/batch.hpp"
-#include "parallel_for.hpp"
+#include "halfback/core/parallel.hpp"
 
 namespace halfback {
 
@@ -210,10 +210,7 @@ ResampledTable resample(const Brdf& brdf, const GridSpec& grid, const ResampleOp
       }
     }
   };
-  if (options.threads == 1)
-    run_blocks(0, blocks);
-  else
-    detail::parallel_for(blocks, 1, run_blocks);
+  parallel_for(blocks, 1, run_blocks, options.threads);
   return t;
 }
 

@@ -20,8 +20,8 @@
 #include <string_view>
 #include <vector>
 
-#include "halfback/io/atomic_file.hpp"
-#include "halfback/io/csv.hpp"
+#include "halfback/util/atomic_file.hpp"
+#include "halfback/util/csv.hpp"
 
 namespace halfback::cli {
 

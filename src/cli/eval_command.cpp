@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "command.hpp"
-#include "halfback/brdf/load.hpp"
 #include "halfback/core/space.hpp"
+#include "halfback/loader/load.hpp"
 
 namespace halfback::cli {
 
@@ -40,7 +40,7 @@ int run_eval(const EvalOptions& o) {
                              std::string(describe(status)));
   }
   std::vector<Rgb> rho(n);
-  brdf->eval(pairs, rho);
+  brdf->eval_batch(pairs, rho);
   std::vector<std::vector<double>> rgb(3, std::vector<double>(n));
   for (std::size_t r = 0; r < n; ++r) {
     rgb[0][r] = rho[r].r;

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "command.hpp"
-#include "halfback/brdf/load.hpp"
-#include "halfback/io/merl.hpp"
+#include "halfback/formats/merl.hpp"
+#include "halfback/loader/load.hpp"
 
 namespace halfback::cli {
 

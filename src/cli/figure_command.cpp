@@ -21,7 +21,6 @@
 #include <vector>
 
 #include "command.hpp"
-#include "halfback/brdf/load.hpp"
 #include "halfback/brdf/test_functions.hpp"
 #include "halfback/core/space.hpp"
 #include "halfback/figure/hemisphere.hpp"
@@ -29,8 +28,9 @@
 #include "halfback/figure/paper.hpp"
 #include "halfback/figure/render.hpp"
 #include "halfback/figure/slices.hpp"
-#include "halfback/io/atomic_file.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
+#include "halfback/util/atomic_file.hpp"
 
 namespace halfback::cli {
 
@@ -47,7 +47,7 @@ struct HemisphereArgs {
   std::string centre = "normal";
   double scale = 2;
   bool no_markers = false, no_isolines = false;
-  unsigned threads = 0;
+  int threads = 0;
   std::string out = "hemisphere.png";
 };
 
@@ -58,7 +58,7 @@ struct SliceArgs {
   std::string levels = "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9";
   std::string colour = "luminance";
   double scale = 2;
-  unsigned threads = 0;
+  int threads = 0;
   std::string out = "slices.png";
 };
 
@@ -70,7 +70,7 @@ struct PaperArgs {
   std::string envs = "default,studio,sunset";
   bool no_materials = false;
   int render_pixels = 176, spp = 48;
-  unsigned threads = 0;
+  int threads = 0;
 };
 
 struct MaterialArgs {
@@ -81,7 +81,7 @@ struct MaterialArgs {
   std::string colour = "rgb";
   int render_pixels = 176, spp = 48;
   double scale = 2;
-  unsigned threads = 0;
+  int threads = 0;
   std::string out = "material.png";
 };
 
@@ -196,11 +196,11 @@ int run_slices(const SliceArgs& a) {
 }
 
 // The environments, each loaded (or built) once; a bad one is a usage error naming it.
-std::vector<figure::NamedEnvironment> environment_list(const std::string& list) {
-  std::vector<figure::NamedEnvironment> envs;
+std::vector<render::Environment> environment_list(const std::string& list) {
+  std::vector<render::Environment> envs;
   for (const std::string& e : split_list(list, "--env", "environment")) {
     try {
-      envs.push_back(figure::load_environment(e));
+      envs.push_back(render::load_environment(e));
     } catch (const std::exception& ex) {
       throw UsageError(fmt::format("--env '{}': {}", e, ex.what()));
     }
@@ -330,7 +330,9 @@ Command register_figure(CLI::App& parent) {
       ->capture_default_str();
   h->add_flag("--no-markers", hemi->no_markers, "Do not mark ωo and its mirror direction");
   h->add_flag("--no-isolines", hemi->no_isolines, "Colours only");
-  h->add_option("--threads", hemi->threads, "Sampling threads (0: all cores)")
+  h->add_option("--threads", hemi->threads,
+                "Threads: 0 all cores, 1 the calling thread, n at most n")
+      ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   h->add_option("-o,--out", hemi->out, "Output file: .png, .svg or .pdf")->capture_default_str();
 
@@ -355,7 +357,9 @@ Command register_figure(CLI::App& parent) {
       ->capture_default_str();
   s->add_option("--scale", sl->scale, "Pixels per point of the PNG (and of the rasters)")
       ->capture_default_str();
-  s->add_option("--threads", sl->threads, "Sampling threads (0: all cores)")->capture_default_str();
+  s->add_option("--threads", sl->threads, "Threads: 0 all cores, 1 the calling thread, n at most n")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
   s->add_option("-o,--out", sl->out, "Output file: .png, .svg or .pdf")->capture_default_str();
 
   auto pa = std::make_shared<PaperArgs>();
@@ -383,7 +387,9 @@ Command register_figure(CLI::App& parent) {
   p->add_option("--spp", pa->spp, "Samples per pixel of the renderings")
       ->check(CLI::Range(1, 1 << 16))
       ->capture_default_str();
-  p->add_option("--threads", pa->threads, "Sampling threads (0: all cores)")->capture_default_str();
+  p->add_option("--threads", pa->threads, "Threads: 0 all cores, 1 the calling thread, n at most n")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
 
   auto ma = std::make_shared<MaterialArgs>();
   CLI::App* m = app->add_subcommand(
@@ -409,7 +415,9 @@ Command register_figure(CLI::App& parent) {
       ->capture_default_str();
   m->add_option("--scale", ma->scale, "Pixels per point of the PNG (and of the rasters)")
       ->capture_default_str();
-  m->add_option("--threads", ma->threads, "Threads (0: all cores)")->capture_default_str();
+  m->add_option("--threads", ma->threads, "Threads: 0 all cores, 1 the calling thread, n at most n")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
   m->add_option("-o,--out", ma->out, "Output file: .png, .svg or .pdf")->capture_default_str();
 
   return {app, [=]() -> int {

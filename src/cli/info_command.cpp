@@ -8,8 +8,8 @@
 
 #include "command.hpp"
 #include "halfback/brdf/albedo.hpp"
-#include "halfback/brdf/load.hpp"
 #include "halfback/brdf/resample.hpp"
+#include "halfback/loader/load.hpp"
 
 namespace halfback::cli {
 

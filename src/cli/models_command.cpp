@@ -4,14 +4,14 @@
 #include <string>
 
 #include "command.hpp"
-#include "halfback/brdf/registry.hpp"
+#include "halfback/loader/load.hpp"
 
 namespace halfback::cli {
 
 namespace {
 
 std::string describe_models() {
-  const ModelRegistry& registry = ModelRegistry::global();
+  const ModelRegistry& registry = model_registry();
   std::string s;
   for (const std::string& name : registry.names()) {
     const ModelInfo* m = registry.find(name);

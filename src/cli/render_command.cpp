@@ -8,9 +8,7 @@
 #include <string>
 
 #include "command.hpp"
-#include "halfback/brdf/load.hpp"
-#include "halfback/brdf/registry.hpp"
-#include "halfback/models/register.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/render/renderer.hpp"
 
 namespace halfback::cli {
@@ -55,9 +53,6 @@ int run_render(const RenderOptions& o) {
   s.tabulation.param = render::table_param_from_name(o.sampling);
   s.progress = !o.quiet;  // drawn only when stderr is a terminal
 
-  // The analytic models (a no-op where the registry already holds them).
-  if (!ModelRegistry::global().find("lambert"))
-    models::register_analytic_models(ModelRegistry::global());
   const BrdfPtr brdf = load_brdf(o.brdf);
   const render::EnvMap env = render::EnvMap::from_spec(o.env, {o.env_rotation, o.env_exposure});
   const render::RenderResult r = render::render(*brdf, env, s);

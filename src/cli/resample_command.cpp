@@ -10,8 +10,9 @@
 #include <vector>
 
 #include "command.hpp"
-#include "halfback/brdf/load.hpp"
 #include "halfback/brdf/resample.hpp"
+#include "halfback/formats/table_file.hpp"
+#include "halfback/loader/load.hpp"
 
 namespace halfback::cli {
 
@@ -23,7 +24,7 @@ struct ResampleOptions {
   double azimuth_deg = 0;
   bool azimuth_given = false;
   bool nodes = false;
-  unsigned threads = 0;
+  int threads = 0;
 };
 
 int run_resample(const ResampleOptions& o) {
@@ -101,7 +102,9 @@ Command register_resample(CLI::App& parent) {
       ->take_all();
   app->add_flag("--nodes", o->nodes,
                 "Sample at N nodes including both ends (default: at the centres of N cells)");
-  app->add_option("--threads", o->threads, "1: one thread; otherwise all cores")
+  app->add_option("--threads", o->threads,
+                  "Threads: 0 all cores, 1 the calling thread, n at most n")
+      ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   app->add_option("-o,--output", o->output, "Output: .exr, .npz or .npy, replaced only on success")
       ->required()

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "command.hpp"
-#include "halfback/brdf/load.hpp"
 #include "halfback/figure/material.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
 
@@ -94,12 +94,10 @@ study::StudyConfig make_config(const StudyOptions& o) {
   if (o.no_gonio) c.budgets.clear();
   if (!o.no_gonio && !o.no_images) {
     if (o.environments.empty()) {
-      for (const auto& e : figure::default_environments())
-        c.environments.push_back({e.label, e.map});
+      c.environments = render::default_environments();
     } else {
       for (const std::string& spec : split_list(o.environments, "--env", "environment")) {
-        const figure::NamedEnvironment e = figure::load_environment(spec);
-        c.environments.push_back({e.label, e.map});
+        c.environments.push_back(render::load_environment(spec));
       }
     }
   }

@@ -24,6 +24,7 @@
 #include <string>
 
 #include "batch_engine.hpp"
+#include "halfback/core/parallel.hpp"
 #include "row_kernels.hpp"
 
 namespace halfback {
@@ -269,9 +270,6 @@ class TileRunner {
 };
 
 // Threads available to this process (TBB reads the affinity mask); more would only oversubscribe.
-std::size_t hardware_threads() {
-  return static_cast<std::size_t>(std::max(1, tbb::info::default_concurrency()));
-}
 
 }  // namespace
 
@@ -290,9 +288,7 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
     for (std::size_t t = t0; t < t1; ++t) runner.run(t * tile, std::min(tile, n - t * tile));
   };
 
-  const std::size_t hw = hardware_threads();
-  const std::size_t requested =
-      options.threads == 0 ? hw : std::min<std::size_t>(options.threads, hw);
+  const std::size_t requested = static_cast<std::size_t>(thread_count(options.threads));
   const std::size_t threads = std::min(requested, tiles / kMinTilesPerThread);
   if (threads <= 1) {
     run_tiles(0, tiles);

@@ -20,7 +20,7 @@
 #include "core/batch_engine.hpp"
 #include "core/batch_simd.hpp"
 #include "core/row_kernels.hpp"
-#include "core/test_util.hpp"
+#include "support/test_util.hpp"
 
 namespace halfback {
 namespace {
@@ -100,7 +100,7 @@ Table<T> inputs_for(Form from, const std::vector<DirPair<double>>& pairs) {
 }
 
 template <class T>
-Result<T> run_batch(Form from, Form to, const Table<T>& in, bool jac, unsigned threads = 1) {
+Result<T> run_batch(Form from, Form to, const Table<T>& in, bool jac, int threads = 1) {
   const std::size_t n = in.empty() ? 0 : in[0].size();
   Result<T> r{make_table<T>(dimension(to), n), std::vector<T>(jac ? n : 0),
               std::vector<std::uint8_t>(n, 7)};
@@ -709,7 +709,7 @@ TYPED_TEST(BatchTest, ThreadCountsGiveIdenticalBits) {
   for (const auto& [from, to] : kSampleConversions) {
     const Table<T> in = big_input<T>(from, n);
     const Result<T> one = run_batch<T>(from, to, in, true, 1);
-    for (unsigned threads : {2u, 7u, 0u}) {
+    for (int threads : {2, 7, 0}) {
       const Result<T> many = run_batch<T>(from, to, in, true, threads);
       EXPECT_TRUE(same_bits(many, one)) << pair_name(from, to) << ", " << threads << " threads";
     }

@@ -9,8 +9,8 @@
 #include <cmath>
 #include <random>
 
-#include "core/test_util.hpp"
 #include "halfback/core/param.hpp"
+#include "support/test_util.hpp"
 
 namespace halfback {
 namespace {

@@ -2,6 +2,7 @@
 // domain predicates, identities (and the paper's erratum), symmetries. Jacobians are tested in
 // jacobian_test.cpp. Error bounds are derived in docs/math.md ("Accuracy").
 #include "halfback/core/param.hpp"
+#include "halfback/core/space.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +10,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/test_util.hpp"
+#include "support/test_util.hpp"
 
 namespace halfback {
 namespace {
@@ -368,6 +369,21 @@ TEST(Azimuth, RangeAndZeroVector) {
   EXPECT_LT(detail::azimuth(-1e-30, 1.0), kTwoPiD);
   EXPECT_LT(detail::azimuth(-1e-30f, 1.0f), kTwoPi<float>);  // -tiny + 2π rounds up in float
   EXPECT_NEAR(detail::azimuth(-1.0, 0.0), 1.5 * kPi, 1e-15);
+}
+
+}  // namespace
+}  // namespace halfback
+
+namespace halfback {
+namespace {
+
+TEST(Space, VisitParameterizationNamesEachAndRefusesDirs) {
+  auto name_of_p = [](auto p) { return decltype(p)::name; };
+  EXPECT_EQ(visit_parameterization(Space::spherical, name_of_p), "spherical");
+  EXPECT_EQ(visit_parameterization(Space::halfdiff, name_of_p), "halfdiff");
+  EXPECT_EQ(visit_parameterization(Space::ortho, name_of_p), "ortho");
+  EXPECT_EQ(visit_parameterization(Space::hybrid, name_of_p), "hybrid");
+  EXPECT_THROW(visit_parameterization(Space::dirs, name_of_p), std::invalid_argument);
 }
 
 }  // namespace

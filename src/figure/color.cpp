@@ -45,13 +45,9 @@ double srgb_encode(double x) {
   return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
 }
 
-double luminance(const Rgb& c) {
-  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
-}
-
 Color tonemap_log(const Rgb& c, double log_lo, double log_hi) {
   const Rgb p{std::max(c.r, 0.0), std::max(c.g, 0.0), std::max(c.b, 0.0)};
-  const double l = luminance(p);
+  const double l = p.luminance();
   if (!(l > 0.0) || !std::isfinite(l)) return {0, 0, 0, 1};
   const double t = std::clamp((std::log10(l) - log_lo) / (log_hi - log_lo), 0.0, 1.0);
   const double s = t / l;

@@ -7,6 +7,8 @@
 #include <mutex>
 #include <thread>
 
+#include "halfback/core/parallel.hpp"
+
 namespace halfback::figure {
 
 Grid Grid::pixel_centres(std::size_t w, std::size_t h, double x0, double x1, double y0, double y1) {
@@ -21,42 +23,22 @@ bool ScalarField::usable(std::size_t i, std::size_t j) const {
   return (valid.empty() || valid[k] != 0) && std::isfinite(values[k]);
 }
 
-void parallel_rows(std::size_t rows, unsigned threads,
-                   const std::function<void(std::size_t)>& body) {
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t n =
-      std::min<std::size_t>(threads == 0 ? hw : threads, std::max<std::size_t>(rows, 1));
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    try {
-      for (std::size_t j; (j = next.fetch_add(1)) < rows;) body(j);
-    } catch (...) {
-      std::lock_guard lock(error_mutex);
-      if (!error) error = std::current_exception();
-      next = rows;  // stop handing out rows
-    }
-  };
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < n; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-}
-
-ScalarField sample(const Grid& grid, const std::function<double(double, double)>& f,
-                   unsigned threads) {
+ScalarField sample(const Grid& grid, const std::function<double(double, double)>& f, int threads) {
   ScalarField out(grid);
   out.valid.assign(grid.size(), 0);
-  parallel_rows(grid.ny, threads, [&](std::size_t j) {
-    const double y = grid.y(j);
-    for (std::size_t i = 0; i < grid.nx; ++i) {
-      const double v = f(grid.x(i), y);
-      out.values[grid.index(i, j)] = v;
-      out.valid[grid.index(i, j)] = std::isfinite(v) ? 1 : 0;
-    }
-  });
+  parallel_for(
+      grid.ny, 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j) {
+          const double y = grid.y(j);
+          for (std::size_t i = 0; i < grid.nx; ++i) {
+            const double v = f(grid.x(i), y);
+            out.values[grid.index(i, j)] = v;
+            out.valid[grid.index(i, j)] = std::isfinite(v) ? 1 : 0;
+          }
+        }
+      },
+      threads);
   return out;
 }
 

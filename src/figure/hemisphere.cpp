@@ -7,6 +7,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
 
 namespace halfback::figure {
@@ -166,7 +167,7 @@ std::optional<Point> HemisphereView::project(const Vec3<double>& w) const {
 }
 
 HemisphereSample sample_hemisphere(Space space, const HemisphereView& view, const Vec3<double>& wo,
-                                   std::size_t pixels, unsigned threads) {
+                                   std::size_t pixels, int threads) {
   if (space == Space::dirs)
     throw std::invalid_argument("hemisphere view: dirs is not a parameterization");
   HemisphereSample s;
@@ -179,23 +180,28 @@ HemisphereSample sample_hemisphere(Space space, const HemisphereView& view, cons
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   visit_parameterization(space, [&](auto p) {
     using P = decltype(p);
-    parallel_rows(s.grid.ny, threads, [&](std::size_t j) {
-      for (std::size_t i = 0; i < s.grid.nx; ++i) {
-        const std::size_t k = s.grid.index(i, j);
-        s.first.values[k] = s.second.values[k] = nan;
-        const auto w = view.direction(s.grid.x(i), s.grid.y(j));
-        if (!w) continue;
-        if (w->z < 0) {
-          s.region[k] = 1;
-          continue;
-        }
-        const Tuple3<double> q = P::forward_iso(DirPair<double>{*w, wo});
-        s.region[k] = 2;
-        s.first.values[k] = q[0];
-        s.second.values[k] = q[1];
-        s.first.valid[k] = s.second.valid[k] = 1;
-      }
-    });
+    parallel_for(
+        s.grid.ny, 1,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t j = begin; j < end; ++j) {
+            for (std::size_t i = 0; i < s.grid.nx; ++i) {
+              const std::size_t k = s.grid.index(i, j);
+              s.first.values[k] = s.second.values[k] = nan;
+              const auto w = view.direction(s.grid.x(i), s.grid.y(j));
+              if (!w) continue;
+              if (w->z < 0) {
+                s.region[k] = 1;
+                continue;
+              }
+              const Tuple3<double> q = P::forward_iso(DirPair<double>{*w, wo});
+              s.region[k] = 2;
+              s.first.values[k] = q[0];
+              s.second.values[k] = q[1];
+              s.first.valid[k] = s.second.valid[k] = 1;
+            }
+          }
+        },
+        threads);
   });
   return s;
 }

@@ -11,25 +11,6 @@
 
 namespace halfback::figure {
 
-NamedEnvironment load_environment(const std::string& spec) {
-  auto map = std::make_shared<const render::EnvMap>(render::EnvMap::from_spec(spec));
-  const auto builtins = render::EnvMap::builtin_names();
-  std::string label;
-  if (std::find(builtins.begin(), builtins.end(), spec) != builtins.end())
-    label = (spec == "default" ? std::string("sky") : spec) + " (built-in)";
-  else if (spec.rfind("constant:", 0) == 0)
-    label = spec;
-  else
-    label = std::filesystem::path(spec).stem().string();
-  return {label, std::move(map)};
-}
-
-const std::vector<NamedEnvironment>& default_environments() {
-  static const std::vector<NamedEnvironment> envs{
-      load_environment("default"), load_environment("studio"), load_environment("sunset")};
-  return envs;
-}
-
 ImageItem rendering_item(const render::Image& image, double x, double y, double size) {
   const std::vector<std::uint8_t> rgb = render::tonemap_srgb8(image, {});
   ImageItem item;
@@ -62,7 +43,7 @@ MaterialFigure material_figure(const MaterialFigureOptions& o) {
   rs.spp = o.spp;
   rs.seed = o.seed;
   rs.threads = int(so.threads);
-  for (const NamedEnvironment& env : o.environments) {
+  for (const render::Environment& env : o.environments) {
     if (!env.map) throw std::invalid_argument("material figure: an environment without a map");
     fig.renders.push_back(render::render(*o.brdf, *env.map, rs).image);
   }

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "halfback/brdf/load.hpp"
+#include "halfback/loader/load.hpp"
 
 namespace halfback::figure {
 namespace {
@@ -26,7 +26,7 @@ MaterialFigureOptions small(const std::string& spec) {
 // whose relative spread is below 1: a few 0.1 %), and the corners show the background, exactly 1.
 TEST(MaterialFigure, FurnaceRenderingIsTheAlbedo) {
   MaterialFigureOptions o = small("lambert:albedo=0.3");
-  o.environments = {load_environment("constant:1"), load_environment("constant:0")};
+  o.environments = {render::load_environment("constant:1"), render::load_environment("constant:0")};
   const MaterialFigure f = material_figure(o);
   ASSERT_EQ(f.renders.size(), 2u);
   const render::Image& white = f.renders[0];
@@ -71,7 +71,7 @@ TEST(MaterialFigure, BadInput) {
   MaterialFigureOptions o = small("lambert");
   o.environments = {};
   EXPECT_THROW(material_figure(o), std::invalid_argument);
-  EXPECT_ANY_THROW(load_environment("no-such-map.hdr"));
+  EXPECT_ANY_THROW(render::load_environment("no-such-map.hdr"));
   o.environments = {{"no map", nullptr}};
   EXPECT_THROW(material_figure(o), std::invalid_argument);
   o = small("lambert");

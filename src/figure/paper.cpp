@@ -7,11 +7,11 @@
 #include <tuple>
 #include <utility>
 
-#include "halfback/brdf/load.hpp"
 #include "halfback/figure/hemisphere.hpp"
 #include "halfback/figure/material.hpp"
 #include "halfback/figure/render.hpp"
 #include "halfback/figure/slices.hpp"
+#include "halfback/loader/load.hpp"
 
 namespace halfback::figure {
 
@@ -75,8 +75,8 @@ std::vector<WrittenFigure> write_paper_figures(const std::filesystem::path& dir,
   s.threads = o.threads;
   written.push_back({"Figure 2, test functions S, G, F on slices",
                      save_all(slice_figure(s).scene, dir, "fig2-slices", o)});
-  const std::vector<NamedEnvironment>& envs =
-      o.environments.empty() ? default_environments() : o.environments;
+  const std::vector<render::Environment>& envs =
+      o.environments.empty() ? render::default_environments() : o.environments;
   for (const PaperMaterial& m : o.materials) {
     MaterialFigureOptions mo;
     mo.brdf = m.brdf ? m.brdf : load_brdf(m.spec);

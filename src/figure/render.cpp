@@ -1,7 +1,7 @@
 #include "halfback/figure/render.hpp"
 
-#include "halfback/io/atomic_file.hpp"
-#include "halfback/io/text_encoding.hpp"
+#include "halfback/util/atomic_file.hpp"
+#include "halfback/util/text_encoding.hpp"
 
 #include <cairo-pdf.h>
 #include <cairo.h>

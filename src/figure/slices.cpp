@@ -8,6 +8,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
 
 namespace halfback::figure {
@@ -73,7 +74,7 @@ std::string power_of_ten_label(double log10_value) {
 
 }  // namespace
 
-SliceSample sample_slice(Space space, double azimuth, const Grid& grid, unsigned threads) {
+SliceSample sample_slice(Space space, double azimuth, const Grid& grid, int threads) {
   if (space == Space::dirs) throw std::invalid_argument("slice: dirs is not a parameterization");
   SliceSample s;
   s.grid = grid;
@@ -81,15 +82,20 @@ SliceSample sample_slice(Space space, double azimuth, const Grid& grid, unsigned
   s.pairs.resize(grid.size());
   visit_parameterization(space, [&](auto p) {
     using P = decltype(p);
-    parallel_rows(grid.ny, threads, [&](std::size_t j) {
-      for (std::size_t i = 0; i < grid.nx; ++i) {
-        const Tuple3<double> q{grid.x(i), grid.y(j), azimuth};
-        const Solved<double> r = inverse_iso<P>(q);
-        const std::size_t k = grid.index(i, j);
-        s.valid[k] = valid_iso<P>(q) ? 1 : 0;
-        s.pairs[k] = r.pair;
-      }
-    });
+    parallel_for(
+        grid.ny, 1,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t j = begin; j < end; ++j) {
+            for (std::size_t i = 0; i < grid.nx; ++i) {
+              const Tuple3<double> q{grid.x(i), grid.y(j), azimuth};
+              const Solved<double> r = inverse_iso<P>(q);
+              const std::size_t k = grid.index(i, j);
+              s.valid[k] = valid_iso<P>(q) ? 1 : 0;
+              s.pairs[k] = r.pair;
+            }
+          }
+        },
+        threads);
   });
   return s;
 }
@@ -151,9 +157,8 @@ SliceFigure slice_figure(const SliceOptions& o) {
   std::string heading, sub;
   if (generic) {
     sc.title = fmt::format("Slices of the isotropic forms: {}", o.brdf->name());
-    heading =
-        fmt::format("Slices of the isotropic forms at fixed relative azimuth: {}",
-                    escape_markup(o.brdf->name()));
+    heading = fmt::format("Slices of the isotropic forms at fixed relative azimuth: {}",
+                          escape_markup(o.brdf->name()));
     sub = fmt::format(
         "{}. Colour: {}; isolines of luminance at log-spaced levels; one scale "
         "for all panels, clipped at the 0.5 % and 99.5 % percentiles; hatched: outside "
@@ -214,14 +219,14 @@ SliceFigure slice_figure(const SliceOptions& o) {
           where.push_back(k);
         }
       std::vector<Rgb> values(pairs.size());
-      o.brdf->eval(pairs, values);
+      o.brdf->eval_batch(pairs, values);
       rgb[n].assign(s.valid.size(), Rgb{kNan, kNan, kNan});
       ScalarField f(s.grid);
       f.valid = s.valid;
       std::fill(f.values.begin(), f.values.end(), kNan);
       for (std::size_t m = 0; m < where.size(); ++m) {
         rgb[n][where[m]] = values[m];
-        const double l = luminance(values[m]);
+        const double l = values[m].luminance();
         if (l > 0 && std::isfinite(l)) {
           f.values[where[m]] = std::log10(l);
           all.push_back(f.values[where[m]]);

@@ -34,13 +34,6 @@ void require_rgb(const std::string& model, const char* name, const Rgb& v, doubl
   require_range(model, name, v.b, lo, hi);
 }
 
-Rgb operator*(const Rgb& a, double s) {
-  return {a.r * s, a.g * s, a.b * s};
-}
-Rgb operator+(const Rgb& a, const Rgb& b) {
-  return {a.r + b.r, a.g + b.g, a.b + b.b};
-}
-
 bool below_horizon(const DirPair<double>& p) {
   return !(p.wi.z > 0 && p.wo.z > 0);
 }

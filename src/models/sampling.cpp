@@ -1,4 +1,4 @@
-// Importance sampling of the analytic models (SamplableBrdf, models/sampling.hpp). The formulas
+// Importance sampling of the analytic models (Brdf::sample and Brdf::pdf). The formulas
 // and their sources are in docs/render.md.
 #include <algorithm>
 #include <array>
@@ -13,10 +13,6 @@ namespace halfback::models {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-double luminance(const Rgb& c) {
-  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
-}
 
 double dot(const Vec3<double>& a, const Vec3<double>& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
@@ -33,27 +29,9 @@ Vec3<double> reflect(const Vec3<double>& wo, const Vec3<double>& m) {
   return {c * m.x - wo.x, c * m.y - wo.y, c * m.z - wo.z};
 }
 
-BrdfSample finish(const SamplableBrdf& s, const Vec3<double>& wo, const Vec3<double>& wi) {
+BrdfSample finish(const Brdf& s, const Vec3<double>& wo, const Vec3<double>& wi) {
   if (!(wi.z > 0)) return {};
   return {wi, s.pdf(wo, wi)};
-}
-
-// The cosine sampler, for terms of a Sum that have no sampler of their own.
-struct CosineSampler final : SamplableBrdf {
-  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override {
-    if (!(wo.z > 0)) return {};
-    const Vec3<double> wi = sample_cosine_hemisphere(u1, u2);
-    return {wi, cosine_hemisphere_pdf(wi)};
-  }
-  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override {
-    return wo.z > 0 ? cosine_hemisphere_pdf(wi) : 0;
-  }
-};
-const CosineSampler kCosine;
-
-const SamplableBrdf& sampler_of(const Brdf& b) {
-  const auto* s = dynamic_cast<const SamplableBrdf*>(&b);
-  return s ? *s : kCosine;
 }
 
 }  // namespace
@@ -95,13 +73,12 @@ void MixtureWeights::weights(double cos_o, std::span<double> out) const {
              t * table_[std::size_t(k0 + 1) * lobes_ + j];
 }
 
-double MixtureWeights::albedo(const Brdf& brdf, const SamplableBrdf& sampler,
-                              const Vec3<double>& wo) {
+double MixtureWeights::albedo(const Brdf& brdf, const Brdf& sampler, const Vec3<double>& wo) {
   double sum = 0;
   for (int i = 0; i < kStrata; ++i)
     for (int j = 0; j < kStrata; ++j) {
       const BrdfSample s = sampler.sample(wo, (i + 0.5) / kStrata, (j + 0.5) / kStrata);
-      if (s.pdf > 0) sum += luminance(brdf.eval({s.wi, wo})) * s.wi.z / s.pdf;
+      if (s.pdf > 0) sum += brdf.eval({s.wi, wo}).luminance() * s.wi.z / s.pdf;
     }
   return sum / (kStrata * kStrata);
 }
@@ -111,17 +88,17 @@ double MixtureWeights::albedo(const Brdf& brdf, const SamplableBrdf& sampler,
 // --- Lambert and sheen: the cosine ------------------------------------------------------------
 
 BrdfSample Lambert::sample(const Vec3<double>& wo, double u1, double u2) const {
-  return kCosine.sample(wo, u1, u2);
+  return Brdf::sample(wo, u1, u2);
 }
 double Lambert::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
-  return kCosine.pdf(wo, wi);
+  return Brdf::pdf(wo, wi);
 }
 
 BrdfSample Sheen::sample(const Vec3<double>& wo, double u1, double u2) const {
-  return kCosine.sample(wo, u1, u2);
+  return Brdf::sample(wo, u1, u2);
 }
 double Sheen::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
-  return kCosine.pdf(wo, wi);
+  return Brdf::pdf(wo, wi);
 }
 
 // --- Microfacet ---------------------------------------------------------------------------------
@@ -207,7 +184,7 @@ struct AbcRadial {
 
 const detail::MixtureWeights& Abc::mixture() const {
   std::call_once(mixture_once_, [this] {
-    const double kd = luminance(params_.kd);
+    const double kd = params_.kd.luminance();
     const AbcRadial radial{params_.b, 1 - 0.5 * (params_.c + 1)};
     mixture_.reset(new detail::MixtureWeights(2, [&](std::size_t lobe, const Vec3<double>& wo) {
       if (lobe == 1) return kd;
@@ -223,7 +200,7 @@ const detail::MixtureWeights& Abc::mixture() const {
           const Vec3<double> wi{x, y, std::sqrt(1 - r2)};
           const double q = std::pow(1 + params_.b * f * f, -0.5 * (params_.c + 1)) /
                            (2 * kPi * radial.integral(2));
-          const double spec = luminance(eval({wi, wo})) - kd / kPi;
+          const double spec = eval({wi, wo}).luminance() - kd / kPi;
           sum += std::max(0.0, spec) * wi.z / (q * wi.z);
         }
       return sum / (n * n);
@@ -262,7 +239,7 @@ const detail::MixtureWeights& Sum::mixture() const {
   std::call_once(mixture_once_, [this] {
     mixture_.reset(
         new detail::MixtureWeights(terms_.size(), [this](std::size_t j, const Vec3<double>& wo) {
-          return detail::MixtureWeights::albedo(*terms_[j], sampler_of(*terms_[j]), wo);
+          return detail::MixtureWeights::albedo(*terms_[j], *terms_[j], wo);
         }));
   });
   return *mixture_;
@@ -273,7 +250,7 @@ BrdfSample Sum::sample(const Vec3<double>& wo, double u1, double u2) const {
   std::vector<double> w(terms_.size());
   mixture().weights(wo.z, w);
   const std::size_t j = detail::pick_lobe(w, u1);
-  const BrdfSample s = sampler_of(*terms_[j]).sample(wo, u1, u2);
+  const BrdfSample s = terms_[j]->sample(wo, u1, u2);
   if (!(s.pdf > 0)) return {};
   return finish(*this, wo, s.wi);
 }
@@ -284,7 +261,7 @@ double Sum::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
   mixture().weights(wo.z, w);
   double p = 0;
   for (std::size_t j = 0; j < terms_.size(); ++j)
-    if (w[j] > 0) p += w[j] * sampler_of(*terms_[j]).pdf(wo, wi);
+    if (w[j] > 0) p += w[j] * terms_[j]->pdf(wo, wi);
   return p;
 }
 

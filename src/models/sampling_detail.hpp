@@ -27,7 +27,7 @@ class MixtureWeights {
   void weights(double cos_o, std::span<double> out) const;
 
   // The luminance albedo of ρ at wo by sampling with `sampler` (stratified, deterministic).
-  static double albedo(const Brdf& brdf, const SamplableBrdf& sampler, const Vec3<double>& wo);
+  static double albedo(const Brdf& brdf, const Brdf& sampler, const Vec3<double>& wo);
 
  private:
   std::size_t lobes_;

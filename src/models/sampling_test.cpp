@@ -13,7 +13,7 @@
 
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/models/analytic.hpp"
-#include "render/test_stats.hpp"
+#include "support/test_stats.hpp"
 
 namespace halfback::models {
 namespace {
@@ -24,10 +24,6 @@ using render::testing::DirSample;
 Vec3<double> dir(double theta_deg, double phi_deg) {
   const double t = theta_deg * std::numbers::pi / 180, p = phi_deg * std::numbers::pi / 180;
   return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
-
-double luminance(const Rgb& c) {
-  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
 }
 
 std::shared_ptr<Microfacet> microfacet(MicrofacetParams::Distribution d, double ax, double ay,
@@ -77,7 +73,8 @@ TEST(ModelSampling, SampleAndPdfAgree) {
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> u(0, 1);
   for (const Case& c : cases()) {
-    const auto& s = dynamic_cast<const SamplableBrdf&>(*c.brdf);
+    const Brdf& s = *c.brdf;
+    ASSERT_TRUE(s.has_importance_sampling()) << c.name;
     for (const auto& wo : kViews) {
       int valid = 0;
       for (int k = 0; k < 2000; ++k) {
@@ -100,7 +97,8 @@ TEST(ModelSampling, SampleAndPdfAgree) {
 TEST(ModelSampling, ChiSquareAndIntegral) {
   for (const Case& c : cases()) {
     if (!c.chi2) continue;
-    const auto& s = dynamic_cast<const SamplableBrdf&>(*c.brdf);
+    const Brdf& s = *c.brdf;
+    ASSERT_TRUE(s.has_importance_sampling()) << c.name;
     for (const auto& wo : kViews) {
       const auto r = chi2_test(
           [&](double u1, double u2) {
@@ -147,7 +145,8 @@ TEST(ModelSampling, GgxWeightIsTheMaskingRatio) {
 // The albedo by each model's own sampler agrees with the independent cosine-sampled estimate.
 TEST(ModelSampling, SampledAlbedoMatchesDirectionalAlbedo) {
   for (const Case& c : cases()) {
-    const auto& s = dynamic_cast<const SamplableBrdf&>(*c.brdf);
+    const Brdf& s = *c.brdf;
+    ASSERT_TRUE(s.has_importance_sampling()) << c.name;
     for (const auto& wo : kViews) {
       constexpr int n = 256;
       double sum = 0, sum2 = 0;
@@ -155,13 +154,13 @@ TEST(ModelSampling, SampledAlbedoMatchesDirectionalAlbedo) {
         for (int j = 0; j < n; ++j) {
           const BrdfSample b = s.sample(wo, (i + 0.5) / n, (j + 0.5) / n);
           if (!(b.pdf > 0)) continue;
-          const double w = luminance(c.brdf->eval({b.wi, wo})) * b.wi.z / b.pdf;
+          const double w = c.brdf->eval({b.wi, wo}).luminance() * b.wi.z / b.pdf;
           sum += w;
           sum2 += w * w;
         }
       const double mean = sum / (n * n);
       const AlbedoEstimate ref = directional_albedo(*c.brdf, wo, 512, 5);
-      const double ref_l = luminance(ref.mean), ref_se = luminance(ref.standard_error);
+      const double ref_l = ref.mean.luminance(), ref_se = ref.standard_error.luminance();
       EXPECT_NEAR(mean, ref_l, 5 * ref_se + 2e-3 * ref_l + 1e-4)
           << c.name << " θo=" << std::acos(wo.z);
     }

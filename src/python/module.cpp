@@ -16,11 +16,12 @@
 #include <vector>
 
 #include "halfback/brdf/albedo.hpp"
-#include "halfback/brdf/load.hpp"
 #include "halfback/brdf/registry.hpp"
 #include "halfback/brdf/resample.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/figure/hemisphere.hpp"
+#include "halfback/formats/table_file.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
 
@@ -196,7 +197,7 @@ py::array_t<double> eval_brdf(const PyBrdf& b, const py::object& wi, const py::o
   std::vector<Rgb> rho(pairs.size());
   {
     py::gil_scoped_release release;
-    b.brdf->eval(pairs, rho);
+    b.brdf->eval_batch(pairs, rho);
   }
   py::array_t<double> out({py::ssize_t(pairs.size()), py::ssize_t(3)});
   double* o = out.mutable_data();
@@ -464,6 +465,6 @@ and wo; row j of the arrays is at v = v[j] (row 0 is the bottom). projection: "e
       R"doc(Loads a BRDF from a SPEC: a MERL/RGL/ALTA file, a model such as "ggx:alpha=0.2" or
 "lambert:albedo=0.5", a sum "a+b", or "embedded:NAME" (as on the command line).)doc");
   m.def(
-      "models", [] { return ModelRegistry::global().names(); },
+      "models", [] { return model_registry().names(); },
       "The names of the analytic models (see `halfback models` for their parameters).");
 }

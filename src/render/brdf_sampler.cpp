@@ -9,16 +9,14 @@
 #include <stdexcept>
 #include <thread>
 
+#include "halfback/core/parallel.hpp"
+
 namespace halfback::render {
 
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
-
-double luminance(const Rgb& c) {
-  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
-}
 
 double azimuth(double y, double x) {
   const double p = std::atan2(y, x);
@@ -114,33 +112,10 @@ Vec3<double> rotate_z(const Vec3<double>& v, double c, double s) {
   return {c * v.x - s * v.y, s * v.x + c * v.y, v.z};
 }
 
-class OwnSampler final : public BrdfSampler {
+// The wrapped BRDF with Brdf's default sampling, the cosine-weighted hemisphere.
+class CosineSampling final : public SamplingWrapper {
  public:
-  OwnSampler(const SamplableBrdf& s, std::string name) : s_(s), name_(std::move(name)) {}
-  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override {
-    return s_.sample(wo, u1, u2);
-  }
-  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override {
-    return s_.pdf(wo, wi);
-  }
-  std::string describe() const override { return "own sampler of " + name_; }
-
- private:
-  const SamplableBrdf& s_;
-  std::string name_;
-};
-
-class CosineOnly final : public BrdfSampler {
- public:
-  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override {
-    if (!(wo.z > 0)) return {};
-    const Vec3<double> wi = sample_cosine_hemisphere(u1, u2);
-    return {wi, cosine_hemisphere_pdf(wi)};
-  }
-  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override {
-    return wo.z > 0 ? cosine_hemisphere_pdf(wi) : 0;
-  }
-  std::string describe() const override { return "cosine-weighted hemisphere"; }
+  using SamplingWrapper::SamplingWrapper;
 };
 
 }  // namespace
@@ -164,23 +139,22 @@ TableParam table_param_from_name(const std::string& name) {
                               "' (expected spherical, halfdiff or hybrid)");
 }
 
-std::shared_ptr<const BrdfSampler> make_brdf_sampler(const Brdf& brdf,
+std::shared_ptr<const Brdf> with_importance_sampling(const Brdf& brdf,
                                                      const TabulationOptions& options,
                                                      bool force_tabulated) {
-  if (!force_tabulated)
-    if (const auto* s = dynamic_cast<const SamplableBrdf*>(&brdf))
-      return std::make_shared<OwnSampler>(*s, brdf.name());
+  if (!force_tabulated && brdf.has_importance_sampling())
+    return std::shared_ptr<const Brdf>(&brdf, [](const Brdf*) {});  // not owned
   return std::make_shared<TabulatedSampler>(brdf, options);
 }
 
-std::shared_ptr<const BrdfSampler> make_cosine_sampler() {
-  return std::make_shared<CosineOnly>();
+std::shared_ptr<const Brdf> with_cosine_sampling(const Brdf& brdf) {
+  return std::make_shared<CosineSampling>(brdf);
 }
 
 // --------------------------------------------------------------------------------------------
 
 TabulatedSampler::TabulatedSampler(const Brdf& brdf, const TabulationOptions& o)
-    : name_(brdf.name()), options_(o), isotropic_(brdf.isotropic()) {
+    : SamplingWrapper(brdf), options_(o), isotropic_(brdf.isotropic()) {
   const auto start = std::chrono::steady_clock::now();
   if (o.radial < 2 || o.azimuthal < 2 || o.theta_slices < 1 || o.aniso_theta_slices < 1 ||
       o.aniso_phi_slices < 1 || o.supersample < 1 || !(o.defensive >= 0 && o.defensive < 1))
@@ -221,33 +195,19 @@ TabulatedSampler::TabulatedSampler(const Brdf& brdf, const TabulationOptions& o)
     for (std::size_t p = 0; p < pairs.size(); ++p) values[p] = brdf.eval(pairs[p]);
     std::vector<double> weights(cells, 0.0);
     for (std::size_t p = 0; p < pairs.size(); ++p) {
-      const double v = luminance(values[p]) * factor[p];
+      const double v = values[p].luminance() * factor[p];
       if (std::isfinite(v) && v > 0) weights[cell_of[p]] += v;
     }
     slices_[std::size_t(index)] =
         Distribution2D(std::size_t(n_radial_), std::size_t(n_azimuthal_), weights);
   };
 
-  const int hw = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-  const int workers = std::min(hw, n_slices);
-  std::atomic<int> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto worker = [&] {
-    for (int i; (i = next.fetch_add(1)) < n_slices;) {
-      try {
-        build(i);
-      } catch (...) {
-        std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 1; w < workers; ++w) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  parallel_for(
+      std::size_t(n_slices), 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) build(int(i));
+      },
+      o.threads);
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -255,11 +215,11 @@ std::size_t TabulatedSampler::cells() const {
   return slices_.size() * std::size_t(n_radial_) * std::size_t(n_azimuthal_);
 }
 
-std::string TabulatedSampler::describe() const {
+std::string TabulatedSampler::describe_sampling() const {
   return std::string("tabulated (") + name_of(options_.param) + (options_.warp ? ", warped" : "") +
          ", " + std::to_string(n_theta_) + (isotropic_ ? "" : " x " + std::to_string(n_phi_)) +
          " slices of " + std::to_string(n_radial_) + " x " + std::to_string(n_azimuthal_) +
-         " cells) of " + name_;
+         " cells) of " + brdf_.name();
 }
 
 TabulatedSampler::Blend TabulatedSampler::blend(const Vec3<double>& wo) const {

@@ -19,7 +19,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "halfback/io/format_error.hpp"
+#include "halfback/util/format_error.hpp"
 
 namespace halfback::render {
 
@@ -27,10 +27,6 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr long long kMaxPixels = 1LL << 28;  // 268 M pixels: 3 GiB of floats
-
-double luminance(float r, float g, float b) {
-  return 0.2126 * r + 0.7152 * g + 0.0722 * b;
-}
 
 std::string describe_value(float v) {
   if (std::isnan(v)) return "NaN";
@@ -274,7 +270,7 @@ EnvMap::EnvMap(int width, int height, std::vector<float> rgb, std::string name, 
   std::vector<double> weights(std::size_t(width) * std::size_t(height));
   for (std::size_t i = 0; i < weights.size(); ++i) {
     const float* p = &rgb_[3 * i];
-    weights[i] = luminance(p[0], p[1], p[2]) * row_solid_angle_[i / std::size_t(width)];
+    weights[i] = Rgb{p[0], p[1], p[2]}.luminance() * row_solid_angle_[i / std::size_t(width)];
   }
   distribution_ = Distribution2D(std::size_t(height), std::size_t(width), weights);
   // MIS compensation: the luminance above its solid-angle mean.
@@ -438,7 +434,7 @@ std::vector<float> procedural_map(int W, int H, Radiance radiance, Edge edge, in
         for (int j = 0; j < n; ++j) {
           const Rgb x =
               radiance(EnvMap::map_direction((c + (i + 0.5) / n) / W, (r + (j + 0.5) / n) / H));
-          v = {v.r + x.r, v.g + x.g, v.b + x.b};
+          v += x;
         }
       float* p = &rgb[3 * (std::size_t(r) * W + std::size_t(c))];
       p[0] = float(v.r / (n * n));
@@ -486,7 +482,7 @@ EnvMap EnvMap::default_sky(EnvOptions options) {
       const double t = 0.55 + 0.45 * std::pow(1 + d.y, 2);
       v = {0.13 * t, 0.115 * t, 0.095 * t};
     }
-    if (cs >= cos_sun) v = {v.r + sun_radiance.r, v.g + sun_radiance.g, v.b + sun_radiance.b};
+    if (cs >= cos_sun) v += sun_radiance;
     return v;
   };
   // The sun disk's edge, supersampled 8 × 8.
@@ -553,6 +549,25 @@ EnvMap EnvMap::sunset(EnvOptions options) {
 
 std::vector<std::string> EnvMap::builtin_names() {
   return {"default", "sky", "studio", "sunset"};
+}
+
+Environment load_environment(const std::string& spec) {
+  auto map = std::make_shared<const EnvMap>(EnvMap::from_spec(spec));
+  const auto builtins = EnvMap::builtin_names();
+  std::string label;
+  if (std::find(builtins.begin(), builtins.end(), spec) != builtins.end())
+    label = (spec == "default" ? std::string("sky") : spec) + " (built-in)";
+  else if (spec.rfind("constant:", 0) == 0)
+    label = spec;
+  else
+    label = std::filesystem::path(spec).stem().string();
+  return {label, std::move(map)};
+}
+
+const std::vector<Environment>& default_environments() {
+  static const std::vector<Environment> envs{
+      load_environment("default"), load_environment("studio"), load_environment("sunset")};
+  return envs;
 }
 
 }  // namespace halfback::render

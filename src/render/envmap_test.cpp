@@ -11,10 +11,10 @@
 #include <random>
 #include <string>
 
-#include "halfback/io/format_error.hpp"
 #include "halfback/render/distribution.hpp"
 #include "halfback/render/image.hpp"
-#include "render/test_stats.hpp"
+#include "halfback/util/format_error.hpp"
+#include "support/test_stats.hpp"
 
 namespace halfback::render {
 namespace {

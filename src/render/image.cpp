@@ -14,7 +14,7 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "halfback/io/atomic_file.hpp"
+#include "halfback/util/atomic_file.hpp"
 
 namespace halfback::render {
 

@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "halfback/core/parallel.hpp"
 #include "sequence.hpp"
 
 namespace halfback::render {
@@ -38,10 +39,6 @@ double dot(const V3& a, const V3& b) {
 V3 cross(const V3& a, const V3& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-double luminance(const Rgb& c) {
-  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
-}
-
 struct Frame {
   V3 t, b, n;
   V3 to_local(const V3& w) const { return {dot(w, t), dot(w, b), dot(w, n)}; }
@@ -113,9 +110,8 @@ class Progress {
 
 class Renderer {
  public:
-  Renderer(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& env, const RenderSettings& s)
+  Renderer(const Brdf& brdf, const EnvMap& env, const RenderSettings& s)
       : brdf_(brdf),
-        sampler_(sampler),
         env_(env),
         s_(s),
         kind_(s.sequence == Sequence::sobol ? detail::SequenceKind::sobol
@@ -154,11 +150,7 @@ class Renderer {
     const V3 wo = f.to_local(wo_world);
     Rgb sum;
     if (!(wo.z > 0)) return sum;
-    auto add = [&](const Rgb& fr, const Rgb& li, double factor) {
-      sum.r += fr.r * li.r * factor;
-      sum.g += fr.g * li.g * factor;
-      sum.b += fr.b * li.b * factor;
-    };
+    auto add = [&](const Rgb& fr, const Rgb& li, double factor) { sum += fr * li * factor; };
     auto env_sample = [&](std::uint32_t dim, double share) {
       double u1, u2;
       detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
@@ -169,13 +161,13 @@ class Renderer {
       if (!(wi.z > 0)) return;
       const Rgb fr = brdf_.eval({wi, wo});
       const double w =
-          s_.strategy == Strategy::mis ? weight(s_.heuristic, es.pdf, sampler_.pdf(wo, wi)) : 1;
+          s_.strategy == Strategy::mis ? weight(s_.heuristic, es.pdf, brdf_.pdf(wo, wi)) : 1;
       add(fr, es.radiance, share * w * wi.z / es.pdf);
     };
     auto brdf_sample = [&](std::uint32_t dim, double share) {
       double u1, u2;
       detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
-      const BrdfSample bs = sampler_.sample(wo, u1, u2);
+      const BrdfSample bs = brdf_.sample(wo, u1, u2);
       if (!(bs.pdf > 0 && bs.wi.z > 0)) return;
       const V3 dir = f.to_world(bs.wi);
       const Rgb li = env_.eval(dir);
@@ -221,7 +213,7 @@ class Renderer {
           r += v.r;
           g += v.g;
           b += v.b;
-          const double l = luminance(v);
+          const double l = v.luminance();
           y += l;
           y2 += l * l;
         }
@@ -238,7 +230,6 @@ class Renderer {
 
  private:
   const Brdf& brdf_;
-  const BrdfSampler& sampler_;
   const EnvMap& env_;
   const RenderSettings& s_;
   detail::SequenceKind kind_;
@@ -271,24 +262,20 @@ RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& s
   const auto start = Clock::now();
   TabulationOptions tab = settings.tabulation;
   if (tab.threads == 0) tab.threads = settings.threads;
-  const auto sampler = make_brdf_sampler(brdf, tab);
+  const auto sampled = with_importance_sampling(brdf, tab);
   const double build = std::chrono::duration<double>(Clock::now() - start).count();
-  RenderResult r = render(brdf, *sampler, env, settings);
+  RenderResult r = render_sampled(*sampled, env, settings);
   r.sampler_seconds = build;
   return r;
 }
 
-RenderResult render(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& env,
-                    const RenderSettings& s) {
+RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSettings& s) {
   validate(s);
   const auto start = Clock::now();
-  const Renderer renderer(brdf, sampler, env, s);
+  const Renderer renderer(brdf, env, s);
   const std::size_t pixels = std::size_t(s.width) * std::size_t(s.height);
   const int tiles_x = (s.width + kTile - 1) / kTile, tiles_y = (s.height + kTile - 1) / kTile;
   const int tiles = tiles_x * tiles_y;
-  const int threads = std::max(
-      1, std::min(tiles, s.threads > 0 ? s.threads
-                                       : int(std::max(1u, std::thread::hardware_concurrency()))));
 
   Accum total, pass;
   total.reset(pixels, s.variance);
@@ -303,35 +290,26 @@ RenderResult render(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& 
   while (done < s.spp) {
     const int count = std::min(pass_size, s.spp - done);
     pass.reset(pixels, s.variance);
-    std::atomic<int> next{0};
     std::atomic<bool> abort{false};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    auto worker = [&] {
-      for (int t; !abort && (t = next.fetch_add(1)) < tiles;) {
+    auto render_tiles = [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end && !abort; ++i) {
         if (s.time_budget > 0 && done > 0 &&
             std::chrono::duration<double>(Clock::now() - start).count() > s.time_budget) {
           abort = true;
-          break;
+          return;
         }
+        const int t = int(i), x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
         try {
-          renderer.tile((t % tiles_x) * kTile, (t / tiles_x) * kTile, std::uint32_t(done),
-                        std::uint32_t(count), pass, nonfinite);
+          renderer.tile(x0, y0, std::uint32_t(done), std::uint32_t(count), pass, nonfinite);
         } catch (...) {
-          std::lock_guard lock(error_mutex);
-          if (!error) error = std::current_exception();
-          abort = true;
+          abort = true;  // the other blocks stop at their next tile
+          throw;
         }
-        const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
         progress.add(std::uint64_t(std::min(kTile, s.width - x0)) *
                      std::uint64_t(std::min(kTile, s.height - y0)) * std::uint64_t(count));
       }
     };
-    std::vector<std::thread> pool;
-    for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
+    parallel_for(std::size_t(tiles), 1, render_tiles, s.threads);
     if (abort) {
       exhausted = true;
       break;
@@ -354,7 +332,7 @@ RenderResult render(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& 
   r.spp = done;
   r.budget_exhausted = exhausted;
   r.nonfinite = nonfinite;
-  r.sampler = sampler.describe();
+  r.sampler = brdf.describe_sampling();
   r.image.width = s.width;
   r.image.height = s.height;
   r.image.rgb.resize(3 * pixels);

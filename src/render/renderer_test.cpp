@@ -12,10 +12,8 @@
 #include <numbers>
 
 #include "halfback/brdf/albedo.hpp"
-#include "halfback/brdf/load.hpp"
-#include "halfback/brdf/registry.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/models/analytic.hpp"
-#include "halfback/models/register.hpp"
 
 namespace halfback::render {
 namespace {
@@ -336,8 +334,6 @@ TEST(Renderer, BadInput) {
   s.time_budget = -1;
   EXPECT_THROW(render(l, env, s), std::invalid_argument);
   // Unknown BRDFs are refused by load_brdf with a message naming them.
-  if (!ModelRegistry::global().find("ggx"))
-    models::register_analytic_models(ModelRegistry::global());
   try {
     load_brdf("no_such_model:alpha=1");
     ADD_FAILURE();

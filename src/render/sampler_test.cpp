@@ -11,7 +11,7 @@
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/models/analytic.hpp"
 #include "halfback/render/brdf_sampler.hpp"
-#include "render/test_stats.hpp"
+#include "support/test_stats.hpp"
 
 namespace halfback::render {
 namespace {
@@ -33,10 +33,6 @@ class Opaque final : public Brdf {
 Vec3<double> dir(double theta_deg, double phi_deg) {
   const double t = theta_deg * std::numbers::pi / 180, p = phi_deg * std::numbers::pi / 180;
   return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
-
-double luminance(const Rgb& c) {
-  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
 }
 
 BrdfPtr ggx(double ax, double ay) {
@@ -72,10 +68,12 @@ TabulationOptions small(const Config& s) {
 
 TEST(TabulatedSampler, OwnSamplerIsPreferred) {
   const auto g = ggx(0.2, 0.2);
-  EXPECT_NE(make_brdf_sampler(*g)->describe().find("own sampler"), std::string::npos);
+  EXPECT_NE(with_importance_sampling(*g)->describe_sampling().find("own sampler"),
+            std::string::npos);
   const Opaque o(g);
-  EXPECT_NE(make_brdf_sampler(o)->describe().find("tabulated"), std::string::npos);
-  EXPECT_NE(make_brdf_sampler(*g, {}, true)->describe().find("tabulated"), std::string::npos);
+  EXPECT_NE(with_importance_sampling(o)->describe_sampling().find("tabulated"), std::string::npos);
+  EXPECT_NE(with_importance_sampling(*g, {}, true)->describe_sampling().find("tabulated"),
+            std::string::npos);
   EXPECT_EQ(table_param_from_name("hybrid"), TableParam::hybrid);
   EXPECT_THROW(table_param_from_name("polar"), std::invalid_argument);
 }
@@ -95,9 +93,9 @@ TEST(TabulatedSampler, SampleAndPdfAgree) {
           ++valid;
           ASSERT_GT(x.wi.z, 0);
           EXPECT_NEAR(std::hypot(x.wi.x, x.wi.y, x.wi.z), 1, 1e-12);
-          EXPECT_NEAR(x.pdf, t.pdf(wo, x.wi), 1e-9 * x.pdf) << t.describe();
+          EXPECT_NEAR(x.pdf, t.pdf(wo, x.wi), 1e-9 * x.pdf) << t.describe_sampling();
         }
-        EXPECT_GT(valid, 2000) << t.describe();
+        EXPECT_GT(valid, 2000) << t.describe_sampling();
       }
     }
 }
@@ -118,10 +116,10 @@ TEST(TabulatedSampler, ChiSquareAndIntegral) {
                                              : Vec3<double>{-wo.x, -wo.y, wo.z},
             10);
         // The quadrature is least accurate at the pdf's integrable singularity.
-        EXPECT_LE(r.integral, 1.02) << t.describe();
-        EXPECT_NEAR(r.integral, r.valid_fraction, 0.02) << t.describe();
-        EXPECT_LT(r.z, 4.5) << t.describe() << " θo=" << std::acos(wo.z) << " chi2=" << r.chi2
-                            << " dof=" << r.dof;
+        EXPECT_LE(r.integral, 1.02) << t.describe_sampling();
+        EXPECT_NEAR(r.integral, r.valid_fraction, 0.02) << t.describe_sampling();
+        EXPECT_LT(r.z, 4.5) << t.describe_sampling() << " θo=" << std::acos(wo.z)
+                            << " chi2=" << r.chi2 << " dof=" << r.dof;
       }
     }
 }
@@ -138,13 +136,13 @@ TEST(TabulatedSampler, SampledAlbedoMatchesDirectionalAlbedo) {
         for (int i = 0; i < n; ++i)
           for (int j = 0; j < n; ++j) {
             const BrdfSample x = t.sample(wo, (i + 0.5) / n, (j + 0.5) / n);
-            if (x.pdf > 0) sum += luminance(b->eval({x.wi, wo})) * x.wi.z / x.pdf;
+            if (x.pdf > 0) sum += b->eval({x.wi, wo}).luminance() * x.wi.z / x.pdf;
           }
         const double mean = sum / (n * n);
         const AlbedoEstimate ref = directional_albedo(*b, wo, 512, 3);
-        EXPECT_NEAR(mean, luminance(ref.mean),
-                    5 * luminance(ref.standard_error) + 0.01 * luminance(ref.mean))
-            << t.describe() << " θo=" << std::acos(wo.z);
+        EXPECT_NEAR(mean, ref.mean.luminance(),
+                    5 * ref.standard_error.luminance() + 0.01 * ref.mean.luminance())
+            << t.describe_sampling() << " θo=" << std::acos(wo.z);
       }
     }
 }

@@ -145,7 +145,7 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
         }
       }
       std::vector<Rgb> rho(inside.size());
-      truth.eval(inside, rho);
+      truth.eval_batch(inside, rho);
       for (std::size_t k = 0; k < inside.size(); ++k) {
         if (!finite(rho[k])) continue;  // no data there: the cell is filled below
         const std::size_t cell = todo[b + which[k]];
@@ -193,13 +193,12 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
           const auto n1 = neighbour(c, a, step);
           if (!n1 || !filled[*n1]) continue;
           const Rgb& v1 = value_[*n1];
-          near = {near.r + v1.r, near.g + v1.g, near.b + v1.b};
+          near += v1;
           ++n_near;
           const auto n2 = neighbour(*n1, a, step);
           if (n2 && filled[*n2] && *n2 != c) {
             const Rgb& v2 = value_[*n2];
-            linear = {linear.r + 2 * v1.r - v2.r, linear.g + 2 * v1.g - v2.g,
-                      linear.b + 2 * v1.b - v2.b};
+            linear = linear + 2 * v1 - v2;
             ++n_linear;
           }
         }
@@ -278,9 +277,7 @@ Rgb GonioReconstruction::reconstruct(const double* x) const {
     for (unsigned k = 0; k < corners; ++k) {
       double w = 1;
       for (std::size_t a = 0; a < dim_; ++a) w *= (k >> a) & 1u ? t[a] : 1 - t[a];
-      v.r += w * value_[cell[k]].r;
-      v.g += w * value_[cell[k]].g;
-      v.b += w * value_[cell[k]].b;
+      v += w * value_[cell[k]];
     }
     return v;
   };
@@ -341,7 +338,8 @@ Rgb GonioReconstruction::eval(const DirPair<double>& pair) const {
   return reconstruct(x);
 }
 
-void GonioReconstruction::eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
+void GonioReconstruction::eval_batch(std::span<const DirPair<double>> pairs,
+                                     std::span<Rgb> out) const {
   if (out.size() != pairs.size())
     throw std::invalid_argument("GonioReconstruction::eval: output size does not match");
   const Form form = cells_.form();
@@ -387,11 +385,11 @@ TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t se
   std::vector<DirPair<double>> all(count);
   for (std::size_t i = 0; i < count; ++i) all[i] = {cosine(i, 0), cosine(i, 1)};
   std::vector<Rgb> rho(count);
-  truth.eval(all, rho);
+  truth.eval_batch(all, rho);
   TestPairs t;
   t.space = es;
   for (std::size_t i = 0; i < count; ++i) {
-    const double y = luminance_of(rho[i]);
+    const double y = rho[i].luminance();
     if (!std::isfinite(y)) continue;
     t.pairs.push_back(all[i]);
     t.truth.push_back(to_error_space(y, es));
@@ -401,10 +399,10 @@ TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t se
 
 double reconstruction_error(const Brdf& reconstruction, const TestPairs& test) {
   std::vector<Rgb> rho(test.pairs.size());
-  reconstruction.eval(test.pairs, rho);
+  reconstruction.eval_batch(test.pairs, rho);
   double err = 0, norm = 0;
   for (std::size_t i = 0; i < rho.size(); ++i) {
-    const double y = to_error_space(luminance_of(rho[i]), test.space);
+    const double y = to_error_space(rho[i].luminance(), test.space);
     if (!std::isfinite(y))
       throw std::runtime_error(reconstruction.name() + ": a reconstructed value is not finite");
     err += (y - test.truth[i]) * (y - test.truth[i]);

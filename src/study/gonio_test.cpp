@@ -10,7 +10,7 @@
 #include <numbers>
 #include <random>
 
-#include "brdf/test_brdfs.hpp"
+#include "support/test_brdfs.hpp"
 
 namespace halfback::study {
 namespace {

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "halfback/core/rgb.hpp"
+
 namespace halfback::study {
 
 namespace {
@@ -48,10 +50,6 @@ double percentile(std::vector<double>& values, double p) {
   // The next order statistic is the smallest of those above the lo-th.
   const double v_hi = *std::min_element(values.begin() + std::ptrdiff_t(lo) + 1, values.end());
   return v_lo + (rank - double(lo)) * (v_hi - v_lo);
-}
-
-double luminance(const float* rgb) {
-  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
 }
 
 // The display transform shared by both images: a scale, then a clamp to the displayable range.
@@ -194,7 +192,7 @@ ImageError compare_images(const render::Image& test, const render::Image& refere
       squared_reference += double(r[c]) * double(r[c]);
     }
     selected.push_back(k);
-    luminances.push_back(luminance(r));
+    luminances.push_back(Rgb{r[0], r[1], r[2]}.luminance());
   }
   if (selected.empty()) throw std::invalid_argument("compare_images: the mask selects no pixel");
 

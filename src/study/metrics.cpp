@@ -26,10 +26,6 @@ double IsoSamples::total_weight() const {
   return std::accumulate(weight.begin(), weight.end(), 0.0);
 }
 
-double luminance_of(const Rgb& rho) {
-  return 0.2126 * rho.r + 0.7152 * rho.g + 0.0722 * rho.b;
-}
-
 double to_error_space(double y, ErrorSpace es) {
   switch (es) {
     case ErrorSpace::linear:
@@ -125,14 +121,14 @@ void sample_grid(const Brdf& brdf, const GridSpec& g, ErrorSpace es, std::vector
       where.push_back(p);
     }
   std::vector<Rgb> rho(pairs.size());
-  brdf.eval(pairs, rho);
+  brdf.eval_batch(pairs, rho);
   value.assign(n, 0.0);
   weight.assign(n, 0.0);
   double cell = 1;
   for (const GridAxis& a : g.axes) cell *= (a.hi - a.lo) / double(a.count);
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const std::size_t p = where[k];
-    const double y = luminance_of(rho[k]);
+    const double y = rho[k].luminance();
     if (!std::isfinite(y)) continue;
     value[p] = to_error_space(y, es);
     weight[p] = jac[p] * pairs[k].wi.z * pairs[k].wo.z * cell;

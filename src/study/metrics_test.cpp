@@ -7,8 +7,8 @@
 #include <functional>
 #include <numbers>
 
-#include "brdf/test_brdfs.hpp"
-#include "halfback/brdf/load.hpp"
+#include "halfback/loader/load.hpp"
+#include "support/test_brdfs.hpp"
 
 namespace halfback::study {
 namespace {

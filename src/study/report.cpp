@@ -14,9 +14,9 @@
 #include "halfback/figure/material.hpp"
 #include "halfback/figure/plot.hpp"
 #include "halfback/figure/render.hpp"
-#include "halfback/io/atomic_file.hpp"
-#include "halfback/io/csv.hpp"
-#include "halfback/io/text_encoding.hpp"
+#include "halfback/util/atomic_file.hpp"
+#include "halfback/util/csv.hpp"
+#include "halfback/util/text_encoding.hpp"
 
 namespace halfback::study {
 

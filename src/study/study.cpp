@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <future>
 #include <stdexcept>
 
+#include "halfback/core/parallel.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/study/image_metrics.hpp"
@@ -33,7 +33,7 @@ void StudyConfig::validate() const {
           fmt::format("study: the image budget {} is not one of the sample budgets", image_budget));
     if (image_size < 8 || image_spp < 1)
       throw std::invalid_argument("study: images need >= 8 pixels and >= 1 sample per pixel");
-    for (const StudyEnvironment& e : environments)
+    for (const render::Environment& e : environments)
       if (!e.map) throw std::invalid_argument("study: environment '" + e.label + "' is empty");
   }
 }
@@ -71,45 +71,44 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
     ParamResult r;
     std::vector<std::unique_ptr<GonioReconstruction>> for_images;  // one per design
   };
-  std::vector<std::future<Task>> tasks;
-  for (Space s : kStudied)
-    tasks.push_back(std::async(std::launch::async, [&, s] {
-      Task t;
-      t.r.space = s;
-      const IsoSamples x = sample_isotropic(brdf, s, config.grid, config.space);
-      t.r.azimuthal = azimuthal_error(x);
-      t.r.separability_2d = separability_2d(x, config.ranks);
-      t.r.separability_3d = separability_unfolded(x, config.ranks);
-      const bool iso = brdf.isotropic();
-      const auto& budgets = iso ? config.budgets : config.budgets_4d;
-      if (gonio)
-        for (Design d : kDesigns)
-          for (std::size_t budget : budgets) {
-            GonioSetup setup{s, iso, d, budget, config.seed};
-            setup.max_theta_deg = config.max_theta_deg;
-            auto rec = std::make_unique<GonioReconstruction>(brdf, setup);
-            (iso ? t.r.gonio : t.r.gonio_4d)
-                .push_back({d, budget, rec->samples(), reconstruction_error(*rec, test)});
-            if (budget == config.image_budget && !config.environments.empty())
-              t.for_images.push_back(std::move(rec));
-          }
-      if (!iso) {
-        const FullSamples f = sample_full(brdf, s, config.full_grid, config.space);
-        t.r.azimuthal_4d = azimuthal_error(f);
-        t.r.separability_4d = separability_4d(f, config.ranks);
-      }
-      say(fmt::format("{} {}", gonio ? "gonio" : "metrics", name_of(s)));
-      return t;
-    }));
-  std::vector<Task> done;
-  for (auto& f : tasks) done.push_back(f.get());
+  auto study_in = [&](Space s) {
+    Task t;
+    t.r.space = s;
+    const IsoSamples x = sample_isotropic(brdf, s, config.grid, config.space);
+    t.r.azimuthal = azimuthal_error(x);
+    t.r.separability_2d = separability_2d(x, config.ranks);
+    t.r.separability_3d = separability_unfolded(x, config.ranks);
+    const bool iso = brdf.isotropic();
+    const auto& budgets = iso ? config.budgets : config.budgets_4d;
+    if (gonio)
+      for (Design d : kDesigns)
+        for (std::size_t budget : budgets) {
+          GonioSetup setup{s, iso, d, budget, config.seed};
+          setup.max_theta_deg = config.max_theta_deg;
+          auto rec = std::make_unique<GonioReconstruction>(brdf, setup);
+          (iso ? t.r.gonio : t.r.gonio_4d)
+              .push_back({d, budget, rec->samples(), reconstruction_error(*rec, test)});
+          if (budget == config.image_budget && !config.environments.empty())
+            t.for_images.push_back(std::move(rec));
+        }
+    if (!iso) {
+      const FullSamples f = sample_full(brdf, s, config.full_grid, config.space);
+      t.r.azimuthal_4d = azimuthal_error(f);
+      t.r.separability_4d = separability_4d(f, config.ranks);
+    }
+    say(fmt::format("{} {}", gonio ? "gonio" : "metrics", name_of(s)));
+    return t;
+  };
+  std::vector<Task> done(kStudied.size());
+  parallel_for(kStudied.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) done[k] = study_in(kStudied[k]);
+  });
 
   if (gonio && !config.environments.empty()) {
     const render::RenderSettings settings = image_settings(config);
-    const auto cosine = render::make_cosine_sampler();  // unused by environment sampling
     const std::vector<std::uint8_t> mask = sphere_mask(settings.width, settings.height);
-    for (const StudyEnvironment& env : config.environments) {
-      const render::RenderResult truth_result = render::render(brdf, *cosine, *env.map, settings);
+    for (const render::Environment& env : config.environments) {
+      const render::RenderResult truth_result = render::render_sampled(brdf, *env.map, settings);
       // A BRDF without data somewhere (an ALTA file's few incidence angles) has no ground-truth
       // image to compare with: its reconstructions extrapolate where it has nothing.
       if (truth_result.nonfinite > 0) {
@@ -121,7 +120,7 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
       if (first) result.example_images.push_back(truth);
       for (Task& t : done)
         for (const auto& rec : t.for_images) {
-          const render::Image img = render::render(*rec, *cosine, *env.map, settings).image;
+          const render::Image img = render::render_sampled(*rec, *env.map, settings).image;
           if (first && rec->setup().design == Design::regular) result.example_images.push_back(img);
           const ImageError e = compare_images(img, truth, mask);
           t.r.images.push_back({rec->setup().design, rec->samples(), env.label, e.relative_rmse,

@@ -21,7 +21,7 @@
 
 #include "halfback/core/batch.hpp"
 #include "halfback/core/space.hpp"
-#include "halfback/io/csv.hpp"
+#include "halfback/util/csv.hpp"
 
 extern char** environ;
 

@@ -1,7 +1,7 @@
 // Uses the installed halfback: a conversion round trip, the batch API, and a BRDF evaluation.
-#include <halfback/brdf/load.hpp>
 #include <halfback/core/batch.hpp>
 #include <halfback/core/param.hpp>
+#include <halfback/loader/load.hpp>
 
 #include <cmath>
 #include <cstdio>

@@ -19,6 +19,19 @@ step(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -G ${GENERATOR}
 step(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 step(${WORK_DIR}/build/consumer)
 step(${WORK_DIR}/prefix/bin/halfback --version)
+# A consumer of the core alone: found without Cairo, OpenEXR or Eigen (core/CMakeLists.txt forbids
+# finding them), and compiled without their include paths.
+step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/core -B ${WORK_DIR}/core-build -G ${GENERATOR}
+     -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release)
+step(${CMAKE_COMMAND} --build ${WORK_DIR}/core-build)
+step(${WORK_DIR}/core-build/core_consumer)
+file(READ ${WORK_DIR}/core-build/compile_commands.json commands)
+foreach(forbidden cairo OpenEXR Imath eigen3 glib)
+  string(FIND "${commands}" "${forbidden}" at)
+  if(NOT at EQUAL -1)
+    message(FATAL_ERROR "the core consumer is compiled with a ${forbidden} path:\n${commands}")
+  endif()
+endforeach()
 # The installed Python package, when the module was built.
 set(pydir ${WORK_DIR}/prefix/lib/python3/dist-packages)
 if(PYTHON AND EXISTS ${pydir}/halfback/__init__.py)

@@ -10,15 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "halfback/brdf/sampling.hpp"
 #include "halfback/core/param.hpp"
+#include "halfback/core/rgb.hpp"
 #include "halfback/core/space.hpp"
 
 namespace halfback {
-
-struct Rgb {
-  double r = 0, g = 0, b = 0;
-  friend bool operator==(const Rgb&, const Rgb&) = default;
-};
 
 class Brdf {
  public:
@@ -45,7 +42,22 @@ class Brdf {
 
   // Batch evaluation (out.size() == pairs.size()). The default runs eval() over all threads;
   // formats with a faster batched path override it.
-  virtual void eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const;
+  virtual void eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const;
+
+  // Importance sampling, the one sampling interface of halfback (sampling.hpp): ωi drawn given ωo
+  // (unit, ωo.z > 0) from two numbers u1, u2 in [0, 1), with a density p(ωi | ωo) per unit solid
+  // angle meant to resemble ρ(ωi, ωo) cos θi. The density may put mass below the horizon (a
+  // microfacet reflection can leave the hemisphere): such a sample comes back with pdf 0, so pdf()
+  // integrates to at most 1 over the upper hemisphere. pdf() is the density of sample() at ωi (0
+  // for ωi or ωo below the horizon). The defaults sample the cosine-weighted hemisphere; a BRDF
+  // that follows its own lobes overrides all three.
+  virtual BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const;
+  virtual double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const;
+  // Whether sample() follows ρ (true) or is the cosine default (false; the renderer then
+  // tabulates ρ to sample it, render/brdf_sampler.hpp).
+  virtual bool has_importance_sampling() const { return false; }
+  // Which sampler sample() is, for reports: "cosine-weighted hemisphere", "own sampler of NAME"...
+  virtual std::string describe_sampling() const;
 };
 
 using BrdfPtr = std::shared_ptr<const Brdf>;

@@ -1,7 +1,7 @@
 // The registry of analytic BRDF models, addressed by a spec "name" or "name:key=value,...":
 // each model declares a name, a description, its parameters (default and range) and a factory.
-// Models register themselves with ModelRegistry::global().add(...) (see load.hpp for how a spec
-// reaches it); the registry validates every spec before the factory sees it.
+// A registry is filled with add(...); the loader's model_registry() (loader/load.hpp) holds every
+// built-in model. The registry validates every spec before the factory sees it.
 #pragma once
 
 #include <functional>
@@ -45,10 +45,6 @@ struct ModelInfo {
 
 class ModelRegistry {
  public:
-  // The process-wide registry used by load_brdf(), with every built-in model registered
-  // (defined in src/brdf/load.cpp, the layer that knows them all).
-  static ModelRegistry& global();
-
   // Registers a model; throws std::invalid_argument on a malformed entry (bad or duplicate name,
   // default outside its range, no factory).
   void add(ModelInfo info);

@@ -39,7 +39,7 @@ struct ConvertOutput {
 };
 
 struct BatchOptions {
-  unsigned threads = 0;  // 0: all hardware threads; 1: the calling thread only
+  int threads = 0;  // as in core/parallel.hpp: 0 all cores, 1 the calling thread, n at most n
 };
 
 // Converts n rows from `from` to `to`. Throws std::invalid_argument when the column counts do not

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -26,7 +27,8 @@ struct Form {
   friend bool operator==(const Form&, const Form&) = default;
 };
 
-// Calls f(P{}) with the parameterization struct named by `space` (not dirs).
+// Calls f(P{}) with the parameterization struct named by `space`; throws std::invalid_argument
+// for dirs, which is not a parameterization.
 template <class F>
 decltype(auto) visit_parameterization(Space space, F&& f) {
   switch (space) {
@@ -37,11 +39,13 @@ decltype(auto) visit_parameterization(Space space, F&& f) {
     case Space::ortho:
       return f(Ortho{});
     case Space::hybrid:
-      break;
+      return f(Hybrid{});
     case Space::dirs:
       break;
   }
-  return f(Hybrid{});  // dirs is rejected by callers before dispatch
+  throw std::invalid_argument(
+      "dirs is not a parameterization (expected spherical, halfdiff, "
+      "ortho or hybrid)");
 }
 
 std::string_view name_of(Space space);

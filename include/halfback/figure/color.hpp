@@ -31,9 +31,6 @@ Color coordinate_colour(double u, double v);
 // sRGB transfer function: linear [0, 1] -> display value (clamped).
 double srgb_encode(double linear);
 
-// Rec. 709 / sRGB luminance of linear RGB.
-double luminance(const Rgb& c);
-
 // Tone mapping of linear RGB for display on a logarithmic scale: the colour is scaled so that its
 // luminance L becomes t = (log10 L − log_lo) / (log_hi − log_lo), clamped to [0, 1], keeping its
 // chromaticity (channels clamped to 1). So the grey levels follow the same scale as the false

@@ -42,13 +42,8 @@ struct ScalarField {
   bool usable(std::size_t i, std::size_t j) const;
 };
 
-// Runs body(j) for every row j in [0, rows) on `threads` threads (0: all hardware threads).
-// Rows are handed out one at a time, so uneven rows balance. The first exception is rethrown.
-void parallel_rows(std::size_t rows, unsigned threads,
-                   const std::function<void(std::size_t)>& body);
-
 // Samples f(x, y) -> value on every node; a NaN value marks the node invalid.
 ScalarField sample(const Grid& grid, const std::function<double(double, double)>& f,
-                   unsigned threads = 0);
+                   int threads = 0);  // as in core/parallel.hpp
 
 }  // namespace halfback::figure

@@ -64,7 +64,7 @@ struct HemisphereSample {
 };
 
 HemisphereSample sample_hemisphere(Space space, const HemisphereView& view, const Vec3<double>& wo,
-                                   std::size_t pixels, unsigned threads = 0);
+                                   std::size_t pixels, int threads = 0);
 
 struct HemisphereOptions {
   std::vector<Space> params{Space::halfdiff, Space::ortho, Space::hybrid};
@@ -73,7 +73,7 @@ struct HemisphereOptions {
   ViewCentre centre = ViewCentre::normal;
   double disk_size = 150;  // points
   double pixels_per_point = 2;
-  unsigned threads = 0;
+  int threads = 0;
   bool isolines = true;
   bool markers = true;  // mark ωo (×) and the mirror direction (○)
 };

@@ -13,19 +13,6 @@
 
 namespace halfback::figure {
 
-// An environment of the renderings and the caption under its sphere. Maps are shared: a set of
-// figures loads (or builds) each environment once.
-struct NamedEnvironment {
-  std::string label;
-  std::shared_ptr<const render::EnvMap> map;
-};
-
-// EnvMap::from_spec(spec) with its caption: "sky (built-in)", ..., a constant's spec, or a
-// file's stem. Throws what from_spec throws.
-NamedEnvironment load_environment(const std::string& spec);
-// The three built-ins, default (sky), studio and sunset; built once per process.
-const std::vector<NamedEnvironment>& default_environments();
-
 // A rendering drawn as a size × size image item at (x, y), tone mapped to 8-bit sRGB at exposure
 // 0 (render::tonemap_srgb8), smoothly interpolated.
 ImageItem rendering_item(const render::Image& image, double x, double y, double size);
@@ -33,8 +20,9 @@ ImageItem rendering_item(const render::Image& image, double x, double y, double 
 struct MaterialFigureOptions {
   BrdfPtr brdf;
   std::string heading;  // the figure's title ("Figure 3, ..."); empty: the BRDF's name
-  std::vector<NamedEnvironment> environments = default_environments();  // one rendering each
-  int render_pixels = 176;  // width and height of each sphere rendering
+  std::vector<render::Environment> environments =
+      render::default_environments();  // one rendering each
+  int render_pixels = 176;             // width and height of each sphere rendering
   int spp = 48;
   std::uint64_t seed = 1;
   // The slices: params, azimuths, colouring, panel size, threads (brdf is set from above).

@@ -23,10 +23,10 @@ struct PaperMaterial {
 std::vector<PaperMaterial> default_paper_materials();
 
 struct PaperFigureOptions {
-  unsigned threads = 0;
+  int threads = 0;
   bool png = true, svg = true, pdf = true;
   std::vector<PaperMaterial> materials = default_paper_materials();  // empty: Figures 1-2 only
-  std::vector<NamedEnvironment> environments;  // empty: default_environments()
+  std::vector<render::Environment> environments;  // empty: render::default_environments()
   int render_pixels = 176, spp = 48;
 };
 

@@ -50,7 +50,4 @@ Raster decode_png(std::string_view png);
 // (naming the path and the reason) when the file cannot be written.
 void save(const Scene& scene, const std::filesystem::path& path, const RenderOptions& options = {});
 
-// The atomic write that save() uses.
-void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
-
 }  // namespace halfback::figure

@@ -31,7 +31,7 @@ struct SliceSample {
   std::vector<std::uint8_t> valid;
   std::vector<DirPair<double>> pairs;
 };
-SliceSample sample_slice(Space space, double azimuth, const Grid& grid, unsigned threads = 0);
+SliceSample sample_slice(Space space, double azimuth, const Grid& grid, int threads = 0);
 
 // A test function on a slice (NaN and invalid outside the domain).
 ScalarField test_function_field(const SliceSample& slice, TestFunction f);
@@ -51,7 +51,7 @@ struct SliceOptions {
   std::size_t luminance_levels = 10;  // at most this many log-spaced isolines
   double panel_size = 170;            // points
   double pixels_per_point = 2;
-  unsigned threads = 0;
+  int threads = 0;
 };
 
 struct SliceFigure {

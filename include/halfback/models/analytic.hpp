@@ -2,7 +2,7 @@
 // docs/models.md. All return ρ in sr⁻¹ without the cosine factor, and 0 below the horizon.
 // Constructors validate their parameters and throw std::invalid_argument naming the bad one.
 //
-// Every model also samples itself (SamplableBrdf, models/sampling.hpp; docs/render.md): Lambert and
+// Every model also samples itself (Brdf::sample and Brdf::pdf; docs/render.md): Lambert and
 // sheen by the cosine, GGX by its visible normals (Heitz 2018), Beckmann by D(m) cos θm, ABC by its
 // lobe in the projected disk plus the cosine for kd, and Sum by a mixture of its terms' samplers
 // weighted by their directional albedos at θo. The sampling code is in src/models/sampling.cpp.
@@ -14,7 +14,6 @@
 
 #include "halfback/brdf/brdf.hpp"
 #include "halfback/models/fresnel.hpp"
-#include "halfback/models/sampling.hpp"
 
 namespace halfback::models {
 
@@ -27,7 +26,7 @@ using MixtureWeightsPtr = std::unique_ptr<MixtureWeights, MixtureWeightsDeleter>
 }  // namespace detail
 
 // ρ = albedo / π.
-class Lambert final : public Brdf, public SamplableBrdf {
+class Lambert final : public Brdf {
  public:
   explicit Lambert(Rgb albedo);
   std::string name() const override { return "lambert"; }
@@ -37,6 +36,7 @@ class Lambert final : public Brdf, public SamplableBrdf {
   Rgb eval(const DirPair<double>& pair) const override;
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
+  bool has_importance_sampling() const override { return true; }
 
  private:
   Rgb albedo_;
@@ -52,7 +52,7 @@ struct MicrofacetParams {
   Fresnel fresnel;
 };
 
-class Microfacet final : public Brdf, public SamplableBrdf {
+class Microfacet final : public Brdf {
  public:
   explicit Microfacet(const MicrofacetParams& params);
   std::string name() const override;
@@ -62,6 +62,7 @@ class Microfacet final : public Brdf, public SamplableBrdf {
   Rgb eval(const DirPair<double>& pair) const override;
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
+  bool has_importance_sampling() const override { return true; }
 
   // The distribution of normals D(m) (∫ D(m) (m·n) dm = 1) and Smith's Λ(ω).
   double distribution(const Vec3<double>& m) const;
@@ -81,7 +82,7 @@ struct AbcParams {
   Rgb kd{0, 0, 0};
 };
 
-class Abc final : public Brdf, public SamplableBrdf {
+class Abc final : public Brdf {
  public:
   explicit Abc(const AbcParams& params);
   std::string name() const override { return "abc"; }
@@ -91,6 +92,7 @@ class Abc final : public Brdf, public SamplableBrdf {
   Rgb eval(const DirPair<double>& pair) const override;
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
+  bool has_importance_sampling() const override { return true; }
 
  private:
   AbcParams params_;
@@ -108,7 +110,7 @@ struct SheenParams {
   double alpha = 0.3;
 };
 
-class Sheen final : public Brdf, public SamplableBrdf {
+class Sheen final : public Brdf {
  public:
   explicit Sheen(const SheenParams& params);
   std::string name() const override { return "sheen"; }
@@ -118,13 +120,14 @@ class Sheen final : public Brdf, public SamplableBrdf {
   Rgb eval(const DirPair<double>& pair) const override;
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
+  bool has_importance_sampling() const override { return true; }
 
  private:
   SheenParams params_;
 };
 
 // The sum of several BRDFs (e.g. a diffuse base with a sheen or a glossy layer on top).
-class Sum final : public Brdf, public SamplableBrdf {
+class Sum final : public Brdf {
  public:
   explicit Sum(std::vector<BrdfPtr> terms);
   std::string name() const override;
@@ -134,6 +137,7 @@ class Sum final : public Brdf, public SamplableBrdf {
   Rgb eval(const DirPair<double>& pair) const override;
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
+  bool has_importance_sampling() const override { return true; }
 
  private:
   std::vector<BrdfPtr> terms_;

@@ -1,6 +1,8 @@
-// BRDF importance sampling for the renderer: a BRDF's own sampler when it has one (the analytic
-// models, SamplableBrdf), else a tabulation of ρ cos θi in a parameterization of ωi given ωo,
-// sampled with piecewise-constant distributions (docs/render.md, "Sampling tabulated BRDFs").
+// BRDF importance sampling for the renderer, through the one sampling interface (Brdf::sample and
+// Brdf::pdf): a BRDF's own sampler when it has one (analytic models, RGL's VNDF warp), else a
+// tabulation of ρ cos θi in a parameterization of ωi given ωo, sampled with piecewise-constant
+// distributions (docs/render.md, "Sampling tabulated BRDFs"). The samplers here are BRDFs that
+// wrap another: ρ is the wrapped one's, only sample() and pdf() change.
 //
 // Directions are in the local frame (n = +z); ωo is the view direction, ωi the sampled light
 // direction; pdfs are per unit solid angle. All samplers are immutable and thread-safe.
@@ -11,18 +13,9 @@
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
-#include "halfback/models/sampling.hpp"
 #include "halfback/render/distribution.hpp"
 
 namespace halfback::render {
-
-class BrdfSampler {
- public:
-  virtual ~BrdfSampler() = default;
-  virtual BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const = 0;
-  virtual double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const = 0;
-  virtual std::string describe() const = 0;
-};
 
 // The 2D parameterization of ωi, for a fixed ωo, that a tabulated sampler's cells live in:
 //  spherical: (θi, φi − φo), dωi = sin θi dθi dφ;
@@ -48,21 +41,42 @@ struct TabulationOptions {
   int threads = 0;          // for building the tables; 0: all cores
 };
 
-// The sampler to render `brdf` with: its own (SamplableBrdf) unless `force_tabulated`, else a
-// TabulatedSampler. The BRDF must outlive the sampler.
-std::shared_ptr<const BrdfSampler> make_brdf_sampler(const Brdf& brdf,
+// A BRDF that samples another's ρ through the sampling methods of a third: the base for the
+// samplers below (eval, name, symmetries and facts are the wrapped BRDF's). The wrapped BRDF must
+// outlive the wrapper.
+class SamplingWrapper : public Brdf {
+ public:
+  explicit SamplingWrapper(const Brdf& brdf) : brdf_(brdf) {}
+  std::string name() const override { return brdf_.name(); }
+  std::string description() const override { return brdf_.description(); }
+  bool isotropic() const override { return brdf_.isotropic(); }
+  bool reciprocal() const override { return brdf_.reciprocal(); }
+  Rgb eval(const DirPair<double>& pair) const override { return brdf_.eval(pair); }
+  void eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const override {
+    brdf_.eval_batch(pairs, out);
+  }
+  std::vector<Fact> facts() const override { return brdf_.facts(); }
+
+ protected:
+  const Brdf& brdf_;
+};
+
+// `brdf` as the renderer samples it: itself when it has importance sampling of its own (unless
+// `force_tabulated`), else a TabulatedSampler around it. The BRDF must outlive the result.
+std::shared_ptr<const Brdf> with_importance_sampling(const Brdf& brdf,
                                                      const TabulationOptions& options = {},
                                                      bool force_tabulated = false);
 
-// Cosine-weighted hemisphere sampling (for comparisons).
-std::shared_ptr<const BrdfSampler> make_cosine_sampler();
+// `brdf` sampled from the cosine-weighted hemisphere (for comparisons).
+std::shared_ptr<const Brdf> with_cosine_sampling(const Brdf& brdf);
 
-class TabulatedSampler final : public BrdfSampler {
+class TabulatedSampler final : public SamplingWrapper {
  public:
   TabulatedSampler(const Brdf& brdf, const TabulationOptions& options = {});
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
-  std::string describe() const override;
+  bool has_importance_sampling() const override { return true; }
+  std::string describe_sampling() const override;
 
   // Table size and build time, for reports.
   std::size_t cells() const;
@@ -77,7 +91,6 @@ class TabulatedSampler final : public BrdfSampler {
   Blend blend(const Vec3<double>& wo_canonical) const;
   double table_pdf(const Vec3<double>& wo, const Vec3<double>& wi, const Blend& b) const;
 
-  std::string name_;
   TabulationOptions options_;
   bool isotropic_;
   int n_theta_, n_phi_, n_radial_, n_azimuthal_;

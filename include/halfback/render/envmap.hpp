@@ -13,6 +13,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -96,5 +97,18 @@ class EnvMap {
   std::vector<double> row_solid_angle_;  // of one pixel of each row
   Distribution2D distribution_, compensated_;
 };
+
+// An environment as figures and reports use it: a map shared by the renderings that light with
+// it (each set of figures loads or builds it once), and the caption written under them.
+struct Environment {
+  std::string label;
+  std::shared_ptr<const EnvMap> map;
+};
+
+// EnvMap::from_spec(spec) with its caption: "sky (built-in)", ..., a constant's spec, or a
+// file's stem. Throws what from_spec throws.
+Environment load_environment(const std::string& spec);
+// The three built-ins, default (sky), studio and sunset; built once per process.
+const std::vector<Environment>& default_environments();
 
 }  // namespace halfback::render

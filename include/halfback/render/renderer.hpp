@@ -66,8 +66,8 @@ struct RenderResult {
 
 // Throws std::invalid_argument for invalid settings (sizes, spp, fov).
 RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings);
-// With a given BRDF sampler (e.g. a tabulated one for a BRDF that has its own).
-RenderResult render(const Brdf& brdf, const BrdfSampler& sampler, const EnvMap& env,
-                    const RenderSettings& settings);
+// With the BRDF's sampling as it is (Brdf::sample, even the cosine default): e.g. a
+// TabulatedSampler for a BRDF that has its own, or a BRDF rendered by environment sampling only.
+RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings);
 
 }  // namespace halfback::render

@@ -82,7 +82,7 @@ class GonioReconstruction final : public Brdf {
   bool isotropic() const override { return setup_.isotropic; }
   bool reciprocal() const override { return false; }  // not enforced by the reconstruction
   Rgb eval(const DirPair<double>& pair) const override;
-  void eval(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const override;
+  void eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const override;
 
   const GonioSetup& setup() const { return setup_; }
   const GridSpec& cells() const { return cells_; }

@@ -24,8 +24,7 @@ namespace halfback::study {
 enum class ErrorSpace { linear, log, cbrt };
 std::string_view name_of(ErrorSpace s);
 
-// The value every metric compares: the luminance of ρ mapped to the error space.
-double luminance_of(const Rgb& rho);
+// The value every metric compares: the luminance of ρ (Rgb::luminance) mapped to the error space.
 double to_error_space(double luminance, ErrorSpace es);
 
 struct IsoGrid {

@@ -25,11 +25,6 @@ namespace halfback::study {
 inline constexpr std::array<Space, 4> kStudied{Space::halfdiff, Space::ortho, Space::hybrid,
                                                Space::spherical};
 
-struct StudyEnvironment {
-  std::string label;
-  std::shared_ptr<const render::EnvMap> map;
-};
-
 struct StudyConfig {
   ErrorSpace space = ErrorSpace::log;
   IsoGrid grid{64, 64, 64};                              // metrics 1-2, isotropic form
@@ -48,7 +43,7 @@ struct StudyConfig {
   // under each environment, against the ground truth. Environment sampling only, with the same
   // random numbers for every image, so that the reconstructions see the same light directions
   // and the difference of two images is not drowned in Monte-Carlo noise.
-  std::vector<StudyEnvironment> environments;  // empty: no image-space error
+  std::vector<render::Environment> environments;  // empty: no image-space error
   std::size_t image_budget = 10000;
   int image_size = 96, image_spp = 16;
   // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.

@@ -1,0 +1,142 @@
+// MERL BRDF database files (Matusik, Pfister, Brand, McMillan 2003, "A Data-Driven Reflectance
+// Model"): reader, evaluation and writer. docs/formats.md describes the format and the choices.
+//
+// A `.binary` file is three little-endian int32 dimensions (90, 90, 180) followed by three planar
+// float64 blocks R, G, B of 90·90·180 values each, indexed [θh][θd][φd] (φd fastest). A stored
+// value times the channel's scale (1/1500, 1.15/1500, 1.66/1500) is ρ in sr⁻¹. Bins:
+//   θh: ⌊90·√(θh/(π/2))⌋   (non-linear: fine near the specular peak)
+//   θd: ⌊θd/(π/2)·90⌋
+//   φd: folded to [0, π) by reciprocity (φd and φd+π are the same configuration), ⌊φd/π·180⌋
+// each clamped to its range. Negative values mark bins that were not measured.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+
+namespace halfback {
+
+namespace merl {
+inline constexpr int kThetaH = 90, kThetaD = 90, kPhiD = 180;
+inline constexpr std::size_t kBins = std::size_t(kThetaH) * kThetaD * kPhiD;  // per channel
+inline constexpr std::size_t kHeaderBytes = 12;
+inline constexpr std::size_t kFileBytes = kHeaderBytes + 3 * kBins * sizeof(double);  // 34992012
+// The reference reader's scale factors, as the same double expressions.
+inline constexpr std::array<double, 3> kScale{1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0};
+
+// Flat index of a bin in one channel's block.
+constexpr std::size_t bin(int th, int td, int pd) {
+  return (std::size_t(th) * kThetaD + std::size_t(td)) * kPhiD + std::size_t(pd);
+}
+
+struct BinIndex {
+  int theta_h, theta_d, phi_d;
+};
+
+// The reference reader's bin of a (θh, θd, φd) in radians, φd in (-π, π] or [0, 2π) (both fold to
+// the same bin). NaN input is mapped to bin 0 (callers filter NaN first).
+BinIndex bin_of(double theta_h, double theta_d, double phi_d);
+
+// Bin of a direction pair: (θh, θd, φd) from the core's HalfDiff::forward (docs/formats.md,
+// "MERL bins" on how this matches the reference's acos-based computation).
+BinIndex bin_of(const DirPair<double>& pair);
+
+// The coordinates of a bin's centre in the stored (non-linear) coordinates: θh = ((i+½)/90)²·π/2,
+// θd = (j+½)/90·π/2, φd = (k+½)/180·π.
+std::array<double, 3> bin_centre(int theta_h, int theta_d, int phi_d);
+}  // namespace merl
+
+// The content of a MERL file.
+struct MerlData {
+  std::vector<double> values;  // 3·kBins stored values, channel blocks R, G, B (unscaled)
+  std::array<std::size_t, 3> missing{};  // negative (unmeasured) values per channel
+  std::string sha256;  // of the whole file, lowercase hex ("" when built in memory)
+  std::optional<std::string> material;  // name when sha256 matches a published MERL material
+};
+
+// Reads and validates a MERL file: size exactly kFileBytes, dimensions 90 90 180, every value
+// finite. Throws FormatError naming the file, the field and the problem. Negative values are
+// accepted and counted (MerlData::missing). With `identify`, computes the file's SHA-256 (~0.1 s)
+// and names the published material it matches, if any.
+MerlData read_merl(const std::filesystem::path& path, bool identify = true);
+// The same from bytes in memory; `name` stands for the file in messages.
+MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name, bool identify = true);
+
+// The 100 published materials: name, SHA-256 (lowercase hex) and size, from
+// src/io/merl_sha256.tsv (embedded at build time).
+struct MerlMaterial {
+  std::string_view name, sha256;
+  std::uint64_t size;
+};
+std::span<const MerlMaterial> merl_materials();
+const MerlMaterial* find_merl_material(std::string_view sha256_hex);
+
+enum class MerlLookup {
+  // The reference reader's bin (bit for bit: same indices, same scale factors). Unmeasured bins
+  // give what the reference gives: their negative stored value times the scale.
+  nearest,
+  // Trilinear between the 8 bin centres around the point in the stored coordinates (√θh index
+  // space, θd, φd). φd wraps (0 ≡ π); θh and θd are clamped at their ends, which is the even
+  // extension of ρ at θh = 0 and θd = 0. Unmeasured corners are skipped and the weights of the
+  // others renormalized, per channel; when all 8 are unmeasured, the nearest bin's value is given.
+  trilinear,
+};
+
+struct MerlOptions {
+  MerlLookup lookup = MerlLookup::nearest;
+};
+
+class MerlBrdf final : public Brdf {
+ public:
+  // `label` names the BRDF ("merl:LABEL") when the data matches no published material.
+  explicit MerlBrdf(MerlData data, MerlOptions options = {}, std::string label = "data");
+
+  std::string name() const override;
+  std::string description() const override;
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return true; }
+  // 0 when a direction is below the horizon (z < 0), NaN when the pair has a NaN.
+  Rgb eval(const DirPair<double>& pair) const override;
+  std::vector<Fact> facts() const override;
+
+  // The value stored in a bin, times the channel scale (what the reference returns for it).
+  Rgb bin_value(int theta_h, int theta_d, int phi_d) const;
+
+  const MerlData& data() const { return data_; }
+  const MerlOptions& options() const { return options_; }
+
+ private:
+  Rgb nearest(double theta_h, double theta_d, double phi_d) const;
+  Rgb trilinear(double theta_h, double theta_d, double phi_d) const;
+
+  MerlData data_;
+  MerlOptions options_;
+  std::string label_;
+};
+
+// Loads a MERL file as a BRDF; the name is "merl:MATERIAL" when the file is one of the published
+// materials, else "merl:STEM" (the file name without extension).
+std::shared_ptr<const MerlBrdf> load_merl(const std::filesystem::path& path,
+                                          MerlOptions options = {});
+
+// Tabulates any BRDF at the bin centres (merl::bin_centre, at φh = 0: the canonical pose of the
+// isotropic halfdiff form) and writes a MERL file: value / scale per channel, so that reading it
+// back gives ρ at every bin centre up to the rounding of the division. Bins whose centre is not a
+// valid configuration (a direction below the horizon) and non-finite values of ρ are written as
+// -1 (unmeasured). Writes to a temporary file in the same directory and renames it into place, so
+// that no partial file is left on error. Throws FormatError on I/O errors.
+void write_merl(const std::filesystem::path& path, const Brdf& brdf);
+// The same, tabulated in memory (the file's content as MerlData, without sha256).
+MerlData tabulate_merl(const Brdf& brdf);
+// Writes tabulated data (same atomic rename).
+void write_merl(const std::filesystem::path& path, const MerlData& data);
+
+}  // namespace halfback

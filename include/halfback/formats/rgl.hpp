@@ -1,0 +1,143 @@
+// RGL measured BRDFs (EPFL Realistic Graphics Lab; Dupuy & Jakob 2018, "An Adaptive
+// Parameterization for Efficient Material Acquisition and Representation", ACM TOG 37(6)): the
+// "tensor_file" container, the material it stores, and its evaluation. docs/formats.md describes
+// the container, the fields, the warp and its inverse as implemented here.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+
+namespace halfback {
+
+// ---------------------------------------------------------------------------------------------
+// The container: "tensor_file\0", version 1.0, a table of named n-dimensional little-endian
+// arrays (name, dtype, shape, byte offset), then the arrays.
+// ---------------------------------------------------------------------------------------------
+enum class TensorDtype : std::uint8_t {
+  uint8 = 1,
+  int8,
+  uint16,
+  int16,
+  uint32,
+  int32,
+  uint64,
+  int64,
+  float16,
+  float32,
+  float64
+};
+std::string_view name_of(TensorDtype dtype);
+std::size_t size_of(TensorDtype dtype);
+
+struct TensorField {
+  std::string name;
+  TensorDtype dtype{};
+  std::vector<std::uint64_t> shape;
+  std::uint64_t offset = 0;
+  std::span<const std::byte> bytes;  // view into TensorFile::storage
+  std::uint64_t count() const;       // product of the shape
+};
+
+struct TensorFile {
+  std::string name;                // the file, for messages
+  std::vector<std::byte> storage;  // the whole file
+  std::uint8_t version_major = 0, version_minor = 0;
+  std::vector<TensorField> fields;  // in file order
+  const TensorField* find(std::string_view name) const;
+};
+
+// Parses the container strictly: magic, version 1.0, a field table that lies inside the file,
+// non-empty unique names, known dtypes, shapes whose byte size (computed without overflow) fits in
+// the file after the table. Nothing is allocated from a size read in the file before it has been
+// checked against the file's size. Throws FormatError.
+TensorFile parse_tensor_file(std::vector<std::byte> bytes, std::string_view name);
+TensorFile read_tensor_file(const std::filesystem::path& path);
+// Serializes fields (name, dtype, shape, little-endian data bytes) as a version 1.0 tensor file,
+// each array 8-byte aligned. For tests and for writing synthetic materials.
+struct TensorFieldData {
+  std::string name;
+  TensorDtype dtype;
+  std::vector<std::uint64_t> shape;
+  std::vector<std::byte> data;
+};
+std::vector<std::byte> serialize_tensor_file(std::span<const TensorFieldData> fields);
+
+// ---------------------------------------------------------------------------------------------
+// The material
+// ---------------------------------------------------------------------------------------------
+struct RglOptions {
+  // The RGB data holds small negative values where the spectral measurement falls outside the
+  // sRGB gamut (e.g. down to -2% of the maximum in chm_mint); by default ρ is clamped at 0.
+  bool clamp_negative = true;
+};
+
+// A point of the unit square of a 2D warp (see RglBrdf::vndf_inverse).
+struct RglWarpPoint {
+  double x, y;
+};
+
+class RglBrdf final : public Brdf {
+ public:
+  // Validates the material fields of a parsed tensor file (names, dtypes, shapes, values: finite,
+  // densities >= 0, sigma > 0, incidence grids increasing and in range). Throws FormatError.
+  RglBrdf(const TensorFile& file, std::string label, RglOptions options = {});
+  ~RglBrdf() override;
+
+  std::string name() const override;
+  std::string description() const override;
+  bool isotropic() const override;
+  bool reciprocal() const override { return false; }  // measured: not exactly reciprocal
+  // fr(ωi, ωo) in sr⁻¹ without the cosine: the reference loader's value divided by cos θo.
+  // ωi is the light direction, the one the tables are indexed by. 0 when either direction is at or
+  // below the horizon (z <= 0), NaN when the pair has a NaN.
+  Rgb eval(const DirPair<double>& pair) const override;
+  std::vector<Fact> facts() const override;
+
+  // fr·cos θo: what the reference loader's eval(wi, wo) returns.
+  Rgb eval_cosine(const DirPair<double>& pair) const;
+
+  const std::string& material_description() const;
+  std::span<const float> theta_i() const;
+  std::span<const float> phi_i() const;
+
+  // The VNDF warp at an incidence (θi, φi) — the map from the stored sample coordinates to the
+  // unit square of microfacet normals (u = √(2θm/π), v = (φm - φi + π)/2π for isotropic data) —
+  // and its inverse, the one the evaluation uses (docs/formats.md, "Inverse warp"). Exposed for
+  // tests.
+  RglWarpPoint vndf_inverse(RglWarpPoint normal_coords, double theta_i, double phi_i) const;
+  RglWarpPoint vndf_forward(RglWarpPoint sample, double theta_i, double phi_i) const;
+  // Density of the VNDF warp's output on the unit square at a point.
+  double vndf_density(RglWarpPoint normal_coords, double theta_i, double phi_i) const;
+
+  // Importance sampling as in Dupuy & Jakob 2018, through Brdf's interface: a uniform (u1, u2)
+  // through the VNDF warp of the incidence ωo gives a microfacet normal m, and ωi is ωo reflected
+  // about m. The tables' incidence is the light direction, so this draws from the lobe of ρ(ωo, ·),
+  // which reciprocity makes a density resembling ρ(·, ωo) (an importance density only: pdf() is
+  // exact for it, so estimates stay unbiased). pdf is per unit solid angle (0 when ωo is at or
+  // below the horizon or ωi falls below it).
+  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
+  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
+  bool has_importance_sampling() const override { return true; }
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+  std::string label_;
+  RglOptions options_;
+};
+
+// Reads an RGL .bsdf file (the RGB variant); the BRDF's name is "rgl:STEM".
+std::shared_ptr<const RglBrdf> load_rgl(const std::filesystem::path& path, RglOptions options = {});
+
+}  // namespace halfback

@@ -1,0 +1,44 @@
+// One entry point for every BRDF source: a file (MERL .binary, RGL .bsdf, ALTA text), recognized
+// by its content, or an analytic model spec "name:key=value,..." from the model registry.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/brdf/registry.hpp"
+
+namespace halfback {
+
+enum class BrdfFileFormat { unknown, merl, rgl, alta };
+
+// The format of a file from its content: MERL by its size and 90/90/180 header, RGL by the
+// "tensor_file\0" magic, ALTA by its `#` header lines (a #DIM line before the first data line).
+// Throws FormatError when the file cannot be read.
+BrdfFileFormat detect_brdf_format(const std::filesystem::path& path);
+
+// The regular files of a directory whose content is a BRDF format (`only` that one, if given),
+// sorted by path. Throws FormatError when the directory cannot be read.
+std::vector<std::filesystem::path> brdf_files_in(const std::filesystem::path& dir,
+                                                 std::optional<BrdfFileFormat> only = {});
+
+// If `spec` names an existing file, reads it with the reader its content calls for (the file's
+// extension only picks the reader whose error to report when the content matches no format).
+// Otherwise `spec` is a model spec for model_registry(). Throws FormatError for file
+// problems and std::invalid_argument for a spec that is neither a file nor a valid model spec.
+//
+// "embedded:NAME" loads one of the measured materials compiled into the library (CC0 RGL
+// measurements, data/README.md), so that the default figures need no file.
+BrdfPtr load_brdf(std::string_view spec);
+
+// The process-wide registry that load_brdf() reads model specs with, holding every built-in
+// model (analytic models and the paper's test functions). Models added to it become loadable.
+ModelRegistry& model_registry();
+
+// The NAMEs of "embedded:NAME": ilm_l3_37_metallic, colodur_azure_4e, acrylic_felt_green.
+std::vector<std::string> embedded_material_names();
+
+}  // namespace halfback

@@ -1,0 +1,364 @@
+#include "halfback/formats/merl.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <system_error>
+
+#include "binary_io.hpp"
+#include "halfback/core/param.hpp"
+#include "halfback/util/atomic_file.hpp"
+#include "halfback/util/format_error.hpp"
+#include "halfback/util/sha256.hpp"
+
+namespace halfback {
+
+namespace {
+
+using io_detail::load_le;
+using io_detail::store_le;
+
+constexpr double kPi = std::numbers::pi;
+constexpr std::array<int, 3> kDims{merl::kThetaH, merl::kThetaD, merl::kPhiD};
+constexpr std::array<const char*, 3> kDimNames{"theta_h", "theta_d", "phi_d"};
+constexpr std::array<const char*, 3> kChannelNames{"red", "green", "blue"};
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The reference reader's index computations, operation for operation (same rounding).
+int theta_h_index(double theta_h) {
+  if (!(theta_h > 0.0)) return 0;  // also NaN
+  const double deg = (theta_h / (kPi / 2.0)) * merl::kThetaH;
+  const double t = std::sqrt(deg * merl::kThetaH);
+  return t < merl::kThetaH - 1 ? static_cast<int>(t) : merl::kThetaH - 1;
+}
+
+int theta_d_index(double theta_d) {
+  const double t = theta_d / (kPi * 0.5) * merl::kThetaD;
+  if (!(t > 0.0)) return 0;
+  return t < merl::kThetaD - 1 ? static_cast<int>(t) : merl::kThetaD - 1;
+}
+
+// φd in (-π, π] (the reference's atan2 range) or [0, 2π) (the core's azimuths).
+int phi_d_index(double phi_d) {
+  if (phi_d < 0.0) {
+    phi_d += kPi;  // the reference's reciprocity fold
+  } else if (phi_d > kPi) {
+    phi_d -=
+        kPi;  // [0, 2π) convention: the same fold; φd = π itself is kept, as the reference does
+  }
+  const double t = phi_d / kPi * (2 * merl::kPhiD) / 2;
+  if (!(t > 0.0)) return 0;
+  return t < merl::kPhiD - 1 ? static_cast<int>(t) : merl::kPhiD - 1;
+}
+
+std::string bin_field(int c, std::size_t flat) {
+  const std::size_t pd = flat % merl::kPhiD, td = (flat / merl::kPhiD) % merl::kThetaD,
+                    th = flat / (std::size_t(merl::kPhiD) * merl::kThetaD);
+  return std::string(kChannelNames[c]) + " value at bin (theta_h " + std::to_string(th) +
+         ", theta_d " + std::to_string(td) + ", phi_d " + std::to_string(pd) + ")";
+}
+
+// Checks the 12-byte header and the total size. `head` holds at least min(size, 12) bytes.
+void check_header(std::span<const std::byte> head, std::uintmax_t size, const std::string& name) {
+  if (size < merl::kHeaderBytes)
+    throw FormatError(name, "header",
+                      "file is " + std::to_string(size) +
+                          " bytes, too short for the 12-byte header (three int32 dimensions)");
+  for (int i = 0; i < 3; ++i) {
+    const auto dim = load_le<std::int32_t>(head.data() + 4 * i);
+    if (dim != kDims[i])
+      throw FormatError(name,
+                        "header dimension " + std::to_string(i + 1) + " (" + kDimNames[i] + ")",
+                        "is " + std::to_string(dim) + ", expected " + std::to_string(kDims[i]) +
+                            " (not a MERL file, or a different resolution)");
+  }
+  if (size != merl::kFileBytes)
+    throw FormatError(name, "file size",
+                      std::to_string(size) + " bytes, expected exactly " +
+                          std::to_string(merl::kFileBytes) +
+                          " (12-byte header + 3 x 90*90*180 float64): " +
+                          (size < merl::kFileBytes ? "truncated" : "trailing data"));
+}
+
+}  // namespace
+
+namespace merl {
+
+BinIndex bin_of(double theta_h, double theta_d, double phi_d) {
+  return {theta_h_index(theta_h), theta_d_index(theta_d), phi_d_index(phi_d)};
+}
+
+BinIndex bin_of(const DirPair<double>& pair) {
+  const Tuple4<double> q = HalfDiff::forward(pair);
+  return bin_of(q[0], q[2], q[3]);
+}
+
+std::array<double, 3> bin_centre(int theta_h, int theta_d, int phi_d) {
+  const double u = (theta_h + 0.5) / kThetaH;
+  return {u * u * (kPi / 2), (theta_d + 0.5) / kThetaD * (kPi / 2), (phi_d + 0.5) / kPhiD * kPi};
+}
+
+}  // namespace merl
+
+MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name_view, bool identify) {
+  const std::string name(name_view);
+  check_header(bytes.first(std::min(bytes.size(), merl::kHeaderBytes)), bytes.size(), name);
+  MerlData data;
+  data.values.resize(3 * merl::kBins);
+  const std::byte* p = bytes.data() + merl::kHeaderBytes;
+  for (int c = 0; c < 3; ++c) {
+    for (std::size_t i = 0; i < merl::kBins; ++i) {
+      const double v = load_le<double>(p + 8 * (c * merl::kBins + i));
+      if (!std::isfinite(v))
+        throw FormatError(name, bin_field(c, i), std::isnan(v) ? "is NaN" : "is infinite");
+      if (v < 0) ++data.missing[c];
+      data.values[c * merl::kBins + i] = v;
+    }
+  }
+  if (identify) {
+    data.sha256 = sha256_hex(bytes);
+    if (const MerlMaterial* m = find_merl_material(data.sha256))
+      data.material = std::string(m->name);
+  }
+  return data;
+}
+
+MerlData read_merl(const std::filesystem::path& path, bool identify) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw FormatError(name, "file", ec ? ec.message() : "not a regular file");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw FormatError(name, "file", "cannot get its size: " + ec.message());
+  if (size != merl::kFileBytes) {
+    // Diagnose from the header without reading a file of the wrong size.
+    std::array<std::byte, merl::kHeaderBytes> head{};
+    std::ifstream in(path, std::ios::binary);
+    in.read(reinterpret_cast<char*>(head.data()), head.size());
+    check_header(std::span(head).first(static_cast<std::size_t>(in.gcount())), size, name);
+  }
+  const std::string bytes = io_detail::read_file_bytes(path, merl::kFileBytes);
+  return parse_merl(io_detail::as_bytes(bytes), name, identify);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Evaluation
+// ---------------------------------------------------------------------------------------------
+
+MerlBrdf::MerlBrdf(MerlData data, MerlOptions options, std::string label)
+    : data_(std::move(data)), options_(options), label_(std::move(label)) {
+  if (data_.values.size() != 3 * merl::kBins)
+    throw std::invalid_argument("MerlBrdf: data has " + std::to_string(data_.values.size()) +
+                                " values, expected " + std::to_string(3 * merl::kBins));
+}
+
+std::string MerlBrdf::name() const {
+  return "merl:" + (data_.material ? *data_.material : label_);
+}
+
+std::string MerlBrdf::description() const {
+  std::string d = "MERL measured BRDF";
+  if (data_.material) d += " '" + *data_.material + "' (identified by SHA-256)";
+  d += options_.lookup == MerlLookup::nearest ? ", nearest-bin lookup" : ", trilinear lookup";
+  const std::size_t missing = std::max({data_.missing[0], data_.missing[1], data_.missing[2]});
+  if (missing > 0) d += ", " + std::to_string(missing) + " unmeasured bins";
+  return d;
+}
+
+std::vector<Brdf::Fact> MerlBrdf::facts() const {
+  std::vector<Fact> f;
+  f.push_back({"format", "MERL .binary: 90 θh × 90 θd × 180 φd bins, RGB float64"});
+  f.push_back({"lookup", options_.lookup == MerlLookup::nearest
+                             ? "nearest bin (the reference reader's)"
+                             : "trilinear in the stored coordinates"});
+  f.push_back({"unmeasured bins", fmt::format("R {}, G {}, B {} of {}", data_.missing[0],
+                                              data_.missing[1], data_.missing[2], merl::kBins)});
+  std::array<double, 3> max{};
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < merl::kBins; ++i)
+      max[c] = std::max(max[c], data_.values[c * merl::kBins + i] * merl::kScale[c]);
+  f.push_back(
+      {"max stored ρ", fmt::format("R {:.6g}, G {:.6g}, B {:.6g} sr⁻¹", max[0], max[1], max[2])});
+  if (!data_.sha256.empty()) f.push_back({"sha256", data_.sha256});
+  f.push_back({"MERL material", data_.material ? *data_.material + " (one of the 100 published)"
+                                               : std::string("not one of the 100 published")});
+  return f;
+}
+
+Rgb MerlBrdf::bin_value(int th, int td, int pd) const {
+  const std::size_t i = merl::bin(th, td, pd);
+  return {data_.values[i] * merl::kScale[0], data_.values[i + merl::kBins] * merl::kScale[1],
+          data_.values[i + 2 * merl::kBins] * merl::kScale[2]};
+}
+
+Rgb MerlBrdf::nearest(double theta_h, double theta_d, double phi_d) const {
+  const merl::BinIndex b = merl::bin_of(theta_h, theta_d, phi_d);
+  return bin_value(b.theta_h, b.theta_d, b.phi_d);
+}
+
+Rgb MerlBrdf::trilinear(double theta_h, double theta_d, double phi_d) const {
+  // Continuous bin coordinates: bin k covers [k, k+1), its centre is at k + ½.
+  const double uh =
+      theta_h > 0 ? std::sqrt(theta_h / (kPi / 2) * (merl::kThetaH * merl::kThetaH)) : 0.0;
+  const double ud = theta_d / (kPi / 2) * merl::kThetaD;
+  double pd = phi_d;
+  if (pd < 0) pd += kPi;
+  if (pd >= kPi) pd -= kPi;
+  const double up = pd / kPi * merl::kPhiD;
+
+  struct Axis {
+    int i0, i1;
+    double t;
+  };
+  // Clamped axis (θh, θd): constant over the half bins at both ends.
+  auto clamped = [](double u, int n) -> Axis {
+    const double x = u - 0.5;
+    if (!(x > 0)) return {0, 0, 0.0};
+    if (x >= n - 1) return {n - 1, n - 1, 0.0};
+    const int i = static_cast<int>(x);
+    return {i, i + 1, x - i};
+  };
+  const Axis ah = clamped(uh, merl::kThetaH), ad = clamped(ud, merl::kThetaD);
+  // Periodic axis (φd, period π = 180 bins).
+  Axis ap;
+  {
+    double x = up - 0.5;
+    if (!(x >= -1 && x < merl::kPhiD)) x = 0;  // only for non-finite input
+    int i = static_cast<int>(std::floor(x));
+    ap.t = x - i;
+    if (i < 0) i += merl::kPhiD;
+    ap.i0 = i;
+    ap.i1 = i + 1 == merl::kPhiD ? 0 : i + 1;
+  }
+
+  double sum[3] = {0, 0, 0}, wsum[3] = {0, 0, 0};
+  for (int a = 0; a < 2; ++a) {
+    const double wa = a ? ah.t : 1 - ah.t;
+    if (wa == 0) continue;
+    const int th = a ? ah.i1 : ah.i0;
+    for (int b = 0; b < 2; ++b) {
+      const double wb = wa * (b ? ad.t : 1 - ad.t);
+      if (wb == 0) continue;
+      const int td = b ? ad.i1 : ad.i0;
+      for (int c = 0; c < 2; ++c) {
+        const double w = wb * (c ? ap.t : 1 - ap.t);
+        if (w == 0) continue;
+        const std::size_t idx = merl::bin(th, td, c ? ap.i1 : ap.i0);
+        for (int ch = 0; ch < 3; ++ch) {
+          const double v = data_.values[idx + ch * merl::kBins];
+          if (v < 0) continue;  // unmeasured
+          sum[ch] += w * v;
+          wsum[ch] += w;
+        }
+      }
+    }
+  }
+  Rgb fallback{};
+  if (wsum[0] == 0 || wsum[1] == 0 || wsum[2] == 0) fallback = nearest(theta_h, theta_d, phi_d);
+  return {wsum[0] > 0 ? sum[0] / wsum[0] * merl::kScale[0] : fallback.r,
+          wsum[1] > 0 ? sum[1] / wsum[1] * merl::kScale[1] : fallback.g,
+          wsum[2] > 0 ? sum[2] / wsum[2] * merl::kScale[2] : fallback.b};
+}
+
+Rgb MerlBrdf::eval(const DirPair<double>& pair) const {
+  const double v[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
+  for (double x : v)
+    if (std::isnan(x)) return {kNaN, kNaN, kNaN};
+  if (pair.wi.z < 0 || pair.wo.z < 0) return {};
+  const Tuple4<double> q = HalfDiff::forward(pair);
+  return options_.lookup == MerlLookup::nearest ? nearest(q[0], q[2], q[3])
+                                                : trilinear(q[0], q[2], q[3]);
+}
+
+std::shared_ptr<const MerlBrdf> load_merl(const std::filesystem::path& path, MerlOptions options) {
+  return std::make_shared<const MerlBrdf>(read_merl(path), options, path.stem().string());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writer
+// ---------------------------------------------------------------------------------------------
+
+MerlData tabulate_merl(const Brdf& brdf) {
+  MerlData data;
+  data.values.assign(3 * merl::kBins, -1.0);
+  constexpr std::size_t kSlab = std::size_t(merl::kThetaD) * merl::kPhiD;  // bins per θh index
+  std::vector<DirPair<double>> pairs;
+  std::vector<std::size_t> where;
+  std::vector<Rgb> rho;
+  pairs.reserve(kSlab);
+  where.reserve(kSlab);
+  for (int th = 0; th < merl::kThetaH; ++th) {
+    pairs.clear();
+    where.clear();
+    for (int td = 0; td < merl::kThetaD; ++td) {
+      for (int pd = 0; pd < merl::kPhiD; ++pd) {
+        const auto c = merl::bin_centre(th, td, pd);
+        const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{c[0], 0.0, c[1], c[2]});
+        if (!s.in_domain) continue;  // a direction below the horizon: left unmeasured (-1)
+        pairs.push_back(s.pair);
+        where.push_back(merl::bin(th, td, pd));
+      }
+    }
+    rho.resize(pairs.size());
+    brdf.eval_batch(pairs, rho);
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const double v[3] = {rho[k].r, rho[k].g, rho[k].b};
+      for (int ch = 0; ch < 3; ++ch) {
+        const double stored = v[ch] / merl::kScale[ch];
+        data.values[where[k] + ch * merl::kBins] = std::isfinite(stored) ? stored : -1.0;
+      }
+    }
+  }
+  for (int ch = 0; ch < 3; ++ch)
+    data.missing[ch] = static_cast<std::size_t>(std::count_if(
+        data.values.begin() + ch * merl::kBins, data.values.begin() + (ch + 1) * merl::kBins,
+        [](double x) { return x < 0; }));
+  return data;
+}
+
+void write_merl(const std::filesystem::path& path, const MerlData& data) {
+  if (data.values.size() != 3 * merl::kBins)
+    throw std::invalid_argument("write_merl: data has " + std::to_string(data.values.size()) +
+                                " values, expected " + std::to_string(3 * merl::kBins));
+  std::vector<std::byte> bytes(merl::kFileBytes);
+  for (int i = 0; i < 3; ++i) store_le<std::int32_t>(bytes.data() + 4 * i, kDims[i]);
+  for (std::size_t i = 0; i < data.values.size(); ++i)
+    store_le<double>(bytes.data() + merl::kHeaderBytes + 8 * i, data.values[i]);
+  try {
+    AtomicFile file(path);  // temporary file + rename: no partial file on error
+    file.write(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+    file.commit();
+  } catch (const std::system_error& e) {
+    throw FormatError(path.string(), "write", e.what());
+  }
+}
+
+void write_merl(const std::filesystem::path& path, const Brdf& brdf) {
+  write_merl(path, tabulate_merl(brdf));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Published materials
+// ---------------------------------------------------------------------------------------------
+
+namespace merl_table {
+// Generated at build time from src/io/merl_sha256.tsv (cmake/embed_merl_table.cmake).
+extern const MerlMaterial kMaterials[];
+extern const std::size_t kMaterialCount;
+}  // namespace merl_table
+
+std::span<const MerlMaterial> merl_materials() {
+  return {merl_table::kMaterials, merl_table::kMaterialCount};
+}
+
+const MerlMaterial* find_merl_material(std::string_view sha256_hex) {
+  for (const MerlMaterial& m : merl_materials())
+    if (m.sha256 == sha256_hex) return &m;
+  return nullptr;
+}
+
+}  // namespace halfback

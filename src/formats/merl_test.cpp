@@ -1,0 +1,488 @@
+// MERL: SHA-256, the material table, bin indices against an independent acos-based reference,
+// validation errors, lookups (nearest and trilinear), writer round trip.
+#include "halfback/formats/merl.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "formats/binary_io.hpp"
+#include "formats/merl_reference.hpp"
+#include "support/test_support.hpp"
+
+namespace halfback {
+namespace {
+
+using test::TempDir;
+constexpr double kPi = std::numbers::pi;
+
+std::span<const std::byte> bytes_of(const std::string& s) {
+  return {reinterpret_cast<const std::byte*>(s.data()), s.size()};
+}
+
+// --------------------------------------------------------------------------------------------
+// The material table
+// --------------------------------------------------------------------------------------------
+
+TEST(MerlMaterials, EmbeddedTable) {
+  const auto table = merl_materials();
+  ASSERT_EQ(table.size(), 100u);
+  std::set<std::string_view> names, hashes;
+  for (const auto& m : table) {
+    EXPECT_EQ(m.size, merl::kFileBytes) << m.name;
+    EXPECT_EQ(m.sha256.size(), 64u) << m.name;
+    names.insert(m.name);
+    hashes.insert(m.sha256);
+  }
+  EXPECT_EQ(names.size(), 100u);
+  EXPECT_EQ(hashes.size(), 100u);
+  const MerlMaterial* gold = nullptr;
+  for (const auto& m : table)
+    if (m.name == "gold-metallic-paint") gold = &m;
+  ASSERT_NE(gold, nullptr);
+  EXPECT_EQ(find_merl_material(gold->sha256), gold);
+  EXPECT_EQ(find_merl_material(std::string(64, '0')), nullptr);
+}
+
+TEST(MerlMaterials, TableMatchesSharedTsv) {
+  HALFBACK_REQUIRE_SHARED(dir, "merl");
+  std::ifstream in(dir / "merl_sha256.tsv");
+  std::string line;
+  std::getline(in, line);
+  std::size_t rows = 0;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    std::istringstream ss(line);
+    std::string name, sha;
+    std::uint64_t size;
+    ss >> name >> sha >> size;
+    const MerlMaterial* m = find_merl_material(sha);
+    ASSERT_NE(m, nullptr) << name;
+    EXPECT_EQ(m->name, name);
+    EXPECT_EQ(m->size, size);
+    ++rows;
+  }
+  EXPECT_EQ(rows, merl_materials().size());
+}
+
+// --------------------------------------------------------------------------------------------
+// Synthetic files
+// --------------------------------------------------------------------------------------------
+
+// A file image: header, then values(channel, flat index).
+template <class F>
+std::string merl_image(F&& values) {
+  std::string s(merl::kFileBytes, '\0');
+  auto* p = reinterpret_cast<std::byte*>(s.data());
+  io_detail::store_le<std::int32_t>(p, 90);
+  io_detail::store_le<std::int32_t>(p + 4, 90);
+  io_detail::store_le<std::int32_t>(p + 8, 180);
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < merl::kBins; ++i)
+      io_detail::store_le<double>(p + 12 + 8 * (c * merl::kBins + i), values(c, i));
+  return s;
+}
+
+// Each bin stores its own indices: red = θh index, green = θd index, blue = φd index.
+const std::string& index_image() {
+  static const std::string image = merl_image([](int c, std::size_t i) -> double {
+    const std::size_t pd = i % 180, td = (i / 180) % 90, th = i / (180 * 90);
+    return c == 0 ? double(th) : c == 1 ? double(td) : double(pd);
+  });
+  return image;
+}
+
+merl::BinIndex decode(const Rgb& v) {
+  return {static_cast<int>(std::lround(v.r / merl::kScale[0])),
+          static_cast<int>(std::lround(v.g / merl::kScale[1])),
+          static_cast<int>(std::lround(v.b / merl::kScale[2]))};
+}
+
+// Distance of a continuous bin coordinate to the nearest bin boundary (an integer).
+double to_boundary(double x) {
+  return std::abs(x - std::round(x));
+}
+
+TEST(Merl, IndicesMatchIndependentReference) {
+  TempDir tmp;
+  const auto path = tmp / "index.binary";
+  test::write_bytes(path, index_image().data(), index_image().size());
+  const MerlBrdf brdf(read_merl(path));
+  EXPECT_FALSE(brdf.data().material.has_value());
+  EXPECT_EQ(brdf.data().missing, (std::array<std::size_t, 3>{0, 0, 0}));
+
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::size_t checked = 0, boundary = 0, fold = 0;
+  auto check = [&](const Vec3<double>& wi, const Vec3<double>& wo) {
+    const merl_reference::V3 in{wi.x, wi.y, wi.z}, out{wo.x, wo.y, wo.z};
+    const auto a = merl_reference::half_diff(in, out);
+    const merl::BinIndex ref{merl_reference::theta_h_index(a.theta_h),
+                             merl_reference::theta_d_index(a.theta_d),
+                             merl_reference::phi_d_index(a.phi_d)};
+    const merl::BinIndex got = decode(brdf.eval(DirPair<double>{wi, wo}));
+    const merl::BinIndex direct = merl::bin_of(DirPair<double>{wi, wo});
+    EXPECT_EQ(got.theta_h, direct.theta_h);
+    EXPECT_EQ(got.theta_d, direct.theta_d);
+    EXPECT_EQ(got.phi_d, direct.phi_d);
+    ++checked;
+    if (got.theta_h == ref.theta_h && got.theta_d == ref.theta_d && got.phi_d == ref.phi_d) return;
+    // A different bin is only acceptable on a bin boundary, where the reference's acos and
+    // halfback's atan2 may round to different sides. On the φd = 0 ≡ π boundary (every in-plane
+    // pair) the reference's rotations leave a ±1e-16 residue in dy whose sign picks bin 0 or 179;
+    // halfback's dy is exactly 0 there and gives bin 0 (and 179 for φd = π, as the reference).
+    const double eps = 1e-7;
+    const double xp = merl_reference::phi_d_coordinate(a.phi_d);
+    if (got.theta_h == ref.theta_h && got.theta_d == ref.theta_d && (xp < eps || xp > 180 - eps) &&
+        (got.phi_d == 0 || got.phi_d == 179)) {
+      ++fold;
+      return;
+    }
+    ++boundary;
+    if (got.theta_h != ref.theta_h) {
+      EXPECT_LT(to_boundary(merl_reference::theta_h_coordinate(a.theta_h)), eps);
+    }
+    if (got.theta_d != ref.theta_d) {
+      EXPECT_LT(to_boundary(merl_reference::theta_d_coordinate(a.theta_d)), eps);
+    }
+    if (got.phi_d != ref.phi_d) {
+      const double x = merl_reference::phi_d_coordinate(a.phi_d);
+      EXPECT_TRUE(to_boundary(x) < eps || x > 180 - eps || x < eps) << x;
+    }
+  };
+  // Uniform pairs, pairs near the specular peak (small θh), in-plane pairs, grazing pairs.
+  for (int n = 0; n < 100000; ++n)
+    check(test::uniform_hemisphere(rng), test::uniform_hemisphere(rng));
+  for (int n = 0; n < 20000; ++n) {
+    const double ti = std::acos(u(rng)), pi = 2 * kPi * u(rng);
+    const Vec3<double> wi = test::direction(ti, pi);
+    const Vec3<double> mirror{-wi.x, -wi.y, wi.z};
+    const double dt = 0.05 * u(rng) * u(rng), dp = 2 * kPi * u(rng);
+    const Vec3<double> wo =
+        test::direction(std::min(ti + dt * std::cos(dp), kPi / 2), pi + kPi + dt * std::sin(dp));
+    check(wi, n % 2 ? mirror : wo);
+  }
+  for (int n = 0; n < 20000; ++n) {
+    const double ti = kPi / 2 * u(rng), to = kPi / 2 * u(rng);
+    check(test::direction(ti, 0), test::direction(to, n % 2 ? 0 : kPi));
+  }
+  for (int n = 0; n < 20000; ++n)
+    check(test::direction(kPi / 2 * (1 - 1e-3 * u(rng)), 2 * kPi * u(rng)),
+          test::uniform_hemisphere(rng));
+  EXPECT_EQ(checked, 160000u);
+  EXPECT_LE(boundary, 20u) << "bins differing from the reference (all on boundaries)";
+  EXPECT_LE(fold, 10000u);  // at most half of the in-plane pairs
+  std::cout << "[ info ] of " << checked << " pairs, " << boundary
+            << " on a θh/θd/φd bin boundary and " << fold
+            << " in-plane ones on the φd = 0 ≡ π boundary got the neighbouring bin\n";
+}
+
+TEST(Merl, BinFormulasAtKnownPoints) {
+  // θh index is non-linear: bin i starts at θh = (i/90)² · 90°.
+  EXPECT_EQ(merl::bin_of(0.0, 0, 0).theta_h, 0);
+  EXPECT_EQ(merl::bin_of(std::pow(1.0 / 90, 2) * kPi / 2 * 0.999, 0, 0).theta_h, 0);
+  EXPECT_EQ(merl::bin_of(std::pow(1.0 / 90, 2) * kPi / 2 * 1.001, 0, 0).theta_h, 1);
+  EXPECT_EQ(merl::bin_of(std::pow(45.5 / 90, 2) * kPi / 2, 0, 0).theta_h, 45);
+  EXPECT_EQ(merl::bin_of(kPi / 2, 0, 0).theta_h, 89);  // clamped
+  EXPECT_EQ(merl::bin_of(0, kPi / 4, 0).theta_d, 45);
+  EXPECT_EQ(merl::bin_of(0, kPi / 2, 0).theta_d, 89);  // clamped
+  // φd folded by reciprocity: φd and φd ± π share a bin; negative (reference) and [0, 2π) (core)
+  // conventions agree.
+  for (double p : {0.1, 1.0, 2.0, 3.0}) {
+    EXPECT_EQ(merl::bin_of(0, 0, p).phi_d, merl::bin_of(0, 0, p + kPi).phi_d) << p;
+    EXPECT_EQ(merl::bin_of(0, 0, p).phi_d, merl::bin_of(0, 0, p - kPi).phi_d) << p;
+  }
+  EXPECT_EQ(merl::bin_of(0, 0, kPi / 2).phi_d, 90);
+  EXPECT_EQ(merl::bin_of(0, 0, kPi).phi_d, 179);  // as the reference (180 clamped)
+  EXPECT_EQ(merl::bin_of(0, 0, std::nan("")).phi_d, 0);
+  // Bin centres map back to their bins.
+  for (int th = 0; th < 90; th += 7)
+    for (int td = 0; td < 90; td += 11)
+      for (int pd = 0; pd < 180; pd += 13) {
+        const auto c = merl::bin_centre(th, td, pd);
+        const auto b = merl::bin_of(c[0], c[1], c[2]);
+        EXPECT_EQ(b.theta_h, th);
+        EXPECT_EQ(b.theta_d, td);
+        EXPECT_EQ(b.phi_d, pd);
+      }
+}
+
+TEST(Merl, ValuesAndScalesAreTheReferences) {
+  // Arbitrary stored values: the lookup must give exactly stored × (1.0/1500.0) etc., as the
+  // reference computes them, for the reference's bin.
+  const std::string image = merl_image([](int c, std::size_t i) {
+    return std::sin(0.37 * double(i) + c) * 1000.0 + 1001.0 + 1e-3 * double(c);
+  });
+  const MerlBrdf brdf(parse_merl(bytes_of(image), "values"));
+  std::vector<double> values(3 * merl::kBins);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] =
+        io_detail::load_le<double>(reinterpret_cast<const std::byte*>(image.data()) + 12 + 8 * i);
+  std::mt19937_64 rng(3);
+  for (int n = 0; n < 2000; ++n) {
+    const auto wi = test::uniform_hemisphere(rng), wo = test::uniform_hemisphere(rng);
+    const auto b = merl::bin_of(DirPair<double>{wi, wo});
+    const std::size_t i = merl::bin(b.theta_h, b.theta_d, b.phi_d);
+    const Rgb v = brdf.eval(DirPair<double>{wi, wo});
+    EXPECT_EQ(v.r, values[i] * (1.0 / 1500.0));
+    EXPECT_EQ(v.g, values[i + merl::kBins] * (1.15 / 1500.0));
+    EXPECT_EQ(v.b, values[i + 2 * merl::kBins] * (1.66 / 1500.0));
+  }
+}
+
+TEST(Merl, NegativeBinsAndHorizon) {
+  // Unmeasured (negative) bins: nearest gives the reference's value (negative), they are counted.
+  const std::string image = merl_image([](int c, std::size_t i) {
+    const std::size_t th = i / (180 * 90);
+    return th >= 80 ? -1.0 : 1500.0 * (c + 1);
+  });
+  const MerlData data = parse_merl(bytes_of(image), "neg");
+  EXPECT_EQ(data.missing[0], std::size_t(10) * 90 * 180);
+  const MerlBrdf brdf(data);
+  const auto c = merl::bin_centre(85, 2, 10);
+  const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{c[0], 0.0, c[1], c[2]});
+  ASSERT_TRUE(s.in_domain);
+  const Rgb v = brdf.eval(s.pair);
+  EXPECT_EQ(v.r, -1.0 * (1.0 / 1500.0));
+  EXPECT_EQ(v.b, -1.0 * (1.66 / 1500.0));
+  // Below the horizon: 0 (the interface's contract); NaN in, NaN out.
+  const Rgb below = brdf.eval(DirPair<double>{{0, 0, 1}, {1, 0, -0.1}});
+  EXPECT_EQ(below, (Rgb{0, 0, 0}));
+  EXPECT_TRUE(std::isnan(brdf.eval(DirPair<double>{{0, 0, std::nan("")}, {0, 0, 1}}).r));
+  EXPECT_NE(brdf.description().find("unmeasured"), std::string::npos);
+}
+
+// --------------------------------------------------------------------------------------------
+// Validation
+// --------------------------------------------------------------------------------------------
+
+TEST(MerlErrors, SizeHeaderAndValues) {
+  const std::string good = merl_image([](int, std::size_t) { return 1.0; });
+  EXPECT_NO_THROW(parse_merl(bytes_of(good), "good"));
+
+  std::string truncated = good.substr(0, good.size() - 1);
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(truncated), "t.binary"), "t.binary", "file size",
+                      "34992011 bytes", "truncated");
+  std::string oversized = good + "x";
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(oversized), "o.binary"), "o.binary", "file size",
+                      "trailing data");
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(std::string("abc")), "tiny"), "tiny", "header",
+                      "too short");
+
+  std::string bad_dim = good;
+  io_detail::store_le<std::int32_t>(reinterpret_cast<std::byte*>(bad_dim.data()) + 8, 360);
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(bad_dim), "d.binary"), "d.binary",
+                      "header dimension 3 (phi_d)", "is 360, expected 180");
+  std::string bad_dim1 = good;
+  io_detail::store_le<std::int32_t>(reinterpret_cast<std::byte*>(bad_dim1.data()), -5);
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(bad_dim1), "d1"), "header dimension 1 (theta_h)",
+                      "is -5");
+
+  auto poke = [&](int channel, int th, int td, int pd, double v) {
+    std::string s = good;
+    io_detail::store_le<double>(reinterpret_cast<std::byte*>(s.data()) + 12 +
+                                    8 * (channel * merl::kBins + merl::bin(th, td, pd)),
+                                v);
+    return s;
+  };
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(0, 1, 2, 3, std::nan(""))), "n.binary"), "n.binary",
+                      "red value at bin (theta_h 1, theta_d 2, phi_d 3)", "is NaN");
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(2, 89, 89, 179, INFINITY)), "i"),
+                      "blue value at bin (theta_h 89, theta_d 89, phi_d 179)", "is infinite");
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(1, 0, 0, 0, -INFINITY)), "i"), "green value",
+                      "is infinite");
+}
+
+TEST(MerlErrors, Files) {
+  TempDir tmp;
+  EXPECT_FORMAT_ERROR(read_merl(tmp / "missing.binary"), "missing.binary", "file");
+  // A wrong size is diagnosed from the header without reading the file.
+  const std::string head = merl_image([](int, std::size_t) { return 1.0; }).substr(0, 1000);
+  test::write_bytes(tmp / "short.binary", head.data(), head.size());
+  EXPECT_FORMAT_ERROR(read_merl(tmp / "short.binary"), "short.binary", "file size", "1000 bytes",
+                      "truncated");
+  const std::string text = "#DIM 3 1\n";
+  test::write_bytes(tmp / "alta.binary", text.data(), text.size());
+  EXPECT_FORMAT_ERROR(read_merl(tmp / "alta.binary"), "alta.binary", "header", "too short");
+  EXPECT_FORMAT_ERROR(read_merl(tmp.path()), "not a regular file");
+}
+
+// --------------------------------------------------------------------------------------------
+// Trilinear lookup
+// --------------------------------------------------------------------------------------------
+
+// A smooth, isotropic, reciprocal test function of the stored coordinates.
+double smooth(double th, double td, double pd) {
+  return 1.0 + 0.5 * std::cos(th) * std::cos(td) + 0.2 * std::cos(2 * pd) * std::sin(th);
+}
+
+TEST(MerlTrilinear, BinCentresWrapAndMissing) {
+  MerlData data;
+  data.values.resize(3 * merl::kBins);
+  for (int th = 0; th < 90; ++th)
+    for (int td = 0; td < 90; ++td)
+      for (int pd = 0; pd < 180; ++pd) {
+        const auto c = merl::bin_centre(th, td, pd);
+        for (int ch = 0; ch < 3; ++ch)
+          data.values[ch * merl::kBins + merl::bin(th, td, pd)] =
+              smooth(c[0], c[1], c[2]) * (ch + 1);
+      }
+  const MerlBrdf near(data), tri(data, {MerlLookup::trilinear});
+  auto pair_at = [](double th, double td, double pd) {
+    const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{th, 0.0, td, pd});
+    return s;
+  };
+  // At bin centres both lookups give the bin value.
+  for (int th : {0, 1, 20, 60}) {
+    for (int td : {0, 5, 40}) {
+      for (int pd : {0, 90, 179}) {
+        const auto c = merl::bin_centre(th, td, pd);
+        const auto s = pair_at(c[0], c[1], c[2]);
+        if (!s.in_domain) continue;
+        const Rgb a = near.eval(s.pair), b = tri.eval(s.pair);
+        EXPECT_NEAR(b.r, a.r, 1e-12 * std::abs(a.r)) << th << " " << td << " " << pd;
+        EXPECT_NEAR(b.b, a.b, 1e-12 * std::abs(a.b));
+      }
+    }
+  }
+  // Between centres the trilinear lookup follows the smooth function much more closely.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  double err_near = 0, err_tri = 0;
+  for (int n = 0; n < 5000; ++n) {
+    const double th = 1.2 * u(rng), td = 0.3 * u(rng), pd = 2 * kPi * u(rng);
+    const auto s = pair_at(th, td, pd);
+    if (!s.in_domain) continue;
+    const double want = smooth(th, td, pd) * merl::kScale[0];
+    err_near = std::max(err_near, std::abs(near.eval(s.pair).r - want) / want);
+    err_tri = std::max(err_tri, std::abs(tri.eval(s.pair).r - want) / want);
+  }
+  EXPECT_LT(err_tri, 2e-3);
+  EXPECT_LT(err_tri, err_near / 5);
+  // φd wrap: φd = ε and φd = π - ε are neighbours (0 ≡ π), and φd ↔ φd + π is the same point.
+  for (double th : {0.3, 0.9}) {
+    const double eps = 1e-9;
+    const Rgb a = tri.eval(pair_at(th, 0.2, eps).pair),
+              b = tri.eval(pair_at(th, 0.2, kPi - eps).pair);
+    const Rgb c = tri.eval(pair_at(th, 0.2, kPi + eps).pair);
+    EXPECT_NEAR(a.r, b.r, 1e-9 * a.r);
+    EXPECT_NEAR(a.r, c.r, 1e-9 * a.r);
+  }
+  // Near θh = 0: continuous, and equal to the θh-bin-0 layer interpolated in θd, φd.
+  {
+    const Rgb at0 = tri.eval(pair_at(0.0, 0.2, 1.0).pair);
+    const Rgb tiny = tri.eval(pair_at(1e-7, 0.2, 1.0).pair);
+    EXPECT_NEAR(at0.r, tiny.r, 1e-9 * at0.r);
+    EXPECT_TRUE(std::isfinite(at0.r));
+  }
+  // Missing corners are skipped and the remaining weights renormalized: a constant function with
+  // holes stays constant.
+  MerlData holes;
+  holes.values.assign(3 * merl::kBins, 1500.0);
+  for (int td = 0; td < 90; td += 2)
+    for (int pd = 0; pd < 180; pd += 3)
+      for (int ch = 0; ch < 3; ++ch) holes.values[ch * merl::kBins + merl::bin(30, td, pd)] = -1;
+  const MerlBrdf with_holes(holes, {MerlLookup::trilinear});
+  for (int n = 0; n < 2000; ++n) {
+    const double th = std::pow((29.5 + u(rng)) / 90, 2) * kPi / 2, td = kPi / 2 * u(rng) * 0.5;
+    const auto s = pair_at(th, td, kPi * u(rng));
+    if (!s.in_domain) continue;
+    EXPECT_NEAR(with_holes.eval(s.pair).r, 1.0, 1e-12);
+  }
+  // All 8 corners missing: the nearest bin's (reference) value.
+  MerlData empty;
+  empty.values.assign(3 * merl::kBins, -2.0);
+  const MerlBrdf all_missing(empty, {MerlLookup::trilinear});
+  EXPECT_EQ(all_missing.eval(pair_at(0.5, 0.3, 1.0).pair).g, -2.0 * merl::kScale[1]);
+}
+
+// --------------------------------------------------------------------------------------------
+// Writer
+// --------------------------------------------------------------------------------------------
+
+// An analytic isotropic, reciprocal BRDF defined here: a diffuse term and a lobe around the
+// specular direction, coloured.
+class TestLobe final : public Brdf {
+ public:
+  std::string name() const override { return "test-lobe"; }
+  std::string description() const override { return "test lobe"; }
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return true; }
+  Rgb eval(const DirPair<double>& p) const override {
+    if (p.wi.z < 0 || p.wo.z < 0) return {};
+    const double hx = p.wi.x + p.wo.x, hy = p.wi.y + p.wo.y, hz = p.wi.z + p.wo.z;
+    const double cos_h = hz / std::sqrt(hx * hx + hy * hy + hz * hz);
+    const double lobe = std::pow(cos_h, 50.0) * 10.0;
+    return {0.2 + lobe, 0.3 + 0.5 * lobe, 0.1 + 0.25 * lobe};
+  }
+};
+
+TEST(MerlWriter, RoundTripAtBinCentres) {
+  TempDir tmp;
+  const auto path = tmp / "lobe.binary";
+  const TestLobe model;
+  write_merl(path, model);
+  EXPECT_EQ(std::filesystem::file_size(path), merl::kFileBytes);
+  // Only the written file remains (no temporary).
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(tmp.path()),
+                          std::filesystem::directory_iterator{}),
+            1);
+  const MerlData back = read_merl(path);
+  EXPECT_FALSE(back.material.has_value());
+  EXPECT_EQ(back.sha256.size(), 64u);
+  const MerlBrdf brdf(back);
+  std::size_t valid = 0, invalid = 0;
+  for (int th = 0; th < 90; th += 3)
+    for (int td = 0; td < 90; td += 3)
+      for (int pd = 0; pd < 180; pd += 7) {
+        const auto c = merl::bin_centre(th, td, pd);
+        const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{c[0], 0.0, c[1], c[2]});
+        const std::size_t i = merl::bin(th, td, pd);
+        if (!s.in_domain) {
+          ++invalid;
+          EXPECT_EQ(back.values[i], -1.0);  // unmeasurable configuration: written as missing
+          continue;
+        }
+        ++valid;
+        const Rgb want = model.eval(s.pair), got = brdf.eval(s.pair);
+        EXPECT_NEAR(got.r, want.r, 1e-14 * want.r) << th << " " << td << " " << pd;
+        EXPECT_NEAR(got.g, want.g, 1e-14 * want.g);
+        EXPECT_NEAR(got.b, want.b, 1e-14 * want.b);
+      }
+  EXPECT_GT(valid, 1000u);
+  EXPECT_GT(invalid, 100u);
+  EXPECT_EQ(back.missing[0], back.missing[2]);
+  // The in-memory tabulation is what was written.
+  const MerlData table = tabulate_merl(model);
+  EXPECT_EQ(table.values, back.values);
+}
+
+TEST(MerlWriter, AtomicReplaceAndErrors) {
+  TempDir tmp;
+  const auto path = tmp / "x.binary";
+  test::write_bytes(path, "old", 3);
+  MerlData data;
+  data.values.assign(3 * merl::kBins, 750.0);
+  write_merl(path, data);
+  EXPECT_EQ(read_merl(path).values[123], 750.0);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(tmp.path()),
+                          std::filesystem::directory_iterator{}),
+            1);
+  EXPECT_FORMAT_ERROR(write_merl(tmp / "no-such-dir" / "y.binary", data), "y.binary", "write");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(tmp.path()),
+                          std::filesystem::directory_iterator{}),
+            1);
+  MerlData wrong;
+  wrong.values.assign(10, 1.0);
+  EXPECT_THROW(write_merl(path, wrong), std::invalid_argument);
+  EXPECT_THROW(MerlBrdf{wrong}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace halfback

@@ -1,0 +1,605 @@
+// RGL material evaluation (docs/formats.md, "RGL"). Notation: a 2D table of W columns (x, the
+// fastest index) and H rows (y) spans the unit square; the value at a point is the bilinear
+// interpolation of the grid values. Tables that depend on the incidence (θi, φi) are interpolated
+// linearly between the slices at the incidence grid values (clamped at the ends).
+#include "halfback/formats/rgl.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "binary_io.hpp"
+#include "halfback/util/format_error.hpp"
+
+namespace halfback {
+
+namespace {
+
+using io_detail::load_le;
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Clamp to [0, 1], NaN to 0 (std::clamp would pass NaN through to an index computation).
+double unit(double x) {
+  return x > 0 ? (x < 1 ? x : 1) : 0;
+}
+
+double theta_to_u(double theta) {
+  return std::sqrt(theta * (2 / kPi));
+}
+double phi_to_u(double phi) {
+  return (phi + kPi) * (0.5 / kPi);
+}
+
+class Validator {
+ public:
+  Validator(const TensorFile& tf, std::string file) : tf_(tf), file_(std::move(file)) {}
+
+  const TensorField& field(std::string_view name, TensorDtype dtype, std::size_t ndim) const {
+    const TensorField* f = tf_.find(name);
+    if (!f) {
+      if (name == "rgb" && tf_.find("spectra"))
+        fail(name,
+             "missing: this is the spectral variant of the format, only the RGB variant "
+             "(field 'rgb') is supported");
+      fail(name, "missing (required by the RGL material format)");
+    }
+    if (f->dtype != dtype)
+      fail(name, "has dtype " + std::string(name_of(f->dtype)) + ", expected " +
+                     std::string(name_of(dtype)));
+    if (f->shape.size() != ndim)
+      fail(name, "has " + std::to_string(f->shape.size()) + " dimensions, expected " +
+                     std::to_string(ndim));
+    return *f;
+  }
+
+  std::vector<double> floats(const TensorField& f) const {
+    std::vector<double> v(static_cast<std::size_t>(f.count()));
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const float x = load_le<float>(f.bytes.data() + 4 * i);
+      if (!std::isfinite(x))
+        fail(f.name, "value " + std::to_string(i) + " is " + (std::isnan(x) ? "NaN" : "infinite"));
+      v[i] = x;
+    }
+    return v;
+  }
+
+  void require_nonnegative(const TensorField& f, const std::vector<double>& v,
+                           bool strictly = false) const {
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (strictly ? !(v[i] > 0) : v[i] < 0)
+        fail(f.name, "value " + std::to_string(i) + " is " + std::to_string(v[i]) + ", must be " +
+                         (strictly ? "positive" : ">= 0"));
+  }
+
+  void require_dim(const TensorField& f, std::size_t axis, std::uint64_t expected,
+                   const std::string& why) const {
+    if (f.shape[axis] != expected)
+      fail(f.name, "dimension " + std::to_string(axis) + " is " + std::to_string(f.shape[axis]) +
+                       ", expected " + std::to_string(expected) + " (" + why + ")");
+  }
+
+  void require_at_least(const TensorField& f, std::size_t axis, std::uint64_t min) const {
+    if (f.shape[axis] < min)
+      fail(f.name, "dimension " + std::to_string(axis) + " is " + std::to_string(f.shape[axis]) +
+                       ", must be at least " + std::to_string(min));
+  }
+
+  [[noreturn]] void fail(std::string_view field, const std::string& problem) const {
+    throw FormatError(file_, "field '" + std::string(field) + "'", problem);
+  }
+
+ private:
+  const TensorFile& tf_;
+  std::string file_;
+};
+
+// A grid over an incidence parameter (θi or φi): where a value falls, and its weights.
+struct Axis {
+  std::vector<double> values;
+  std::size_t stride = 0;  // in slices; 0 when the axis has a single value
+
+  // Index of the lower grid value and the weight of the upper one, clamped at the ends.
+  void locate(double x, std::size_t& index, double& t) const {
+    const std::size_t n = values.size();
+    if (n == 1) {
+      index = 0;
+      t = 0;
+      return;
+    }
+    const auto k = static_cast<std::size_t>(std::lower_bound(values.begin(), values.end(), x) -
+                                            values.begin());
+    index = std::min(k == 0 ? 0 : k - 1, n - 2);
+    const double lo = values[index], hi = values[index + 1];
+    t = std::clamp((x - lo) / (hi - lo), 0.0, 1.0);
+    if (std::isnan(t)) t = 0;
+  }
+};
+
+// Up to 4 slices (2 incidence axes) and their weights.
+struct Slices {
+  std::size_t index[4];
+  double weight[4];
+  int count;
+};
+
+// A plain bilinear table on the unit square.
+struct Table {
+  std::size_t w = 0, h = 0;
+  std::vector<double> v;  // slices of h·w values
+
+  double eval(const Slices& s, double x, double y) const {
+    x = unit(x) * double(w - 1);
+    y = unit(y) * double(h - 1);
+    const std::size_t i = std::min(static_cast<std::size_t>(x), w - 2);
+    const std::size_t j = std::min(static_cast<std::size_t>(y), h - 2);
+    const double tx = x - double(i), ty = y - double(j);
+    double r = 0;
+    for (int k = 0; k < s.count; ++k) {
+      const double* p = v.data() + s.index[k] * w * h + j * w + i;
+      const double top = (1 - tx) * p[0] + tx * p[1];
+      const double bottom = (1 - tx) * p[w] + tx * p[w + 1];
+      r += s.weight[k] * ((1 - ty) * top + ty * bottom);
+    }
+    return r;
+  }
+};
+
+// A 2D distribution with the density bilinear in its grid values (a table per slice), sampled by
+// inverting its marginal CDF in y and its conditional CDF in x (docs/formats.md).
+struct Warp {
+  std::size_t w = 0, h = 0;
+  std::vector<double> f;     // density grid values, each slice normalized (index units)
+  std::vector<double> cond;  // per row: C(j, i) = ∫_0^i f(s, j) ds (trapezoids), h·w per slice
+  std::vector<double> marginal;  // M(j) = ∫_0^j R(t) dt, R(j) = C(j, w-1); h per slice; M(h-1) = 1
+
+  // Builds the CDFs of slice values `data`; returns false when a slice integrates to 0.
+  bool build(const std::vector<double>& data, std::size_t slices) {
+    f.resize(data.size());
+    cond.resize(data.size());
+    marginal.resize(slices * h);
+    for (std::size_t s = 0; s < slices; ++s) {
+      const double* in = data.data() + s * w * h;
+      double* c = cond.data() + s * w * h;
+      double* m = marginal.data() + s * h;
+      for (std::size_t j = 0; j < h; ++j) {
+        c[j * w] = 0;
+        for (std::size_t i = 0; i + 1 < w; ++i)
+          c[j * w + i + 1] = c[j * w + i] + 0.5 * (in[j * w + i] + in[j * w + i + 1]);
+      }
+      m[0] = 0;
+      for (std::size_t j = 0; j + 1 < h; ++j)
+        m[j + 1] = m[j] + 0.5 * (c[j * w + w - 1] + c[(j + 1) * w + w - 1]);
+      const double total = m[h - 1];
+      if (!(total > 0)) return false;
+      for (std::size_t k = 0; k < w * h; ++k) {
+        f[s * w * h + k] = in[k] / total;
+        c[k] /= total;
+      }
+      for (std::size_t j = 0; j < h; ++j) m[j] /= total;
+    }
+    return true;
+  }
+
+  double blend(const std::vector<double>& a, std::size_t per_slice, const Slices& s,
+               std::size_t k) const {
+    double r = 0;
+    for (int n = 0; n < s.count; ++n) r += s.weight[n] * a[s.index[n] * per_slice + k];
+    return r;
+  }
+  double F(const Slices& s, std::size_t j, std::size_t i) const {
+    return blend(f, w * h, s, j * w + i);
+  }
+  double C(const Slices& s, std::size_t j, std::size_t i) const {
+    return blend(cond, w * h, s, j * w + i);
+  }
+  double M(const Slices& s, std::size_t j) const { return blend(marginal, h, s, j); }
+
+  // Density on the unit square at p (the blended, normalized grid values, bilinear).
+  double density(const Slices& s, RglWarpPoint p) const {
+    const double x = unit(p.x) * double(w - 1);
+    const double y = unit(p.y) * double(h - 1);
+    const std::size_t i = std::min(static_cast<std::size_t>(x), w - 2);
+    const std::size_t j = std::min(static_cast<std::size_t>(y), h - 2);
+    const double sx = x - double(i), ty = y - double(j);
+    const double c0 = (1 - ty) * F(s, j, i) + ty * F(s, j + 1, i);
+    const double c1 = (1 - ty) * F(s, j, i + 1) + ty * F(s, j + 1, i + 1);
+    return ((1 - sx) * c0 + sx * c1) * double(w - 1) * double(h - 1);
+  }
+
+  // Point p of the unit square -> sample (the CDFs at p): the inverse of the warp.
+  RglWarpPoint inverse(const Slices& s, RglWarpPoint p) const {
+    const double x = unit(p.x) * double(w - 1);
+    const double y = unit(p.y) * double(h - 1);
+    const std::size_t i = std::min(static_cast<std::size_t>(x), w - 2);
+    const std::size_t j = std::min(static_cast<std::size_t>(y), h - 2);
+    const double sx = x - double(i), ty = y - double(j);
+    const double c0 = (1 - ty) * F(s, j, i) + ty * F(s, j + 1, i);
+    const double c1 = (1 - ty) * F(s, j, i + 1) + ty * F(s, j + 1, i + 1);
+    const double below = (1 - ty) * C(s, j, i) + ty * C(s, j + 1, i);
+    const double num = below + sx * c0 + 0.5 * sx * sx * (c1 - c0);
+    const double r0 = C(s, j, w - 1), r1 = C(s, j + 1, w - 1);
+    const double row = (1 - ty) * r0 + ty * r1;
+    RglWarpPoint u;
+    u.x = row > 0 ? unit(num / row) : unit(p.x);
+    u.y = unit(M(s, j) + ty * r0 + 0.5 * ty * ty * (r1 - r0));
+    return u;
+  }
+
+  // Sample -> point: inverts the marginal CDF in y, then the conditional CDF in x.
+  RglWarpPoint forward(const Slices& s, RglWarpPoint u) const {
+    u.x = unit(u.x);
+    u.y = unit(u.y);
+    // Row: the last j in [0, h-2] with M(j) < u.y.
+    std::size_t lo = 0, hi = h - 2;
+    while (lo < hi) {
+      const std::size_t mid = (lo + hi + 1) / 2;
+      if (M(s, mid) < u.y)
+        lo = mid;
+      else
+        hi = mid - 1;
+    }
+    const std::size_t j = lo;
+    const double r0 = C(s, j, w - 1), r1 = C(s, j + 1, w - 1);
+    const double ty = solve_linear_density(r0, r1, u.y - M(s, j));
+    // Column: the last i in [0, w-2] with C_ty(i) < u.x · R(ty).
+    const double target = u.x * ((1 - ty) * r0 + ty * r1);
+    auto ct = [&](std::size_t i) { return (1 - ty) * C(s, j, i) + ty * C(s, j + 1, i); };
+    lo = 0;
+    hi = w - 2;
+    while (lo < hi) {
+      const std::size_t mid = (lo + hi + 1) / 2;
+      if (ct(mid) < target)
+        lo = mid;
+      else
+        hi = mid - 1;
+    }
+    const std::size_t i = lo;
+    const double c0 = (1 - ty) * F(s, j, i) + ty * F(s, j + 1, i);
+    const double c1 = (1 - ty) * F(s, j, i + 1) + ty * F(s, j + 1, i + 1);
+    const double sx = solve_linear_density(c0, c1, target - ct(i));
+    return {(double(i) + sx) / double(w - 1), (double(j) + ty) / double(h - 1)};
+  }
+
+  // t in [0, 1] with ∫_0^t ((1-τ) a + τ b) dτ = a t + (b - a) t²/2 = area, in the form that stays
+  // accurate when b ≈ a.
+  static double solve_linear_density(double a, double b, double area) {
+    if (!(area > 0)) return 0;
+    const double disc = std::max(a * a + 2 * (b - a) * area, 0.0);
+    const double den = a + std::sqrt(disc);
+    if (!(den > 0)) return 0;
+    return unit(2 * area / den);
+  }
+};
+
+bool negative_sign(double v) {
+  return !std::signbit(v);
+}  // mulsign_neg: flip when v >= +0
+
+}  // namespace
+
+struct RglBrdf::Impl {
+  std::string description;
+  std::vector<float> theta_i_raw, phi_i_raw;
+  Axis phi, theta;  // incidence grids; slices are ordered [φi][θi]
+  bool isotropic = true;
+  bool jacobian = true;
+  int reduction = 1;  // anisotropic data covering 2π / reduction of φi, by symmetry
+  Table ndf, sigma;   // no incidence dependence
+  Warp vndf;
+  Table rgb;  // slices [φi][θi][channel]
+  std::size_t n_slices = 1;
+
+  Slices slices(double phi_i, double theta_i, std::size_t channels = 1,
+                std::size_t channel = 0) const {
+    std::size_t ip, it;
+    double tp, tt;
+    phi.locate(phi_i, ip, tp);
+    theta.locate(theta_i, it, tt);
+    Slices s{};
+    s.count = 0;
+    for (int a = 0; a < 2; ++a) {
+      const double wa = a ? tp : 1 - tp;
+      if (a && phi.stride == 0) break;
+      for (int b = 0; b < 2; ++b) {
+        const double wb = b ? tt : 1 - tt;
+        if (b && theta.stride == 0) break;
+        const std::size_t slice = (ip + a) * phi.stride + (it + b) * theta.stride;
+        s.index[s.count] = slice * channels + channel;
+        s.weight[s.count] = wa * wb;
+        ++s.count;
+      }
+    }
+    return s;
+  }
+};
+
+RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
+    : impl_(std::make_unique<Impl>()), label_(std::move(label)), options_(options) {
+  Validator v(tf, tf.name.empty() ? label_ : tf.name);
+  Impl& m = *impl_;
+
+  const TensorField& desc = v.field("description", TensorDtype::uint8, 1);
+  m.description.assign(reinterpret_cast<const char*>(desc.bytes.data()), desc.bytes.size());
+  while (!m.description.empty() && m.description.back() == '\0') m.description.pop_back();
+
+  if (const TensorField* ver = tf.find("version")) {
+    if (ver->dtype != TensorDtype::uint32 || ver->shape.size() != 1 || ver->shape[0] != 2)
+      v.fail("version", "expected 2 uint32 values");
+  }
+
+  auto incidence = [&](std::string_view name, double lo, double hi, std::vector<float>& raw,
+                       Axis& axis) {
+    const TensorField& f = v.field(name, TensorDtype::float32, 1);
+    v.require_at_least(f, 0, 1);
+    axis.values = v.floats(f);
+    raw.assign(axis.values.begin(), axis.values.end());
+    for (std::size_t i = 0; i < axis.values.size(); ++i) {
+      const double x = axis.values[i];
+      if (x < lo || x > hi)
+        v.fail(name, "value " + std::to_string(i) + " is " + std::to_string(x) + " rad, outside [" +
+                         std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      if (i > 0 && !(x > axis.values[i - 1])) v.fail(name, "values are not strictly increasing");
+    }
+    return axis.values.size();
+  };
+  const double tol = 1e-5;
+  const std::size_t n_theta = incidence("theta_i", -tol, kPi / 2 + tol, m.theta_i_raw, m.theta);
+  const std::size_t n_phi = incidence("phi_i", -kPi - tol, kPi + tol, m.phi_i_raw, m.phi);
+  m.theta.stride = n_theta > 1 ? 1 : 0;
+  m.phi.stride = n_phi > 1 ? n_theta : 0;
+  m.n_slices = n_theta * n_phi;
+  // As in the reference loader: at most 2 φi values means isotropic data, whose tables are
+  // indexed by the azimuth of the half vector relative to ωi. Anisotropic data may cover a fraction
+  // 1/reduction of the azimuths, the rest following by symmetry.
+  m.isotropic = n_phi <= 2;
+  if (!m.isotropic) {
+    const double span = m.phi.values.back() - m.phi.values.front();
+    m.reduction = static_cast<int>(std::lround(2 * kPi / span));
+    if (m.reduction != 1 && m.reduction != 2 && m.reduction != 4)
+      v.fail("phi_i", "covers " + std::to_string(span) +
+                          " rad: expected 2π, π or π/2 (full, half or quarter symmetry)");
+  }
+
+  auto table = [&](std::string_view name, Table& t, bool strictly_positive) {
+    const TensorField& f = v.field(name, TensorDtype::float32, 2);
+    v.require_at_least(f, 0, 2);
+    v.require_at_least(f, 1, 2);
+    t.h = static_cast<std::size_t>(f.shape[0]);
+    t.w = static_cast<std::size_t>(f.shape[1]);
+    t.v = v.floats(f);
+    v.require_nonnegative(f, t.v, strictly_positive);
+  };
+  table("ndf", m.ndf, false);
+  table("sigma", m.sigma, true);  // divides ρ
+
+  {
+    const TensorField& f = v.field("vndf", TensorDtype::float32, 4);
+    v.require_dim(f, 0, n_phi, "number of phi_i values");
+    v.require_dim(f, 1, n_theta, "number of theta_i values");
+    v.require_at_least(f, 2, 2);
+    v.require_at_least(f, 3, 2);
+    m.vndf.h = static_cast<std::size_t>(f.shape[2]);
+    m.vndf.w = static_cast<std::size_t>(f.shape[3]);
+    const std::vector<double> data = v.floats(f);
+    v.require_nonnegative(f, data);
+    if (!m.vndf.build(data, m.n_slices)) v.fail("vndf", "a slice integrates to zero");
+  }
+
+  const TensorField& lum = v.field("luminance", TensorDtype::float32, 4);
+  v.require_dim(lum, 0, n_phi, "number of phi_i values");
+  v.require_dim(lum, 1, n_theta, "number of theta_i values");
+  v.require_at_least(lum, 2, 2);
+  v.require_dim(lum, 3, lum.shape[2], "the sample grid is square");
+  v.require_nonnegative(lum, v.floats(lum));
+
+  {
+    const TensorField& f = v.field("rgb", TensorDtype::float32, 5);
+    v.require_dim(f, 0, n_phi, "number of phi_i values");
+    v.require_dim(f, 1, n_theta, "number of theta_i values");
+    v.require_dim(f, 2, 3, "red, green, blue");
+    v.require_dim(f, 3, lum.shape[2], "the luminance grid's resolution");
+    v.require_dim(f, 4, lum.shape[3], "the luminance grid's resolution");
+    m.rgb.h = static_cast<std::size_t>(f.shape[3]);
+    m.rgb.w = static_cast<std::size_t>(f.shape[4]);
+    m.rgb.v = v.floats(f);  // may be slightly negative (out of gamut): see RglOptions
+  }
+
+  {
+    const TensorField& f = v.field("jacobian", TensorDtype::uint8, 1);
+    v.require_dim(f, 0, 1, "a single flag");
+    const auto flag = static_cast<std::uint8_t>(f.bytes[0]);
+    if (flag > 1) v.fail("jacobian", "is " + std::to_string(flag) + ", expected 0 or 1");
+    m.jacobian = flag == 1;
+  }
+}
+
+RglBrdf::~RglBrdf() = default;
+
+std::string RglBrdf::name() const {
+  return "rgl:" + label_;
+}
+
+std::string RglBrdf::description() const {
+  return "RGL measured BRDF: " + impl_->description + " (" + std::to_string(impl_->n_slices) +
+         " incidence slices, " + (impl_->isotropic ? "isotropic" : "anisotropic") + ")";
+}
+
+std::vector<Brdf::Fact> RglBrdf::facts() const {
+  const Impl& m = *impl_;
+  std::vector<Fact> f;
+  f.push_back({"format", "RGL tensor_file (Dupuy & Jakob 2018), RGB variant"});
+  f.push_back({"material", m.description});
+  f.push_back({"incidence grid",
+               fmt::format("{} θi × {} φi{}", m.theta_i_raw.size(), m.phi_i_raw.size(),
+                           m.reduction > 1 ? fmt::format(" (1/{} of the azimuths, the rest "
+                                                         "by symmetry)",
+                                                         m.reduction)
+                                           : std::string())});
+  f.push_back({"spectral slices",
+               fmt::format("{} × {} samples per incidence, 3 channels", m.rgb.h, m.rgb.w)});
+  f.push_back({"VNDF / NDF tables",
+               fmt::format("{} × {} / {} × {}", m.vndf.h, m.vndf.w, m.ndf.h, m.ndf.w)});
+  f.push_back({"symmetry", m.isotropic ? "isotropic" : "anisotropic"});
+  return f;
+}
+
+bool RglBrdf::isotropic() const {
+  return impl_->isotropic;
+}
+const std::string& RglBrdf::material_description() const {
+  return impl_->description;
+}
+std::span<const float> RglBrdf::theta_i() const {
+  return impl_->theta_i_raw;
+}
+std::span<const float> RglBrdf::phi_i() const {
+  return impl_->phi_i_raw;
+}
+
+RglWarpPoint RglBrdf::vndf_inverse(RglWarpPoint p, double theta_i, double phi_i) const {
+  return impl_->vndf.inverse(impl_->slices(phi_i, theta_i), p);
+}
+
+RglWarpPoint RglBrdf::vndf_forward(RglWarpPoint u, double theta_i, double phi_i) const {
+  return impl_->vndf.forward(impl_->slices(phi_i, theta_i), u);
+}
+
+double RglBrdf::vndf_density(RglWarpPoint p, double theta_i, double phi_i) const {
+  return impl_->vndf.density(impl_->slices(phi_i, theta_i), p);
+}
+
+namespace {
+
+// The data's symmetry (a rotation by π, or reflections across both axes) that moves the given
+// direction into the covered range of φ: which axes to flip.
+struct Flips {
+  bool x = false, y = false;
+  Vec3<double> apply(Vec3<double> v) const {
+    if (x) v.x = -v.x;
+    if (y) v.y = -v.y;
+    return v;
+  }
+};
+
+Flips flips_for(int reduction, const Vec3<double>& given) {
+  if (reduction < 2) return {};
+  const double sy = given.y, sx = reduction == 4 ? given.x : sy;
+  return {negative_sign(sx), negative_sign(sy)};
+}
+
+// dωm = sin θm dθm dφm = 2π² u sin θm du dv, and dω = 4 |ω·m| dωm (reflection about m).
+double reflection_jacobian(RglWarpPoint um, double theta_m, double cos_gm) {
+  return 2 * kPi * kPi * um.x * std::sin(theta_m) * 4 * std::abs(cos_gm);
+}
+
+}  // namespace
+
+BrdfSample RglBrdf::sample(const Vec3<double>& wo, double u1, double u2) const {
+  const Impl& m = *impl_;
+  if (!(wo.z > 0)) return {};
+  const Flips flips = flips_for(m.reduction, wo);
+  const Vec3<double> g = flips.apply(wo);
+  const double theta_g = std::atan2(std::hypot(g.x, g.y), g.z);
+  const double phi_g = std::atan2(g.y, g.x);
+  const Slices s = m.slices(phi_g, theta_g);
+  const RglWarpPoint um = m.vndf.forward(s, {u1, u2});
+  const double pdf_u = m.vndf.density(s, um);
+  const double theta_m = um.x * um.x * (kPi / 2);
+  const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g : 0.0);
+  const Vec3<double> n{std::sin(theta_m) * std::cos(phi_m), std::sin(theta_m) * std::sin(phi_m),
+                       std::cos(theta_m)};
+  const double dot = g.x * n.x + g.y * n.y + g.z * n.z;
+  const Vec3<double> wi =
+      flips.apply({2 * dot * n.x - g.x, 2 * dot * n.y - g.y, 2 * dot * n.z - g.z});
+  const double jacobian = reflection_jacobian(um, theta_m, dot);
+  return {wi, jacobian > 0 && wi.z > 0 ? pdf_u / jacobian : 0.0};
+}
+
+double RglBrdf::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  const Impl& m = *impl_;
+  if (!(wo.z > 0) || !(wi.z > 0)) return 0;
+  const Flips flips = flips_for(m.reduction, wo);
+  const Vec3<double> g = flips.apply(wo), d = flips.apply(wi);
+  // The microfacet normal that reflects g into d: their half vector.
+  const Vec3<double> h{g.x + d.x, g.y + d.y, g.z + d.z};
+  const double len = std::sqrt(h.x * h.x + h.y * h.y + h.z * h.z);
+  if (!(len > 0)) return 0;
+  const Vec3<double> n{h.x / len, h.y / len, h.z / len};
+  const double theta_g = std::atan2(std::hypot(g.x, g.y), g.z);
+  const double phi_g = std::atan2(g.y, g.x);
+  const double theta_m = std::atan2(std::hypot(n.x, n.y), n.z);
+  double v = (std::atan2(n.y, n.x) - (m.isotropic ? phi_g : 0.0) + kPi) / (2 * kPi);
+  v -= std::floor(v);
+  const RglWarpPoint um{std::sqrt(theta_m / (kPi / 2)), v};
+  const double pdf_u = m.vndf.density(m.slices(phi_g, theta_g), um);
+  const double jacobian = reflection_jacobian(um, theta_m, g.x * n.x + g.y * n.y + g.z * n.z);
+  return jacobian > 0 && std::isfinite(pdf_u) ? pdf_u / jacobian : 0;
+}
+
+Rgb RglBrdf::eval_cosine(const DirPair<double>& pair) const {
+  const Impl& m = *impl_;
+  Vec3<double> wi = pair.wi, wo = pair.wo;
+  const double v[6] = {wi.x, wi.y, wi.z, wo.x, wo.y, wo.z};
+  for (double x : v)
+    if (std::isnan(x)) return {kNaN, kNaN, kNaN};
+  if (!(wi.z > 0) || !(wo.z > 0)) return {};
+
+  if (m.reduction >= 2) {
+    // Map ωi into the covered range of φi by the data's symmetry (a rotation by π, or the
+    // reflections across both axes), moving ωo with it.
+    const double sy = wi.y, sx = m.reduction == 4 ? wi.x : sy;
+    const bool fx = negative_sign(sx), fy = negative_sign(sy);
+    if (fx) wi.x = -wi.x, wo.x = -wo.x;
+    if (fy) wi.y = -wi.y, wo.y = -wo.y;
+  }
+
+  const double hx = wi.x + wo.x, hy = wi.y + wo.y, hz = wi.z + wo.z;
+  const double theta_i = std::atan2(std::hypot(wi.x, wi.y), wi.z);
+  const double phi_i = std::atan2(wi.y, wi.x);
+  const double theta_m = std::atan2(std::hypot(hx, hy), hz);
+  const double phi_m = std::atan2(hy, hx);
+
+  double um_y = phi_to_u(m.isotropic ? phi_m - phi_i : phi_m);
+  um_y -= std::floor(um_y);
+  const RglWarpPoint um{theta_to_u(theta_m), um_y};
+  const RglWarpPoint uwi{theta_to_u(theta_i), phi_to_u(phi_i)};
+
+  const Slices slices = m.slices(phi_i, theta_i);
+  const RglWarpPoint sample = m.vndf.inverse(slices, um);
+
+  double scale = 1;
+  if (m.jacobian) {
+    const Slices none{{0, 0, 0, 0}, {1, 0, 0, 0}, 1};
+    scale = m.ndf.eval(none, um.x, um.y) / (4 * m.sigma.eval(none, uwi.x, uwi.y));
+  }
+  double c[3];
+  for (std::size_t ch = 0; ch < 3; ++ch) {
+    const Slices s = m.slices(phi_i, theta_i, 3, ch);
+    c[ch] = m.rgb.eval(s, sample.x, sample.y) * scale;
+    if (options_.clamp_negative) c[ch] = std::max(c[ch], 0.0);
+  }
+  return {c[0], c[1], c[2]};
+}
+
+Rgb RglBrdf::eval(const DirPair<double>& pair) const {
+  Rgb r = eval_cosine(pair);
+  if (!(pair.wi.z > 0) || !(pair.wo.z > 0)) return r;  // 0, or NaN for NaN input
+  // The reference loader returns fr·cos θo (a sampling-friendly quantity); fr is that over cos θo.
+  const double cos_o =
+      pair.wo.z / std::sqrt(pair.wo.x * pair.wo.x + pair.wo.y * pair.wo.y + pair.wo.z * pair.wo.z);
+  r.r /= cos_o;
+  r.g /= cos_o;
+  r.b /= cos_o;
+  return r;
+}
+
+std::shared_ptr<const RglBrdf> load_rgl(const std::filesystem::path& path, RglOptions options) {
+  return std::make_shared<const RglBrdf>(read_tensor_file(path), path.stem().string(), options);
+}
+
+}  // namespace halfback
