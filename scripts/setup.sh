@@ -5,6 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 # ccache (when installed): paths relative to the tree, so that another clone hits the same cache.
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
+export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
 
 packages=$(grep -v '^\s*#' scripts/debian-packages.txt | tr '\n' ' ')
 if command -v apt-get >/dev/null; then

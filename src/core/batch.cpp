@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <new>
 #include <stdexcept>
@@ -173,23 +174,35 @@ struct Plan {
   typename Stages::CheckFn check = nullptr;
   typename Stages::DecodeFn decode = nullptr;
   typename Stages::EncodeFn encode = nullptr;
+  // The measure: of the output coordinates, or of the input ones when `to` is dirs; none (1 for a
+  // valid row) when both are dirs.
+  typename Stages::JacobianFn jacobian_in = nullptr, jacobian_out = nullptr;
 
   Plan(const Stages& k, Form f, Form t, std::span<const ConstColumn<T>> i,
        const ConvertOutput<T>& o)
       : from(f), to(t), dim_in(dimension(f)), dim_out(dimension(t)), in(i), out(&o) {
     want_jac = o.jacobian.data != nullptr;
     const bool to_dirs = t.space == Space::dirs;
-    // The jacobian comes from the output coordinates, or from the input ones when `to` is dirs.
-    const int jac_at_input = want_jac && to_dirs ? 1 : 0;
-    const int jac_at_output = want_jac && !to_dirs ? 1 : 0;
-    if (f.space == Space::dirs)
-      check = k.check[to_dirs ? 1 : 0][jac_at_input];
-    else
-      decode = k.decode[static_cast<int>(f.space) - 1][f.isotropic ? 1 : 0][jac_at_input];
-    if (!to_dirs)
-      encode = k.encode[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0][jac_at_output];
+    if (f.space == Space::dirs) {
+      check = k.check[to_dirs ? 1 : 0];
+    } else {
+      decode = k.decode[static_cast<int>(f.space) - 1][f.isotropic ? 1 : 0];
+      if (want_jac && to_dirs)
+        jacobian_in = k.jacobian[static_cast<int>(f.space) - 1][f.isotropic ? 1 : 0];
+    }
+    if (!to_dirs) {
+      encode = k.encode[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0];
+      if (want_jac) jacobian_out = k.jacobian[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0];
+    }
   }
 };
+
+// The measure where the mask is 1, NaN elsewhere; without a stage (dirs to dirs), 1.
+template <class T>
+void mask_jacobian(const T* mask, T* jac, std::size_t m, bool unit) {
+  constexpr T nan = std::numeric_limits<T>::quiet_NaN();
+  for (std::size_t i = 0; i < m; ++i) jac[i] = mask[i] > T(0) ? (unit ? T(1) : jac[i]) : nan;
+}
 
 template <class T>
 struct AlignedDelete {
@@ -230,17 +243,21 @@ class TileRunner {
     T* jac = p.want_jac ? (jcol.stride == 1 ? jcol.data + base : column(kJacobian)) : nullptr;
     T* mask = column(kMask);
 
+    // The input's measure before decoding: `out` may share memory with `in`.
+    if (jac && p.jacobian_in) p.jacobian_in(in, jac, m);
     if (p.check) {
-      p.check(in, out, mask, p.encode ? nullptr : jac, m);
-      if (p.encode) p.encode(in, mask, out, jac, m);
+      p.check(in, out, mask, m);
+      if (p.encode) p.encode(in, mask, out, m);
     } else if (!p.encode) {
-      p.decode(in, out, mask, jac, m);
+      p.decode(in, out, mask, m);
     } else {
       T* dirs[6];
       for (int c = 0; c < 6; ++c) dirs[c] = column(kDirs + c);
-      p.decode(in, dirs, mask, nullptr, m);
-      p.encode(dirs, mask, out, jac, m);
+      p.decode(in, dirs, mask, m);
+      p.encode(dirs, mask, out, m);
     }
+    if (jac && p.jacobian_out) p.jacobian_out(out, jac, m);
+    if (jac) mask_jacobian(mask, jac, m, !p.jacobian_in && !p.jacobian_out);
 
     for (std::size_t c = 0; c < p.dim_out; ++c) {
       const Column<T>& col = p.out->columns[c];

@@ -3,11 +3,15 @@
 // each instruction set's table is built in its own translation unit (batch_kernels_<isa>.cpp)
 // compiled with that set's -m flags.
 //
-// A conversion runs in tiles of rows, in up to three stages on SoA columns:
-//   check  (dirs input)   6 direction columns -> mask [, NaN-masked copy] [, J = 1]
-//   decode (P input)      dim(P) columns -> 6 direction columns (NaN if invalid), mask [, J(q)]
-//   encode (P output)     6 direction columns + mask -> dim(P) columns (NaN if invalid) [, J(q)]
-// Masks are stored as T: 1 for a valid row, 0 otherwise.
+// A conversion runs in tiles of rows, in up to three stages on SoA columns, and a fourth when the
+// measure is asked for:
+//   check    (dirs input)   6 direction columns -> mask [, NaN-masked copy]
+//   decode   (P input)      dim(P) columns -> 6 direction columns (NaN if invalid), mask
+//   encode   (P output)     6 direction columns + mask -> dim(P) columns (NaN if invalid)
+//   jacobian (P in or out)  dim(P) columns -> J(q), not masked (the engine masks it)
+// Masks are stored as T: 1 for a valid row, 0 otherwise. The Jacobian is a stage of its own rather
+// than a variant of decode and encode so that those, the largest kernels, are compiled once.
+
 #pragma once
 
 #include <cstddef>
@@ -23,14 +27,15 @@ inline constexpr SimdIsa kAllIsas[] = {SimdIsa::scalar, SimdIsa::sse2, SimdIsa::
 
 template <class T>
 struct StageKernels {
-  using CheckFn = void (*)(const T* const* in, T* const* copy, T* mask, T* jac, std::size_t m);
-  using DecodeFn = void (*)(const T* const* in, T* const* dirs, T* mask, T* jac, std::size_t m);
-  using EncodeFn = void (*)(const T* const* dirs, const T* mask, T* const* out, T* jac,
-                            std::size_t m);
-  std::size_t width;         // lanes per vector
-  CheckFn check[2][2];       // [copy][jacobian]
-  DecodeFn decode[4][2][2];  // [space - 1][isotropic][jacobian]
-  EncodeFn encode[4][2][2];  // [space - 1][isotropic][jacobian]
+  using CheckFn = void (*)(const T* const* in, T* const* copy, T* mask, std::size_t m);
+  using DecodeFn = void (*)(const T* const* in, T* const* dirs, T* mask, std::size_t m);
+  using EncodeFn = void (*)(const T* const* dirs, const T* mask, T* const* out, std::size_t m);
+  using JacobianFn = void (*)(const T* const* coords, T* jac, std::size_t m);
+  std::size_t width;          // lanes per vector
+  CheckFn check[2];           // [copy]
+  DecodeFn decode[4][2];      // [space - 1][isotropic]
+  EncodeFn encode[4][2];      // [space - 1][isotropic]
+  JacobianFn jacobian[4][2];  // [space - 1][isotropic]
 };
 
 struct KernelSet {

@@ -95,38 +95,34 @@ inline B mask_to_lanes(const MaskOf<B>& m) {
 // The stages are flattened: everything they call, down to the xsimd intrinsics, is inlined into
 // one loop (GCC otherwise keeps the larger param.hpp functions and xsimd's sincos out of line,
 // passing 512-bit vectors through memory, which costs 2-3x).
-template <class B, bool Copy, bool Jac>
+template <class B, bool Copy>
 HALFBACK_FLATTEN void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy,
-                                  ScalarOf<B>* mask, ScalarOf<B>* jac, std::size_t m) {
+                                  ScalarOf<B>* mask, std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int kCopy = Copy ? 6 : 0;
-  constexpr int NO = kCopy + 1 + (Jac ? 1 : 0);
+  constexpr int NO = kCopy + 1;
   S* outs[NO];
   for (int c = 0; c < kCopy; ++c) outs[c] = copy[c];
   outs[kCopy] = mask;
-  if constexpr (Jac) outs[kCopy + 1] = jac;
   for_rows<B, 6, NO>(in, outs, m, [](const B* x, B* y) {
     const DirPair<B> p{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
     const auto ok = pair_is_valid(p);
     for (int c = 0; c < kCopy; ++c) y[c] = L::select(ok, x[c], nan_lanes<B>());
     y[kCopy] = mask_to_lanes<B>(ok);
-    if constexpr (Jac) y[kCopy + 1] = L::select(ok, B(S(1)), nan_lanes<B>());
   });
 }
 
-// P input: the pair (NaN where invalid), the domain mask and, with Jac, the measure of q.
-template <class B, class P, bool Iso, bool Jac>
+// P input: the pair (NaN where invalid) and the domain mask.
+template <class B, class P, bool Iso>
 HALFBACK_FLATTEN void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs,
-                                   ScalarOf<B>* mask, ScalarOf<B>* jac, std::size_t m) {
+                                   ScalarOf<B>* mask, std::size_t m) {
   using S = ScalarOf<B>;
-  using L = LaneOps<B>;
   constexpr int NI = Iso ? 3 : 4;
-  constexpr int NO = 6 + 1 + (Jac ? 1 : 0);
+  constexpr int NO = 6 + 1;
   S* outs[NO];
   for (int c = 0; c < 6; ++c) outs[c] = dirs[c];
   outs[6] = mask;
-  if constexpr (Jac) outs[7] = jac;
   for_rows<B, NI, NO>(in, outs, m, [](const B* q, B* y) {
     const Solved<B> s = decode_param<P, B>(Iso, q);
     y[0] = s.pair.wi.x;
@@ -136,51 +132,55 @@ HALFBACK_FLATTEN void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* co
     y[4] = s.pair.wo.y;
     y[5] = s.pair.wo.z;
     y[6] = mask_to_lanes<B>(s.in_domain);
-    if constexpr (Jac) y[7] = L::select(s.in_domain, jacobian_of<P, B>(Iso, q), nan_lanes<B>());
   });
 }
 
-// P output: the coordinates of the pair (NaN where the mask is 0) and, with Jac, their measure.
-template <class B, class P, bool Iso, bool Jac>
+// P output: the coordinates of the pair (NaN where the mask is 0).
+template <class B, class P, bool Iso>
 HALFBACK_FLATTEN void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask,
-                                   ScalarOf<B>* const* out, ScalarOf<B>* jac, std::size_t m) {
+                                   ScalarOf<B>* const* out, std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int kDim = Iso ? 3 : 4;
-  constexpr int NO = kDim + (Jac ? 1 : 0);
   const S* ins[7] = {dirs[0], dirs[1], dirs[2], dirs[3], dirs[4], dirs[5], mask};
-  S* outs[NO];
+  S* outs[kDim];
   for (int c = 0; c < kDim; ++c) outs[c] = out[c];
-  if constexpr (Jac) outs[kDim] = jac;
-  for_rows<B, 7, NO>(ins, outs, m, [](const B* x, B* y) {
+  for_rows<B, 7, kDim>(ins, outs, m, [](const B* x, B* y) {
     const auto ok = x[6] > B(S(0));
     const DirPair<B> p{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
     encode_param<P, B>(Iso, p, y);
-    if constexpr (Jac) y[kDim] = jacobian_of<P, B>(Iso, y);
-    for (int c = 0; c < NO; ++c) y[c] = L::select(ok, y[c], nan_lanes<B>());
+    for (int c = 0; c < kDim; ++c) y[c] = L::select(ok, y[c], nan_lanes<B>());
   });
+}
+
+// The measure J(q) of coordinates of P at every row, not masked: the engine puts NaN where the
+// row is invalid. (decode and encode computed it from the same q in the same lanes before, so the
+// bits are those of convert_one.)
+template <class B, class P, bool Iso>
+HALFBACK_FLATTEN void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<B>* jac,
+                                     std::size_t m) {
+  using S = ScalarOf<B>;
+  constexpr int NI = Iso ? 3 : 4;
+  S* outs[1] = {jac};
+  for_rows<B, NI, 1>(coords, outs, m, [](const B* q, B* y) { y[0] = jacobian_of<P, B>(Iso, q); });
 }
 
 template <class B, class P, int Space>
 constexpr void fill_param(StageKernels<ScalarOf<B>>& k) {
-  k.decode[Space][0][0] = &decode_stage<B, P, false, false>;
-  k.decode[Space][0][1] = &decode_stage<B, P, false, true>;
-  k.decode[Space][1][0] = &decode_stage<B, P, true, false>;
-  k.decode[Space][1][1] = &decode_stage<B, P, true, true>;
-  k.encode[Space][0][0] = &encode_stage<B, P, false, false>;
-  k.encode[Space][0][1] = &encode_stage<B, P, false, true>;
-  k.encode[Space][1][0] = &encode_stage<B, P, true, false>;
-  k.encode[Space][1][1] = &encode_stage<B, P, true, true>;
+  k.decode[Space][0] = &decode_stage<B, P, false>;
+  k.decode[Space][1] = &decode_stage<B, P, true>;
+  k.encode[Space][0] = &encode_stage<B, P, false>;
+  k.encode[Space][1] = &encode_stage<B, P, true>;
+  k.jacobian[Space][0] = &jacobian_stage<B, P, false>;
+  k.jacobian[Space][1] = &jacobian_stage<B, P, true>;
 }
 
 template <class B>
 constexpr StageKernels<ScalarOf<B>> make_stages() {
   StageKernels<ScalarOf<B>> k{};
   k.width = Lanes<B>::size;
-  k.check[0][0] = &check_stage<B, false, false>;
-  k.check[0][1] = &check_stage<B, false, true>;
-  k.check[1][0] = &check_stage<B, true, false>;
-  k.check[1][1] = &check_stage<B, true, true>;
+  k.check[0] = &check_stage<B, false>;
+  k.check[1] = &check_stage<B, true>;
   // Indices follow Space: spherical = 1, halfdiff = 2, ortho = 3, hybrid = 4.
   fill_param<B, Spherical, 0>(k);
   fill_param<B, HalfDiff, 1>(k);
