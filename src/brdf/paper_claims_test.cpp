@@ -147,9 +147,9 @@ FibreMeans fibre_means(double a, double b, double theta_h, double theta_d) {
 // azimuth with a measure on the pairs (any L² projection weighted by solid angle, as the study's
 // metrics do): (θh, θd) ↔ (‖h̄‖, ‖k‖) is a bijection, so both average over the same fibre with
 // the same weights. With a plain average over the coordinate (uniform in φd vs uniform in
-// φk − φh) it is false, because φd is not φk − φh (see AzimuthRelation… in core). The μ-variance
-// over each fibre agrees too, so the azimuthal dependence of any BRDF (docs/study.md, metric 1) is
-// the same in both. Counter-example
+// φk − φh) it is false, because φd is not φk − φh (core:
+// AzimuthRelationPhiKEqualsPhiHPlusPhiDIsFalse). The μ-variance over each fibre agrees too, so the
+// azimuthal dependence of any BRDF (docs/study.md, metric 1) is the same in both. Counter-example
 // at θh = 45°, θd = 30°: mean (ωi·n)(ωo·n) = 5/16 uniform in φd, but
 // 3/8 − 1/(8(1 + cos 45°)) = 0.30178 uniform in Δφ.
 TEST(PaperClaims, TwoDProjectionsAgreeOnlyUnderAMeasureOnPairs) {

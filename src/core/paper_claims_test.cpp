@@ -198,7 +198,8 @@ TEST(PaperClaims, OrthoKbarIsHbarOfTheHalfTurnedOutgoingDirection) {
 // Equations (5) and (6), ωi = h + k and ωo = h − k, with h and k rebuilt from the coordinates as in
 // the appendix: h = (‖h̄‖ cos φh, ‖h̄‖ sin φh, √(1 − ‖k‖² − ‖h̄‖²)), k = ‖k‖ (sin θk cos φk,
 // sin θk sin φk, cos θk), and h·k = ‖h̄‖‖k‖ sin θk cos(φh − φk) + (h·n)‖k‖ cos θk = 0. Hold (θk from
-// the quadrant-correct form; see PrintedThetaKFormula... for the printed one).
+// the quadrant-correct form; PrintedThetaKFormulaSwapsThePairWhenKbarPointsAlongHbar tests the
+// printed one).
 TEST(PaperClaims, HybridInverseFromTheAppendixHolds) {
   for (const auto& p : generic_pairs(20000, 8)) {
     const Tuple4<double> q = Hybrid::forward(p);
