@@ -282,8 +282,9 @@ TEST(Identities, GrazingProduct) {
   }
 }
 
-// Erratum (docs/math.md): (ωi·n)(ωo·n) = 1 − ‖h̄‖² − ‖k‖² holds only where kz = 0, i.e. on the
-// slice φk − φh = ±90° (and when zi = zo). A counter-example: ωi = n, ωo = t.
+// (ωi·n)(ωo·n) = 1 − ‖h̄‖² − ‖k‖² holds only where kz = 0, i.e. on the slice φk − φh = ±90° (and
+// when zi = zo): G is not a function of (‖h̄‖, ‖k‖) alone. The paper's identity keeps the
+// ‖k‖² cos²θk term and holds (docs/paper.md #25). A counter-example: ωi = n, ωo = t.
 TEST(Identities, GrazingProductIsNotAFunctionOfHbarAndKAlone) {
   const DirPair<double> p{{0, 0, 1}, {1, 0, 0}};
   const Tuple4<double> q = Hybrid::forward(p);
