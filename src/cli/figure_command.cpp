@@ -292,25 +292,11 @@ int run_paper(const PaperArgs& a) {
   return kExitOk;
 }
 
-}  // namespace
+// One function per subcommand of `halfback figure`: its options, and what runs it.
 
-Command register_figure(CLI::App& parent) {
-  CLI::App* app = parent.add_subcommand(
-      "figure",
-      "Draw the figures of Barla et al. 2015 (hemisphere views, slices, materials) as "
-      "PNG/SVG/PDF");
-  app->require_subcommand(1, 1);
-  app->footer(
-      "Examples:\n"
-      "  halfback figure paper --out figures\n"
-      "  halfback figure hemisphere --param halfdiff,hybrid --elevations 0,60 --out fig1.pdf\n"
-      "  halfback figure slices --brdf test:S,G,F --azimuths 0,45,90 --out fig2.svg\n"
-      "  halfback figure slices --brdf ggx:alpha=0.1 --colour rgb --out ggx.png\n"
-      "  halfback figure material --brdf embedded:acrylic_felt_green --env studio --out felt.pdf\n"
-      "See docs/figures.md.");
-
+Command add_hemisphere(CLI::App& figure) {
   auto hemi = std::make_shared<HemisphereArgs>();
-  CLI::App* h = app->add_subcommand(
+  CLI::App* h = figure.add_subcommand(
       "hemisphere",
       "Figure 1: every incoming direction of the hemisphere for fixed outgoing directions, "
       "coloured by the pair's two non-azimuthal coordinates (red, green)");
@@ -335,9 +321,12 @@ Command register_figure(CLI::App& parent) {
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   h->add_option("-o,--out", hemi->out, "Output file: .png, .svg or .pdf")->capture_default_str();
+  return {h, [hemi] { return run_hemisphere(*hemi); }};
+}
 
+Command add_slices(CLI::App& figure) {
   auto sl = std::make_shared<SliceArgs>();
-  CLI::App* s = app->add_subcommand(
+  CLI::App* s = figure.add_subcommand(
       "slices",
       "Figure 2: slices of the isotropic forms at fixed relative azimuths, with the test "
       "functions as isolines or any BRDF in false colour");
@@ -361,9 +350,12 @@ Command register_figure(CLI::App& parent) {
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   s->add_option("-o,--out", sl->out, "Output file: .png, .svg or .pdf")->capture_default_str();
+  return {s, [sl] { return run_slices(*sl); }};
+}
 
+Command add_paper(CLI::App& figure) {
   auto pa = std::make_shared<PaperArgs>();
-  CLI::App* p = app->add_subcommand(
+  CLI::App* p = figure.add_subcommand(
       "paper",
       "Figures 1 (three views), 2 and 3-5 (measured and analytic materials) on their default "
       "settings, into a folder, and print where they are");
@@ -390,9 +382,12 @@ Command register_figure(CLI::App& parent) {
   p->add_option("--threads", pa->threads, "Threads: 0 all cores, 1 the calling thread, n at most n")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
+  return {p, [pa] { return run_paper(*pa); }};
+}
 
+Command add_material(CLI::App& figure) {
   auto ma = std::make_shared<MaterialArgs>();
-  CLI::App* m = app->add_subcommand(
+  CLI::App* m = figure.add_subcommand(
       "material",
       "Figures 3-5 for any BRDF: sphere renderings under environments, then its slices");
   m->add_option("--brdf", ma->brdf, "BRDF SPEC: a file (MERL, RGL, ALTA) or a model")->required();
@@ -419,12 +414,32 @@ Command register_figure(CLI::App& parent) {
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   m->add_option("-o,--out", ma->out, "Output file: .png, .svg or .pdf")->capture_default_str();
+  return {m, [ma] { return run_material(*ma); }};
+}
 
+}  // namespace
+
+Command register_figure(CLI::App& parent) {
+  CLI::App* app = parent.add_subcommand(
+      "figure",
+      "Draw the figures of Barla et al. 2015 (hemisphere views, slices, materials) as "
+      "PNG/SVG/PDF");
+  app->require_subcommand(1, 1);
+  app->footer(
+      "Examples:\n"
+      "  halfback figure paper --out figures\n"
+      "  halfback figure hemisphere --param halfdiff,hybrid --elevations 0,60 --out fig1.pdf\n"
+      "  halfback figure slices --brdf test:S,G,F --azimuths 0,45,90 --out fig2.svg\n"
+      "  halfback figure slices --brdf ggx:alpha=0.1 --colour rgb --out ggx.png\n"
+      "  halfback figure material --brdf embedded:acrylic_felt_green --env studio --out felt.pdf\n"
+      "See docs/figures.md.");
+  // In the order of `halfback figure --help`.
+  const Command hemisphere = add_hemisphere(*app), slices = add_slices(*app),
+                paper = add_paper(*app), material = add_material(*app);
   return {app, [=]() -> int {
-            if (h->parsed()) return run_hemisphere(*hemi);
-            if (s->parsed()) return run_slices(*sl);
-            if (m->parsed()) return run_material(*ma);
-            return run_paper(*pa);
+            for (const Command* c : {&hemisphere, &slices, &material})
+              if (c->app->parsed()) return c->run();
+            return paper.run();
           }};
 }
 

@@ -4,37 +4,21 @@
 
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <sstream>
 
 #include "halfback/figure/color.hpp"
 #include "halfback/figure/scene.hpp"
+#include "support/test_support.hpp"
 
 namespace halfback::figure {
 namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh empty directory under the system temp directory, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("halfback-figure-test-" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  std::size_t entries() const {
-    return std::size_t(std::distance(fs::directory_iterator(path_), fs::directory_iterator()));
-  }
-
- private:
-  fs::path path_;
-};
+// The number of entries of a directory (a save must leave no temporary file behind).
+std::size_t entries(const fs::path& dir) {
+  return std::size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+}
 
 std::string read(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
@@ -159,12 +143,12 @@ TEST(Render, Pdf) {
 }
 
 TEST(Save, WritesEachFormatAtomically) {
-  TempDir dir;
+  const test::TempDir dir;
   for (const char* name : {"a.png", "b.SVG", "c.pdf"}) {
     save(sample_scene(), dir.path() / name);
     EXPECT_GT(fs::file_size(dir.path() / name), 100u);
   }
-  EXPECT_EQ(dir.entries(), 3u);  // no temporary files left
+  EXPECT_EQ(entries(dir.path()), 3u);  // no temporary files left
   EXPECT_EQ(read(dir.path() / "b.SVG").rfind("<?xml", 0), 0u);
   // Overwriting replaces the file whole.
   save(sample_scene(), dir.path() / "a.png");
@@ -172,7 +156,7 @@ TEST(Save, WritesEachFormatAtomically) {
 }
 
 TEST(Save, BadPathsFailCleanly) {
-  TempDir dir;
+  const test::TempDir dir;
   const Scene s = sample_scene();
   // Unknown format: nothing written.
   try {
@@ -196,7 +180,7 @@ TEST(Save, BadPathsFailCleanly) {
   // Target is a directory: the rename fails, the temporary file is removed.
   fs::create_directories(dir.path() / "d.pdf" / "inner");
   EXPECT_THROW(save(s, dir.path() / "d.pdf"), std::runtime_error);
-  EXPECT_EQ(dir.entries(), 2u);  // "plain" and the directory "d.pdf": nothing else
+  EXPECT_EQ(entries(dir.path()), 2u);  // "plain" and the directory "d.pdf": nothing else
   EXPECT_TRUE(fs::is_directory(dir.path() / "d.pdf" / "inner"));
 }
 

@@ -336,11 +336,7 @@ py::array_t<float> render_brdf(const PyBrdf& b, const std::string& env, int widt
   return img;
 }
 
-}  // namespace
-
-PYBIND11_MODULE(_core, m) {
-  m.doc() = "halfback: exact, fast changes of variables between BRDF parameterizations";
-
+void bind_conversions(py::module_& m) {
   m.def(
       "convert",
       [](const py::object& x, const std::string& src, const std::string& dst, bool isotropic,
@@ -392,7 +388,9 @@ forms, the measure of the 3 coordinates: 2*pi times the 4D J of the canonical po
         return cols;
       },
       py::arg("name"), py::arg("isotropic") = false, "Column names of a form, in order.");
+}
 
+void bind_brdf_class(py::module_& m) {
   py::class_<PyBrdf>(m, "Brdf", "A BRDF: an analytic model or measured data (MERL, RGL, ALTA).")
       .def_property_readonly("name", [](const PyBrdf& b) { return b.brdf->name(); })
       .def_property_readonly("description", [](const PyBrdf& b) { return b.brdf->description(); })
@@ -449,7 +447,9 @@ Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape
 float32 array of linear radiance, row 0 at the top. env: "default", "studio", "sunset",
 "constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".)doc")
       .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; });
+}
 
+void bind_hemisphere(py::module_& m) {
   m.def(
       "hemisphere", &hemisphere_view, py::arg("param"), py::arg("theta_o"), py::arg("pixels") = 256,
       py::arg("projection") = "equal-area", py::arg("centre") = "normal",
@@ -459,7 +459,9 @@ coordinates in `param` (NaN where there is no valid pair), region (0 outside the
 the horizon, 2 valid), u (columns) and v (rows) the disk coordinates of the pixel centres (v up),
 and wo; row j of the arrays is at v = v[j] (row 0 is the bottom). projection: "equal-area", "orthographic" or "equidistant"; centre: "normal", "mirror" or
 "back".)doc");
+}
 
+void bind_loading(py::module_& m) {
   m.def(
       "load", [](const std::string& spec) { return PyBrdf{load_brdf(spec)}; }, py::arg("spec"),
       R"doc(Loads a BRDF from a SPEC: a MERL/RGL/ALTA file, a model such as "ggx:alpha=0.2" or
@@ -467,4 +469,15 @@ and wo; row j of the arrays is at v = v[j] (row 0 is the bottom). projection: "e
   m.def(
       "models", [] { return model_registry().names(); },
       "The names of the analytic models (see `halfback models` for their parameters).");
+}
+
+}  // namespace
+
+// The class before the functions that return it, so that their signatures name it.
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "halfback: exact, fast changes of variables between BRDF parameterizations";
+  bind_conversions(m);
+  bind_brdf_class(m);
+  bind_hemisphere(m);
+  bind_loading(m);
 }

@@ -15,6 +15,7 @@
 #include "halfback/render/image.hpp"
 #include "halfback/util/format_error.hpp"
 #include "support/test_stats.hpp"
+#include "support/test_support.hpp"
 
 namespace halfback::render {
 namespace {
@@ -33,12 +34,6 @@ std::filesystem::path shared_envmaps() {
     GTEST_SKIP() << "shared data not found: " << (path)                  \
                  << " (set HALFBACK_SHARED_DIR to the shared/ folder)";  \
   }
-
-std::filesystem::path temp_file(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "halfback_envmap_test";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
 
 void write_text(const std::filesystem::path& p, const std::string& s) {
   std::ofstream(p, std::ios::binary) << s;
@@ -237,7 +232,8 @@ TEST(EnvMap, RealMaps) {
 TEST(EnvMap, OpenExrRoundTrip) {
   Image img{8, 4, {}};
   for (int i = 0; i < 32 * 3; ++i) img.rgb.push_back(float(i) * 0.25f);
-  const auto p = temp_file("ok.exr");
+  const test::TempDir tmp;
+  const auto p = tmp / "ok.exr";
   write_exr(p, img);
   const EnvMap m = EnvMap::load(p);
   EXPECT_EQ(m.width(), 8);
@@ -258,28 +254,29 @@ void expect_error(const std::filesystem::path& p, const std::string& words) {
 }
 
 TEST(EnvMap, BadInput) {
-  expect_error(temp_file("does_not_exist.hdr"), "cannot open");
-  expect_error(std::filesystem::temp_directory_path(), "directory");
-  const auto empty = temp_file("empty.hdr");
+  const test::TempDir tmp;
+  expect_error(tmp / "does_not_exist.hdr", "cannot open");
+  expect_error(tmp.path(), "directory");
+  const auto empty = tmp / "empty.hdr";
   write_text(empty, "");
   expect_error(empty, "empty file");
-  const auto png = temp_file("ldr.hdr");
+  const auto png = tmp / "ldr.hdr";
   write_text(png, std::string("\x89PNG\r\n\x1a\n", 8) + "not really");
   expect_error(png, "not an HDR image");
-  const auto zero = temp_file("zero.hdr");
+  const auto zero = tmp / "zero.hdr";
   write_text(zero, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 0\n");
   expect_error(zero, "zero-size");
-  const auto truncated = temp_file("truncated.hdr");
+  const auto truncated = tmp / "truncated.hdr";
   write_text(truncated, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n\x01\x02");
   expect_error(truncated, "truncated");
-  const auto noheader = temp_file("noheader.hdr");
+  const auto noheader = tmp / "noheader.hdr";
   write_text(noheader, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n");
   expect_error(noheader, "header");
 
-  auto exr_with = [](const std::string& name, float bad, int w = 8, int h = 4) {
+  auto exr_with = [&tmp](const std::string& name, float bad, int w = 8, int h = 4) {
     Image img{w, h, std::vector<float>(std::size_t(w * h * 3), 0.5f)};
     img.rgb[std::size_t(3 * (w + 2) + 1)] = bad;  // pixel (2, 1), channel G
-    const auto p = temp_file(name);
+    const auto p = tmp / name;
     write_exr(p, img);
     return p;
   };
@@ -288,7 +285,7 @@ TEST(EnvMap, BadInput) {
   expect_error(exr_with("inf.exr", INFINITY), "Inf");
   expect_error(exr_with("neg.exr", -1.0f), "-1");
   expect_error(exr_with("square.exr", 1.0f, 4, 4), "not a latitude-longitude map");
-  const auto bad_exr = temp_file("bad.exr");
+  const auto bad_exr = tmp / "bad.exr";
   write_text(bad_exr, std::string("\x76\x2f\x31\x01", 4) + "garbage");
   expect_error(bad_exr, "OpenEXR");
 

@@ -14,6 +14,7 @@
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/models/analytic.hpp"
+#include "support/test_support.hpp"
 
 namespace halfback::render {
 namespace {
@@ -295,8 +296,8 @@ TEST(Renderer, CameraConventions) {
 TEST(Renderer, ImageFiles) {
   const RenderResult r =
       render(models::Lambert({0.5, 0.5, 0.5}), EnvMap::default_sky(), small(8, 2));
-  const auto dir = std::filesystem::temp_directory_path() / "halfback_render_test";
-  std::filesystem::create_directories(dir);
+  const test::TempDir tmp;
+  const std::filesystem::path& dir = tmp.path();
   write_image(dir / "a.exr", r.image, {});
   EXPECT_EQ(read_exr(dir / "a.exr").rgb, r.image.rgb);
   write_image(dir / "a.PNG", r.image, {1, true});

@@ -102,9 +102,19 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
   const std::size_t n = cells_.points();
   offset_.assign(n, {0.5f, 0.5f, 0.5f, 0.5f});
   value_.assign(n, Rgb{});
-  std::vector<std::uint8_t> filled(n, 0);
+  std::vector<std::uint8_t> filled = measure(truth);
+  if (samples_ == 0)
+    throw std::runtime_error(
+        fmt::format("gonio-reflectometer: {} has no finite value at any of the {} cells of {}",
+                    truth_name_, n, name_of(setup_.space)));
+  fill_unmeasured(filled);
+}
 
-  // Where each cell is measured: its centre, or random points for the stratified design.
+// Where each cell is measured: its centre, or random points for the stratified design (drawn
+// again, up to kStratifiedTries times, while one falls outside the domain or the reach).
+std::vector<std::uint8_t> GonioReconstruction::measure(const Brdf& truth) {
+  const std::size_t n = cells_.points();
+  std::vector<std::uint8_t> filled(n, 0);
   std::vector<std::size_t> todo(n);
   for (std::size_t c = 0; c < n; ++c) todo[c] = c;
   const int tries = setup_.design == Design::regular ? 1 : kStratifiedTries;
@@ -112,104 +122,124 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
   const double min_z = setup_.max_theta_deg >= 90
                            ? -std::numeric_limits<double>::infinity()
                            : std::cos(setup_.max_theta_deg * std::numbers::pi / 180);
-  const Form form = cells_.form();
   for (int attempt = 0; attempt < tries && !todo.empty(); ++attempt) {
     std::vector<std::size_t> again;
     for (std::size_t b = 0; b < todo.size(); b += kBlock) {
-      const std::size_t m = std::min(kBlock, todo.size() - b);
-      std::vector<std::vector<double>> coords(dim_, std::vector<double>(m));
-      std::vector<std::array<float, 4>> offsets(m, {0.5f, 0.5f, 0.5f, 0.5f});
-      for (std::size_t j = 0; j < m; ++j) {
-        const std::size_t cell = todo[b + j];
-        for (std::size_t a = 0; a < dim_; ++a) {
-          const GridAxis& ax = cells_.axes[a];
-          const std::size_t i = cell / stride_[a] % ax.count;
-          if (setup_.design == Design::stratified)
-            offsets[j][a] = std::min(float(uniform(setup_.seed, cell, std::uint64_t(attempt), a)),
-                                     std::nextafter(1.0f, 0.0f));
-          coords[a][j] = ax.lo + (double(i) + offsets[j][a]) * (ax.hi - ax.lo) / double(ax.count);
-        }
-      }
-      std::vector<DirPair<double>> pairs(m);
-      std::vector<std::uint8_t> ok(m);
-      const std::vector<std::span<const double>> columns(coords.begin(), coords.end());
-      coordinates_to_pairs(form, columns, pairs, ok);
-      std::vector<DirPair<double>> inside;
-      std::vector<std::size_t> which;
-      for (std::size_t j = 0; j < m; ++j) {
-        if (ok[j] && pairs[j].wi.z >= min_z && pairs[j].wo.z >= min_z) {
-          inside.push_back(pairs[j]);
-          which.push_back(j);
-        } else {
-          again.push_back(todo[b + j]);
-        }
-      }
-      std::vector<Rgb> rho(inside.size());
-      truth.eval_batch(inside, rho);
-      for (std::size_t k = 0; k < inside.size(); ++k) {
-        if (!finite(rho[k])) continue;  // no data there: the cell is filled below
-        const std::size_t cell = todo[b + which[k]];
-        value_[cell] = rho[k];
-        offset_[cell] = offsets[which[k]];
-        filled[cell] = 1;
-        ++samples_;
-      }
+      const std::span<const std::size_t> block =
+          std::span<const std::size_t>(todo).subspan(b, std::min(kBlock, todo.size() - b));
+      measure_block(truth, block, attempt, min_z, filled, again);
     }
     todo = std::move(again);
   }
-  if (samples_ == 0)
-    throw std::runtime_error(
-        fmt::format("gonio-reflectometer: {} has no finite value at any of the {} cells of {}",
-                    truth_name_, n, name_of(setup_.space)));
+  return filled;
+}
 
-  // Dilation: each round, every empty cell next to filled ones takes the mean of the linear
-  // extrapolations from them (2 v₁ − v₂ along an axis where two filled cells line up; the mean of
-  // the neighbours v₁ where none do), at its centre, clamped to >= 0. Linear extrapolation keeps
-  // affine functions exact up to the domain's edge, where a plain mean would make an O(h) error in
-  // every cell the edge cuts.
-  auto neighbour = [&](std::size_t c, std::size_t a, int step) -> std::optional<std::size_t> {
-    const std::size_t len = cells_.axes[a].count, i = c / stride_[a] % len;
-    std::size_t j;
-    if (step < 0 ? i > 0 : i + 1 < len)
-      j = step < 0 ? i - 1 : i + 1;
-    else if (periodic_[a] && len > 2)
-      j = step < 0 ? len - 1 : 0;
-    else
-      return std::nullopt;
-    return c - i * stride_[a] + j * stride_[a];
-  };
+std::array<float, 4> GonioReconstruction::measurement_offset(std::size_t cell, int attempt) const {
+  std::array<float, 4> offset{0.5f, 0.5f, 0.5f, 0.5f};
+  if (setup_.design == Design::stratified)
+    for (std::size_t a = 0; a < dim_; ++a)
+      offset[a] = std::min(float(uniform(setup_.seed, cell, std::uint64_t(attempt), a)),
+                           std::nextafter(1.0f, 0.0f));
+  return offset;
+}
+
+void GonioReconstruction::measure_block(const Brdf& truth, std::span<const std::size_t> cells,
+                                        int attempt, double min_z,
+                                        std::vector<std::uint8_t>& filled,
+                                        std::vector<std::size_t>& missed) {
+  const std::size_t m = cells.size();
+  std::vector<std::vector<double>> coords(dim_, std::vector<double>(m));
+  std::vector<std::array<float, 4>> offsets(m);
+  for (std::size_t j = 0; j < m; ++j) {
+    offsets[j] = measurement_offset(cells[j], attempt);
+    for (std::size_t a = 0; a < dim_; ++a) {
+      const GridAxis& ax = cells_.axes[a];
+      const std::size_t i = cells[j] / stride_[a] % ax.count;
+      coords[a][j] = ax.lo + (double(i) + offsets[j][a]) * (ax.hi - ax.lo) / double(ax.count);
+    }
+  }
+  std::vector<DirPair<double>> pairs(m);
+  std::vector<std::uint8_t> ok(m);
+  const std::vector<std::span<const double>> columns(coords.begin(), coords.end());
+  coordinates_to_pairs(cells_.form(), columns, pairs, ok);
+  std::vector<DirPair<double>> inside;
+  std::vector<std::size_t> which;
+  for (std::size_t j = 0; j < m; ++j) {
+    if (ok[j] && pairs[j].wi.z >= min_z && pairs[j].wo.z >= min_z) {
+      inside.push_back(pairs[j]);
+      which.push_back(j);
+    } else {
+      missed.push_back(cells[j]);
+    }
+  }
+  std::vector<Rgb> rho(inside.size());
+  truth.eval_batch(inside, rho);
+  for (std::size_t k = 0; k < inside.size(); ++k) {
+    if (!finite(rho[k])) continue;  // no data there: the cell is filled by fill_unmeasured()
+    const std::size_t cell = cells[which[k]];
+    value_[cell] = rho[k];
+    offset_[cell] = offsets[which[k]];
+    filled[cell] = 1;
+    ++samples_;
+  }
+}
+
+std::optional<std::size_t> GonioReconstruction::neighbour(std::size_t c, std::size_t a,
+                                                          int step) const {
+  const std::size_t len = cells_.axes[a].count, i = c / stride_[a] % len;
+  std::size_t j;
+  if (step < 0 ? i > 0 : i + 1 < len)
+    j = step < 0 ? i - 1 : i + 1;
+  else if (periodic_[a] && len > 2)
+    j = step < 0 ? len - 1 : 0;
+  else
+    return std::nullopt;
+  return c - i * stride_[a] + j * stride_[a];
+}
+
+std::optional<Rgb> GonioReconstruction::dilated_value(
+    std::size_t c, const std::vector<std::uint8_t>& filled) const {
+  // Linear estimates where two filled cells line up, else the filled neighbours' values.
+  Rgb linear{}, near{};
+  int n_linear = 0, n_near = 0;
+  for (std::size_t a = 0; a < dim_; ++a)
+    for (int step : {-1, 1}) {
+      const auto n1 = neighbour(c, a, step);
+      if (!n1 || !filled[*n1]) continue;
+      const Rgb& v1 = value_[*n1];
+      near += v1;
+      ++n_near;
+      const auto n2 = neighbour(*n1, a, step);
+      if (n2 && filled[*n2] && *n2 != c) {
+        const Rgb& v2 = value_[*n2];
+        linear = linear + 2 * v1 - v2;
+        ++n_linear;
+      }
+    }
+  if (n_near == 0) return std::nullopt;
+  const Rgb& sum = n_linear ? linear : near;
+  const double count = n_linear ? n_linear : n_near;
+  return Rgb{std::max(sum.r / count, 0.0), std::max(sum.g / count, 0.0),
+             std::max(sum.b / count, 0.0)};
+}
+
+// Dilation: each round, every empty cell next to filled ones takes the mean of the linear
+// extrapolations from them (2 v₁ − v₂ along an axis where two filled cells line up; the mean of
+// the neighbours v₁ where none do), at its centre, clamped to >= 0. Linear extrapolation keeps
+// affine functions exact up to the domain's edge, where a plain mean would make an O(h) error in
+// every cell the edge cuts.
+void GonioReconstruction::fill_unmeasured(std::vector<std::uint8_t>& filled) {
   std::vector<std::size_t> empty;
-  for (std::size_t c = 0; c < n; ++c)
+  for (std::size_t c = 0; c < filled.size(); ++c)
     if (!filled[c]) empty.push_back(c);
   while (!empty.empty()) {
     std::vector<std::pair<std::size_t, Rgb>> round;
     std::vector<std::size_t> still;
     for (std::size_t c : empty) {
-      // Linear estimates where two filled cells line up, else the filled neighbours' values.
-      Rgb linear{}, near{};
-      int n_linear = 0, n_near = 0;
-      for (std::size_t a = 0; a < dim_; ++a)
-        for (int step : {-1, 1}) {
-          const auto n1 = neighbour(c, a, step);
-          if (!n1 || !filled[*n1]) continue;
-          const Rgb& v1 = value_[*n1];
-          near += v1;
-          ++n_near;
-          const auto n2 = neighbour(*n1, a, step);
-          if (n2 && filled[*n2] && *n2 != c) {
-            const Rgb& v2 = value_[*n2];
-            linear = linear + 2 * v1 - v2;
-            ++n_linear;
-          }
-        }
-      if (n_near == 0) {
+      if (const std::optional<Rgb> v = dilated_value(c, filled))
+        round.push_back({c, *v});
+      else
         still.push_back(c);
-        continue;
-      }
-      const Rgb& sum = n_linear ? linear : near;
-      const double count = n_linear ? n_linear : n_near;
-      round.push_back({c, Rgb{std::max(sum.r / count, 0.0), std::max(sum.g / count, 0.0),
-                              std::max(sum.b / count, 0.0)}});
     }
     if (round.empty()) break;  // cannot happen: the cells are connected and one is measured
     for (const auto& [c, v] : round) {

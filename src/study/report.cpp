@@ -166,384 +166,548 @@ void save_plot(const figure::Scene& sc, const std::filesystem::path& dir, const 
   }
 }
 
-}  // namespace
+// What the results hold beyond the isotropic metrics 1-2, which decides the optional sections,
+// files and plots.
+struct Contents {
+  bool anisotropic = false, gonio = false, images = false;
+};
 
-StudyOutput write_study(const std::filesystem::path& dir, const std::vector<BrdfResult>& results,
-                        const StudyConfig& config, double seconds) {
-  StudyOutput out;
-  const std::string es(name_of(config.space));
-  bool any_aniso = false, any_gonio = false, any_images = false;
+Contents contents_of(const std::vector<BrdfResult>& results) {
+  Contents has;
   for (const BrdfResult& b : results) {
-    any_aniso |= !b.isotropic;
+    has.anisotropic |= !b.isotropic;
     for (const ParamResult& p : b.params) {
-      any_gonio |= !p.gonio.empty() || !p.gonio_4d.empty();
-      any_images |= !p.images.empty();
+      has.gonio |= !p.gonio.empty() || !p.gonio_4d.empty();
+      has.images |= !p.images.empty();
     }
   }
+  return has;
+}
 
-  // CSV files: the columns of the issue first, then what tells rows apart (dims, budget, ...).
-  std::string az = "brdf,parameterization,error,dims\n";
-  std::string sep = "brdf,parameterization,rank,error,dims\n";
-  std::string gon = "brdf,parameterization,design,samples,error,dims,budget\n";
-  std::string bud = "brdf,parameterization,design,dims,target_error,samples,note\n";
-  std::string img =
+// The CSV files' text: the columns of the issue first, then what tells rows apart (dims,
+// budget, ...).
+struct CsvTables {
+  std::string azimuthal = "brdf,parameterization,error,dims\n";
+  std::string separability = "brdf,parameterization,rank,error,dims\n";
+  std::string gonio = "brdf,parameterization,design,samples,error,dims,budget\n";
+  std::string budget = "brdf,parameterization,design,dims,target_error,samples,note\n";
+  std::string image =
       "brdf,parameterization,design,samples,environment,relative_rmse,mean_delta_e2000,"
       "p95_delta_e2000\n";
+};
+
+void add_separability_rows(std::string& csv, const std::string& brdf, std::string_view pn,
+                           const std::vector<double>& errors, int dims,
+                           const std::vector<int>& ranks) {
+  for (std::size_t i = 0; i < errors.size() && i < ranks.size(); ++i)
+    csv += fmt::format("{},{},{},{:.6g},{}\n", brdf, pn, ranks[i], errors[i], dims);
+}
+
+// The gonio points, and for each design the samples needed to reach each target error.
+void add_gonio_rows(CsvTables& t, const std::string& brdf, std::string_view pn,
+                    const std::vector<GonioPoint>& pts, int dims) {
+  for (const GonioPoint& g : pts)
+    t.gonio += fmt::format("{},{},{},{},{:.6g},{},{}\n", brdf, pn, name_of(g.design), g.samples,
+                           g.error, dims, g.budget);
+  for (Design d : kDesigns) {
+    const auto [n, e] = curve(pts, d);
+    if (n.empty()) continue;
+    for (double target : kTargetErrors) {
+      const double s = samples_to_reach(n, e, target);
+      t.budget += fmt::format("{},{},{},{},{},{},{}\n", brdf, pn, name_of(d), dims, target,
+                              s == 0 || std::isinf(s) ? std::string() : fmt::format("{:.0f}", s),
+                              s == 0          ? "below_range"
+                              : std::isinf(s) ? "not_reached"
+                                              : "reached");
+    }
+  }
+}
+
+CsvTables csv_tables(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  CsvTables t;
   for (const BrdfResult& b : results) {
     const std::string brdf = csv_text_field(b.label);
     for (const ParamResult& p : b.params) {
       const std::string_view pn = name_of(p.space);
-      az += fmt::format("{},{},{:.6g},3\n", brdf, pn, p.azimuthal);
-      if (!b.isotropic) az += fmt::format("{},{},{:.6g},4\n", brdf, pn, p.azimuthal_4d);
-      auto ranks = [&](const std::vector<double>& v, int dims) {
-        for (std::size_t i = 0; i < v.size() && i < config.ranks.size(); ++i)
-          sep += fmt::format("{},{},{},{:.6g},{}\n", brdf, pn, config.ranks[i], v[i], dims);
-      };
-      ranks(p.separability_2d, 2);
-      ranks(p.separability_3d, 3);
-      if (!b.isotropic) ranks(p.separability_4d, 4);
-      auto gonio_rows = [&](const std::vector<GonioPoint>& pts, int dims) {
-        for (const GonioPoint& g : pts)
-          gon += fmt::format("{},{},{},{},{:.6g},{},{}\n", brdf, pn, name_of(g.design), g.samples,
-                             g.error, dims, g.budget);
-        for (Design d : kDesigns) {
-          const auto [n, e] = curve(pts, d);
-          if (n.empty()) continue;
-          for (double target : kTargetErrors) {
-            const double s = samples_to_reach(n, e, target);
-            bud += fmt::format("{},{},{},{},{},{},{}\n", brdf, pn, name_of(d), dims, target,
-                               s == 0 || std::isinf(s) ? std::string() : fmt::format("{:.0f}", s),
-                               s == 0          ? "below_range"
-                               : std::isinf(s) ? "not_reached"
-                                               : "reached");
-          }
-        }
-      };
-      gonio_rows(p.gonio, 3);
-      gonio_rows(p.gonio_4d, 4);
+      t.azimuthal += fmt::format("{},{},{:.6g},3\n", brdf, pn, p.azimuthal);
+      if (!b.isotropic) t.azimuthal += fmt::format("{},{},{:.6g},4\n", brdf, pn, p.azimuthal_4d);
+      add_separability_rows(t.separability, brdf, pn, p.separability_2d, 2, config.ranks);
+      add_separability_rows(t.separability, brdf, pn, p.separability_3d, 3, config.ranks);
+      if (!b.isotropic)
+        add_separability_rows(t.separability, brdf, pn, p.separability_4d, 4, config.ranks);
+      add_gonio_rows(t, brdf, pn, p.gonio, 3);
+      add_gonio_rows(t, brdf, pn, p.gonio_4d, 4);
       for (const ImagePoint& i : p.images)
-        img += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g}\n", brdf, pn, name_of(i.design),
-                           i.samples, csv_text_field(i.environment), i.relative_rmse,
-                           i.mean_delta_e, i.p95_delta_e);
+        t.image += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g}\n", brdf, pn, name_of(i.design),
+                               i.samples, csv_text_field(i.environment), i.relative_rmse,
+                               i.mean_delta_e, i.p95_delta_e);
     }
   }
+  return t;
+}
+
+void write_csv_files(const std::filesystem::path& dir, const CsvTables& t, const Contents& has,
+                     std::vector<std::string>& files) {
   auto csv = [&](const char* name, const std::string& text) {
     write_file_atomically(dir / name, text);
-    out.files.push_back(name);
+    files.push_back(name);
   };
-  csv("azimuthal.csv", az);
-  csv("separability.csv", sep);
-  if (any_gonio) {
-    csv("gonio.csv", gon);
-    csv("budget.csv", bud);
+  csv("azimuthal.csv", t.azimuthal);
+  csv("separability.csv", t.separability);
+  if (has.gonio) {
+    csv("gonio.csv", t.gonio);
+    csv("budget.csv", t.budget);
   }
-  if (any_images) csv("image.csv", img);
+  if (has.images) csv("image.csv", t.image);
+}
 
-  // The plots that may have nothing to draw (every curve exact, no rendering): the report links
-  // only those that are written.
-  const figure::Scene gonio_scene =
-      any_gonio ? gonio_chart(results, false, config) : figure::Scene{};
-  const figure::Scene gonio4d_scene =
-      any_gonio && any_aniso ? gonio_chart(results, true, config) : figure::Scene{};
-  const figure::Scene renderings_scene =
-      any_images ? examples_chart(results, config) : figure::Scene{};
-  auto link = [](const figure::Scene& sc, const char* alt, const char* stem) {
-    return sc.items.empty() ? std::string() : fmt::format("![{}]({}.png)\n\n", alt, stem);
-  };
+// The mean image-space error of one parameterization's renderings of a design, over the
+// environments (INFINITY when there is none).
+struct MeanImageError {
+  double relative_rmse = INFINITY, delta_e = INFINITY;
+  int count = 0;
+};
 
-  // The report.
-  std::string md = fmt::format(
+MeanImageError mean_image_error(const std::vector<ImagePoint>& images, Design d) {
+  double r = 0, e = 0;
+  int n = 0;
+  for (const ImagePoint& p : images)
+    if (p.design == d) {
+      r += p.relative_rmse;
+      e += p.mean_delta_e;
+      ++n;
+    }
+  if (n == 0) return {};
+  return {r / n, e / n, n};
+}
+
+bool has_images(const BrdfResult& b) {
+  for (const ParamResult& p : b.params)
+    if (!p.images.empty()) return true;
+  return false;
+}
+
+figure::BarChart azimuthal_chart(const std::vector<BrdfResult>& results, const std::string& es) {
+  figure::BarChart c;
+  for (Space s : kStudied) c.series.emplace_back(name_of(s));
+  c.title = fmt::format("Azimuthal dependence ({} error space)", es);
+  c.x_label = "relative error of dropping the relative azimuth";
+  for (const BrdfResult& b : results) {
+    c.rows.push_back(b.label);
+    c.values.emplace_back();
+    for (const ParamResult& p : b.params) c.values.back().push_back(p.azimuthal);
+  }
+  return c;
+}
+
+figure::BarChart separability_chart(const std::vector<BrdfResult>& results, const std::string& es) {
+  figure::BarChart c;
+  for (Space s : kStudied) c.series.emplace_back(name_of(s));
+  c.title = fmt::format("Separability of the 2D projection, rank 1 ({} error space)", es);
+  c.x_label = "relative error of the best rank-1 approximation";
+  for (const BrdfResult& b : results) {
+    c.rows.push_back(b.label);
+    c.values.emplace_back();
+    for (const ParamResult& p : b.params)
+      c.values.back().push_back(p.separability_2d.empty() ? 0.0 : p.separability_2d[0]);
+  }
+  return c;
+}
+
+// The regular design's relative RMSE of the BRDFs that were rendered (0 where not finite).
+figure::BarChart image_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  figure::BarChart c;
+  for (Space s : kStudied) c.series.emplace_back(name_of(s));
+  c.title = fmt::format("Image-space error of the reconstructions from {} measurements",
+                        config.image_budget);
+  c.x_label = "relative RMSE of the sphere renderings (regular design, mean over maps)";
+  for (const BrdfResult& b : results) {
+    if (!has_images(b)) continue;
+    c.rows.push_back(b.label);
+    c.values.emplace_back();
+    for (const ParamResult& p : b.params) {
+      const MeanImageError m = mean_image_error(p.images, Design::regular);
+      c.values.back().push_back(m.count && std::isfinite(m.relative_rmse) ? m.relative_rmse : 0.0);
+    }
+  }
+  return c;
+}
+
+// The plots, in the order they are written. Some may have nothing to draw (every curve exact, no
+// rendering): the report links only those that are written.
+struct ReportPlots {
+  figure::Scene azimuthal, separability, gonio, gonio4d, image, renderings;
+};
+
+ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                         const Contents& has) {
+  const std::string es(name_of(config.space));
+  ReportPlots p;
+  p.azimuthal = figure::bar_chart(azimuthal_chart(results, es));
+  p.separability = figure::bar_chart(separability_chart(results, es));
+  if (has.gonio) p.gonio = gonio_chart(results, false, config);
+  if (has.gonio && has.anisotropic) p.gonio4d = gonio_chart(results, true, config);
+  if (has.images) {
+    p.image = figure::bar_chart(image_chart(results, config));
+    p.renderings = examples_chart(results, config);
+  }
+  return p;
+}
+
+void save_plots(const ReportPlots& p, const std::filesystem::path& dir,
+                std::vector<std::string>& files) {
+  save_plot(p.azimuthal, dir, "azimuthal", files);
+  save_plot(p.separability, dir, "separability", files);
+  save_plot(p.gonio, dir, "gonio", files);
+  save_plot(p.gonio4d, dir, "gonio4d", files);
+  save_plot(p.image, dir, "image", files);
+  save_plot(p.renderings, dir, "renderings", files);
+}
+
+std::string plot_link(const figure::Scene& sc, const char* alt, const char* stem) {
+  return sc.items.empty() ? std::string() : fmt::format("![{}]({}.png)\n\n", alt, stem);
+}
+
+std::string report_header(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                          bool any_aniso, double seconds) {
+  return fmt::format(
       "# halfback study\n\n"
       "Measure: cos θi cos θo dωi dωo, through each parameterization's Jacobian. Values: the "
       "luminance of ρ in the **{}** error space. Metrics 1–2 on a {} × {} × {} grid of cell "
       "centres of each isotropic form (midpoint rule){}. Definitions: docs/study.md. {} BRDFs "
       "in {:.1f} s.\n\n",
-      es, config.grid.a, config.grid.b, config.grid.phi,
+      name_of(config.space), config.grid.a, config.grid.b, config.grid.phi,
       any_aniso ? fmt::format(", and {} × {} × {} × {} cells of the full form for the anisotropic "
                               "ones",
                               config.full_grid[0], config.full_grid[1], config.full_grid[2],
                               config.full_grid[3])
                 : "",
       results.size(), seconds);
+}
 
-  // 1. Azimuthal dependence.
-  Wins az_wins;
-  md +=
+// 1. Azimuthal dependence.
+std::string azimuthal_section(const std::vector<BrdfResult>& results, bool any_aniso) {
+  std::string md =
       "## 1. Azimuthal dependence\n\nThe relative error of replacing the BRDF by its mean over "
       "the relative azimuth of each parameterization (lower: the BRDF is more nearly 2D "
       "there).\n\n" +
       table_header("BRDF");
-  figure::BarChart az_chart, sep_chart;
-  for (Space s : kStudied) {
-    az_chart.series.emplace_back(name_of(s));
-    sep_chart.series.emplace_back(name_of(s));
-  }
-  az_chart.title = fmt::format("Azimuthal dependence ({} error space)", es);
-  az_chart.x_label = "relative error of dropping the relative azimuth";
-  sep_chart.title = fmt::format("Separability of the 2D projection, rank 1 ({} error space)", es);
-  sep_chart.x_label = "relative error of the best rank-1 approximation";
+  Wins wins;
   for (const BrdfResult& b : results) {
-    std::string row = "| " + md_cell(b.label) + " |";
+    md += "| " + md_cell(b.label) + " |";
     std::array<double, kStudied.size()> v{};
-    az_chart.rows.push_back(b.label);
-    sep_chart.rows.push_back(b.label);
-    az_chart.values.emplace_back();
-    sep_chart.values.emplace_back();
     for (std::size_t i = 0; i < b.params.size(); ++i) {
       v[i] = b.params[i].azimuthal;
-      row += fmt::format(" {:.4f} |", v[i]);
-      az_chart.values.back().push_back(v[i]);
-      sep_chart.values.back().push_back(
-          b.params[i].separability_2d.empty() ? 0.0 : b.params[i].separability_2d[0]);
+      md += fmt::format(" {:.4f} |", v[i]);
     }
-    az_wins.add(v);
-    md += row + "\n";
+    wins.add(v);
+    md += "\n";
   }
   md += fmt::format(
       "\nLowest error (BRDFs; ties count for each): {}.\n\n![Azimuthal "
       "dependence](azimuthal.png)\n\n",
-      az_wins.text());
-  if (any_aniso) {
-    md +=
-        "Anisotropic BRDFs, 4D: the error of dropping the second azimuth (φd, φk or φo) at "
-        "fixed (a, φa, b).\n\n" +
-        table_header("BRDF");
-    for (const BrdfResult& b : results) {
-      if (b.isotropic) continue;
-      md += "| " + md_cell(b.label) + " |";
-      for (const ParamResult& p : b.params) md += fmt::format(" {:.4f} |", p.azimuthal_4d);
-      md += "\n";
-    }
+      wins.text());
+  if (!any_aniso) return md;
+  md +=
+      "Anisotropic BRDFs, 4D: the error of dropping the second azimuth (φd, φk or φo) at "
+      "fixed (a, φa, b).\n\n" +
+      table_header("BRDF");
+  for (const BrdfResult& b : results) {
+    if (b.isotropic) continue;
+    md += "| " + md_cell(b.label) + " |";
+    for (const ParamResult& p : b.params) md += fmt::format(" {:.4f} |", p.azimuthal_4d);
     md += "\n";
   }
+  return md + "\n";
+}
 
-  // 2. Separability.
-  auto sep_table = [&](const char* heading, auto member, bool aniso_only) {
-    std::string t = std::string(heading) + "\n\n" + table_header("BRDF");
-    Wins w;
-    for (const BrdfResult& b : results) {
-      if (aniso_only && b.isotropic) continue;
-      t += "| " + md_cell(b.label) + " |";
-      std::array<double, kStudied.size()> first{};
-      for (std::size_t i = 0; i < b.params.size(); ++i) {
-        const std::vector<double>& v = b.params[i].*member;
-        std::string cell;
-        for (std::size_t k = 0; k < v.size(); ++k)
-          cell += fmt::format("{}{:.3f}", k ? " / " : "", v[k]);
-        t += " " + cell + " |";
-        first[i] = v.empty() ? INFINITY : v[0];
-      }
-      w.add(first);
-      t += "\n";
+// One table of separability errors ("r1 / r2 / ..." per cell), and which parameterization has
+// the lowest rank-1 error.
+std::string separability_table(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                               const char* heading, std::vector<double> ParamResult::*member,
+                               bool aniso_only) {
+  std::string t = std::string(heading) + "\n\n" + table_header("BRDF");
+  Wins w;
+  for (const BrdfResult& b : results) {
+    if (aniso_only && b.isotropic) continue;
+    t += "| " + md_cell(b.label) + " |";
+    std::array<double, kStudied.size()> first{};
+    for (std::size_t i = 0; i < b.params.size(); ++i) {
+      const std::vector<double>& v = b.params[i].*member;
+      std::string cell;
+      for (std::size_t k = 0; k < v.size(); ++k)
+        cell += fmt::format("{}{:.3f}", k ? " / " : "", v[k]);
+      t += " " + cell + " |";
+      first[i] = v.empty() ? INFINITY : v[0];
     }
-    return t + fmt::format("\nLowest rank-{} error (BRDFs): {}.\n\n",
-                           config.ranks.empty() ? 0 : config.ranks[0], w.text());
-  };
+    w.add(first);
+    t += "\n";
+  }
+  return t + fmt::format("\nLowest rank-{} error (BRDFs): {}.\n\n",
+                         config.ranks.empty() ? 0 : config.ranks[0], w.text());
+}
+
+// 2. Separability.
+std::string separability_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                                 bool any_aniso) {
   std::string ranks;
   for (std::size_t i = 0; i < config.ranks.size(); ++i)
     ranks += fmt::format("{}{}", i ? ", " : "", config.ranks[i]);
-  md += fmt::format(
+  std::string md = fmt::format(
       "## 2. Separability\n\nRelative errors of the best rank-r approximations, "
       "r = {}.\n\n",
       ranks);
-  md += sep_table("2D projection ρ̄(a, b):", &ParamResult::separability_2d, false);
+  md += separability_table(results, config, "2D projection ρ̄(a, b):", &ParamResult::separability_2d,
+                           false);
   md += "![Separability, rank 1](separability.png)\n\n";
-  md += sep_table("3D table unfolded along its azimuth, (a, b) × φ:", &ParamResult::separability_3d,
-                  false);
+  md += separability_table(results, config, "3D table unfolded along its azimuth, (a, b) × φ:",
+                           &ParamResult::separability_3d, false);
   if (any_aniso)
-    md += sep_table("Anisotropic BRDFs, 4D table unfolded as (a, φa) × (b, φb):",
-                    &ParamResult::separability_4d, true);
+    md += separability_table(results, config,
+                             "Anisotropic BRDFs, 4D table unfolded as (a, φa) × (b, φb):",
+                             &ParamResult::separability_4d, true);
+  return md;
+}
 
-  // 3. Gonio-reflectometer.
-  if (any_gonio) {
-    md += fmt::format(
-        "## 3. Virtual gonio-reflectometer\n\nRelative error of the reconstruction from N "
-        "measurements placed in each parameterization's isotropic form (regular grid / "
-        "stratified random), against the BRDF at {} test pairs drawn from the measure.\n\n",
-        config.test_pairs);
-    for (std::size_t budget : config.budgets) {
-      md += fmt::format("Budget {} (regular / stratified):\n\n", budget) + table_header("BRDF");
-      Wins w;
-      for (const BrdfResult& b : results) {
-        md += "| " + md_cell(b.label) + " |";
-        std::array<double, kStudied.size()> v{};
-        for (std::size_t i = 0; i < b.params.size(); ++i) {
-          md += design_cells(b.params[i].gonio, budget);
-          const GonioPoint* r = find_point(b.params[i].gonio, Design::regular, budget);
-          v[i] = r ? r->error : INFINITY;
-        }
-        w.add(v);
-        md += "\n";
-      }
-      md += fmt::format("\nLowest error, regular design (BRDFs): {}.\n\n", w.text());
+// The errors of both designs at one budget, and which parameterization is best (regular design).
+std::string gonio_budget_table(const std::vector<BrdfResult>& results, std::size_t budget) {
+  std::string md =
+      fmt::format("Budget {} (regular / stratified):\n\n", budget) + table_header("BRDF");
+  Wins w;
+  for (const BrdfResult& b : results) {
+    md += "| " + md_cell(b.label) + " |";
+    std::array<double, kStudied.size()> v{};
+    for (std::size_t i = 0; i < b.params.size(); ++i) {
+      md += design_cells(b.params[i].gonio, budget);
+      const GonioPoint* r = find_point(b.params[i].gonio, Design::regular, budget);
+      v[i] = r ? r->error : INFINITY;
     }
-    const double target = kTargetErrors[1];
-    md += fmt::format(
-              "Measurements needed to reach a relative error of {} (regular / stratified; "
-              "interpolated log-log between budgets):\n\n",
-              target) +
-          table_header("BRDF");
-    for (const BrdfResult& b : results) {
-      md += "| " + md_cell(b.label) + " |";
-      for (const ParamResult& p : b.params) {
-        std::string cell;
-        for (Design d : kDesigns) {
-          const auto [n, e] = curve(p.gonio, d);
-          cell += (cell.empty() ? "" : " / ") +
-                  (n.empty() ? std::string("–")
-                             : samples_text(samples_to_reach(n, e, target), n.front()));
-        }
-        md += " " + cell + " |";
+    w.add(v);
+    md += "\n";
+  }
+  return md + fmt::format("\nLowest error, regular design (BRDFs): {}.\n\n", w.text());
+}
+
+// The samples each design needs to reach `target`, interpolated between the budgets.
+std::string samples_to_target_table(const std::vector<BrdfResult>& results, double target) {
+  std::string md = fmt::format(
+                       "Measurements needed to reach a relative error of {} (regular / "
+                       "stratified; interpolated log-log between budgets):\n\n",
+                       target) +
+                   table_header("BRDF");
+  for (const BrdfResult& b : results) {
+    md += "| " + md_cell(b.label) + " |";
+    for (const ParamResult& p : b.params) {
+      std::string cell;
+      for (Design d : kDesigns) {
+        const auto [n, e] = curve(p.gonio, d);
+        cell += (cell.empty() ? "" : " / ") +
+                (n.empty() ? std::string("–")
+                           : samples_text(samples_to_reach(n, e, target), n.front()));
       }
-      md += "\n";
+      md += " " + cell + " |";
     }
-    // The budget each parameterization needs to match the best one at a reference budget.
-    const std::size_t ref = std::find(config.budgets.begin(), config.budgets.end(),
-                                      config.image_budget) != config.budgets.end()
-                                ? config.image_budget
-                                : config.budgets[config.budgets.size() / 2];
-    md += fmt::format(
-              "\nMeasurements each parameterization needs to reach E*, the lowest error of the "
-              "regular design at N = {} (as a multiple of the best one's samples; log-log "
-              "interpolation; “> ×k” when even the largest budget does not reach E*):\n\n",
-              ref) +
-          table_header("BRDF (E*)");
-    std::array<std::vector<double>, kStudied.size()> ratios;
-    std::string exact;
-    for (const BrdfResult& b : results) {
-      double best = INFINITY, best_samples = 0;
-      for (const ParamResult& p : b.params)
-        if (const GonioPoint* g = find_point(p.gonio, Design::regular, ref); g && g->error < best) {
-          best = g->error;
-          best_samples = double(g->samples);
-        }
-      if (!std::isfinite(best)) continue;  // not measured
-      if (best <= 1e-12) {                 // reconstructed exactly by some parameterization
-        exact += (exact.empty() ? "" : ", ") + b.label;
-        continue;
-      }
-      md += fmt::format("| {} ({:.3g}) |", md_cell(b.label), best);
-      for (std::size_t i = 0; i < b.params.size(); ++i) {
-        const auto [n, e] = curve(b.params[i].gonio, Design::regular);
-        const double need = samples_to_reach(n, e, best * (1 + 1e-9));
-        const double ratio = need == 0 ? n.front() / best_samples : need / best_samples;
-        ratios[i].push_back(ratio);
-        md += std::isinf(ratio) ? fmt::format(" > ×{:.3g} |", n.back() / best_samples)
-                                : fmt::format(" ×{:.2f} |", ratio);
-      }
-      md += "\n";
+    md += "\n";
+  }
+  return md;
+}
+
+// The reference budget of the matching table: the image budget when it is one of the budgets,
+// else the middle one.
+std::size_t reference_budget(const StudyConfig& config) {
+  return std::find(config.budgets.begin(), config.budgets.end(), config.image_budget) !=
+                 config.budgets.end()
+             ? config.image_budget
+             : config.budgets[config.budgets.size() / 2];
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// The lowest regular-design error at budget `ref` over the parameterizations, with its samples
+// (INFINITY when not measured).
+std::pair<double, double> best_regular_error(const BrdfResult& b, std::size_t ref) {
+  double best = INFINITY, best_samples = 0;
+  for (const ParamResult& p : b.params)
+    if (const GonioPoint* g = find_point(p.gonio, Design::regular, ref); g && g->error < best) {
+      best = g->error;
+      best_samples = double(g->samples);
     }
-    std::string medians;
-    for (std::size_t i = 0; i < kStudied.size(); ++i) {
-      std::vector<double> r = ratios[i];
-      if (r.empty()) continue;
-      std::sort(r.begin(), r.end());
-      const double m =
-          r.size() % 2 ? r[r.size() / 2] : 0.5 * (r[r.size() / 2 - 1] + r[r.size() / 2]);
-      medians += fmt::format("{}{} ×{:.3g}", medians.empty() ? "" : ", ", name_of(kStudied[i]), m);
+  return {best, best_samples};
+}
+
+// The budget each parameterization needs to match the best one at a reference budget, its
+// median over the BRDFs, and the BRDFs left out because some parameterization is exact.
+std::string matching_budget_table(const std::vector<BrdfResult>& results, std::size_t ref) {
+  std::string md =
+      fmt::format(
+          "\nMeasurements each parameterization needs to reach E*, the lowest error of the "
+          "regular design at N = {} (as a multiple of the best one's samples; log-log "
+          "interpolation; “> ×k” when even the largest budget does not reach E*):\n\n",
+          ref) +
+      table_header("BRDF (E*)");
+  std::array<std::vector<double>, kStudied.size()> ratios;
+  std::string exact;
+  for (const BrdfResult& b : results) {
+    const auto [best, best_samples] = best_regular_error(b, ref);
+    if (!std::isfinite(best)) continue;  // not measured
+    if (best <= 1e-12) {                 // reconstructed exactly by some parameterization
+      exact += (exact.empty() ? "" : ", ") + b.label;
+      continue;
     }
-    if (!medians.empty()) md += "\nMedian over the BRDFs: " + medians + ".\n";
-    if (!exact.empty())
-      md +=
-          "\nLeft out, reconstructed exactly (E* = 0) by at least one parameterization: " + exact +
+    md += fmt::format("| {} ({:.3g}) |", md_cell(b.label), best);
+    for (std::size_t i = 0; i < b.params.size(); ++i) {
+      const auto [n, e] = curve(b.params[i].gonio, Design::regular);
+      const double need = samples_to_reach(n, e, best * (1 + 1e-9));
+      const double ratio = need == 0 ? n.front() / best_samples : need / best_samples;
+      ratios[i].push_back(ratio);
+      md += std::isinf(ratio) ? fmt::format(" > ×{:.3g} |", n.back() / best_samples)
+                              : fmt::format(" ×{:.2f} |", ratio);
+    }
+    md += "\n";
+  }
+  std::string medians;
+  for (std::size_t i = 0; i < kStudied.size(); ++i)
+    if (!ratios[i].empty())
+      medians += fmt::format("{}{} ×{:.3g}", medians.empty() ? "" : ", ", name_of(kStudied[i]),
+                             median(ratios[i]));
+  if (!medians.empty()) md += "\nMedian over the BRDFs: " + medians + ".\n";
+  if (!exact.empty())
+    md += "\nLeft out, reconstructed exactly (E* = 0) by at least one parameterization: " + exact +
           ".\n";
-    md += "\n" + link(gonio_scene, "Virtual gonio-reflectometer", "gonio");
-    if (any_aniso) {
-      md += "Anisotropic BRDFs, 4D (measured in the full form; regular / stratified):\n\n";
-      md += "| BRDF | budget |";
-      for (Space s : kStudied) md += fmt::format(" {} |", name_of(s));
-      md += "\n|---|---|---|---|---|---|\n";
-      for (const BrdfResult& b : results) {
-        if (b.isotropic) continue;
-        for (std::size_t budget : config.budgets_4d) {
-          md += "| " + md_cell(b.label) + fmt::format(" | {} |", budget);
-          for (const ParamResult& p : b.params) md += design_cells(p.gonio_4d, budget);
-          md += "\n";
-        }
-      }
-      md += "\n" + link(gonio4d_scene, "Virtual gonio-reflectometer, 4D", "gonio4d");
+  return md;
+}
+
+// The anisotropic BRDFs' 4D gonio-reflectometer, one row per BRDF and 4D budget.
+std::string gonio_4d_table(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  std::string md = "Anisotropic BRDFs, 4D (measured in the full form; regular / stratified):\n\n";
+  md += "| BRDF | budget |";
+  for (Space s : kStudied) md += fmt::format(" {} |", name_of(s));
+  md += "\n|---|---|---|---|---|---|\n";
+  for (const BrdfResult& b : results) {
+    if (b.isotropic) continue;
+    for (std::size_t budget : config.budgets_4d) {
+      md += "| " + md_cell(b.label) + fmt::format(" | {} |", budget);
+      for (const ParamResult& p : b.params) md += design_cells(p.gonio_4d, budget);
+      md += "\n";
     }
   }
+  return md;
+}
 
-  // 4. Image-space error.
-  figure::BarChart im_chart;
-  if (any_images) {
-    std::string envs;
-    for (std::size_t i = 0; i < config.environments.size(); ++i)
-      envs += (i ? ", " : "") + config.environments[i].label;
-    md += fmt::format(
-              "## 4. Image-space error\n\nThe reconstructions from {} measurements rendered on a "
-              "sphere ({}², {} environment samples per pixel, the same for every image) under "
-              "{}, against the rendering of the BRDF itself: relative RMSE / mean CIEDE2000 of "
-              "the tone-mapped images, averaged over the environments; regular design, then "
-              "stratified.\n\n",
-              config.image_budget, config.image_size, config.image_spp, envs) +
-          table_header("BRDF");
-    for (Space s : kStudied) im_chart.series.emplace_back(name_of(s));
-    im_chart.title = fmt::format("Image-space error of the reconstructions from {} measurements",
-                                 config.image_budget);
-    im_chart.x_label = "relative RMSE of the sphere renderings (regular design, mean over maps)";
-    std::array<Wins, 2> rmse_wins, de_wins;
-    std::string strat_rows;
-    std::string no_images;
-    for (const BrdfResult& b : results) {
-      bool has_images = false;
-      for (const ParamResult& p : b.params) has_images |= !p.images.empty();
-      if (!has_images) {  // no finite ground truth to compare with (an ALTA file's gaps)
-        no_images += (no_images.empty() ? "" : ", ") + b.label;
-        continue;
-      }
-      im_chart.rows.push_back(b.label);
-      im_chart.values.emplace_back();
-      std::array<std::string, 2> row{"| " + md_cell(b.label) + " |",
-                                     "| " + md_cell(b.label) + " |"};
-      std::array<std::array<double, kStudied.size()>, 2> rm{}, de{};
-      for (std::size_t i = 0; i < b.params.size(); ++i)
-        for (std::size_t d = 0; d < 2; ++d) {
-          double r = 0, e = 0;
-          int n = 0;
-          for (const ImagePoint& p : b.params[i].images)
-            if (p.design == kDesigns[d]) {
-              r += p.relative_rmse;
-              e += p.mean_delta_e;
-              ++n;
-            }
-          rm[d][i] = n ? r / n : INFINITY;
-          de[d][i] = n ? e / n : INFINITY;
-          row[d] += n ? fmt::format(" {:.4f} / {:.2f} |", r / n, e / n) : " – |";
-          if (d == 0) im_chart.values.back().push_back(n && std::isfinite(r) ? r / n : 0.0);
-        }
-      for (std::size_t d = 0; d < 2; ++d) {
-        rmse_wins[d].add(rm[d]);
-        de_wins[d].add(de[d]);
-      }
-      md += row[0] + "\n";
-      strat_rows += row[1] + "\n";
+// 3. Gonio-reflectometer.
+std::string gonio_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                          bool any_aniso, const ReportPlots& plots) {
+  std::string md = fmt::format(
+      "## 3. Virtual gonio-reflectometer\n\nRelative error of the reconstruction from N "
+      "measurements placed in each parameterization's isotropic form (regular grid / "
+      "stratified random), against the BRDF at {} test pairs drawn from the measure.\n\n",
+      config.test_pairs);
+  for (std::size_t budget : config.budgets) md += gonio_budget_table(results, budget);
+  md += samples_to_target_table(results, kTargetErrors[1]);
+  md += matching_budget_table(results, reference_budget(config));
+  md += "\n" + plot_link(plots.gonio, "Virtual gonio-reflectometer", "gonio");
+  if (any_aniso)
+    md += gonio_4d_table(results, config) + "\n" +
+          plot_link(plots.gonio4d, "Virtual gonio-reflectometer, 4D", "gonio4d");
+  return md;
+}
+
+// One rendered BRDF's rows of the image-space tables (regular, stratified): "rmse / ΔE" cells,
+// and the values the lowest errors are counted on.
+struct ImageRows {
+  std::array<std::string, 2> text;
+  std::array<std::array<double, kStudied.size()>, 2> rmse{}, delta_e{};
+};
+
+ImageRows image_rows(const BrdfResult& b) {
+  ImageRows rows;
+  for (std::string& t : rows.text) t = "| " + md_cell(b.label) + " |";
+  for (std::size_t i = 0; i < b.params.size(); ++i)
+    for (std::size_t d = 0; d < 2; ++d) {
+      const MeanImageError m = mean_image_error(b.params[i].images, kDesigns[d]);
+      rows.rmse[d][i] = m.relative_rmse;
+      rows.delta_e[d][i] = m.delta_e;
+      rows.text[d] +=
+          m.count ? fmt::format(" {:.4f} / {:.2f} |", m.relative_rmse, m.delta_e) : " – |";
     }
-    md += fmt::format(
-              "\nLowest relative RMSE (BRDFs): {}; lowest ΔE00: {}.\n\nStratified "
-              "design:\n\n",
-              rmse_wins[0].text(), de_wins[0].text()) +
-          table_header("BRDF") + strat_rows +
-          fmt::format(
-              "\nLowest relative RMSE (BRDFs): {}; lowest ΔE00: {}.\n\n"
-              "![Image-space error](image.png)\n\n",
-              rmse_wins[1].text(), de_wins[1].text()) +
-          link(renderings_scene, "Renderings of the reconstructions", "renderings");
-    if (!no_images.empty())
-      md += "Not rendered (the BRDF has no value somewhere, so there is no ground-truth image): " +
-            no_images + ".\n\n";
-  }
-  md += "Files: ";
-  for (std::size_t i = 0; i < out.files.size(); ++i) md += (i ? ", " : "") + out.files[i];
-  md += ", the plots as PNG and SVG, and report.html (this report with the plots embedded).\n";
+  return rows;
+}
 
-  save_plot(figure::bar_chart(az_chart), dir, "azimuthal", out.files);
-  save_plot(figure::bar_chart(sep_chart), dir, "separability", out.files);
-  save_plot(gonio_scene, dir, "gonio", out.files);
-  save_plot(gonio4d_scene, dir, "gonio4d", out.files);
-  if (any_images) save_plot(figure::bar_chart(im_chart), dir, "image", out.files);
-  save_plot(renderings_scene, dir, "renderings", out.files);
+// 4. Image-space error.
+std::string image_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                          const ReportPlots& plots) {
+  std::string envs;
+  for (std::size_t i = 0; i < config.environments.size(); ++i)
+    envs += (i ? ", " : "") + config.environments[i].label;
+  std::string md =
+      fmt::format(
+          "## 4. Image-space error\n\nThe reconstructions from {} measurements rendered on a "
+          "sphere ({}², {} environment samples per pixel, the same for every image) under "
+          "{}, against the rendering of the BRDF itself: relative RMSE / mean CIEDE2000 of "
+          "the tone-mapped images, averaged over the environments; regular design, then "
+          "stratified.\n\n",
+          config.image_budget, config.image_size, config.image_spp, envs) +
+      table_header("BRDF");
+  std::array<Wins, 2> rmse_wins, de_wins;
+  std::string strat_rows, no_images;
+  for (const BrdfResult& b : results) {
+    if (!has_images(b)) {  // no finite ground truth to compare with (an ALTA file's gaps)
+      no_images += (no_images.empty() ? "" : ", ") + b.label;
+      continue;
+    }
+    const ImageRows rows = image_rows(b);
+    for (std::size_t d = 0; d < 2; ++d) {
+      rmse_wins[d].add(rows.rmse[d]);
+      de_wins[d].add(rows.delta_e[d]);
+    }
+    md += rows.text[0] + "\n";
+    strat_rows += rows.text[1] + "\n";
+  }
+  md += fmt::format(
+            "\nLowest relative RMSE (BRDFs): {}; lowest ΔE00: {}.\n\nStratified "
+            "design:\n\n",
+            rmse_wins[0].text(), de_wins[0].text()) +
+        table_header("BRDF") + strat_rows +
+        fmt::format(
+            "\nLowest relative RMSE (BRDFs): {}; lowest ΔE00: {}.\n\n"
+            "![Image-space error](image.png)\n\n",
+            rmse_wins[1].text(), de_wins[1].text()) +
+        plot_link(plots.renderings, "Renderings of the reconstructions", "renderings");
+  if (!no_images.empty())
+    md += "Not rendered (the BRDF has no value somewhere, so there is no ground-truth image): " +
+          no_images + ".\n\n";
+  return md;
+}
+
+// The closing line: the CSV files written so far, then what always follows them.
+std::string files_paragraph(const std::vector<std::string>& csv_files) {
+  std::string md = "Files: ";
+  for (std::size_t i = 0; i < csv_files.size(); ++i) md += (i ? ", " : "") + csv_files[i];
+  return md +
+         ", the plots as PNG and SVG, and report.html (this report with the plots embedded).\n";
+}
+
+}  // namespace
+
+StudyOutput write_study(const std::filesystem::path& dir, const std::vector<BrdfResult>& results,
+                        const StudyConfig& config, double seconds) {
+  StudyOutput out;
+  const Contents has = contents_of(results);
+  write_csv_files(dir, csv_tables(results, config), has, out.files);
+
+  const ReportPlots plots = report_plots(results, config, has);
+  std::string md = report_header(results, config, has.anisotropic, seconds) +
+                   azimuthal_section(results, has.anisotropic) +
+                   separability_section(results, config, has.anisotropic);
+  if (has.gonio) md += gonio_section(results, config, has.anisotropic, plots);
+  if (has.images) md += image_section(results, config, plots);
+  md += files_paragraph(out.files);
+
+  // The plots before report.html, which embeds them.
+  save_plots(plots, dir, out.files);
   write_file_atomically(dir / "report.md", md);
   write_file_atomically(dir / "report.html", markdown_to_html(md, dir, "halfback study"));
   out.files.push_back("report.md");

@@ -7,19 +7,14 @@
 #include <iterator>
 #include <sstream>
 
+#include "support/test_support.hpp"
+
 namespace halfback::study {
 namespace {
 
 std::string slurp(const std::filesystem::path& p) {
   std::ifstream f(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
-
-std::filesystem::path fresh_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("halfback_report_test_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
 }
 
 // A made-up result whose numbers the files must repeat.
@@ -51,7 +46,8 @@ BrdfResult fake(const std::string& label, bool isotropic) {
 }
 
 TEST(Report, FilesRepeatTheResults) {
-  const auto dir = fresh_dir("files");
+  const test::TempDir tmp;
+  const std::filesystem::path& dir = tmp.path();
   StudyConfig c;
   c.budgets = {1000, 1000000};
   c.image_budget = 1000;
@@ -97,7 +93,8 @@ TEST(Report, FilesRepeatTheResults) {
 TEST(Report, OnlyWhatWasComputedIsWrittenAndLinked) {
   // Anisotropic BRDFs only: the 4D gonio-reflectometer still gets its CSV files; no example
   // renderings: no renderings plot, and no link to one.
-  const auto dir = fresh_dir("aniso_only");
+  const test::TempDir tmp;
+  const std::filesystem::path& dir = tmp.path();
   StudyConfig c;
   c.budgets = {1000, 1000000};
   c.image_budget = 1000;
@@ -116,7 +113,8 @@ TEST(Report, OnlyWhatWasComputedIsWrittenAndLinked) {
 }
 
 TEST(Report, MarkdownToHtml) {
-  const auto dir = fresh_dir("html");
+  const test::TempDir tmp;
+  const std::filesystem::path& dir = tmp.path();
   {
     std::ofstream f(dir / "x.png", std::ios::binary);
     f << "Man";  // base64 "TWFu"

@@ -1,7 +1,6 @@
 #include "halfback/util/csv.hpp"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <array>
 #include <bit>
@@ -13,6 +12,8 @@
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "support/test_support.hpp"
 
 namespace halfback {
 namespace {
@@ -252,9 +253,8 @@ TEST(CsvRead, SplitLine) {
 }
 
 TEST(CsvRead, ReadTextFile) {
-  const auto dir =
-      std::filesystem::path(testing::TempDir()) / ("csv_test_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
+  const test::TempDir tmp;
+  const std::filesystem::path& dir = tmp.path();
   const auto missing = dir / "missing.csv";
   try {
     read_text_file(missing);
@@ -264,7 +264,6 @@ TEST(CsvRead, ReadTextFile) {
               "cannot read '" + missing.string() + "': No such file or directory");
   }
   EXPECT_THROW(read_text_file(dir), std::system_error);  // a directory
-  std::filesystem::remove_all(dir);
 }
 
 // ---------------------------------------------------------------------------------------------

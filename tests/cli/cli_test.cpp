@@ -22,6 +22,7 @@
 #include "halfback/core/batch.hpp"
 #include "halfback/core/space.hpp"
 #include "halfback/util/csv.hpp"
+#include "support/test_support.hpp"
 
 extern char** environ;
 
@@ -52,20 +53,14 @@ void put(const fs::path& p, const std::string& text) {
 
 class CliTest : public testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(testing::TempDir()) /
-           ("halfback_cli_test_" + std::to_string(getpid()) + "_" +
-            testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  // A test may leave a read-only folder "ro": made writable again so that the directory can be
+  // removed.
   void TearDown() override {
     std::error_code ec;
-    fs::permissions(dir_ / "ro", fs::perms::owner_all, fs::perm_options::add, ec);
-    fs::remove_all(dir_, ec);
+    fs::permissions(dir_.path() / "ro", fs::perms::owner_all, fs::perm_options::add, ec);
   }
 
-  fs::path path(const std::string& name) const { return dir_ / name; }
+  fs::path path(const std::string& name) const { return dir_.path() / name; }
 
   // Runs halfback with `args` in the test's directory, `input` on stdin.
   Result run(const std::vector<std::string>& args, const std::string& input = "") const {
@@ -82,7 +77,7 @@ class CliTest : public testing::Test {
     for (auto& a : argv_storage) argv.push_back(a.data());
     argv.push_back(nullptr);
     const fs::path cwd = fs::current_path();
-    fs::current_path(dir_);
+    fs::current_path(dir_.path());
     pid_t pid = 0;
     const int rc = posix_spawn(&pid, HALFBACK_CLI_PATH, &actions, nullptr, argv.data(), environ);
     fs::current_path(cwd);
@@ -106,12 +101,12 @@ class CliTest : public testing::Test {
   // The files of the test's directory, sorted (no leftover temporary files).
   std::vector<std::string> entries() const {
     std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename());
+    for (const auto& e : fs::directory_iterator(dir_.path())) names.push_back(e.path().filename());
     std::sort(names.begin(), names.end());
     return names;
   }
 
-  fs::path dir_;
+  test::TempDir dir_;  // the test's own, removed after it
 };
 
 // Parses the tool's output (nan allowed).

@@ -37,6 +37,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -89,6 +90,20 @@ class GonioReconstruction final : public Brdf {
   std::size_t samples() const { return samples_; }  // measurements taken (finite values)
 
  private:
+  // The constructor's steps: measure the cells (filled[c] = 1 where a finite value was taken),
+  // then fill the others by dilation.
+  std::vector<std::uint8_t> measure(const Brdf& truth);
+  void measure_block(const Brdf& truth, std::span<const std::size_t> cells, int attempt,
+                     double min_z, std::vector<std::uint8_t>& filled,
+                     std::vector<std::size_t>& missed);
+  // Where a cell is measured at a try, in cell units from its lower corner.
+  std::array<float, 4> measurement_offset(std::size_t cell, int attempt) const;
+  void fill_unmeasured(std::vector<std::uint8_t>& filled);
+  // An empty cell's value from its filled neighbours (none when it has no filled neighbour).
+  std::optional<Rgb> dilated_value(std::size_t cell, const std::vector<std::uint8_t>& filled) const;
+  // The next cell along `axis` in direction `step` (±1), wrapping around an azimuth.
+  std::optional<std::size_t> neighbour(std::size_t cell, std::size_t axis, int step) const;
+
   Rgb reconstruct(const double* x) const;        // at coordinates x of the form
   static Rgb outside(const DirPair<double>& p);  // at a pair the form does not take
 
