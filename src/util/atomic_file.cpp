@@ -58,7 +58,7 @@ int standard_stream_fd(const fs::path& path) {
   return -1;
 }
 
-std::string fmt_mode(const char* text, mode_t mode) {
+std::string text_with_mode(const char* text, mode_t mode) {
   char digits[8];
   std::snprintf(digits, sizeof digits, "%04o", unsigned(mode & 07777));
   return text + std::string(digits);
@@ -90,8 +90,9 @@ bool is_direct_destination(const struct stat& st, const fs::path& resolved,
                "; only regular files, character devices and FIFOs are written");
   // Read-only: no write bit at all (root included, like cp), or not writable by this process.
   if ((st.st_mode & 0222) == 0 || (::access(resolved.c_str(), W_OK) != 0 && errno == EACCES))
-    refuse(EACCES, target,
-           fmt_mode("it is read-only, mode ", st.st_mode) + "; make it writable or remove it");
+    refuse(
+        EACCES, target,
+        text_with_mode("it is read-only, mode ", st.st_mode) + "; make it writable or remove it");
   return false;
 }
 
