@@ -1,14 +1,25 @@
 #include "halfback/brdf/albedo.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 namespace halfback {
 
 AlbedoEstimate directional_albedo(const Brdf& brdf, const Vec3<double>& wi, int n,
                                   std::uint64_t seed) {
+  // A NaN direction would give NaN-free zeros (every pair invalid), i.e. a plausible wrong answer.
+  const double norm2 = wi.x * wi.x + wi.y * wi.y + wi.z * wi.z;
+  if (!(std::abs(norm2 - 1) <= 1e-6))
+    throw std::invalid_argument(fmt::format(
+        "directional albedo: the incident direction ({:g}, {:g}, {:g}) is not a finite unit vector",
+        wi.x, wi.y, wi.z));
+  if (n < 1)
+    throw std::invalid_argument(fmt::format("directional albedo: n = {} samples per axis", n));
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> jitter(0, 1);
   std::vector<DirPair<double>> pairs;

@@ -30,7 +30,33 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
+// Checks the parameter `p` that defaults to another one of `params`.
+void check_default_from(const std::string& model, const std::vector<ModelParam>& params,
+                        const ModelParam& p) {
+  const std::string what =
+      "model '" + model + "': parameter '" + p.name + "' defaults to '" + p.default_from + "'";
+  const ModelParam* from = nullptr;
+  for (const ModelParam& q : params) {
+    if (&q == &p) break;  // only those declared before
+    if (q.name == p.default_from) from = &q;
+  }
+  if (!from) throw std::invalid_argument(what + ", which is not declared before it");
+  if (!from->default_from.empty() || !from->choices.empty() || !p.choices.empty())
+    throw std::invalid_argument(what + ": both must be numbers, the other with a default value");
+  if (!(p.min <= from->min && from->max <= p.max))
+    throw std::invalid_argument(what + ", whose range [" + format_number(from->min) + ", " +
+                                format_number(from->max) + "] is not inside [" +
+                                format_number(p.min) + ", " + format_number(p.max) + "]");
+}
+
 }  // namespace
+
+ModelParam defaults_to(std::string name, std::string description, std::string from, double min,
+                       double max) {
+  ModelParam p{std::move(name), std::move(description), min, min, max};
+  p.default_from = std::move(from);
+  return p;
+}
 
 double ModelArgs::operator[](std::string_view name) const {
   const auto it = values_.find(name);
@@ -55,6 +81,10 @@ void ModelRegistry::add(ModelInfo info) {
     if (!seen.insert(p.name).second)
       throw std::invalid_argument("model '" + info.name + "': parameter '" + p.name +
                                   "' declared twice");
+    if (!p.default_from.empty()) {
+      check_default_from(info.name, info.params, p);
+      continue;
+    }
     if (!(p.min <= p.default_value && p.default_value <= p.max))
       throw std::invalid_argument("model '" + info.name + "': default of '" + p.name +
                                   "' is outside [" + format_number(p.min) + ", " +
@@ -102,9 +132,9 @@ BrdfPtr ModelRegistry::create(std::string_view spec) const {
   }
   ModelArgs args;
   for (const auto& p : info->params) args.set(p.name, p.default_value);
+  std::set<std::string, std::less<>> given;
   if (colon != std::string_view::npos) {
     std::string_view rest = spec.substr(colon + 1);
-    std::set<std::string, std::less<>> given;
     while (true) {
       const std::size_t comma = rest.find(',');
       const std::string_view item = trim(rest.substr(0, comma));
@@ -157,6 +187,9 @@ BrdfPtr ModelRegistry::create(std::string_view spec) const {
       rest.remove_prefix(comma + 1);
     }
   }
+  // Parameters not given that default to another one (declared before, so already final).
+  for (const auto& p : info->params)
+    if (!p.default_from.empty() && !given.count(p.name)) args.set(p.name, args[p.default_from]);
   return info->factory(args);
 }
 

@@ -35,6 +35,22 @@ std::vector<std::string_view> axis_names(Space space, GridKind kind) {
 
 }  // namespace
 
+double wrap_azimuth_degrees(double degrees, std::string_view what) {
+  if (!std::isfinite(degrees))
+    throw std::invalid_argument(
+        fmt::format("{}: '{}' is not a finite azimuth in degrees", what, degrees));
+  double wrapped = std::fmod(degrees, 360.0);  // exact, in (−360, 360)
+  if (wrapped < 0) wrapped += 360;
+  return wrapped < 360 ? wrapped : 0.0;  // −1e-20 + 360 rounds to 360
+}
+
+double wrap_azimuth_radians(double radians) {
+  if (!std::isfinite(radians)) return radians;  // validate() reports it
+  double wrapped = std::fmod(radians, 2 * kPi);
+  if (wrapped < 0) wrapped += 2 * kPi;
+  return wrapped < 2 * kPi ? wrapped : 0.0;
+}
+
 std::string_view name_of(GridKind kind) {
   switch (kind) {
     case GridKind::full:
@@ -64,7 +80,7 @@ std::array<double, 4> GridSpec::point(std::size_t flat) const {
     x[a] = axes[a].position(flat % axes[a].count, sampling);
     flat /= axes[a].count;
   }
-  if (kind == GridKind::slice) x[axes.size()] = slice_azimuth;
+  if (kind == GridKind::slice) x[axes.size()] = wrap_azimuth_radians(slice_azimuth);
   return x;
 }
 
@@ -99,7 +115,7 @@ GridSpec default_grid(Space space, GridKind kind, std::vector<std::size_t> count
   GridSpec g;
   g.space = space;
   g.kind = kind;
-  g.slice_azimuth = slice_azimuth;
+  g.slice_azimuth = wrap_azimuth_radians(slice_azimuth);
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto [lo, hi] = natural_range(names[i]);
     g.axes.push_back({std::string(names[i]), lo, hi, counts[i]});

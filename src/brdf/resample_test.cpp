@@ -206,5 +206,54 @@ TEST(Resample, ThreadCountDoesNotChangeTheBits) {
   EXPECT_EQ(std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(double)), 0);
 }
 
+// Issue 12, class 8: one rule for azimuths everywhere, wrap any finite value into [0°, 360°).
+TEST(Resample, AzimuthsWrapIntoZeroTo360Degrees) {
+  const std::pair<double, double> cases[] = {
+      {0, 0},       {-90, 270}, {360, 0},       {400, 40},   {-45, 315},
+      {720.5, 0.5}, {-360, 0},  {359.5, 359.5}, {-1e-20, 0}, {1e17, std::fmod(1e17, 360.0)}};
+  for (const auto& [in, out] : cases) {
+    const double w = wrap_azimuth_degrees(in, "--azimuth");
+    EXPECT_EQ(w, out) << in;
+    EXPECT_TRUE(w >= 0 && w < 360) << in;
+  }
+  for (const double bad : {std::nan(""), double(INFINITY), -double(INFINITY)}) {
+    try {
+      wrap_azimuth_degrees(bad, "--azimuth");
+      ADD_FAILURE() << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--azimuth: '", 0), 0u) << e.what();
+    }
+  }
+  for (const double r : {-1e-17, -kPi / 2, 2 * kPi, 7.0, -100.0}) {
+    const double w = wrap_azimuth_radians(r);
+    EXPECT_TRUE(w >= 0 && w < 2 * kPi) << r;
+    EXPECT_NEAR(std::remainder(w - r, 2 * kPi), 0, 1e-13) << r;
+  }
+}
+
+// A slice at −90° (or 630°) is the slice at 270°, point for point; it was all NaN (the core's
+// inverse wants [0, 2π)). A hand-made GridSpec with an unwrapped azimuth is wrapped too.
+TEST(Resample, SlicesAtEquivalentAzimuthsAreTheSame) {
+  const Smooth brdf;
+  for (Space s : kParameterizations) {
+    const ResampledTable ref = resample(brdf, default_grid(s, GridKind::slice, {16}, 1.5 * kPi));
+    ASSERT_GT(ref.valid_count(), 16u) << name_of(s);
+    for (const double az : {-0.5 * kPi, 3.5 * kPi, -2.5 * kPi}) {
+      const GridSpec g = default_grid(s, GridKind::slice, {16}, az);
+      EXPECT_NEAR(g.slice_azimuth, 1.5 * kPi, 1e-13);
+      GridSpec raw = g;
+      raw.slice_azimuth = az;
+      for (const GridSpec& grid : {g, raw}) {
+        const ResampledTable t = resample(brdf, grid);
+        ASSERT_EQ(t.valid, ref.valid) << name_of(s) << " at " << az;
+        for (std::size_t i = 0; i < t.rgb.size(); ++i) {
+          if (!ref.valid[i / 3]) continue;
+          EXPECT_NEAR(t.rgb[i], ref.rgb[i], 1e-12 * std::abs(ref.rgb[i]));
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace halfback

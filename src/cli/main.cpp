@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "halfback/util/signal_cleanup.hpp"
 
 #ifndef HALFBACK_VERSION
 #define HALFBACK_VERSION "unknown"
@@ -99,6 +100,8 @@ int run(int argc, char** argv) {
 }  // namespace halfback::cli
 
 int main(int argc, char** argv) {
+  // Ctrl-C, SIGTERM and SIGHUP remove the hidden temporaries beside the outputs before dying.
+  halfback::install_temporary_cleanup_handlers();
   try {
     return halfback::cli::run(argc, argv);
   } catch (const std::exception& e) {

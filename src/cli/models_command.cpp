@@ -22,12 +22,10 @@ std::string describe_models() {
         for (const auto& c : p.choices) range += (range.empty() ? "" : " | ") + c;
         range =
             fmt::format("one of {}, default {}", range, p.choices.at(std::size_t(p.default_value)));
+      } else if (!p.default_from.empty()) {
+        range = fmt::format("default: {}, in [{:g}, {:g}]", p.default_from, p.min, p.max);
       } else {
-        // A description that explains its own default ("default: alpha") shows only the range.
-        if (p.description.find("(default") != std::string::npos)
-          range = fmt::format("in [{:g}, {:g}]", p.min, p.max);
-        else
-          range = fmt::format("default {:g}, in [{:g}, {:g}]", p.default_value, p.min, p.max);
+        range = fmt::format("default {:g}, in [{:g}, {:g}]", p.default_value, p.min, p.max);
       }
       s += fmt::format("  {:<12} {} ({})\n", p.name, p.description, range);
     }

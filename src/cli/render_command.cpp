@@ -56,6 +56,13 @@ int run_render(const RenderOptions& o) {
   const BrdfPtr brdf = load_brdf(o.brdf);
   const render::EnvMap env = render::EnvMap::from_spec(o.env, {o.env_rotation, o.env_exposure});
   const render::RenderResult r = render::render(*brdf, env, s);
+  if (r.nonfinite_pixels)
+    throw std::runtime_error(
+        std::to_string(r.nonfinite_pixels) + " of " +
+        std::to_string(std::size_t(o.width) * o.height) +
+        " pixels are infinite or NaN (the radiance overflows the image's float range, about "
+        "3.4e38): lower --env-exposure or the environment's values; " +
+        o.output + " was not written");
   render::write_image(o.output, r.image, {o.exposure, o.filmic});
 
   if (r.budget_exhausted)

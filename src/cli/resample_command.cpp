@@ -38,10 +38,16 @@ int run_resample(const ResampleOptions& o) {
                                                 : GridKind::slice;
   if (o.azimuth_given && kind != GridKind::slice)
     throw UsageError("--azimuth fixes the relative azimuth of a slice: it needs --kind slice");
+  double azimuth_deg = 0;
+  try {
+    azimuth_deg = wrap_azimuth_degrees(o.azimuth_deg, "--azimuth");  // -90 is 270, 400 is 40
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
   GridSpec grid;
   try {
     grid = default_grid(*space, kind, count_list(o.size, "--size", "sample count"),
-                        o.azimuth_deg * std::numbers::pi / 180);
+                        azimuth_deg * std::numbers::pi / 180);
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("--size: {}", e.what()));
   }
@@ -72,6 +78,9 @@ int run_resample(const ResampleOptions& o) {
   ro.threads = o.threads;
   const ResampledTable t = resample(*brdf, grid, ro);
   write_table(o.output, t);
+  if (t.valid_count() == 0)
+    warn("resample", "no grid point is inside the domain of " + o.param +
+                         ": every value is NaN (check the --range options)");
   fmt::print(stderr, "halfback resample: {} written: {} grid points ({} inside the domain)\n",
              o.output, grid.points(), t.valid_count());
   return kExitOk;
@@ -92,7 +101,7 @@ Command register_resample(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--azimuth", o->azimuth_deg,
                   "Slice: the relative azimuth in degrees (phi_d, or phi_k - phi_h, or phi_o - "
-                  "phi_i)")
+                  "phi_i); any finite value, wrapped into [0, 360)")
       ->each([o](const std::string&) { o->azimuth_given = true; });
   app->add_option("--size", o->size, "Samples per axis: N (every axis) or N1,N2,...")
       ->capture_default_str();

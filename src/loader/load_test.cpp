@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <numbers>
 #include <random>
 #include <stdexcept>
 
@@ -16,6 +17,7 @@
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
+#include "halfback/models/analytic.hpp"
 #include "support/test_brdfs.hpp"
 #include "support/test_support.hpp"
 
@@ -367,6 +369,98 @@ TEST(Embedded, MaterialsAreTheDataFiles) {
         << ex.what();
     EXPECT_NE(std::string(ex.what()).find("acrylic_felt_green"), std::string::npos);
   }
+}
+
+}  // namespace
+}  // namespace halfback
+
+// --- Issue 12, class 7: no "not given" sentinel inside a range; every parameter checked ----------
+namespace halfback {
+namespace {
+
+ModelInfo tinted_model() {
+  return {"test-tinted",
+          "a constant BRDF whose blue channel defaults to its grey value (tests)",
+          {{"grey", "the value", 0.25, 0.1, 1}, defaults_to("blue", "blue channel", "grey", 0, 2)},
+          [](const ModelArgs& a) {
+            return std::make_shared<Constant>(Rgb{a["grey"], a["grey"], a["blue"]});
+          }};
+}
+
+TEST(Registry, ParameterThatDefaultsToAnotherOne) {
+  ModelRegistry r;
+  r.add(tinted_model());
+  const DirPair<double> p{{0, 0, 1}, {0, 0, 1}};
+  EXPECT_EQ(r.create("test-tinted")->eval(p), (Rgb{0.25, 0.25, 0.25}));
+  EXPECT_EQ(r.create("test-tinted:grey=0.5")->eval(p), (Rgb{0.5, 0.5, 0.5}));
+  EXPECT_EQ(r.create("test-tinted:grey=0.5,blue=0")->eval(p), (Rgb{0.5, 0.5, 0}));
+  // A negative value is out of range, not "not given".
+  expect_invalid(r, "test-tinted:blue=-1", {"blue=-1 is outside [0, 2]"});
+  expect_invalid(r, "test-tinted:blue=-0.3", {"blue=-0.3 is outside [0, 2]"});
+}
+
+TEST(Registry, DefaultFromIsCheckedWhenAdded) {
+  ModelRegistry r;
+  auto undeclared = tinted_model();
+  undeclared.params[1].default_from = "green";
+  EXPECT_THROW(r.add(undeclared), std::invalid_argument);
+  auto declared_after = tinted_model();
+  std::swap(declared_after.params[0], declared_after.params[1]);
+  EXPECT_THROW(r.add(declared_after), std::invalid_argument);
+  auto narrower = tinted_model();
+  narrower.params[1].max = 0.5;  // grey's range [0.1, 1] would pass values out of [0, 0.5]
+  try {
+    r.add(narrower);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("[0.1, 1] is not inside [0, 0.5]"), std::string::npos)
+        << e.what();
+  }
+  auto chained = tinted_model();
+  chained.params.push_back(defaults_to("red", "red", "blue", 0, 2));
+  EXPECT_THROW(r.add(chained), std::invalid_argument);
+  EXPECT_NO_THROW(r.add(tinted_model()));
+}
+
+// The reproductions of the issue: each was silently treated as "not given" (or let through).
+TEST(BuiltinModels, EveryParameterIsCheckedAgainstItsRange) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"lambert:albedo_r=-0.3", "albedo_r=-0.3 is outside [0, 1]"},
+      {"lambert:albedo_g=-1", "albedo_g=-1 is outside [0, 1]"},
+      {"ggx:f0_r=-0.5", "f0_r=-0.5 is outside [0, 1]"},
+      {"ggx:alpha_x=-0.5", "alpha_x=-0.5 is outside [0.001, 10]"},
+      {"ggx:alpha_y=0.0001", "alpha_y=0.0001 is outside [0.001, 10]"},
+      {"beckmann:alpha_x=-1", "alpha_x=-1 is outside [0.001, 10]"},
+      {"sheen:color_b=-1", "color_b=-1 is outside [0, 1]"},
+  };
+  for (const auto& [spec, message] : cases) {
+    try {
+      load_brdf(spec);
+      ADD_FAILURE() << spec << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(BuiltinModels, ChannelsAndAxesDefaultToTheirParameter) {
+  const auto ggx = [](const std::string& spec) {
+    const BrdfPtr b = load_brdf(spec);
+    const auto* m = dynamic_cast<const models::Microfacet*>(b.get());
+    EXPECT_NE(m, nullptr) << spec;
+    return m ? m->params() : models::MicrofacetParams{};
+  };
+  const models::MicrofacetParams a = ggx("ggx:alpha=0.3,f0=0.5,f0_g=0.25");
+  EXPECT_EQ(a.alpha_x, 0.3);
+  EXPECT_EQ(a.alpha_y, 0.3);
+  EXPECT_EQ(a.fresnel.f0, (Rgb{0.5, 0.25, 0.5}));
+  const models::MicrofacetParams b = ggx("ggx:alpha=0.3,alpha_y=0.001,f0_r=0");
+  EXPECT_EQ(b.alpha_x, 0.3);
+  EXPECT_EQ(b.alpha_y, 0.001);
+  EXPECT_EQ(b.fresnel.f0, (Rgb{0, 0.04, 0.04}));
+  const DirPair<double> n{{0, 0, 1}, {0, 0, 1}};
+  EXPECT_NEAR(load_brdf("lambert:albedo=0.6,albedo_b=0")->eval(n).r, 0.6 / std::numbers::pi, 1e-15);
+  EXPECT_EQ(load_brdf("lambert:albedo=0.6,albedo_b=0")->eval(n).b, 0.0);
 }
 
 }  // namespace

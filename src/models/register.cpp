@@ -8,23 +8,18 @@ namespace halfback::models {
 
 namespace {
 
-// Colour parameters: a grey value plus optional per-channel overrides (−1 = use the grey value),
-// because registry parameters are scalars.
+// Colour parameters: a grey value plus per-channel overrides that default to it, because
+// registry parameters are scalars. Every channel has the grey value's range.
 std::vector<ModelParam> colour_params(const std::string& name, const std::string& what,
                                       double default_value, double max) {
   return {{name, what + " (grey)", default_value, 0, max},
-          {name + "_r", what + ", red channel (default: " + name + ")", -1, -1, max},
-          {name + "_g", what + ", green channel (default: " + name + ")", -1, -1, max},
-          {name + "_b", what + ", blue channel (default: " + name + ")", -1, -1, max}};
+          defaults_to(name + "_r", what + ", red channel", name, 0, max),
+          defaults_to(name + "_g", what + ", green channel", name, 0, max),
+          defaults_to(name + "_b", what + ", blue channel", name, 0, max)};
 }
 
 Rgb colour(const ModelArgs& a, const std::string& name) {
-  const double grey = a[name];
-  auto channel = [&](const char* suffix) {
-    const double v = a[name + suffix];
-    return v < 0 ? grey : v;
-  };
-  return {channel("_r"), channel("_g"), channel("_b")};
+  return {a[name + "_r"], a[name + "_g"], a[name + "_b"]};
 }
 
 std::vector<ModelParam> concat(std::vector<ModelParam> a, const std::vector<ModelParam>& b) {
@@ -35,8 +30,8 @@ std::vector<ModelParam> concat(std::vector<ModelParam> a, const std::vector<Mode
 ModelInfo microfacet_info(MicrofacetParams::Distribution d, std::string name, std::string title) {
   std::vector<ModelParam> params{
       {"alpha", "roughness (both directions)", 0.2, 1e-3, 10},
-      {"alpha_x", "roughness along t (default: alpha)", -1, -1, 10},
-      {"alpha_y", "roughness along b (default: alpha)", -1, -1, 10},
+      defaults_to("alpha_x", "roughness along t", "alpha", 1e-3, 10),
+      defaults_to("alpha_y", "roughness along b", "alpha", 1e-3, 10),
       {"eta", "index of refraction; > 0 selects exact Fresnel instead of Schlick", 0, 0, 100},
       {"k", "extinction coefficient (conductor when > 0; needs eta)", 0, 0, 100},
   };
@@ -44,8 +39,8 @@ ModelInfo microfacet_info(MicrofacetParams::Distribution d, std::string name, st
   return {std::move(name), std::move(title), std::move(params), [d](const ModelArgs& a) {
             MicrofacetParams p;
             p.distribution = d;
-            p.alpha_x = a["alpha_x"] < 0 ? a["alpha"] : a["alpha_x"];
-            p.alpha_y = a["alpha_y"] < 0 ? a["alpha"] : a["alpha_y"];
+            p.alpha_x = a["alpha_x"];
+            p.alpha_y = a["alpha_y"];
             if (a["eta"] > 0) {
               p.fresnel.kind = a["k"] > 0 ? Fresnel::Kind::conductor : Fresnel::Kind::dielectric;
               p.fresnel.eta = {a["eta"], a["eta"], a["eta"]};
@@ -63,9 +58,8 @@ ModelInfo microfacet_info(MicrofacetParams::Distribution d, std::string name, st
 
 void register_analytic_models(ModelRegistry& registry) {
   registry.add({"lambert", "Lambertian diffuse reflection, rho = albedo / pi",
-                colour_params("albedo", "albedo", 0.5, 1), [](const ModelArgs& a) {
-                  return std::make_shared<Lambert>(colour(a, "albedo"));
-                }});
+                colour_params("albedo", "albedo", 0.5, 1),
+                [](const ModelArgs& a) { return std::make_shared<Lambert>(colour(a, "albedo")); }});
   registry.add(microfacet_info(MicrofacetParams::Distribution::ggx, "ggx",
                                "GGX microfacet reflection, anisotropic, Smith G2, Fresnel"));
   registry.add(microfacet_info(MicrofacetParams::Distribution::beckmann, "beckmann",
@@ -87,7 +81,8 @@ void register_analytic_models(ModelRegistry& registry) {
                   p.kd = {a["kd"], a["kd"], a["kd"]};
                   return std::make_shared<Abc>(p);
                 }});
-  registry.add({"sheen", "Charlie sheen lobe (Estevez & Kulla 2017) for cloth-like grazing reflection",
+  registry.add({"sheen",
+                "Charlie sheen lobe (Estevez & Kulla 2017) for cloth-like grazing reflection",
                 concat({{"alpha", "roughness of the sheen distribution", 0.3, 1e-3, 1}},
                        colour_params("color", "sheen colour", 1, 1)),
                 [](const ModelArgs& a) {

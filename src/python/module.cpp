@@ -232,7 +232,8 @@ py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::str
       counts.push_back(std::size_t(c));
     }
   }
-  GridSpec g = default_grid(space, parse_kind(kind), counts, azimuth_deg * std::numbers::pi / 180);
+  const double azimuth = wrap_azimuth_degrees(azimuth_deg, "azimuth");  // as the CLI (class 8)
+  GridSpec g = default_grid(space, parse_kind(kind), counts, azimuth * std::numbers::pi / 180);
   g.sampling = nodes ? GridSampling::nodes : GridSampling::centres;
   for (const auto& [key, value] : ranges) {
     GridAxis* axis = nullptr;
@@ -251,6 +252,10 @@ py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::str
     py::gil_scoped_release release;
     t = resample(*b.brdf, g);
   }
+  if (t.valid_count() == 0 &&
+      PyErr_WarnEx(PyExc_RuntimeWarning,
+                   "resample: no grid point is inside the domain: every value is NaN", 1) != 0)
+    throw py::error_already_set();  // warnings turned into errors
   std::vector<py::ssize_t> shape;
   for (const GridAxis& a : g.axes) shape.push_back(py::ssize_t(a.count));
   std::vector<py::ssize_t> rgb_shape = shape;
@@ -342,6 +347,8 @@ void bind_conversions(py::module_& m) {
       [](const py::object& x, const std::string& src, const std::string& dst, bool isotropic,
          const py::object& out) {
         const Form from = parse_form(src, isotropic, "src"), to = parse_form(dst, isotropic, "dst");
+        if (isotropic && from.space == Space::dirs && to.space == Space::dirs)  // as the CLI
+          throw py::value_error("isotropic needs a parameterization on one side (src or dst)");
         return dispatch(x, from, to, true, false, out).result;
       },
       py::arg("x"), py::arg("src"), py::arg("dst"), py::arg("isotropic") = false,
@@ -418,6 +425,10 @@ a direction that is not a unit vector raises ValueError naming the row.)doc")
           "albedo",
           [](const PyBrdf& b, double theta_i, int n) {
             if (n < 1) throw py::value_error("n must be positive");
+            if (!std::isfinite(theta_i))
+              throw py::value_error(
+                  "theta_i: " + py::repr(py::float_(theta_i)).cast<std::string>() +
+                  " is not a finite angle in radians");
             AlbedoEstimate a;
             {
               py::gil_scoped_release release;

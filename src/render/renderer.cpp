@@ -337,6 +337,10 @@ RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSet
   r.image.height = s.height;
   r.image.rgb.resize(3 * pixels);
   for (std::size_t i = 0; i < 3 * pixels; ++i) r.image.rgb[i] = float(total.rgb[i] / done);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const float* v = &r.image.rgb[3 * p];
+    r.nonfinite_pixels += !(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]));
+  }
   if (s.variance) {
     r.variance.resize(pixels);
     for (std::size_t i = 0; i < pixels; ++i) {

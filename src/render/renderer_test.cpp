@@ -352,5 +352,20 @@ TEST(Renderer, StrategyNames) {
   EXPECT_FALSE(strategy_from_name("").has_value());
 }
 
+// Issue 12, class 11: an environment scaled beyond the float range gives an image of +Inf; the
+// result counts such pixels (the CLI refuses to write the image). The same radiance 2^64 times
+// lower is finite everywhere.
+TEST(Renderer, PixelsBeyondTheFloatRangeAreCounted) {
+  const auto lambert = load_brdf("lambert:albedo=0.5");
+  const RenderSettings s = small(8, 2);
+  const RenderResult over =
+      render(*lambert, EnvMap::from_spec("constant:1e30", {0, 64}), s);  // 1.8e49 > 3.4e38
+  EXPECT_EQ(over.nonfinite_pixels, 64u);
+  EXPECT_TRUE(std::isinf(over.image.rgb[0]));
+  const RenderResult fine = render(*lambert, EnvMap::from_spec("constant:1e30"), s);
+  EXPECT_EQ(fine.nonfinite_pixels, 0u);
+  EXPECT_NEAR(fine.image.rgb[0], 1e30, 1e24);  // the background is the environment itself
+}
+
 }  // namespace
 }  // namespace halfback::render

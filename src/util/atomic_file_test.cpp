@@ -1,15 +1,21 @@
 #include "halfback/util/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <sys/un.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <thread>
 
 namespace halfback {
 namespace {
@@ -188,6 +194,132 @@ TEST_F(AtomicFileTest, RelativePathInTheCurrentDirectory) {
   write_file_atomically("plain.csv", "x");
   fs::current_path(cwd);
   EXPECT_EQ(slurp(dir_ / "plain.csv"), "x");
+}
+
+// Reads a FIFO on a thread. It holds a writer end of its own, so that it neither blocks when the
+// tool never opens the FIFO (e.g. replaced it by a file) nor sees an early end of file:
+// finish() closes that writer and returns what came through.
+class FifoReader {
+ public:
+  explicit FifoReader(const fs::path& fifo)
+      : read_(::open(fifo.c_str(), O_RDONLY | O_NONBLOCK)), write_(::open(fifo.c_str(), O_WRONLY)) {
+    ::fcntl(read_, F_SETFL, 0);  // blocking reads from now on
+    thread_ = std::thread([this] {
+      char buf[1 << 16];
+      ssize_t n = 0;
+      while ((n = ::read(read_, buf, sizeof buf)) > 0) data_.append(buf, std::size_t(n));
+    });
+  }
+  FifoReader(const FifoReader&) = delete;
+  FifoReader& operator=(const FifoReader&) = delete;
+  ~FifoReader() {
+    if (thread_.joinable()) finish();
+  }
+  std::string finish() {
+    ::close(write_);
+    thread_.join();
+    ::close(read_);
+    return data_;
+  }
+
+ private:
+  int read_, write_;
+  std::thread thread_;
+  std::string data_;
+};
+
+// Outputs that are not regular files (issue 12, class 2). A FIFO is written directly to its
+// reader, and a probe (constructed, then discarded) does not open it: opening the writer end
+// twice would give the reader an early end of file.
+TEST_F(AtomicFileTest, FifoIsWrittenDirectlyAndKept) {
+  const fs::path fifo = dir_ / "pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  { AtomicFile probe(fifo); }  // would block here if it opened the FIFO (no reader yet)
+  FifoReader reader(fifo);
+  {
+    AtomicFile f(fifo);
+    EXPECT_TRUE(f.direct());
+    EXPECT_TRUE(f.temporary_path().empty());
+    f.write("through ");
+    f.write("the pipe");
+    f.commit();
+  }
+  EXPECT_EQ(reader.finish(), "through the pipe");
+  struct stat st {};
+  ASSERT_EQ(::stat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"pipe"}));
+}
+
+// A character device is written, never renamed over (as root, renaming over /dev/null destroyed
+// it). A private copy of /dev/null (mknod needs root) shows it without risking the real one.
+TEST_F(AtomicFileTest, CharacterDeviceIsWrittenDirectlyAndKept) {
+  const fs::path null = dir_ / "null";
+  if (::mknod(null.c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0)
+    GTEST_SKIP() << "mknod needs root: " << std::strerror(errno);
+  write_file_atomically(null, "discarded");
+  struct stat st {};
+  ASSERT_EQ(::stat(null.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "the device was replaced";
+  EXPECT_EQ(st.st_rdev, makedev(1, 3));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"null"}));
+}
+
+// /dev/fd/N (like /dev/stdout) is that descriptor, written at its offset, not a file to replace.
+TEST_F(AtomicFileTest, DescriptorPathIsWrittenDirectly) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  write_file_atomically("/dev/fd/" + std::to_string(fds[1]), "via the descriptor");
+  ::close(fds[1]);
+  char buf[64] = {};
+  const ssize_t n = ::read(fds[0], buf, sizeof buf);
+  ::close(fds[0]);
+  EXPECT_EQ(std::string(buf, std::size_t(std::max<ssize_t>(n, 0))), "via the descriptor");
+}
+
+// A read-only regular file is refused like cp refuses it, even for root, and left as it was.
+TEST_F(AtomicFileTest, ReadOnlyFileIsRefused) {
+  const fs::path out = dir_ / "kept.csv";
+  put(out, "precious");
+  fs::permissions(out, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  try {
+    write_file_atomically(out, "new");
+    ADD_FAILURE() << "no exception";
+  } catch (const std::system_error& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot write '" + out.string() +
+                                         "' (it is read-only, mode 0444; make it writable or "
+                                         "remove it): Permission denied");
+  }
+  EXPECT_EQ(slurp(out), "precious");
+  EXPECT_EQ(entries(), (std::vector<std::string>{"kept.csv"}));
+}
+
+TEST_F(AtomicFileTest, SocketIsRefused) {
+  const fs::path sock = dir_ / "s";
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  ASSERT_LT(sock.native().size(), sizeof addr.sun_path);
+  std::strcpy(addr.sun_path, sock.c_str());
+  ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr), 0);
+  try {
+    write_file_atomically(sock, "x");
+    ADD_FAILURE() << "no exception";
+  } catch (const std::system_error& e) {
+    EXPECT_NE(std::string(e.what()).find("it is a socket"), std::string::npos) << e.what();
+  }
+  ::close(fd);
+  EXPECT_TRUE(fs::is_socket(fs::symlink_status(sock)));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"s"}));
+}
+
+TEST_F(AtomicFileTest, DirectoryIsRefusedAndKept) {
+  fs::create_directory(dir_ / "sub");
+  put(dir_ / "sub" / "inside", "x");
+  EXPECT_THROW(write_file_atomically(dir_ / "sub", "y"), std::system_error);
+  EXPECT_EQ(slurp(dir_ / "sub" / "inside"), "x");
+  EXPECT_EQ(entries(), (std::vector<std::string>{"sub"}));
 }
 
 }  // namespace

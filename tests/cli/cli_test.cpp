@@ -2,12 +2,15 @@
 // standard input, and checks its standard output, standard error, exit status and files.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -17,6 +20,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "halfback/core/batch.hpp"
@@ -691,8 +695,23 @@ TEST_F(CliTest, ModelsListsEveryModelWithItsParameters) {
   const Result r = run({"models"});
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* s : {"lambert", "ggx", "beckmann", "abc", "sheen", "test", "albedo", "alpha_x",
-                        "default 0.2, in [0.001, 10]", "one of F | S | G"})
+                        "default 0.2, in [0.001, 10]", "one of F | S | G",
+                        "roughness along t (default: alpha, in [0.001, 10])",
+                        "red channel (default: albedo, in [0, 1])"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+  EXPECT_EQ(r.out.find("-1"), std::string::npos) << "a sentinel is shown as a bound:\n" << r.out;
+}
+
+// Issue 12, class 7: a value below a parameter's range is an error, not "not given".
+TEST_F(CliTest, ModelParametersOutOfRangeAreErrors) {
+  const std::string in = std::string(kDirsHeader) + "0,0,1,0,0,1\n";
+  for (const char* spec :
+       {"lambert:albedo_r=-0.3", "ggx:f0_r=-0.5", "ggx:alpha_x=-0.5", "ggx:alpha_y=0.0001"}) {
+    const Result r = run({"eval", "--brdf", spec}, in);
+    EXPECT_NE(r.status, 0) << spec << " was accepted:\n" << r.out;
+    const std::string name(spec + std::string(spec).find(':') + 1);
+    EXPECT_NE(r.err.find(name + " is outside ["), std::string::npos) << r.err;
+  }
 }
 
 // Lambert is ρ = albedo/π; GGX at normal incidence and normal view is D(0) F0 G / (4 cos²) with
@@ -822,6 +841,194 @@ TEST_F(CliTest, ResampleWritesEachFormatAndRejectsBadGrids) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find(".exr, .npz or .npy"), std::string::npos) << r.err;
   EXPECT_EQ(entries(), (std::vector<std::string>{"t.exr", "t.npy", "t.npz"}));
+}
+
+// Issue 12, class 8: one rule for azimuths, wrap into [0, 360): -90 and 630 are 270 (the table
+// was all NaN before); NaN is an error naming --azimuth; an all-NaN table is a warning.
+TEST_F(CliTest, ResampleWrapsTheSliceAzimuth) {
+  std::map<std::string, std::string> tables;
+  for (const char* az : {"270", "-90", "630"}) {
+    const std::string out = std::string("a") + az + ".npy";
+    const Result r = run({"resample", "--brdf", "ggx:alpha=0.3", "--param", "hybrid", "--kind",
+                          "slice", "--azimuth", az, "--size", "12", "-o", out});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("144 grid points"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("(0 inside"), std::string::npos) << az << ": " << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    tables[az] = slurp(path(out));
+  }
+  EXPECT_EQ(tables["-90"], tables["270"]);
+  EXPECT_EQ(tables["630"], tables["270"]);
+  for (const char* az : {"nan", "inf", "-inf"}) {
+    const Result r = run({"resample", "--brdf", "lambert", "--kind", "slice", "--azimuth", az,
+                          "--size", "4", "-o", "n.npy"});
+    EXPECT_EQ(r.status, 2) << az;
+    EXPECT_NE(r.err.find("--azimuth: '"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("is not a finite azimuth"), std::string::npos) << r.err;
+  }
+  const Result r = run({"resample", "--brdf", "lambert", "--kind", "slice", "--size", "4",
+                        "--range", "k=1.5:2", "-o", "outside.npy"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("(0 inside the domain)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("halfback resample: warning: no grid point is inside the domain"),
+            std::string::npos)
+      << r.err;
+}
+
+// Issue 12, class 11: an image that overflows the float range is refused, not written as +Inf.
+TEST_F(CliTest, RenderRefusesAnImageThatIsNotFinite) {
+  Result r = run({"render", "--brdf", "lambert", "--env", "constant:1e30", "--env-exposure", "64",
+                  "--width", "8", "--height", "8", "--spp", "2", "-q", "-o", "over.exr"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("64 of 64 pixels are infinite or NaN"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--env-exposure"), std::string::npos) << r.err;
+  EXPECT_EQ(entries(), std::vector<std::string>{});
+  r = run({"render", "--brdf", "lambert", "--env", "constant:1e30", "--width", "8", "--height", "8",
+           "--spp", "2", "-q", "-o", "bright.exr"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(entries(), std::vector<std::string>{"bright.exr"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Outputs that are not regular files (issue 12, class 2) and signals (class 3)
+// ---------------------------------------------------------------------------------------------
+
+// Reads a FIFO on a thread. It holds a writer end of its own, so that it neither blocks when the
+// tool never opens the FIFO (e.g. replaced it by a file) nor sees an early end of file:
+// finish() closes that writer and returns what came through.
+class FifoReader {
+ public:
+  explicit FifoReader(const fs::path& fifo)
+      : read_(::open(fifo.c_str(), O_RDONLY | O_NONBLOCK)), write_(::open(fifo.c_str(), O_WRONLY)) {
+    ::fcntl(read_, F_SETFL, 0);  // blocking reads from now on
+    thread_ = std::thread([this] {
+      char buf[1 << 16];
+      ssize_t n = 0;
+      while ((n = ::read(read_, buf, sizeof buf)) > 0) data_.append(buf, std::size_t(n));
+    });
+  }
+  FifoReader(const FifoReader&) = delete;
+  FifoReader& operator=(const FifoReader&) = delete;
+  ~FifoReader() {
+    if (thread_.joinable()) finish();
+  }
+  std::string finish() {
+    ::close(write_);
+    thread_.join();
+    ::close(read_);
+    return data_;
+  }
+
+ private:
+  int read_, write_;
+  std::thread thread_;
+  std::string data_;
+};
+
+bool is_char_device(const fs::path& p) {
+  struct stat st {};
+  return ::stat(p.c_str(), &st) == 0 && S_ISCHR(st.st_mode);
+}
+
+// `-o /dev/null` must leave /dev/null a character device (as root the rename destroyed it). The
+// real /dev/null is tried only after a private copy of it (mknod, root only) came through
+// intact, so that a regression cannot destroy it.
+TEST_F(CliTest, OutputToADeviceWritesItAndKeepsIt) {
+  const std::string in = std::string(kDirsHeader) + "0,0,1,0.6,0,0.8\n";
+  const std::vector<std::string> convert{"convert", "--from", "dirs", "--to", "hybrid", "-o"};
+  const auto to = [&](const std::string& out) {
+    std::vector<std::string> args = convert;
+    args.push_back(out);
+    return run(args, in);
+  };
+  if (::mknod(path("null").c_str(), S_IFCHR | 0666, makedev(1, 3)) == 0) {
+    const Result r = to("null");
+    EXPECT_EQ(r.status, 0) << r.err;
+    ASSERT_TRUE(is_char_device(path("null"))) << "the device node was replaced by a file";
+    EXPECT_EQ(entries(), std::vector<std::string>{"null"});
+  }
+  ASSERT_TRUE(is_char_device("/dev/null"));
+  Result r = to("/dev/null");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(is_char_device("/dev/null"));
+  // /dev/stdout is standard output as it is (here a file the test opened), not a file to replace.
+  r = to("/dev/stdout");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("hbar,phi_h,k,phi_k\n", 0), 0u) << r.out;
+}
+
+TEST_F(CliTest, OutputToAFifoIsWrittenToItsReader) {
+  ASSERT_EQ(::mkfifo(path("fifo").c_str(), 0600), 0);
+  FifoReader reader(path("fifo"));
+  const Result r = run({"export-merl", "--brdf", "lambert", "-o", "fifo"});
+  const std::string received = reader.finish();
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(received.size(), 12u + 3u * 8u * 90u * 90u * 180u);  // a whole MERL file
+  struct stat st {};
+  ASSERT_EQ(::stat(path("fifo").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_EQ(entries(), std::vector<std::string>{"fifo"});
+}
+
+TEST_F(CliTest, ReadOnlyOutputIsRefusedLikeCp) {
+  const std::string in = std::string(kDirsHeader) + "0,0,1,0.6,0,0.8\n";
+  put(path("out.csv"), "precious\n");
+  fs::permissions(path("out.csv"), fs::perms::owner_read | fs::perms::group_read);
+  Result r = run({"convert", "--from", "dirs", "--to", "hybrid", "-o", "out.csv"}, in);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err,
+            "halfback convert: error: cannot write 'out.csv' (it is read-only, mode 0440; make it "
+            "writable or remove it): Permission denied\n");
+  r = run({"export-merl", "--brdf", "lambert", "-o", "out.csv"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("read-only"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(path("out.csv")), "precious\n");
+  EXPECT_EQ(entries(), std::vector<std::string>{"out.csv"});
+}
+
+// Ctrl-C, SIGTERM and SIGHUP remove the hidden temporary beside the output, and the tool dies of
+// the signal. `convert` creates its output's temporary before reading its input, so a standard
+// input that never ends holds it open for as long as the test needs.
+TEST_F(CliTest, SignalsRemoveTheTemporaryFiles) {
+  for (const int sig : {SIGTERM, SIGINT, SIGHUP}) {
+    int input[2];
+    ASSERT_EQ(::pipe(input), 0);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, input[0], 0);
+    posix_spawn_file_actions_addclose(&actions, input[1]);
+    posix_spawn_file_actions_addopen(&actions, 2, path("err").c_str(), O_WRONLY | O_CREAT, 0644);
+    const std::string out = path("out.csv").string();
+    std::vector<std::string> args{HALFBACK_CLI_PATH, "convert", "--from", "dirs", "--to",
+                                  "hybrid",          "-o",      out};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, HALFBACK_CLI_PATH, &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(input[0]);
+    const std::string header(kDirsHeader);
+    ASSERT_EQ(::write(input[1], header.data(), header.size()), ssize_t(header.size()));
+    const auto has_temporary = [&] {
+      for (const auto& e : fs::directory_iterator(dir_))
+        if (e.path().filename().string().starts_with(".out.csv.tmp")) return true;
+      return false;
+    };
+    for (int i = 0; i < 1000 && !has_temporary(); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    EXPECT_TRUE(has_temporary()) << "no temporary file to remove";
+    ::kill(pid, sig);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ::close(input[1]);
+    EXPECT_TRUE(WIFSIGNALED(status)) << "signal " << sig << ": status " << status;
+    if (WIFSIGNALED(status)) {
+      EXPECT_EQ(WTERMSIG(status), sig);
+    }
+    EXPECT_EQ(entries(), std::vector<std::string>{"err"}) << "signal " << sig;
+    fs::remove(path("err"));
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -189,3 +189,48 @@ def test_bad_grids_and_render_settings_raise():
         b.render(width=0)
     with pytest.raises(ValueError, match="pixels"):
         halfback.hemisphere("hybrid", 0.1, pixels=1)
+
+
+# Issue 12, classes 8 and 10: the same rules as the command line.
+
+def test_albedo_of_a_non_finite_angle_raises():
+    b = halfback.load("lambert:albedo=0.25")
+    for theta in (float("nan"), float("inf"), -float("inf")):
+        with pytest.raises(ValueError, match="theta_i"):
+            b.albedo(theta)
+    (mean, _) = b.albedo(0.0, 16)
+    np.testing.assert_allclose(mean, 0.25, rtol=1e-6)
+
+
+def test_isotropic_needs_a_parameterization_on_one_side():
+    x = np.array([[0.0, 0.0, 1.0, 0.6, 0.0, 0.8]])
+    with pytest.raises(ValueError, match="isotropic needs a parameterization"):
+        halfback.convert(x, "dirs", "dirs", isotropic=True)
+    np.testing.assert_array_equal(halfback.convert(x, "dirs", "dirs"), x)
+    assert halfback.convert(x, "dirs", "hybrid", isotropic=True).shape == (1, 3)
+    cli = os.environ.get("HALFBACK_CLI")
+    if cli:
+        r = subprocess.run([cli, "convert", "--from", "dirs", "--to", "dirs", "--isotropic"],
+                           input="wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n0,0,1,0.6,0,0.8\n",
+                           capture_output=True, text=True)
+        assert r.returncode == 2 and "isotropic needs a parameterization" in r.stderr
+
+
+def test_slice_azimuths_wrap_into_0_360_and_nan_raises():
+    b = halfback.load("ggx:alpha=0.3")
+    ref = b.resample("hybrid", "slice", 12, azimuth=270)
+    assert ref["valid"].any()
+    for az in (-90, 630, 270 - 3600):
+        t = b.resample("hybrid", "slice", 12, azimuth=az)
+        np.testing.assert_array_equal(t["valid"], ref["valid"])
+        np.testing.assert_array_equal(t["rho"], ref["rho"])
+        assert t["metadata"]["slice_azimuth"] == ref["metadata"]["slice_azimuth"]
+    for az in (float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="azimuth"):
+            b.resample("hybrid", "slice", 12, azimuth=az)
+
+
+def test_an_all_invalid_table_warns():
+    with pytest.warns(RuntimeWarning, match="no grid point is inside the domain"):
+        t = halfback.load("lambert").resample("hybrid", "slice", 4, ranges={"k": (1.5, 2)})
+    assert not t["valid"].any()

@@ -19,11 +19,20 @@ struct ModelParam {
   std::string name;         // [a-z][a-z0-9_]*
   std::string description;  // one line
   double default_value = 0;
-  double min = 0, max = 0;  // inclusive range; default_value must lie in it
+  double min = 0, max = 0;  // inclusive range of every value given; default_value must lie in it
   // Named values (e.g. {"F", "S", "G"}): the spec gives a name, the factory receives its index.
   // For such a parameter min and max are set by add() to 0 and choices.size() − 1.
   std::vector<std::string> choices = {};
+  // When not empty: a parameter that is not given takes the value of this one (e.g. alpha_x
+  // defaults to alpha), and default_value is unused. "Not given" is said here, never by a value
+  // inside the range. The named parameter must be declared before, be numeric, default to a
+  // value of its own, and have a range inside [min, max] (so the value it passes is valid).
+  std::string default_from = {};
 };
+
+// A parameter that defaults to another one (see ModelParam::default_from).
+ModelParam defaults_to(std::string name, std::string description, std::string from, double min,
+                       double max);
 
 // The parameter values a factory receives: every declared parameter, defaults filled in.
 class ModelArgs {

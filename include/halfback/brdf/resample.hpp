@@ -45,7 +45,7 @@ struct GridSpec {
   Space space = Space::hybrid;  // a parameterization, not dirs
   GridKind kind = GridKind::isotropic;
   GridSampling sampling = GridSampling::centres;
-  double slice_azimuth = 0;    // kind == slice: the relative azimuth, radians
+  double slice_azimuth = 0;    // kind == slice: the relative azimuth, radians (wrapped by point)
   std::vector<GridAxis> axes;  // 4, 3 or 2 axes (full, isotropic, slice)
 
   std::size_t points() const;
@@ -58,10 +58,17 @@ struct GridSpec {
   GridAxis& axis(std::string_view name);
 };
 
+// The one rule for relative azimuths given by users (the CLI, Python, the figures): any finite
+// azimuth is wrapped into [0°, 360°) (−90 → 270, 360 → 0, 400 → 40); NaN and infinities are an
+// error (std::invalid_argument "WHAT: 'nan' is not a finite azimuth in degrees").
+double wrap_azimuth_degrees(double degrees, std::string_view what);
+// The same in radians, into [0, 2π), for the azimuth a slice is evaluated at (GridSpec::point).
+double wrap_azimuth_radians(double radians);
+
 // The grid of a kind over `space`, each axis on the range that bounds the domain (angles θ in
 // [0, π/2], azimuths in [0, 2π), ‖h̄‖, ‖k̄‖, ‖k‖ in [0, 1]), with counts[i] samples on axis i (a
-// single count applies to every axis). Throws std::invalid_argument for dirs, a wrong number of
-// counts or a count of 0.
+// single count applies to every axis), a slice at slice_azimuth wrapped into [0, 2π). Throws
+// std::invalid_argument for dirs, a wrong number of counts, a count of 0 or a non-finite azimuth.
 GridSpec default_grid(Space space, GridKind kind, std::vector<std::size_t> counts,
                       double slice_azimuth = 0);
 

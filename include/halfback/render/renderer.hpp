@@ -61,7 +61,11 @@ struct RenderResult {
   double sampler_seconds = 0;   // building the BRDF sampler (tabulation)
   bool budget_exhausted = false;
   std::uint64_t nonfinite = 0;  // sample values that were NaN or infinite, counted as 0
-  std::string sampler;          // which BRDF sampler was used
+  // Pixels with a channel that is not finite in the float image: the mean radiance overflows
+  // the float range (about 3.4e38), e.g. an environment scaled far too high. Such an image is
+  // not a picture of anything; the CLI refuses to write it.
+  std::uint64_t nonfinite_pixels = 0;
+  std::string sampler;  // which BRDF sampler was used
 };
 
 // Throws std::invalid_argument for invalid settings (sizes, spp, fov).

@@ -10,7 +10,23 @@
 // The new file gets the permission bits of the file it replaces, or 0666 minus the umask for a
 // new file, like a file opened with fopen(). When the destination is a symbolic link, the file it
 // points to is replaced and the link kept.
+//
+// Only a regular file is ever replaced. What the destination is decides the rest:
+//   - absent, or a regular file: the temporary file and rename above. A regular file that is
+//     read-only (no write permission bit, or not writable by this process) is refused with
+//     "... is read-only", like cp(1), even for root (who could otherwise replace it silently);
+//   - a character device (/dev/null, a terminal) or a FIFO: written directly, never replaced
+//     (renaming over /dev/null as root would destroy it). Opened at the first write or at
+//     commit(), so that a probe (constructed, then discarded) does not open a FIFO's reader end;
+//   - /dev/stdout, /dev/stderr, /dev/fd/N, /proc/self/fd/N: that descriptor, written directly
+//     at its current offset (whatever it is: a pipe, a terminal or a file the shell opened);
+//   - a directory, a socket, a block device: refused, naming what it is.
+// Data written directly cannot be taken back: discard() then only closes the descriptor.
+// While a temporary file exists it is registered for removal on SIGINT, SIGTERM and SIGHUP
+// (util/signal_cleanup.hpp; the program installs the handlers).
 #pragma once
+
+#include <sys/types.h>
 
 #include <filesystem>
 #include <string_view>
@@ -19,8 +35,9 @@ namespace halfback {
 
 class AtomicFile {
  public:
-  // Creates the temporary file. Throws std::system_error ("cannot write 'PATH': REASON") when the
-  // directory does not exist or is not writable, or when `target` is a directory.
+  // Creates the temporary file (for a regular destination). Throws std::system_error ("cannot
+  // write 'PATH': REASON") when the directory does not exist or is not writable, or when `target`
+  // is a directory, a socket, a block device or a read-only file.
   explicit AtomicFile(std::filesystem::path target);
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -29,22 +46,32 @@ class AtomicFile {
   // Appends to the temporary file. Throws std::system_error (e.g. "No space left on device").
   void write(std::string_view data);
 
-  // Flushes the data to disk and renames the temporary file over the target. Throws
-  // std::system_error on failure, after removing the temporary file. At most once.
+  // Flushes the data to disk and renames the temporary file over the target (closes a direct
+  // destination). Throws std::system_error on failure, after removing the temporary file. At
+  // most once.
   void commit();
 
   // Removes the temporary file without touching the target (also done by the destructor).
   void discard() noexcept;
 
   const std::filesystem::path& target() const noexcept { return target_; }
-  const std::filesystem::path& temporary_path() const noexcept { return temp_; }
+  const std::filesystem::path& temporary_path() const noexcept { return temp_; }  // "" if direct
   bool committed() const noexcept { return committed_; }
+  // Whether the destination is written directly (a device, a FIFO, a standard stream).
+  bool direct() const noexcept { return direct_; }
 
  private:
+  void create_temporary(mode_t mode);
+  void open_direct();  // at the first write or at commit
+
   std::filesystem::path target_;    // as given, for messages
   std::filesystem::path resolved_;  // the file that is replaced (symbolic links followed)
   std::filesystem::path temp_;
   int fd_ = -1;
+  int stream_fd_ = -1;  // direct: the descriptor named by /dev/stdout, /dev/fd/N, ...
+  int temp_slot_ = -1;  // the temporary's slot in the signal-cleanup registry
+  bool direct_ = false;
+  bool finished_ = false;  // committed or discarded
   bool committed_ = false;
 };
 
