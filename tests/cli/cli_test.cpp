@@ -1011,7 +1011,7 @@ TEST_F(CliTest, SignalsRemoveTheTemporaryFiles) {
     const std::string header(kDirsHeader);
     ASSERT_EQ(::write(input[1], header.data(), header.size()), ssize_t(header.size()));
     const auto has_temporary = [&] {
-      for (const auto& e : fs::directory_iterator(dir_))
+      for (const auto& e : fs::directory_iterator(dir_.path()))
         if (e.path().filename().string().starts_with(".out.csv.tmp")) return true;
       return false;
     };
