@@ -1,0 +1,107 @@
+// Compiled with -ffp-contract=fast (src/formats/CMakeLists.txt): the products and sums of a layer
+// may fuse into FMA instructions, which only changes their rounding (the networks were trained in
+// float32 with whatever their hardware did).
+#include "formats/nbrdf_kernel.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+
+namespace halfback::nbrdf_detail {
+namespace {
+
+// The block kernel is compiled for the baseline and for AVX2/AVX-512, and the loader picks the
+// clone the CPU runs (GCC function multi-versioning); the helpers below are inlined into each.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(HALFBACK_NO_FLATTEN)
+#define HALFBACK_NBRDF_CLONES \
+  __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
+#else
+#define HALFBACK_NBRDF_CLONES
+#endif
+#define HALFBACK_NBRDF_INLINE inline __attribute__((always_inline))
+
+// max(exp(y) − 1, 0) in float without a library call, so that a loop of it vectorizes: y ≤ 0
+// gives 0 (and so does a NaN, which only weights that overflow float can produce), y is capped at
+// 88 (exp(88) ≈ 1.7e38, near float's largest), and exp(y) = 2^n·e^r with n = round(y/ln 2), r = y −
+// n·ln 2 in [−ln2/2, ln2/2] (ln 2 split in two so that n·ln2_hi is exact), e^r by its Taylor
+// polynomial of degree 7 (truncation < 6e-9, below float rounding).
+HALFBACK_NBRDF_INLINE float exp_minus_one_clamped(float y) {
+  const float positive = y > 0.0f ? y : 0.0f;
+  const float x = positive < 88.0f ? positive : 88.0f;
+  const float n = float(int(x * 1.44269504088896341f + 0.5f));
+  const float r = (x - n * 0.693145751953125f) - n * 1.428606765330187e-06f;
+  float p = 1.0f / 5040.0f;
+  p = p * r + 1.0f / 720.0f;
+  p = p * r + 1.0f / 120.0f;
+  p = p * r + 1.0f / 24.0f;
+  p = p * r + 1.0f / 6.0f;
+  p = p * r + 0.5f;
+  p = p * r + 1.0f;
+  p = p * r + 1.0f;
+  const float scale = std::bit_cast<float>(std::uint32_t(int(n) + 127) << 23);
+  return std::max(p * scale - 1.0f, 0.0f);
+}
+
+// One dense layer on a block: out[j][p] = act(bias[j] + Σk in[k][p]·kernel[k][j]).
+HALFBACK_NBRDF_INLINE void dense_block(const NbrdfLayer& layer, bool relu, const float* in,
+                                       float* out) {
+  const std::size_t n_in = layer.inputs, n_out = layer.outputs;
+  const float* kernel = layer.kernel.data();
+  for (std::size_t j = 0; j < n_out; ++j) {
+    float acc[kBlock];
+    for (std::size_t p = 0; p < kBlock; ++p) acc[p] = layer.bias[j];
+    for (std::size_t k = 0; k < n_in; ++k) {
+      const float w = kernel[k * n_out + j];
+      const float* x = in + k * kBlock;
+      for (std::size_t p = 0; p < kBlock; ++p) acc[p] += w * x[p];
+    }
+    float* o = out + j * kBlock;
+    if (relu)
+      for (std::size_t p = 0; p < kBlock; ++p) o[p] = std::max(acc[p], 0.0f);
+    else
+      for (std::size_t p = 0; p < kBlock; ++p) o[p] = acc[p];
+  }
+}
+
+HALFBACK_NBRDF_CLONES void evaluate_block_impl(const NbrdfNetwork& network, const float* inputs,
+                                               float* outputs) {
+  alignas(64) float ping[nbrdf::kMaxWidth * kBlock];
+  alignas(64) float pong[nbrdf::kMaxWidth * kBlock];
+  const std::size_t n_layers = network.layers.size();
+  const float* in = inputs;
+  for (std::size_t l = 0; l < n_layers; ++l) {
+    float* out = (l % 2 == 0) ? ping : pong;
+    dense_block(network.layers[l], l + 1 < n_layers, in, out);
+    in = out;
+  }
+  for (std::size_t i = 0; i < nbrdf::kOutputs * kBlock; ++i)
+    outputs[i] = exp_minus_one_clamped(in[i]);
+}
+
+}  // namespace
+
+std::array<float, nbrdf::kOutputs> evaluate_one(const NbrdfNetwork& network,
+                                                const std::array<float, nbrdf::kInputs>& input) {
+  std::array<float, nbrdf::kMaxWidth> ping{}, pong{};
+  std::copy(input.begin(), input.end(), ping.begin());
+  float* in = ping.data();
+  float* out = pong.data();
+  const std::size_t n_layers = network.layers.size();
+  for (std::size_t l = 0; l < n_layers; ++l) {
+    const NbrdfLayer& layer = network.layers[l];
+    for (std::size_t j = 0; j < layer.outputs; ++j) {
+      float acc = layer.bias[j];
+      for (std::size_t k = 0; k < layer.inputs; ++k)
+        acc += layer.kernel[k * layer.outputs + j] * in[k];
+      out[j] = (l + 1 < n_layers) ? std::max(acc, 0.0f) : acc;
+    }
+    std::swap(in, out);
+  }
+  return {exp_minus_one_clamped(in[0]), exp_minus_one_clamped(in[1]), exp_minus_one_clamped(in[2])};
+}
+
+void evaluate_block(const NbrdfNetwork& network, const float* inputs, float* outputs) {
+  evaluate_block_impl(network, inputs, outputs);
+}
+
+}  // namespace halfback::nbrdf_detail
