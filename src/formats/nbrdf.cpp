@@ -17,21 +17,9 @@ namespace halfback {
 // Input encoding
 // ---------------------------------------------------------------------------------------------
 std::array<double, nbrdf::kInputs> nbrdf::encode(const DirPair<double>& pair) {
-  const Vec3<double>& wi = pair.wi;
-  const Vec3<double>& wo = pair.wo;
-  double hx = wi.x + wo.x, hy = wi.y + wo.y, hz = wi.z + wo.z;
-  const double norm = std::sqrt(hx * hx + hy * hy + hz * hz);
-  if (norm > 0)
-    hx /= norm, hy /= norm, hz /= norm;
-  else  // ωo = −ωi (both grazing): h is undefined, its limit from above the surface is n
-    hx = 0, hy = 0, hz = 1;
-  const double sin_h = std::sqrt(hx * hx + hy * hy);
-  const double cos_phi = sin_h > 0 ? hx / sin_h : 1.0, sin_phi = sin_h > 0 ? hy / sin_h : 0.0;
-  // ωo (the view direction: docs/formats.md, "Neural BRDFs", on why not ωi) rotated by −φh about
-  // n, then by −θh about the binormal.
-  const double ax = cos_phi * wo.x + sin_phi * wo.y;
-  const double ay = -sin_phi * wo.x + cos_phi * wo.y;
-  return {sin_h, 0.0, hz, hz * ax - sin_h * wo.z, ay, sin_h * ax + hz * wo.z};
+  const auto e =
+      nbrdf_detail::encode_pair(pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z);
+  return {e.x0, 0.0, e.x2, e.d0, e.d1, e.d2};
 }
 
 namespace {
@@ -43,6 +31,11 @@ bool has_nan(const DirPair<double>& p) {
 
 bool below_horizon(const DirPair<double>& p) {
   return p.wi.z < 0 || p.wo.z < 0;
+}
+
+// A pair the network is evaluated at (eval() gives the others: 0 or NaN).
+bool usable(const DirPair<double>& p) {
+  return !has_nan(p) && !below_horizon(p);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -235,22 +228,22 @@ void NbrdfBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb
     throw std::invalid_argument("NbrdfBrdf::eval_batch: output size differs from the pairs'");
   using nbrdf_detail::kBlock;
   parallel_for(pairs.size(), 16 * kBlock, [&](std::size_t begin, std::size_t end) {
-    alignas(64) float inputs[nbrdf::kInputs * kBlock];
+    alignas(64) double block[6 * kBlock];
     alignas(64) float outputs[nbrdf::kOutputs * kBlock];
     for (std::size_t start = begin; start < end; start += kBlock) {
       const std::size_t count = std::min(kBlock, end - start);
       for (std::size_t p = 0; p < kBlock; ++p) {
-        // Pairs past the end, below the horizon or with a NaN are evaluated at a valid input
-        // (normal incidence) and overwritten below.
-        const DirPair<double>& pair = pairs[start + std::min(p, count - 1)];
-        const bool usable = p < count && !has_nan(pair) && !below_horizon(pair);
-        const auto x = usable ? nbrdf::encode(pair) : std::array<double, 6>{0, 0, 1, 0, 0, 1};
-        for (std::size_t i = 0; i < nbrdf::kInputs; ++i) inputs[i * kBlock + p] = float(x[i]);
+        // Pairs past the end, below the horizon or with a NaN are evaluated at normal incidence
+        // and view, and overwritten below.
+        DirPair<double> pair{{0, 0, 1}, {0, 0, 1}};
+        if (p < count && usable(pairs[start + p])) pair = pairs[start + p];
+        const double v[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
+        for (std::size_t i = 0; i < 6; ++i) block[i * kBlock + p] = v[i];
       }
-      nbrdf_detail::evaluate_block(network_, inputs, outputs);
+      nbrdf_detail::evaluate_block(network_, block, outputs);
       for (std::size_t p = 0; p < count; ++p) {
         const DirPair<double>& pair = pairs[start + p];
-        if (has_nan(pair) || below_horizon(pair))
+        if (!usable(pair))
           out[start + p] = eval(pair);
         else
           out[start + p] = {outputs[p], outputs[kBlock + p], outputs[2 * kBlock + p]};

@@ -42,31 +42,60 @@ HALFBACK_NBRDF_INLINE float exp_minus_one_clamped(float y) {
   return std::max(p * scale - 1.0f, 0.0f);
 }
 
-// One dense layer on a block: out[j][p] = act(bias[j] + Σk in[k][p]·kernel[k][j]).
-HALFBACK_NBRDF_INLINE void dense_block(const NbrdfLayer& layer, bool relu, const float* in,
-                                       float* out) {
+// Outputs j0 .. j0+G−1 of a dense layer on a block: out[j][p] = act(bias[j] + Σk in[k][p]·W[k][j]).
+// G outputs at a time keep G × kBlock accumulators in registers and load each input row once for
+// all G (the register blocking of a matrix product).
+template <std::size_t G>
+HALFBACK_NBRDF_INLINE void dense_outputs(const NbrdfLayer& layer, std::size_t j0, bool relu,
+                                         const float* in, float* out) {
   const std::size_t n_in = layer.inputs, n_out = layer.outputs;
   const float* kernel = layer.kernel.data();
-  for (std::size_t j = 0; j < n_out; ++j) {
-    float acc[kBlock];
-    for (std::size_t p = 0; p < kBlock; ++p) acc[p] = layer.bias[j];
-    for (std::size_t k = 0; k < n_in; ++k) {
-      const float w = kernel[k * n_out + j];
-      const float* x = in + k * kBlock;
-      for (std::size_t p = 0; p < kBlock; ++p) acc[p] += w * x[p];
+  float acc[G][kBlock];
+  for (std::size_t g = 0; g < G; ++g)
+    for (std::size_t p = 0; p < kBlock; ++p) acc[g][p] = layer.bias[j0 + g];
+  for (std::size_t k = 0; k < n_in; ++k) {
+    const float* x = in + k * kBlock;
+    for (std::size_t g = 0; g < G; ++g) {
+      const float w = kernel[k * n_out + j0 + g];
+      for (std::size_t p = 0; p < kBlock; ++p) acc[g][p] += w * x[p];
     }
-    float* o = out + j * kBlock;
-    if (relu)
-      for (std::size_t p = 0; p < kBlock; ++p) o[p] = std::max(acc[p], 0.0f);
-    else
-      for (std::size_t p = 0; p < kBlock; ++p) o[p] = acc[p];
+  }
+  for (std::size_t g = 0; g < G; ++g) {
+    float* o = out + (j0 + g) * kBlock;
+    for (std::size_t p = 0; p < kBlock; ++p) o[p] = relu ? std::max(acc[g][p], 0.0f) : acc[g][p];
   }
 }
 
-HALFBACK_NBRDF_CLONES void evaluate_block_impl(const NbrdfNetwork& network, const float* inputs,
+// One dense layer on a block, three outputs at a time (the published widths, 21 and 3, are
+// multiples of 3), then the rest one by one.
+HALFBACK_NBRDF_INLINE void dense_block(const NbrdfLayer& layer, bool relu, const float* in,
+                                       float* out) {
+  std::size_t j = 0;
+  for (; j + 3 <= layer.outputs; j += 3) dense_outputs<3>(layer, j, relu, in, out);
+  for (; j < layer.outputs; ++j) dense_outputs<1>(layer, j, relu, in, out);
+}
+
+// The network inputs of a block of pairs (rows of kBlock, as evaluate_block's).
+HALFBACK_NBRDF_INLINE void encode_block(const double* pairs, float* inputs) {
+  for (std::size_t p = 0; p < kBlock; ++p) {
+    const Encoded e =
+        encode_pair(pairs[p], pairs[kBlock + p], pairs[2 * kBlock + p], pairs[3 * kBlock + p],
+                    pairs[4 * kBlock + p], pairs[5 * kBlock + p]);
+    inputs[p] = float(e.x0);
+    inputs[kBlock + p] = 0.0f;
+    inputs[2 * kBlock + p] = float(e.x2);
+    inputs[3 * kBlock + p] = float(e.d0);
+    inputs[4 * kBlock + p] = float(e.d1);
+    inputs[5 * kBlock + p] = float(e.d2);
+  }
+}
+
+HALFBACK_NBRDF_CLONES void evaluate_block_impl(const NbrdfNetwork& network, const double* pairs,
                                                float* outputs) {
+  alignas(64) float inputs[nbrdf::kInputs * kBlock];
   alignas(64) float ping[nbrdf::kMaxWidth * kBlock];
   alignas(64) float pong[nbrdf::kMaxWidth * kBlock];
+  encode_block(pairs, inputs);
   const std::size_t n_layers = network.layers.size();
   const float* in = inputs;
   for (std::size_t l = 0; l < n_layers; ++l) {
@@ -100,8 +129,8 @@ std::array<float, nbrdf::kOutputs> evaluate_one(const NbrdfNetwork& network,
   return {exp_minus_one_clamped(in[0]), exp_minus_one_clamped(in[1]), exp_minus_one_clamped(in[2])};
 }
 
-void evaluate_block(const NbrdfNetwork& network, const float* inputs, float* outputs) {
-  evaluate_block_impl(network, inputs, outputs);
+void evaluate_block(const NbrdfNetwork& network, const double* pairs, float* outputs) {
+  evaluate_block_impl(network, pairs, outputs);
 }
 
 }  // namespace halfback::nbrdf_detail
