@@ -1,6 +1,7 @@
 // Compiled with -ffp-contract=fast (src/formats/CMakeLists.txt): the products and sums of a layer
 // may fuse into FMA instructions, which only changes their rounding (the networks were trained in
-// float32 with whatever their hardware did).
+// float32 with whatever their hardware did); and with -fno-math-errno -fno-trapping-math, so that
+// the loops of encode_block and of the output's exp, with their selects, vectorize.
 #include "formats/nbrdf_kernel.hpp"
 
 #include <algorithm>
@@ -28,8 +29,9 @@ namespace {
 HALFBACK_NBRDF_INLINE float exp_minus_one_clamped(float y) {
   const float positive = y > 0.0f ? y : 0.0f;
   const float x = positive < 88.0f ? positive : 88.0f;
-  const float n = float(int(x * 1.44269504088896341f + 0.5f));
-  const float r = (x - n * 0.693145751953125f) - n * 1.428606765330187e-06f;
+  const std::int32_t n = std::int32_t(x * 1.44269504088896341f + 0.5f);
+  const float nf = float(n);
+  const float r = (x - nf * 0.693145751953125f) - nf * 1.428606765330187e-06f;
   float p = 1.0f / 5040.0f;
   p = p * r + 1.0f / 720.0f;
   p = p * r + 1.0f / 120.0f;
@@ -38,8 +40,10 @@ HALFBACK_NBRDF_INLINE float exp_minus_one_clamped(float y) {
   p = p * r + 0.5f;
   p = p * r + 1.0f;
   p = p * r + 1.0f;
-  const float scale = std::bit_cast<float>(std::uint32_t(int(n) + 127) << 23);
-  return std::max(p * scale - 1.0f, 0.0f);
+  // 2^n from its exponent bits (n in [0, 127]).
+  const float scale = std::bit_cast<float>((n + 127) << 23);
+  const float e = p * scale - 1.0f;
+  return e > 0.0f ? e : 0.0f;
 }
 
 // Outputs j0 .. j0+G−1 of a dense layer on a block: out[j][p] = act(bias[j] + Σk in[k][p]·W[k][j]).

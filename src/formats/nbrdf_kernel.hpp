@@ -24,11 +24,13 @@ struct Encoded {
   double hx = ix + ox, hy = iy + oy, hz = iz + oz;
   const double norm = std::sqrt(hx * hx + hy * hy + hz * hz);
   // ωo = −ωi (both grazing): h is undefined, its limit from above the surface is n.
+  // (Selects on the divisors rather than around the divisions, so that a loop of this
+  // vectorizes: a compiler may not speculate a division that could trap.)
   const bool degenerate = !(norm > 0);
-  const double inv = degenerate ? 0.0 : 1.0 / norm;
+  const double inv = degenerate ? 0.0 : 1.0 / (degenerate ? 1.0 : norm);
   hx *= inv, hy *= inv, hz = degenerate ? 1.0 : hz * inv;
   const double sin_h = std::sqrt(hx * hx + hy * hy);
-  const double inv_sin = sin_h > 0 ? 1.0 / sin_h : 0.0;
+  const double inv_sin = 1.0 / (sin_h > 0 ? sin_h : 1.0);  // hx = hy = 0 when sin_h = 0
   const double cos_phi = sin_h > 0 ? hx * inv_sin : 1.0, sin_phi = hy * inv_sin;
   // ωo (the view direction: docs/formats.md, "Neural BRDFs", on why not ωi) rotated by −φh about
   // n, then by −θh about the binormal.
