@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path dir = argv[1];
-  for (const char* sub : {"merl", "rgl", "alta"}) fs::create_directories(dir / sub);
+  for (const char* sub : {"merl", "rgl", "alta", "npy"}) fs::create_directories(dir / sub);
 
   const auto iso = rgl_material(3, 4, 2, {0.0f});
   write(dir / "rgl" / "iso.bsdf", iso.data(), iso.size());
@@ -89,5 +89,23 @@ int main(int argc, char** argv) {
   write(dir / "merl" / "header.bin", merl.data(), merl.size());
   const double pair[6] = {0.3, 0.1, 0.948683, -0.2, 0.4, 0.894427};
   write(dir / "merl" / "pair.bin", pair, sizeof pair);
+  // .npy: a 6 × 3 float32 kernel (format 1.0) and a 1-D array.
+  auto npy = [](const std::string& shape, std::size_t count) {
+    std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': " + shape + ", }";
+    while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+    header += '\n';
+    std::string out("\x93NUMPY\x01\x00", 8);
+    out += char(header.size() & 0xff);
+    out += char(header.size() >> 8);
+    out += header;
+    for (std::size_t i = 0; i < count; ++i) {
+      const float v = 0.1f * float(i) - 0.5f;
+      out.append(reinterpret_cast<const char*>(&v), sizeof v);
+    }
+    return out;
+  };
+  const std::string kernel = npy("(6, 3)", 18), bias = npy("(3,)", 3);
+  write(dir / "npy" / "kernel.npy", kernel.data(), kernel.size());
+  write(dir / "npy" / "bias.npy", bias.data(), bias.size());
   return 0;
 }

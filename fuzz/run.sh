@@ -11,7 +11,7 @@ build="${FUZZ_BUILD_DIR:-build/fuzz}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 
 cmake --preset fuzz -B "$build" >/dev/null
-cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz make_fuzz_seeds
+cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz make_fuzz_seeds
 
 corpus="$build/corpus"
 mkdir -p "$corpus"
@@ -20,11 +20,12 @@ artifacts="$build/artifacts"
 mkdir -p "$artifacts"
 
 status=0
-for target in merl rgl alta; do
+for target in merl rgl alta npy; do
   case "$target" in
     merl) max_len=4096 ;;     # full-size files are built inside the target
     rgl)  max_len=65536 ;;
     alta) max_len=65536 ;;
+    npy)  max_len=4096 ;;
   esac
   echo "== ${target}_fuzz: ${seconds}s"
   if ! "$build/fuzz/${target}_fuzz" "$corpus/$target" -max_total_time="$seconds" \

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <string>
@@ -11,6 +12,7 @@
 #include "halfback/brdf/test_functions.hpp"
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
+#include "halfback/formats/nbrdf.hpp"
 #include "halfback/formats/rgl.hpp"
 #include "halfback/models/analytic.hpp"
 #include "halfback/models/register.hpp"
@@ -54,6 +56,8 @@ bool looks_like_alta(const std::string& head) {
 
 BrdfFileFormat detect_brdf_format(const std::filesystem::path& path) {
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    return is_nbrdf_npy(path) ? BrdfFileFormat::nbrdf_npy : BrdfFileFormat::unknown;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) throw FormatError(path.string(), "file", "cannot get its size: " + ec.message());
   std::ifstream in(path, std::ios::binary);
@@ -65,6 +69,9 @@ BrdfFileFormat detect_brdf_format(const std::filesystem::path& path) {
     return BrdfFileFormat::merl;
   if (head.size() >= 12 && head.compare(0, 12, std::string("tensor_file\0", 12)) == 0)
     return BrdfFileFormat::rgl;
+  if (head.compare(0, nbrdf::kHdf5Magic.size(), nbrdf::kHdf5Magic) == 0)
+    return BrdfFileFormat::nbrdf_h5;
+  if (head.compare(0, 6, "\x93NUMPY") == 0 && is_nbrdf_npy(path)) return BrdfFileFormat::nbrdf_npy;
   if (looks_like_alta(head)) return BrdfFileFormat::alta;
   return BrdfFileFormat::unknown;
 }
@@ -147,12 +154,17 @@ BrdfPtr load_brdf(std::string_view spec) {
 
 namespace {
 
-// "embedded:NAME": a measured material compiled into the library (data/README.md).
+// "embedded:NAME": a measured material compiled into the library (data/README.md): an RGL file,
+// or a neural BRDF's Keras weights (by the HDF5 signature).
 BrdfPtr load_embedded(std::string_view name) {
   for (const detail::EmbeddedFile& f : detail::embedded_files()) {
     if (f.name != name) continue;
     const auto* b = reinterpret_cast<const std::byte*>(f.bytes.data());
     const std::string label = "embedded:" + std::string(name);
+    const std::span<const std::byte> bytes(b, f.bytes.size());
+    if (bytes.size() >= nbrdf::kHdf5Magic.size() &&
+        std::memcmp(b, nbrdf::kHdf5Magic.data(), nbrdf::kHdf5Magic.size()) == 0)
+      return std::make_shared<NbrdfBrdf>(parse_nbrdf_h5(bytes, label), std::string(name));
     return std::make_shared<RglBrdf>(
         parse_tensor_file(std::vector<std::byte>(b, b + f.bytes.size()), label),
         std::string(name) + "_rgb");
@@ -170,6 +182,9 @@ BrdfPtr load_one(std::string_view spec) {
   const std::filesystem::path path{std::string(spec)};
   std::error_code ec;
   if (!spec.empty() && std::filesystem::exists(path, ec)) {
+    // A folder is a BRDF only as the NumPy form of a neural BRDF (its reader says what is
+    // missing).
+    if (std::filesystem::is_directory(path, ec)) return load_nbrdf(path);
     if (!std::filesystem::is_regular_file(path, ec))
       throw FormatError(path.string(), "file", "not a regular file");
     BrdfFileFormat format = detect_brdf_format(path);
@@ -182,10 +197,15 @@ BrdfPtr load_one(std::string_view spec) {
         format = BrdfFileFormat::rgl;
       else if (ext == ".dat" || ext == ".alta")
         format = BrdfFileFormat::alta;
+      else if (ext == ".h5")
+        format = BrdfFileFormat::nbrdf_h5;
+      else if (ext == ".npy")
+        format = BrdfFileFormat::nbrdf_npy;
       else
         throw FormatError(path.string(), "format",
                           "not a MERL .binary (34992012 bytes, 90 90 180 header), RGL .bsdf "
-                          "(\"tensor_file\" magic) or ALTA text file (#DIM header)");
+                          "(\"tensor_file\" magic), ALTA text file (#DIM header), neural BRDF "
+                          "(HDF5 .h5, or NAME_fc1.npy)");
     }
     switch (format) {
       case BrdfFileFormat::merl:
@@ -194,6 +214,10 @@ BrdfPtr load_one(std::string_view spec) {
         return load_rgl(path);
       case BrdfFileFormat::alta:
         return load_alta(path);
+      case BrdfFileFormat::nbrdf_h5:
+        return std::make_shared<NbrdfBrdf>(read_nbrdf_h5(path), path.stem().string());
+      case BrdfFileFormat::nbrdf_npy:
+        return load_nbrdf(path);
       case BrdfFileFormat::unknown:
         break;
     }

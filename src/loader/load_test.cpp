@@ -278,7 +278,8 @@ TEST(LoadBrdf, ErrorsForFiles) {
   write_text(tmp / "broken.txt", kAlta + "0.5 0 0\n");
   EXPECT_FORMAT_ERROR(load_brdf((tmp / "broken.txt").string()), "broken.txt", "line 7",
                       "3 numbers, expected 4");
-  EXPECT_FORMAT_ERROR(load_brdf(tmp.path().string()), "not a regular file");
+  // A folder is read as the NumPy form of a neural BRDF, which says what is missing.
+  EXPECT_FORMAT_ERROR(load_brdf(tmp.path().string()), "folder", "holds no NAME_fc1.npy");
 }
 
 TEST(LoadBrdf, ModelSpecs) {
@@ -344,16 +345,22 @@ TEST(BuiltinModels, SumOfSpecs) {
   EXPECT_THROW(load_brdf("lambert+nosuchmodel"), std::invalid_argument);
 }
 
-// The embedded materials are the files of data/rgl/ (same bytes, so the same values), and an
-// unknown name lists the known ones.
+// The embedded materials are the files of data/rgl/ and data/nbrdf/ (same bytes, so the same
+// values), and an unknown name lists the known ones.
 TEST(Embedded, MaterialsAreTheDataFiles) {
   const auto names = embedded_material_names();
-  ASSERT_EQ(names.size(), 3u);
+  ASSERT_EQ(names, (std::vector<std::string>{"ilm_l3_37_metallic", "colodur_azure_4e",
+                                             "acrylic_felt_green", "gold-metallic-paint3",
+                                             "colonial-maple-223", "pink-felt"}));
   const auto pairs = random_pairs(500, 17);
-  for (const std::string& n : names) {
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const std::string& n = names[k];
+    const bool rgl = k < 3;
     const BrdfPtr e = load_brdf("embedded:" + n);
-    EXPECT_EQ(e->name(), "rgl:" + n + "_rgb");
-    const BrdfPtr f = load_brdf(std::string(HALFBACK_SOURCE_DIR) + "/data/rgl/" + n + "_rgb.bsdf");
+    EXPECT_EQ(e->name(), rgl ? "rgl:" + n + "_rgb" : "nbrdf:" + n);
+    const BrdfPtr f =
+        load_brdf(std::string(HALFBACK_SOURCE_DIR) +
+                  (rgl ? "/data/rgl/" + n + "_rgb.bsdf" : "/data/nbrdf/" + n + ".h5"));
     for (const auto& p : pairs) {
       const Rgb a = e->eval(p), b = f->eval(p);
       ASSERT_EQ(a, b) << n;

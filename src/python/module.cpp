@@ -398,7 +398,8 @@ forms, the measure of the 3 coordinates: 2*pi times the 4D J of the canonical po
 }
 
 void bind_brdf_class(py::module_& m) {
-  py::class_<PyBrdf>(m, "Brdf", "A BRDF: an analytic model or measured data (MERL, RGL, ALTA).")
+  py::class_<PyBrdf>(m, "Brdf",
+                     "A BRDF: an analytic model, measured data (MERL, RGL, ALTA) or a neural BRDF.")
       .def_property_readonly("name", [](const PyBrdf& b) { return b.brdf->name(); })
       .def_property_readonly("description", [](const PyBrdf& b) { return b.brdf->description(); })
       .def_property_readonly("isotropic", [](const PyBrdf& b) { return b.brdf->isotropic(); })
@@ -475,7 +476,8 @@ and wo; row j of the arrays is at v = v[j] (row 0 is the bottom). projection: "e
 void bind_loading(py::module_& m) {
   m.def(
       "load", [](const std::string& spec) { return PyBrdf{load_brdf(spec)}; }, py::arg("spec"),
-      R"doc(Loads a BRDF from a SPEC: a MERL/RGL/ALTA file, a model such as "ggx:alpha=0.2" or
+      R"doc(Loads a BRDF from a SPEC: a MERL/RGL/ALTA file, a neural BRDF (.h5, or the folder or
+NAME_fc1.npy of its NumPy form), a model such as "ggx:alpha=0.2" or
 "lambert:albedo=0.5", a sum "a+b", or "embedded:NAME" (as on the command line).)doc");
   m.def(
       "models", [] { return model_registry().names(); },

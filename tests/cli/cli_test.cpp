@@ -793,6 +793,57 @@ TEST_F(CliTest, InfoOfAModelAndOfAMerlFileItWrote) {
     EXPECT_NEAR(ta.columns[c][0], tb.columns[c][0], 1e-9 * tb.columns[c][0]);
 }
 
+// The shared data folder (../shared/data/SUB from HALFBACK_SHARED_DIR, which CTest sets), or ""
+// when it is absent (the test then skips, or fails under CI=true).
+fs::path shared_data(const std::string& sub) {
+  const char* dir = std::getenv("HALFBACK_SHARED_DIR");
+  const fs::path p = fs::path(dir && *dir ? dir : HALFBACK_SOURCE_DIR "/../shared") / "data" / sub;
+  std::error_code ec;
+  return fs::exists(p, ec) ? p : fs::path{};
+}
+
+TEST_F(CliTest, InfoAndEvalOfAnEmbeddedNeuralBrdf) {
+  Result r = run({"info", "embedded:pink-felt"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* s : {"nbrdf:pink-felt", "Keras HDF5", "6-21-21-3", "675 float32",
+                        "source:", "embedded:pink-felt", "albedo at θi = 60°:"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+  // Below the horizon: 0; above: positive, finite values.
+  r = run({"eval", "--brdf", "embedded:pink-felt"},
+          std::string(kDirsHeader) + "0.6,0,0.8,-0.6,0,0.8\n0,0,1,0.6,0,-0.8\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const CsvTable t = parse(r.out);
+  ASSERT_EQ(t.rows(), 2u);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GT(t.columns[c][0], 0.0);
+    EXPECT_LT(t.columns[c][0], 10.0);
+    EXPECT_EQ(t.columns[c][1], 0.0);
+  }
+}
+
+TEST_F(CliTest, EvalOfTheH5AndNpyFormsOfANeuralBrdfAgree) {
+  const fs::path dir = shared_data("nbrdf/merl_nbrdf");
+  if (dir.empty()) {
+    const char* ci = std::getenv("CI");
+    if (ci && std::string(ci) == "true") FAIL() << "../shared/data/nbrdf is missing under CI";
+    GTEST_SKIP() << "../shared/data/nbrdf not found (set HALFBACK_SHARED_DIR)";
+  }
+  const std::string input = dirs_csv(well_conditioned_pairs(50, 5));
+  const Result a = run({"eval", "--brdf", (dir / "blue-acrylic.h5").string()}, input);
+  const Result b = run({"eval", "--brdf", (dir / "npy").string()}, input);
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(a.out, b.out);
+  EXPECT_EQ(parse(a.out).rows(), 50u);
+  const Result info = run({"info", (dir / "npy").string()});
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("NumPy .npy files"), std::string::npos) << info.out;
+  // A folder that is not the NumPy form is an error naming it.
+  const Result bad = run({"info", dir.string()});
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("NumPy form of a neural BRDF"), std::string::npos) << bad.err;
+}
+
 TEST_F(CliTest, ExportMerlBadInputKeepsTheOutput) {
   put(path("x.binary"), "old");
   Result r = run({"export-merl", "--brdf", "nope", "-o", "x.binary"});

@@ -17,9 +17,11 @@ struct PaperMaterial {
   BrdfPtr brdf = nullptr;
 };
 
-// The defaults: three measured materials embedded in the library (a metallic paint, a wall paint,
-// a felt: data/README.md) standing for the paper's three MERL materials, and three analytic models
-// with comparable behaviour (a glossy metal, a diffuse with sheen, a textile-like grazing lobe).
+// The defaults: the paper's three MERL materials (gold-metallic-paint3, colonial-maple-223,
+// pink-felt) as the neural fits of Sztrajman et al. 2021 embedded in the library, then as
+// additional figures three RGL measurements (a metallic paint, a wall paint, a felt;
+// data/README.md) and three analytic models with comparable behaviour (a glossy metal, a diffuse
+// with sheen, a textile-like grazing lobe).
 std::vector<PaperMaterial> default_paper_materials();
 
 struct PaperFigureOptions {

@@ -1,4 +1,5 @@
-// One entry point for every BRDF source: a file (MERL .binary, RGL .bsdf, ALTA text), recognized
+// One entry point for every BRDF source: a file (MERL .binary, RGL .bsdf, ALTA text, a neural
+// BRDF's Keras .h5 or NumPy files), recognized
 // by its content, or an analytic model spec "name:key=value,..." from the model registry.
 #pragma once
 
@@ -13,10 +14,13 @@
 
 namespace halfback {
 
-enum class BrdfFileFormat { unknown, merl, rgl, alta };
+enum class BrdfFileFormat { unknown, merl, rgl, alta, nbrdf_h5, nbrdf_npy };
 
 // The format of a file from its content: MERL by its size and 90/90/180 header, RGL by the
-// "tensor_file\0" magic, ALTA by its `#` header lines (a #DIM line before the first data line).
+// "tensor_file\0" magic, ALTA by its `#` header lines (a #DIM line before the first data line),
+// a neural BRDF's Keras weights by the HDF5 signature "\x89HDF\r\n\x1a\n". The NumPy form of a
+// neural BRDF (six files) is recognized by a NumPy signature in a file named NAME_fc1.npy, and a
+// folder is that form when it holds exactly one *_fc1.npy (any other folder is unknown).
 // Throws FormatError when the file cannot be read.
 BrdfFileFormat detect_brdf_format(const std::filesystem::path& path);
 
@@ -31,14 +35,16 @@ std::vector<std::filesystem::path> brdf_files_in(const std::filesystem::path& di
 // problems and std::invalid_argument for a spec that is neither a file nor a valid model spec.
 //
 // "embedded:NAME" loads one of the measured materials compiled into the library (CC0 RGL
-// measurements, data/README.md), so that the default figures need no file.
+// measurements and MIT-licensed neural fits of MERL measurements, data/README.md), so that the
+// default figures need no file.
 BrdfPtr load_brdf(std::string_view spec);
 
 // The process-wide registry that load_brdf() reads model specs with, holding every built-in
 // model (analytic models and the paper's test functions). Models added to it become loadable.
 ModelRegistry& model_registry();
 
-// The NAMEs of "embedded:NAME": ilm_l3_37_metallic, colodur_azure_4e, acrylic_felt_green.
+// The NAMEs of "embedded:NAME": ilm_l3_37_metallic, colodur_azure_4e, acrylic_felt_green (RGL),
+// gold-metallic-paint3, colonial-maple-223, pink-felt (neural BRDFs of MERL materials).
 std::vector<std::string> embedded_material_names();
 
 }  // namespace halfback

@@ -1,0 +1,115 @@
+// Neural BRDFs (Sztrajman, Rainer, Ritschel, Weyrich 2021, "Neural BRDF Representation and
+// Importance Sampling", Computer Graphics Forum 40(6)): one small multilayer perceptron per
+// material, read from the authors' Keras weights file (.h5, HDF5) or from their six-file NumPy
+// form (NAME_fc1.npy ... NAME_fc3.npy kernels, NAME_b1.npy ... NAME_b3.npy biases).
+//
+// The network maps x = (sin θh, 0, cos θh, dx, dy, dz) — the half vector with its azimuth rotated
+// to 0 and Rusinkiewicz's difference vector d — through dense layers with ReLU activations, a
+// last dense layer without activation, and y ↦ max(exp(y) − 1, 0): ρ in RGB, 1/sr, no cosine.
+// docs/formats.md ("Neural BRDFs") describes both files, the checks, and the direction convention
+// (d is ωo, the view direction, expressed in the half-vector frame), which tests against the RGL
+// reader decide.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+
+namespace halfback {
+
+// A float32 NumPy array read from a .npy file (format 1.0, 2.0 or 3.0; dtype '<f4'; C order).
+struct NpyArray {
+  std::vector<std::size_t> shape;
+  std::vector<float> values;  // C order
+};
+
+// Parses a .npy file strictly: magic, version, header length inside the file, a header dict with
+// exactly 'descr', 'fortran_order' and 'shape', descr '<f4' (other dtypes and big-endian data are
+// rejected by name), fortran_order False, and a data size that is exactly the shape's. Nothing
+// is allocated from the shape before it has been checked against the file's size. Throws
+// FormatError naming `name`.
+NpyArray parse_npy_float32(std::span<const std::byte> bytes, std::string_view name);
+NpyArray read_npy_float32(const std::filesystem::path& path);
+
+// One dense layer: y = x·kernel + bias, kernel stored inputs × outputs in row-major order
+// (Keras's layout).
+struct NbrdfLayer {
+  std::size_t inputs = 0, outputs = 0;
+  std::vector<float> kernel;  // inputs × outputs
+  std::vector<float> bias;    // outputs
+};
+
+struct NbrdfNetwork {
+  std::vector<NbrdfLayer> layers;  // ReLU after each but the last
+  std::string source;              // the file or folder it was read from
+  std::string form;                // "Keras HDF5" or "NumPy .npy files"
+};
+
+namespace nbrdf {
+inline constexpr std::size_t kInputs = 6, kOutputs = 3;
+// The widest layer this reader evaluates (the published networks have 21 units): single-pair
+// evaluation keeps its activations in fixed arrays of this size.
+inline constexpr std::size_t kMaxWidth = 64;
+inline constexpr std::size_t kMaxLayers = 16;
+// The HDF5 signature, the first 8 bytes of an .h5 file.
+inline constexpr std::string_view kHdf5Magic{"\x89HDF\r\n\x1a\n", 8};
+
+// The network input of a pair: (sin θh, 0, cos θh, d) with d = ωo rotated by −φh about n and by
+// −θh about the binormal (Rusinkiewicz 1998, with the roles of the two directions exchanged: the
+// networks were trained with the view direction in d). θh = 0 takes φh = 0; ωo = −ωi (both
+// grazing) takes h = n.
+std::array<double, kInputs> encode(const DirPair<double>& pair);
+}  // namespace nbrdf
+
+// The Keras weights file: root attribute `layer_names`, each layer a group with attribute
+// `weight_names`; layers with weights must be dense (a float32 kernel in × out and bias out), and
+// the list must end with exactly one layer without weights (the authors' output Lambda).
+NbrdfNetwork read_nbrdf_h5(const std::filesystem::path& path);
+// The same from a file image in memory (an embedded material); `name` stands for the file.
+NbrdfNetwork parse_nbrdf_h5(std::span<const std::byte> image, std::string_view name);
+// The NumPy form: `path` is NAME_fc1.npy, or a folder holding exactly one *_fc1.npy; the layers
+// are NAME_fc1.npy/NAME_b1.npy, NAME_fc2.npy/NAME_b2.npy, ... up to the first missing kernel.
+NbrdfNetwork read_nbrdf_npy(const std::filesystem::path& path);
+// Whether `path` is the NumPy form: a file named *_fc1.npy, or a folder with exactly one such file.
+bool is_nbrdf_npy(const std::filesystem::path& path);
+
+class NbrdfBrdf final : public Brdf {
+ public:
+  // Validates the network: 1 to kMaxLayers layers, input width 6, output 3, each layer's inputs
+  // the previous one's outputs, widths ≤ kMaxWidth, kernel and bias sizes, every weight finite.
+  // Throws FormatError naming network.source.
+  NbrdfBrdf(NbrdfNetwork network, std::string label);
+
+  std::string name() const override;
+  std::string description() const override;
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return false; }  // nothing makes the fit reciprocal
+  // ρ(ωi, ωo); 0 when a direction is below the horizon (z < 0), NaN when the pair has a NaN.
+  // Allocates nothing (fixed arrays of kMaxWidth floats).
+  Rgb eval(const DirPair<double>& pair) const override;
+  // Blocks of pairs through the layers as small matrix products in float, over all threads.
+  void eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const override;
+  std::vector<Fact> facts() const override;
+
+  const NbrdfNetwork& network() const { return network_; }
+  // "6-21-21-3"; and the number of weights and biases.
+  std::string architecture() const;
+  std::size_t parameter_count() const;
+
+ private:
+  NbrdfNetwork network_;
+  std::string label_;
+};
+
+// Reads either form (the .h5 file by its HDF5 signature, else the NumPy form); the BRDF's name is
+// "nbrdf:STEM" (the file name without extension, or NAME of NAME_fc1.npy).
+std::shared_ptr<const NbrdfBrdf> load_nbrdf(const std::filesystem::path& path);
+
+}  // namespace halfback

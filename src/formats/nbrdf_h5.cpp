@@ -1,0 +1,200 @@
+// The Keras weights file of a neural BRDF, read through the HDF5 C library (libhdf5-dev).
+//
+// Keras 2 writes: a root attribute `layer_names` (fixed-length strings), one group per layer with
+// an attribute `weight_names` ("dense_1/kernel:0", "dense_1/bias:0"), and the weights as datasets
+// at GROUP/WEIGHT_NAME. The layer types and activations are not in the weights file (they are in
+// the separate model description, NAME.json): this reader takes the layers with weights as dense
+// layers (two weights, a 2-D kernel and a 1-D bias), and requires the list to end with the single
+// weightless output layer of the authors' networks (their Lambda y ↦ exp(y) − 1).
+#include <hdf5.h>
+
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "halfback/formats/nbrdf.hpp"
+#include "halfback/util/format_error.hpp"
+
+namespace halfback {
+namespace {
+
+// Debian's serial HDF5 is not thread-safe: every use of it holds this lock.
+std::mutex& hdf5_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+// An HDF5 identifier closed by `close` when it goes out of scope.
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+class KerasReader {
+ public:
+  KerasReader(hid_t file, std::string name) : file_(file), name_(std::move(name)) {}
+
+  NbrdfNetwork read() {
+    const std::vector<std::string> layers = string_attribute(file_, "/", "layer_names");
+    if (layers.empty()) fail("layer_names", "lists no layer");
+    NbrdfNetwork network;
+    network.source = name_;
+    network.form = "Keras HDF5";
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+      Handle group(H5Gopen2(file_, layers[i].c_str(), H5P_DEFAULT), H5Gclose);
+      if (!group.valid()) fail(layers[i], "layer group listed in layer_names is missing");
+      const auto weights = string_attribute(group.get(), layers[i], "weight_names");
+      const bool last = i + 1 == layers.size();
+      if (weights.empty() != last)
+        fail(layers[i], last ? "the last layer has weights; expected the weightless output "
+                               "layer (exp(y) - 1) after the dense layers"
+                             : "a layer without weights before the last layer; only dense "
+                               "layers are supported");
+      if (!last) network.layers.push_back(dense_layer(group.get(), layers[i], weights));
+    }
+    return network;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
+    throw FormatError(name_, field, problem);
+  }
+
+  // A 0-D or 1-D attribute of fixed-length strings (NUL-padded or NUL-terminated).
+  std::vector<std::string> string_attribute(hid_t loc, const std::string& where,
+                                            const char* attr_name) const {
+    const std::string field = where + " attribute " + attr_name;
+    if (H5Aexists(loc, attr_name) <= 0) fail(field, "missing");
+    Handle attr(H5Aopen(loc, attr_name, H5P_DEFAULT), H5Aclose);
+    Handle type(H5Aget_type(attr.get()), H5Tclose);
+    Handle space(H5Aget_space(attr.get()), H5Sclose);
+    if (!attr.valid() || !type.valid() || !space.valid()) fail(field, "unreadable");
+    // Keras writes an empty list as an empty float array (a layer without weights).
+    if (H5Sget_simple_extent_npoints(space.get()) == 0) return {};
+    if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0)
+      fail(field, "not fixed-length strings");
+    const int rank = H5Sget_simple_extent_ndims(space.get());
+    if (rank < 0 || rank > 1) fail(field, "not a list of strings");
+    const hssize_t count = H5Sget_simple_extent_npoints(space.get());
+    const std::size_t width = H5Tget_size(type.get());
+    if (count < 0 || count > 1024 || width == 0 || width > 4096)
+      fail(field, "implausible size (" + std::to_string(count) + " strings of " +
+                      std::to_string(width) + " bytes)");
+    std::string buffer(std::size_t(count) * width, '\0');
+    if (H5Aread(attr.get(), type.get(), buffer.data()) < 0) fail(field, "unreadable");
+    std::vector<std::string> out;
+    for (hssize_t i = 0; i < count; ++i) {
+      std::string s = buffer.substr(std::size_t(i) * width, width);
+      s.resize(s.find('\0') == std::string::npos ? s.size() : s.find('\0'));
+      out.push_back(std::move(s));
+    }
+    return out;
+  }
+
+  // A float32 dataset of the expected rank (dimensions in `dims`), read into `values`.
+  std::vector<float> float_dataset(hid_t group, const std::string& path, int rank,
+                                   std::vector<hsize_t>& dims) const {
+    Handle data(H5Dopen2(group, path.c_str(), H5P_DEFAULT), H5Dclose);
+    if (!data.valid()) fail(path, "dataset named in weight_names is missing");
+    Handle type(H5Dget_type(data.get()), H5Tclose);
+    Handle space(H5Dget_space(data.get()), H5Sclose);
+    if (!type.valid() || !space.valid()) fail(path, "unreadable");
+    if (H5Tget_class(type.get()) != H5T_FLOAT || H5Tget_size(type.get()) != 4)
+      fail(path, "dtype is not float32");
+    const int actual = H5Sget_simple_extent_ndims(space.get());
+    if (actual != rank)
+      fail(path, std::to_string(actual) + " dimensions, expected " + std::to_string(rank));
+    dims.assign(std::size_t(rank), 0);
+    H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
+    hsize_t count = 1;
+    for (const hsize_t d : dims) {
+      if (d == 0 || d > nbrdf::kMaxWidth)
+        fail(path,
+             "dimension " + std::to_string(d) + " outside 1.." + std::to_string(nbrdf::kMaxWidth));
+      count *= d;
+    }
+    std::vector<float> values(count);
+    if (H5Dread(data.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)
+      fail(path, "cannot read its data (truncated or corrupt file?)");
+    return values;
+  }
+
+  NbrdfLayer dense_layer(hid_t group, const std::string& layer,
+                         const std::vector<std::string>& weights) const {
+    auto ends_with = [](const std::string& s, std::string_view tail) {
+      return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+    };
+    if (weights.size() != 2 || !ends_with(weights[0], "kernel:0") ||
+        !ends_with(weights[1], "bias:0"))
+      fail(layer, "weight_names is not (kernel, bias): not a dense layer");
+    NbrdfLayer out;
+    std::vector<hsize_t> kdims, bdims;
+    out.kernel = float_dataset(group, weights[0], 2, kdims);
+    out.bias = float_dataset(group, weights[1], 1, bdims);
+    out.inputs = kdims[0];
+    out.outputs = kdims[1];
+    if (bdims[0] != kdims[1])
+      fail(layer, "bias has " + std::to_string(bdims[0]) + " values for " +
+                      std::to_string(kdims[1]) + " outputs");
+    return out;
+  }
+
+  hid_t file_;
+  std::string name_;
+};
+
+NbrdfNetwork read_open_file(hid_t file, const std::string& name) {
+  Handle handle(file, H5Fclose);
+  if (!handle.valid())
+    throw FormatError(name, "HDF5", "cannot be opened (truncated or corrupt HDF5 file)");
+  return KerasReader(handle.get(), name).read();
+}
+
+void silence_hdf5_errors() {
+  // The library prints its error stack to stderr by default; the reader reports its own errors.
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
+}  // namespace
+
+NbrdfNetwork read_nbrdf_h5(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw FormatError(name, "file", ec ? ec.message() : "not a regular file");
+  std::lock_guard lock(hdf5_mutex());
+  silence_hdf5_errors();
+  if (H5Fis_hdf5(name.c_str()) <= 0)
+    throw FormatError(name, "HDF5", "not an HDF5 file (no HDF5 signature)");
+  return read_open_file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), name);
+}
+
+NbrdfNetwork parse_nbrdf_h5(std::span<const std::byte> image, std::string_view name_view) {
+  const std::string name(name_view);
+  if (image.size() < nbrdf::kHdf5Magic.size() ||
+      std::string_view(reinterpret_cast<const char*>(image.data()), nbrdf::kHdf5Magic.size()) !=
+          nbrdf::kHdf5Magic)
+    throw FormatError(name, "HDF5", "not an HDF5 file (no HDF5 signature)");
+  std::lock_guard lock(hdf5_mutex());
+  silence_hdf5_errors();
+  // The core driver opens a copy of the image as an in-memory file.
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!fapl.valid() || H5Pset_fapl_core(fapl.get(), 1 << 16, false) < 0 ||
+      H5Pset_file_image(fapl.get(), const_cast<std::byte*>(image.data()), image.size()) < 0)
+    throw FormatError(name, "HDF5", "cannot set up an in-memory file");
+  return read_open_file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, fapl.get()), name);
+}
+
+}  // namespace halfback
