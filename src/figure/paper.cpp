@@ -31,15 +31,14 @@ std::vector<std::filesystem::path> save_all(const Scene& scene, const std::files
 }  // namespace
 
 std::vector<PaperMaterial> default_paper_materials() {
-  // The paper's materials first. Their titles must fit the figure's width (about 78
-  // characters): the material's name is in the slices' heading just below (nbrdf:NAME).
+  // The paper's materials first. Titles must fit the figure's width (about 78 characters).
   return {
       {"fig3-gold-metallic-paint3", "embedded:gold-metallic-paint3",
-       "Figure 3: neural fit (Sztrajman et al. 2021) of the MERL measurement"},
+       "Figure 3: MERL gold-metallic-paint3, neural fit (Sztrajman et al. 2021)"},
       {"fig4-colonial-maple-223", "embedded:colonial-maple-223",
-       "Figure 4: neural fit (Sztrajman et al. 2021) of the MERL measurement"},
+       "Figure 4: MERL colonial-maple-223, neural fit (Sztrajman et al. 2021)"},
       {"fig5-pink-felt", "embedded:pink-felt",
-       "Figure 5: neural fit (Sztrajman et al. 2021) of the MERL measurement"},
+       "Figure 5: MERL pink-felt, neural fit (Sztrajman et al. 2021)"},
       {"fig3-metallic", "embedded:ilm_l3_37_metallic",
        "Figure 3, a glossy metallic: metallic paint, measured (RGL ilm_l3_37_metallic)"},
       {"fig4-paint", "embedded:colodur_azure_4e",
