@@ -296,6 +296,39 @@ TEST(EnvMapAllocation, ExrHeaderClaimingHugeSizeFailsBeforeAllocating) {
   expect_refused_small(huge, "huge.exr");
 }
 
+// A file that has all the chunks its header declares, but chunks that do not decode: the pixels
+// are decoded in bands into a growing output, so the failure at the first band costs that band and
+// OpenEXR's own buffers for a chunk of the declared width (10 MB here), not the declared image.
+TEST(EnvMapAllocation, ExrChunksThatDoNotDecodeFailAtTheFirstBand) {
+  const test::TempDir tmp;
+  const auto small = tmp / "small.exr";
+  write_exr(small, Image{8, 4, std::vector<float>(8 * 4 * 3, 0.5f)});
+  std::string bytes = file_bytes(small);
+  const std::string key("dataWindow\0box2i\0", 17);
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const std::int32_t window[4] = {0, 0, 16383, 8191};
+  std::memcpy(bytes.data() + at + key.size() + 4, window, sizeof window);
+  // The header (write_exr uses ZIP: 16 scanlines a chunk), a zero offset table (OpenEXR then
+  // finds the chunks by walking them), and 512 chunks of one byte that is not zlib data.
+  const std::size_t header_end = bytes.find(std::string("screenWindowWidth\0float\0", 24));
+  ASSERT_NE(header_end, std::string::npos);
+  bytes.resize(header_end + 24 + 4 + 4 + 1);
+  bytes.append(8 * 512, '\0');
+  for (std::int32_t chunk = 0; chunk < 512; ++chunk) {
+    const std::int32_t head[2] = {16 * chunk, 1};
+    bytes.append(reinterpret_cast<const char*>(head), sizeof head);
+    bytes.push_back('\x55');
+  }
+  const auto bad = tmp / "bad-chunks.exr";
+  write_text(bad, bytes);
+  const std::size_t size = bytes.size();
+  const std::size_t chunk_of_lines = 16u * 16384 * 3 * sizeof(float);  // 3 MiB
+  test::AllocationProbe probe;
+  expect_error(bad, "Data decompression (zlib) failed");
+  EXPECT_LT(probe.growth(), 64 * size + 6 * chunk_of_lines) << size << " bytes";
+}
+
 TEST(EnvMapAllocation, RadianceHeaderClaimingHugeSizeFailsBeforeAllocating) {
   const test::TempDir tmp;
   const auto huge = tmp / "huge.hdr";
