@@ -286,9 +286,10 @@ void read_exr_pixels(Imf::InputFile& in, bool rgb, Loaded& out, std::size_t file
   const std::size_t w = std::size_t(out.width), line = 3 * w;
   const std::size_t total = line * std::size_t(out.height);
   out.rgb.reserve(std::min(total, 64 * file_bytes / sizeof(float)));  // a small multiple
-  constexpr int kBand = 16;
-  for (int y = dw.min.y; y <= dw.max.y; y += kBand) {
-    const int last = std::min(dw.max.y, y + kBand - 1);
+  // Whole chunks (16 lines at least), so that no chunk is decompressed twice.
+  const int band = std::max(16, exr_lines_per_chunk(in.header().compression()));
+  for (long long y = dw.min.y; y <= dw.max.y; y += band) {
+    const int last = int(std::min<long long>(dw.max.y, y + band - 1));
     out.rgb.resize(line * std::size_t(last - dw.min.y + 1), 0.0f);
     // The frame buffer's base points at pixel (0, 0) of the coordinate system, so that the data
     // window's first pixel lands at index 0.
@@ -305,7 +306,7 @@ void read_exr_pixels(Imf::InputFile& in, bool rgb, Loaded& out, std::size_t file
       fb.insert("Y", Imf::Slice(Imf::FLOAT, base, xs, ys));
     }
     in.setFrameBuffer(fb);
-    in.readPixels(y, last);
+    in.readPixels(int(y), last);
   }
   if (!rgb)
     for (std::size_t i = 0; i < out.rgb.size(); i += 3)
