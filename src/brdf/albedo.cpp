@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -36,21 +37,28 @@ AlbedoEstimate directional_albedo(const Brdf& brdf, const Vec3<double>& wi, int 
   brdf.eval_batch(pairs, values);
   // Strata are equal-weight; the spread of the per-stratum values bounds the error from above.
   double s[3] = {0, 0, 0}, s2[3] = {0, 0, 0};
+  std::size_t measured = 0;
   for (const Rgb& v : values) {
+    if (!std::isfinite(v.r + v.g + v.b)) continue;  // missing: not part of the average
+    ++measured;
     const double c[3] = {v.r, v.g, v.b};
     for (int k = 0; k < 3; ++k) {
       s[k] += c[k];
       s2[k] += c[k] * c[k];
     }
   }
-  const double m = double(values.size()), pi = std::numbers::pi;
+  if (measured == 0) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {{nan, nan, nan}, {nan, nan, nan}, 0.0};
+  }
+  const double m = double(measured), pi = std::numbers::pi;
   double mean[3], se[3];
   for (int k = 0; k < 3; ++k) {
     mean[k] = pi * s[k] / m;
     const double var = std::max(0.0, s2[k] / m - (s[k] / m) * (s[k] / m));
     se[k] = pi * std::sqrt(var / m);
   }
-  return {{mean[0], mean[1], mean[2]}, {se[0], se[1], se[2]}};
+  return {{mean[0], mean[1], mean[2]}, {se[0], se[1], se[2]}, m / double(values.size())};
 }
 
 }  // namespace halfback

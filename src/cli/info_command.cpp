@@ -70,13 +70,21 @@ int run_info(const InfoOptions& o) {
     const AlbedoEstimate a =
         directional_albedo(*brdf, {std::sin(th), 0, std::cos(th)}, o.albedo_samples);
     const std::string label = fmt::format("albedo at θi = {:g}°", theta_deg);
-    if (!std::isfinite(a.mean.r + a.mean.g + a.mean.b)) {
-      lines.push_back({label, "undefined: the data does not cover every ωo at this incidence"});
+    if (!(a.measured > 0)) {
+      lines.push_back({label, "undefined: no ωo at this incidence was measured"});
       continue;
     }
-    lines.push_back({label, fmt::format("{}  (± {:.2g})", rgb_text(a.mean),
-                                        std::max({a.standard_error.r, a.standard_error.g,
-                                                  a.standard_error.b}))});
+    // Missing values are left out of the average; say how much of the hemisphere it covers.
+    const std::string coverage =
+        a.measured < 1 ? fmt::format(
+                             ", mean over the measured {:.4g} % of the cosine-weighted "
+                             "hemisphere",
+                             100 * a.measured)
+                       : std::string();
+    lines.push_back(
+        {label, fmt::format("{}  (± {:.2g}{})", rgb_text(a.mean),
+                            std::max({a.standard_error.r, a.standard_error.g, a.standard_error.b}),
+                            coverage)});
   }
 
   std::size_t width = 0;

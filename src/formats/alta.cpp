@@ -219,6 +219,7 @@ struct AltaBrdf::Impl {
   std::vector<Slice> slices;  // by increasing θl
   std::string param_out, sample;
   std::size_t samples = 0, dropped = 0, dim_out = 1;
+  std::size_t negative = 0;  // samples with a negative value, clamped to 0
 };
 
 AltaBrdf::AltaBrdf(const AltaData& data, std::string file, std::string label, AltaOptions options)
@@ -255,12 +256,18 @@ AltaBrdf::AltaBrdf(const AltaData& data, std::string file, std::string label, Al
     const double* y = &data.y[data.dim_out * r];
     const std::string field = "line " + std::to_string(data.line[r]);
     if (x[0] < -tol || x[0] > kPi / 2 + tol)
-      throw FormatError(file, field, "θl = " + std::to_string(x[0]) + " rad is outside [0, π/2]");
+      throw FormatError(file, field, fmt::format("θl = {:g} rad is outside [0, π/2]", x[0]));
     const double theta_v = std::hypot(x[1], x[2]);
     if (theta_v > kPi / 2 + tol)
       throw FormatError(file, field,
-                        "θv = √(x2² + x3²) = " + std::to_string(theta_v) + " rad exceeds π/2");
+                        fmt::format("θv = √(x2² + x3²) = {:g} rad exceeds π/2", theta_v));
     std::array<double, 3> rho{y[0], y[data.dim_out == 3 ? 1 : 0], y[data.dim_out == 3 ? 2 : 0]};
+    // A negative measurement of ρ (noise around 0) counts as 0 (docs/formats.md, "Missing and
+    // negative measurements").
+    if (std::any_of(rho.begin(), rho.end(), [](double v) { return v < 0; })) {
+      ++m.negative;
+      for (double& v : rho) v = std::max(v, 0.0);
+    }
     if (cosine) {
       const double c = std::cos(std::min(theta_v, kPi / 2));
       if (c < kMinCosView) {
@@ -278,10 +285,9 @@ AltaBrdf::AltaBrdf(const AltaData& data, std::string file, std::string label, Al
     while (e < rows.size() && rows[e].theta_l == rows[b].theta_l) ++e;
     if (e - b < 3)
       throw FormatError(file, "data",
-                        "incidence θl = " + std::to_string(rows[b].theta_l) + " has " +
-                            std::to_string(e - b) +
-                            " samples: evaluation needs the samples grouped by incidence angle, at "
-                            "least 3 per angle");
+                        fmt::format("incidence θl = {:g} has {} samples: evaluation needs the "
+                                    "samples grouped by incidence angle, at least 3 per angle",
+                                    rows[b].theta_l, e - b));
     Slice s;
     s.theta_l = rows[b].theta_l;
     std::vector<Tree::Point> pts;
@@ -326,6 +332,8 @@ std::vector<Brdf::Fact> AltaBrdf::facts() const {
   if (!m.sample.empty()) f.push_back({"sample", m.sample});
   f.push_back({"samples", fmt::format("{} used, {} dropped at grazing view (see docs/formats.md)",
                                       m.samples, m.dropped)});
+  f.push_back({"negative samples", fmt::format("{} (clamped to 0)", m.negative)});
+  f.push_back({"missing", "ρ is NaN where no sample is near (outside the measured support)"});
   std::string angles;
   for (const double a : incidence_angles())
     angles += fmt::format("{}{:.4g}°", angles.empty() ? "" : ", ", a * 180 / std::numbers::pi);
@@ -339,6 +347,9 @@ std::size_t AltaBrdf::samples() const {
 }
 std::size_t AltaBrdf::dropped_grazing() const {
   return impl_->dropped;
+}
+std::size_t AltaBrdf::negative_samples() const {
+  return impl_->negative;
 }
 std::vector<double> AltaBrdf::incidence_angles() const {
   std::vector<double> r;

@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 
+#include "support/allocation_probe.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback {
@@ -179,6 +180,31 @@ TEST(AltaEval, OutsideTheDataAndCoordinates) {
   EXPECT_TRUE(std::isnan(b.eval({{0, 0, std::nan("")}, {0, 0, 1}}).r));
 }
 
+// Class 6 of docs/reliability-readers.md: a negative sample is a measurement of 0 with noise; it
+// is read as 0, counted, and no evaluation (at it or between samples) is negative. Where there is
+// no sample, ρ is missing (NaN), as above.
+double dips_below_zero(double, double px, double) {
+  return px > 0.2 ? -0.003 : 0.5;
+}
+
+TEST(AltaEval, NegativeSamplesAreZeroAndCounted) {
+  const AltaBrdf b = brdf_of(grid_file(dips_below_zero, false, 0.05, 0.5));
+  EXPECT_GT(b.negative_samples(), 100u);
+  EXPECT_LT(b.negative_samples(), b.samples());
+  bool counted = false;
+  for (const auto& f : b.facts())
+    counted |= f.label == "negative samples" &&
+               f.value == std::to_string(b.negative_samples()) + " (clamped to 0)";
+  EXPECT_TRUE(counted);
+  const double tl = 40 * kPi / 180;
+  EXPECT_EQ(b.eval_coords(tl, 0.45, 0.0).r, 0.0);  // on a negative sample
+  for (double px = -0.5; px <= 0.5; px += 0.013) {
+    const Rgb v = b.eval_coords(tl + 0.1, px, 0.1);
+    EXPECT_FALSE(v.r < 0 || v.g < 0 || v.b < 0) << px << " " << v.r;
+  }
+  EXPECT_EQ(brdf_of(grid_file(smooth, false)).negative_samples(), 0u);
+}
+
 TEST(AltaEval, CosineFactorIsRemoved) {
   // INV_STERADIAN_COSINE_FACTOR stores ρ·cos θv: the BRDF gives ρ.
   const AltaBrdf b = brdf_of(grid_file(smooth, true));
@@ -283,6 +309,21 @@ TEST(AltaPublished, CosineFactorEvidence) {
   EXPECT_LT(v90, 0.05 * v81);  // ~0 at grazing
   const double r81 = v81 / std::cos(81 * kPi / 180), r87 = v87 / std::cos(87 * kPi / 180);
   EXPECT_GT(r87, 0.4 * r81);  // ρ itself does not collapse
+}
+
+// Class 4 of docs/reliability-readers.md: ALTA text declares no sizes, so what the reader holds
+// grows with the lines it has read; a real file costs a small multiple of its size.
+TEST(AltaAllocation, BoundedByTheFile) {
+  HALFBACK_REQUIRE_SHARED(dir, "alta");
+  const auto real = dir / "retro-orange-tape-dense.dat";
+  test::AllocationProbe probe;
+  (void)load_alta(real);
+  EXPECT_LT(probe.growth(), 8 * std::filesystem::file_size(real)) << probe.growth();
+  // A #DIM claiming the largest dimensions changes nothing: there is no count to trust.
+  const std::string text = "#DIM 6 3\n#PARAM_IN CARTESIAN\n0 0 1 0 0 1 0.5 0.5 0.5\n";
+  test::AllocationProbe small;
+  EXPECT_EQ(parse_alta(text, "small.dat").rows(), 1u);
+  EXPECT_LT(small.growth(), 64 * text.size() + 4096) << small.growth();
 }
 
 }  // namespace

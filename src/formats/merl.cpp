@@ -197,7 +197,11 @@ Rgb MerlBrdf::bin_value(int th, int td, int pd) const {
 
 Rgb MerlBrdf::nearest(double theta_h, double theta_d, double phi_d) const {
   const merl::BinIndex b = merl::bin_of(theta_h, theta_d, phi_d);
-  return bin_value(b.theta_h, b.theta_d, b.phi_d);
+  Rgb v = bin_value(b.theta_h, b.theta_d, b.phi_d);
+  // An unmeasured bin (a negative stored value) is missing: NaN, never a negative ρ.
+  for (double* c : {&v.r, &v.g, &v.b})
+    if (*c < 0) *c = kNaN;
+  return v;
 }
 
 Rgb MerlBrdf::trilinear(double theta_h, double theta_d, double phi_d) const {
@@ -257,11 +261,10 @@ Rgb MerlBrdf::trilinear(double theta_h, double theta_d, double phi_d) const {
       }
     }
   }
-  Rgb fallback{};
-  if (wsum[0] == 0 || wsum[1] == 0 || wsum[2] == 0) fallback = nearest(theta_h, theta_d, phi_d);
-  return {wsum[0] > 0 ? sum[0] / wsum[0] * merl::kScale[0] : fallback.r,
-          wsum[1] > 0 ? sum[1] / wsum[1] * merl::kScale[1] : fallback.g,
-          wsum[2] > 0 ? sum[2] / wsum[2] * merl::kScale[2] : fallback.b};
+  // A channel with its 8 corners unmeasured is missing (NaN).
+  return {wsum[0] > 0 ? sum[0] / wsum[0] * merl::kScale[0] : kNaN,
+          wsum[1] > 0 ? sum[1] / wsum[1] * merl::kScale[1] : kNaN,
+          wsum[2] > 0 ? sum[2] / wsum[2] * merl::kScale[2] : kNaN};
 }
 
 Rgb MerlBrdf::eval(const DirPair<double>& pair) const {

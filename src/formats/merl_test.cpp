@@ -14,6 +14,7 @@
 
 #include "formats/binary_io.hpp"
 #include "formats/merl_reference.hpp"
+#include "support/allocation_probe.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback {
@@ -237,7 +238,7 @@ TEST(Merl, ValuesAndScalesAreTheReferences) {
 }
 
 TEST(Merl, NegativeBinsAndHorizon) {
-  // Unmeasured (negative) bins: nearest gives the reference's value (negative), they are counted.
+  // Unmeasured (negative) bins are missing: NaN (never a negative ρ), and they are counted.
   const std::string image = merl_image([](int c, std::size_t i) {
     const std::size_t th = i / (180 * 90);
     return th >= 80 ? -1.0 : 1500.0 * (c + 1);
@@ -249,8 +250,11 @@ TEST(Merl, NegativeBinsAndHorizon) {
   const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{c[0], 0.0, c[1], c[2]});
   ASSERT_TRUE(s.in_domain);
   const Rgb v = brdf.eval(s.pair);
-  EXPECT_EQ(v.r, -1.0 * (1.0 / 1500.0));
-  EXPECT_EQ(v.b, -1.0 * (1.66 / 1500.0));
+  EXPECT_TRUE(std::isnan(v.r) && std::isnan(v.g) && std::isnan(v.b)) << v.r;
+  // A measured bin keeps the reference's value, bit for bit.
+  const auto m = merl::bin_centre(40, 2, 10);
+  const Solved<double> sm = inverse<HalfDiff>(Tuple4<double>{m[0], 0.0, m[1], m[2]});
+  EXPECT_EQ(brdf.eval(sm.pair).b, 4500.0 * (1.66 / 1500.0));
   // Below the horizon: 0 (the interface's contract); NaN in, NaN out.
   const Rgb below = brdf.eval(DirPair<double>{{0, 0, 1}, {1, 0, -0.1}});
   EXPECT_EQ(below, (Rgb{0, 0, 0}));
@@ -395,11 +399,11 @@ TEST(MerlTrilinear, BinCentresWrapAndMissing) {
     if (!s.in_domain) continue;
     EXPECT_NEAR(with_holes.eval(s.pair).r, 1.0, 1e-12);
   }
-  // All 8 corners missing: the nearest bin's (reference) value.
+  // All 8 corners missing: missing (NaN), not the negative stored value.
   MerlData empty;
   empty.values.assign(3 * merl::kBins, -2.0);
   const MerlBrdf all_missing(empty, {MerlLookup::trilinear});
-  EXPECT_EQ(all_missing.eval(pair_at(0.5, 0.3, 1.0).pair).g, -2.0 * merl::kScale[1]);
+  EXPECT_TRUE(std::isnan(all_missing.eval(pair_at(0.5, 0.3, 1.0).pair).g));
 }
 
 // --------------------------------------------------------------------------------------------
@@ -463,6 +467,41 @@ TEST(MerlWriter, RoundTripAtBinCentres) {
   EXPECT_EQ(table.values, back.values);
 }
 
+// Class 6 of docs/reliability-readers.md: an exported model read back gives, at a configuration
+// whose bin centre is below the horizon (θi = 89.9°, θo = 80°, Δφ = 90°), a missing value (NaN),
+// not the -1 mark times the scale (-0.000667); and no lookup anywhere gives a negative ρ.
+TEST(MerlMissing, UnmeasuredBinsAreNaNNeverNegative) {
+  const MerlData table = tabulate_merl(TestLobe{});
+  const double deg = kPi / 180;
+  const DirPair<double> grazing{{std::sin(89.9 * deg), 0, std::cos(89.9 * deg)},
+                                {0, std::sin(80 * deg), std::cos(80 * deg)}};
+  const merl::BinIndex b = merl::bin_of(grazing);
+  ASSERT_LT(table.values[merl::bin(b.theta_h, b.theta_d, b.phi_d)], 0) << "not an unmeasured bin";
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (const MerlLookup lookup : {MerlLookup::nearest, MerlLookup::trilinear}) {
+    const MerlBrdf brdf(table, {lookup});
+    const Rgb at = brdf.eval(grazing);
+    if (lookup == MerlLookup::nearest) {
+      EXPECT_TRUE(std::isnan(at.r) && std::isnan(at.g) && std::isnan(at.b)) << at.r;
+    }
+    std::size_t missing = 0;
+    for (int n = 0; n < 20000; ++n) {
+      const double ti = std::acos(u(rng)), to = std::acos(u(rng)), dphi = 2 * kPi * u(rng);
+      const Rgb v =
+          brdf.eval({{std::sin(ti), 0, std::cos(ti)},
+                     {std::sin(to) * std::cos(dphi), std::sin(to) * std::sin(dphi), std::cos(to)}});
+      for (const double c : {v.r, v.g, v.b}) {
+        EXPECT_FALSE(c < 0) << c;
+        missing += std::isnan(c);
+      }
+    }
+    if (lookup == MerlLookup::nearest) {
+      EXPECT_GT(missing, 0u);  // some grazing pairs hit holes
+    }
+  }
+}
+
 TEST(MerlWriter, AtomicReplaceAndErrors) {
   TempDir tmp;
   const auto path = tmp / "x.binary";
@@ -482,6 +521,29 @@ TEST(MerlWriter, AtomicReplaceAndErrors) {
   wrong.values.assign(10, 1.0);
   EXPECT_THROW(write_merl(path, wrong), std::invalid_argument);
   EXPECT_THROW(MerlBrdf{wrong}, std::invalid_argument);
+}
+
+// Class 4 of docs/reliability-readers.md: the reader allocates from the sizes a file declares only
+// after checking them against the file: a short file costs nothing, a whole one its own size plus
+// the declared output (3 x 90 x 90 x 180 doubles).
+TEST(MerlAllocation, BoundedByTheFileAndTheTable) {
+  TempDir tmp;
+  std::string head(12, '\0');
+  const std::int32_t dims[3] = {90, 90, 180};
+  std::memcpy(head.data(), dims, sizeof dims);
+  test::write_bytes(tmp / "head.binary", head.data(), head.size());
+  {
+    test::AllocationProbe probe;
+    EXPECT_FORMAT_ERROR(read_merl(tmp / "head.binary"), "head.binary", "truncated");
+    EXPECT_LT(probe.growth(), 64u * 1024) << probe.growth();
+  }
+  const std::string image = merl_image([](int c, std::size_t i) { return double(c + i % 7); });
+  test::write_bytes(tmp / "whole.binary", image.data(), image.size());
+  test::AllocationProbe probe;
+  const MerlData data = read_merl(tmp / "whole.binary", false);
+  EXPECT_EQ(data.values.size(), 3 * merl::kBins);
+  EXPECT_LT(probe.growth(), merl::kFileBytes + 3 * merl::kBins * sizeof(double) + (1u << 20))
+      << probe.growth();
 }
 
 }  // namespace

@@ -62,25 +62,42 @@ class Validator {
     for (std::size_t i = 0; i < v.size(); ++i) {
       const float x = load_le<float>(f.bytes.data() + 4 * i);
       if (!std::isfinite(x))
-        fail(f.name, "value " + std::to_string(i) + " is " + (std::isnan(x) ? "NaN" : "infinite"));
+        fail(f.name, fmt::format("value {} is {}", i, std::isnan(x) ? "NaN" : "infinite"));
       v[i] = x;
     }
     return v;
   }
 
-  void require_nonnegative(const TensorField& f, const std::vector<double>& v,
-                           bool strictly = false) const {
+  void require_positive(const TensorField& f, const std::vector<double>& v) const {
     for (std::size_t i = 0; i < v.size(); ++i)
-      if (strictly ? !(v[i] > 0) : v[i] < 0)
-        fail(f.name, "value " + std::to_string(i) + " is " + std::to_string(v[i]) + ", must be " +
-                         (strictly ? "positive" : ">= 0"));
+      if (!(v[i] > 0)) fail(f.name, fmt::format("value {} is {:g}, must be positive", i, v[i]));
+  }
+
+  // A density measured with noise: negative values within kRglNoiseFraction of the field's largest
+  // value are set to 0 (the reference loader uses them as they are); larger ones are refused.
+  // Returns how many were set to 0.
+  std::size_t clamp_noise(const TensorField& f, std::vector<double>& v) const {
+    double largest = 0;
+    for (double x : v) largest = std::max(largest, x);
+    const double floor = -kRglNoiseFraction * largest;
+    std::size_t clamped = 0;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (v[i] >= 0) continue;
+      if (v[i] < floor)
+        fail(f.name, fmt::format("value {} is {:g}, below the noise tolerance {:g} ({:g} times the "
+                                 "field's largest value {:g}): not a density",
+                                 i, v[i], floor, -kRglNoiseFraction, largest));
+      v[i] = 0;
+      ++clamped;
+    }
+    return clamped;
   }
 
   void require_dim(const TensorField& f, std::size_t axis, std::uint64_t expected,
                    const std::string& why) const {
     if (f.shape[axis] != expected)
-      fail(f.name, "dimension " + std::to_string(axis) + " is " + std::to_string(f.shape[axis]) +
-                       ", expected " + std::to_string(expected) + " (" + why + ")");
+      fail(f.name,
+           fmt::format("dimension {} is {}, expected {} ({})", axis, f.shape[axis], expected, why));
   }
 
   void require_at_least(const TensorField& f, std::size_t axis, std::uint64_t min) const {
@@ -293,6 +310,8 @@ struct RglBrdf::Impl {
   Warp vndf;
   Table rgb;  // slices [φi][θi][channel]
   std::size_t n_slices = 1;
+  std::size_t noise_clamped = 0;  // tiny negative ndf, vndf and luminance values set to 0
+  std::size_t rgb_negative = 0;   // negative (out-of-gamut) RGB values
 
   Slices slices(double phi_i, double theta_i, std::size_t channels = 1,
                 std::size_t channel = 0) const {
@@ -341,8 +360,7 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     for (std::size_t i = 0; i < axis.values.size(); ++i) {
       const double x = axis.values[i];
       if (x < lo || x > hi)
-        v.fail(name, "value " + std::to_string(i) + " is " + std::to_string(x) + " rad, outside [" +
-                         std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        v.fail(name, fmt::format("value {} is {:g} rad, outside [{:g}, {:g}]", i, x, lo, hi));
       if (i > 0 && !(x > axis.values[i - 1])) v.fail(name, "values are not strictly increasing");
     }
     return axis.values.size();
@@ -361,21 +379,22 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     const double span = m.phi.values.back() - m.phi.values.front();
     m.reduction = static_cast<int>(std::lround(2 * kPi / span));
     if (m.reduction != 1 && m.reduction != 2 && m.reduction != 4)
-      v.fail("phi_i", "covers " + std::to_string(span) +
-                          " rad: expected 2π, π or π/2 (full, half or quarter symmetry)");
+      v.fail("phi_i", fmt::format("covers {:g} rad: expected 2π, π or π/2 (full, half or quarter "
+                                  "symmetry)",
+                                  span));
   }
 
-  auto table = [&](std::string_view name, Table& t, bool strictly_positive) {
+  auto table = [&](std::string_view name, Table& t) -> const TensorField& {
     const TensorField& f = v.field(name, TensorDtype::float32, 2);
     v.require_at_least(f, 0, 2);
     v.require_at_least(f, 1, 2);
     t.h = static_cast<std::size_t>(f.shape[0]);
     t.w = static_cast<std::size_t>(f.shape[1]);
     t.v = v.floats(f);
-    v.require_nonnegative(f, t.v, strictly_positive);
+    return f;
   };
-  table("ndf", m.ndf, false);
-  table("sigma", m.sigma, true);  // divides ρ
+  m.noise_clamped += v.clamp_noise(table("ndf", m.ndf), m.ndf.v);
+  v.require_positive(table("sigma", m.sigma), m.sigma.v);  // divides ρ
 
   {
     const TensorField& f = v.field("vndf", TensorDtype::float32, 4);
@@ -385,8 +404,8 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     v.require_at_least(f, 3, 2);
     m.vndf.h = static_cast<std::size_t>(f.shape[2]);
     m.vndf.w = static_cast<std::size_t>(f.shape[3]);
-    const std::vector<double> data = v.floats(f);
-    v.require_nonnegative(f, data);
+    std::vector<double> data = v.floats(f);
+    m.noise_clamped += v.clamp_noise(f, data);
     if (!m.vndf.build(data, m.n_slices)) v.fail("vndf", "a slice integrates to zero");
   }
 
@@ -395,7 +414,10 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
   v.require_dim(lum, 1, n_theta, "number of theta_i values");
   v.require_at_least(lum, 2, 2);
   v.require_dim(lum, 3, lum.shape[2], "the sample grid is square");
-  v.require_nonnegative(lum, v.floats(lum));
+  {
+    std::vector<double> luminance = v.floats(lum);  // checked only: the evaluation does not use it
+    m.noise_clamped += v.clamp_noise(lum, luminance);
+  }
 
   {
     const TensorField& f = v.field("rgb", TensorDtype::float32, 5);
@@ -407,6 +429,8 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     m.rgb.h = static_cast<std::size_t>(f.shape[3]);
     m.rgb.w = static_cast<std::size_t>(f.shape[4]);
     m.rgb.v = v.floats(f);  // may be slightly negative (out of gamut): see RglOptions
+    m.rgb_negative = static_cast<std::size_t>(
+        std::count_if(m.rgb.v.begin(), m.rgb.v.end(), [](double x) { return x < 0; }));
   }
 
   {
@@ -445,6 +469,11 @@ std::vector<Brdf::Fact> RglBrdf::facts() const {
   f.push_back({"VNDF / NDF tables",
                fmt::format("{} × {} / {} × {}", m.vndf.h, m.vndf.w, m.ndf.h, m.ndf.w)});
   f.push_back({"symmetry", m.isotropic ? "isotropic" : "anisotropic"});
+  f.push_back({"negative values",
+               fmt::format("{} tiny negative density values (noise) set to 0; {} negative RGB "
+                           "values (out of gamut) {}",
+                           m.noise_clamped, m.rgb_negative,
+                           options_.clamp_negative ? "clamped to 0 in ρ" : "kept in ρ")});
   return f;
 }
 

@@ -25,12 +25,15 @@ inline TensorFieldData f32(std::string name, std::vector<std::uint64_t> shape,
 }
 
 // A small isotropic material: n_theta incidence slices, W×W VNDF grids, R×R RGB grids. The
-// callbacks give vndf(slice, y, x) and rgb(slice, channel, y, x).
+// callbacks give vndf(slice, y, x), luminance(slice, y, x) and rgb(slice, channel, y, x).
 struct Synthetic {
   std::vector<float> theta_i{0.0f, 0.5f, 1.0f, 1.5f};
   std::vector<float> phi_i{0.0f};
   std::size_t w = 16, r = 8;
   std::function<float(std::size_t, std::size_t, std::size_t)> vndf = [](auto, auto, auto) {
+    return 1.0f;
+  };
+  std::function<float(std::size_t, std::size_t, std::size_t)> luminance = [](auto, auto, auto) {
     return 1.0f;
   };
   std::function<float(std::size_t, std::size_t, std::size_t, std::size_t)> rgb =
@@ -45,7 +48,7 @@ struct Synthetic {
       for (std::size_t y = 0; y < w; ++y)
         for (std::size_t x = 0; x < w; ++x) vn.push_back(vndf(s, y, x));
       for (std::size_t y = 0; y < r; ++y)
-        for (std::size_t x = 0; x < r; ++x) lum.push_back(1.0f);
+        for (std::size_t x = 0; x < r; ++x) lum.push_back(luminance(s, y, x));
       for (std::size_t c = 0; c < 3; ++c)
         for (std::size_t y = 0; y < r; ++y)
           for (std::size_t x = 0; x < r; ++x) col.push_back(rgb(s, c, y, x));

@@ -14,6 +14,7 @@
 
 #include "formats/binary_io.hpp"
 #include "formats/rgl_synthetic.hpp"
+#include "support/allocation_probe.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback {
@@ -169,7 +170,8 @@ TEST(TensorFileErrors, MaterialFields) {
   {
     Synthetic s;
     s.vndf = [](auto, auto, auto) { return -1.0f; };
-    EXPECT_FORMAT_ERROR(brdf_of(s.fields()), "field 'vndf'", "must be >= 0");
+    EXPECT_FORMAT_ERROR(brdf_of(s.fields()), "field 'vndf'", "value 0 is -1,",
+                        "below the noise tolerance");
   }
   {
     Synthetic s;
@@ -324,6 +326,45 @@ TEST(RglEval, NonFiniteInputIsSafe) {
   EXPECT_TRUE(std::isnan(v.r) || v.r >= 0);
   (void)b.sample({inf, inf, 1}, nan, 0.5);
   EXPECT_FALSE(b.pdf({inf, inf, 1}, {0, 0, 1}) > 0);
+}
+
+// Class 1 of docs/reliability-readers.md: a real file (ilm_solo_m_68_rgb) has sixteen luminance
+// values between -4e-10 and -7e-11, which the reference loader reads; so must this reader, in every
+// density field, while a negative value beyond the noise tolerance is refused with a readable
+// number (never "-0.000000").
+TEST(RglNoise, TinyNegativeDensitiesLoadAsZero) {
+  Synthetic s;
+  s.luminance = [](std::size_t slice, std::size_t y, std::size_t x) {
+    const std::size_t k = (slice * 8 + y) * 8 + x;
+    return k % 16 == 11 ? -4e-10f + 2.1e-11f * float(k / 16) : 1.0f;  // 16 values, -4e-10..-7e-11
+  };
+  s.vndf = [](std::size_t, std::size_t y, std::size_t x) {
+    return y == 0 && x < 3 ? -2e-9f : 1.0f;
+  };
+  const RglBrdf plain = Synthetic{}.brdf();
+  const RglBrdf noisy(parse_tensor_file(s.bytes(), "noisy.bsdf"), "noisy");
+  bool found = false;
+  for (const auto& f : noisy.facts())
+    if (f.label == "negative values") {
+      found = true;
+      EXPECT_NE(f.value.find("28 tiny negative density values"), std::string::npos) << f.value;
+    }
+  EXPECT_TRUE(found);
+  // The noise is read as 0: the same ρ as the noiseless material within float rounding.
+  const DirPair<double> p{{0.3, 0.1, std::sqrt(0.9)}, {-0.2, 0.4, std::sqrt(0.8)}};
+  EXPECT_NEAR(noisy.eval(p).g, plain.eval(p).g, 1e-6 * plain.eval(p).g);
+
+  Synthetic bad;
+  bad.luminance = [](std::size_t slice, auto, auto) { return slice == 1 ? -0.0123f : 1.0f; };
+  try {
+    (void)RglBrdf(parse_tensor_file(bad.bytes(), "bad.bsdf"), "bad");
+    ADD_FAILURE() << "a luminance of -1.2% of the maximum was accepted";
+  } catch (const FormatError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("field 'luminance'"), std::string::npos) << what;
+    EXPECT_NE(what.find("value 64 is -0.0123,"), std::string::npos) << what;
+    EXPECT_EQ(what.find("0.000000"), std::string::npos) << what;
+  }
 }
 
 TEST(RglEval, NegativeRgbIsClampedByDefault) {
@@ -598,6 +639,27 @@ TEST(RglPublished, PaperWhiteIsNearLambertian) {
     EXPECT_LT(c, 1.0);
   }
   EXPECT_NEAR(mean * kPi, (Rgb{a.c[0], a.c[1], a.c[2]}.luminance()), 0.1);
+}
+
+// Class 4 of docs/reliability-readers.md: a tensor file declaring a field far larger than itself is
+// refused before anything is allocated from that shape; a real file costs a small multiple of its
+// size (the bytes, and the float tables as doubles).
+TEST(RglAllocation, BoundedByTheFile) {
+  test::TempDir tmp;
+  auto fields = Synthetic{}.fields();
+  find(fields, "rgb")->shape = {1, 4, 3, 1u << 20, 1u << 20};
+  const std::vector<std::byte> hostile = serialize_tensor_file(fields);
+  test::write_bytes(tmp / "hostile.bsdf", hostile.data(), hostile.size());
+  {
+    test::AllocationProbe probe;
+    EXPECT_FORMAT_ERROR(load_rgl(tmp / "hostile.bsdf"), "field 'rgb'", "larger than the file");
+    EXPECT_LT(probe.growth(), 4 * hostile.size() + 64 * 1024) << probe.growth();
+  }
+  HALFBACK_REQUIRE_SHARED(dir, "rgl");
+  const auto real = dir / "paper_white_rgb.bsdf";
+  test::AllocationProbe probe;
+  (void)load_rgl(real);
+  EXPECT_LT(probe.growth(), 8 * std::filesystem::file_size(real)) << probe.growth();
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -55,6 +56,22 @@ std::string check_pixels(int width, std::span<const float> rgb) {
   return s.str();
 }
 
+// Measured radiance carries noise: negative values no further below 0 than kEnvNoiseFraction of the
+// map's largest value are set to 0 (counted); larger ones are left for check_pixels to refuse.
+std::size_t clamp_noise(std::vector<float>& rgb) {
+  float largest = 0;
+  for (float v : rgb)
+    if (std::isfinite(v)) largest = std::max(largest, v);
+  const float floor = -float(kEnvNoiseFraction) * largest;
+  std::size_t clamped = 0;
+  for (float& v : rgb)
+    if (v < 0 && v >= floor) {
+      v = 0;
+      ++clamped;
+    }
+  return clamped;
+}
+
 std::vector<unsigned char> read_bytes(const std::filesystem::path& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
@@ -66,6 +83,21 @@ std::vector<unsigned char> read_bytes(const std::filesystem::path& path) {
                                    std::istreambuf_iterator<char>());
   if (in.bad()) throw FormatError(path.string(), "file", "read error");
   return bytes;
+}
+
+// The size a header declares, checked before anything is allocated from it: pixels, the limit on
+// their number, and the 2:1 shape of a latitude-longitude map.
+void check_map_size(const std::string& file, const std::string& field, long long w, long long h) {
+  if (w <= 0 || h <= 0)
+    throw FormatError(file, field, "zero-size image: an environment map needs pixels");
+  if (w > kMaxPixels / h)
+    throw FormatError(file, field,
+                      "image too large: " + std::to_string(w) + " x " + std::to_string(h) +
+                          " pixels, more than the limit of " + std::to_string(kMaxPixels));
+  if (std::abs(w - 2 * h) > 1)
+    throw FormatError(file, "size",
+                      std::to_string(w) + " x " + std::to_string(h) +
+                          " is not a latitude-longitude map (width must be twice the height)");
 }
 
 bool is_exr(std::span<const unsigned char> b) {
@@ -143,7 +175,7 @@ void check_radiance_resolution(const std::string& file, std::span<const unsigned
   if (a1 != "-Y" || a2 != "+X")
     throw FormatError(file, "Radiance resolution line",
                       "unsupported orientation '" + line + "' (expected -Y H +X W)");
-  if (n1 * n2 > kMaxPixels) throw FormatError(file, "Radiance resolution line", "image too large");
+  check_map_size(file, "Radiance resolution line", n2, n1);
   check_radiance_data(file, b.subspan(std::min(i, b.size())), std::size_t(n2), std::size_t(n1));
 }
 
@@ -174,7 +206,115 @@ Loaded load_radiance(const std::string& file, std::span<const unsigned char> byt
   return out;
 }
 
-Loaded load_openexr(const std::string& file) {
+// Lines per chunk of a scanline OpenEXR file, by compression (the OpenEXR file layout).
+int exr_lines_per_chunk(Imf::Compression c) {
+  switch (c) {
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION:
+      return 16;
+    case Imf::PIZ_COMPRESSION:
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION:
+    case Imf::DWAA_COMPRESSION:
+      return 32;
+    case Imf::DWAB_COMPRESSION:
+      return 256;
+    default:
+      return 1;
+  }
+}
+
+// Checks, before OpenEXR or this reader allocate anything from the header's sizes, that a
+// single-part scanline file holds the chunks its header declares. Its chunks follow the offset
+// table (8 bytes a chunk) one after the other, each an int32 y, an int32 data size and the data;
+// they are walked as OpenEXR walks them when the table is incomplete, which also covers files
+// whose table was left zero. Tiled and multi-part files, and headers this walk cannot follow, are
+// left to OpenEXR and to the incremental decoding.
+void check_exr_chunks(const std::string& file, std::span<const unsigned char> b) {
+  if (b.size() < 8 || (b[5] & 0x1a) != 0) return;  // tiled, deep or multi-part: not checked here
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 3; i >= 0; --i) v = v << 8 | b[at + std::size_t(i)];
+    return v;
+  };
+  std::size_t pos = 8;
+  long long height = -1, width = -1;
+  auto compression = Imf::NUM_COMPRESSION_METHODS;
+  while (pos < b.size() && b[pos] != 0) {  // attributes: name\0 type\0 size value
+    const std::size_t name = pos;
+    for (int strings = 0; strings < 2; ++strings) {
+      while (pos < b.size() && b[pos] != 0) ++pos;
+      ++pos;
+    }
+    if (pos + 4 > b.size()) return;
+    const std::uint32_t size = u32(pos);
+    pos += 4;
+    if (size > b.size() - pos) return;
+    const std::string_view key(reinterpret_cast<const char*>(&b[name]));
+    if (key == "dataWindow" && size == 16) {
+      width = (long long)std::int32_t(u32(pos + 8)) - std::int32_t(u32(pos)) + 1;
+      height = (long long)std::int32_t(u32(pos + 12)) - std::int32_t(u32(pos + 4)) + 1;
+    } else if (key == "compression" && size == 1 && b[pos] < Imf::NUM_COMPRESSION_METHODS) {
+      compression = Imf::Compression(b[pos]);
+    }
+    pos += size;
+  }
+  if (pos >= b.size() || height < 0 || compression == Imf::NUM_COMPRESSION_METHODS) return;
+  check_map_size(file, "dataWindow", width, height);
+  const int lines = exr_lines_per_chunk(compression);
+  const auto chunks = std::uint64_t((height + lines - 1) / lines);
+  std::uint64_t found = 0;
+  std::uint64_t at = std::uint64_t(pos) + 1 + 8 * chunks;  // after the offset table
+  while (found < chunks && at + 8 <= b.size() && u32(std::size_t(at) + 4) <= b.size() - at - 8) {
+    at += 8 + u32(std::size_t(at) + 4);
+    ++found;
+  }
+  if (found < chunks)
+    throw FormatError(file, "dataWindow",
+                      "the file is too short for its header: " + std::to_string(width) + " x " +
+                          std::to_string(height) + " pixels in " + std::to_string(chunks) +
+                          " chunks, the file (" + std::to_string(b.size()) + " bytes) holds " +
+                          std::to_string(found));
+}
+
+// Decodes the pixels in bands of scanlines, growing the output as the bands decode, so that a
+// header claiming more pixels than the file holds fails at its first missing chunk, having
+// allocated about what the file really contains (plus an initial reserve in proportion to the
+// file's size).
+void read_exr_pixels(Imf::InputFile& in, bool rgb, Loaded& out, std::size_t file_bytes) {
+  const Imath::Box2i dw = in.header().dataWindow();
+  const std::size_t w = std::size_t(out.width), line = 3 * w;
+  const std::size_t total = line * std::size_t(out.height);
+  out.rgb.reserve(std::min(total, 64 * file_bytes / sizeof(float)));  // a small multiple
+  // Whole chunks (16 lines at least), so that no chunk is decompressed twice.
+  const int band = std::max(16, exr_lines_per_chunk(in.header().compression()));
+  for (long long y = dw.min.y; y <= dw.max.y; y += band) {
+    const int last = int(std::min<long long>(dw.max.y, y + band - 1));
+    out.rgb.resize(line * std::size_t(last - dw.min.y + 1), 0.0f);
+    // The frame buffer's base points at pixel (0, 0) of the coordinate system, so that the data
+    // window's first pixel lands at index 0.
+    char* base = reinterpret_cast<char*>(out.rgb.data()) -
+                 (std::ptrdiff_t(dw.min.x) + std::ptrdiff_t(dw.min.y) * std::ptrdiff_t(w)) * 3 *
+                     std::ptrdiff_t(sizeof(float));
+    const std::size_t xs = 3 * sizeof(float), ys = w * xs;
+    Imf::FrameBuffer fb;
+    if (rgb) {
+      fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+      fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+      fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    } else {
+      fb.insert("Y", Imf::Slice(Imf::FLOAT, base, xs, ys));
+    }
+    in.setFrameBuffer(fb);
+    in.readPixels(int(y), last);
+  }
+  if (!rgb)
+    for (std::size_t i = 0; i < out.rgb.size(); i += 3)
+      out.rgb[i + 1] = out.rgb[i + 2] = out.rgb[i];
+}
+
+Loaded load_openexr(const std::string& file, std::span<const unsigned char> bytes) {
+  check_exr_chunks(file, bytes);
   try {
     Imf::InputFile in(file.c_str());
     const Imf::Header& header = in.header();
@@ -183,11 +323,7 @@ Loaded load_openexr(const std::string& file) {
                         "a cube map; only latitude-longitude maps are supported");
     const Imath::Box2i dw = header.dataWindow();
     const long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
-    if (w <= 0 || h <= 0)
-      throw FormatError(file, "dataWindow", "zero-size image: an environment map needs pixels");
-    if (w * h > kMaxPixels)
-      throw FormatError(file, "dataWindow",
-                        "image too large (" + std::to_string(w) + " x " + std::to_string(h) + ")");
+    check_map_size(file, "dataWindow", w, h);
     const Imf::ChannelList& channels = header.channels();
     const bool rgb =
         channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
@@ -203,25 +339,7 @@ Loaded load_openexr(const std::string& file) {
     Loaded out;
     out.width = int(w);
     out.height = int(h);
-    out.rgb.assign(std::size_t(w * h * 3), 0.0f);
-    // The frame buffer's base points at pixel (0, 0) of the coordinate system, so that the data
-    // window's first pixel lands at index 0.
-    char* base = reinterpret_cast<char*>(out.rgb.data()) -
-                 (std::ptrdiff_t(dw.min.x) + std::ptrdiff_t(dw.min.y) * w) * 3 * sizeof(float);
-    const std::size_t xs = 3 * sizeof(float), ys = std::size_t(w) * xs;
-    Imf::FrameBuffer fb;
-    if (rgb) {
-      fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-      fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-      fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
-    } else {
-      fb.insert("Y", Imf::Slice(Imf::FLOAT, base, xs, ys));
-    }
-    in.setFrameBuffer(fb);
-    in.readPixels(dw.min.y, dw.max.y);
-    if (grey)
-      for (std::size_t i = 0; i < out.rgb.size(); i += 3)
-        out.rgb[i + 1] = out.rgb[i + 2] = out.rgb[i];
+    read_exr_pixels(in, rgb, out, bytes.size());
     return out;
   } catch (const FormatError&) {
     throw;
@@ -333,7 +451,7 @@ EnvMap EnvMap::load(const std::filesystem::path& path, EnvOptions options) {
   if (bytes.empty()) throw FormatError(file, "file", "empty file, not an HDR image");
   Loaded img;
   if (is_exr(bytes)) {
-    img = load_openexr(file);
+    img = load_openexr(file, bytes);
   } else if (is_radiance(bytes)) {
     img = load_radiance(file, bytes);
   } else {
@@ -347,9 +465,12 @@ EnvMap EnvMap::load(const std::filesystem::path& path, EnvOptions options) {
     throw FormatError(file, "size",
                       std::to_string(img.width) + " x " + std::to_string(img.height) +
                           " is not a latitude-longitude map (width must be twice the height)");
+  const std::size_t clamped = clamp_noise(img.rgb);
   if (const std::string bad = check_pixels(img.width, img.rgb); !bad.empty())
     throw FormatError(file, "pixels", bad);
-  return EnvMap(img.width, img.height, std::move(img.rgb), file, options);
+  EnvMap map(img.width, img.height, std::move(img.rgb), file, options);
+  map.noise_clamped_ = clamped;
+  return map;
 }
 
 // --------------------------------------------------------------------------------------------

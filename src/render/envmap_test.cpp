@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <numbers>
 #include <random>
@@ -14,6 +15,7 @@
 #include "halfback/render/distribution.hpp"
 #include "halfback/render/image.hpp"
 #include "halfback/util/format_error.hpp"
+#include "support/allocation_probe.hpp"
 #include "support/test_stats.hpp"
 #include "support/test_support.hpp"
 
@@ -251,6 +253,120 @@ void expect_error(const std::filesystem::path& p, const std::string& words) {
     EXPECT_NE(what.find(p.string()), std::string::npos) << what;
     EXPECT_NE(what.find(words), std::string::npos) << what;
   }
+}
+
+// Class 4 of docs/reliability-readers.md: a small file whose header declares a huge image must be
+// refused before the pixels are allocated: the reader may allocate a small multiple of the file's
+// size, not what the header claims.
+std::string file_bytes(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void expect_refused_small(const std::filesystem::path& p, const std::string& words) {
+  const std::size_t size = std::filesystem::file_size(p);
+  test::AllocationProbe probe;
+  expect_error(p, words);
+  EXPECT_LT(probe.growth(), 64 * size + (1u << 20)) << p << ": " << size << " bytes";
+}
+
+TEST(EnvMapAllocation, ExrHeaderClaimingHugeSizeFailsBeforeAllocating) {
+  const test::TempDir tmp;
+  const auto small = tmp / "small.exr";
+  // Noise, so that the file (about 20 KB, as in the issue) holds the offset table of the claimed
+  // size and OpenEXR opens it.
+  Image img{96, 48, std::vector<float>(96 * 48 * 3)};
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0, 1);
+  for (float& v : img.rgb) v = u(rng);
+  write_exr(small, img);
+  EXPECT_EQ(EnvMap::load(small).width(), 96);
+  // The reproduction: the dataWindow patched to 16384 x 8192 (1.6 GB of floats).
+  std::string bytes = file_bytes(small);
+  const std::string key("dataWindow\0box2i\0", 17);
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const std::int32_t window[4] = {0, 0, 16383, 8191};
+  std::memcpy(bytes.data() + at + key.size() + 4, window, sizeof window);
+  const auto huge = tmp / "huge.exr";
+  write_text(huge, bytes);
+  expect_refused_small(huge, "too short for its header");
+  // The same with the file cut after its header and offset table.
+  write_text(huge, bytes.substr(0, at + 200));
+  expect_refused_small(huge, "huge.exr");
+}
+
+// A file that has all the chunks its header declares, but chunks that do not decode: the pixels
+// are decoded in bands into a growing output, so the failure at the first band costs that band and
+// OpenEXR's own buffers for a chunk of the declared width (10 MB here), not the declared image.
+TEST(EnvMapAllocation, ExrChunksThatDoNotDecodeFailAtTheFirstBand) {
+  const test::TempDir tmp;
+  const auto small = tmp / "small.exr";
+  write_exr(small, Image{8, 4, std::vector<float>(8 * 4 * 3, 0.5f)});
+  std::string bytes = file_bytes(small);
+  const std::string key("dataWindow\0box2i\0", 17);
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const std::int32_t window[4] = {0, 0, 16383, 8191};
+  std::memcpy(bytes.data() + at + key.size() + 4, window, sizeof window);
+  // The header (write_exr uses ZIP: 16 scanlines a chunk), a zero offset table (OpenEXR then
+  // finds the chunks by walking them), and 512 chunks of one byte that is not zlib data.
+  const std::size_t header_end = bytes.find(std::string("screenWindowWidth\0float\0", 24));
+  ASSERT_NE(header_end, std::string::npos);
+  bytes.resize(header_end + 24 + 4 + 4 + 1);
+  bytes.append(8 * 512, '\0');
+  for (std::int32_t chunk = 0; chunk < 512; ++chunk) {
+    const std::int32_t head[2] = {16 * chunk, 1};
+    bytes.append(reinterpret_cast<const char*>(head), sizeof head);
+    bytes.push_back('\x55');
+  }
+  const auto bad = tmp / "bad-chunks.exr";
+  write_text(bad, bytes);
+  const std::size_t size = bytes.size();
+  const std::size_t chunk_of_lines = 16u * 16384 * 3 * sizeof(float);  // 3 MiB
+  test::AllocationProbe probe;
+  expect_error(bad, "Data decompression (zlib) failed");
+  EXPECT_LT(probe.growth(), 64 * size + 6 * chunk_of_lines) << size << " bytes";
+}
+
+TEST(EnvMapAllocation, RadianceHeaderClaimingHugeSizeFailsBeforeAllocating) {
+  const test::TempDir tmp;
+  const auto huge = tmp / "huge.hdr";
+  write_text(huge, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n");
+  expect_refused_small(huge, "image too large: 100000 x 100000 pixels, more than the limit");
+  write_text(huge, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 16384\n\x02\x02\x40");
+  expect_refused_small(huge, "truncated");
+  write_text(huge, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 8192\n");
+  expect_refused_small(huge, "not a latitude-longitude map");
+}
+
+TEST(EnvMapAllocation, RealMapNeedsAboutItsPixels) {
+  HALFBACK_REQUIRE_SHARED(dir, "envmaps");
+  const auto p = dir / "venice_sunset_1k.hdr";
+  test::AllocationProbe probe;
+  const EnvMap m = EnvMap::load(p);
+  // The file, the decoded floats (twice: stb's and ours), the two sampling distributions.
+  const std::size_t pixels = std::size_t(m.width()) * std::size_t(m.height());
+  EXPECT_LT(probe.growth(), std::filesystem::file_size(p) + pixels * (3 * 4 * 2 + 8 * 6))
+      << probe.growth();
+}
+
+// Class 1: a map with tiny negative values (noise) loads, the values read as 0 and counted; a
+// negative value beyond the noise tolerance is still refused.
+TEST(EnvMap, TinyNegativeRadianceIsNoise) {
+  const test::TempDir tmp;
+  Image img{8, 4, std::vector<float>(8 * 4 * 3, 0.5f)};
+  img.rgb[7] = -2e-7f;
+  img.rgb[40] = -1e-4f;
+  const auto p = tmp / "noisy.exr";
+  write_exr(p, img);
+  const EnvMap m = EnvMap::load(p);
+  EXPECT_EQ(m.noise_clamped(), 2u);
+  EXPECT_EQ(m.pixels()[7], 0.0f);
+  EXPECT_EQ(m.pixels()[8], 0.5f);
+  img.rgb[40] = -1e-3f;  // 0.2 % of the largest value: not noise
+  write_exr(p, img);
+  expect_error(p, "-0.001");
 }
 
 TEST(EnvMap, BadInput) {

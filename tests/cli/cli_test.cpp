@@ -25,6 +25,7 @@
 
 #include "halfback/core/batch.hpp"
 #include "halfback/core/space.hpp"
+#include "halfback/formats/merl.hpp"
 #include "halfback/util/csv.hpp"
 #include "support/test_support.hpp"
 
@@ -842,6 +843,64 @@ TEST_F(CliTest, EvalOfTheH5AndNpyFormsOfANeuralBrdfAgree) {
   const Result bad = run({"info", dir.string()});
   EXPECT_EQ(bad.status, 1);
   EXPECT_NE(bad.err.find("NumPy form of a neural BRDF"), std::string::npos) << bad.err;
+
+// Class 6 of docs/reliability-readers.md: unmeasured MERL bins are missing, never a negative ρ;
+// the albedo is the mean over the measured directions, with the fraction measured shown.
+TEST_F(CliTest, UnmeasuredMerlBinsAreMissingInEvalAndInfo) {
+  Result r = run({"export-merl", "--brdf", "ggx:alpha=0.3,f0=0.5", "-o", "ggx.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const double deg = kPi / 180;
+  const std::array<double, 6> grazing{
+      std::sin(89.9 * deg), 0, std::cos(89.9 * deg), 0, std::sin(80 * deg), std::cos(80 * deg)};
+  r = run({"eval", "--brdf", "ggx.binary"}, std::string(kDirsHeader) + fmt_row(grazing) + "\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("nan,nan,nan"), std::string::npos) << r.out;  // was -0.000667
+  EXPECT_EQ(r.out.find(",-"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("\n-"), std::string::npos) << r.out;
+
+  // The albedo of each incidence: a number >= 0; at 80° part of the hemisphere is unmeasured.
+  auto albedo_line = [](const std::string& out, const std::string& angle) {
+    const std::size_t at = out.find("albedo at θi = " + angle + "°:");
+    return at == std::string::npos ? std::string() : out.substr(at, out.find('\n', at) - at);
+  };
+  r = run({"info", "ggx.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const std::string angle : {"0", "30", "60", "80"}) {
+    const std::string line = albedo_line(r.out, angle);
+    ASSERT_FALSE(line.empty()) << r.out;
+    const double red = std::stod(line.substr(line.find(':') + 1));
+    EXPECT_GT(red, 0.0) << line;
+    EXPECT_LT(red, 1.0) << line;
+  }
+  // The same file with every bin of θh index >= 45 unmeasured (a partial measurement).
+  std::string holes = slurp(path("ggx.binary"));
+  const double unmeasured = -1;
+  for (std::size_t c = 0; c < 3; ++c)
+    for (std::size_t i = merl::bin(45, 0, 0); i < merl::kBins; ++i)
+      std::memcpy(holes.data() + merl::kHeaderBytes + 8 * (c * merl::kBins + i), &unmeasured, 8);
+  put(path("holes.binary"), holes);
+  r = run({"info", "holes.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const std::string angle : {"0", "80"}) {
+    const std::string line = albedo_line(r.out, angle);
+    EXPECT_NE(line.find("mean over the measured"), std::string::npos) << r.out;
+    EXPECT_GT(std::stod(line.substr(line.find(':') + 1)), 0.0) << line;
+  }
+
+  // A file with no measured bin: no albedo at all (it was -0.0105), and no negative value.
+  std::string bytes(merl::kFileBytes, '\0');
+  const std::int32_t dims[3] = {90, 90, 180};
+  std::memcpy(bytes.data(), dims, sizeof dims);
+  for (std::size_t i = 0; i < 3 * merl::kBins; ++i) {
+    std::memcpy(bytes.data() + merl::kHeaderBytes + 8 * i, &unmeasured, 8);
+  }
+  put(path("empty.binary"), bytes);
+  r = run({"info", "empty.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(albedo_line(r.out, "0").find("undefined: no ωo at this incidence was measured"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("-0.0"), std::string::npos) << r.out;
 }
 
 TEST_F(CliTest, ExportMerlBadInputKeepsTheOutput) {

@@ -53,7 +53,8 @@ struct AltaOptions {
 
 // ρ from the samples of an ALTA file with #PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI (θl, θv·cos Δφ,
 // θv·sin Δφ) and #PARAM_OUT INV_STERADIAN or INV_STERADIAN_COSINE_FACTOR (ρ·cos θv, converted to
-// ρ at load), one or three values. The light direction is ωi, the view direction ωo.
+// ρ at load), one or three values. The light direction is ωi, the view direction ωo. A negative
+// sample is read as 0 and counted (negative_samples(), facts()).
 class AltaBrdf final : public Brdf {
  public:
   AltaBrdf(const AltaData& data, std::string name_for_messages, std::string label,
@@ -72,6 +73,7 @@ class AltaBrdf final : public Brdf {
 
   std::size_t samples() const;          // used for evaluation
   std::size_t dropped_grazing() const;  // cosine-factor samples at θv ≈ 90°, see docs/formats.md
+  std::size_t negative_samples() const;  // samples with a negative value, read as 0
   std::vector<double> incidence_angles() const;
   double support_radius(std::size_t slice) const;
 

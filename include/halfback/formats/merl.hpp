@@ -80,13 +80,14 @@ std::span<const MerlMaterial> merl_materials();
 const MerlMaterial* find_merl_material(std::string_view sha256_hex);
 
 enum class MerlLookup {
-  // The reference reader's bin (bit for bit: same indices, same scale factors). Unmeasured bins
-  // give what the reference gives: their negative stored value times the scale.
+  // The reference reader's bin (bit for bit: same indices, same scale factors) for measured bins.
+  // An unmeasured bin is missing: NaN in its channel (the reference returns its negative stored
+  // value times the scale; docs/formats.md, "Missing and negative measurements").
   nearest,
   // Trilinear between the 8 bin centres around the point in the stored coordinates (√θh index
   // space, θd, φd). φd wraps (0 ≡ π); θh and θd are clamped at their ends, which is the even
   // extension of ρ at θh = 0 and θd = 0. Unmeasured corners are skipped and the weights of the
-  // others renormalized, per channel; when all 8 are unmeasured, the nearest bin's value is given.
+  // others renormalized, per channel; when all 8 are unmeasured, the channel is missing (NaN).
   trilinear,
 };
 
@@ -103,7 +104,8 @@ class MerlBrdf final : public Brdf {
   std::string description() const override;
   bool isotropic() const override { return true; }
   bool reciprocal() const override { return true; }
-  // 0 when a direction is below the horizon (z < 0), NaN when the pair has a NaN.
+  // 0 when a direction is below the horizon (z < 0), NaN when the pair has a NaN or the lookup
+  // finds only unmeasured bins (missing, per channel).
   Rgb eval(const DirPair<double>& pair) const override;
   std::vector<Fact> facts() const override;
 

@@ -75,6 +75,12 @@ std::vector<std::byte> serialize_tensor_file(std::span<const TensorFieldData> fi
 // ---------------------------------------------------------------------------------------------
 // The material
 // ---------------------------------------------------------------------------------------------
+// Measured densities carry noise: a negative ndf, vndf or luminance value no further below 0 than
+// this fraction of its field's largest value is read as 0 (and counted in facts()); a more negative
+// one is refused. Real files have values down to -4e-10 where the maximum is of order 1
+// (docs/formats.md, "Negative values").
+inline constexpr double kRglNoiseFraction = 1e-3;
+
 struct RglOptions {
   // The RGB data holds small negative values where the spectral measurement falls outside the
   // sRGB gamut (e.g. down to -2% of the maximum in chm_mint); by default ρ is clamped at 0.
@@ -89,7 +95,8 @@ struct RglWarpPoint {
 class RglBrdf final : public Brdf {
  public:
   // Validates the material fields of a parsed tensor file (names, dtypes, shapes, values: finite,
-  // densities >= 0, sigma > 0, incidence grids increasing and in range). Throws FormatError.
+  // densities >= 0 up to noise (kRglNoiseFraction), sigma > 0, incidence grids increasing and in
+  // range). Throws FormatError.
   RglBrdf(const TensorFile& file, std::string label, RglOptions options = {});
   ~RglBrdf() override;
 

@@ -24,6 +24,11 @@
 
 namespace halfback::render {
 
+// A negative pixel value of a map file no further below 0 than this fraction of the map's largest
+// value is noise and read as 0 (EnvMap::noise_clamped()); a more negative one is refused
+// (docs/formats.md, "Missing and negative measurements").
+inline constexpr double kEnvNoiseFraction = 1e-3;
+
 struct EnvOptions {
   double rotation_deg = 0;  // turns the environment about +y (counter-clockwise seen from above)
   double exposure = 0;      // radiance scale 2^exposure
@@ -40,7 +45,9 @@ class EnvMap {
   // file name.
   static EnvMap from_spec(std::string_view spec, EnvOptions options = {});
   // A Radiance .hdr or OpenEXR file, recognized by its content. Throws FormatError naming the file
-  // and the problem: unreadable, not an HDR image, zero size, not 2:1, NaN/Inf/negative pixels.
+  // and the problem: unreadable, not an HDR image, zero size, not 2:1, more pixels than the file
+  // can hold (checked before the pixels are allocated), NaN/Inf/negative pixels beyond noise
+  // (kEnvNoiseFraction).
   static EnvMap load(const std::filesystem::path& path, EnvOptions options = {});
   static EnvMap constant(const Rgb& radiance, EnvOptions options = {});
   // The built-in procedural environment (1024 × 512): a blue sky gradient, a small bright sun
@@ -79,6 +86,8 @@ class EnvMap {
   const std::string& name() const { return name_; }
   const EnvOptions& options() const { return options_; }
   std::span<const float> pixels() const { return rgb_; }  // without the exposure scale
+  // Tiny negative values of the file read as 0 (kEnvNoiseFraction); 0 for maps made in memory.
+  std::size_t noise_clamped() const { return noise_clamped_; }
 
   // The map frame: direction of map coordinates (u, v) ∈ [0, 1]² and back (u ∈ [0, 1)).
   static Vec3<double> map_direction(double u, double v);
@@ -96,6 +105,7 @@ class EnvMap {
   double scale_ = 1, cos_rot_ = 1, sin_rot_ = 0;
   std::vector<double> row_solid_angle_;  // of one pixel of each row
   Distribution2D distribution_, compensated_;
+  std::size_t noise_clamped_ = 0;
 };
 
 // An environment as figures and reports use it: a map shared by the renderings that light with
