@@ -843,6 +843,7 @@ TEST_F(CliTest, EvalOfTheH5AndNpyFormsOfANeuralBrdfAgree) {
   const Result bad = run({"info", dir.string()});
   EXPECT_EQ(bad.status, 1);
   EXPECT_NE(bad.err.find("NumPy form of a neural BRDF"), std::string::npos) << bad.err;
+}
 
 // Class 6 of docs/reliability-readers.md: unmeasured MERL bins are missing, never a negative ρ;
 // the albedo is the mean over the measured directions, with the fraction measured shown.
