@@ -147,9 +147,11 @@ void validate(const GridSpec& g) {
           fmt::format("axis {}: an empty range [{}, {}] takes one sample", a.name, a.lo, a.hi));
     points *= double(a.count);
   }
-  if (points > double(std::size_t{1} << 31))
-    throw std::invalid_argument(
-        fmt::format("the grid has {:.3g} points, more than the 2^31 this tool tabulates", points));
+  if (points > double(kMaxGridPoints))
+    throw std::invalid_argument(fmt::format(
+        "the grid has {:.3g} points, more than the maximum of 2^26 = {} (25 bytes a point in "
+        "memory, 1.7 GB at the maximum)",
+        points, kMaxGridPoints));
 }
 
 std::size_t ResampledTable::valid_count() const {

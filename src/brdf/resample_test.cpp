@@ -168,8 +168,12 @@ TEST(Resample, DefaultGridsAndValidation) {
   bad = g;
   bad.axes[0].name = "theta_h";
   EXPECT_NE(message([&] { validate(bad); }).find("'theta_h'"), std::string::npos);
-  EXPECT_NE(message([] { default_grid(Space::hybrid, GridKind::full, {400}); }).find("2^31"),
+  EXPECT_NE(message([] { default_grid(Space::hybrid, GridKind::full, {400}); }).find("2^26"),
             std::string::npos);
+  // 91^4 = 68574961 points is just above the limit, 90^4 = 65610000 just below it.
+  EXPECT_NE(message([] { default_grid(Space::hybrid, GridKind::full, {91}); }).find("1.7 GB"),
+            std::string::npos);
+  EXPECT_NO_THROW(validate(default_grid(Space::hybrid, GridKind::full, {90})));
 }
 
 TEST(Resample, CoordinatesToPairs) {

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <system_error>
 
+#include <unistd.h>
+
 #include "halfback/core/space.hpp"
 
 namespace halfback::cli {
@@ -16,20 +18,9 @@ void warn(std::string_view command, std::string_view message) {
   fmt::print(stderr, "halfback {}: warning: {}\n", command, message);
 }
 
-InputText read_input(const std::string& path) {
-  if (path != "-") return {read_text_file(path), path};
-  InputText in{{}, "<stdin>"};
-  char buf[1 << 16];
-  while (true) {
-    const std::size_t n = std::fread(buf, 1, sizeof buf, stdin);
-    in.text.append(buf, n);
-    if (n < sizeof buf) {
-      if (std::ferror(stdin))
-        throw std::system_error(errno, std::generic_category(), "cannot read standard input");
-      break;
-    }
-  }
-  return in;
+std::unique_ptr<CsvStreamReader> open_csv_input(const std::string& path) {
+  if (path == "-") return std::make_unique<CsvStreamReader>(STDIN_FILENO, "<stdin>");
+  return std::make_unique<CsvStreamReader>(path);
 }
 
 Output::Output(const std::string& path) {

@@ -59,19 +59,15 @@ Command register_study(CLI::App& parent);
 // "halfback COMMAND: warning: MESSAGE" on stderr.
 void warn(std::string_view command, std::string_view message);
 
-// The text of an input given as a path, or "-" for standard input, and its name for messages.
-struct InputText {
-  std::string text;
-  std::string name;  // the path, or "<stdin>"
-};
-// Throws std::system_error ("cannot read 'PATH': REASON").
-InputText read_input(const std::string& path);
+// A CSV input given as a path, or "-" for standard input ("<stdin>" in messages), read a block of
+// rows at a time. Throws as CsvStreamReader's constructors.
+std::unique_ptr<CsvStreamReader> open_csv_input(const std::string& path);
 
 // An output given as a path, or "-" for standard output. A file is written through an
 // AtomicFile, created by the constructor (so an unwritable destination fails before any work)
 // and renamed into place by commit(): on error, nothing is left and an existing file is kept.
-// Standard output is written directly; commands write only once their input is fully read and
-// checked, so that a data error prints nothing there.
+// Standard output is written directly; streaming commands (convert, eval) hold their first
+// block's output until it is checked, so that a data error in a small input prints nothing there.
 class Output {
  public:
   explicit Output(const std::string& path);

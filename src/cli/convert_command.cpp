@@ -1,15 +1,17 @@
 // `halfback convert`: CSV in, CSV out, through the library's batch convert<double>().
 //
 // Steps: open the output (an AtomicFile: an unwritable destination fails before any work), read
-// the whole input, check the header against the columns of --from, read every row (CsvReader),
-// check direction pairs with check_pair(), convert all rows at once, then write. Every data
-// problem is found before the first byte is written, so a bad input leaves stdout empty and an
-// existing output file untouched. With --skip-invalid, rows with a problem are kept as valid = 0
-// rows (nan coordinates) and one warning on stderr counts them.
+// the header and check it against the columns of --from, then, a block of rows at a time
+// (CsvStreamReader): read the rows, check direction pairs with check_pair(), convert, write. Memory
+// is bounded by the block, whatever the input's length. A bad row fails the command: an output
+// file is then left untouched (AtomicFile); standard output holds the blocks before the bad one
+// (nothing when the input is a single block, up to 65536 rows). With --skip-invalid, rows with a
+// problem are kept as valid = 0 rows (nan coordinates) and one warning on stderr counts them.
 #include <fmt/format.h>
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -95,57 +97,60 @@ std::string pair_problem(PairStatus status, const DirPair<double>& p) {
   }
 }
 
-int run_convert(const ConvertOptions& o) {
-  const Space from_space = *space_from_name(o.from);  // (checked by the validator)
-  const Space to_space = *space_from_name(o.to);
-  if (from_space == Space::dirs && to_space == Space::dirs) {
-    if (o.isotropic)
-      throw UsageError("--isotropic needs a parameterization on one side (--from or --to)");
-    if (o.jacobian)
-      throw UsageError("--jacobian needs a parameterization on one side (--from or --to)");
-  }
-  const Form from{from_space, o.isotropic && from_space != Space::dirs};
-  const Form to{to_space, o.isotropic && to_space != Space::dirs};
+// Rows per block: the input is read, checked, converted and written a block at a time, so that
+// memory stays bounded on inputs of any length (docs/performance.md, "Streaming").
+constexpr std::size_t kBlockRows = std::size_t{1} << 16;
 
-  Output out(o.output);
-  const InputText input = read_input(o.input);
-  CsvReader reader(input.text, input.name);
-  reader.require_header(column_names(from), header_hint(reader.header(), from));
-  CsvReadOptions read_options;
-  read_options.keep_bad_rows = o.skip_invalid;
-  const CsvTable table = reader.read_rows(read_options);
-  const std::size_t n = table.rows();
+// The bad rows of the input so far: how many, and the message of the first.
+struct BadRows {
+  std::size_t count = 0;
+  std::string first;
+};
 
-  // Rows to force to valid = 0, and the first message about them.
+// Marks the rows of `block` to write as valid = 0: rows the reader kept as bad, and direction
+// pairs that check_pair() rejects (an error without --skip-invalid).
+std::vector<std::uint8_t> find_bad_rows(const CsvTable& block, Form from, bool skip_invalid,
+                                        const std::string& source, BadRows& bad_rows) {
+  const std::size_t n = block.rows();
   std::vector<std::uint8_t> bad(n, 0);
-  std::size_t bad_count = table.problems.size();
-  std::string first_problem = bad_count ? table.problems.front().message : std::string();
-  std::size_t first_problem_row = bad_count ? table.problems.front().row : n;
-  for (const CsvRowProblem& p : table.problems) bad[p.row] = 1;
-
+  std::size_t first_row = n;
+  std::string first;
+  if (!block.problems.empty()) {
+    first_row = block.problems.front().row;
+    first = block.problems.front().message;
+  }
+  for (const CsvRowProblem& p : block.problems) bad[p.row] = 1;
+  bad_rows.count += block.problems.size();
   if (from.space == Space::dirs) {
-    const auto& c = table.columns;
+    const auto& c = block.columns;
     for (std::size_t r = 0; r < n; ++r) {
       if (bad[r]) continue;
       const DirPair<double> pair{{c[0][r], c[1][r], c[2][r]}, {c[3][r], c[4][r], c[5][r]}};
       const PairStatus status = check_pair(pair);
       if (status == PairStatus::ok) continue;
       std::string message =
-          CsvError::location(input.name, table.lines[r], "") + pair_problem(status, pair);
-      if (!o.skip_invalid) throw std::runtime_error(message);
+          CsvError::location(source, block.lines[r], "") + pair_problem(status, pair);
+      if (!skip_invalid) throw std::runtime_error(message);
       bad[r] = 1;
-      ++bad_count;
-      if (r < first_problem_row) {
-        first_problem_row = r;
-        first_problem = std::move(message);
+      ++bad_rows.count;
+      if (r < first_row) {
+        first_row = r;
+        first = std::move(message);
       }
     }
   }
+  if (bad_rows.first.empty()) bad_rows.first = std::move(first);
+  return bad;
+}
 
-  // Convert every row at once.
+// Converts one block and writes its rows: the columns of `to`, then valid and jacobian when asked.
+void convert_block(const CsvTable& block, Form from, Form to, const ConvertOptions& o,
+                   const std::string& source, const std::vector<std::uint8_t>& bad,
+                   const CsvSink& sink) {
+  const std::size_t n = block.rows();
   const std::size_t dim_in = dimension(from), dim_out = dimension(to);
   std::vector<ConstColumn<double>> in_cols(dim_in);
-  for (std::size_t c = 0; c < dim_in; ++c) in_cols[c] = {table.columns[c].data(), 1};
+  for (std::size_t c = 0; c < dim_in; ++c) in_cols[c] = {block.columns[c].data(), 1};
   std::vector<std::vector<double>> values(dim_out, std::vector<double>(n));
   std::vector<Column<double>> out_cols(dim_out);
   for (std::size_t c = 0; c < dim_out; ++c) out_cols[c] = {values[c].data(), 1};
@@ -161,7 +166,7 @@ int run_convert(const ConvertOptions& o) {
     if (!bad[r]) {
       // A pair that check_pair() accepts is valid for the conversion too (same tolerances).
       if (from.space == Space::dirs && !valid[r] && !o.skip_invalid)
-        throw std::runtime_error(CsvError::location(input.name, table.lines[r], "") +
+        throw std::runtime_error(CsvError::location(source, block.lines[r], "") +
                                  "the direction pair was rejected by the conversion");
       continue;
     }
@@ -170,29 +175,64 @@ int run_convert(const ConvertOptions& o) {
     if (o.jacobian) jacobian[r] = kNaN;
   }
 
-  // The output table.
-  std::vector<std::string> header;
-  std::vector<std::span<const double>> columns;
-  for (std::size_t c = 0; c < dim_out; ++c) {
-    header.emplace_back(column_names(to)[c]);
-    columns.emplace_back(values[c]);
-  }
+  std::vector<std::span<const double>> columns(values.begin(), values.end());
   std::vector<double> valid_column;
   if (from.space != Space::dirs || o.skip_invalid) {
     valid_column.assign(valid.begin(), valid.end());
-    header.emplace_back("valid");
     columns.emplace_back(valid_column);
   }
-  if (o.jacobian) {
-    header.emplace_back("jacobian");
-    columns.emplace_back(jacobian);
+  if (o.jacobian) columns.emplace_back(jacobian);
+  write_csv_rows(columns, sink);
+}
+
+std::vector<std::string> output_header(Form from, Form to, const ConvertOptions& o) {
+  std::vector<std::string> header;
+  for (std::string_view name : column_names(to)) header.emplace_back(name);
+  if (from.space != Space::dirs || o.skip_invalid) header.emplace_back("valid");
+  if (o.jacobian) header.emplace_back("jacobian");
+  return header;
+}
+
+int run_convert(const ConvertOptions& o) {
+  const Space from_space = *space_from_name(o.from);  // (checked by the validator)
+  const Space to_space = *space_from_name(o.to);
+  if (from_space == Space::dirs && to_space == Space::dirs) {
+    if (o.isotropic)
+      throw UsageError("--isotropic needs a parameterization on one side (--from or --to)");
+    if (o.jacobian)
+      throw UsageError("--jacobian needs a parameterization on one side (--from or --to)");
   }
-  write_csv(header, columns, out.sink());
+  const Form from{from_space, o.isotropic && from_space != Space::dirs};
+  const Form to{to_space, o.isotropic && to_space != Space::dirs};
+
+  Output out(o.output);
+  const std::unique_ptr<CsvStreamReader> reader = open_csv_input(o.input);
+  reader->require_header(column_names(from), header_hint(reader->header(), from));
+  CsvReadOptions read_options;
+  read_options.keep_bad_rows = o.skip_invalid;
+
+  // The header goes out with the first block, so that an input of one block with a bad row
+  // leaves standard output empty, as it did when the whole input was read first.
+  std::string header = csv_header_line(output_header(from, to, o));
+  const CsvSink sink = [&](std::string_view text) {
+    if (!header.empty()) {
+      out.write(header);
+      header.clear();
+    }
+    out.write(text);
+  };
+  BadRows bad_rows;
+  CsvTable block;
+  while (reader->read_block(block, kBlockRows, read_options)) {
+    const auto bad = find_bad_rows(block, from, o.skip_invalid, reader->source(), bad_rows);
+    convert_block(block, from, to, o, reader->source(), bad, sink);
+  }
+  if (!header.empty()) out.write(header);
   out.commit();
 
-  if (bad_count > 0)
+  if (bad_rows.count > 0)
     warn("convert", fmt::format("{} invalid input row{} written with valid = 0; the first: {}",
-                                bad_count, bad_count == 1 ? "" : "s", first_problem));
+                                bad_rows.count, bad_rows.count == 1 ? "" : "s", bad_rows.first));
   return kExitOk;
 }
 
@@ -249,8 +289,10 @@ Command register_convert(CLI::App& parent) {
       "            --from ones when --to is dirs); for isotropic forms, the measure of q\n"
       "\n"
       "Input directions must be unit vectors (| |w|^2 - 1 | <= 1e-6) above the horizon\n"
-      "(w_z >= 0, to within rounding). A malformed row, a field that is not a finite number or a\n"
-      "bad direction is an error naming the line; with --skip-invalid, a valid = 0 row.\n"
+      "(w_z >= 0, to within rounding); accepted directions are normalized (and put on the\n"
+      "horizon if just below it) before conversion. A malformed row, a field that is not a\n"
+      "finite number or a bad direction is an error naming the line; with --skip-invalid, a\n"
+      "valid = 0 row.\n"
       "\n"
       "Examples:\n"
       "  halfback convert --from dirs --to hybrid -i pairs.csv -o hybrid.csv\n"

@@ -6,6 +6,7 @@
 // sr⁻¹ (no cosine factor), one row per input row, %.17g.
 #include <fmt/format.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,14 +22,14 @@ struct EvalOptions {
   std::string brdf, input = "-", output = "-";
 };
 
-int run_eval(const EvalOptions& o) {
-  Output out(o.output);
-  const BrdfPtr brdf = load_brdf(o.brdf);
-  const InputText input = read_input(o.input);
-  const Form dirs{Space::dirs, false};
-  const CsvTable table = read_csv(input.text, input.name, column_names(dirs));
-  const std::size_t n = table.rows();
-  const auto& c = table.columns;
+// Rows per block: read, checked, evaluated and written a block at a time (bounded memory).
+constexpr std::size_t kBlockRows = std::size_t{1} << 16;
+
+// ρ at the pairs of one block, written as r,g,b rows.
+void eval_block(const Brdf& brdf, const CsvTable& block, const std::string& source,
+                const CsvSink& sink) {
+  const std::size_t n = block.rows();
+  const auto& c = block.columns;
   std::vector<DirPair<double>> pairs(n);
   for (std::size_t r = 0; r < n; ++r) {
     pairs[r] = {{c[0][r], c[1][r], c[2][r]}, {c[3][r], c[4][r], c[5][r]}};
@@ -36,20 +37,38 @@ int run_eval(const EvalOptions& o) {
     if (status == PairStatus::ok || status == PairStatus::wi_below_horizon ||
         status == PairStatus::wo_below_horizon)
       continue;
-    throw std::runtime_error(CsvError::location(input.name, table.lines[r], "") +
+    throw std::runtime_error(CsvError::location(source, block.lines[r], "") +
                              std::string(describe(status)));
   }
   std::vector<Rgb> rho(n);
-  brdf->eval_batch(pairs, rho);
+  brdf.eval_batch(pairs, rho);
   std::vector<std::vector<double>> rgb(3, std::vector<double>(n));
   for (std::size_t r = 0; r < n; ++r) {
     rgb[0][r] = rho[r].r;
     rgb[1][r] = rho[r].g;
     rgb[2][r] = rho[r].b;
   }
-  const std::vector<std::string> header{"r", "g", "b"};
   const std::vector<std::span<const double>> columns{rgb[0], rgb[1], rgb[2]};
-  write_csv(header, columns, out.sink());
+  write_csv_rows(columns, sink);
+}
+
+int run_eval(const EvalOptions& o) {
+  Output out(o.output);
+  const BrdfPtr brdf = load_brdf(o.brdf);
+  const std::unique_ptr<CsvStreamReader> reader = open_csv_input(o.input);
+  reader->require_header(column_names(Form{Space::dirs, false}));
+  // The header goes out with the first block (a bad row in a one-block input writes nothing).
+  std::string header = csv_header_line(std::vector<std::string>{"r", "g", "b"});
+  const CsvSink sink = [&](std::string_view text) {
+    if (!header.empty()) {
+      out.write(header);
+      header.clear();
+    }
+    out.write(text);
+  };
+  CsvTable block;
+  while (reader->read_block(block, kBlockRows)) eval_block(*brdf, block, reader->source(), sink);
+  if (!header.empty()) out.write(header);
   out.commit();
   return kExitOk;
 }

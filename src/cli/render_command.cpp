@@ -35,6 +35,8 @@ int run_render(const RenderOptions& o) {
   if (ext != ".png" && ext != ".exr")
     throw UsageError("the output must be a .png (tone-mapped sRGB) or .exr (linear) file: '" +
                      o.output + "'");
+  if (static_cast<long long>(o.width) * o.height > render::kMaxRenderPixels)
+    throw UsageError("--width, --height: " + render::pixel_limit_message(o.width, o.height));
   {
     // Fail before rendering when the destination cannot be written.
     AtomicFile probe(o.output);
@@ -107,8 +109,10 @@ Command register_render(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--seed", o->seed, "random seed (the image does not depend on --threads)")
       ->capture_default_str();
-  app->add_option("--time-budget", o->time_budget,
-                  "stop after about SEC seconds, keeping the finished passes (0: no limit)")
+  app->add_option(
+         "--time-budget", o->time_budget,
+         "stop after about SEC seconds, sampler set-up included, keeping the finished passes "
+         "(0: no limit; an error if not one sample per pixel fits)")
       ->check(CLI::Range(0.0, 1e9))
       ->capture_default_str();
   app->add_option("--exposure", o->exposure, "PNG exposure in stops")->capture_default_str();

@@ -183,7 +183,7 @@ Command register_study(CLI::App& parent) {
                   "(default 1000,10000,100000,1000000)");
   app->add_option("--test-pairs", o->test_pairs,
                   "Pairs the reconstructions are checked at (default 200000)")
-      ->check(CLI::Range(std::size_t(100), std::size_t(1) << 30));
+      ->check(CLI::Range(std::size_t(100), study::kMaxTestPairs));
   app->add_option("--env", o->environments,
                   "Environments of the image-space error, comma-separated: built-in names "
                   "(default, sky, studio, sunset) or .hdr/.exr files (default: the built-ins)");

@@ -184,7 +184,7 @@ struct Plan {
     want_jac = o.jacobian.data != nullptr;
     const bool to_dirs = t.space == Space::dirs;
     if (f.space == Space::dirs) {
-      check = k.check[to_dirs ? 1 : 0];
+      check = k.check;
     } else {
       decode = k.decode[static_cast<int>(f.space) - 1][f.isotropic ? 1 : 0];
       if (want_jac && to_dirs)
@@ -245,9 +245,13 @@ class TileRunner {
 
     // The input's measure before decoding: `out` may share memory with `in`.
     if (jac && p.jacobian_in) p.jacobian_in(in, jac, m);
-    if (p.check) {
+    if (p.check && !p.encode) {
       p.check(in, out, mask, m);
-      if (p.encode) p.encode(in, mask, out, m);
+    } else if (p.check) {
+      T* dirs[6];
+      for (int c = 0; c < 6; ++c) dirs[c] = column(kDirs + c);
+      p.check(in, dirs, mask, m);
+      p.encode(dirs, mask, out, m);
     } else if (!p.encode) {
       p.decode(in, out, mask, m);
     } else {

@@ -5,7 +5,7 @@
 //
 // A conversion runs in tiles of rows, in up to three stages on SoA columns, and a fourth when the
 // measure is asked for:
-//   check    (dirs input)   6 direction columns -> mask [, NaN-masked copy]
+//   check    (dirs input)   6 direction columns -> mask, accepted pair (NaN if invalid)
 //   decode   (P input)      dim(P) columns -> 6 direction columns (NaN if invalid), mask
 //   encode   (P output)     6 direction columns + mask -> dim(P) columns (NaN if invalid)
 //   jacobian (P in or out)  dim(P) columns -> J(q), not masked (the engine masks it)
@@ -31,8 +31,8 @@ struct StageKernels {
   using DecodeFn = void (*)(const T* const* in, T* const* dirs, T* mask, std::size_t m);
   using EncodeFn = void (*)(const T* const* dirs, const T* mask, T* const* out, std::size_t m);
   using JacobianFn = void (*)(const T* const* coords, T* jac, std::size_t m);
-  std::size_t width;          // lanes per vector
-  CheckFn check[2];           // [copy]
+  std::size_t width;  // lanes per vector
+  CheckFn check;
   DecodeFn decode[4][2];      // [space - 1][isotropic]
   EncodeFn encode[4][2];      // [space - 1][isotropic]
   JacobianFn jacobian[4][2];  // [space - 1][isotropic]

@@ -91,25 +91,24 @@ inline B mask_to_lanes(const MaskOf<B>& m) {
   return LaneOps<B>::select(m, B(S(1)), B(S(0)));
 }
 
-// dirs input: the pair_is_valid() mask; with Copy, the pair itself (NaN where invalid).
+// dirs input: the pair_is_valid() mask and the accepted pair, onto the unit upper hemisphere
+// (accepted_pair(); NaN where invalid), which the encode stage reads.
 // The stages are flattened: everything they call, down to the xsimd intrinsics, is inlined into
 // one loop (GCC otherwise keeps the larger param.hpp functions and xsimd's sincos out of line,
 // passing 512-bit vectors through memory, which costs 2-3x).
-template <class B, bool Copy>
+template <class B>
 HALFBACK_FLATTEN void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy,
                                   ScalarOf<B>* mask, std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
-  constexpr int kCopy = Copy ? 6 : 0;
-  constexpr int NO = kCopy + 1;
-  S* outs[NO];
-  for (int c = 0; c < kCopy; ++c) outs[c] = copy[c];
-  outs[kCopy] = mask;
-  for_rows<B, 6, NO>(in, outs, m, [](const B* x, B* y) {
-    const DirPair<B> p{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
-    const auto ok = pair_is_valid(p);
-    for (int c = 0; c < kCopy; ++c) y[c] = L::select(ok, x[c], nan_lanes<B>());
-    y[kCopy] = mask_to_lanes<B>(ok);
+  S* outs[7] = {copy[0], copy[1], copy[2], copy[3], copy[4], copy[5], mask};
+  for_rows<B, 6, 7>(in, outs, m, [](const B* x, B* y) {
+    const DirPair<B> raw{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
+    const auto ok = pair_is_valid(raw);
+    const DirPair<B> p = accepted_pair(raw);
+    const B v[6] = {p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z};
+    for (int c = 0; c < 6; ++c) y[c] = L::select(ok, v[c], nan_lanes<B>());
+    y[6] = mask_to_lanes<B>(ok);
   });
 }
 
@@ -135,7 +134,8 @@ HALFBACK_FLATTEN void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* co
   });
 }
 
-// P output: the coordinates of the pair (NaN where the mask is 0).
+// P output: the coordinates of the pair (NaN where the mask is 0), onto the unit hemisphere first
+// as convert_row() does: a decoded pair is unit only to rounding.
 template <class B, class P, bool Iso>
 HALFBACK_FLATTEN void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask,
                                    ScalarOf<B>* const* out, std::size_t m) {
@@ -147,7 +147,7 @@ HALFBACK_FLATTEN void encode_stage(const ScalarOf<B>* const* dirs, const ScalarO
   for (int c = 0; c < kDim; ++c) outs[c] = out[c];
   for_rows<B, 7, kDim>(ins, outs, m, [](const B* x, B* y) {
     const auto ok = x[6] > B(S(0));
-    const DirPair<B> p{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
+    const DirPair<B> p = accepted_pair(DirPair<B>{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}});
     encode_param<P, B>(Iso, p, y);
     for (int c = 0; c < kDim; ++c) y[c] = L::select(ok, y[c], nan_lanes<B>());
   });
@@ -179,8 +179,7 @@ template <class B>
 constexpr StageKernels<ScalarOf<B>> make_stages() {
   StageKernels<ScalarOf<B>> k{};
   k.width = Lanes<B>::size;
-  k.check[0] = &check_stage<B, false>;
-  k.check[1] = &check_stage<B, true>;
+  k.check = &check_stage<B>;
   // Indices follow Space: spherical = 1, halfdiff = 2, ortho = 3, hybrid = 4.
   fill_param<B, Spherical, 0>(k);
   fill_param<B, HalfDiff, 1>(k);

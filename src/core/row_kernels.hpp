@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include "halfback/core/space.hpp"
 
@@ -20,6 +21,30 @@ inline MaskOf<T> pair_is_valid(const DirPair<T>& p) {
   };
   return L::mask_and(L::mask_and(unit(p.wi), unit(p.wo)),
                      L::mask_and(p.wi.z >= -horizon_tol, p.wo.z >= -horizon_tol));
+}
+
+// An accepted direction onto the unit upper hemisphere: a z below the horizon (within the
+// tolerance) onto it, then unit length. The tolerances let through directions off unit length by
+// up to 1e-6, whose coordinates would leave their range (‖h̄‖ = 1.0000004) and not convert back.
+// A direction already unit to rounding (‖ω‖² within 4ε of 1, z >= 0) is kept bit for bit:
+// dividing it by its norm would only round it again.
+template <class T>
+inline Vec3<T> onto_unit_hemisphere(const Vec3<T>& w) {
+  using L = LaneOps<T>;
+  using S = ScalarOf<T>;
+  const T z = L::max(w.z, T(0));
+  const T n2 = w.x * w.x + w.y * w.y + z * z;
+  const T inv = T(1) / L::sqrt(n2);
+  const T e = n2 - T(1), unit_tol(S(4) * std::numeric_limits<S>::epsilon());
+  const auto keep = L::mask_and(L::mask_and(e <= unit_tol, e >= -unit_tol), w.z >= T(0));
+  return {L::select(keep, w.x, w.x * inv), L::select(keep, w.y, w.y * inv),
+          L::select(keep, w.z, z * inv)};
+}
+
+// The accepted pair that the conversions use (see onto_unit_hemisphere).
+template <class T>
+inline DirPair<T> accepted_pair(const DirPair<T>& p) {
+  return {onto_unit_hemisphere(p.wi), onto_unit_hemisphere(p.wo)};
 }
 
 // Decodes coordinates `in` (dimension(from) values) into a pair; the mask says whether valid.
@@ -57,6 +82,7 @@ inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
   if (from.space == Space::dirs) {
     pair = {{in[0], in[1], in[2]}, {in[3], in[4], in[5]}};
     ok = pair_is_valid(pair);
+    pair = accepted_pair(pair);
   } else {
     const Solved<T> s = visit_parameterization(
         from.space, [&](auto p) { return decode_param<decltype(p)>(from.isotropic, in); });
@@ -73,8 +99,10 @@ inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
     const T v[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
     for (int i = 0; i < 6; ++i) out[i] = v[i];
   } else {
+    // A decoded pair too is unit only to rounding (accepted_pair keeps it when within 4ε).
+    const DirPair<T> unit = accepted_pair(pair);
     visit_parameterization(to.space,
-                           [&](auto p) { encode_param<decltype(p)>(to.isotropic, pair, out); });
+                           [&](auto p) { encode_param<decltype(p)>(to.isotropic, unit, out); });
   }
   if (jacobian) {
     const Form side = to.space != Space::dirs ? to : from;

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <numbers>
 #include <stdexcept>
@@ -120,6 +121,12 @@ class CosineSampling final : public SamplingWrapper {
 
 }  // namespace
 
+std::string format_seconds(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", seconds);
+  return text;
+}
+
 const char* name_of(TableParam p) {
   switch (p) {
     case TableParam::spherical:
@@ -202,12 +209,26 @@ TabulatedSampler::TabulatedSampler(const Brdf& brdf, const TabulationOptions& o)
         Distribution2D(std::size_t(n_radial_), std::size_t(n_azimuthal_), weights);
   };
 
+  const bool budgeted = o.time_budget > 0;
+  auto seconds = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  std::atomic<bool> out_of_time{false};
   parallel_for(
       std::size_t(n_slices), 1,
       [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) build(int(i));
+        for (std::size_t i = begin; i < end && !out_of_time; ++i) {
+          if (budgeted && seconds() > o.time_budget) {
+            out_of_time = true;
+            return;
+          }
+          build(int(i));
+        }
       },
       o.threads);
+  if (out_of_time)
+    throw TimeBudgetExceeded("the time budget of " + format_seconds(o.time_budget) +
+                             " ran out while tabulating the BRDF's sampler");
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

@@ -237,9 +237,11 @@ class Renderer {
 };
 
 void validate(const RenderSettings& s) {
-  if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
+  if (s.width < 1 || s.height < 1 || s.width > kMaxRenderSide || s.height > kMaxRenderSide)
     throw std::invalid_argument("render: width and height must be in [1, 16384]");
-  if (s.spp < 1 || s.spp > (1 << 24))
+  if (static_cast<long long>(s.width) * s.height > kMaxRenderPixels)
+    throw std::invalid_argument("render: " + pixel_limit_message(s.width, s.height));
+  if (s.spp < 1 || s.spp > kMaxRenderSpp)
     throw std::invalid_argument("render: samples per pixel must be in [1, 16777216]");
   if (!(s.time_budget >= 0) || !std::isfinite(s.time_budget))
     throw std::invalid_argument("render: the time budget must be >= 0 seconds");
@@ -257,21 +259,46 @@ std::optional<Strategy> strategy_from_name(std::string_view name) {
   return std::nullopt;
 }
 
+std::string pixel_limit_message(int width, int height) {
+  return std::to_string(width) + " x " + std::to_string(height) + " = " +
+         std::to_string(static_cast<long long>(width) * height) + " pixels is above the limit of " +
+         std::to_string(kMaxRenderPixels) +
+         " pixels (4096 x 4096; rendering keeps about 100 bytes per pixel)";
+}
+
+namespace {
+RenderResult render_passes(const Brdf& brdf, const EnvMap& env, const RenderSettings& s,
+                           Clock::time_point start);
+}
+
 RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings) {
   validate(settings);
   const auto start = Clock::now();
   TabulationOptions tab = settings.tabulation;
   if (tab.threads == 0) tab.threads = settings.threads;
+  tab.time_budget = settings.time_budget;  // the sampler's set-up counts against the budget
   const auto sampled = with_importance_sampling(brdf, tab);
   const double build = std::chrono::duration<double>(Clock::now() - start).count();
-  RenderResult r = render_sampled(*sampled, env, settings);
+  if (settings.time_budget > 0 && !(build < settings.time_budget))
+    throw TimeBudgetExceeded("the time budget of " + format_seconds(settings.time_budget) +
+                             " ran out while building the BRDF's sampler (" +
+                             format_seconds(build) + ")");
+  RenderResult r = render_passes(*sampled, env, settings, start);
   r.sampler_seconds = build;
   return r;
 }
 
 RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSettings& s) {
   validate(s);
-  const auto start = Clock::now();
+  return render_passes(brdf, env, s, Clock::now());
+}
+
+namespace {
+
+// The passes of a render whose time budget started at `start` (before the sampler's set-up).
+RenderResult render_passes(const Brdf& brdf, const EnvMap& env, const RenderSettings& s,
+                           Clock::time_point start) {
+  const auto render_start = Clock::now();
   const Renderer renderer(brdf, env, s);
   const std::size_t pixels = std::size_t(s.width) * std::size_t(s.height);
   const int tiles_x = (s.width + kTile - 1) / kTile, tiles_y = (s.height + kTile - 1) / kTile;
@@ -291,9 +318,11 @@ RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSet
     const int count = std::min(pass_size, s.spp - done);
     pass.reset(pixels, s.variance);
     std::atomic<bool> abort{false};
+    std::atomic<int> tiles_done{0};
     auto render_tiles = [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end && !abort; ++i) {
-        if (s.time_budget > 0 && done > 0 &&
+        // Checked at every tile, the first pass included: a pass over a large image is long.
+        if (s.time_budget > 0 &&
             std::chrono::duration<double>(Clock::now() - start).count() > s.time_budget) {
           abort = true;
           return;
@@ -305,11 +334,17 @@ RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSet
           abort = true;  // the other blocks stop at their next tile
           throw;
         }
+        ++tiles_done;
         progress.add(std::uint64_t(std::min(kTile, s.width - x0)) *
                      std::uint64_t(std::min(kTile, s.height - y0)) * std::uint64_t(count));
       }
     };
     parallel_for(std::size_t(tiles), 1, render_tiles, s.threads);
+    if (abort && done == 0)
+      throw TimeBudgetExceeded("the time budget of " + format_seconds(s.time_budget) +
+                               " ran out before every pixel had one sample (" +
+                               std::to_string(tiles_done.load()) + " of " + std::to_string(tiles) +
+                               " tiles of the first pass): raise the budget or lower the size");
     if (abort) {
       exhausted = true;
       break;
@@ -350,8 +385,10 @@ RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSet
       r.variance[i] = float(var / done);
     }
   }
-  r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  r.seconds = std::chrono::duration<double>(Clock::now() - render_start).count();
   return r;
 }
+
+}  // namespace
 
 }  // namespace halfback::render

@@ -5,11 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/loader/load.hpp"
@@ -265,6 +268,69 @@ TEST(Renderer, TimeBudgetStopsEarly) {
   EXPECT_LT(r.spp, 1 << 16);
   EXPECT_LT(r.seconds, 5);
   for (float v : r.image.rgb) EXPECT_TRUE(std::isfinite(v));
+}
+
+// Class 5 of issue 12: the budget is checked at every tile, so a first pass over a large image
+// that does not fit stops within about a tile of the budget, with an error that says so (it was
+// checked only between passes: 16384² ran past 40 s with a 1 s budget).
+TEST(Renderer, TimeBudgetBoundsTheFirstPass) {
+  RenderSettings s = small(2048, 64);
+  s.variance = false;
+  s.threads = 1;  // 4 million samples take seconds on one thread, far more than the budget
+  s.time_budget = 0.2;
+  const EnvMap sky = EnvMap::default_sky();
+  const BrdfPtr brdf = ggx(0.2);
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    render(*brdf, sky, s);
+    ADD_FAILURE() << "a 0.2 s budget fitted a 2048 x 2048 pass on one thread";
+  } catch (const TimeBudgetExceeded& e) {
+    EXPECT_NE(std::string(e.what()).find("time budget of 0.2 s ran out before every pixel had one "
+                                         "sample"),
+              std::string::npos)
+        << e.what();
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 5.0);
+}
+
+// The sampler's set-up counts against the budget: a tabulated BRDF with a budget shorter than its
+// tabulation stops there.
+TEST(Renderer, TimeBudgetIncludesTheSamplerSetUp) {
+  RenderSettings s = small(64, 4);
+  s.tabulation = {};  // the default tables: 32 slices of 64 x 128 cells, 4 points a cell
+  s.threads = 1;
+  s.time_budget = 1e-4;
+  const EnvMap sky = EnvMap::default_sky();
+  const Opaque brdf(ggx(0.3));
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    render(brdf, sky, s);
+    ADD_FAILURE() << "a 0.1 ms budget fitted the tabulation and a pass";
+  } catch (const TimeBudgetExceeded& e) {
+    EXPECT_NE(std::string(e.what()).find("sampler"), std::string::npos) << e.what();
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 5.0);
+}
+
+// Memory is bounded by a stated pixel limit, whatever the side lengths allow.
+TEST(Renderer, PixelLimitStated) {
+  RenderSettings s = small(64, 1);
+  s.width = 16384;
+  s.height = 16384;
+  try {
+    render(*ggx(0.2), EnvMap::default_sky(), s);
+    ADD_FAILURE() << "16384 x 16384 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("above the limit of 16777216 pixels"), std::string::npos)
+        << e.what();
+  }
+  s.width = 4096;
+  s.height = 4097;
+  EXPECT_THROW(render(*ggx(0.2), EnvMap::default_sky(), s), std::invalid_argument);
 }
 
 TEST(Renderer, CameraConventions) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <initializer_list>
 #include <stdexcept>
 
 #include "halfback/core/parallel.hpp"
@@ -13,17 +14,43 @@
 
 namespace halfback::study {
 
+namespace {
+
+// a × b × ... cells, or an error naming the grid when it is empty or above kMaxGridCells.
+void check_grid(std::initializer_list<std::size_t> axes, const char* which) {
+  std::size_t cells = 1;
+  for (std::size_t n : axes) {
+    if (n == 0)
+      throw std::invalid_argument(
+          fmt::format("study: the {} needs at least one cell per axis", which));
+    if (n > kMaxGridCells || cells > kMaxGridCells / n)
+      cells = kMaxGridCells + 1;
+    else
+      cells *= n;
+  }
+  if (cells > kMaxGridCells)
+    throw std::invalid_argument(
+        fmt::format("study: the {} has more than the maximum of {} cells", which, kMaxGridCells));
+}
+
+}  // namespace
+
 void StudyConfig::validate() const {
-  if (grid.a == 0 || grid.b == 0 || grid.phi == 0)
-    throw std::invalid_argument("study: the isotropic grid needs at least one cell per axis");
-  for (std::size_t c : full_grid)
-    if (c == 0) throw std::invalid_argument("study: the 4D grid needs at least one cell per axis");
+  check_grid({grid.a, grid.b, grid.phi}, "isotropic grid");
+  check_grid({full_grid[0], full_grid[1], full_grid[2], full_grid[3]}, "4D grid");
   for (const auto* b : {&budgets, &budgets_4d}) {
-    for (std::size_t i = 0; i < b->size(); ++i)
+    for (std::size_t i = 0; i < b->size(); ++i) {
       if ((*b)[i] == 0 || (i > 0 && (*b)[i] <= (*b)[i - 1]))
         throw std::invalid_argument("study: sample budgets must be >= 1 and ascending");
+      if ((*b)[i] > kMaxSampleBudget)
+        throw std::invalid_argument(fmt::format(
+            "study: the sample budget {} is above the maximum of {}", (*b)[i], kMaxSampleBudget));
+    }
   }
   if (test_pairs < 100) throw std::invalid_argument("study: at least 100 test pairs");
+  if (test_pairs > kMaxTestPairs)
+    throw std::invalid_argument(
+        fmt::format("study: {} test pairs is above the maximum of {}", test_pairs, kMaxTestPairs));
   if (!(max_theta_deg > 0 && max_theta_deg <= 90))
     throw std::invalid_argument(
         "study: the gonio-reflectometer's reach must be in (0, 90] degrees");
@@ -33,6 +60,10 @@ void StudyConfig::validate() const {
           fmt::format("study: the image budget {} is not one of the sample budgets", image_budget));
     if (image_size < 8 || image_spp < 1)
       throw std::invalid_argument("study: images need >= 8 pixels and >= 1 sample per pixel");
+    if (std::size_t(image_size) > kMaxImageSize || image_spp > render::kMaxRenderSpp)
+      throw std::invalid_argument(
+          fmt::format("study: images of at most {} pixels a side and {} samples per pixel",
+                      kMaxImageSize, render::kMaxRenderSpp));
     for (const render::Environment& e : environments)
       if (!e.map) throw std::invalid_argument("study: environment '" + e.label + "' is empty");
   }

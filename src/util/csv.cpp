@@ -205,6 +205,143 @@ std::string format_csv_number(double value) {
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+void check_names(const std::vector<std::string>& header, const std::string& source,
+                 std::size_t header_line) {
+  std::unordered_set<std::string_view> seen;
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    if (header[i].empty())
+      throw CsvError(source, header_line, "",
+                     fmt::format("header: the name of column {} is empty", i + 1));
+    if (!seen.insert(header[i]).second)
+      throw CsvError(source, header_line, "",
+                     fmt::format("header: duplicate column name '{}'", shown(header[i])));
+  }
+}
+
+void require_names(const std::vector<std::string>& header, const std::string& source,
+                   std::size_t header_line, std::span<const std::string_view> expected,
+                   std::string_view note) {
+  bool same = expected.size() == header.size();
+  for (std::size_t i = 0; same && i < expected.size(); ++i) same = expected[i] == header[i];
+  if (same) return;
+  std::string problem = fmt::format("header does not match: expected '{}', found '{}'",
+                                    join(expected), shown(join(header)));
+  if (!note.empty()) problem += fmt::format("; {}", note);
+  throw CsvError(source, header_line, "", std::move(problem));
+}
+
+// The header line split into names; throws CsvError for a blank or malformed one.
+std::vector<std::string> parse_header(std::string_view line, const std::string& source,
+                                      std::size_t header_line) {
+  if (is_blank_line(line))
+    throw CsvError(source, header_line, "", "the header row is empty (expected column names)");
+  std::vector<std::string_view> fields;
+  std::deque<std::string> scratch;
+  if (std::string problem = split_fields(line, fields, scratch); !problem.empty())
+    throw CsvError(source, header_line, "", "header: " + problem);
+  return {fields.begin(), fields.end()};
+}
+
+}  // namespace
+
+// The data lines after the header, one at a time, into rows of a table. Blank lines are held
+// until a data line shows that they are inside the data (then each is a bad row); blank lines at
+// the end are allowed. emit() adds one row at a time, so a reader can stop at any row count.
+class CsvRowParser {
+ public:
+  CsvRowParser(const std::vector<std::string>& header, const std::string& source,
+               const CsvReadOptions& options)
+      : header_(header), source_(source), options_(options), values_(header.size()) {}
+
+  void take(std::string_view line, std::size_t line_no) {
+    if (is_blank_line(line)) {
+      if (blanks_++ == 0) first_blank_ = line_no;
+      return;
+    }
+    inside_blanks_ = blanks_;
+    inside_first_ = first_blank_;
+    blanks_ = 0;
+    held_.assign(line);
+    held_line_ = line_no;
+    holding_ = true;
+  }
+
+  bool pending() const { return inside_blanks_ > 0 || holding_; }
+
+  // Adds the next pending row to `table`: a blank line inside the data, or the held line.
+  void emit(CsvTable& table) {
+    if (inside_blanks_ > 0) {
+      const std::size_t line = inside_first_++;
+      --inside_blanks_;
+      bad_row(table, line, "",
+              "empty line inside the data (blank lines are allowed only at the end)");
+      push_nan_row(table, line);
+      return;
+    }
+    holding_ = false;
+    row(table, held_, held_line_);
+  }
+
+ private:
+  void bad_row(CsvTable& table, std::size_t line, std::string column, std::string problem) {
+    if (!options_.keep_bad_rows) throw CsvError(source_, line, std::move(column), problem);
+    CsvRowProblem p;
+    p.row = table.rows();
+    p.line = line;
+    p.message = CsvError::location(source_, line, column) + problem;
+    p.column = std::move(column);
+    p.problem = std::move(problem);
+    table.problems.push_back(std::move(p));
+  }
+  static void push_nan_row(CsvTable& table, std::size_t line) {
+    for (auto& c : table.columns) c.push_back(kNaN);
+    table.lines.push_back(line);
+  }
+
+  void row(CsvTable& table, std::string_view line, std::size_t line_no) {
+    const std::size_t ncols = header_.size();
+    if (std::string problem = split_fields(line, fields_, scratch_); !problem.empty()) {
+      bad_row(table, line_no, "", std::move(problem));
+      push_nan_row(table, line_no);
+      return;
+    }
+    if (fields_.size() != ncols) {
+      std::string problem =
+          fmt::format("expected {} fields ({}), found {}", ncols,
+                      join(std::span<const std::string>(header_)), fields_.size());
+      if (fields_.size() == ncols + 1 && fields_.back().empty()) problem += " (a trailing comma?)";
+      bad_row(table, line_no, "", std::move(problem));
+      push_nan_row(table, line_no);
+      return;
+    }
+    bool row_ok = true;
+    for (std::size_t c = 0; c < ncols; ++c) {
+      std::string problem = parse_csv_number(fields_[c], values_[c], options_.allow_non_finite);
+      if (!problem.empty()) {
+        values_[c] = kNaN;
+        if (row_ok) bad_row(table, line_no, header_[c], std::move(problem));
+        row_ok = false;
+      }
+    }
+    for (std::size_t c = 0; c < ncols; ++c) table.columns[c].push_back(values_[c]);
+    table.lines.push_back(line_no);
+  }
+
+  const std::vector<std::string>& header_;
+  const std::string& source_;
+  CsvReadOptions options_;
+  std::vector<std::string_view> fields_;
+  std::deque<std::string> scratch_;
+  std::vector<double> values_;
+  std::size_t blanks_ = 0, first_blank_ = 0;  // blank lines not yet known to be inside the data
+  std::size_t inside_blanks_ = 0, inside_first_ = 0;  // blank lines inside the data, to emit
+  std::string held_;                                  // the data line after them
+  std::size_t held_line_ = 0;
+  bool holding_ = false;
+};
+
 CsvReader::CsvReader(std::string_view text, std::string source)
     : text_(text), source_(std::move(source)) {
   if (text_.substr(0, 3) == "\xEF\xBB\xBF") text_.remove_prefix(3);  // UTF-8 byte-order mark
@@ -214,105 +351,150 @@ CsvReader::CsvReader(std::string_view text, std::string source)
   std::string_view line;
   cursor.next(line);
   header_line_ = cursor.line;
-  if (is_blank_line(line))
-    throw CsvError(source_, header_line_, "", "the header row is empty (expected column names)");
-  std::vector<std::string_view> fields;
-  std::deque<std::string> scratch;
-  if (std::string problem = split_fields(line, fields, scratch); !problem.empty())
-    throw CsvError(source_, header_line_, "", "header: " + problem);
-  header_.assign(fields.begin(), fields.end());
+  header_ = parse_header(line, source_, header_line_);
   pos_ = cursor.pos;
 }
 
 void CsvReader::check_names() const {
-  std::unordered_set<std::string_view> seen;
-  for (std::size_t i = 0; i < header_.size(); ++i) {
-    if (header_[i].empty())
-      throw CsvError(source_, header_line_, "",
-                     fmt::format("header: the name of column {} is empty", i + 1));
-    if (!seen.insert(header_[i]).second)
-      throw CsvError(source_, header_line_, "",
-                     fmt::format("header: duplicate column name '{}'", shown(header_[i])));
-  }
+  halfback::check_names(header_, source_, header_line_);
 }
 
 void CsvReader::require_header(std::span<const std::string_view> expected,
                                std::string_view note) const {
-  bool same = expected.size() == header_.size();
-  for (std::size_t i = 0; same && i < expected.size(); ++i) same = expected[i] == header_[i];
-  if (same) return;
-  std::string problem = fmt::format("header does not match: expected '{}', found '{}'",
-                                    join(expected), shown(join(header_)));
-  if (!note.empty()) problem += fmt::format("; {}", note);
-  throw CsvError(source_, header_line_, "", std::move(problem));
+  require_names(header_, source_, header_line_, expected, note);
 }
 
 CsvTable CsvReader::read_rows(const CsvReadOptions& options) {
   check_names();
-  const std::size_t ncols = header_.size();
   CsvTable table;
   table.header = header_;
-  table.columns.assign(ncols, {});
-
-  auto bad_row = [&](std::size_t line, std::string column, std::string problem) {
-    if (!options.keep_bad_rows) throw CsvError(source_, line, std::move(column), problem);
-    CsvRowProblem p;
-    p.row = table.rows();
-    p.line = line;
-    p.message = CsvError::location(source_, line, column) + problem;
-    p.column = std::move(column);
-    p.problem = std::move(problem);
-    table.problems.push_back(std::move(p));
-  };
-  auto push_nan_row = [&](std::size_t line) {
-    for (auto& c : table.columns) c.push_back(kNaN);
-    table.lines.push_back(line);
-  };
-
+  table.columns.assign(header_.size(), {});
+  CsvRowParser parser(header_, source_, options);
   LineCursor cursor{text_, pos_, header_line_};
   std::string_view line;
-  std::vector<std::string_view> fields;
-  std::deque<std::string> scratch;
-  std::vector<double> values(ncols);
-  std::size_t first_blank = 0, blanks = 0;  // blank lines not yet known to be inside the data
-  while (cursor.next(line)) {
-    if (is_blank_line(line)) {
-      if (blanks++ == 0) first_blank = cursor.line;
-      continue;
+  while (true) {
+    if (parser.pending()) {
+      parser.emit(table);
+    } else if (cursor.next(line)) {
+      parser.take(line, cursor.line);
+    } else {
+      break;
     }
-    for (std::size_t b = 0; b < blanks; ++b) {
-      bad_row(first_blank + b, "",
-              "empty line inside the data (blank lines are allowed only at the end)");
-      push_nan_row(first_blank + b);
-    }
-    blanks = 0;
-
-    if (std::string problem = split_fields(line, fields, scratch); !problem.empty()) {
-      bad_row(cursor.line, "", std::move(problem));
-      push_nan_row(cursor.line);
-      continue;
-    }
-    if (fields.size() != ncols) {
-      std::string problem = fmt::format("expected {} fields ({}), found {}", ncols,
-                                        join(std::span<const std::string>(header_)), fields.size());
-      if (fields.size() == ncols + 1 && fields.back().empty()) problem += " (a trailing comma?)";
-      bad_row(cursor.line, "", std::move(problem));
-      push_nan_row(cursor.line);
-      continue;
-    }
-    bool row_ok = true;
-    for (std::size_t c = 0; c < ncols; ++c) {
-      std::string problem = parse_csv_number(fields[c], values[c], options.allow_non_finite);
-      if (!problem.empty()) {
-        values[c] = kNaN;
-        if (row_ok) bad_row(cursor.line, header_[c], std::move(problem));
-        row_ok = false;
-      }
-    }
-    for (std::size_t c = 0; c < ncols; ++c) table.columns[c].push_back(values[c]);
-    table.lines.push_back(cursor.line);
   }
   return table;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+CsvStreamReader::CsvStreamReader(const std::filesystem::path& path) : source_(path.string()) {
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0)
+    throw std::system_error(errno, std::generic_category(), "cannot read '" + source_ + "'");
+  owns_fd_ = true;
+  start();
+}
+
+CsvStreamReader::CsvStreamReader(int fd, std::string source)
+    : source_(std::move(source)), fd_(fd), owns_fd_(false) {
+  start();
+}
+
+CsvStreamReader::~CsvStreamReader() {
+  if (owns_fd_) ::close(fd_);
+}
+
+// Reads more bytes into the buffer; false at the end of the input.
+bool CsvStreamReader::fill() {
+  if (eof_) return false;
+  if (pos_ > 0) {  // drop the lines already returned
+    buffer_.erase(0, pos_);
+    pos_ = 0;
+  }
+  char chunk[1 << 16];
+  while (true) {
+    const ssize_t n = ::read(fd_, chunk, sizeof chunk);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw std::system_error(errno, std::generic_category(),
+                              source_ == "<stdin>" ? std::string("cannot read standard input")
+                                                   : "cannot read '" + source_ + "'");
+    }
+    if (n == 0) {
+      eof_ = true;
+      return false;
+    }
+    buffer_.append(chunk, static_cast<std::size_t>(n));
+    return true;
+  }
+}
+
+bool CsvStreamReader::next_line(std::string_view& out) {
+  std::size_t end = buffer_.find('\n', pos_);
+  while (end == std::string::npos) {
+    const std::size_t unread = buffer_.size() - pos_;
+    if (unread > kMaxLineBytes)
+      throw CsvError(source_, line_ + 1, "",
+                     fmt::format("the line is longer than the limit of {} bytes", kMaxLineBytes));
+    if (!fill()) break;
+    end = buffer_.find('\n', unread);  // fill() moved the unread bytes to the front
+  }
+  if (end == std::string::npos) {
+    if (pos_ >= buffer_.size()) return false;
+    end = buffer_.size();
+  }
+  out = std::string_view(buffer_).substr(pos_, end - pos_);
+  if (!out.empty() && out.back() == '\r') out.remove_suffix(1);
+  pos_ = end == buffer_.size() ? end : end + 1;
+  ++line_;
+  return true;
+}
+
+void CsvStreamReader::start() {
+  while (buffer_.size() < 3 && fill()) {
+  }
+  if (std::string_view(buffer_).substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3;  // UTF-8 byte-order mark
+  std::string_view line;
+  // As CsvReader: an input of blank lines only is empty; a blank first line is an empty header.
+  std::size_t first = 0;
+  while (next_line(line)) {
+    if (first == 0) first = line_;
+    if (!is_blank_line(line)) {
+      if (first != line_)
+        throw CsvError(source_, first, "", "the header row is empty (expected column names)");
+      header_ = parse_header(line, source_, line_);
+      header_line_ = line_;
+      return;
+    }
+  }
+  throw CsvError(source_, 0, "", "the input is empty (expected a header row)");
+}
+
+void CsvStreamReader::require_header(std::span<const std::string_view> expected,
+                                     std::string_view note) const {
+  require_names(header_, source_, header_line_, expected, note);
+}
+
+bool CsvStreamReader::read_block(CsvTable& block, std::size_t max_rows,
+                                 const CsvReadOptions& options) {
+  if (!parser_) {
+    check_names(header_, source_, header_line_);
+    parser_ = std::make_unique<CsvRowParser>(header_, source_, options);
+  }
+  block.header = header_;
+  block.columns.assign(header_.size(), {});
+  block.lines.clear();
+  block.problems.clear();
+  std::string_view line;
+  while (block.rows() < max_rows) {
+    if (parser_->pending()) {
+      parser_->emit(block);
+    } else if (next_line(line)) {
+      parser_->take(line, line_);
+    } else {
+      break;
+    }
+  }
+  return block.rows() > 0;
 }
 
 CsvTable read_csv(std::string_view text, std::string source,
@@ -373,21 +555,22 @@ std::string csv_text_field(std::string_view text) {
   return fmt::to_string(buf);
 }
 
-void write_csv(std::span<const std::string> header,
-               std::span<const std::span<const double>> columns, const CsvSink& sink,
-               std::size_t chunk_bytes) {
-  if (header.size() != columns.size())
-    throw std::invalid_argument("write_csv: the header and the columns differ in number");
-  const std::size_t rows = columns.empty() ? 0 : columns.front().size();
-  for (const auto& c : columns)
-    if (c.size() != rows) throw std::invalid_argument("write_csv: columns of different lengths");
-
+std::string csv_header_line(std::span<const std::string> header) {
   fmt::memory_buffer buf;
   for (std::size_t c = 0; c < header.size(); ++c) {
     if (c > 0) buf.push_back(',');
     append_name(buf, header[c]);
   }
   buf.push_back('\n');
+  return fmt::to_string(buf);
+}
+
+void write_csv_rows(std::span<const std::span<const double>> columns, const CsvSink& sink,
+                    std::size_t chunk_bytes) {
+  const std::size_t rows = columns.empty() ? 0 : columns.front().size();
+  for (const auto& c : columns)
+    if (c.size() != rows) throw std::invalid_argument("write_csv: columns of different lengths");
+  fmt::memory_buffer buf;
   for (std::size_t r = 0; r < rows; ++r) {
     for (std::size_t c = 0; c < columns.size(); ++c) {
       if (c > 0) buf.push_back(',');
@@ -404,6 +587,32 @@ void write_csv(std::span<const std::string> header,
     }
   }
   if (buf.size() > 0) sink(std::string_view(buf.data(), buf.size()));
+}
+
+void write_csv(std::span<const std::string> header,
+               std::span<const std::span<const double>> columns, const CsvSink& sink,
+               std::size_t chunk_bytes) {
+  if (header.size() != columns.size())
+    throw std::invalid_argument("write_csv: the header and the columns differ in number");
+  const std::size_t rows = columns.empty() ? 0 : columns.front().size();
+  for (const auto& c : columns)
+    if (c.size() != rows) throw std::invalid_argument("write_csv: columns of different lengths");
+  // The header goes out with the first chunk of rows (one write for a small table).
+  std::string head = csv_header_line(header);
+  bool sent = false;
+  write_csv_rows(
+      columns,
+      [&](std::string_view rows_text) {
+        if (!sent) {
+          head += rows_text;
+          sink(head);
+          sent = true;
+        } else {
+          sink(rows_text);
+        }
+      },
+      chunk_bytes);
+  if (!sent) sink(head);
 }
 
 std::string to_csv(std::span<const std::string> header,

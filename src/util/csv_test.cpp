@@ -1,5 +1,8 @@
 #include "halfback/util/csv.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -307,6 +310,134 @@ TEST(CsvWrite, ChunkedSinkGivesTheSameText) {
       256);
   EXPECT_GT(calls, 10);
   EXPECT_EQ(chunked, to_csv(header, cols));
+}
+
+// ---------------------------------------------------------------------------------------------
+// CsvStreamReader: the same tables and errors as CsvReader, a block of rows at a time
+// ---------------------------------------------------------------------------------------------
+
+struct FdCloser {
+  int fd;
+  ~FdCloser() { ::close(fd); }
+};
+
+// The whole table of `text` read through a file in blocks of `block` rows (problems' rows made
+// absolute), or the CsvError's message.
+std::string stream_read(const std::string& text, std::size_t block, CsvTable& table,
+                        const CsvReadOptions& options = {}) {
+  test::TempDir dir;
+  test::write_bytes(dir / "t.csv", text.data(), text.size());
+  const int fd = ::open((dir / "t.csv").c_str(), O_RDONLY);
+  const FdCloser closer{fd};
+  try {
+    CsvStreamReader reader(fd, "t.csv");
+    table = {};
+    table.header = reader.header();
+    table.columns.assign(reader.header().size(), {});
+    CsvTable part;
+    while (reader.read_block(part, block, options)) {
+      EXPECT_LE(part.rows(), block);
+      for (CsvRowProblem p : part.problems) {
+        p.row += table.rows();
+        table.problems.push_back(p);
+      }
+      for (std::size_t c = 0; c < part.columns.size(); ++c)
+        table.columns[c].insert(table.columns[c].end(), part.columns[c].begin(),
+                                part.columns[c].end());
+      table.lines.insert(table.lines.end(), part.lines.begin(), part.lines.end());
+    }
+  } catch (const CsvError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+std::string whole_read(const std::string& text, CsvTable& table,
+                       const CsvReadOptions& options = {}) {
+  try {
+    CsvReader reader(text, "t.csv");
+    table = reader.read_rows(options);
+  } catch (const CsvError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+void expect_same_tables(const CsvTable& a, const CsvTable& b) {
+  EXPECT_EQ(a.header, b.header);
+  EXPECT_EQ(a.lines, b.lines);
+  ASSERT_EQ(a.columns.size(), b.columns.size());
+  for (std::size_t c = 0; c < a.columns.size(); ++c) {
+    ASSERT_EQ(a.columns[c].size(), b.columns[c].size());
+    for (std::size_t r = 0; r < a.columns[c].size(); ++r)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(a.columns[c][r]),
+                std::bit_cast<std::uint64_t>(b.columns[c][r]));
+  }
+  ASSERT_EQ(a.problems.size(), b.problems.size());
+  for (std::size_t i = 0; i < a.problems.size(); ++i) {
+    EXPECT_EQ(a.problems[i].row, b.problems[i].row);
+    EXPECT_EQ(a.problems[i].line, b.problems[i].line);
+    EXPECT_EQ(a.problems[i].problem, b.problems[i].problem);
+  }
+}
+
+// Every rule of the reader at every block size: line ends, byte-order mark, blank lines at the
+// end and inside the data (kept as bad rows across block boundaries), bad fields, empty inputs.
+TEST(CsvStream, SameTablesAndErrorsAsTheWholeTextReader) {
+  const std::vector<std::string> inputs{
+      "a,b,c\n1,2,3\n4,5,6\n",
+      "\xEF\xBB\xBF"
+      "a,b,c\r\n1,2,3\r\n4,5,6",
+      "a,b,c\n1,2,3\n\n\n",
+      "a,b,c\n1,2,3\n\n\n4,5,6\n7,8,9\n",
+      "a,b,c\n1,2,3\n4,x,6\n7,8\n1,2,3,\n\"1\",\"2\",3\n",
+      "a,b,c\n",
+      "a,b,c",
+      "",
+      "\n \n\t\n",
+      "\n\na,b,c\n1,2,3\n",
+      "a,a,c\n1,2,3\n",
+      "a,,c\n1,2,3\n",
+  };
+  for (const std::string& text : inputs) {
+    for (bool keep : {false, true}) {
+      CsvReadOptions options;
+      options.keep_bad_rows = keep;
+      CsvTable whole, streamed;
+      const std::string whole_error = whole_read(text, whole, options);
+      for (std::size_t block : {1, 2, 3, 1000}) {
+        SCOPED_TRACE("input '" + text + "', block " + std::to_string(block) +
+                     (keep ? ", keep bad rows" : ""));
+        const std::string stream_error = stream_read(text, block, streamed, options);
+        EXPECT_EQ(stream_error, whole_error);
+        if (whole_error.empty() && stream_error.empty()) expect_same_tables(streamed, whole);
+      }
+    }
+  }
+}
+
+// Lines that cross the reader's 64 KiB chunks, many rows, and a line without an end past the
+// limit (an error, not unbounded memory).
+TEST(CsvStream, LongInputsAndTheLineLimit) {
+  std::string text = "a,b,c\n";
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int r = 0; r < 20000; ++r)
+    text += format_csv_number(u(rng)) + ", " + format_csv_number(u(rng)) + "," +
+            format_csv_number(u(rng)) + "\n";
+  CsvTable whole, streamed;
+  ASSERT_EQ(whole_read(text, whole), "");
+  ASSERT_EQ(stream_read(text, 4096, streamed), "");
+  expect_same_tables(streamed, whole);
+
+  const std::string endless = "a,b,c\n1,2," + std::string(CsvStreamReader::kMaxLineBytes, '3');
+  const std::string error = stream_read(endless, 10, streamed);
+  EXPECT_NE(error.find(":2: the line is longer than the limit of 1048576 bytes"), std::string::npos)
+      << error;
+}
+
+TEST(CsvStream, MissingFileIsASystemError) {
+  EXPECT_THROW(CsvStreamReader(std::filesystem::path("/nonexistent/t.csv")), std::system_error);
 }
 
 TEST(CsvRoundTrip, ExactForEveryDouble) {

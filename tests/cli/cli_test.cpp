@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -39,6 +40,7 @@ using namespace std::string_literals;
 
 constexpr double kPi = std::numbers::pi;
 constexpr const char* kDirsHeader = "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n";
+constexpr const char* kTimePath = "/usr/bin/time";  // GNU time, for peak resident memory
 
 struct Result {
   int status = -1;  // exit status, or -1 when killed by a signal
@@ -68,7 +70,11 @@ class CliTest : public testing::Test {
   fs::path path(const std::string& name) const { return dir_.path() / name; }
 
   // Runs halfback with `args` in the test's directory, `input` on stdin.
-  Result run(const std::vector<std::string>& args, const std::string& input = "") const {
+  // With `max_rss_kb`, the command's peak resident memory is stored there, measured by
+  // /usr/bin/time (its fork starts small; the ru_maxrss of a posix_spawn child would include this
+  // process's memory, from before the exec).
+  Result run(const std::vector<std::string>& args, const std::string& input = "",
+             long* max_rss_kb = nullptr) const {
     const fs::path in = path(".stdin"), out = path(".stdout"), err = path(".stderr");
     put(in, input);
     posix_spawn_file_actions_t actions;
@@ -76,7 +82,9 @@ class CliTest : public testing::Test {
     posix_spawn_file_actions_addopen(&actions, 0, in.c_str(), O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const fs::path rss = path(".rss");
     std::vector<std::string> argv_storage{HALFBACK_CLI_PATH};
+    if (max_rss_kb) argv_storage = {kTimePath, "-f", "%M", "-o", rss.string(), HALFBACK_CLI_PATH};
     argv_storage.insert(argv_storage.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (auto& a : argv_storage) argv.push_back(a.data());
@@ -84,7 +92,7 @@ class CliTest : public testing::Test {
     const fs::path cwd = fs::current_path();
     fs::current_path(dir_.path());
     pid_t pid = 0;
-    const int rc = posix_spawn(&pid, HALFBACK_CLI_PATH, &actions, nullptr, argv.data(), environ);
+    const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
     fs::current_path(cwd);
     posix_spawn_file_actions_destroy(&actions);
     Result r;
@@ -94,6 +102,11 @@ class CliTest : public testing::Test {
     }
     int status = 0;
     waitpid(pid, &status, 0);
+    if (max_rss_kb) {
+      std::istringstream lines(slurp(rss));
+      for (std::string line; std::getline(lines, line);) *max_rss_kb = std::atol(line.c_str());
+      fs::remove(rss);
+    }
     r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     r.out = slurp(out);
     r.err = slurp(err);
@@ -1307,6 +1320,138 @@ TEST_F(CliTest, StudyBadInput) {
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("nowhere.hdr"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("study")));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bounded work (issue 12, class 5) and streaming (docs/reliability-bounds.md)
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(CliTest, RenderLimitsAreStated) {
+  Result r =
+      run({"render", "--brdf", "lambert", "--width", "16384", "--height", "16384", "-o", "a.exr"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("16384 x 16384 = 268435456 pixels is above the limit of 16777216 pixels"),
+            std::string::npos)
+      << r.err;
+  r = run({"render", "--brdf", "lambert", "--spp", "20000000", "-o", "a.exr"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("16777216"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("a.exr")));
+}
+
+TEST_F(CliTest, RenderTimeBudgetEndsALargeFirstPass) {
+  const auto start = std::chrono::steady_clock::now();
+  const Result r = run({"render", "--brdf", "ggx:alpha=0.2", "--width", "2048", "--height", "2048",
+                        "--threads", "1", "--time-budget", "0.2", "-q", "-o", "a.exr"});
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("the time budget of 0.2 s ran out before every pixel had one sample"),
+            std::string::npos)
+      << r.err;
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_FALSE(fs::exists(path("a.exr")));
+}
+
+TEST_F(CliTest, StudyLimitsAreStated) {
+  Result r = run({"study", "--budgets", "2000000000", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("the sample budget 2000000000 is above the maximum of 10000000"),
+            std::string::npos)
+      << r.err;
+  r = run({"study", "--budgets-4d", "1000,20000000", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("above the maximum of 10000000"), std::string::npos) << r.err;
+  r = run({"study", "--test-pairs", "2000000000", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("10000000"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("study")));
+}
+
+TEST_F(CliTest, ResampleGridLimitIsStatedInBytes) {
+  const Result r = run({"resample", "--brdf", "lambert", "--param", "hybrid", "--kind", "full",
+                        "--size", "91", "-o", "t.npz"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("more than the maximum of 2^26 = 67108864"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1.7 GB"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("t.npz")));
+}
+
+// Pairs of ordinary directions, n rows of dirs CSV, from a cheap generator.
+std::string many_pairs_csv(std::size_t n) {
+  std::string text = kDirsHeader;
+  text.reserve(n * 120);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = 0.001 * double(i % 6283), b = 0.3 + 0.5 * double(i % 97) / 97;
+    const double s = std::sqrt(1 - b * b);
+    text += fmt_row({s * std::cos(a), s * std::sin(a), b, -s * std::sin(a), s * std::cos(a), b});
+    text += '\n';
+  }
+  return text;
+}
+
+// convert reads, converts and writes blocks of 65536 rows: the output of several blocks is the
+// library's conversion of the whole input, byte for byte.
+TEST_F(CliTest, ConvertStreamsBlocksByteIdentically) {
+  constexpr std::size_t n = 150000;
+  const std::string input = many_pairs_csv(n);
+  const Result r = run({"convert", "--from", "dirs", "--to", "hybrid", "--jacobian"}, input);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const CsvTable in = read_csv(input, "in");
+  std::vector<ConstColumn<double>> in_cols;
+  for (const auto& c : in.columns) in_cols.push_back({c.data(), 1});
+  std::vector<std::vector<double>> out(5, std::vector<double>(n));
+  std::vector<Column<double>> out_cols;
+  for (int c = 0; c < 4; ++c) out_cols.push_back({out[c].data(), 1});
+  ConvertOutput<double> conv;
+  conv.columns = out_cols;
+  conv.jacobian = {out[4].data(), 1};
+  convert<double>({Space::dirs, false}, {Space::hybrid, false}, in_cols, n, conv);
+  const std::vector<std::span<const double>> cols(out.begin(), out.end());
+  EXPECT_TRUE(r.out == to_csv(header_of(column_names({Space::hybrid, false}), {"jacobian"}), cols))
+      << "the streamed output differs from the whole-input conversion";
+}
+
+// A bad row in a later block still fails the command and leaves no output file; with
+// --skip-invalid it is counted and named like a bad row of the first block.
+TEST_F(CliTest, ConvertStreamingKeepsTheErrorBehaviour) {
+  std::string input = many_pairs_csv(140000);
+  const std::size_t line = 140000;  // row 139999 (0-based 139998): in the third block
+  std::size_t pos = 0;
+  for (std::size_t l = 1; l < line; ++l) pos = input.find('\n', pos) + 1;
+  input.replace(pos, input.find('\n', pos) - pos, "0,0,1,0,0,2");
+  put(path("in.csv"), input);
+  put(path("out.csv"), "kept\n");
+  Result r = run({"convert", "--from", "dirs", "--to", "ortho", "-i", "in.csv", "-o", "out.csv"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("in.csv:140000: wo is not a unit vector"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(path("out.csv")), "kept\n");
+  r = run({"convert", "--from", "dirs", "--to", "ortho", "--skip-invalid", "-i", "in.csv"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("1 invalid input row written with valid = 0; the first: in.csv:140000:"),
+            std::string::npos)
+      << r.err;
+  const CsvTable t = parse(r.out);
+  ASSERT_EQ(t.rows(), 140000u);
+  EXPECT_EQ(t.columns[4][line - 2], 0.0);
+  EXPECT_TRUE(std::isnan(t.columns[0][line - 2]));
+  EXPECT_EQ(t.columns[4][line - 3], 1.0);
+}
+
+// Memory does not grow with the input: 400000 rows (48 MB of text) were held whole before, with
+// their columns and output (well over 100 MB resident); a block at a time needs a few MB.
+TEST_F(CliTest, ConvertAndEvalRunInBoundedMemory) {
+  if (access(kTimePath, X_OK) != 0) GTEST_SKIP() << kTimePath << " is needed to measure memory";
+  const std::string input = many_pairs_csv(400000);
+  long rss_kb = 0;
+  Result r = run({"convert", "--from", "dirs", "--to", "hybrid"}, input, &rss_kb);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 400001);
+  EXPECT_LT(rss_kb, 48 * 1024) << "convert: peak resident memory " << rss_kb << " kB";
+  r = run({"eval", "--brdf", "lambert"}, input, &rss_kb);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 400001);
+  EXPECT_LT(rss_kb, 48 * 1024) << "eval: peak resident memory " << rss_kb << " kB";
 }
 
 }  // namespace

@@ -72,8 +72,12 @@ double wrap_azimuth_radians(double radians);
 GridSpec default_grid(Space space, GridKind kind, std::vector<std::size_t> counts,
                       double slice_azimuth = 0);
 
+// The most points a grid may have: a table keeps 25 bytes a point (RGB doubles and the mask), so
+// 1.7 GB at this limit (it was 2^31 = 54 GB, more than most machines have).
+inline constexpr std::size_t kMaxGridPoints = std::size_t{1} << 26;
+
 // Checks a grid (the right axes for its kind, finite ranges with lo < hi, counts >= 1, nodes
-// need counts >= 2 only when lo != hi, at most 2^31 points); throws std::invalid_argument.
+// need counts >= 2 only when lo != hi, at most kMaxGridPoints); throws std::invalid_argument.
 void validate(const GridSpec& grid);
 
 // The direction pairs of points [begin, begin + pairs.size()) of a grid, by the core's checked

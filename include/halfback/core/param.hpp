@@ -234,7 +234,7 @@ struct HalfDiff {
     const auto flat = rxy == T(0), null = len == T(0);
     const T cp = L::select(flat, T(1), sx / rxy), sp = L::select(flat, T(0), sy / rxy);
     const T ct = L::select(null, T(1), sz / len), st = L::select(null, T(0), rxy / len);
-    const T theta_h = L::select(null, T(0), L::atan2(rxy, sz));
+    const T theta_h_raw = L::select(null, T(0), L::atan2(rxy, sz));
     // d = R_y(-θh) R_z(-φh) ωi, computed symmetrically in ωi and ωo: R⁻¹h = (0, 0, ‖h‖) exactly,
     // so d = (R⁻¹k)_xy + ‖h‖ n. Rotating ωi alone would make the inverse reflect ωi about ĥ, and
     // amplify the inputs' unit-norm rounding (‖ωi‖ ≠ ‖ωo‖ by an ulp) by 1/‖h‖ near h = 0; with
@@ -246,6 +246,13 @@ struct HalfDiff {
     const T dy = cp * ky - sp * kx;
     const T dx = ct * a - st * kz;
     const T dz = half * len;
+    // The inverse's elevations are dz cos θh ∓ dx sin θh, both >= 0 iff θh <= atan2(dz, |dx|).
+    // For inputs unit only to rounding, h·k = (‖ωi‖² − ‖ωo‖²)/4 is not 0, and near h = 0 (a pair
+    // opposite each other at the horizon) θh is then noise that breaks this by up to ε/‖h‖. A tilt
+    // of ĥ down to the bound rotates the pair by no more than that error, and keeps the round trip
+    // of every accepted pair valid (docs/math.md §6). Valid pairs are unchanged but for rounding.
+    const T theta_h_max = L::atan2(dz, L::abs(dx));
+    const T theta_h = L::select(theta_h_raw > theta_h_max, theta_h_max, theta_h_raw);
     return {theta_h, detail::azimuth(sy, sx), detail::elevation(dx, dy, dz),
             detail::azimuth(dy, dx)};
   }
@@ -345,6 +352,14 @@ inline PlanarHK<T> planar_hk(const DirPair<T>& p) {
           half * (p.wi.y - p.wo.y), half * (p.wi.z - p.wo.z)};
 }
 
+// ‖v‖ from ‖v‖², clamped into [0, 1], the range of ‖h̄‖, ‖k̄‖ and ‖k‖ for unit directions: for
+// ωi = ωo on the horizon, ‖h̄‖ rounds to 1 + 2e-16 and would fall outside the valid domain.
+template <class T>
+inline T magnitude(T squared) {
+  const T m = LaneOps<T>::sqrt(squared);
+  return LaneOps<T>::select(m > T(1), T(1), m);  // NaN stays NaN
+}
+
 // Δφ = φk - φh of the canonical pose: 0 when either planar vector is zero.
 template <class T>
 inline T relative_azimuth(T hbar, T kbar, T phi_h, T phi_k) {
@@ -380,10 +395,9 @@ struct Ortho {
 
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
-    using L = LaneOps<T>;
     const auto v = detail::planar_hk(p);
-    return {L::sqrt(v.hx * v.hx + v.hy * v.hy), detail::azimuth(v.hy, v.hx),
-            L::sqrt(v.kx * v.kx + v.ky * v.ky), detail::azimuth(v.ky, v.kx)};
+    return {detail::magnitude(v.hx * v.hx + v.hy * v.hy), detail::azimuth(v.hy, v.hx),
+            detail::magnitude(v.kx * v.kx + v.ky * v.ky), detail::azimuth(v.ky, v.kx)};
   }
 
   template <class T>
@@ -456,10 +470,10 @@ struct Hybrid {
 
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
-    using L = LaneOps<T>;
     const auto v = detail::planar_hk(p);
-    return {L::sqrt(v.hx * v.hx + v.hy * v.hy), detail::azimuth(v.hy, v.hx),
-            L::sqrt(v.kx * v.kx + v.ky * v.ky + v.kz * v.kz), detail::azimuth(v.ky, v.kx)};
+    return {detail::magnitude(v.hx * v.hx + v.hy * v.hy), detail::azimuth(v.hy, v.hx),
+            detail::magnitude(v.kx * v.kx + v.ky * v.ky + v.kz * v.kz),
+            detail::azimuth(v.ky, v.kx)};
   }
 
   // The pieces of the inverse that the Jacobian shares: hz² = 1 - ‖h̄‖² - ‖k‖², and

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,18 @@ struct TabulationOptions {
   int supersample = 2;      // ρ cos θi |J| per cell: mean over supersample² points
   double defensive = 0.05;  // probability of a cosine-weighted sample instead (never 0 where ρ ≠ 0)
   int threads = 0;          // for building the tables; 0: all cores
+  // Seconds the build may take (0: no limit), checked between slices: past it the constructor
+  // throws TimeBudgetExceeded (a render's --time-budget includes its sampler set-up).
+  double time_budget = 0;
 };
+
+// A bounded piece of work (a render, the build of its sampler) that ran out of its time budget
+// before it had a usable result.
+class TimeBudgetExceeded : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+std::string format_seconds(double seconds);  // "0.2 s", "1e+09 s" (%g)
 
 // A BRDF that samples another's ρ through the sampling methods of a third: the base for the
 // samplers below (eval, name, symmetries and facts are the wrapped BRDF's). The wrapped BRDF must

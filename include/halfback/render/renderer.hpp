@@ -34,11 +34,22 @@ std::optional<Strategy> strategy_from_name(std::string_view name);
 enum class Heuristic { balance, power };
 enum class Sequence { sobol, random };  // scrambled Sobol (0,2) points per pixel, or independent
 
+// The largest image: width × height pixels. Rendering keeps about 100 bytes per pixel (two
+// double-precision accumulators, the variance sums and the float image), 1.6 GB at this limit.
+inline constexpr long long kMaxRenderPixels = 1LL << 24;  // 4096 × 4096
+inline constexpr int kMaxRenderSide = 16384;
+inline constexpr int kMaxRenderSpp = 1 << 24;
+// "W x H = N pixels is above the limit of ..." for a size above kMaxRenderPixels.
+std::string pixel_limit_message(int width, int height);
+
 struct RenderSettings {
   int width = 512, height = 512;
   int spp = 64;            // pixel samples
   std::uint64_t seed = 1;  // the image is a function of the seed (not of the thread count)
-  double time_budget = 0;  // seconds; 0: none. Stops after the last pass that fits (>= 1 spp)
+  // Seconds, 0: none. Counts the sampler's set-up; checked at every tile. The render stops after
+  // the last pass that fits (>= 1 spp); when not even one sample per pixel fits, it throws
+  // TimeBudgetExceeded.
+  double time_budget = 0;
   Projection projection = Projection::orthographic;
   double background_fov_deg = 60;  // orthographic view: the background's field of view
   Strategy strategy = Strategy::mis;
@@ -68,7 +79,8 @@ struct RenderResult {
   std::string sampler;  // which BRDF sampler was used
 };
 
-// Throws std::invalid_argument for invalid settings (sizes, spp, fov).
+// Throws std::invalid_argument for invalid settings (sizes, spp, fov), TimeBudgetExceeded when the
+// budget ends before every pixel has a sample.
 RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings);
 // With the BRDF's sampling as it is (Brdf::sample, even the cosine default): e.g. a
 // TabulatedSampler for a BRDF that has its own, or a BRDF rendered by environment sampling only.

@@ -25,6 +25,13 @@ namespace halfback::study {
 inline constexpr std::array<Space, 4> kStudied{Space::halfdiff, Space::ortho, Space::hybrid,
                                                Space::spherical};
 
+// Stated maxima of a study's work (StudyConfig::validate refuses more): a budget's tables and the
+// test pairs take tens of bytes per sample, so these keep one study within a few GB and hours.
+inline constexpr std::size_t kMaxSampleBudget = 10'000'000;         // 10x the default largest (4D)
+inline constexpr std::size_t kMaxTestPairs = 10'000'000;            // 50x the default
+inline constexpr std::size_t kMaxGridCells = std::size_t(1) << 24;  // metrics 1-2, either form
+inline constexpr std::size_t kMaxImageSize = 4096;                  // pixels a side, metric 4
+
 struct StudyConfig {
   ErrorSpace space = ErrorSpace::log;
   IsoGrid grid{64, 64, 64};                              // metrics 1-2, isotropic form

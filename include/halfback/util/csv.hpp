@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -100,6 +101,49 @@ class CsvReader {
   std::size_t pos_ = 0;  // start of the first data line
 };
 
+class CsvRowParser;
+
+// Reads CSV from a file or a descriptor in blocks of rows, in memory bounded by the block size and
+// the longest line: the same rules and messages as CsvReader, for inputs larger than memory.
+class CsvStreamReader {
+ public:
+  static constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;  // longer: a CsvError
+
+  // Opens `path` (std::system_error "cannot read 'PATH': REASON") and reads the header (CsvError
+  // as CsvReader's constructor).
+  explicit CsvStreamReader(const std::filesystem::path& path);
+  // Reads from `fd`, which stays open; `source` names it in messages ("<stdin>").
+  CsvStreamReader(int fd, std::string source);
+  ~CsvStreamReader();
+  CsvStreamReader(const CsvStreamReader&) = delete;
+  CsvStreamReader& operator=(const CsvStreamReader&) = delete;
+
+  const std::vector<std::string>& header() const noexcept { return header_; }
+  std::size_t header_line() const noexcept { return header_line_; }
+  const std::string& source() const noexcept { return source_; }
+  void require_header(std::span<const std::string_view> expected, std::string_view note = {}) const;
+
+  // Replaces `block` with the next rows, at most `max_rows` (CsvRowProblem::row counts from the
+  // block's first row). Returns false, with an empty block, at the end of the input. Throws as
+  // CsvReader::read_rows; `options` must be the same on every call.
+  bool read_block(CsvTable& block, std::size_t max_rows, const CsvReadOptions& options = {});
+
+ private:
+  void start();
+  bool fill();
+  bool next_line(std::string_view& out);
+
+  std::string source_;
+  int fd_ = -1;
+  bool owns_fd_ = false, eof_ = false;
+  std::string buffer_;  // bytes read and not yet returned start at pos_
+  std::size_t pos_ = 0;
+  std::size_t line_ = 0;  // number of the line last returned
+  std::vector<std::string> header_;
+  std::size_t header_line_ = 1;
+  std::unique_ptr<CsvRowParser> parser_;
+};
+
 // Reads `text`; when `expected_header` is not empty the header must match it exactly.
 CsvTable read_csv(std::string_view text, std::string source,
                   std::span<const std::string_view> expected_header = {},
@@ -131,6 +175,12 @@ using CsvSink = std::function<void(std::string_view)>;
 void write_csv(std::span<const std::string> header,
                std::span<const std::span<const double>> columns, const CsvSink& sink,
                std::size_t chunk_bytes = std::size_t{1} << 20);
+
+// The pieces of write_csv, for writers that stream blocks of rows: the header line (with its
+// newline), and rows without a header (columns of equal lengths, else std::invalid_argument).
+std::string csv_header_line(std::span<const std::string> header);
+void write_csv_rows(std::span<const std::span<const double>> columns, const CsvSink& sink,
+                    std::size_t chunk_bytes = std::size_t{1} << 20);
 
 // The same, as one string.
 std::string to_csv(std::span<const std::string> header,
