@@ -25,10 +25,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const DirPair<double>& p : {DirPair<double>{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}},
                                      DirPair<double>{{0.3, 0.1, 0.9}, {-0.2, 0.4, 0.8}}}) {
       const Rgb c = brdf.eval(p);
-      const RglSample s = brdf.sample(p.wi, 0.37, 0.61);
+      const BrdfSample s = brdf.sample(p.wo, 0.37, 0.61);
+      const double pdf = brdf.pdf(p.wo, p.wi);
       const RglWarpPoint q = brdf.vndf_inverse({v[0], v[1]}, v[2], v[3]);
       const RglWarpPoint r = brdf.vndf_forward({v[4], v[5]}, v[2], v[3]);
-      sink = c.r + c.g + c.b + s.pdf + q.x + q.y + r.x + r.y;
+      sink = c.r + c.g + c.b + s.pdf + pdf + q.x + q.y + r.x + r.y;
     }
   } catch (const FormatError&) {
   }
