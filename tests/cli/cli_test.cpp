@@ -1441,6 +1441,11 @@ TEST_F(CliTest, ConvertStreamingKeepsTheErrorBehaviour) {
 // Memory does not grow with the input: 400000 rows (48 MB of text) were held whole before, with
 // their columns and output (well over 100 MB resident); a block at a time needs a few MB.
 TEST_F(CliTest, ConvertAndEvalRunInBoundedMemory) {
+#if defined(__SANITIZE_ADDRESS__)
+  // ASan's shadow memory and quarantine put the tool at 140-170 MB whatever it holds: the release
+  // build's run of this test is the one that measures.
+  GTEST_SKIP() << "resident memory is not meaningful under AddressSanitizer";
+#endif
   if (access(kTimePath, X_OK) != 0) GTEST_SKIP() << kTimePath << " is needed to measure memory";
   const std::string input = many_pairs_csv(400000);
   long rss_kb = 0;
