@@ -1,5 +1,7 @@
 #include "halfback/util/atomic_file.hpp"
 
+#include "support/fifo_reader.hpp"
+
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/socket.h>
@@ -196,37 +198,7 @@ TEST_F(AtomicFileTest, RelativePathInTheCurrentDirectory) {
   EXPECT_EQ(slurp(dir_ / "plain.csv"), "x");
 }
 
-// Reads a FIFO on a thread. It holds a writer end of its own, so that it neither blocks when the
-// tool never opens the FIFO (e.g. replaced it by a file) nor sees an early end of file:
-// finish() closes that writer and returns what came through.
-class FifoReader {
- public:
-  explicit FifoReader(const fs::path& fifo)
-      : read_(::open(fifo.c_str(), O_RDONLY | O_NONBLOCK)), write_(::open(fifo.c_str(), O_WRONLY)) {
-    ::fcntl(read_, F_SETFL, 0);  // blocking reads from now on
-    thread_ = std::thread([this] {
-      char buf[1 << 16];
-      ssize_t n = 0;
-      while ((n = ::read(read_, buf, sizeof buf)) > 0) data_.append(buf, std::size_t(n));
-    });
-  }
-  FifoReader(const FifoReader&) = delete;
-  FifoReader& operator=(const FifoReader&) = delete;
-  ~FifoReader() {
-    if (thread_.joinable()) finish();
-  }
-  std::string finish() {
-    ::close(write_);
-    thread_.join();
-    ::close(read_);
-    return data_;
-  }
-
- private:
-  int read_, write_;
-  std::thread thread_;
-  std::string data_;
-};
+using test::FifoReader;
 
 // Outputs that are not regular files (issue 12, class 2). A FIFO is written directly to its
 // reader, and a probe (constructed, then discarded) does not open it: opening the writer end

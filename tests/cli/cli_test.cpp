@@ -28,6 +28,7 @@
 #include "halfback/core/space.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/util/csv.hpp"
+#include "support/fifo_reader.hpp"
 #include "support/test_support.hpp"
 
 extern char** environ;
@@ -1017,37 +1018,7 @@ TEST_F(CliTest, RenderRefusesAnImageThatIsNotFinite) {
 // Outputs that are not regular files (issue 12, class 2) and signals (class 3)
 // ---------------------------------------------------------------------------------------------
 
-// Reads a FIFO on a thread. It holds a writer end of its own, so that it neither blocks when the
-// tool never opens the FIFO (e.g. replaced it by a file) nor sees an early end of file:
-// finish() closes that writer and returns what came through.
-class FifoReader {
- public:
-  explicit FifoReader(const fs::path& fifo)
-      : read_(::open(fifo.c_str(), O_RDONLY | O_NONBLOCK)), write_(::open(fifo.c_str(), O_WRONLY)) {
-    ::fcntl(read_, F_SETFL, 0);  // blocking reads from now on
-    thread_ = std::thread([this] {
-      char buf[1 << 16];
-      ssize_t n = 0;
-      while ((n = ::read(read_, buf, sizeof buf)) > 0) data_.append(buf, std::size_t(n));
-    });
-  }
-  FifoReader(const FifoReader&) = delete;
-  FifoReader& operator=(const FifoReader&) = delete;
-  ~FifoReader() {
-    if (thread_.joinable()) finish();
-  }
-  std::string finish() {
-    ::close(write_);
-    thread_.join();
-    ::close(read_);
-    return data_;
-  }
-
- private:
-  int read_, write_;
-  std::thread thread_;
-  std::string data_;
-};
+using test::FifoReader;
 
 bool is_char_device(const fs::path& p) {
   struct stat st {};
