@@ -27,17 +27,12 @@ namespace {
 
 using detail::SimdIsa;
 
+using test::form_name;
+
 std::vector<Form> all_forms() {
   std::vector<Form> forms{{Space::dirs, false}};
-  for (Space s : kParameterizations) {
-    forms.push_back({s, false});
-    forms.push_back({s, true});
-  }
+  for (Form f : test::parameterization_forms()) forms.push_back(f);
   return forms;
-}
-
-std::string form_name(Form f) {
-  return std::string(name_of(f.space)) + (f.isotropic ? "_iso" : "");
 }
 
 std::string pair_name(Form from, Form to) {

@@ -14,24 +14,15 @@
 
 #include "core/batch_engine.hpp"
 #include "halfback/core/batch.hpp"
+#include "support/test_util.hpp"
 
 namespace halfback {
 namespace {
 
 constexpr std::size_t kPairs = 100000;
 
-std::vector<Form> parameterization_forms() {
-  std::vector<Form> forms;
-  for (Space s : kParameterizations) {
-    forms.push_back({s, false});
-    forms.push_back({s, true});
-  }
-  return forms;
-}
-
-std::string form_name(Form f) {
-  return std::string(name_of(f.space)) + (f.isotropic ? "_iso" : "");
-}
+using test::form_name;
+using test::parameterization_forms;
 
 // A unit direction at elevation z (>= 0) and azimuth phi.
 std::array<double, 3> direction(double z, double phi) {

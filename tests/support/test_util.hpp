@@ -4,9 +4,11 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "halfback/core/param.hpp"
+#include "halfback/core/space.hpp"
 
 namespace halfback::test {
 
@@ -109,6 +111,20 @@ inline DirPair<double> rotate_pair(const DirPair<double>& p, double alpha) {
     return Vec3<double>{c * v.x - s * v.y, s * v.x + c * v.y, v.z};
   };
   return {r(p.wi), r(p.wo)};
+}
+
+// Every parameterization's full and isotropic forms, and a form's name for test messages.
+inline std::vector<Form> parameterization_forms() {
+  std::vector<Form> forms;
+  for (Space s : kParameterizations) {
+    forms.push_back({s, false});
+    forms.push_back({s, true});
+  }
+  return forms;
+}
+
+inline std::string form_name(Form f) {
+  return std::string(name_of(f.space)) + (f.isotropic ? "_iso" : "");
 }
 
 }  // namespace halfback::test
