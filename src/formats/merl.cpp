@@ -115,6 +115,12 @@ MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name_view
       const double v = load_le<double>(p + 8 * (c * merl::kBins + i));
       if (!std::isfinite(v))
         throw FormatError(name, bin_field(c, i), std::isnan(v) ? "is NaN" : "is infinite");
+      if (v * merl::kScale[c] > merl::kMaxRho)
+        throw FormatError(name, bin_field(c, i),
+                          fmt::format("is {:g}, i.e. ρ = {:g} sr⁻¹, above the {:g} sr⁻¹ a "
+                                      "measured bin can hold (a corrupt file, or big-endian "
+                                      "values: MERL files are little-endian)",
+                                      v, v * merl::kScale[c], merl::kMaxRho));
       if (v < 0) ++data.missing[c];
       data.values[c * merl::kBins + i] = v;
     }
@@ -311,6 +317,14 @@ MerlData tabulate_merl(const Brdf& brdf) {
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       const double v[3] = {rho[k].r, rho[k].g, rho[k].b};
       for (int ch = 0; ch < 3; ++ch) {
+        if (v[ch] > merl::kMaxRho) {
+          const Tuple4<double> q = HalfDiff::forward(pairs[k]);
+          throw std::invalid_argument(fmt::format(
+              "{}: ρ = {:g} sr⁻¹ at θh = {:.4g}°, θd = {:.4g}°, φd = {:.4g}°, above the {:g} "
+              "sr⁻¹ a MERL bin can hold",
+              brdf.name(), v[ch], q[0] * 180 / kPi, q[2] * 180 / kPi, q[3] * 180 / kPi,
+              merl::kMaxRho));
+        }
         const double stored = v[ch] / merl::kScale[ch];
         data.values[where[k] + ch * merl::kBins] = std::isfinite(stored) ? stored : -1.0;
       }

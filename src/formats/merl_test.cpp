@@ -15,6 +15,7 @@
 #include "formats/binary_io.hpp"
 #include "formats/merl_reference.hpp"
 #include "support/allocation_probe.hpp"
+#include "support/test_brdfs.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback {
@@ -301,6 +302,15 @@ TEST(MerlErrors, SizeHeaderAndValues) {
                       "blue value at bin (theta_h 89, theta_d 89, phi_d 179)", "is infinite");
   EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(1, 0, 0, 0, -INFINITY)), "i"), "green value",
                       "is infinite");
+  // Finite but absurd (1e308, or a big-endian file read as little-endian): named, not integrated
+  // into an infinite albedo. The bound is on ρ, so the largest accepted stored value is per channel.
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(0, 4, 5, 6, 1e308)), "huge"),
+                      "red value at bin (theta_h 4, theta_d 5, phi_d 6)", "is 1e+308",
+                      "above the 1e+10 sr⁻¹", "little-endian");
+  const double largest_blue = merl::kMaxRho / merl::kScale[2];
+  EXPECT_NO_THROW(parse_merl(bytes_of(poke(2, 4, 5, 6, 0.999 * largest_blue)), "edge"));
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(2, 4, 5, 6, largest_blue * 1.001)), "edge"),
+                      "blue value");
 }
 
 TEST(MerlErrors, Files) {
@@ -517,6 +527,16 @@ TEST(MerlWriter, AtomicReplaceAndErrors) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(tmp.path()),
                           std::filesystem::directory_iterator{}),
             1);
+  // A BRDF whose values no MERL bin can hold is refused by name, and nothing is written.
+  const test::FunctionBrdf spike(
+      [](const DirPair<double>& p) { return p.wi.z > 0.999 && p.wo.z > 0.999 ? 1e12 : 1.0; });
+  try {
+    write_merl(tmp / "spike.binary", spike);
+    ADD_FAILURE() << "no error for ρ = 1e12";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("ρ = 1e+12 sr⁻¹ at θh"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp / "spike.binary"));
   MerlData wrong;
   wrong.values.assign(10, 1.0);
   EXPECT_THROW(write_merl(path, wrong), std::invalid_argument);

@@ -216,22 +216,47 @@ GridKind parse_kind(const std::string& kind) {
   throw py::value_error("kind: expected 'full', 'isotropic' or 'slice', got '" + kind + "'");
 }
 
+std::string python_repr(const py::handle& v) {
+  return std::string(py::str(py::type::of(v).attr("__name__"))) + " " +
+         std::string(py::repr(v));
+}
+
+// resample()'s size: an int, or a sequence of ints (one per axis); a clear TypeError otherwise
+// (a str is a sequence too, but of characters).
+std::vector<std::size_t> grid_counts(const py::object& size) {
+  const auto count = [&](const py::handle& v) {
+    if (!py::isinstance<py::int_>(v) || py::isinstance<py::bool_>(v))
+      throw py::type_error("resample(): size must be an int or a sequence of ints (one per "
+                           "axis), got " + python_repr(size));
+    const long c = v.cast<long>();
+    if (c <= 0) throw py::value_error("resample(): size must be positive, got " + python_repr(v));
+    return std::size_t(c);
+  };
+  if (py::isinstance<py::int_>(size)) return {count(size)};
+  if (py::isinstance<py::str>(size) || py::isinstance<py::bytes>(size) ||
+      !py::isinstance<py::sequence>(size))
+    throw py::type_error("resample(): size must be an int or a sequence of ints (one per axis), "
+                         "got " + python_repr(size));
+  std::vector<std::size_t> counts;
+  for (const auto& v : size) counts.push_back(count(v));
+  return counts;
+}
+
+// resample()'s ranges[axis]: a (lo, hi) pair of numbers.
+std::pair<double, double> range_bounds(const py::handle& value, const std::string& axis) {
+  try {
+    if (!py::isinstance<py::str>(value)) return value.cast<std::pair<double, double>>();
+  } catch (const py::cast_error&) {
+  }
+  throw py::type_error("resample(): ranges['" + axis + "'] must be a (lo, hi) pair of numbers, got " +
+                       python_repr(value));
+}
+
 py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::string& kind,
                        const py::object& size, double azimuth_deg, bool nodes,
                        const py::dict& ranges) {
   const Space space = parse_space(param, "param");
-  std::vector<std::size_t> counts;
-  if (py::isinstance<py::int_>(size)) {
-    const long v = size.cast<long>();
-    if (v <= 0) throw py::value_error("size must be positive");
-    counts.push_back(std::size_t(v));
-  } else {
-    for (const auto& v : size) {
-      const long c = v.cast<long>();
-      if (c <= 0) throw py::value_error("size must be positive");
-      counts.push_back(std::size_t(c));
-    }
-  }
+  const std::vector<std::size_t> counts = grid_counts(size);
   const double azimuth = wrap_azimuth_degrees(azimuth_deg, "azimuth");  // as the CLI (class 8)
   GridSpec g = default_grid(space, parse_kind(kind), counts, azimuth * std::numbers::pi / 180);
   g.sampling = nodes ? GridSampling::nodes : GridSampling::centres;
@@ -242,7 +267,7 @@ py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::str
     } catch (const std::invalid_argument& e) {
       throw py::value_error(std::string("ranges: ") + e.what());
     }
-    const auto lohi = value.cast<std::pair<double, double>>();
+    const auto lohi = range_bounds(value, key.cast<std::string>());
     axis->lo = lohi.first;
     axis->hi = lohi.second;
   }

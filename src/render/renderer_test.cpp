@@ -17,6 +17,7 @@
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/models/analytic.hpp"
+#include "support/exr_offsets.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::render {
@@ -366,6 +367,14 @@ TEST(Renderer, ImageFiles) {
   const std::filesystem::path& dir = tmp.path();
   write_image(dir / "a.exr", r.image, {});
   EXPECT_EQ(read_exr(dir / "a.exr").rgb, r.image.rgb);
+  // The scan-line offset table is written (readers would otherwise have to rebuild it).
+  const std::string exr = test::read_file(dir / "a.exr");
+  const std::vector<std::uint64_t> offsets = test::exr_scanline_offsets(exr);
+  ASSERT_EQ(offsets.size(), std::size_t(r.image.height + 15) / 16) << "ZIP chunks of 16 lines";
+  for (std::uint64_t o : offsets) {
+    EXPECT_GT(o, 0u);
+    EXPECT_LT(o, exr.size());
+  }
   write_image(dir / "a.PNG", r.image, {1, true});
   std::ifstream png(dir / "a.PNG", std::ios::binary);
   char magic[4] = {};

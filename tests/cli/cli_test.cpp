@@ -1166,8 +1166,8 @@ TEST_F(CliTest, FigureBadInputLeavesNothing) {
             std::string::npos)
       << r.err;
   r = run({"figure", "paper", "--out", "figs", "--env", "default,missing.hdr"});
-  EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("--env 'missing.hdr'"), std::string::npos) << r.err;
+  EXPECT_EQ(r.status, 1);  // a file that cannot be read: a data error, as in `halfback render`
+  EXPECT_NE(r.err.find("missing.hdr: file: cannot open"), std::string::npos) << r.err;
   r = run({"figure", "material", "--brdf", "lambert", "--azimuths", "", "-o", "m.png"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--azimuths: no azimuth given"), std::string::npos) << r.err;
@@ -1177,6 +1177,55 @@ TEST_F(CliTest, FigureBadInputLeavesNothing) {
   r = run({"figure", "paper", "--out", "figs", "--no-materials", "--material", "lambert"});
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(entries(), std::vector<std::string>{});
+}
+
+// Class 12 of docs/reliability.md: each message names the option or file, the problem and what
+// is accepted, and the exit status says whose fault it is (2 the command line, 1 the data).
+TEST_F(CliTest, MessagesNameTheProblemAndExitCodesAgree) {
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    std::vector<std::string> parts;
+  };
+  put(path("pairs.csv"), std::string(kDirsHeader) + "0,0,1,0,0,1\n");
+  const Case cases[] = {
+      {{"figure", "bogus"},
+       2,
+       {"halfback figure: error: 'bogus' is not a figure subcommand (the subcommands are: "
+        "hemisphere, slices, paper, material)"}},
+      {{"figure"}, 2, {"a subcommand is required (one of: hemisphere, slices"}},
+      {{"eval", "--brdf", "+ggx", "-i", "pairs.csv"},
+       1,
+       {"'+ggx': a sum has an empty term (a sum is SPEC+SPEC+..."}},
+      {{"render", "--brdf", "ggx", "--env", "missing.hdr", "-o", "r.exr"},
+       1,
+       {"missing.hdr: file: cannot open"}},
+      {{"figure", "material", "--brdf", "ggx", "--env", "missing.hdr", "-o", "m.png"},
+       1,
+       {"missing.hdr: file: cannot open"}},
+      {{"render", "--brdf", "ggx", "--env", "constant:1,x", "-o", "r.exr"},
+       2,
+       {"--env 'constant:1,x'", "'x' is not a number"}},
+      {{"figure", "material", "--brdf", "ggx", "--env", "constant:0.5,0.2", "-o", "m.png"},
+       2,
+       {"--env 'constant:0.5,0.2'", "expected constant:V or constant:R,G,B"}},
+  };
+  for (const Case& c : cases) {
+    const Result r = run(c.args);
+    EXPECT_EQ(r.status, c.status) << c.args[0] << " " << c.args[1] << ": " << r.err;
+    for (const std::string& part : c.parts) EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+  }
+  // 901 elevations: refused from the figure's layout, before any sampling.
+  std::string many = "0";
+  for (int i = 1; i <= 900; ++i) (many += ',') += std::to_string(i * 0.1);
+  Result r = run({"figure", "hemisphere", "--elevations", many, "-o", "h.png"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("fewer elevations (901 given)"), std::string::npos) << r.err;
+  // constant:R,G,B keeps its commas in a list of environments.
+  r = run({"figure", "material", "--brdf", "lambert", "--env", "constant:0.5,0.2,0.1,studio",
+           "--render-size", "16", "--spp", "1", "-o", "m.png"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(entries(), std::vector<std::string>({"m.png", "pairs.csv"}));
 }
 
 // ---------------------------------------------------------------------------------------------
