@@ -94,8 +94,7 @@ TEST(AltaParse, ByteOrderMarkAndFunctionFiles) {
   const AltaData d = parse_alta("\xEF\xBB\xBF" + body, "bom.dat");
   EXPECT_EQ(d.rows(), 1u);
   EXPECT_EQ(d.dim_in, 3u);
-  EXPECT_FORMAT_ERROR(parse_alta("\xEF\xBB" + body, "half-bom.dat"), "line 1",
-                      "data before #DIM");
+  EXPECT_FORMAT_ERROR(parse_alta("\xEF\xBB" + body, "half-bom.dat"), "line 1", "data before #DIM");
   const std::string fit =
       "#ALTA FUNC HEADER\n#CMD brdf_fit --data x.dat\n#DIM 2 1\n#PARAM_IN RUSIN_TH_TD\n"
       "#PARAM_OUT INV_STERADIAN\n#ALTA HEADER END\n#FUNC nonlinear_function_lambertian\nkd 0.5\n";

@@ -303,7 +303,8 @@ TEST(MerlErrors, SizeHeaderAndValues) {
   EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(1, 0, 0, 0, -INFINITY)), "i"), "green value",
                       "is infinite");
   // Finite but absurd (1e308, or a big-endian file read as little-endian): named, not integrated
-  // into an infinite albedo. The bound is on ρ, so the largest accepted stored value is per channel.
+  // into an infinite albedo. The bound is on ρ, so the largest accepted stored value is per
+  // channel.
   EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(0, 4, 5, 6, 1e308)), "huge"),
                       "red value at bin (theta_h 4, theta_d 5, phi_d 6)", "is 1e+308",
                       "above the 1e+10 sr⁻¹", "little-endian");

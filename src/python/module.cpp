@@ -217,8 +217,7 @@ GridKind parse_kind(const std::string& kind) {
 }
 
 std::string python_repr(const py::handle& v) {
-  return std::string(py::str(py::type::of(v).attr("__name__"))) + " " +
-         std::string(py::repr(v));
+  return std::string(py::str(py::type::of(v).attr("__name__"))) + " " + std::string(py::repr(v));
 }
 
 // resample()'s size: an int, or a sequence of ints (one per axis); a clear TypeError otherwise
@@ -226,8 +225,10 @@ std::string python_repr(const py::handle& v) {
 std::vector<std::size_t> grid_counts(const py::object& size) {
   const auto count = [&](const py::handle& v) {
     if (!py::isinstance<py::int_>(v) || py::isinstance<py::bool_>(v))
-      throw py::type_error("resample(): size must be an int or a sequence of ints (one per "
-                           "axis), got " + python_repr(size));
+      throw py::type_error(
+          "resample(): size must be an int or a sequence of ints (one per "
+          "axis), got " +
+          python_repr(size));
     const long c = v.cast<long>();
     if (c <= 0) throw py::value_error("resample(): size must be positive, got " + python_repr(v));
     return std::size_t(c);
@@ -235,8 +236,10 @@ std::vector<std::size_t> grid_counts(const py::object& size) {
   if (py::isinstance<py::int_>(size)) return {count(size)};
   if (py::isinstance<py::str>(size) || py::isinstance<py::bytes>(size) ||
       !py::isinstance<py::sequence>(size))
-    throw py::type_error("resample(): size must be an int or a sequence of ints (one per axis), "
-                         "got " + python_repr(size));
+    throw py::type_error(
+        "resample(): size must be an int or a sequence of ints (one per axis), "
+        "got " +
+        python_repr(size));
   std::vector<std::size_t> counts;
   for (const auto& v : size) counts.push_back(count(v));
   return counts;
@@ -248,8 +251,8 @@ std::pair<double, double> range_bounds(const py::handle& value, const std::strin
     if (!py::isinstance<py::str>(value)) return value.cast<std::pair<double, double>>();
   } catch (const py::cast_error&) {
   }
-  throw py::type_error("resample(): ranges['" + axis + "'] must be a (lo, hi) pair of numbers, got " +
-                       python_repr(value));
+  throw py::type_error("resample(): ranges['" + axis +
+                       "'] must be a (lo, hi) pair of numbers, got " + python_repr(value));
 }
 
 py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::string& kind,
