@@ -68,9 +68,10 @@ double relative_l2(const Brdf& a, const Brdf& b, int n = 200000, std::uint64_t s
 constexpr double k80 = 80 * kPi / 180;
 
 // GGX and Beckmann, isotropic, α from 0.05 to 0.8: the file read back agrees with the model.
-// Measured (docs/formats.md, "RGL writer, accuracy"): for θi, θo ≤ 80°, GGX 0.3–1.2%, Beckmann
-// 0.7–2.8%; over the whole hemisphere the last degrees before the horizon dominate (the format
-// stores ρ cos θo, which the reader divides by cos θo).
+// Measured (docs/formats.md, "Accuracy"): for θi, θo ≤ 80°, GGX 0.3–1.2%, Beckmann 0.5–1.9%; to
+// 85°, 1.6–2.8%. Over the whole hemisphere the estimate has no stable value (printed for two
+// seeds): the format stores ρ cos θo, which the reader divides by cos θo, so an absolute error at
+// the horizon becomes a relative error whose square, under cos θo, is not integrable there.
 TEST(RglExport, MicrofacetModelsAgreeWithTheirExport) {
   for (const char* dist : {"ggx", "beckmann"}) {
     for (double alpha : {0.05, 0.1, 0.2, 0.4, 0.8}) {
@@ -78,11 +79,15 @@ TEST(RglExport, MicrofacetModelsAgreeWithTheirExport) {
           load_brdf(fmt::format("{}:alpha={},f0_r=0.9,f0_g=0.6,f0_b=0.3", dist, alpha));
       const auto file = exported(*model);
       const double err = relative_l2(*model, *file, 200000, 7, k80);
+      const double err85 = relative_l2(*model, *file, 200000, 7, 85 * kPi / 180);
       const double whole = relative_l2(*model, *file, 200000, 7);
-      std::printf("%s α = %.2f: relative L2 %.4f (θ ≤ 80°), %.4f (hemisphere)\n", dist, alpha, err,
-                  whole);
+      const double whole2 = relative_l2(*model, *file, 200000, 8);
+      std::printf(
+          "%s α = %.2f: relative L2 %.4f (θ ≤ 80°), %.4f (θ ≤ 85°), %.3f and %.3f "
+          "(hemisphere, two seeds)\n",
+          dist, alpha, err, err85, whole, whole2);
       EXPECT_LT(err, std::string(dist) == "ggx" ? 0.02 : 0.04) << dist << " α = " << alpha;
-      EXPECT_LT(whole, 1.5) << dist << " α = " << alpha;
+      EXPECT_LT(err85, 0.04) << dist << " α = " << alpha;
     }
   }
 }
