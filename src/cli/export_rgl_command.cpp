@@ -1,5 +1,5 @@
 // `halfback export-rgl`: any isotropic BRDF as an RGL tensor file (formats/rgl_writer.hpp), the
-// format Mitsuba 3's and pbrt-v4's `measured` materials and RGL's reference loader read.
+// RGB variant that RGL's reference loader and Mitsuba 3's `measured` plugin read.
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -57,8 +57,8 @@ Command register_export_rgl(CLI::App& parent) {
   auto o = std::make_shared<ExportRglOptions>();
   CLI::App* app = parent.add_subcommand(
       "export-rgl",
-      "Write an isotropic BRDF as an RGL .bsdf tensor file (Dupuy & Jakob 2018; Mitsuba 3, "
-      "pbrt-v4 and RGL's loader read it)");
+      "Write an isotropic BRDF as an RGL .bsdf tensor file (Dupuy & Jakob 2018, RGB variant; "
+      "RGL's loader and Mitsuba 3's measured plugin read it)");
   app->add_option("--brdf", o->brdf, "BRDF SPEC: a file or a model such as ggx:alpha=0.2")
       ->required();
   app->add_option("-o,--output", o->output, "Output .bsdf file, replaced only on success")

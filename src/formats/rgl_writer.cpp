@@ -268,32 +268,6 @@ Geometry geometry_fields(const Brdf& brdf, const RglExportOptions& o, const std:
   return g;
 }
 
-// Samples whose ωo is below the horizon are never returned by a reader (ρ is 0 there), but they
-// are corners of the cells that straddle the horizon, where ρ cos θo must fall to 0 like cos θo.
-// Their value is extrapolated linearly from the two nearest samples above the horizon along each
-// axis that has them (averaged), so that the bilinear interpolation crosses 0 near the horizon
-// instead of ramping down to the far corner (docs/formats.md, "The other fields": rgb).
-void extrapolate_below_horizon(double* t, const std::vector<char>& above, std::size_t res) {
-  std::vector<double> out(t, t + res * res);
-  const long n = static_cast<long>(res);
-  for (long j = 0; j < n; ++j)
-    for (long i = 0; i < n; ++i) {
-      if (above[j * n + i]) continue;
-      double sum = 0;
-      int count = 0;
-      static constexpr long kSteps[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-      for (const auto& [di, dj] : kSteps) {
-        const long i1 = i + di, j1 = j + dj, i2 = i + 2 * di, j2 = j + 2 * dj;
-        if (i2 < 0 || i2 >= n || j2 < 0 || j2 >= n) continue;
-        if (!above[j1 * n + i1] || !above[j2 * n + i2]) continue;
-        sum += 2 * t[j1 * n + i1] - t[j2 * n + i2];
-        ++count;
-      }
-      if (count) out[j * n + i] = sum / count;
-    }
-  std::copy(out.begin(), out.end(), t);
-}
-
 // ρ cos θo · 4σ(ωi)/D(m) at the sample nodes of one incidence slice, through the VNDF warp of
 // `warp` (the file being written, read by halfback's reader), with D and σ interpolated from the
 // stored tables as every reader does.
@@ -302,7 +276,6 @@ void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, st
   const double theta_i = g.theta_i[slice];
   const Vec3<double> wi = direction(theta_i, 0);
   const double sigma = table_at(g.sigma, std::sqrt(theta_i * (2 / kPi)));
-  std::vector<char> above(res * res, 0);
   parallel_for(
       res * res, 16,
       [&](std::size_t begin, std::size_t end) {
@@ -321,7 +294,6 @@ void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, st
                               brdf.name(), format_dir(wi), format_dir(wo)));
             const double scale = table_at(g.ndf, um.x) / (4 * sigma);
             if (scale > 0) value = rho * (wo.z / scale);
-            above[node] = 1;
           }
           rgb[node] = value.r;
           rgb[res * res + node] = value.g;
@@ -330,7 +302,6 @@ void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, st
         }
       },
       threads);
-  for (int c = 0; c < 3; ++c) extrapolate_below_horizon(rgb + c * res * res, above, res);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <numbers>
 #include <random>
@@ -68,8 +69,8 @@ double relative_l2(const Brdf& a, const Brdf& b, int n = 200000, std::uint64_t s
 constexpr double k80 = 80 * kPi / 180;
 
 // GGX and Beckmann, isotropic, α from 0.05 to 0.8: the file read back agrees with the model.
-// Measured (docs/formats.md, "Accuracy"): for θi, θo ≤ 80°, GGX 0.3–1.2%, Beckmann 0.5–1.9%; to
-// 85°, 1.6–2.8%. Over the whole hemisphere the estimate has no stable value (printed for two
+// Measured (docs/formats.md, "Accuracy"): for θi, θo ≤ 80°, GGX 0.3–1.2%, Beckmann 0.7–2.8%; to
+// 85°, 1.6–3.6%. Over the whole hemisphere the estimate has no stable value (printed for two
 // seeds): the format stores ρ cos θo, which the reader divides by cos θo, so an absolute error at
 // the horizon becomes a relative error whose square, under cos θo, is not integrable there.
 TEST(RglExport, MicrofacetModelsAgreeWithTheirExport) {
@@ -87,7 +88,7 @@ TEST(RglExport, MicrofacetModelsAgreeWithTheirExport) {
           "(hemisphere, two seeds)\n",
           dist, alpha, err, err85, whole, whole2);
       EXPECT_LT(err, std::string(dist) == "ggx" ? 0.02 : 0.04) << dist << " α = " << alpha;
-      EXPECT_LT(err85, 0.04) << dist << " α = " << alpha;
+      EXPECT_LT(err85, 0.05) << dist << " α = " << alpha;
     }
   }
 }
@@ -206,6 +207,27 @@ TEST(RglExport, FieldsLikeThePublishedFiles) {
   const auto back = read_back(rgl_fields(*ggx));
   EXPECT_NE(back->material_description().find("ggx"), std::string::npos)
       << back->material_description();
+}
+
+// Mitsuba 3 reads the `rgb` field without clipping negative values: for a non-negative source
+// every stored value is >= 0 (and finite).
+TEST(RglExport, StoredValuesAreNonNegative) {
+  for (const char* spec : {"ggx:alpha=0.05", "beckmann:alpha=0.8", "lambert", "embedded:pink-felt",
+                           "embedded:acrylic_felt_green"}) {
+    const TensorFile tf =
+        parse_tensor_file(serialize_tensor_file(rgl_fields(*load_brdf(spec))), spec);
+    for (const char* name : {"rgb", "luminance", "vndf", "ndf", "sigma"}) {
+      const TensorField* f = tf.find(name);
+      ASSERT_NE(f, nullptr);
+      std::size_t bad = 0;
+      for (std::uint64_t i = 0; i < f->count(); ++i) {
+        float v;
+        std::memcpy(&v, f->bytes.data() + 4 * i, 4);
+        bad += !(v >= 0) || !std::isfinite(v);
+      }
+      EXPECT_EQ(bad, 0u) << spec << " " << name;
+    }
+  }
 }
 
 // Energy: the directional albedo of the file agrees with the source's. Exact up to the tables'

@@ -1,9 +1,9 @@
 // Writing any isotropic BRDF as an RGL "tensor_file" material (the format of Dupuy & Jakob 2018,
-// read by RGL's reference loader, Mitsuba 3's `measured` plugin and pbrt-v4's `measured`
-// material). The microfacet distribution is recovered from the BRDF's backscattering by power
-// iteration (Dupuy, Heitz, Iehl, Poulin & Ostromoukhov 2015); the visible-normal distributions
-// and their warps follow from it, and the RGB and luminance tables are ρ sampled through the
-// warps. docs/formats.md ("RGL writer") derives every field.
+// RGB variant: read by RGL's reference loader and by Mitsuba 3's `measured` plugin in its RGB
+// variants; the spectral variant is not written). The microfacet distribution is recovered from the
+// BRDF's backscattering by power iteration (Dupuy, Heitz, Iehl, Poulin & Ostromoukhov 2015); the
+// visible-normal distributions and their warps follow from it, and the RGB and luminance tables are
+// ρ sampled through the warps. docs/formats.md ("RGL writer") derives every field.
 #pragma once
 
 #include <cstddef>
