@@ -53,6 +53,7 @@ Command register_info(CLI::App& parent);
 Command register_eval(CLI::App& parent);
 Command register_resample(CLI::App& parent);
 Command register_export_merl(CLI::App& parent);
+Command register_export_rgl(CLI::App& parent);
 Command register_models(CLI::App& parent);
 Command register_study(CLI::App& parent);
 

@@ -932,6 +932,53 @@ TEST_F(CliTest, ExportMerlBadInputKeepsTheOutput) {
   EXPECT_EQ(entries(), (std::vector<std::string>{"x.binary"}));
 }
 
+TEST_F(CliTest, ExportRglWritesAFileTheReaderReads) {
+  Result r = run({"export-rgl", "--brdf", "ggx:alpha=0.3,f0=0.5", "-o", "ggx.bsdf", "--theta-i",
+                  "6", "--resolution", "16", "--vndf-resolution", "64"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("ggx.bsdf written (6 incidence elevations, 16x16"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("incidence slice"), std::string::npos) << r.err;  // no terminal here
+  r = run({"info", "ggx.bsdf"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* s : {"RGL tensor_file", "6 θi × 1 φi", "16 × 16 samples", "2 × 64",
+                        "exported by halfback export-rgl from 'ggx:alpha=0.3,f0=0.5'"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+  r = run({"export-rgl", "--brdf", "lambert", "-o", "l.bsdf", "-q", "--description", "grey"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  r = run({"info", "l.bsdf"});
+  EXPECT_NE(r.out.find("material:              grey"), std::string::npos) << r.out;
+}
+
+TEST_F(CliTest, ExportRglBadInputKeepsTheOutput) {
+  put(path("x.bsdf"), "old");
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    const char* message;
+  };
+  const Case cases[] = {
+      {{"--brdf", "ggx:alpha_x=0.1,alpha_y=0.3"}, 1, "anisotropic"},
+      {{"--brdf", "lambert:albedo=0"}, 1, "zero in every backscattering direction"},
+      {{"--brdf", "nope"}, 1, "nope"},
+      {{"--brdf", "lambert", "--theta-i", "1"}, 2, "--theta-i"},
+      {{"--brdf", "lambert", "--resolution", "1"}, 2, "--resolution"},
+      {{"--brdf", "lambert", "--vndf-resolution", "x"}, 2, "--vndf-resolution"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"export-rgl", "-o", "x.bsdf"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const Result r = run(args);
+    EXPECT_EQ(r.status, c.status) << c.message << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(path("x.bsdf")), "old");
+  }
+  const Result r = run({"export-rgl", "--brdf", "lambert", "-o", "-"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"x.bsdf"}));
+}
+
 TEST_F(CliTest, ResampleWritesEachFormatAndRejectsBadGrids) {
   for (const char* f : {"t.exr", "t.npz", "t.npy"}) {
     const Result r = run({"resample", "--brdf", "test:S", "--param", "hybrid", "--kind", "slice",
