@@ -688,7 +688,9 @@ figure::Scene designs_chart(const DesignComparison& c, std::size_t ref, ErrorSpa
     chart.rows.emplace_back(name_of(kStudied[i]));
     chart.values.push_back(c.median[i]);
   }
-  return figure::bar_chart(chart);
+  figure::BarChartLayout layout;
+  layout.label_width = 110;  // the rows are parameterization names
+  return figure::bar_chart(chart, layout);
 }
 
 figure::Scene designs_plot(const std::vector<BrdfResult>& results, const StudyConfig& config) {
