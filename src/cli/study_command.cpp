@@ -147,8 +147,8 @@ int run_study(const StudyOptions& o) {
     fmt::print(stderr, "halfback study: profiles of {} BRDFs for the learned design\n",
                brdfs.size());
     for (const auto& [spec, brdf] : brdfs)
-      profiles.push_back(study::design_profile(*brdf, study::kStudied, config.profile_grid,
-                                               config.space));
+      profiles.push_back(
+          study::design_profile(*brdf, study::kStudied, config.profile_grid, config.space));
   }
   std::vector<study::BrdfResult> results;
   for (std::size_t k = 0; k < brdfs.size(); ++k) {

@@ -7,7 +7,6 @@
 #include <numbers>
 #include <stdexcept>
 
-
 namespace halfback::study {
 
 std::string_view name_of(Spacing s) {
@@ -114,8 +113,8 @@ double AxisWarp::inverse(double u) const {
     case Kind::table: {
       // The segment whose values bracket f, then linear inside it.
       const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), f);
-      const auto i = std::size_t(std::clamp<std::ptrdiff_t>(it - cdf_.begin() - 1, 0,
-                                                            std::ptrdiff_t(cdf_.size()) - 2));
+      const auto i = std::size_t(
+          std::clamp<std::ptrdiff_t>(it - cdf_.begin() - 1, 0, std::ptrdiff_t(cdf_.size()) - 2));
       const double n = double(cdf_.size() - 1);
       t = (double(i) + (f - cdf_[i]) / (cdf_[i + 1] - cdf_[i])) / n;
       break;
@@ -127,9 +126,9 @@ double AxisWarp::inverse(double u) const {
 std::vector<AxisWarp> design_warps(const GridSpec& cells, Spacing spacing,
                                    const LearnedWarps* learned) {
   if (spacing == Spacing::learned && (!learned || learned->space != cells.space))
-    throw std::invalid_argument(fmt::format(
-        "the learned design of {} needs warps learned for {} (study::learn_warps)",
-        name_of(cells.space), name_of(cells.space)));
+    throw std::invalid_argument(
+        fmt::format("the learned design of {} needs warps learned for {} (study::learn_warps)",
+                    name_of(cells.space), name_of(cells.space)));
   std::vector<AxisWarp> warps;
   std::size_t magnitude = 0;  // the learned warps' axis of each magnitude (a: 0, b: 1)
   for (const GridAxis& a : cells.axes) {

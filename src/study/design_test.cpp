@@ -66,9 +66,8 @@ TEST(Design, EveryWarpIsAMonotoneBijectionOfItsAxis) {
         for (std::size_t a = 0; a < warps.size(); ++a) {
           EXPECT_EQ(warps[a].lo(), g.axes[a].lo);
           EXPECT_EQ(warps[a].hi(), g.axes[a].hi);
-          expect_bijection(warps[a], std::string(name_of(l.space)) + " " +
-                                         std::string(name_of(s)) + " " + g.axes[a].name +
-                                         (iso ? " 3D" : " 4D"));
+          expect_bijection(warps[a], std::string(name_of(l.space)) + " " + std::string(name_of(s)) +
+                                         " " + g.axes[a].name + (iso ? " 3D" : " 4D"));
         }
       }
     }
@@ -118,8 +117,9 @@ TEST(Design, LearnedWarpsPutTheSamplesWhereTheFamilyVariesAndBeatUniform) {
   // Learned on the family without its first member (σ = 0.08), tested on that member.
   const std::vector<DesignProfile> profiles = family_profiles();
   const std::vector<LearnedWarps> learned = learn_warps(profiles, 0);
-  const auto halfdiff = std::find_if(learned.begin(), learned.end(),
-                                     [](const LearnedWarps& w) { return w.space == Space::halfdiff; });
+  const auto halfdiff = std::find_if(learned.begin(), learned.end(), [](const LearnedWarps& w) {
+    return w.space == Space::halfdiff;
+  });
   ASSERT_NE(halfdiff, learned.end());
   // The lobes live at θh < 0.3 rad, 19 % of θh's range: the learned θh axis gives them at least
   // half of its cells.

@@ -177,7 +177,7 @@ void GonioReconstruction::measure_block(const Brdf& truth, std::span<const std::
       const GridAxis& ax = cells_.axes[a];
       const std::size_t i = cells[j] / stride_[a] % ax.count;
       coords[a][j] = warps_[a].inverse(ax.lo + (double(i) + offsets[j][a]) * (ax.hi - ax.lo) /
-                                                      double(ax.count));
+                                                   double(ax.count));
     }
   }
   std::vector<DirPair<double>> pairs(m);
@@ -285,8 +285,7 @@ std::string GonioReconstruction::description() const {
       "{} measured at {} points of a {} layout spaced {} in the {} {} form ({} cells), "
       "reconstructed by {}",
       truth_name_, samples_, name_of(setup_.design), name_of(setup_.spacing),
-      setup_.isotropic ? "isotropic" : "full",
-      name_of(setup_.space), counts,
+      setup_.isotropic ? "isotropic" : "full", name_of(setup_.space), counts,
       setup_.design == Design::regular ? "multilinear interpolation" : "local affine fits");
 }
 
@@ -462,8 +461,8 @@ double reconstruction_error(const Brdf& reconstruction, const TestPairs& test) {
   reconstruction.eval_batch(test.pairs, rho);
   double err = 0, norm = 0;
   for (std::size_t i = 0; i < rho.size(); ++i) {
-    const double y = to_error_space(rho[i].luminance(), test.space, test.pairs[i].wi.z,
-                                    test.pairs[i].wo.z);
+    const double y =
+        to_error_space(rho[i].luminance(), test.space, test.pairs[i].wi.z, test.pairs[i].wo.z);
     if (!std::isfinite(y))
       throw std::runtime_error(reconstruction.name() + ": a reconstructed value is not finite");
     err += (y - test.truth[i]) * (y - test.truth[i]);

@@ -292,8 +292,7 @@ double ssim(std::span<const double> x, std::span<const double> y, int width, int
           xy += w * x[k] * y[k];
         }
       const double vx = xx - mx * mx, vy = yy - my * my, cxy = xy - mx * my;
-      sum += (2 * mx * my + kC1) * (2 * cxy + kC2) /
-             ((mx * mx + my * my + kC1) * (vx + vy + kC2));
+      sum += (2 * mx * my + kC1) * (2 * cxy + kC2) / ((mx * mx + my * my + kC1) * (vx + vy + kC2));
       ++count;
     }
   if (count == 0)

@@ -399,7 +399,8 @@ TEST(CompareImages, PublishedMetricsOfToneMappedGreys) {
   EXPECT_EQ(same.mae, 0.0);
   EXPECT_NEAR(same.ssim, 1.0, 1e-12);
   // Too small for the window: SSIM is NaN, the other metrics are still there.
-  EXPECT_TRUE(std::isnan(compare_images(pattern(), pattern(), std::vector<std::uint8_t>(48, 1)).ssim));
+  EXPECT_TRUE(
+      std::isnan(compare_images(pattern(), pattern(), std::vector<std::uint8_t>(48, 1)).ssim));
 }
 
 }  // namespace

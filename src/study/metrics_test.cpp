@@ -123,7 +123,8 @@ TEST(Metrics, ErrorSpacesMatchTheirDefinitions) {
   EXPECT_NEAR(to_error_space(1, ErrorSpace::nielsen, 0.05, 0.1), std::log(11.0), 1e-12);
   // Löw et al. 2012: ln(1 + Y cos θi), whatever cos θo.
   EXPECT_NEAR(to_error_space(2, ErrorSpace::low, 0.5, 0.9), std::log(2.0), 1e-15);
-  EXPECT_EQ(to_error_space(2, ErrorSpace::low, 0.5, 0.1), to_error_space(2, ErrorSpace::low, 0.5, 1));
+  EXPECT_EQ(to_error_space(2, ErrorSpace::low, 0.5, 0.1),
+            to_error_space(2, ErrorSpace::low, 0.5, 1));
   for (ErrorSpace es : kErrorSpaces) EXPECT_EQ(parse_error_space(name_of(es)), es);
   EXPECT_EQ(parse_error_space("ln"), std::nullopt);
 }

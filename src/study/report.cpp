@@ -210,8 +210,8 @@ void add_separability_rows(std::string& csv, const std::string& brdf, std::strin
 void add_gonio_rows(CsvTables& t, const std::string& brdf, std::string_view pn,
                     const std::vector<GonioPoint>& pts, int dims) {
   for (const GonioPoint& g : pts)
-    t.gonio += fmt::format("{},{},{},{},{:.6g},{},{},{}\n", brdf, pn, name_of(g.design),
-                           g.samples, g.error, dims, g.budget, name_of(g.spacing));
+    t.gonio += fmt::format("{},{},{},{},{:.6g},{},{},{}\n", brdf, pn, name_of(g.design), g.samples,
+                           g.error, dims, g.budget, name_of(g.spacing));
   for (Spacing spacing : kSpacings)
     for (Design d : kDesigns) {
       const auto [n, e] = curve(pts, d, spacing);
@@ -243,10 +243,10 @@ CsvTables csv_tables(const std::vector<BrdfResult>& results, const StudyConfig& 
       add_gonio_rows(t, brdf, pn, p.gonio, 3);
       add_gonio_rows(t, brdf, pn, p.gonio_4d, 4);
       for (const ImagePoint& i : p.images)
-        t.image += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", brdf,
-                               pn, name_of(i.design), i.samples, csv_text_field(i.environment),
-                               i.relative_rmse, i.mean_delta_e, i.p95_delta_e, i.mae, i.rmse,
-                               i.ssim);
+        t.image +=
+            fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", brdf, pn,
+                        name_of(i.design), i.samples, csv_text_field(i.environment),
+                        i.relative_rmse, i.mean_delta_e, i.p95_delta_e, i.mae, i.rmse, i.ssim);
     }
   }
   return t;
@@ -630,7 +630,8 @@ std::vector<DesignKey> designs_measured(const std::vector<BrdfResult>& results, 
     for (Design d : kDesigns) {
       bool any = false;
       for (const BrdfResult& b : results)
-        for (const ParamResult& p : b.params) any |= find_point(p.gonio, d, ref, spacing) != nullptr;
+        for (const ParamResult& p : b.params)
+          any |= find_point(p.gonio, d, ref, spacing) != nullptr;
       if (any) keys.push_back({spacing, d});
     }
   return keys;
@@ -671,8 +672,8 @@ DesignComparison compare_designs(const std::vector<BrdfResult>& results, std::si
       for (const BrdfResult* b : c.brdfs) e.push_back(design_error(b->params[i], k, ref));
       c.median[i].push_back(median(e));
     }
-    c.best[i] = std::size_t(std::min_element(c.median[i].begin(), c.median[i].end()) -
-                            c.median[i].begin());
+    c.best[i] =
+        std::size_t(std::min_element(c.median[i].begin(), c.median[i].end()) - c.median[i].begin());
   }
   return c;
 }
@@ -680,9 +681,10 @@ DesignComparison compare_designs(const std::vector<BrdfResult>& results, std::si
 figure::Scene designs_chart(const DesignComparison& c, std::size_t ref, ErrorSpace es) {
   if (c.brdfs.empty() || c.keys.size() < 2) return {};
   figure::BarChart chart;
-  chart.title = fmt::format("Designs: median relative error ({} space) at N = {}", name_of(es), ref);
-  chart.x_label = fmt::format("median over {} BRDFs of the reconstruction's relative error",
-                              c.brdfs.size());
+  chart.title =
+      fmt::format("Designs: median relative error ({} space) at N = {}", name_of(es), ref);
+  chart.x_label =
+      fmt::format("median over {} BRDFs of the reconstruction's relative error", c.brdfs.size());
   for (const DesignKey& k : c.keys) chart.series.push_back(design_name(k));
   for (std::size_t i = 0; i < kStudied.size(); ++i) {
     chart.rows.emplace_back(name_of(kStudied[i]));
@@ -866,8 +868,8 @@ std::string published_image_table(const std::vector<BrdfResult>& results) {
     ssim.add(one_minus_ssim);
     md += "\n";
   }
-  return md + fmt::format("\nLowest MAE (BRDFs): {}; highest SSIM: {}.\n\n", mae.text(),
-                          ssim.text());
+  return md +
+         fmt::format("\nLowest MAE (BRDFs): {}; highest SSIM: {}.\n\n", mae.text(), ssim.text());
 }
 
 // 4. Image-space error.

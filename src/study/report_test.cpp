@@ -33,7 +33,8 @@ BrdfResult fake(const std::string& label, bool isotropic) {
     for (Design d : {Design::regular, Design::stratified})
       for (std::size_t n : {1000u, 1000000u})
         p.gonio.push_back({d, n, n, 0.5 * k * std::pow(n / 1000.0, -2.0 / 3)});
-    p.images.push_back({Design::regular, 1000, "sky", 0.03 * k, 1.5 * k, 3 * k, 0.1 * k, 0.2 * k, 0.4 * k});
+    p.images.push_back(
+        {Design::regular, 1000, "sky", 0.03 * k, 1.5 * k, 3 * k, 0.1 * k, 0.2 * k, 0.4 * k});
     if (!isotropic) {
       p.azimuthal_4d = 0.3 * k;
       p.separability_4d = p.separability_2d;
@@ -71,7 +72,8 @@ TEST(Report, FilesRepeatTheResults) {
   EXPECT_EQ(gon.rfind("brdf,parameterization,design,samples,error,", 0), 0u);
   EXPECT_NE(gon.find("aniso,spherical,stratified,1000000,0.02,4,1000000,own\n"), std::string::npos);
   const std::string bud = slurp(dir / "budget.csv");
-  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.02,125000,reached,own\n"), std::string::npos) << bud;
+  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.02,125000,reached,own\n"), std::string::npos)
+      << bud;
   EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.01,353553,reached,own\n"), std::string::npos);
   EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.05,31623,reached,own\n"), std::string::npos);
   // ortho (k = 2) reaches 0.05 at 1000 · 20^(3/2); spherical (k = 4) is 0.02 at 10^6.

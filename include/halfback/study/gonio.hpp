@@ -2,10 +2,10 @@
 // at N points laid out in one parameterization, reconstructed everywhere by interpolation in that
 // parameterization, and compared with the ground truth over the whole space of direction pairs.
 //
-// Layouts (the `Design` of the code). Both divide the bounding box of the parameterization's isotropic form (a, b, φ) — or
-// of its full form (a, φa, b, φb) for anisotropic BRDFs — into cells, n per magnitude axis and 2n
-// per azimuth (which spans [0, 2π)), n chosen so that the number of cells inside the domain is
-// nearest the budget N (in ratio):
+// Layouts (the `Design` of the code). Both divide the bounding box of the parameterization's
+// isotropic form (a, b, φ) — or of its full form (a, φa, b, φb) for anisotropic BRDFs — into cells,
+// n per magnitude axis and 2n per azimuth (which spans [0, 2π)), n chosen so that the number of
+// cells inside the domain is nearest the budget N (in ratio):
 //   regular     one measurement at the centre of every cell inside the domain;
 //   stratified  one at a uniformly random point of every cell (redrawn up to 8 times until it
 //               falls inside the domain; a cell that never does has no measurement).
