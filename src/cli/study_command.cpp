@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "halfback/core/parallel.hpp"
 #include "halfback/figure/material.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/study/report.hpp"
@@ -146,9 +147,12 @@ int run_study(const StudyOptions& o) {
   if (learned && !config.budgets.empty() && brdfs.size() > 1) {
     fmt::print(stderr, "halfback study: profiles of {} BRDFs for the learned design\n",
                brdfs.size());
-    for (const auto& [spec, brdf] : brdfs)
-      profiles.push_back(
-          study::design_profile(*brdf, study::kStudied, config.profile_grid, config.space));
+    profiles.resize(brdfs.size());
+    parallel_for(brdfs.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k)
+        profiles[k] = study::design_profile(*brdfs[k].second, study::kStudied, config.profile_grid,
+                                            config.space);
+    });
   }
   std::vector<study::BrdfResult> results;
   for (std::size_t k = 0; k < brdfs.size(); ++k) {

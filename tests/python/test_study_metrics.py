@@ -29,7 +29,8 @@ def ssim_numpy(x, y, mask=None):
     vx = filter_valid(x * x, w) - mx * mx
     vy = filter_valid(y * y, w) - my * my
     cxy = filter_valid(x * y, w) - mx * my
-    ssim_map = ((2 * mx * my + c1) * (2 * cxy + c2)) / ((mx**2 + my**2 + c1) * (vx + vy + c2))
+    numerator = (2 * mx * my + c1) * (2 * cxy + c2)
+    ssim_map = numerator / ((mx**2 + my**2 + c1) * (vx + vy + c2))
     if mask is None:
         return float(ssim_map.mean())
     r = w.shape[0] // 2
@@ -42,7 +43,8 @@ def fixed_pair():
     v, u = np.mgrid[0:48, 0:40] / 40.0
     reference = 0.5 + 0.3 * np.sin(7 * u) * np.cos(5 * v) + 0.15 * (u + v > 0.9)
     rng = np.random.default_rng(20040401)
-    test = 0.9 * np.roll(reference, 1, axis=1) + 0.05 + 0.04 * rng.standard_normal(reference.shape)
+    noise = 0.04 * rng.standard_normal(reference.shape)
+    test = 0.9 * np.roll(reference, 1, axis=1) + 0.05 + noise
     return np.clip(test, 0, 1), np.clip(reference, 0, 1)
 
 
