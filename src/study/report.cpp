@@ -750,9 +750,40 @@ std::string design_median_table(const DesignComparison& c) {
 }
 
 // What changes between the comparison in the own regular design and best against best.
+// The index in c.keys of a design, or c.keys.size() when it was not measured.
+std::size_t key_index(const DesignComparison& c, Spacing spacing, Design layout) {
+  for (std::size_t k = 0; k < c.keys.size(); ++k)
+    if (c.keys[k].spacing == spacing && c.keys[k].layout == layout) return k;
+  return c.keys.size();
+}
+
+// The paper's question in one line per parameterization whose angle design differs from its own
+// (ortho, hybrid): the same iso-surfaces with halfdiff's spacing of the magnitudes.
+std::string angle_line(const DesignComparison& c) {
+  const std::size_t own = key_index(c, Spacing::own, Design::regular);
+  const std::size_t angle = key_index(c, Spacing::angle, Design::regular);
+  if (own == c.keys.size() || angle == c.keys.size()) return {};
+  std::string md;
+  for (std::size_t i = 0; i < kStudied.size(); ++i)
+    if (!same_as_own(kStudied[i], true, Spacing::angle))
+      md += fmt::format("{}{} {:.4f} → {:.4f} (×{:.2f})", md.empty() ? "" : "; ",
+                        name_of(kStudied[i]), c.median[i][own], c.median[i][angle],
+                        c.median[i][angle] / c.median[i][own]);
+  return md.empty() ? md
+                    : "Uniform in angle instead of their own coordinates (median error, own "
+                      "regular → angle): " +
+                          md + ".\n\n";
+}
+
+// What changes between the comparison in the own regular design and best against best.
 std::string design_conclusions(const DesignComparison& c, std::size_t ref) {
-  std::array<std::size_t, kStudied.size()> own{};  // own regular is keys[0]
-  const std::vector<std::size_t> before = winners(c, ref, own), after = winners(c, ref, c.best);
+  const std::vector<std::size_t> after = winners(c, ref, c.best);
+  const std::size_t own_key = key_index(c, Spacing::own, Design::regular);
+  if (own_key == c.keys.size())  // nothing to compare with
+    return fmt::format("\nLowest error, best against best (BRDFs): {}.\n\n", win_counts(after));
+  std::array<std::size_t, kStudied.size()> own{};
+  own.fill(own_key);
+  const std::vector<std::size_t> before = winners(c, ref, own);
   std::string changed;
   int n_changed = 0;
   for (std::size_t j = 0; j < c.brdfs.size(); ++j)
@@ -774,7 +805,7 @@ std::string design_conclusions(const DesignComparison& c, std::size_t ref) {
   md += n_changed == 0 ? std::string("No BRDF changes its best parameterization.\n\n")
                        : fmt::format("{} of {} BRDFs change their best parameterization: {}.\n\n",
                                      n_changed, c.brdfs.size(), changed);
-  return md;
+  return md + angle_line(c);
 }
 
 // 3b. Designs: the coordinates against the spacing of the samples.

@@ -121,6 +121,21 @@ TEST(Report, DesignsSectionComparesBestAgainstBest) {
             std::string::npos);
   EXPECT_NE(md.find("changes, from halfdiff to hybrid"), std::string::npos);
   EXPECT_NE(md.find("2 of 2 BRDFs change their best parameterization"), std::string::npos);
+  // The angle design doubles ortho's (k = 2) and hybrid's (k = 3) errors at N = 1000.
+  EXPECT_NE(md.find("ortho 1.0000 → 2.0000 (×2.00); hybrid 1.5000 → 3.0000 (×2.00)"),
+            std::string::npos)
+      << md;
+  // Without the own design, best against best only.
+  StudyConfig no_own = c;
+  std::vector<BrdfResult> without = results;
+  for (BrdfResult& b : without)
+    for (ParamResult& p : b.params)
+      std::erase_if(p.gonio, [](const GonioPoint& g) { return g.spacing == Spacing::own; });
+  const test::TempDir tmp2;
+  const std::string md2 = write_study(tmp2.path(), without, no_own, 1).markdown;
+  EXPECT_NE(md2.find("Lowest error, best against best (BRDFs): halfdiff 0, ortho 0, hybrid 2"),
+            std::string::npos)
+      << md2;
   EXPECT_NE(slurp(tmp.path() / "gonio.csv").find("x,hybrid,regular,1000,0.15,3,1000,learned\n"),
             std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(tmp.path() / "designs.png"));
