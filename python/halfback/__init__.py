@@ -10,6 +10,6 @@ vectorized eval(wi, wo), info, albedo(), resample() and render(); hemisphere() g
 the paper's Figure 1.
 """
 
-from ._core import Brdf, columns, convert, hemisphere, jacobian, load, models, valid
+from ._core import Brdf, columns, convert, hemisphere, jacobian, load, models, ssim, valid
 
-__all__ = ["Brdf", "columns", "convert", "hemisphere", "jacobian", "load", "models", "valid"]
+__all__ = ["Brdf", "columns", "convert", "hemisphere", "jacobian", "load", "models", "ssim", "valid"]

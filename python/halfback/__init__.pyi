@@ -81,3 +81,8 @@ def load(spec: str) -> Brdf:
 
 def models() -> list[str]:
     """The analytic models' names."""
+
+def ssim(
+    x: npt.ArrayLike, y: npt.ArrayLike, mask: npt.ArrayLike | None = None
+) -> float:
+    """SSIM (Wang et al. 2004) of two 2D images in [0, 1], over the masked full windows."""

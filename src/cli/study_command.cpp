@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "halfback/core/parallel.hpp"
 #include "halfback/figure/material.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/study/report.hpp"
@@ -27,6 +28,7 @@ struct StudyOptions {
   std::string out = "study";
   std::string space = "log";
   std::string budgets, budgets_4d, environments;
+  std::string designs = "own,angle,merl,learned";  // issue 14: designs and error spaces
   std::size_t test_pairs = 0, image_budget = 0;
   int image_size = 0, image_spp = 0;
   double max_theta = 85;
@@ -53,14 +55,19 @@ std::vector<std::pair<std::string, BrdfPtr>> load_all(const std::vector<std::str
 
 study::StudyConfig make_config(const StudyOptions& o) {
   study::StudyConfig c;
-  if (o.space == "linear")
-    c.space = study::ErrorSpace::linear;
-  else if (o.space == "log")
-    c.space = study::ErrorSpace::log;
-  else if (o.space == "cbrt")
-    c.space = study::ErrorSpace::cbrt;
-  else
-    throw UsageError(fmt::format("--space '{}': expected linear, log or cbrt", o.space));
+  const auto space = study::parse_error_space(o.space);
+  if (!space)
+    throw UsageError(fmt::format(
+        "--error-space '{}': expected linear, log, cbrt, nielsen or low (docs/study.md)", o.space));
+  c.space = *space;
+  c.spacings.clear();
+  for (const std::string& name : split_list(o.designs, "--designs", "design")) {
+    const auto spacing = study::parse_spacing(name);
+    if (!spacing)
+      throw UsageError(
+          fmt::format("--designs: '{}' is not a design (own, angle, merl or learned)", name));
+    c.spacings.push_back(*spacing);
+  }
   if (o.quick) {
     c.grid = {24, 24, 32};
     c.full_grid = {8, 16, 8, 16};
@@ -133,8 +140,23 @@ int run_study(const StudyOptions& o) {
       const std::lock_guard lock(progress_mutex);
       fmt::print(stderr, "\r\x1b[K{}: {} ({:.0f} s)", current, stage, elapsed());
     };
+  // The learned design: each BRDF's profile first, then per BRDF the warps of all the others.
+  std::vector<study::DesignProfile> profiles;
+  const bool learned = std::find(config.spacings.begin(), config.spacings.end(),
+                                 study::Spacing::learned) != config.spacings.end();
+  if (learned && !config.budgets.empty() && brdfs.size() > 1) {
+    fmt::print(stderr, "halfback study: profiles of {} BRDFs for the learned design\n",
+               brdfs.size());
+    profiles.resize(brdfs.size());
+    parallel_for(brdfs.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k)
+        profiles[k] = study::design_profile(*brdfs[k].second, study::kStudied, config.profile_grid,
+                                            config.space);
+    });
+  }
   std::vector<study::BrdfResult> results;
   for (std::size_t k = 0; k < brdfs.size(); ++k) {
+    if (!profiles.empty()) config.learned = study::learn_warps(profiles, k);
     const auto& [spec, brdf] = brdfs[k];
     // Files by their BRDF's name (merl:..., rgl:...), models by their spec, which holds their
     // parameters (two GGX of different roughness are both named "ggx").
@@ -171,7 +193,14 @@ Command register_study(CLI::App& parent) {
       ->required();
   app->add_option("-o,--out", o->out, "Output directory (created if missing)")
       ->capture_default_str();
-  app->add_option("--space", o->space, "Error space: linear, log (log(1 + Y)) or cbrt (Y^(1/3))")
+  app->add_option("--space,--error-space", o->space,
+                  "Error space: linear, log (ln(1 + Y)), cbrt (Y^(1/3)), nielsen (Nielsen et al. "
+                  "2015's log-relative mapping) or low (Low et al. 2012's cosine-weighted log)")
+      ->capture_default_str();
+  app->add_option("--designs", o->designs,
+                  "Designs of the gonio-reflectometer, comma-separated: own (uniform in the "
+                  "coordinates), angle (sine-like magnitudes through asin), merl (angle, and sqrt "
+                  "of the half-vector angle), learned (warps fitted on the other BRDFs)")
       ->capture_default_str();
   app->add_flag("--quick", o->quick,
                 "A small study: 24 x 24 x 32 grids, budgets 1000,10000, 20000 test pairs, "
@@ -210,11 +239,12 @@ Command register_study(CLI::App& parent) {
       "  separability.csv  brdf,parameterization,rank,error,dims: best rank-r approximations of\n"
       "                    the 2D projection (dims 2), the 3D table unfolded along the azimuth\n"
       "                    (3), the 4D table as (a, phi_a) x (b, phi_b) (4)\n"
-      "  gonio.csv         brdf,parameterization,design,samples,error,dims,budget: the virtual\n"
-      "                    gonio-reflectometer (regular and stratified designs)\n"
+      "  gonio.csv         brdf,parameterization,design,samples,error,dims,budget,spacing: the\n"
+      "                    virtual gonio-reflectometer (regular and stratified layouts; the\n"
+      "                    spacing of --designs)\n"
       "  budget.csv        the samples each needs to reach errors of 0.05, 0.02, 0.01\n"
       "  image.csv         brdf,parameterization,design,samples,environment,relative_rmse,\n"
-      "                    mean_delta_e2000,p95_delta_e2000\n"
+      "                    mean_delta_e2000,p95_delta_e2000,mae,rmse,ssim\n"
       "Example:\n"
       "  halfback study --out study ggx:alpha=0.2 ../shared/data/rgl");
   return {app, [o] { return run_study(*o); }};

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@
 #include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
+#include "halfback/study/image_metrics.hpp"
 
 namespace py = pybind11;
 using namespace halfback;
@@ -512,6 +514,35 @@ NAME_fc1.npy of its NumPy form), a model such as "ggx:alpha=0.2" or
       "The names of the analytic models (see `halfback models` for their parameters).");
 }
 
+// The study's SSIM (Wang et al. 2004), for checking it against other implementations.
+void bind_image_metrics(py::module_& m) {
+  using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  m.def(
+      "ssim",
+      [](const Doubles& x, const Doubles& y, std::optional<Doubles> mask) {
+        if (x.ndim() != 2 || y.ndim() != 2 || x.shape(0) != y.shape(0) || x.shape(1) != y.shape(1))
+          throw py::value_error("ssim: x and y must be 2D arrays of the same shape");
+        const auto h = int(x.shape(0)), w = int(x.shape(1));
+        const std::size_t n = std::size_t(x.size());
+        std::vector<std::uint8_t> selected(n, 1);
+        if (mask) {
+          if (mask->ndim() != 2 || mask->shape(0) != h || mask->shape(1) != w)
+            throw py::value_error("ssim: the mask must have the shape of the images");
+          for (std::size_t k = 0; k < n; ++k) selected[k] = mask->data()[k] != 0;
+        }
+        try {
+          return study::ssim({x.data(), n}, {y.data(), n}, w, h, selected);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+      },
+      py::arg("x"), py::arg("y"), py::arg("mask") = py::none(),
+      R"doc(The structural similarity of two 2D images with values in [0, 1] (Wang et al. 2004:
+11 x 11 Gaussian window of sigma 1.5, K1 = 0.01, K2 = 0.03, L = 1), averaged over the pixels whose
+whole window is inside the image and where mask (same shape; default all) is nonzero. The SSIM of
+`halfback study`'s image-space error (docs/study.md).)doc");
+}
+
 }  // namespace
 
 // The class before the functions that return it, so that their signatures name it.
@@ -521,4 +552,5 @@ PYBIND11_MODULE(_core, m) {
   bind_brdf_class(m);
   bind_hemisphere(m);
   bind_loading(m);
+  bind_image_metrics(m);
 }

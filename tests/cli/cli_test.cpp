@@ -1313,11 +1313,14 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
   const std::vector<std::vector<std::string>> gonio = csv_rows(slurp(path("st") / "gonio.csv"));
   ASSERT_FALSE(gonio.empty());
   EXPECT_EQ(gonio[0], (std::vector<std::string>{"brdf", "parameterization", "design", "samples",
-                                                "error", "dims", "budget"}));
+                                                "error", "dims", "budget", "spacing"}));
   std::map<std::string, std::map<std::string, double>> g_error;  // param/design -> budget -> e
   int four_d = 0, s_exact = 0;
+  std::map<std::string, int> spacings;  // the other designs (issue 14): rows of each spacing
   for (std::size_t i = 1; i < gonio.size(); ++i) {
-    ASSERT_EQ(gonio[i].size(), 7u);
+    ASSERT_EQ(gonio[i].size(), 8u);
+    ++spacings[gonio[i][7]];
+    if (gonio[i][7] != "own") continue;  // the checks below are those of the own design
     if (gonio[i][0] == "test:G")
       g_error[gonio[i][1] + "/" + gonio[i][2]][gonio[i][6]] = std::stod(gonio[i][4]);
     if (gonio[i][0] == "test:S" && gonio[i][2] == "regular" &&
@@ -1335,10 +1338,14 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
     EXPECT_LT(e.at("10000"), 0.05) << key;
   }
   EXPECT_EQ(four_d, 16);
+  // angle, merl and learned rows (learned from the three other BRDFs), in the regular layout:
+  // for each BRDF, 4 parameterizations x 2 budgets each (the copies of own included).
+  for (const char* spacing : {"angle", "merl", "learned"})
+    EXPECT_EQ(spacings[spacing], 4 * 4 * 2) << spacing;
   // Measured data too: the felt's reconstruction improves with the budget.
   std::map<std::string, double> felt;
   for (const auto& row : gonio)
-    if (row[0] == "embedded:acrylic_felt_green" && row[2] == "regular")
+    if (row[0] == "embedded:acrylic_felt_green" && row[2] == "regular" && row[7] == "own")
       felt[row[1] + row[6]] = std::stod(row[4]);
   ASSERT_EQ(felt.size(), 8u);
   for (const char* p : {"halfdiff", "ortho", "hybrid", "spherical"})
@@ -1347,19 +1354,22 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
   const std::vector<std::vector<std::string>> image = csv_rows(slurp(path("st") / "image.csv"));
   ASSERT_GT(image.size(), 1u);
   EXPECT_EQ(image[0][5], "relative_rmse");
+  EXPECT_EQ(image[0].back(), "ssim");
   for (std::size_t i = 1; i < image.size(); ++i)
     if (image[i][0] == "test:S") {
       EXPECT_LT(std::stod(image[i][5]), 0.05) << image[i][1];
     }
 
   const std::string report = slurp(path("st") / "report.md");
-  for (const char* h : {"## 1. Azimuthal dependence", "## 2. Separability",
-                        "## 3. Virtual gonio-reflectometer", "## 4. Image-space error"})
+  for (const char* h :
+       {"## 1. Azimuthal dependence", "## 2. Separability", "## 3. Virtual gonio-reflectometer",
+        "## 3b. Designs", "## 4. Image-space error"})
     EXPECT_NE(report.find(h), std::string::npos) << h;
   EXPECT_NE(slurp(path("st") / "report.html").find("src=\"data:image/png;base64,"),
             std::string::npos);
-  for (const char* f : {"azimuthal.png", "azimuthal.svg", "separability.png", "separability.svg",
-                        "gonio.png", "gonio.svg", "gonio4d.png", "image.png", "budget.csv"})
+  for (const char* f :
+       {"azimuthal.png", "azimuthal.svg", "separability.png", "separability.svg", "gonio.png",
+        "gonio.svg", "gonio4d.png", "image.png", "budget.csv", "designs.png"})
     EXPECT_GT(fs::file_size(path("st") / f), 100u) << f;
 }
 
@@ -1369,7 +1379,12 @@ TEST_F(CliTest, StudyBadInput) {
   EXPECT_NE(r.err.find("'nope' is neither"), std::string::npos) << r.err;
   r = run({"study", "--space", "sqrt", "lambert"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("--space 'sqrt'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--error-space 'sqrt': expected linear, log, cbrt, nielsen or low"),
+            std::string::npos)
+      << r.err;
+  r = run({"study", "--designs", "own,uniform", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("'uniform' is not a design"), std::string::npos) << r.err;
   fs::create_directories(path("empty"));
   r = run({"study", "-o", "st", "empty"});
   EXPECT_EQ(r.status, 2);
