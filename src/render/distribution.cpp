@@ -15,6 +15,8 @@ constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
 Distribution1D::Distribution1D(std::span<const double> weights)
     : weights_(weights.begin(), weights.end()) {
   if (weights_.empty()) throw std::invalid_argument("Distribution1D: no cells");
+  if (weights_.size() > std::size_t(UINT32_MAX))
+    throw std::invalid_argument("Distribution1D: more than 2^32 - 1 cells");
   cdf_.resize(weights_.size() + 1);
   cdf_[0] = 0;
   for (std::size_t i = 0; i < weights_.size(); ++i) {
@@ -32,16 +34,40 @@ Distribution1D::Distribution1D(std::span<const double> weights)
     for (std::size_t i = 0; i < cdf_.size(); ++i) cdf_[i] = double(i) / double(weights_.size());
   }
   cdf_.back() = 1;
+  // Bucket k starts at the cell a search for u = k / n finds (one pass: both are increasing).
+  const std::size_t n = weights_.size();
+  guide_.resize(n);
+  std::size_t cell = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double u = double(k) / double(n);
+    while (cell + 1 < n && !(cdf_[cell + 1] > u)) ++cell;
+    guide_[k] = std::uint32_t(cell);
+  }
 }
 
 Distribution1D::Sample Distribution1D::sample(double u) const {
-  Sample s;
-  if (total_ <= 0 || weights_.empty()) return s;
+  if (total_ <= 0 || weights_.empty()) return {};
+  u = u >= 0 ? std::min(u, kOneMinusEpsilon) : 0.0;  // NaN too: the index below must be valid
+  const std::size_t n = weights_.size();
+  std::size_t i = guide_[std::min(std::size_t(u * double(n)), n - 1)];
+  // The first cell whose upper bound exceeds u, as the binary search finds it; the guide may be
+  // one cell ahead when u * n rounded up to the next bucket.
+  while (i > 0 && cdf_[i] > u) --i;
+  while (i + 1 < n && !(cdf_[i + 1] > u)) ++i;
+  return finish(i, u);
+}
+
+Distribution1D::Sample Distribution1D::sample_by_search(double u) const {
+  if (total_ <= 0 || weights_.empty()) return {};
   u = std::clamp(u, 0.0, kOneMinusEpsilon);
   // The first cell whose upper bound exceeds u: cells of weight 0 have an empty interval.
   const auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), u);
-  std::size_t i = std::size_t(it - cdf_.begin()) - 1;
-  i = std::min(i, weights_.size() - 1);
+  const std::size_t i = std::size_t(it - cdf_.begin()) - 1;
+  return finish(std::min(i, weights_.size() - 1), u);
+}
+
+Distribution1D::Sample Distribution1D::finish(std::size_t i, double u) const {
+  Sample s;
   while (weights_[i] == 0 && i > 0) --i;  // rounding at the last cell: step back to a live cell
   s.index = i;
   s.probability = weights_[i] / total_;

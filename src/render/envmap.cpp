@@ -380,11 +380,11 @@ EnvMap::EnvMap(int width, int height, std::vector<float> rgb, std::string name, 
 
   // Pixel probability ∝ luminance × solid angle; within a pixel, uniform in solid angle.
   row_solid_angle_.resize(std::size_t(height));
+  row_cos_.resize(std::size_t(height) + 1);
+  for (int r = 0; r <= height; ++r) row_cos_[std::size_t(r)] = std::cos(kPi * double(r) / height);
   const double dphi = 2 * kPi / width;
-  for (int r = 0; r < height; ++r) {
-    const double c0 = std::cos(kPi * r / height), c1 = std::cos(kPi * (r + 1) / height);
-    row_solid_angle_[std::size_t(r)] = dphi * (c0 - c1);
-  }
+  for (std::size_t r = 0; r < std::size_t(height); ++r)
+    row_solid_angle_[r] = dphi * (row_cos_[r] - row_cos_[r + 1]);
   std::vector<double> weights(std::size_t(width) * std::size_t(height));
   for (std::size_t i = 0; i < weights.size(); ++i) {
     const float* p = &rgb_[3 * i];
@@ -517,8 +517,7 @@ EnvMap::Sample EnvMap::sample(double u1, double u2, bool compensated) const {
   Sample s;
   const auto cell = (compensated ? compensated_ : distribution_).sample(u1, u2);
   if (cell.probability <= 0) return s;
-  const double c0 = std::cos(kPi * double(cell.row) / height_);
-  const double c1 = std::cos(kPi * double(cell.row + 1) / height_);
+  const double c0 = row_cos_[cell.row], c1 = row_cos_[cell.row + 1];
   const double cos_theta = std::clamp(c0 + (c1 - c0) * cell.remapped_row, -1.0, 1.0);
   const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
   const double phi = 2 * kPi * (double(cell.col) + cell.remapped_col) / width_ - kPi;
@@ -534,6 +533,17 @@ double EnvMap::pdf(const Vec3<double>& dir, bool compensated) const {
   std::size_t row, col;
   pixel_of(to_map(dir), row, col);
   return (compensated ? compensated_ : distribution_).probability(row, col) / row_solid_angle_[row];
+}
+
+EnvMap::Lookup EnvMap::lookup(const Vec3<double>& dir, bool compensated) const {
+  std::size_t row, col;
+  const std::size_t i = pixel_of(to_map(dir), row, col);
+  const float* p = &rgb_[3 * i];
+  Lookup l;
+  l.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
+  l.pdf =
+      (compensated ? compensated_ : distribution_).probability(row, col) / row_solid_angle_[row];
+  return l;
 }
 
 // --------------------------------------------------------------------------------------------

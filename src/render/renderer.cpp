@@ -118,12 +118,26 @@ class Renderer {
                                             : detail::SequenceKind::random),
         aspect_(double(s.width) / s.height),
         tan_bg_(std::tan(0.5 * s.background_fov_deg * kPi / 180)),
-        tan_persp_(std::tan(0.5 * kPerspectiveFov * kPi / 180)) {}
+        tan_persp_(std::tan(0.5 * kPerspectiveFov * kPi / 180)) {
+    for (std::uint32_t d = 0; d < kPairs; ++d) keys_[d] = detail::dimension_key(s.seed, d);
+  }
+
+  // The sequences of one pixel: the pixel position, then two light samples.
+  static constexpr std::uint32_t kPairs = 3;
+  struct PixelSequences {
+    detail::PixelPair pair[kPairs];
+  };
+  PixelSequences sequences(std::uint64_t pixel) const {
+    PixelSequences q;
+    for (std::uint32_t d = 0; d < kPairs; ++d)
+      q.pair[d] = detail::PixelPair(kind_, keys_[d], pixel);
+    return q;
+  }
 
   // The radiance of one pixel sample.
-  Rgb pixel_sample(int px, int py, std::uint64_t pixel, std::uint32_t index) const {
+  Rgb pixel_sample(int px, int py, const PixelSequences& q, std::uint32_t index) const {
     double jx, jy;
-    detail::sample_2d(kind_, s_.seed, pixel, index, 0, jx, jy);
+    q.pair[0].point(index, jx, jy);
     const double ndc_x = (2 * (px + jx) / s_.width - 1) * aspect_;
     const double ndc_y = 1 - 2 * (py + jy) / s_.height;
     V3 n, wo;
@@ -142,10 +156,10 @@ class Renderer {
       n = normalize({o.x + t * d.x, o.y + t * d.y, o.z + t * d.z});
       wo = {-d.x, -d.y, -d.z};
     }
-    return shade(n, wo, pixel, index);
+    return shade(n, wo, q, index);
   }
 
-  Rgb shade(const V3& n, const V3& wo_world, std::uint64_t pixel, std::uint32_t index) const {
+  Rgb shade(const V3& n, const V3& wo_world, const PixelSequences& q, std::uint32_t index) const {
     const Frame f = shading_frame(n);
     const V3 wo = f.to_local(wo_world);
     Rgb sum;
@@ -153,7 +167,7 @@ class Renderer {
     auto add = [&](const Rgb& fr, const Rgb& li, double factor) { sum += fr * li * factor; };
     auto env_sample = [&](std::uint32_t dim, double share) {
       double u1, u2;
-      detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
+      q.pair[dim].point(index, u1, u2);
       const bool comp = s_.strategy == Strategy::mis && s_.compensation;
       const EnvMap::Sample es = env_.sample(u1, u2, comp);
       if (!(es.pdf > 0)) return;
@@ -166,16 +180,14 @@ class Renderer {
     };
     auto brdf_sample = [&](std::uint32_t dim, double share) {
       double u1, u2;
-      detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
+      q.pair[dim].point(index, u1, u2);
       const BrdfSample bs = brdf_.sample(wo, u1, u2);
       if (!(bs.pdf > 0 && bs.wi.z > 0)) return;
-      const V3 dir = f.to_world(bs.wi);
-      const Rgb li = env_.eval(dir);
+      const EnvMap::Lookup light = env_.lookup(f.to_world(bs.wi), s_.compensation);
+      const Rgb& li = light.radiance;
       if (li.r == 0 && li.g == 0 && li.b == 0) return;
       const Rgb fr = brdf_.eval({bs.wi, wo});
-      const double w = s_.strategy == Strategy::mis
-                           ? weight(s_.heuristic, bs.pdf, env_.pdf(dir, s_.compensation))
-                           : 1;
+      const double w = s_.strategy == Strategy::mis ? weight(s_.heuristic, bs.pdf, light.pdf) : 1;
       add(fr, li, share * w * bs.wi.z / bs.pdf);
     };
     switch (s_.strategy) {
@@ -204,8 +216,9 @@ class Renderer {
         const std::size_t p = std::size_t(py) * std::size_t(s_.width) + std::size_t(px);
         double r = 0, g = 0, b = 0, y = 0, y2 = 0;
         std::uint64_t bad = 0;
+        const PixelSequences q = sequences(p);
         for (std::uint32_t i = first; i < first + count; ++i) {
-          const Rgb v = pixel_sample(px, py, p, i);
+          const Rgb v = pixel_sample(px, py, q, i);
           if (!(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b))) {
             ++bad;
             continue;
@@ -234,6 +247,7 @@ class Renderer {
   const RenderSettings& s_;
   detail::SequenceKind kind_;
   double aspect_, tan_bg_, tan_persp_;
+  std::uint64_t keys_[kPairs];
 };
 
 void validate(const RenderSettings& s) {

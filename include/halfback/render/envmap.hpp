@@ -80,6 +80,12 @@ class EnvMap {
   Sample sample(double u1, double u2, bool compensated = false) const;
   // The density of sample() at `dir`, per unit solid angle.
   double pdf(const Vec3<double>& dir, bool compensated = false) const;
+  // eval(dir) and pdf(dir, compensated) from one lookup of the pixel (equal to both, bit for bit).
+  struct Lookup {
+    Rgb radiance;
+    double pdf = 0;
+  };
+  Lookup lookup(const Vec3<double>& dir, bool compensated = false) const;
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -104,6 +110,7 @@ class EnvMap {
   EnvOptions options_;
   double scale_ = 1, cos_rot_ = 1, sin_rot_ = 0;
   std::vector<double> row_solid_angle_;  // of one pixel of each row
+  std::vector<double> row_cos_;          // cos θ of the rows' edges, height + 1 of them
   Distribution2D distribution_, compensated_;
   std::size_t noise_clamped_ = 0;
 };
