@@ -30,15 +30,19 @@ class Distribution1D {
   Sample sample(double u) const;
   // The same by a binary search of the CDF (the reference the guide table is tested against).
   Sample sample_by_search(double u) const;
-  double probability(std::size_t index) const { return total_ > 0 ? weights_[index] / total_ : 0; }
+  double probability(std::size_t index) const { return cells_[index].probability; }
   double total() const { return total_; }
-  std::size_t size() const { return weights_.size(); }
+  std::size_t size() const { return cells_.empty() ? 0 : cells_.size() - 1; }
 
  private:
   Sample finish(std::size_t i, double u) const;
 
-  std::vector<double> weights_;
-  std::vector<double> cdf_;           // size() + 1 entries, cdf_[0] = 0, cdf_.back() = 1
+  // The CDF at the cell's lower edge and the cell's probability side by side, so that a sample
+  // reads one cache line: size() + 1 entries, the last {1, 0}.
+  struct Cell {
+    double cdf = 0, probability = 0;
+  };
+  std::vector<Cell> cells_;
   std::vector<std::uint32_t> guide_;  // size() buckets: the cell of u = k / size()
   double total_ = 0;
 };

@@ -111,6 +111,11 @@ class EnvMap {
   double scale_ = 1, cos_rot_ = 1, sin_rot_ = 0;
   std::vector<double> row_solid_angle_;  // of one pixel of each row
   std::vector<double> row_cos_;          // cos θ of the rows' edges, height + 1 of them
+  struct Edge {
+    double cos = 1, sin = 0;
+  };
+  std::vector<Edge> col_edge_;  // of φ at each column's left edge
+  void column_sincos(std::size_t col, double t, double& sin_phi, double& cos_phi) const;
   Distribution2D distribution_, compensated_;
   std::size_t noise_clamped_ = 0;
 };
