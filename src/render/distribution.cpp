@@ -106,6 +106,28 @@ Distribution2D::Sample Distribution2D::sample(double u1, double u2) const {
   return s;
 }
 
+void Distribution2D::sample(std::span<const double> u1, std::span<const double> u2,
+                            std::span<Sample> out) const {
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const auto r = marginal_.sample(u1[i]);
+    out[i] = Sample{};
+    out[i].row = r.index;
+    out[i].probability = r.probability;
+    out[i].remapped_row = r.remapped;
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    Sample& s = out[i];
+    if (s.probability <= 0) {
+      s = Sample{};
+      continue;
+    }
+    const auto c = conditional_[s.row].sample(u2[i]);
+    s.col = c.index;
+    s.probability *= c.probability;
+    s.remapped_col = c.remapped;
+  }
+}
+
 double Distribution2D::probability(std::size_t row, std::size_t col) const {
   if (row >= rows_ || col >= cols_) return 0;
   return marginal_.probability(row) * conditional_[row].probability(col);

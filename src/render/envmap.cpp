@@ -569,8 +569,25 @@ Rgb EnvMap::eval(const Vec3<double>& dir) const {
 }
 
 EnvMap::Sample EnvMap::sample(double u1, double u2, bool compensated) const {
+  return sample_in((compensated ? compensated_ : distribution_).sample(u1, u2));
+}
+
+void EnvMap::sample(std::span<const double> u1, std::span<const double> u2, bool compensated,
+                    std::span<Sample> out) const {
+  if (u1.size() != out.size() || u2.size() != out.size())
+    throw std::invalid_argument("EnvMap::sample: the spans' sizes differ");
+  constexpr std::size_t kChunk = 32;
+  Distribution2D::Sample cells[kChunk];
+  const Distribution2D& d = compensated ? compensated_ : distribution_;
+  for (std::size_t begin = 0; begin < out.size(); begin += kChunk) {
+    const std::size_t n = std::min(kChunk, out.size() - begin);
+    d.sample(u1.subspan(begin, n), u2.subspan(begin, n), std::span(cells, n));
+    for (std::size_t i = 0; i < n; ++i) out[begin + i] = sample_in(cells[i]);
+  }
+}
+
+EnvMap::Sample EnvMap::sample_in(const Distribution2D::Sample& cell) const {
   Sample s;
-  const auto cell = (compensated ? compensated_ : distribution_).sample(u1, u2);
   if (cell.probability <= 0) return s;
   const double c0 = row_cos_[cell.row], c1 = row_cos_[cell.row + 1];
   const double cos_theta = std::clamp(c0 + (c1 - c0) * cell.remapped_row, -1.0, 1.0);
@@ -602,11 +619,35 @@ void EnvMap::column_sincos(std::size_t col, double t, double& sin_phi, double& c
     return;
   }
   const double d = 2 * kPi * t / width_, d2 = d * d;
-  const double sd = d * (1 - d2 / 6 * (1 - d2 / 20 * (1 - d2 / 42 * (1 - d2 / 72))));
-  const double cd = 1 - d2 / 2 * (1 - d2 / 12 * (1 - d2 / 30 * (1 - d2 / 56 * (1 - d2 / 90))));
+  // Taylor coefficients ±1/n!, by Horner's rule.
+  const double sd =
+      d * (1 + d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040 + d2 * (1.0 / 362880)))));
+  const double cd =
+      1 + d2 * (-0.5 + d2 * (1.0 / 24 + d2 * (-1.0 / 720 + d2 * (1.0 / 40320 - d2 / 3628800))));
   const Edge& e = col_edge_[col];
   sin_phi = e.sin * cd + e.cos * sd;
   cos_phi = e.cos * cd - e.sin * sd;
+}
+
+void EnvMap::lookup(std::span<const Vec3<double>> dirs, bool compensated,
+                    std::span<Lookup> out) const {
+  if (dirs.size() != out.size())
+    throw std::invalid_argument("EnvMap::lookup: the spans' sizes differ");
+  // The pixels first, then their values: the loads of different directions overlap.
+  constexpr std::size_t kChunk = 32;
+  std::size_t rows[kChunk], cols[kChunk], index[kChunk];
+  const Distribution2D& d = compensated ? compensated_ : distribution_;
+  for (std::size_t begin = 0; begin < out.size(); begin += kChunk) {
+    const std::size_t n = std::min(kChunk, out.size() - begin);
+    for (std::size_t i = 0; i < n; ++i)
+      index[i] = pixel_of(to_map(dirs[begin + i]), rows[i], cols[i]);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float* p = &rgb_[3 * index[i]];
+      Lookup& l = out[begin + i];
+      l.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
+      l.pdf = d.probability(rows[i], cols[i]) / row_solid_angle_[rows[i]];
+    }
+  }
 }
 
 EnvMap::Lookup EnvMap::lookup(const Vec3<double>& dir, bool compensated) const {

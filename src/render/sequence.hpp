@@ -28,11 +28,10 @@ inline std::uint32_t hash32(std::uint64_t a, std::uint64_t b, std::uint64_t c) {
 }
 
 constexpr std::uint32_t reverse_bits(std::uint32_t x) {
+  x = __builtin_bswap32(x);  // the bytes, then the bits within each byte
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-  return (x >> 16) | (x << 16);
+  return ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
 }
 
 // A hash that only lets a bit depend on the bits below it (Laine and Karras 2011), applied to the

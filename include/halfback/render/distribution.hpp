@@ -59,6 +59,9 @@ class Distribution2D {
     double remapped_row = 0, remapped_col = 0;  // in [0, 1), the position inside the cell
   };
   Sample sample(double u1, double u2) const;
+  // sample() of each (u1[i], u2[i]), equal to it: all the rows first, then all the columns, so
+  // that the table lookups of different samples overlap. The spans have the same size.
+  void sample(std::span<const double> u1, std::span<const double> u2, std::span<Sample> out) const;
   double probability(std::size_t row, std::size_t col) const;
   double total() const { return marginal_.total(); }
   std::size_t rows() const { return rows_; }

@@ -78,6 +78,10 @@ class EnvMap {
   // directions that this density leaves out (pdf 0). The same as the plain density when the map
   // is constant.
   Sample sample(double u1, double u2, bool compensated = false) const;
+  // sample() of each (u1[i], u2[i]), equal to it; the table lookups of different samples overlap.
+  // Throws std::invalid_argument when the sizes differ.
+  void sample(std::span<const double> u1, std::span<const double> u2, bool compensated,
+              std::span<Sample> out) const;
   // The density of sample() at `dir`, per unit solid angle.
   double pdf(const Vec3<double>& dir, bool compensated = false) const;
   // eval(dir) and pdf(dir, compensated) from one lookup of the pixel (equal to both, bit for bit).
@@ -86,6 +90,8 @@ class EnvMap {
     double pdf = 0;
   };
   Lookup lookup(const Vec3<double>& dir, bool compensated = false) const;
+  // lookup() of each direction, equal to it (throws std::invalid_argument when the sizes differ).
+  void lookup(std::span<const Vec3<double>> dirs, bool compensated, std::span<Lookup> out) const;
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -115,6 +121,7 @@ class EnvMap {
     double cos = 1, sin = 0;
   };
   std::vector<Edge> col_edge_;  // of φ at each column's left edge
+  Sample sample_in(const Distribution2D::Sample& cell) const;
   void column_sincos(std::size_t col, double t, double& sin_phi, double& cos_phi) const;
   Distribution2D distribution_, compensated_;
   std::size_t noise_clamped_ = 0;
