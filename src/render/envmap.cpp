@@ -387,6 +387,13 @@ EnvMap::EnvMap(int width, int height, std::vector<float> rgb, std::string name, 
     const double phi = 2 * kPi * c / width - kPi;
     col_edge_[std::size_t(c)] = {std::cos(phi), std::sin(phi)};
   }
+  // The row of cos θ = 1 − 2k / n at the top of each of n = 4 × height buckets in cos θ.
+  row_guide_.resize(4 * std::size_t(height));
+  for (std::size_t k = 0, r = 0; k < row_guide_.size(); ++k) {
+    const double c = 1 - 2 * double(k) / double(row_guide_.size());
+    while (r + 1 < std::size_t(height) && !(c > row_cos_[r + 1])) ++r;
+    row_guide_[k] = std::uint32_t(r);
+  }
   const double dphi = 2 * kPi / width;
   for (std::size_t r = 0; r < std::size_t(height); ++r)
     row_solid_angle_[r] = dphi * (row_cos_[r] - row_cos_[r + 1]);
@@ -527,7 +534,7 @@ double approx_atan2(double y, double x) {
 // map_coordinates. Equal to it except within rounding of an edge.
 std::size_t EnvMap::pixel_of(const Vec3<double>& d, std::size_t& row, std::size_t& col) const {
   const std::size_t w = std::size_t(width_), h = std::size_t(height_);
-  const double rho = std::sqrt(d.x * d.x + d.z * d.z), len = std::sqrt(rho * rho + d.y * d.y);
+  const double rho2 = d.x * d.x + d.z * d.z, len = std::sqrt(rho2 + d.y * d.y);
   auto exact = [&] {
     double u, v;
     map_coordinates(d, u, v);
@@ -535,9 +542,12 @@ std::size_t EnvMap::pixel_of(const Vec3<double>& d, std::size_t& row, std::size_
     row = std::min(std::size_t(v * height_), h - 1);
     return row * w + col;
   };
-  if (w < 8 || !(rho > 1e-300)) return exact();
-  // Row r holds cos θ ∈ (row_cos_[r + 1], row_cos_[r]].
-  std::size_t r = std::min(std::size_t(approx_atan2(rho, d.y) / kPi * double(h)), h - 1);
+  if (w < 8 || !(rho2 > 1e-300)) return exact();
+  // Row r holds cos θ ∈ (row_cos_[r + 1], row_cos_[r]]; the guide gives the row of the bucket's
+  // top in cos θ.
+  const double t = std::clamp(0.5 * (1 - d.y / len), 0.0, 1.0);
+  const std::size_t buckets = row_guide_.size();
+  std::size_t r = row_guide_[std::min(std::size_t(t * double(buckets)), buckets - 1)];
   while (r > 0 && d.y > row_cos_[r] * len) --r;
   while (r + 1 < h && !(d.y > row_cos_[r + 1] * len)) ++r;
   // Column c holds the directions on or after its left edge and before the next one.

@@ -12,6 +12,7 @@
 // constant in direction, which is exactly the function the sampler importance samples.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <span>
@@ -115,8 +116,9 @@ class EnvMap {
   std::string name_;
   EnvOptions options_;
   double scale_ = 1, cos_rot_ = 1, sin_rot_ = 0;
-  std::vector<double> row_solid_angle_;  // of one pixel of each row
-  std::vector<double> row_cos_;          // cos θ of the rows' edges, height + 1 of them
+  std::vector<double> row_solid_angle_;   // of one pixel of each row
+  std::vector<double> row_cos_;           // cos θ of the rows' edges, height + 1 of them
+  std::vector<std::uint32_t> row_guide_;  // the row at the top of each bucket of cos θ
   struct Edge {
     double cos = 1, sin = 0;
   };
