@@ -1,5 +1,5 @@
 // halfback_render_bench: the renderer's speed and the efficiency of its sampling strategies
-// (docs/performance.md, "Rendering"). Prints Markdown tables.
+// (docs/performance.md, "Renderer"). Prints Markdown tables.
 //
 // 1. Time for a 512 × 512 sphere at 256 samples per pixel under the built-in sky, with 1 and all
 //    threads, for an analytic GGX, a MERL-format table (a model tabulated by tabulate_merl, read
@@ -18,7 +18,7 @@
 //    sampling tables, the BRDF's sampler), for GGX and the RGL metallic file under uffizi.hdr from
 //    ../shared/data (or $HALFBACK_SHARED_DIR/data). The same source builds against an older tree
 //    (the API it uses is unchanged), so the baseline is that build, run alternately with this one
-//    (scripts in docs/performance.md). Options: --size N (512), --spp N (256), --threads N (1),
+//    (docs/performance.md, "Renderer"). Options: --size N (512), --spp N (256), --threads N (1),
 //    --material ggx|rgl|all, --repeat N.
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
