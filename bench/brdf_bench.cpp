@@ -1,11 +1,13 @@
 // Measured-BRDF evaluation throughput (docs/performance.md, "BRDF evaluation"):
-//   MERL nearest-bin and trilinear lookups, one thread and batched over all threads, against a
+//   MERL nearest-bin and trilinear lookups, per pair, batched on one core and batched over all
+//   threads (wall time, and the process's CPU time), against a
 //   straightforward per-pair implementation of the MERL reference lookup (acos-based half/diff
 //   angles, Rodrigues rotations: src/formats/merl_reference.hpp) measured in the same run;
 //   RGL evaluations (../shared/data/rgl, skipped when absent); ALTA scattered-data evaluations.
 // Every benchmark processes the same 65536 random direction pairs (fixed seed); items/s counts
 // pairs.
 #include <benchmark/benchmark.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -81,6 +83,18 @@ void run_batch(benchmark::State& state, const Brdf& brdf) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
 }
 
+// eval_batch in a one-thread arena: one core (CPU time = wall time of that thread).
+void run_batch_one_core(benchmark::State& state, const Brdf& brdf) {
+  const auto& p = pairs();
+  std::vector<Rgb> out(p.size());
+  tbb::task_arena one_core(1);
+  for (auto _ : state) {
+    one_core.execute([&] { brdf.eval_batch(p, out); });
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
+}
+
 void BM_MerlReference_OneThread(benchmark::State& state) {
   const auto& p = pairs();
   const double* values = merl_data().values.data();
@@ -103,11 +117,20 @@ void BM_MerlNearest_OneThread(benchmark::State& state) {
 }
 BENCHMARK(BM_MerlNearest_OneThread)->Unit(benchmark::kMillisecond);
 
+void BM_MerlNearest_BatchOneCore(benchmark::State& state) {
+  static const MerlBrdf brdf(merl_data(), {MerlLookup::nearest});
+  run_batch_one_core(state, brdf);
+}
+BENCHMARK(BM_MerlNearest_BatchOneCore)->Unit(benchmark::kMillisecond);
+
 void BM_MerlNearest_Batch(benchmark::State& state) {
   static const MerlBrdf brdf(merl_data(), {MerlLookup::nearest});
   run_batch(state, brdf);
 }
-BENCHMARK(BM_MerlNearest_Batch)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MerlNearest_Batch)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 void BM_MerlTrilinear_OneThread(benchmark::State& state) {
   static const MerlBrdf brdf(merl_data(), {MerlLookup::trilinear});
@@ -115,11 +138,20 @@ void BM_MerlTrilinear_OneThread(benchmark::State& state) {
 }
 BENCHMARK(BM_MerlTrilinear_OneThread)->Unit(benchmark::kMillisecond);
 
+void BM_MerlTrilinear_BatchOneCore(benchmark::State& state) {
+  static const MerlBrdf brdf(merl_data(), {MerlLookup::trilinear});
+  run_batch_one_core(state, brdf);
+}
+BENCHMARK(BM_MerlTrilinear_BatchOneCore)->Unit(benchmark::kMillisecond);
+
 void BM_MerlTrilinear_Batch(benchmark::State& state) {
   static const MerlBrdf brdf(merl_data(), {MerlLookup::trilinear});
   run_batch(state, brdf);
 }
-BENCHMARK(BM_MerlTrilinear_Batch)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MerlTrilinear_Batch)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 std::filesystem::path shared_file(const char* sub) {
   const char* dir = std::getenv("HALFBACK_SHARED_DIR");
@@ -146,7 +178,13 @@ void BM_Rgl_Batch(benchmark::State& state) {
   if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
   run_batch(state, *rgl());
 }
-BENCHMARK(BM_Rgl_Batch)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Rgl_Batch)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+
+void BM_Rgl_BatchOneCore(benchmark::State& state) {
+  if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
+  run_batch_one_core(state, *rgl());
+}
+BENCHMARK(BM_Rgl_BatchOneCore)->Unit(benchmark::kMillisecond);
 
 const AltaBrdf* alta() {
   static const std::shared_ptr<const AltaBrdf> b = [] {
