@@ -3,7 +3,8 @@
 //   threads (wall time, and the process's CPU time), against a
 //   straightforward per-pair implementation of the MERL reference lookup (acos-based half/diff
 //   angles, Rodrigues rotations: src/formats/merl_reference.hpp) measured in the same run;
-//   RGL evaluations (../shared/data/rgl, skipped when absent); ALTA scattered-data evaluations.
+//   RGL evaluations (../shared/data/rgl, skipped when absent), against RGL's own loader when the
+//   build is given a checkout of it (-DHALFBACK_RGL_REFERENCE_DIR=...); ALTA scattered data.
 // Every benchmark processes the same 65536 random direction pairs (fixed seed); items/s counts
 // pairs.
 #include <benchmark/benchmark.h>
@@ -20,6 +21,11 @@
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
+
+#if defined(HALFBACK_RGL_REFERENCE)
+#define POWITACQ_IMPLEMENTATION
+#include <powitacq_rgb.h>
+#endif
 
 namespace {
 
@@ -167,6 +173,27 @@ const RglBrdf* rgl() {
   }();
   return b.get();
 }
+
+#if defined(HALFBACK_RGL_REFERENCE)
+// RGL's own loader on the same file and pairs (it returns fr·cos θo, in float).
+void BM_RglReference_OneThread(benchmark::State& state) {
+  if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
+  static const powitacq_rgb::BRDF reference(
+      shared_file("rgl/ilm_l3_37_metallic_rgb.bsdf").string());
+  const auto& p = pairs();
+  for (auto _ : state) {
+    float sum = 0;
+    for (const auto& x : p) {
+      const powitacq_rgb::Vector3f wi(float(x.wi.x), float(x.wi.y), float(x.wi.z)),
+          wo(float(x.wo.x), float(x.wo.y), float(x.wo.z));
+      sum += reference.eval(wi, wo)[1];
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
+}
+BENCHMARK(BM_RglReference_OneThread)->Unit(benchmark::kMillisecond);
+#endif
 
 void BM_Rgl_OneThread(benchmark::State& state) {
   if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
