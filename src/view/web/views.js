@@ -39,8 +39,16 @@ function percentile(values, p) {
 // A colour scale shared by several fields: transform (value -> t), range [lo, hi], colour map.
 export function makeScale(fields, mode, kind) {
   const diverge = mode === 'diff' || mode === 'ratio';
+  // A signed logarithm for differences on the log scale: linear below eps (a tenth of the
+  // median difference), logarithmic above, so that both small and peak differences show.
+  let eps = 1;
+  if (mode === 'diff' && kind === 'log') {
+    const abs = [];
+    for (const f of fields) for (let k = 0; k < f.length; k += 7) if (Number.isFinite(f[k])) abs.push(Math.abs(f[k]));
+    eps = Math.max((percentile(abs, 0.5) || 1) / 10, 1e-12);
+  }
   const tf = mode === 'ratio' ? (v) => (v > 0 ? Math.log2(v) : NaN)
-    : mode === 'diff' ? (v) => v
+    : mode === 'diff' ? (kind === 'log' ? (v) => Math.sign(v) * Math.log10(1 + Math.abs(v) / eps) : (v) => v)
       : kind === 'log' ? (v) => (v > 0 ? Math.log10(v) : NaN) : (v) => v;
   const sample = [];
   for (const f of fields) {
@@ -62,7 +70,8 @@ export function makeScale(fields, mode, kind) {
     hi = percentile(sample, 0.995);
   }
   if (!(hi > lo)) hi = lo + 1;
-  return { tf, lo, hi, map: diverge ? diverging : viridis, diverge, kind, mode };
+  return { tf, lo, hi, map: diverge ? diverging : viridis, diverge, kind, mode, eps,
+    line: diverge ? [20, 20, 20] : [255, 255, 255] };
 }
 
 // Isoline levels in transformed units: 'none', 'auto' (decades or tenths), or a list of values.
@@ -97,12 +106,18 @@ export function drawScalar(canvas, values, w, h, scale, levels) {
         c = ((i + (h - 1 - j)) % 8) < 2 ? [110, 110, 118] : [40, 40, 46];  // hatched
       } else {
         c = scale.map((t[k] - scale.lo) / (scale.hi - scale.lo));
-        if (isIsoline(t, w, h, i, j, levels)) c = [255, 255, 255];
+        if (isIsoline(t, w, h, i, j, levels)) c = scale.line;
       }
       img.data[p] = c[0]; img.data[p + 1] = c[1]; img.data[p + 2] = c[2]; img.data[p + 3] = 255;
     }
   }
   ctx.putImageData(img, 0, 0);
+  canvas.base = img;  // markers are drawn over a copy of this
+}
+
+// Puts a canvas' picture back (without the markers drawn on it since).
+export function restore(canvas) {
+  if (canvas.base) canvas.getContext('2d').putImageData(canvas.base, 0, 0);
 }
 
 function isIsoline(t, w, h, i, j, levels) {
