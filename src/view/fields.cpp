@@ -9,7 +9,6 @@
 #include "halfback/figure/coordinates.hpp"
 #include "halfback/figure/field.hpp"
 #include "halfback/figure/hemisphere.hpp"
-#include "halfback/figure/slices.hpp"
 
 namespace halfback::view {
 
@@ -54,11 +53,31 @@ void mirror_azimuth(const Vec3<double>& wo, double& cx, double& cy) {
 
 std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, std::size_t n,
                                int threads) {
+  // The grid of figure/slices.hpp (pixel centres), converted to direction pairs by the core's
+  // batch engine (SIMD, with the domain mask): the same pairs as figure::sample_slice, which
+  // converts one tuple at a time and costs several times more (docs/performance.md, "Viewer").
   const auto coords = figure::iso_coordinates(space);
   const figure::Grid grid =
       figure::Grid::pixel_centres(n, n, 0, coords[0].max, 0, coords[1].max);
-  const figure::SliceSample sample = figure::sample_slice(space, azimuth, grid, threads);
-  return eval_where(brdf, sample.pairs, sample.valid);
+  std::vector<double> x(grid.size()), y(grid.size()), az(grid.size(), azimuth);
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t i = 0; i < n; ++i) {
+      x[grid.index(i, j)] = grid.x(i);
+      y[grid.index(i, j)] = grid.y(j);
+    }
+  std::vector<DirPair<double>> pairs(grid.size());
+  std::vector<std::uint8_t> valid(grid.size());
+  double* base = &pairs.data()->wi.x;  // DirPair<double> is six packed doubles
+  static_assert(sizeof(DirPair<double>) == 6 * sizeof(double));
+  const ConstColumn<double> in[3] = {{x.data()}, {y.data()}, {az.data()}};
+  const Column<double> out_cols[6] = {{base, 6},     {base + 1, 6}, {base + 2, 6},
+                                      {base + 3, 6}, {base + 4, 6}, {base + 5, 6}};
+  ConvertOutput<double> out{out_cols};
+  out.valid = valid.data();
+  BatchOptions options;
+  options.threads = threads;
+  convert<double>(Form{space, true}, Form{Space::dirs, false}, in, grid.size(), out, options);
+  return eval_where(brdf, pairs, valid);
 }
 
 std::vector<float> hemisphere_field(const Brdf* brdf, Space space, const Vec3<double>& wo,
