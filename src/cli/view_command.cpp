@@ -30,7 +30,7 @@ struct ViewOptions {
   int port = 8765;
   bool open = false;
   int threads = 0;
-  int workers = 4;
+  int workers = 16;
 };
 
 // Opens the system browser on `url` (xdg-open; a failure is a warning only).
@@ -108,7 +108,7 @@ Command register_view(CLI::App& parent) {
   app->add_option("--port", o->port, "Port (default 8765; 0: any free port)");
   app->add_flag("--open", o->open, "Open the page in the system browser");
   app->add_option("--threads", o->threads, "Threads per computation (0: all cores)");
-  app->add_option("--workers", o->workers, "Requests served at once (default 4)");
+  app->add_option("--workers", o->workers, "Connections served at once (default 16; a browser tab opens up to 6)");
   app->footer(
       "Prints the URL to open, with a random token that every request must carry; Ctrl-C\n"
       "stops the server. See docs/view.md for the page, the API and the security model.\n"

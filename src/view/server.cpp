@@ -35,6 +35,10 @@ Server::Server(Api& api, int workers) : impl_(std::make_unique<Impl>(api)) {
   const std::size_t n = std::size_t(std::max(workers, 1));
   impl_->http.new_task_queue = [n] { return new httplib::ThreadPool(n); };
   impl_->http.set_payload_max_length(1 << 16);  // the API takes no bodies
+  // A kept-alive connection holds a worker while it waits, and a browser keeps up to six per
+  // host: a short keep-alive frees the workers of idle connections (with httplib's 5 s default,
+  // the seventh connection of two tabs waited that long).
+  impl_->http.set_keep_alive_timeout(1);
   impl_->http.set_pre_routing_handler([this](const httplib::Request& req,
                                              httplib::Response& res) {
     const Response r = impl_->api.handle_target(req.method, req.target,

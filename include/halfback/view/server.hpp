@@ -11,7 +11,8 @@ namespace halfback::view {
 
 class Server {
  public:
-  // `workers`: threads answering requests (several tabs at once); at least 1.
+  // `workers`: threads answering connections (a browser opens up to six per host, and a kept-
+  // alive connection holds its thread until it closes); at least 1.
   Server(Api& api, int workers);
   ~Server();
   Server(const Server&) = delete;

@@ -93,12 +93,16 @@ const axisMax = (a) => (a.angle ? '90°' : '1');
 let sliceFields = {};
 async function updateSlices() {
   const n = interactive ? DRAG : FULL;
+  const t0 = performance.now();
   const fields = await Promise.all(info.forms.map(async (f) => Promise.all(specs().map((s, b) =>
     getField(`slice-${f.space}-${b}`, '/api/slice',
       [['brdf', s], ['form', f.space], ['azimuth', state.az], ['n', n]])))));
   sliceFields = {};
   info.forms.forEach((f, k) => { sliceFields[f.space] = fields[k]; });
+  const t1 = performance.now();
   drawSlices();
+  stats.sliceFetchMs = t1 - t0;  // the four requests (server and transfer)
+  stats.sliceDrawMs = performance.now() - t1;  // colours, isolines, markers
 }
 function drawSlices() {
   const scalars = {};

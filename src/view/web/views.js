@@ -30,11 +30,11 @@ export function sliceScalar(a, b, mode) {
   return out;
 }
 
-function percentile(values, p) {
-  if (!values.length) return NaN;
-  const s = Float64Array.from(values).sort();
-  return s[Math.min(s.length - 1, Math.round(p * (s.length - 1)))];
+function percentile(sorted, p) {
+  if (!sorted.length) return NaN;
+  return sorted[Math.min(sorted.length - 1, Math.round(p * (sorted.length - 1)))];
 }
+const sortedOf = (values) => Float64Array.from(values).sort();
 
 // A colour scale shared by several fields: transform (value -> t), range [lo, hi], colour map.
 export function makeScale(fields, mode, kind) {
@@ -45,29 +45,30 @@ export function makeScale(fields, mode, kind) {
   if (mode === 'diff' && kind === 'log') {
     const abs = [];
     for (const f of fields) for (let k = 0; k < f.length; k += 7) if (Number.isFinite(f[k])) abs.push(Math.abs(f[k]));
-    eps = Math.max((percentile(abs, 0.5) || 1) / 10, 1e-12);
+    eps = Math.max((percentile(sortedOf(abs), 0.5) || 1) / 10, 1e-12);
   }
   const tf = mode === 'ratio' ? (v) => (v > 0 ? Math.log2(v) : NaN)
     : mode === 'diff' ? (kind === 'log' ? (v) => Math.sign(v) * Math.log10(1 + Math.abs(v) / eps) : (v) => v)
       : kind === 'log' ? (v) => (v > 0 ? Math.log10(v) : NaN) : (v) => v;
   const sample = [];
   for (const f of fields) {
-    const step = Math.max(1, Math.floor(f.length / 20000));
+    const step = Math.max(1, Math.floor(f.length / 4000));  // a sample is enough for a range
     for (let k = 0; k < f.length; k += step) {
       const t = tf(f[k]);
       if (Number.isFinite(t)) sample.push(diverge ? Math.abs(t) : t);
     }
   }
+  const sorted = sortedOf(sample);
   let lo, hi;
   if (diverge) {
-    hi = percentile(sample, 0.99) || 1;
+    hi = percentile(sorted, 0.99) || 1;
     lo = -hi;
   } else if (kind === 'log') {
-    hi = percentile(sample, 0.995);
-    lo = Math.max(percentile(sample, 0.01), hi - 4);
+    hi = percentile(sorted, 0.995);
+    lo = Math.max(percentile(sorted, 0.01), hi - 4);
   } else {
     lo = 0;
-    hi = percentile(sample, 0.995);
+    hi = percentile(sorted, 0.995);
   }
   if (!(hi > lo)) hi = lo + 1;
   return { tf, lo, hi, map: diverge ? diverging : viridis, diverge, kind, mode, eps,
