@@ -4,10 +4,10 @@
 // model, MERL data (an analytic lobe tabulated in memory, so no file is needed), an RGL material
 // and a neural BRDF (both embedded in the library), on ONE thread: oneTBB is limited to one worker
 // (tbb::global_control), so all the work is on the calling thread, whose CPU time is the
-// "CPU" column (on the shared machine, wall time is several times longer and varies). Baseline in the same run: Brdf::eval_batch of
-// the same valid pairs alone (BM_EvalOnly), so the ratio is the cost the slice adds to ρ.
-// Also the whole request, through Api::handle (BM_Request: the parameter checks and the copy to
-// the float32 body).
+// "CPU" column (on the shared machine, wall time is several times longer and varies). Baseline in
+// the same run: Brdf::eval_batch of the same valid pairs alone (BM_EvalOnly), so the ratio is the
+// cost the slice adds to ρ. Also the whole request, through Api::handle (BM_Request: the parameter
+// checks and the copy to the float32 body).
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
@@ -99,9 +99,9 @@ void BM_EvalOnly(benchmark::State& state) {
   const BrdfPtr brdf = brdf_of(int(state.range(0)));
   state.SetLabel(kNames[state.range(0)]);
   const auto c = figure::iso_coordinates(Space::hybrid);
-  const figure::SliceSample s = figure::sample_slice(
-      Space::hybrid, kAzimuth, figure::Grid::pixel_centres(kSide, kSide, 0, c[0].max, 0, c[1].max),
-      1);
+  const figure::SliceSample s =
+      figure::sample_slice(Space::hybrid, kAzimuth,
+                           figure::Grid::pixel_centres(kSide, kSide, 0, c[0].max, 0, c[1].max), 1);
   std::vector<DirPair<double>> pairs;
   for (std::size_t k = 0; k < s.pairs.size(); ++k)
     if (s.valid[k]) pairs.push_back(s.pairs[k]);
@@ -122,8 +122,11 @@ void BM_Request(benchmark::State& state) {
   const view::Api api(config);
   view::Request r;
   r.path = "/api/slice";
-  r.query = {{"token", "t"}, {"brdf", "ggx:alpha=0.2,f0=0.9"}, {"form", "hybrid"},
-             {"azimuth", "40"}, {"n", std::to_string(kSide)}};
+  r.query = {{"token", "t"},
+             {"brdf", "ggx:alpha=0.2,f0=0.9"},
+             {"form", "hybrid"},
+             {"azimuth", "40"},
+             {"n", std::to_string(kSide)}};
   r.headers = {{"host", "127.0.0.1:1"}};
   for (auto _ : state) {
     const view::Response res = api.handle(r);

@@ -47,7 +47,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // A sphere render's cost grows with size × spp (up to 512² × 64 samples): the fuzzer keeps to
   // the default size and samples, which exercise the same code.
   if (target.find("render") != std::string_view::npos &&
-      (target.find("size") != std::string_view::npos || target.find("spp") != std::string_view::npos))
+      (target.find("size") != std::string_view::npos ||
+       target.find("spp") != std::string_view::npos))
     return 0;
   std::map<std::string, std::string> headers{{"host", "127.0.0.1:8765"}};
   while (!input.empty()) {

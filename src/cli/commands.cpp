@@ -8,9 +8,9 @@ namespace halfback::cli {
 
 namespace {
 constexpr std::array<RegisterCommand, 10> kCommands{
-    &register_convert,  &register_info,        &register_eval,
-    &register_resample, &register_export_merl, &register_models,
-    &register_render,   &register_figure,      &register_study, &register_view,
+    &register_convert,     &register_info,   &register_eval,   &register_resample,
+    &register_export_merl, &register_models, &register_render, &register_figure,
+    &register_study,       &register_view,
 };
 }  // namespace
 

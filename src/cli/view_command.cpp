@@ -4,10 +4,10 @@
 // clean stop of the server).
 #include <fmt/format.h>
 #include <signal.h>
+#include <spawn.h>
 
 #include <atomic>
 #include <cerrno>
-#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <memory>
@@ -18,6 +18,8 @@
 #include "command.hpp"
 #include "halfback/view/api.hpp"
 #include "halfback/view/server.hpp"
+
+extern char** environ;
 
 namespace halfback::cli {
 
@@ -33,10 +35,21 @@ struct ViewOptions {
   int workers = 16;
 };
 
-// Opens the system browser on `url` (xdg-open; a failure is a warning only).
+// Opens the system browser on `url` (xdg-open, started without a shell; a failure is a warning).
 void open_browser(const std::string& url) {
-  const std::string command = "xdg-open '" + url + "' >/dev/null 2>&1 &";
-  if (std::system(command.c_str()) != 0) warn("view", "could not start a browser (xdg-open)");
+  std::string program = "xdg-open", argument = url;
+  char* argv[] = {program.data(), argument.data(), nullptr};
+  // The stop signals are blocked in this process (see run_view): not in the browser.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attributes, &none);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, "xdg-open", nullptr, &attributes, argv, environ) != 0)
+    warn("view", "could not start a browser (xdg-open); open the URL by hand");
+  posix_spawnattr_destroy(&attributes);
 }
 
 // Waits for SIGINT/SIGTERM/SIGHUP (blocked in every thread of the process) and stops the server,
@@ -62,10 +75,11 @@ int run_view(const ViewOptions& o) {
   config.threads = o.threads;
   for (const std::string& r : o.roots) config.roots.emplace_back(r);
   view::Api api(std::move(config));  // throws for a --root that is not a directory
-  api.load_specs();  // a bad command-line BRDF fails here, not in the page
+  api.load_specs();                  // a bad command-line BRDF fails here, not in the page
   if (!view::is_loopback(o.host))
     warn("view", fmt::format("--host {} is not a loopback address: anyone who can reach it and "
-                             "learns the token can use the server", o.host));
+                             "learns the token can use the server",
+                             o.host));
 
   // Block the stop signals before any server thread exists, so that they all inherit the mask.
   sigset_t signals;
@@ -108,7 +122,8 @@ Command register_view(CLI::App& parent) {
   app->add_option("--port", o->port, "Port (default 8765; 0: any free port)");
   app->add_flag("--open", o->open, "Open the page in the system browser");
   app->add_option("--threads", o->threads, "Threads per computation (0: all cores)");
-  app->add_option("--workers", o->workers, "Connections served at once (default 16; a browser tab opens up to 6)");
+  app->add_option("--workers", o->workers,
+                  "Connections served at once (default 16; a browser tab opens up to 6)");
   app->footer(
       "Prints the URL to open, with a random token that every request must carry; Ctrl-C\n"
       "stops the server. See docs/view.md for the page, the API and the security model.\n"

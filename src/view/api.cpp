@@ -91,8 +91,12 @@ struct Api::State {
 Api::Api(ApiConfig config) : state_(std::make_unique<State>(std::move(config))) {}
 Api::~Api() = default;
 
-void Api::set_port(int port) { state_->config.port = port; }
-const ApiConfig& Api::config() const { return state_->config; }
+void Api::set_port(int port) {
+  state_->config.port = port;
+}
+const ApiConfig& Api::config() const {
+  return state_->config;
+}
 
 void Api::load_specs() const {
   for (std::size_t i = 0; i < state_->config.specs.size(); ++i) {
@@ -125,13 +129,16 @@ bool same_secret(std::string_view a, std::string_view b) {
 
 bool is_ip_literal(std::string_view name) {
   if (name.size() > 2 && name.front() == '[' && name.back() == ']') {
-    return std::all_of(name.begin() + 1, name.end() - 1,
-                       [](char c) { return std::isxdigit((unsigned char)c) || c == ':' || c == '.'; });
+    return std::all_of(name.begin() + 1, name.end() - 1, [](char c) {
+      return std::isxdigit((unsigned char)c) || c == ':' || c == '.';
+    });
   }
   int dots = 0;
   for (const char c : name) {
-    if (c == '.') ++dots;
-    else if (!std::isdigit((unsigned char)c)) return false;
+    if (c == '.')
+      ++dots;
+    else if (!std::isdigit((unsigned char)c))
+      return false;
   }
   return dots == 3;
 }
@@ -144,12 +151,13 @@ bool accepted_host(std::string_view value, const ApiConfig& c) {
     return false;
   const std::string_view name = value.substr(0, colon);
   if (name.empty()) return false;
-  const std::string bound =
-      c.host.find(':') != std::string::npos ? "[" + c.host + "]" : c.host;
+  const std::string bound = c.host.find(':') != std::string::npos ? "[" + c.host + "]" : c.host;
   return name == "localhost" || name == bound || is_ip_literal(name);
 }
 
-std::string cookie_name(const ApiConfig& c) { return fmt::format("halfback_token_{}", c.port); }
+std::string cookie_name(const ApiConfig& c) {
+  return fmt::format("halfback_token_{}", c.port);
+}
 
 // The token of the request: token= in the query, else the page's cookie.
 std::string request_token(const Request& r, const ApiConfig& c) {
@@ -172,20 +180,21 @@ std::string request_token(const Request& r, const ApiConfig& c) {
 // The refusal of a request that is not for this server, or nothing.
 std::optional<Response> refusal(const Request& r, const ApiConfig& c) {
   if (r.method != "GET" && r.method != "HEAD") {
-    Response res = error(405, fmt::format("method {} is not allowed (GET only)",
-                                          r.method.substr(0, 16)));
+    Response res =
+        error(405, fmt::format("method {} is not allowed (GET only)", r.method.substr(0, 16)));
     res.headers.emplace_back("Allow", "GET, HEAD");
     return res;
   }
   const std::string* host = r.header("host");
   if (!host || !accepted_host(*host, c))
     return error(403, fmt::format("Host '{}' is not this server (expected 127.0.0.1:{} or "
-                                  "localhost:{})", host ? host->substr(0, 128) : "", c.port, c.port));
+                                  "localhost:{})",
+                                  host ? host->substr(0, 128) : "", c.port, c.port));
   if (const std::string* origin = r.header("origin")) {
     const bool own = origin->substr(0, 7) == "http://" && accepted_host(origin->substr(7), c);
     if (!own)
-      return error(403, fmt::format("cross-origin request from '{}' refused",
-                                    origin->substr(0, 128)));
+      return error(403,
+                   fmt::format("cross-origin request from '{}' refused", origin->substr(0, 128)));
   }
   if (!same_secret(request_token(r, c), c.token))
     return error(403, "missing or wrong token: open the URL that `halfback view` printed");
@@ -219,8 +228,8 @@ Response route(const Catalog& catalog, const Request& r, const ApiConfig& c) {
   if (p == "/" || p == "/index.html") {
     Response res = *asset("index.html");
     if (r.param("token"))  // later loads (the modules, a reload) carry the cookie instead
-      res.headers.emplace_back("Set-Cookie", cookie_name(c) + "=" + c.token +
-                                                 "; Path=/; HttpOnly; SameSite=Strict");
+      res.headers.emplace_back(
+          "Set-Cookie", cookie_name(c) + "=" + c.token + "; Path=/; HttpOnly; SameSite=Strict");
     return res;
   }
   if (p.rfind("/static/", 0) == 0)
@@ -273,7 +282,7 @@ Response Api::handle(const Request& request) const {
 }
 
 Response Api::handle_target(std::string method, std::string_view target,
-                           std::map<std::string, std::string> headers) const {
+                            std::map<std::string, std::string> headers) const {
   Request request;
   request.method = std::move(method);
   request.headers = std::move(headers);

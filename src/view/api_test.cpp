@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <fmt/format.h>
 #include <numbers>
 
 #include "fields.hpp"
@@ -100,7 +100,8 @@ TEST(ViewApi, PageLoadWithTokenSetsAnHttpOnlyCookie) {
       cookie = v.find(kToken) != std::string::npos && v.find("HttpOnly") != std::string::npos &&
                v.find("SameSite=Strict") != std::string::npos;
   EXPECT_TRUE(cookie);
-  for (const char* asset : {"/static/app.js", "/static/views.js", "/static/api.js", "/static/style.css"})
+  for (const char* asset :
+       {"/static/app.js", "/static/views.js", "/static/api.js", "/static/style.css"})
     EXPECT_EQ(api.handle(get(asset)).status, 200) << asset;
   EXPECT_EQ(api.handle(get("/static/../api.cpp")).status, 404);
 }
@@ -109,13 +110,14 @@ TEST(ViewApi, HostHeaderMustNameThisServer) {
   Api api(config());
   Request r = get("/api/info");
   for (const std::string& ok : {fmt::format("localhost:{}", kPort), fmt::format("[::1]:{}", kPort),
-                               fmt::format("192.168.1.7:{}", kPort)}) {
+                                fmt::format("192.168.1.7:{}", kPort)}) {
     r.headers["host"] = ok;
     EXPECT_EQ(api.handle(r).status, 200) << ok;
   }
   for (const std::string& bad :
        {fmt::format("evil.example:{}", kPort), fmt::format("127.0.0.1:{}", kPort + 1),
-        std::string("127.0.0.1"), fmt::format(":{}", kPort), fmt::format("127.0.0.1.evil:{}", kPort)}) {
+        std::string("127.0.0.1"), fmt::format(":{}", kPort),
+        fmt::format("127.0.0.1.evil:{}", kPort)}) {
     r.headers["host"] = bad;
     EXPECT_TRUE(has_error(api.handle(r), 403, "Host")) << bad;
   }
@@ -146,14 +148,16 @@ TEST(ViewApi, OnlyGetAndHead) {
 TEST(ViewApi, MalformedAndOversizedTargets) {
   Api api(config());
   const std::map<std::string, std::string> host{{"host", fmt::format("127.0.0.1:{}", kPort)}};
-  EXPECT_TRUE(has_error(api.handle_target("GET", "/api/info?token=" + kToken + "&x=%zz", host),
-                        400, "percent"));
-  EXPECT_TRUE(has_error(api.handle_target("GET", "/api/info?token=" + kToken + "&x=%00", host),
-                        400, "NUL"));
+  EXPECT_TRUE(has_error(api.handle_target("GET", "/api/info?token=" + kToken + "&x=%zz", host), 400,
+                        "percent"));
+  EXPECT_TRUE(has_error(api.handle_target("GET", "/api/info?token=" + kToken + "&x=%00", host), 400,
+                        "NUL"));
   EXPECT_EQ(api.handle_target("GET", "/api/info?token=" + kToken + "&&=&a", host).status, 200);
-  EXPECT_EQ(api.handle_target("GET", "/api/info?token=" + kToken + "&pad=" +
-                                         std::string(kMaxTargetBytes, 'x'), host).status,
-            414);
+  EXPECT_EQ(
+      api.handle_target(
+             "GET", "/api/info?token=" + kToken + "&pad=" + std::string(kMaxTargetBytes, 'x'), host)
+          .status,
+      414);
   EXPECT_EQ(api.handle(get("/no/such")).status, 404);
 }
 
@@ -259,8 +263,8 @@ TEST(ViewApi, HemisphereIsRhoOfTheEqualAreaDirection) {
   Api api(config());
   const BrdfPtr brdf = load_brdf(kSpec);
   const std::size_t n = 32;
-  const Response r = api.handle(get("/api/hemisphere", {{"brdf", "arg:0"}, {"theta_o", "30"},
-                                                        {"phi_o", "180"}, {"n", "32"}}));
+  const Response r = api.handle(get(
+      "/api/hemisphere", {{"brdf", "arg:0"}, {"theta_o", "30"}, {"phi_o", "180"}, {"n", "32"}}));
   ASSERT_EQ(r.status, 200);
   const std::vector<float> v = floats_of(r);
   ASSERT_EQ(v.size(), n * n * 3);
@@ -269,15 +273,16 @@ TEST(ViewApi, HemisphereIsRhoOfTheEqualAreaDirection) {
   const Vec3<double> wo{-std::sin(t), 0, std::cos(t)};
   for (const std::size_t i : {5u, 16u, 20u, 27u}) {
     const std::size_t j = 14;
-    const double u = -1 + (2.0 * double(i) + 1) / double(n), w = -1 + (2.0 * double(j) + 1) / double(n);
+    const double u = -1 + (2.0 * double(i) + 1) / double(n),
+                 w = -1 + (2.0 * double(j) + 1) / double(n);
     const double rr = std::hypot(u, w), psi = 2 * std::asin(rr / std::sqrt(2.0));
     const Vec3<double> wi{std::sin(psi) * u / rr, std::sin(psi) * w / rr, std::cos(psi)};
     const Rgb rho = brdf->eval({wi, wo});
     EXPECT_NEAR(v[3 * (j * n + i)], rho.g, 1e-4 * std::max(1.0, rho.g)) << i;
   }
   // Coordinates instead of ρ: the isotropic coordinates of the pair (no BRDF needed).
-  const Response c = api.handle(
-      get("/api/hemisphere", {{"colour", "hybrid"}, {"theta_o", "30"}, {"n", "32"}}));
+  const Response c =
+      api.handle(get("/api/hemisphere", {{"colour", "hybrid"}, {"theta_o", "30"}, {"n", "32"}}));
   ASSERT_EQ(c.status, 200);
   EXPECT_EQ(floats_of(c).size(), n * n * 3);
   EXPECT_EQ(api.handle(get("/api/hemisphere", {{"colour", "bogus"}})).status, 400);
@@ -304,11 +309,12 @@ TEST(ViewApi, PolarCurvesPassThroughTheNormalAndTheMirrorDirection) {
 TEST(ViewApi, PointListsEveryParameterizationAndRho) {
   Api api(config());
   const DirPair<double> pair{{0.48, 0.0, 0.8772684879784524}, {-0.6, 0.0, 0.8}};
-  const Response r = api.handle(get(
-      "/api/point",
-      {{"brdf", "arg:0"}, {"brdf", "lambert"},
-       {"wi", fmt::format("{:.17g},{:.17g},{:.17g}", pair.wi.x, pair.wi.y, pair.wi.z)},
-       {"wo", fmt::format("{:.17g},{:.17g},{:.17g}", pair.wo.x, pair.wo.y, pair.wo.z)}}));
+  const Response r = api.handle(
+      get("/api/point",
+          {{"brdf", "arg:0"},
+           {"brdf", "lambert"},
+           {"wi", fmt::format("{:.17g},{:.17g},{:.17g}", pair.wi.x, pair.wi.y, pair.wi.z)},
+           {"wo", fmt::format("{:.17g},{:.17g},{:.17g}", pair.wo.x, pair.wo.y, pair.wo.z)}}));
   ASSERT_EQ(r.status, 200);
   EXPECT_NE(r.body.find("\"valid\":true"), std::string::npos);
   Rgb rho{};
@@ -316,7 +322,8 @@ TEST(ViewApi, PointListsEveryParameterizationAndRho) {
   EXPECT_NE(r.body.find(fmt::format("{:.17g}", rho.r)), std::string::npos) << r.body;
   const double d[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
   double q[4], jacobian = 0;
-  ASSERT_TRUE(convert_one<double>(Form{Space::dirs, false}, Form{Space::hybrid, false}, d, q, &jacobian));
+  ASSERT_TRUE(
+      convert_one<double>(Form{Space::dirs, false}, Form{Space::hybrid, false}, d, q, &jacobian));
   EXPECT_NE(r.body.find(fmt::format("{:.17g},{:.17g},{:.17g},{:.17g}", q[0], q[1], q[2], q[3])),
             std::string::npos);
   EXPECT_NE(r.body.find(fmt::format("\"jacobian\":{:.17g}", jacobian)), std::string::npos);
@@ -324,8 +331,9 @@ TEST(ViewApi, PointListsEveryParameterizationAndRho) {
 
 TEST(ViewApi, PointFromIsotropicCoordinatesAndItsErrors) {
   Api api(config());
-  const Response in = api.handle(get(
-      "/api/point", {{"brdf", "arg:0"}, {"form", "halfdiff"}, {"iso", "1"}, {"coords", "0.3,0.5,1"}}));
+  const Response in = api.handle(
+      get("/api/point",
+          {{"brdf", "arg:0"}, {"form", "halfdiff"}, {"iso", "1"}, {"coords", "0.3,0.5,1"}}));
   ASSERT_EQ(in.status, 200);
   EXPECT_NE(in.body.find("\"valid\":true"), std::string::npos);
   const Response out = api.handle(get(
@@ -336,7 +344,8 @@ TEST(ViewApi, PointFromIsotropicCoordinatesAndItsErrors) {
   EXPECT_EQ(api.handle(get("/api/point", {{"wi", "0,0,2"}, {"wo", "0,0,1"}})).status, 400);
   EXPECT_EQ(api.handle(get("/api/point", {{"wi", "0,0,1"}})).status, 400);
   EXPECT_EQ(api.handle(get("/api/point", {{"wi", "0,0,1,"}, {"wo", "0,0,1"}})).status, 400);
-  std::vector<std::pair<std::string, std::string>> many(kMaxBrdfsPerRequest + 1, {"brdf", "lambert"});
+  std::vector<std::pair<std::string, std::string>> many(kMaxBrdfsPerRequest + 1,
+                                                        {"brdf", "lambert"});
   many.emplace_back("wi", "0,0,1");
   many.emplace_back("wo", "0,0,1");
   EXPECT_EQ(api.handle(get("/api/point", many)).status, 413);
@@ -345,8 +354,9 @@ TEST(ViewApi, PointFromIsotropicCoordinatesAndItsErrors) {
 TEST(ViewApi, RenderPassesAreSeededAndLimited) {
   Api api(config());
   const auto render = [&](std::string pass, std::string size = "16", std::string env = "sky") {
-    return api.handle(get("/api/render", {{"brdf", "arg:0"}, {"size", size}, {"spp", "1"},
-                                          {"pass", pass}, {"env", env}}));
+    return api.handle(
+        get("/api/render",
+            {{"brdf", "arg:0"}, {"size", size}, {"spp", "1"}, {"pass", pass}, {"env", env}}));
   };
   const Response a = render("0"), b = render("0"), c = render("1");
   ASSERT_EQ(a.status, 200);
@@ -379,8 +389,9 @@ TEST(ViewApi, FilesOnlyUnderTheRoots) {
   EXPECT_TRUE(has_error(brdf("sub/s.hdr"), 403, "outside"));
   EXPECT_TRUE(has_error(brdf("missing.binary"), 404, "no such file"));
   EXPECT_EQ(brdf("").status, 400);
-  EXPECT_TRUE(has_error(api.handle(get("/api/render", {{"brdf", "arg:0"}, {"env", "file:out/secret.hdr"}})),
-                        403, "outside"));
+  EXPECT_TRUE(
+      has_error(api.handle(get("/api/render", {{"brdf", "arg:0"}, {"env", "file:out/secret.hdr"}})),
+                403, "outside"));
   const Response info = api.handle(get("/api/info"));
   EXPECT_EQ(info.body.find("secret"), std::string::npos);  // links out are not listed
   EXPECT_THROW(Api(config({outside.path() / "none"})), std::invalid_argument);
@@ -393,8 +404,8 @@ TEST(ViewApi, LoadsAFileUnderARoot) {
   Api api(config({root.path()}));
   EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "file:felt.bsdf"}})).status, 200);
   EXPECT_NE(api.handle(get("/api/info")).body.find("\"felt.bsdf\""), std::string::npos);
-  const Response s = api.handle(
-      get("/api/slice", {{"brdf", "file:felt.bsdf"}, {"form", "hybrid"}, {"n", "8"}}));
+  const Response s =
+      api.handle(get("/api/slice", {{"brdf", "file:felt.bsdf"}, {"form", "hybrid"}, {"n", "8"}}));
   EXPECT_EQ(s.status, 200);
 }
 

@@ -1,8 +1,8 @@
 #include "catalog.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cctype>
-#include <fmt/format.h>
 #include <system_error>
 
 #include "halfback/loader/load.hpp"
@@ -68,7 +68,8 @@ fs::path Catalog::resolve(std::string_view relative) const {
   const fs::path rel{std::string(relative)};
   if (rel.is_absolute() || rel.has_root_directory() || rel.has_root_name())
     throw RequestError(403, fmt::format("'{}': absolute paths are refused; give a path relative "
-                                        "to a --root directory", relative));
+                                        "to a --root directory",
+                                        relative));
   for (const fs::path& part : rel)
     if (part == "..")
       throw RequestError(403, fmt::format("'{}': '..' is refused in file paths", relative));
@@ -80,11 +81,11 @@ fs::path Catalog::resolve(std::string_view relative) const {
     if (ec || !fs::exists(candidate, ec)) continue;
     if (!is_inside(candidate, root))
       throw RequestError(403, fmt::format("'{}' leads outside the --root directories (a symbolic "
-                                          "link?)", relative));
+                                          "link?)",
+                                          relative));
     return candidate;
   }
-  throw RequestError(404, fmt::format("'{}': no such file under the --root directories",
-                                      relative));
+  throw RequestError(404, fmt::format("'{}': no such file under the --root directories", relative));
 }
 
 BrdfPtr Catalog::load(std::string_view spec) const {
@@ -184,7 +185,8 @@ std::shared_ptr<const render::EnvMap> Catalog::environment(std::string_view spec
     map = std::make_shared<const render::EnvMap>(render::EnvMap::load(path));
   } else {
     throw RequestError(400, fmt::format("unknown environment '{}' (expected sky, studio, sunset, "
-                                        "constant:V, constant:R,G,B or file:PATH)", spec));
+                                        "constant:V, constant:R,G,B or file:PATH)",
+                                        spec));
   }
   std::lock_guard lock(mutex_);
   if (envs_.size() >= kMaxCachedEnvironments) envs_.clear();

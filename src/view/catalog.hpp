@@ -14,10 +14,10 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <cstdint>
 #include <mutex>
 #include <stdexcept>
 #include <string>

@@ -57,8 +57,7 @@ std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, st
   // batch engine (SIMD, with the domain mask): the same pairs as figure::sample_slice, which
   // converts one tuple at a time and costs several times more (docs/performance.md, "Viewer").
   const auto coords = figure::iso_coordinates(space);
-  const figure::Grid grid =
-      figure::Grid::pixel_centres(n, n, 0, coords[0].max, 0, coords[1].max);
+  const figure::Grid grid = figure::Grid::pixel_centres(n, n, 0, coords[0].max, 0, coords[1].max);
   std::vector<double> x(grid.size()), y(grid.size()), az(grid.size(), azimuth);
   for (std::size_t j = 0; j < n; ++j)
     for (std::size_t i = 0; i < n; ++i) {
@@ -82,8 +81,7 @@ std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, st
 
 std::vector<float> hemisphere_field(const Brdf* brdf, Space space, const Vec3<double>& wo,
                                     std::size_t n, int threads) {
-  const auto view =
-      figure::HemisphereView::around({0, 0, 1}, figure::Projection::equal_area);
+  const auto view = figure::HemisphereView::around({0, 0, 1}, figure::Projection::equal_area);
   const figure::Grid grid = figure::Grid::pixel_centres(n, n, -1, 1, -1, 1);
   std::vector<DirPair<double>> pairs(grid.size());
   std::vector<std::uint8_t> inside(grid.size(), 0);

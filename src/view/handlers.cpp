@@ -31,8 +31,8 @@ double parse_finite(std::string_view text, std::string_view what) {
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data(), end, x);
   if (ec != std::errc() || ptr != end || !std::isfinite(x))
-    throw RequestError(400, fmt::format("{}: '{}' is not a finite number", what,
-                                        text.substr(0, 64)));
+    throw RequestError(400,
+                       fmt::format("{}: '{}' is not a finite number", what, text.substr(0, 64)));
   return x;
 }
 
@@ -57,10 +57,10 @@ Space space_param(const Request& r, std::string_view key, bool allow_dirs) {
   const std::string& name = required(r, key);
   const auto s = space_from_name(name);
   if (!s || (*s == Space::dirs && !allow_dirs))
-    throw RequestError(400, fmt::format("parameter '{}': '{}' is not one of {}", key,
-                                        name.substr(0, 64),
-                                        allow_dirs ? "rho, " + space_names()
-                                                   : "spherical, halfdiff, ortho, hybrid"));
+    throw RequestError(
+        400,
+        fmt::format("parameter '{}': '{}' is not one of {}", key, name.substr(0, 64),
+                    allow_dirs ? "rho, " + space_names() : "spherical, halfdiff, ortho, hybrid"));
   return *s;
 }
 
@@ -134,7 +134,10 @@ void write_forms(JsonWriter& w) {
     w.begin_object().field("space", name_of(s));
     w.field("azimuth_label", figure::relative_azimuth_label(s)).key("axes").begin_array();
     for (const auto& c : coords)
-      w.begin_object().field("label", c.label).field("max", c.max).field("angle", c.angle)
+      w.begin_object()
+          .field("label", c.label)
+          .field("max", c.max)
+          .field("angle", c.angle)
           .end_object();
     w.end_array().key("columns").begin_array();
     for (const auto c : column_names(Form{s, false})) w.value(c);
@@ -241,8 +244,8 @@ bool point_pair(const Request& request, DirPair<double>& pair) {
   const std::string* iso_text = request.param("iso");
   const bool iso = iso_text && *iso_text == "1";
   const Form from{space, iso};
-  const std::vector<double> q = number_list(required(request, "coords"), "parameter 'coords'",
-                                            dimension(from));
+  const std::vector<double> q =
+      number_list(required(request, "coords"), "parameter 'coords'", dimension(from));
   double d[6];
   const bool ok = convert_one<double>(from, Form{Space::dirs, false}, q, d);
   pair = {{d[0], d[1], d[2]}, {d[3], d[4], d[5]}};
@@ -257,7 +260,8 @@ void write_coordinates(JsonWriter& w, const DirPair<double>& pair, bool valid) {
     for (const bool iso : {false, true}) {
       const Form to{s, iso};
       double q[4] = {NAN, NAN, NAN, NAN}, jacobian = NAN;
-      if (valid) convert_one<double>(Form{Space::dirs, false}, to, d, {q, dimension(to)}, &jacobian);
+      if (valid)
+        convert_one<double>(Form{Space::dirs, false}, to, d, {q, dimension(to)}, &jacobian);
       w.key(iso ? "iso" : "coords").begin_array();
       for (std::size_t k = 0; k < dimension(to); ++k) w.value(q[k]);
       w.end_array().field(iso ? "iso_jacobian" : "jacobian", jacobian);

@@ -39,10 +39,9 @@ Server::Server(Api& api, int workers) : impl_(std::make_unique<Impl>(api)) {
   // host: a short keep-alive frees the workers of idle connections (with httplib's 5 s default,
   // the seventh connection of two tabs waited that long).
   impl_->http.set_keep_alive_timeout(1);
-  impl_->http.set_pre_routing_handler([this](const httplib::Request& req,
-                                             httplib::Response& res) {
-    const Response r = impl_->api.handle_target(req.method, req.target,
-                                                lower_case_headers(req.headers));
+  impl_->http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    const Response r =
+        impl_->api.handle_target(req.method, req.target, lower_case_headers(req.headers));
     res.status = r.status;
     for (const auto& [name, value] : r.headers) res.set_header(name.c_str(), value);
     res.set_content(r.body, r.content_type.c_str());
@@ -53,10 +52,8 @@ Server::Server(Api& api, int workers) : impl_(std::make_unique<Impl>(api)) {
 Server::~Server() = default;
 
 int Server::bind(const std::string& host, int port) {
-  const int bound =
-      port == 0 ? impl_->http.bind_to_any_port(host) : (impl_->http.bind_to_port(host, port)
-                                                            ? port
-                                                            : -1);
+  const int bound = port == 0 ? impl_->http.bind_to_any_port(host)
+                              : (impl_->http.bind_to_port(host, port) ? port : -1);
   if (bound <= 0)
     throw std::runtime_error("cannot listen on " + host + ":" + std::to_string(port) +
                              " (address in use, or not an address of this machine?)");
@@ -64,9 +61,13 @@ int Server::bind(const std::string& host, int port) {
   return bound;
 }
 
-bool Server::run() { return impl_->http.listen_after_bind(); }
+bool Server::run() {
+  return impl_->http.listen_after_bind();
+}
 
-void Server::stop() { impl_->http.stop(); }
+void Server::stop() {
+  impl_->http.stop();
+}
 
 bool is_loopback(const std::string& host) {
   return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;

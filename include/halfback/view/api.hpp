@@ -54,12 +54,12 @@ struct Response {
 };
 
 struct ApiConfig {
-  std::string token;                      // required on every request (empty: refused always)
-  std::string host = "127.0.0.1";         // the bound address, as given to --host
-  int port = 0;                           // the bound port (after binding port 0)
-  std::vector<std::string> specs;         // the BRDFs named on the command line, in order
+  std::string token;                         // required on every request (empty: refused always)
+  std::string host = "127.0.0.1";            // the bound address, as given to --host
+  int port = 0;                              // the bound port (after binding port 0)
+  std::vector<std::string> specs;            // the BRDFs named on the command line, in order
   std::vector<std::filesystem::path> roots;  // directories whose files may be loaded
-  int threads = 0;                        // as in core/parallel.hpp
+  int threads = 0;                           // as in core/parallel.hpp
 };
 
 // A fresh token: 128 random bits (std::random_device) as 32 hexadecimal digits.
