@@ -365,6 +365,8 @@ function polarCursorAngle() {
 
 // --- model sliders -----------------------------------------------------------------------------
 function parseModelSpec(spec) {
+  const arg = /^arg:(\d+)$/.exec(spec);  // a model named on the command line has sliders too
+  if (arg && info.specs[Number(arg[1])] !== undefined) spec = info.specs[Number(arg[1])];
   if (/^(arg|file|embedded):/.test(spec)) return null;
   const [name, rest] = spec.split(/:(.*)/s);
   const model = info.models.find((m) => m.name === name);
@@ -402,9 +404,12 @@ function buildSliders() {
       input.map = map;
     }
     input.dataset.param = p.name;
+    // A parameter that defaults to another (alpha_x to alpha) follows it until it is moved.
+    if (p.default_from && values[p.name] === undefined) input.dataset.follows = p.default_from;
     const out = document.createElement('output');
     out.textContent = p.choices.length ? '' : Number(input.map.fromSlider(input.value)).toPrecision(3);
     input.addEventListener('input', () => {
+      delete input.dataset.follows;
       if (input.map) out.textContent = Number(input.map.fromSlider(input.value)).toPrecision(3);
       state.a = sliderSpec(model);
       ensureOption($('brdf-a'), state.a);
@@ -431,6 +436,7 @@ function sliderMap(p) {
 function sliderSpec(model) {
   const items = [];
   for (const input of document.querySelectorAll('#sliders [data-param]')) {
+    if (input.dataset.follows) continue;
     const v = input.map ? Number(Number(input.map.fromSlider(input.value)).toPrecision(4)) : input.value;
     items.push(`${input.dataset.param}=${v}`);
   }
