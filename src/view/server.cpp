@@ -39,6 +39,9 @@ Server::Server(Api& api, int workers) : impl_(std::make_unique<Impl>(api)) {
   // host: a short keep-alive frees the workers of idle connections (with httplib's 5 s default,
   // the seventh connection of two tabs waited that long).
   impl_->http.set_keep_alive_timeout(1);
+  // Without TCP_NODELAY, Nagle's algorithm holds the body's last segment until the client's
+  // delayed ACK (up to 40 ms on Linux) — in every response of a slider move.
+  impl_->http.set_tcp_nodelay(true);
   impl_->http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     const Response r =
         impl_->api.handle_target(req.method, req.target, lower_case_headers(req.headers));
