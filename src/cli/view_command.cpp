@@ -74,6 +74,7 @@ int run_view(const ViewOptions& o) {
   config.specs = o.specs;
   config.threads = o.threads;
   for (const std::string& r : o.roots) config.roots.emplace_back(r);
+  view::keep_freed_memory();
   view::Api api(std::move(config));  // throws for a --root that is not a directory
   api.load_specs();                  // a bad command-line BRDF fails here, not in the page
   if (!view::is_loopback(o.host))

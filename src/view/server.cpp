@@ -3,6 +3,7 @@
 #include "halfback/view/server.hpp"
 
 #include <httplib.h>
+#include <malloc.h>
 
 #include <algorithm>
 #include <cctype>
@@ -70,6 +71,11 @@ bool Server::run() {
 
 void Server::stop() {
   impl_->http.stop();
+}
+
+bool keep_freed_memory() {
+  constexpr int kThreshold = 256 << 20;
+  return mallopt(M_MMAP_THRESHOLD, kThreshold) == 1 && mallopt(M_TRIM_THRESHOLD, kThreshold) == 1;
 }
 
 bool is_loopback(const std::string& host) {

@@ -31,6 +31,12 @@ class Server {
   std::unique_ptr<Impl> impl_;
 };
 
+// Tells the C library to keep freed memory for reuse (mallopt: no mmap for blocks under 256 MB,
+// no trimming): a request's buffers (a 256² slice allocates ~8 MB) are then recycled by the next
+// instead of being mapped afresh, whose page faults cost more than the computation on a virtual
+// machine (docs/performance.md, "Viewer"). For the server process; returns whether it applied.
+bool keep_freed_memory();
+
 // Whether `host` is a loopback address (127.0.0.0/8, ::1, localhost).
 bool is_loopback(const std::string& host);
 
