@@ -1,4 +1,4 @@
-// The page's files (src/view/web/), embedded at build time by cmake/embed_files.cmake into the
+// The page's files (src/view/web/), embedded at build time by cmake/embed_web_assets.cmake into the
 // generated web_assets.cpp.
 #pragma once
 
