@@ -11,21 +11,36 @@ build="${FUZZ_BUILD_DIR:-build/fuzz}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 
 cmake --preset fuzz -B "$build" >/dev/null
-cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz make_fuzz_seeds
+cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz view_fuzz make_fuzz_seeds
 
 corpus="$build/corpus"
 mkdir -p "$corpus"
 "$build/fuzz/make_fuzz_seeds" "$corpus"
+# Seeds of the view's request handler: one request per file (fuzz/view_fuzz.cpp).
+mkdir -p "$corpus/view"
+k=0
+for seed in "/api/info?token=t" "/?token=t" "/static/app.js?token=t" \
+    "/api/slice?token=t&brdf=arg:0&form=halfdiff&azimuth=30&n=16" \
+    "/api/hemisphere?token=t&brdf=arg:1&colour=rho&theta_o=40&phi_o=180&n=8" \
+    "/api/hemisphere?token=t&colour=ortho&n=8" "/api/polar?token=t&brdf=ggx:alpha=0.2&n=19" \
+    "/api/point?token=t&brdf=arg:0&wi=0,0,1&wo=0.6,0,0.8" \
+    "/api/point?token=t&brdf=lambert&form=hybrid&iso=1&coords=0.2,0.3,1" \
+    "/api/brdf?token=t&brdf=file:../x" "/api/render?token=t&brdf=arg:1&pass=3" \
+    $'/api/info\ncookie: halfback_token_8765=t\norigin: http://127.0.0.1:8765'; do
+  printf '%s' "$seed" > "$corpus/view/seed$k"
+  k=$((k + 1))
+done
 artifacts="$build/artifacts"
 mkdir -p "$artifacts"
 
 status=0
-for target in merl rgl alta npy; do
+for target in merl rgl alta npy view; do
   case "$target" in
     merl) max_len=4096 ;;     # full-size files are built inside the target
     rgl)  max_len=65536 ;;
     alta) max_len=65536 ;;
     npy)  max_len=4096 ;;
+    view) max_len=2048 ;;
   esac
   echo "== ${target}_fuzz: ${seconds}s"
   if ! "$build/fuzz/${target}_fuzz" "$corpus/$target" -max_total_time="$seconds" \

@@ -1541,5 +1541,22 @@ TEST_F(CliTest, ConvertAndEvalRunInBoundedMemory) {
   EXPECT_LT(rss_kb, 48 * 1024) << "eval: peak resident memory " << rss_kb << " kB";
 }
 
+// `halfback view` fails before serving on a bad command line or BRDF (the server itself is
+// tested by src/view/api_test.cpp and tests/browser/view_test.py).
+TEST_F(CliTest, ViewRefusesBadOptionsBeforeServing) {
+  Result r = run({"view", "--port", "70000"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--port: expected 0 ... 65535"), std::string::npos) << r.err;
+  r = run({"view", "ggx:alpha=-1", "--port", "0"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("'ggx:alpha=-1'"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+  r = run({"view", "--root", "/nonexistent/halfback-root", "--port", "0"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--root '/nonexistent/halfback-root': not a readable directory"),
+            std::string::npos)
+      << r.err;
+}
+
 }  // namespace
 }  // namespace halfback

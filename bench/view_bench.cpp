@@ -1,0 +1,156 @@
+// halfback_view_bench: the slice handler of `halfback view` (docs/performance.md, "Viewer").
+//
+// A 256 × 256 slice (the pairs of the canonical poses, then ρ of the valid ones) for an analytic
+// model, MERL data (an analytic lobe tabulated in memory, so no file is needed), an RGL material
+// and a neural BRDF (both embedded in the library), on ONE thread: oneTBB is limited to one worker
+// (tbb::global_control), so all the work is on the calling thread, whose CPU time is the
+// "CPU" column (on the shared machine, wall time is several times longer and varies). Baseline in
+// the same run: Brdf::eval_batch of the same valid pairs alone (BM_EvalOnly), so the ratio is the
+// cost the slice adds to ρ. Also the whole request, through Api::handle (BM_Request: the parameter
+// checks and the copy to the float32 body).
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#include <fmt/format.h>
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/figure/coordinates.hpp"
+#include "halfback/figure/slices.hpp"
+#include "halfback/formats/merl.hpp"
+#include "halfback/loader/load.hpp"
+#include "halfback/view/api.hpp"
+#include "halfback/view/server.hpp"
+#include "view/fields.hpp"
+
+namespace {
+
+using namespace halfback;
+
+constexpr std::size_t kSide = 256;
+constexpr double kAzimuth = 40 * 3.14159265358979323846 / 180;  // radians
+
+// A smooth isotropic lobe, for the in-memory MERL table.
+class Lobe final : public Brdf {
+ public:
+  std::string name() const override { return "lobe"; }
+  std::string description() const override { return "bench lobe"; }
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return true; }
+  Rgb eval(const DirPair<double>& p) const override {
+    const double hz = p.wi.z + p.wo.z, hx = p.wi.x + p.wo.x, hy = p.wi.y + p.wo.y;
+    const double c = hz / std::sqrt(hx * hx + hy * hy + hz * hz);
+    const double lobe = 5 * std::pow(c, 40.0);
+    return {0.1 + lobe, 0.2 + lobe, 0.3 + lobe};
+  }
+};
+
+BrdfPtr brdf_of(int which) {
+  switch (which) {
+    case 0:
+      return load_brdf("ggx:alpha=0.2,f0=0.9");
+    case 1:
+      return std::make_shared<MerlBrdf>(tabulate_merl(Lobe{}));
+    case 2:
+      return load_brdf("embedded:acrylic_felt_green");
+    default:
+      return load_brdf("embedded:pink-felt");
+  }
+}
+const char* kNames[] = {"analytic_ggx", "merl_lobe", "rgl_felt", "neural_pink_felt"};
+
+void BM_Slice(benchmark::State& state) {
+  const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  const BrdfPtr brdf = brdf_of(int(state.range(0)));
+  state.SetLabel(kNames[state.range(0)]);
+  for (auto _ : state) {
+    auto v = view::slice_field(*brdf, Space::hybrid, kAzimuth, kSide, 1);
+    benchmark::DoNotOptimize(v.data());
+  }
+}
+BENCHMARK(BM_Slice)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
+
+// The pairs alone, two ways: the core's batch engine (what slice_field does) and figure's
+// sample_slice (a tuple at a time, inverse_iso and valid_iso).
+void BM_PairsBatch(benchmark::State& state) {
+  const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  const BrdfPtr lambert = load_brdf("lambert");
+  for (auto _ : state) {
+    auto v = view::slice_field(*lambert, Space::hybrid, kAzimuth, kSide, 1);
+    benchmark::DoNotOptimize(v.data());
+  }
+}
+BENCHMARK(BM_PairsBatch)->Unit(benchmark::kMillisecond);
+
+void BM_PairsPerTuple(benchmark::State& state) {
+  const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  const auto c = figure::iso_coordinates(Space::hybrid);
+  const auto grid = figure::Grid::pixel_centres(kSide, kSide, 0, c[0].max, 0, c[1].max);
+  for (auto _ : state) {
+    auto s = figure::sample_slice(Space::hybrid, kAzimuth, grid, 1);
+    benchmark::DoNotOptimize(s.pairs.data());
+  }
+}
+BENCHMARK(BM_PairsPerTuple)->Unit(benchmark::kMillisecond);
+
+void BM_EvalOnly(benchmark::State& state) {
+  const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  const BrdfPtr brdf = brdf_of(int(state.range(0)));
+  state.SetLabel(kNames[state.range(0)]);
+  const auto c = figure::iso_coordinates(Space::hybrid);
+  const figure::SliceSample s =
+      figure::sample_slice(Space::hybrid, kAzimuth,
+                           figure::Grid::pixel_centres(kSide, kSide, 0, c[0].max, 0, c[1].max), 1);
+  std::vector<DirPair<double>> pairs;
+  for (std::size_t k = 0; k < s.pairs.size(); ++k)
+    if (s.valid[k]) pairs.push_back(s.pairs[k]);
+  std::vector<Rgb> out(pairs.size());
+  for (auto _ : state) {
+    brdf->eval_batch(pairs, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+}
+BENCHMARK(BM_EvalOnly)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
+
+void BM_Request(benchmark::State& state) {
+  const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  view::ApiConfig config;
+  config.token = "t";
+  config.port = 1;
+  config.threads = 1;
+  const view::Api api(config);
+  view::Request r;
+  r.path = "/api/slice";
+  r.query = {{"token", "t"},
+             {"brdf", "ggx:alpha=0.2,f0=0.9"},
+             {"form", "hybrid"},
+             {"azimuth", "40"},
+             {"n", std::to_string(kSide)}};
+  r.headers = {{"host", "127.0.0.1:1"}};
+  for (auto _ : state) {
+    const view::Response res = api.handle(r);
+    if (res.status != 200) state.SkipWithError("request failed");
+    benchmark::DoNotOptimize(res.body.data());
+  }
+}
+BENCHMARK(BM_Request)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+// As `halfback view` does (view::keep_freed_memory): the buffers of one request are reused by the
+// next instead of being mapped afresh (page faults cost ~30 ms per slice on this virtual machine).
+int main(int argc, char** argv) {
+  if (argc > 1 && std::string_view(argv[1]) == "--fresh-memory") {
+    --argc;
+    ++argv;
+  } else {
+    view::keep_freed_memory();
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,99 @@
+// The HTTP-free core of `halfback view` (docs/view.md): a request (method, path, query, headers)
+// goes in, a response (status, content type, body) comes out. The socket adapter (server.hpp)
+// only translates; tests and the fuzzer call Api::handle() directly.
+//
+// Every request is checked before it is routed (docs/view.md, "Security model"):
+//   * the token: `token=` in the query, or the cookie `halfback_token` that the page's first
+//     load sets (compared in constant time);
+//   * the Host header: the bound host:port, or localhost / 127.0.0.1 / [::1] with the port (a
+//     DNS-rebinding page has its own name there);
+//   * the Origin header, when present: http:// followed by one of the accepted hosts;
+//   * the size of the target (path + query).
+// Every refusal and every malformed request is a 4xx response with a JSON {"error": message}
+// body; handle() never throws.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace halfback::view {
+
+// Limits of one request (docs/view.md, "Limits").
+inline constexpr std::size_t kMaxTargetBytes = 8192;   // path + query
+inline constexpr std::size_t kMaxSpecBytes = 1024;     // one BRDF or environment spec
+inline constexpr std::size_t kMaxGridSide = 512;       // slice and hemisphere side
+inline constexpr std::size_t kMaxPolarSamples = 2001;  // polar plot samples per curve
+inline constexpr int kMaxRenderSide = 512;             // sphere render side
+inline constexpr int kMaxRenderSpp = 64;               // samples per pixel of one pass
+inline constexpr std::size_t kMaxBrdfsPerRequest = 8;  // brdf= repeated in /api/point
+inline constexpr std::size_t kMaxCachedBrdfs = 32;     // loaded BRDFs kept (least recent dropped)
+
+struct Request {
+  std::string method = "GET";
+  std::string path = "/";
+  std::vector<std::pair<std::string, std::string>> query;  // decoded, in order (keys may repeat)
+  std::map<std::string, std::string> headers;              // names in lower case
+
+  // The first value of a query key, or nullptr.
+  const std::string* param(std::string_view key) const;
+  // The header `name` (lower case), or nullptr.
+  const std::string* header(std::string_view name) const;
+};
+
+struct Response {
+  int status = 200;
+  std::string content_type = "application/json";
+  std::string body;
+  std::vector<std::pair<std::string, std::string>> headers;  // extra headers (Set-Cookie, ...)
+};
+
+struct ApiConfig {
+  std::string token;                         // required on every request (empty: refused always)
+  std::string host = "127.0.0.1";            // the bound address, as given to --host
+  int port = 0;                              // the bound port (after binding port 0)
+  std::vector<std::string> specs;            // the BRDFs named on the command line, in order
+  std::vector<std::filesystem::path> roots;  // directories whose files may be loaded
+  int threads = 0;                           // as in core/parallel.hpp
+};
+
+// A fresh token: 128 random bits (std::random_device) as 32 hexadecimal digits.
+std::string random_token();
+
+// Splits "a=1&b=%20x" into decoded pairs ('+' is a space). Throws std::invalid_argument for a
+// malformed percent escape or a NUL byte.
+std::vector<std::pair<std::string, std::string>> parse_query(std::string_view query);
+
+class Api {
+ public:
+  explicit Api(ApiConfig config);
+  ~Api();
+  Api(const Api&) = delete;
+  Api& operator=(const Api&) = delete;
+
+  // Sets the port once the server knows it (port 0 picks one when binding).
+  void set_port(int port);
+  const ApiConfig& config() const;
+  // Loads every BRDF of config().specs (they are then cached). Throws what loading throws, the
+  // message naming the spec.
+  void load_specs() const;
+
+  // The response to a request; never throws (an internal failure is a 500 with a message).
+  Response handle(const Request& request) const;
+  // The same for a raw request target "/path?query" (the path is taken as it is, the query
+  // decoded by parse_query): what the socket adapter and the fuzzer call. A malformed query is
+  // a 400.
+  Response handle_target(std::string method, std::string_view target,
+                         std::map<std::string, std::string> headers) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace halfback::view

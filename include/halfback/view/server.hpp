@@ -1,0 +1,43 @@
+// The socket side of `halfback view`: an HTTP/1.1 server (Debian's cpp-httplib, included by
+// server.cpp alone) that hands every request to an Api and writes its response back.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "halfback/view/api.hpp"
+
+namespace halfback::view {
+
+class Server {
+ public:
+  // `workers`: threads answering connections (a browser opens up to six per host, and a kept-
+  // alive connection holds its thread until it closes); at least 1.
+  Server(Api& api, int workers);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Binds host:port (port 0: any free port), tells the Api the port and returns it. Throws
+  // std::runtime_error naming the address when it cannot bind.
+  int bind(const std::string& host, int port);
+  // Serves until stop() (returns false when the listening loop fails).
+  bool run();
+  // Stops run() from another thread.
+  void stop();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Tells the C library to keep freed memory for reuse (mallopt: no mmap for blocks under 256 MB,
+// no trimming): a request's buffers (a 256² slice allocates ~8 MB) are then recycled by the next
+// instead of being mapped afresh, whose page faults cost more than the computation on a virtual
+// machine (docs/performance.md, "Viewer"). For the server process; returns whether it applied.
+bool keep_freed_memory();
+
+// Whether `host` is a loopback address (127.0.0.0/8, ::1, localhost).
+bool is_loopback(const std::string& host);
+
+}  // namespace halfback::view

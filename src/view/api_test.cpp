@@ -1,0 +1,428 @@
+// The view's API without a socket: security checks, every endpoint with good and bad requests,
+// limits and path escapes. Values are checked against the library computed independently here
+// (the inverse of the core, Brdf::eval, convert_one).
+#include "halfback/view/api.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+
+#include "fields.hpp"
+#include "halfback/core/batch.hpp"
+#include "halfback/loader/load.hpp"
+#include "json.hpp"
+#include "support/test_support.hpp"
+
+namespace halfback::view {
+namespace {
+
+constexpr int kPort = 40123;
+const std::string kToken = "0123456789abcdef0123456789abcdef";
+const std::string kSpec = "ggx:alpha=0.3,f0=0.9";
+
+ApiConfig config(std::vector<std::filesystem::path> roots = {}) {
+  ApiConfig c;
+  c.token = kToken;
+  c.port = kPort;
+  c.specs = {kSpec};
+  c.roots = std::move(roots);
+  c.threads = 1;
+  return c;
+}
+
+Request get(std::string path, std::vector<std::pair<std::string, std::string>> query = {}) {
+  Request r;
+  r.path = std::move(path);
+  r.query = std::move(query);
+  r.query.emplace_back("token", kToken);
+  r.headers["host"] = fmt::format("127.0.0.1:{}", kPort);
+  return r;
+}
+
+std::vector<float> floats_of(const Response& r) {
+  std::vector<float> v(r.body.size() / sizeof(float));
+  std::memcpy(v.data(), r.body.data(), v.size() * sizeof(float));
+  return v;
+}
+
+bool has_error(const Response& r, int status, std::string_view words) {
+  return r.status == status && r.content_type == "application/json" &&
+         r.body.find("\"error\"") != std::string::npos && r.body.find(words) != std::string::npos;
+}
+
+TEST(ViewApi, RandomTokensAre128BitsAndDiffer) {
+  const std::string a = random_token(), b = random_token();
+  EXPECT_EQ(a.size(), 32u);
+  EXPECT_EQ(a.find_first_not_of("0123456789abcdef"), std::string::npos);
+  EXPECT_NE(a, b);
+}
+
+TEST(ViewApi, TokenIsRequiredFromQueryOrCookie) {
+  Api api(config());
+  Request r = get("/api/info");
+  EXPECT_EQ(api.handle(r).status, 200);
+  r.query.clear();
+  EXPECT_TRUE(has_error(api.handle(r), 403, "token"));
+  r.query = {{"token", kToken.substr(1) + "0"}};  // same length, wrong
+  EXPECT_TRUE(has_error(api.handle(r), 403, "token"));
+  r.query = {{"token", ""}};
+  EXPECT_EQ(api.handle(r).status, 403);
+  r.query.clear();
+  r.headers["cookie"] = fmt::format("other=1; halfback_token_{}={}", kPort, kToken);
+  EXPECT_EQ(api.handle(r).status, 200);
+  r.headers["cookie"] = fmt::format("halfback_token_{}={}", kPort + 1, kToken);  // another server's
+  EXPECT_EQ(api.handle(r).status, 403);
+}
+
+TEST(ViewApi, EmptyConfiguredTokenRefusesEverything) {
+  ApiConfig c = config();
+  c.token.clear();
+  Api api(c);
+  Request r = get("/api/info");
+  r.query = {{"token", ""}};
+  EXPECT_EQ(api.handle(r).status, 403);
+}
+
+TEST(ViewApi, PageLoadWithTokenSetsAnHttpOnlyCookie) {
+  Api api(config());
+  const Response r = api.handle(get("/"));
+  ASSERT_EQ(r.status, 200);
+  EXPECT_NE(r.content_type.find("text/html"), std::string::npos);
+  EXPECT_NE(r.body.find("app.js"), std::string::npos);
+  bool cookie = false;
+  for (const auto& [k, v] : r.headers)
+    if (k == "Set-Cookie")
+      cookie = v.find(kToken) != std::string::npos && v.find("HttpOnly") != std::string::npos &&
+               v.find("SameSite=Strict") != std::string::npos;
+  EXPECT_TRUE(cookie);
+  for (const char* asset :
+       {"/static/app.js", "/static/views.js", "/static/api.js", "/static/style.css"})
+    EXPECT_EQ(api.handle(get(asset)).status, 200) << asset;
+  EXPECT_EQ(api.handle(get("/static/../api.cpp")).status, 404);
+}
+
+TEST(ViewApi, HostHeaderMustNameThisServer) {
+  Api api(config());
+  Request r = get("/api/info");
+  for (const std::string& ok : {fmt::format("localhost:{}", kPort), fmt::format("[::1]:{}", kPort),
+                                fmt::format("192.168.1.7:{}", kPort)}) {
+    r.headers["host"] = ok;
+    EXPECT_EQ(api.handle(r).status, 200) << ok;
+  }
+  for (const std::string& bad :
+       {fmt::format("evil.example:{}", kPort), fmt::format("127.0.0.1:{}", kPort + 1),
+        std::string("127.0.0.1"), fmt::format(":{}", kPort),
+        fmt::format("127.0.0.1.evil:{}", kPort)}) {
+    r.headers["host"] = bad;
+    EXPECT_TRUE(has_error(api.handle(r), 403, "Host")) << bad;
+  }
+  r.headers.erase("host");
+  EXPECT_EQ(api.handle(r).status, 403);
+}
+
+TEST(ViewApi, OriginWhenPresentMustBeOurs) {
+  Api api(config());
+  Request r = get("/api/info");
+  r.headers["origin"] = fmt::format("http://127.0.0.1:{}", kPort);
+  EXPECT_EQ(api.handle(r).status, 200);
+  for (const char* bad : {"http://evil.example", "null", "https://127.0.0.1:40123", ""}) {
+    r.headers["origin"] = bad;
+    EXPECT_TRUE(has_error(api.handle(r), 403, "cross-origin")) << bad;
+  }
+}
+
+TEST(ViewApi, OnlyGetAndHead) {
+  Api api(config());
+  Request r = get("/api/info");
+  r.method = "POST";
+  EXPECT_EQ(api.handle(r).status, 405);
+  r.method = "HEAD";
+  EXPECT_EQ(api.handle(r).status, 200);
+}
+
+TEST(ViewApi, MalformedAndOversizedTargets) {
+  Api api(config());
+  const std::map<std::string, std::string> host{{"host", fmt::format("127.0.0.1:{}", kPort)}};
+  EXPECT_TRUE(has_error(api.handle_target("GET", "/api/info?token=" + kToken + "&x=%zz", host), 400,
+                        "percent"));
+  EXPECT_TRUE(has_error(api.handle_target("GET", "/api/info?token=" + kToken + "&x=%00", host), 400,
+                        "NUL"));
+  EXPECT_EQ(api.handle_target("GET", "/api/info?token=" + kToken + "&&=&a", host).status, 200);
+  EXPECT_EQ(
+      api.handle_target(
+             "GET", "/api/info?token=" + kToken + "&pad=" + std::string(kMaxTargetBytes, 'x'), host)
+          .status,
+      414);
+  EXPECT_EQ(api.handle(get("/no/such")).status, 404);
+}
+
+TEST(ViewApi, ParseQueryDecodes) {
+  const auto q = parse_query("a=1&b=%20x+y&c&=v&a=2");
+  ASSERT_EQ(q.size(), 5u);
+  EXPECT_EQ(q[1], (std::pair<std::string, std::string>{"b", " x y"}));
+  EXPECT_EQ(q[2], (std::pair<std::string, std::string>{"c", ""}));
+  EXPECT_EQ(q[4].second, "2");
+  EXPECT_THROW(parse_query("a=%4"), std::invalid_argument);
+}
+
+TEST(ViewApi, InfoListsSpecsModelsFormsAndEnvironments) {
+  Api api(config());
+  const Response r = api.handle(get("/api/info"));
+  ASSERT_EQ(r.status, 200);
+  for (const char* s : {"\"specs\":[\"ggx:alpha=0.3,f0=0.9\"]", "\"name\":\"ggx\"",
+                        "\"space\":\"halfdiff\"", "\"space\":\"hybrid\"", "\"sky\"", "\"limits\""})
+    EXPECT_NE(r.body.find(s), std::string::npos) << s;
+}
+
+TEST(ViewApi, BrdfEndpointAndSpecKinds) {
+  Api api(config());
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "arg:0"}})).status, 200);
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "lambert"}})).status, 200);
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "embedded:pink-felt"}})).status, 200);
+  EXPECT_TRUE(has_error(api.handle(get("/api/brdf", {{"brdf", "arg:1"}})), 404, "arg:0"));
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "arg:"}})).status, 404);
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "arg:99999999999999999999"}})).status, 404);
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "embedded:nothing"}})).status, 404);
+  EXPECT_TRUE(has_error(api.handle(get("/api/brdf", {{"brdf", "ggx:alpha=-1"}})), 400, "alpha"));
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "no-such-model"}})).status, 400);
+  EXPECT_TRUE(has_error(api.handle(get("/api/brdf")), 400, "missing query parameter 'brdf'"));
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", std::string(kMaxSpecBytes + 1, 'a')}})).status,
+            413);
+  // A model spec is never a file, even when a file of that name exists.
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "/etc/passwd"}})).status, 400);
+}
+
+TEST(ViewApi, ManyBrdfsStayWithinTheCache) {
+  Api api(config());
+  for (int k = 0; k < int(kMaxCachedBrdfs) + 10; ++k)
+    ASSERT_EQ(api.handle(get("/api/brdf", {{"brdf", fmt::format("ggx:alpha={}", 0.01 * (k + 1))}}))
+                  .status,
+              200);
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "ggx:alpha=0.01"}})).status, 200);
+}
+
+TEST(ViewApi, SliceIsRhoAtTheCanonicalPoseOfEachPixel) {
+  Api api(config());
+  const BrdfPtr brdf = load_brdf(kSpec);
+  const std::size_t n = 16;
+  const Response r = api.handle(
+      get("/api/slice", {{"brdf", "arg:0"}, {"form", "halfdiff"}, {"azimuth", "0"}, {"n", "16"}}));
+  ASSERT_EQ(r.status, 200);
+  EXPECT_EQ(r.content_type, "application/octet-stream");
+  const std::vector<float> v = floats_of(r);
+  ASSERT_EQ(v.size(), n * n * 3);
+  const double half_pi = std::numbers::pi / 2;
+  int valid = 0, invalid = 0;
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Tuple3<double> q{(double(i) + 0.5) / double(n) * half_pi,
+                             (double(j) + 0.5) / double(n) * half_pi, 0.0};
+      const std::size_t k = 3 * (j * n + i);
+      if (!valid_iso<HalfDiff>(q)) {
+        EXPECT_TRUE(std::isnan(v[k])) << i << "," << j;
+        ++invalid;
+        continue;
+      }
+      ++valid;
+      // On the domain's edge (θh + θd = 90°, i + j = n − 1) ωi grazes the horizon: whether ρ is 0
+      // there depends on the last bit of the pixel's coordinates.
+      if (i + j == n - 1) continue;
+      const Rgb rho = brdf->eval(inverse_iso<HalfDiff>(q).pair);
+      EXPECT_NEAR(v[k], rho.r, 1e-5 * std::max(1.0, rho.r)) << i << "," << j;
+    }
+  EXPECT_GT(valid, 0);
+  EXPECT_GT(invalid, 0);  // at φd = 0 the pairs with θh + θd > 90° are outside the domain
+}
+
+TEST(ViewApi, SliceRefusesBadParameters) {
+  Api api(config());
+  const auto slice = [&](std::vector<std::pair<std::string, std::string>> extra) {
+    std::vector<std::pair<std::string, std::string>> q{{"brdf", "arg:0"}, {"form", "ortho"}};
+    for (auto& e : extra) q.insert(q.begin(), e);  // first value wins
+    return api.handle(get("/api/slice", q));
+  };
+  EXPECT_EQ(slice({{"n", "513"}}).status, 400);
+  EXPECT_EQ(slice({{"n", "1"}}).status, 400);
+  EXPECT_EQ(slice({{"n", "2.5"}}).status, 400);
+  EXPECT_EQ(slice({{"n", "1e9"}}).status, 400);
+  EXPECT_EQ(slice({{"n", "abc"}}).status, 400);
+  EXPECT_EQ(slice({{"azimuth", "nan"}}).status, 400);
+  EXPECT_EQ(slice({{"azimuth", "inf"}}).status, 400);
+  EXPECT_EQ(slice({{"form", "dirs"}}).status, 400);
+  EXPECT_EQ(slice({{"form", "polar"}}).status, 400);
+  EXPECT_EQ(slice({{"n", "8"}, {"azimuth", "-45"}}).status, 200);
+  EXPECT_EQ(api.handle(get("/api/slice", {{"form", "ortho"}})).status, 400);
+}
+
+TEST(ViewApi, HemisphereIsRhoOfTheEqualAreaDirection) {
+  Api api(config());
+  const BrdfPtr brdf = load_brdf(kSpec);
+  const std::size_t n = 32;
+  const Response r = api.handle(get(
+      "/api/hemisphere", {{"brdf", "arg:0"}, {"theta_o", "30"}, {"phi_o", "180"}, {"n", "32"}}));
+  ASSERT_EQ(r.status, 200);
+  const std::vector<float> v = floats_of(r);
+  ASSERT_EQ(v.size(), n * n * 3);
+  EXPECT_TRUE(std::isnan(v[0]));  // the corner is outside the disk
+  const double t = std::numbers::pi / 6;
+  const Vec3<double> wo{-std::sin(t), 0, std::cos(t)};
+  for (const std::size_t i : {5u, 16u, 20u, 27u}) {
+    const std::size_t j = 14;
+    const double u = -1 + (2.0 * double(i) + 1) / double(n),
+                 w = -1 + (2.0 * double(j) + 1) / double(n);
+    const double rr = std::hypot(u, w), psi = 2 * std::asin(rr / std::sqrt(2.0));
+    const Vec3<double> wi{std::sin(psi) * u / rr, std::sin(psi) * w / rr, std::cos(psi)};
+    const Rgb rho = brdf->eval({wi, wo});
+    EXPECT_NEAR(v[3 * (j * n + i)], rho.g, 1e-4 * std::max(1.0, rho.g)) << i;
+  }
+  // Coordinates instead of ρ: the isotropic coordinates of the pair (no BRDF needed).
+  const Response c =
+      api.handle(get("/api/hemisphere", {{"colour", "hybrid"}, {"theta_o", "30"}, {"n", "32"}}));
+  ASSERT_EQ(c.status, 200);
+  EXPECT_EQ(floats_of(c).size(), n * n * 3);
+  EXPECT_EQ(api.handle(get("/api/hemisphere", {{"colour", "bogus"}})).status, 400);
+  EXPECT_EQ(api.handle(get("/api/hemisphere", {{"brdf", "arg:0"}, {"theta_o", "91"}})).status, 400);
+  EXPECT_EQ(api.handle(get("/api/hemisphere", {{"brdf", "arg:0"}, {"n", "100000"}})).status, 400);
+}
+
+TEST(ViewApi, PolarCurvesPassThroughTheNormalAndTheMirrorDirection) {
+  const BrdfPtr brdf = load_brdf(kSpec);
+  const double t = 40 * std::numbers::pi / 180;
+  const Vec3<double> wo{-std::sin(t), 0, std::cos(t)};
+  const PolarCurves c = polar_curves(*brdf, wo, 181);  // 1° steps from −90°
+  ASSERT_EQ(c.angles_deg.size(), 181u);
+  EXPECT_NEAR(c.in_plane[90].g, brdf->eval({{0, 0, 1}, wo}).g, 1e-12);
+  const Vec3<double> mirror{std::sin(t), 0, std::cos(t)};
+  EXPECT_NEAR(c.in_plane[130].g, brdf->eval({mirror, wo}).g, 1e-9);
+  EXPECT_NEAR(c.across[90].g, c.in_plane[130].g, 1e-9);  // both curves meet at the mirror
+  EXPECT_NEAR(c.across[60].g, c.across[120].g, 1e-9);    // isotropic: symmetric across the plane
+  Api api(config());
+  EXPECT_EQ(api.handle(get("/api/polar", {{"brdf", "arg:0"}, {"theta_o", "40"}})).status, 200);
+  EXPECT_EQ(api.handle(get("/api/polar", {{"brdf", "arg:0"}, {"n", "2002"}})).status, 400);
+}
+
+TEST(ViewApi, PointListsEveryParameterizationAndRho) {
+  Api api(config());
+  const DirPair<double> pair{{0.48, 0.0, 0.8772684879784524}, {-0.6, 0.0, 0.8}};
+  const Response r = api.handle(
+      get("/api/point",
+          {{"brdf", "arg:0"},
+           {"brdf", "lambert"},
+           {"wi", fmt::format("{:.17g},{:.17g},{:.17g}", pair.wi.x, pair.wi.y, pair.wi.z)},
+           {"wo", fmt::format("{:.17g},{:.17g},{:.17g}", pair.wo.x, pair.wo.y, pair.wo.z)}}));
+  ASSERT_EQ(r.status, 200);
+  EXPECT_NE(r.body.find("\"valid\":true"), std::string::npos);
+  Rgb rho{};
+  load_brdf(kSpec)->eval_batch({&pair, 1}, {&rho, 1});
+  EXPECT_NE(r.body.find(fmt::format("{:.17g}", rho.r)), std::string::npos) << r.body;
+  const double d[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
+  double q[4], jacobian = 0;
+  ASSERT_TRUE(
+      convert_one<double>(Form{Space::dirs, false}, Form{Space::hybrid, false}, d, q, &jacobian));
+  EXPECT_NE(r.body.find(fmt::format("{:.17g},{:.17g},{:.17g},{:.17g}", q[0], q[1], q[2], q[3])),
+            std::string::npos);
+  EXPECT_NE(r.body.find(fmt::format("\"jacobian\":{:.17g}", jacobian)), std::string::npos);
+}
+
+TEST(ViewApi, PointFromIsotropicCoordinatesAndItsErrors) {
+  Api api(config());
+  const Response in = api.handle(
+      get("/api/point",
+          {{"brdf", "arg:0"}, {"form", "halfdiff"}, {"iso", "1"}, {"coords", "0.3,0.5,1"}}));
+  ASSERT_EQ(in.status, 200);
+  EXPECT_NE(in.body.find("\"valid\":true"), std::string::npos);
+  const Response out = api.handle(get(
+      "/api/point", {{"brdf", "arg:0"}, {"form", "ortho"}, {"iso", "1"}, {"coords", "0.9,0.9,0"}}));
+  ASSERT_EQ(out.status, 200);  // outside the domain: an answer, not an error
+  EXPECT_NE(out.body.find("\"valid\":false"), std::string::npos);
+  EXPECT_EQ(api.handle(get("/api/point", {{"form", "ortho"}, {"coords", "0.1,0.2"}})).status, 400);
+  EXPECT_EQ(api.handle(get("/api/point", {{"wi", "0,0,2"}, {"wo", "0,0,1"}})).status, 400);
+  EXPECT_EQ(api.handle(get("/api/point", {{"wi", "0,0,1"}})).status, 400);
+  EXPECT_EQ(api.handle(get("/api/point", {{"wi", "0,0,1,"}, {"wo", "0,0,1"}})).status, 400);
+  std::vector<std::pair<std::string, std::string>> many(kMaxBrdfsPerRequest + 1,
+                                                        {"brdf", "lambert"});
+  many.emplace_back("wi", "0,0,1");
+  many.emplace_back("wo", "0,0,1");
+  EXPECT_EQ(api.handle(get("/api/point", many)).status, 413);
+}
+
+TEST(ViewApi, RenderPassesAreSeededAndLimited) {
+  Api api(config());
+  const auto render = [&](std::string pass, std::string size = "16", std::string env = "sky") {
+    return api.handle(
+        get("/api/render",
+            {{"brdf", "arg:0"}, {"size", size}, {"spp", "1"}, {"pass", pass}, {"env", env}}));
+  };
+  const Response a = render("0"), b = render("0"), c = render("1");
+  ASSERT_EQ(a.status, 200);
+  const std::vector<float> v = floats_of(a);
+  ASSERT_EQ(v.size(), 16u * 16u * 3u);
+  for (const float x : v) ASSERT_TRUE(std::isfinite(x) && x >= 0);
+  EXPECT_EQ(a.body, b.body);
+  EXPECT_NE(a.body, c.body);
+  EXPECT_EQ(render("0", "513").status, 400);
+  EXPECT_EQ(render("0", "16", "nowhere").status, 400);
+  EXPECT_EQ(render("0", "16", "/etc/passwd").status, 400);
+  EXPECT_EQ(render("0", "16", "file:x.hdr").status, 403);  // no root
+  EXPECT_EQ(api.handle(get("/api/render", {{"brdf", "arg:0"}, {"spp", "65"}})).status, 400);
+}
+
+TEST(ViewApi, FilesOnlyUnderTheRoots) {
+  test::TempDir root, outside;
+  std::filesystem::create_directories(root.path() / "sub");
+  { std::ofstream(outside.path() / "secret.hdr") << "x"; }
+  std::filesystem::create_symlink(outside.path(), root.path() / "out");
+  std::filesystem::create_symlink(outside.path() / "secret.hdr", root.path() / "sub" / "s.hdr");
+  Api api(config({root.path()}));
+  const auto brdf = [&](const std::string& p) {
+    return api.handle(get("/api/brdf", {{"brdf", "file:" + p}}));
+  };
+  EXPECT_TRUE(has_error(brdf("../secret.hdr"), 403, ".."));
+  EXPECT_TRUE(has_error(brdf("sub/../../secret.hdr"), 403, ".."));
+  EXPECT_TRUE(has_error(brdf((outside.path() / "secret.hdr").string()), 403, "absolute"));
+  EXPECT_TRUE(has_error(brdf("out/secret.hdr"), 403, "outside"));
+  EXPECT_TRUE(has_error(brdf("sub/s.hdr"), 403, "outside"));
+  EXPECT_TRUE(has_error(brdf("missing.binary"), 404, "no such file"));
+  EXPECT_EQ(brdf("").status, 400);
+  EXPECT_TRUE(
+      has_error(api.handle(get("/api/render", {{"brdf", "arg:0"}, {"env", "file:out/secret.hdr"}})),
+                403, "outside"));
+  const Response info = api.handle(get("/api/info"));
+  EXPECT_EQ(info.body.find("secret"), std::string::npos);  // links out are not listed
+  EXPECT_THROW(Api(config({outside.path() / "none"})), std::invalid_argument);
+}
+
+TEST(ViewApi, LoadsAFileUnderARoot) {
+  HALFBACK_REQUIRE_SHARED(rgl, "rgl");
+  test::TempDir root;
+  std::filesystem::copy_file(rgl / "acrylic_felt_green_rgb.bsdf", root.path() / "felt.bsdf");
+  Api api(config({root.path()}));
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "file:felt.bsdf"}})).status, 200);
+  EXPECT_NE(api.handle(get("/api/info")).body.find("\"felt.bsdf\""), std::string::npos);
+  const Response s =
+      api.handle(get("/api/slice", {{"brdf", "file:felt.bsdf"}, {"form", "hybrid"}, {"n", "8"}}));
+  EXPECT_EQ(s.status, 200);
+}
+
+TEST(ViewJson, EscapesAndNulls) {
+  JsonWriter w;
+  w.begin_object().field("s", std::string_view("a\"b\\c\n\x01")).field("x", NAN).key("a");
+  w.begin_array().value(1.5).value(2).end_array().end_object();
+  EXPECT_EQ(w.str(), "{\"s\":\"a\\\"b\\\\c\\u000a\\u0001\",\"x\":null,\"a\":[1.5,2]}");
+}
+
+TEST(ViewApi, ErrorsAreJson) {
+  Api api(config());
+  const Response r = api.handle(get("/api/brdf", {{"brdf", "ggx:alpha=\"x"}}));
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body.front(), '{');
+  EXPECT_EQ(r.body.find("\"x\""), std::string::npos);  // the quote is escaped
+}
+
+}  // namespace
+}  // namespace halfback::view

@@ -1,0 +1,220 @@
+#include "catalog.hpp"
+
+#include <fmt/format.h>
+#include <algorithm>
+#include <cctype>
+#include <system_error>
+
+#include "halfback/loader/load.hpp"
+#include "halfback/render/brdf_sampler.hpp"
+#include "halfback/view/api.hpp"
+
+namespace halfback::view {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::size_t kMaxCachedEnvironments = 8;
+
+bool starts_with(std::string_view s, std::string_view prefix) {
+  return s.substr(0, prefix.size()) == prefix;
+}
+
+// Whether `path` is `root` or inside it (both canonical), component by component.
+bool is_inside(const fs::path& path, const fs::path& root) {
+  auto p = path.begin();
+  for (auto r = root.begin(); r != root.end(); ++r, ++p) {
+    if (r->empty()) continue;  // a trailing separator
+    if (p == path.end() || *p != *r) return false;
+  }
+  return true;
+}
+
+std::string lower_extension(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+bool is_environment_file(const fs::path& p) {
+  const std::string e = lower_extension(p);
+  return e == ".hdr" || e == ".exr";
+}
+
+bool is_brdf_file(const fs::path& p) {
+  const std::string e = lower_extension(p);
+  return e == ".binary" || e == ".bsdf" || e == ".h5" || e == ".alta" || e == ".txt";
+}
+
+}  // namespace
+
+Catalog::Catalog(std::vector<std::string> specs, const std::vector<fs::path>& roots)
+    : specs_(std::move(specs)) {
+  for (const fs::path& root : roots) {
+    std::error_code ec;
+    fs::path canonical = fs::canonical(root, ec);
+    if (ec || !fs::is_directory(canonical, ec))
+      throw std::invalid_argument(
+          fmt::format("--root '{}': not a readable directory", root.string()));
+    roots_.push_back(std::move(canonical));
+  }
+}
+
+fs::path Catalog::resolve(std::string_view relative) const {
+  if (relative.empty()) throw RequestError(400, "empty file path");
+  if (relative.find('\0') != std::string_view::npos)
+    throw RequestError(400, "file path with a NUL byte");
+  const fs::path rel{std::string(relative)};
+  if (rel.is_absolute() || rel.has_root_directory() || rel.has_root_name())
+    throw RequestError(403, fmt::format("'{}': absolute paths are refused; give a path relative "
+                                        "to a --root directory",
+                                        relative));
+  for (const fs::path& part : rel)
+    if (part == "..")
+      throw RequestError(403, fmt::format("'{}': '..' is refused in file paths", relative));
+  if (roots_.empty())
+    throw RequestError(403, "no --root directory was given: files cannot be loaded");
+  for (const fs::path& root : roots_) {
+    std::error_code ec;
+    const fs::path candidate = fs::weakly_canonical(root / rel, ec);
+    if (ec || !fs::exists(candidate, ec)) continue;
+    if (!is_inside(candidate, root))
+      throw RequestError(403, fmt::format("'{}' leads outside the --root directories (a symbolic "
+                                          "link?)",
+                                          relative));
+    return candidate;
+  }
+  throw RequestError(404, fmt::format("'{}': no such file under the --root directories", relative));
+}
+
+BrdfPtr Catalog::load(std::string_view spec) const {
+  if (spec.empty()) throw RequestError(400, "empty BRDF spec");
+  if (spec.size() > kMaxSpecBytes)
+    throw RequestError(413, fmt::format("BRDF spec longer than {} bytes", kMaxSpecBytes));
+  if (starts_with(spec, "arg:")) {
+    const std::string_view n = spec.substr(4);
+    std::size_t index = 0;
+    for (const char c : n) {
+      if (c < '0' || c > '9' || index > specs_.size()) {
+        index = specs_.size();
+        break;
+      }
+      index = index * 10 + std::size_t(c - '0');
+    }
+    if (n.empty() || index >= specs_.size())
+      throw RequestError(404, fmt::format("'{}': the command line named {} BRDF(s) (arg:0 ...)",
+                                          spec, specs_.size()));
+    return load_brdf(specs_[index]);
+  }
+  if (starts_with(spec, "file:")) return load_brdf(resolve(spec.substr(5)).string());
+  if (starts_with(spec, "embedded:")) {
+    const auto names = embedded_material_names();
+    if (std::find(names.begin(), names.end(), spec.substr(9)) == names.end())
+      throw RequestError(404, fmt::format("'{}': no such embedded material", spec));
+    return load_brdf(spec);
+  }
+  return model_registry().create(spec);  // never a file: a model spec only
+}
+
+void Catalog::evict_locked() const {
+  while (brdfs_.size() > kMaxCachedBrdfs) {
+    auto oldest = std::min_element(brdfs_.begin(), brdfs_.end(), [](const auto& a, const auto& b) {
+      return a.second.used < b.second.used;
+    });
+    brdfs_.erase(oldest);
+  }
+}
+
+BrdfPtr Catalog::brdf(std::string_view spec) const {
+  {
+    std::lock_guard lock(mutex_);
+    if (auto it = brdfs_.find(spec); it != brdfs_.end()) {
+      it->second.used = ++clock_;
+      return it->second.brdf;
+    }
+  }
+  BrdfPtr loaded = load(spec);  // outside the lock: a large file does not hold the other tabs
+  std::lock_guard lock(mutex_);
+  Entry& e = brdfs_[std::string(spec)];
+  if (!e.brdf) e.brdf = std::move(loaded);
+  e.used = ++clock_;
+  BrdfPtr result = e.brdf;
+  evict_locked();
+  return result;
+}
+
+BrdfPtr Catalog::sampled_brdf(std::string_view spec) const {
+  BrdfPtr base = brdf(spec);
+  {
+    std::lock_guard lock(mutex_);
+    if (auto it = brdfs_.find(spec); it != brdfs_.end() && it->second.sampled)
+      return it->second.sampled;
+  }
+  // The sampler refers to the BRDF: one block owns both, the result points at the sampler.
+  struct Owner {
+    BrdfPtr base;
+    std::shared_ptr<const Brdf> sampler;
+  };
+  auto owner = std::make_shared<Owner>();
+  owner->base = base;
+  owner->sampler = render::with_importance_sampling(*base);
+  BrdfPtr sampled(owner, owner->sampler.get());
+  std::lock_guard lock(mutex_);
+  if (auto it = brdfs_.find(spec); it != brdfs_.end() && it->second.brdf == base)
+    it->second.sampled = sampled;
+  return sampled;
+}
+
+std::shared_ptr<const render::EnvMap> Catalog::environment(std::string_view spec) const {
+  if (spec.size() > kMaxSpecBytes)
+    throw RequestError(413, fmt::format("environment spec longer than {} bytes", kMaxSpecBytes));
+  {
+    std::lock_guard lock(mutex_);
+    if (auto it = envs_.find(spec); it != envs_.end()) return it->second;
+  }
+  std::shared_ptr<const render::EnvMap> map;
+  const auto builtins = render::EnvMap::builtin_names();
+  if (std::find(builtins.begin(), builtins.end(), spec) != builtins.end() ||
+      starts_with(spec, "constant:")) {
+    map = std::make_shared<const render::EnvMap>(render::EnvMap::from_spec(spec));
+  } else if (starts_with(spec, "file:")) {
+    const fs::path path = resolve(spec.substr(5));
+    if (!is_environment_file(path))
+      throw RequestError(400, fmt::format("'{}': an environment file is a .hdr or .exr", spec));
+    map = std::make_shared<const render::EnvMap>(render::EnvMap::load(path));
+  } else {
+    throw RequestError(400, fmt::format("unknown environment '{}' (expected sky, studio, sunset, "
+                                        "constant:V, constant:R,G,B or file:PATH)",
+                                        spec));
+  }
+  std::lock_guard lock(mutex_);
+  if (envs_.size() >= kMaxCachedEnvironments) envs_.clear();
+  envs_.emplace(std::string(spec), map);
+  return map;
+}
+
+Catalog::Listing Catalog::list_files(std::size_t limit) const {
+  Listing listing;
+  for (const fs::path& root : roots_) {
+    std::error_code ec;
+    std::size_t visited = 0;  // bounded: a huge tree does not stall the request
+    for (fs::recursive_directory_iterator it(root, ec), end; !ec && it != end && visited < 20000;
+         it.increment(ec), ++visited) {
+      if (!it->is_regular_file(ec)) continue;
+      std::error_code ec2;
+      const fs::path real = fs::weakly_canonical(it->path(), ec2);
+      if (ec2 || !is_inside(real, root)) continue;  // a link out of the root is not offered
+      const std::string rel = it->path().lexically_relative(root).generic_string();
+      if (is_environment_file(real) && listing.environments.size() < limit)
+        listing.environments.push_back(rel);
+      else if (is_brdf_file(real) && listing.brdfs.size() < limit)
+        listing.brdfs.push_back(rel);
+    }
+  }
+  std::sort(listing.brdfs.begin(), listing.brdfs.end());
+  std::sort(listing.environments.begin(), listing.environments.end());
+  return listing;
+}
+
+}  // namespace halfback::view

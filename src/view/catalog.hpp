@@ -1,0 +1,85 @@
+// What the view serves: the BRDFs and environments a request may name, resolved and cached.
+//
+// A BRDF spec in a request is one of
+//   arg:N          the N-th BRDF named on the command line (0-based; loaded with load_brdf);
+//   file:PATH      a file under one of the --root directories (PATH relative to the root);
+//   embedded:NAME  a material compiled into the library;
+//   anything else  an analytic model spec for model_registry() ("ggx:alpha=0.2"), never a file.
+// An environment spec is a built-in name (sky, default, studio, sunset), "constant:V" or
+// "constant:R,G,B", or file:PATH (a .hdr or .exr under a root).
+//
+// Paths: an absolute PATH, or one with a `..` component, is refused; the path is resolved with
+// std::filesystem::weakly_canonical (symbolic links followed) and must stay inside the canonical
+// root. Problems are RequestErrors carrying the HTTP status.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/render/envmap.hpp"
+
+namespace halfback::view {
+
+// A request that cannot be served: the status (4xx) and a message for the user.
+class RequestError : public std::runtime_error {
+ public:
+  RequestError(int status, const std::string& message)
+      : std::runtime_error(message), status_(status) {}
+  int status() const noexcept { return status_; }
+
+ private:
+  int status_;
+};
+
+class Catalog {
+ public:
+  Catalog(std::vector<std::string> specs, const std::vector<std::filesystem::path>& roots);
+
+  const std::vector<std::string>& specs() const { return specs_; }
+
+  // The BRDF of a request spec (see above); cached (kMaxCachedBrdfs, least recently used out).
+  BrdfPtr brdf(std::string_view spec) const;
+  // The same BRDF as the renderer samples it (render::with_importance_sampling), cached with it.
+  BrdfPtr sampled_brdf(std::string_view spec) const;
+  // The environment of a request spec; cached.
+  std::shared_ptr<const render::EnvMap> environment(std::string_view spec) const;
+
+  // The file a root-relative path names (see above). Throws RequestError: 403 for an absolute
+  // path, a `..` component or a path leaving its root, 404 when no root holds it.
+  std::filesystem::path resolve(std::string_view relative) const;
+
+  // Root-relative paths (generic form) of the files under the roots whose extension suggests a
+  // BRDF (.binary, .bsdf, .h5, .alta, .txt) or an environment (.hdr, .exr); at most `limit` of
+  // each, sorted.
+  struct Listing {
+    std::vector<std::string> brdfs, environments;
+  };
+  Listing list_files(std::size_t limit) const;
+
+ private:
+  struct Entry {
+    BrdfPtr brdf;
+    BrdfPtr sampled;  // built on first use
+    std::uint64_t used = 0;
+  };
+  BrdfPtr load(std::string_view spec) const;
+  void evict_locked() const;  // drops the least recently used BRDFs beyond kMaxCachedBrdfs
+
+  std::vector<std::string> specs_;
+  std::vector<std::filesystem::path> roots_;  // canonical
+  mutable std::mutex mutex_;
+  mutable std::map<std::string, Entry, std::less<>> brdfs_;
+  mutable std::map<std::string, std::shared_ptr<const render::EnvMap>, std::less<>> envs_;
+  mutable std::uint64_t clock_ = 0;
+};
+
+}  // namespace halfback::view

@@ -1,0 +1,19 @@
+// The endpoints of the view's API (docs/view.md, "API"), each a function of the catalog and the
+// request. They throw RequestError (a 4xx with its message) for a bad request; Api::handle()
+// turns that and the library's own exceptions into responses.
+#pragma once
+
+#include "catalog.hpp"
+#include "halfback/view/api.hpp"
+
+namespace halfback::view {
+
+Response info_response(const Catalog& catalog);
+Response brdf_response(const Catalog& catalog, const Request& request);
+Response slice_response(const Catalog& catalog, const Request& request, int threads);
+Response hemisphere_response(const Catalog& catalog, const Request& request, int threads);
+Response polar_response(const Catalog& catalog, const Request& request);
+Response point_response(const Catalog& catalog, const Request& request);
+Response render_response(const Catalog& catalog, const Request& request, int threads);
+
+}  // namespace halfback::view

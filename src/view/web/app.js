@@ -1,0 +1,616 @@
+// The page of `halfback view`: state (kept in the URL's fragment), the linked views and their
+// requests. Views: slices of the four isotropic forms, the hemisphere of ωi, the polar plot, the
+// lit sphere; a configuration (ωi, ωo) hovered or clicked in one is marked in all of them and
+// listed in every parameterization (the server's numbers, the same as `halfback convert/eval`).
+import { getJson, getField, isAbort } from './api.js';
+import * as V from './views.js';
+
+const $ = (id) => document.getElementById(id);
+const DEG = Math.PI / 180;
+const COLOURS = ['#ff9a3c', '#3cc8ff'];
+const FULL = 256, DRAG = 128;  // slice resolution at rest and while dragging
+
+const state = {
+  a: '', b: '', mode: 'a', az: 0, scale: 'log', levels: 'auto', to: 45, po: 180,
+  hemi: 'rho', env: 'sky', exposure: 0, polar: 'linear',
+};
+let info = null;
+let cursor = null;      // the last /api/point answer
+let pinned = false;
+let interactive = false;  // while dragging: lower resolution
+let refineTimer = 0;
+let sphereStale = false;  // the sphere waits for the end of a slider's drag
+const pending = new Set();
+const stats = { updates: 0, lastUpdateMs: 0 };
+
+// --- state <-> URL ------------------------------------------------------------------------
+function readHash() {
+  const h = new URLSearchParams(location.hash.slice(1));
+  for (const k of Object.keys(state)) {
+    if (!h.has(k)) continue;
+    state[k] = typeof state[k] === 'number' ? Number(h.get(k)) : h.get(k);
+  }
+}
+function writeHash() {
+  const h = new URLSearchParams();
+  for (const [k, v] of Object.entries(state)) h.set(k, String(v));
+  history.replaceState(null, '', `${location.pathname}${location.search}#${h}`);
+}
+
+function setStatus(text, error = false) {
+  $('status').textContent = text;
+  $('status').className = error ? 'error' : '';
+}
+
+// Tracks a view update; failures other than cancellations are shown in the status line.
+function track(promise) {
+  const started = performance.now();
+  const p = promise.then(() => {
+    stats.updates += 1;
+    stats.lastUpdateMs = performance.now() - started;
+  }).catch((e) => {
+    if (!isAbort(e)) setStatus(e.message, true);
+  }).finally(() => pending.delete(p));
+  pending.add(p);
+  return p;
+}
+async function idle() {
+  while (pending.size) await Promise.allSettled([...pending]);
+}
+const spheres = new Set();  // the progressive renders, apart: they run for seconds
+async function spheresDone() {
+  while (spheres.size) await Promise.allSettled([...spheres]);
+}
+window.halfback = { state, stats, idle, spheresDone, cursor: () => cursor };
+
+const specs = () => (state.b && state.mode !== 'a' ? [state.a, state.b] : [state.a]);
+const formInfo = (space) => info.forms.find((f) => f.space === space);
+
+// --- slices ---------------------------------------------------------------------------------
+const sliceCanvases = {};
+function buildSlices() {
+  const box = $('slices');
+  for (const f of info.forms) {
+    const div = document.createElement('div');
+    div.className = 'slice';
+    const canvas = document.createElement('canvas');
+    canvas.id = `slice-${f.space}`;
+    canvas.dataset.space = f.space;
+    div.append(Object.assign(document.createElement('h2'), { textContent: f.space }), canvas,
+      Object.assign(document.createElement('span'), {
+        className: 'axis',
+        textContent: `x: ${plain(f.axes[0].label)} 0…${axisMax(f.axes[0])}, y: ${plain(f.axes[1].label)} 0…${axisMax(f.axes[1])}, azimuth ${plain(f.azimuth_label)}`,
+      }));
+    box.append(div);
+    sliceCanvases[f.space] = canvas;
+    canvas.addEventListener('mousemove', (e) => pointerOnSlice(e, f, false));
+    canvas.addEventListener('click', (e) => pointerOnSlice(e, f, true));
+  }
+}
+const plain = (label) => label.replace(/_/g, '').replace(/[{}]/g, '');
+const axisMax = (a) => (a.angle ? '90°' : '1');
+
+let sliceFields = {};
+async function updateSlices() {
+  const n = interactive ? DRAG : FULL;
+  const t0 = performance.now();
+  const fields = await Promise.all(info.forms.map(async (f) => Promise.all(specs().map((s, b) =>
+    getField(`slice-${f.space}-${b}`, '/api/slice',
+      [['brdf', s], ['form', f.space], ['azimuth', state.az], ['n', n]])))));
+  sliceFields = {};
+  info.forms.forEach((f, k) => { sliceFields[f.space] = fields[k]; });
+  const t1 = performance.now();
+  drawSlices();
+  stats.sliceFetchMs = t1 - t0;  // the four requests (server and transfer)
+  stats.sliceDrawMs = performance.now() - t1;  // colours, isolines, markers
+}
+function drawSlices() {
+  const scalars = {};
+  for (const f of info.forms) {
+    const [a, b] = sliceFields[f.space] || [];
+    if (!a) return;
+    scalars[f.space] = V.sliceScalar(a, b, specs().length > 1 ? state.mode : 'a');
+  }
+  const scale = V.makeScale(Object.values(scalars), specs().length > 1 ? state.mode : 'a', state.scale);
+  const levels = V.isoLevels(state.levels, scale);
+  for (const f of info.forms) {
+    const field = sliceFields[f.space][0];
+    V.drawScalar(sliceCanvases[f.space], scalars[f.space], field.width, field.height, scale, levels);
+  }
+  drawColourbar(scale);
+  markSlices();
+}
+function drawColourbar(scale) {
+  const box = $('colorbar');
+  box.replaceChildren();
+  const c = document.createElement('canvas');
+  V.colourbar(c, scale);
+  const unit = scale.mode === 'ratio' ? 'log₂ ratio'
+    : scale.mode === 'diff' ? (scale.kind === 'log' ? `signed log₁₀(1 + |Δ|/${scale.eps.toPrecision(2)}) of Δ luminance` : 'Δ luminance (sr⁻¹)')
+    : scale.kind === 'log' ? 'log₁₀ luminance of ρ (sr⁻¹)' : 'luminance of ρ (sr⁻¹)';
+  box.append(`${scale.lo.toPrecision(3)}`, c, `${scale.hi.toPrecision(3)}  ${unit}; hatched: outside the valid domain`);
+}
+
+function pointerOnSlice(e, f, click) {
+  if (pinned && !click) return;
+  const r = e.target.getBoundingClientRect();
+  const x = (e.clientX - r.left) / r.width, y = 1 - (e.clientY - r.top) / r.height;
+  const coords = [x * f.axes[0].max, y * f.axes[1].max, state.az * DEG];
+  if (click) pinned = !pinned;
+  setCursor([['form', f.space], ['iso', 1], ['coords', coords.join(',')]]);
+}
+
+// --- hemisphere -------------------------------------------------------------------------------
+const wo = () => [Math.sin(state.to * DEG) * Math.cos(state.po * DEG),
+  Math.sin(state.to * DEG) * Math.sin(state.po * DEG), Math.cos(state.to * DEG)];
+let hemiField = null;
+async function updateHemisphere() {
+  const n = interactive ? DRAG : FULL;
+  const common = [['theta_o', state.to], ['phi_o', state.po], ['n', n]];
+  if (state.hemi === 'rho') {
+    const fields = await Promise.all(specs().map((s, b) => getField(`hemi-${b}`, '/api/hemisphere',
+      [['brdf', s], ['colour', 'rho'], ...common])));
+    hemiField = { rho: fields };
+  } else {
+    hemiField = { coords: await getField('hemi-0', '/api/hemisphere', [['colour', state.hemi], ...common]) };
+  }
+  drawHemisphere();
+}
+function drawHemisphere() {
+  const canvas = $('hemisphere');
+  if (!hemiField) return;
+  if (hemiField.rho) {
+    const [a, b] = hemiField.rho;
+    const mode = specs().length > 1 ? state.mode : 'a';
+    const s = V.sliceScalar(a, b, mode);
+    for (let k = 0; k < s.length; ++k) if (!Number.isFinite(a.data[3 * k])) s[k] = NaN;
+    V.drawScalar(canvas, s, a.width, a.height, V.makeScale([s], mode, 'log'), []);
+    blackOutside(canvas);
+  } else {
+    V.drawCoordinates(canvas, hemiField.coords, formInfo(state.hemi).axes);
+  }
+  const o = wo();
+  const p = V.diskPoint(o), m = V.diskPoint([-o[0], -o[1], o[2]]);
+  V.drawMarker(canvas, (p[0] + 1) / 2, (p[1] + 1) / 2, true, 'cross');
+  V.drawMarker(canvas, (m[0] + 1) / 2, (m[1] + 1) / 2, false);
+  $('theta-o').textContent = `${state.to.toFixed(1)}°`;
+  $('phi-o').textContent = `${state.po.toFixed(1)}°`;
+  markHemisphere();
+}
+function blackOutside(canvas) {  // the corners outside the disk
+  const ctx = canvas.getContext('2d'), w = canvas.width;
+  ctx.save();
+  ctx.fillStyle = '#000';
+  ctx.beginPath();
+  ctx.rect(0, 0, w, w);
+  ctx.arc(w / 2, w / 2, w / 2, 0, 2 * Math.PI, true);
+  ctx.fill('evenodd');
+  ctx.restore();
+}
+function diskFromEvent(e) {
+  const r = e.target.getBoundingClientRect();
+  return [2 * (e.clientX - r.left) / r.width - 1, 1 - 2 * (e.clientY - r.top) / r.height];
+}
+let dragging = false;
+function setupHemisphere() {
+  const c = $('hemisphere');
+  c.addEventListener('mousedown', (e) => { dragging = true; moveWo(e); });
+  window.addEventListener('mouseup', () => {
+    if (!dragging) return;
+    dragging = false;
+    refineSoon();
+  });
+  c.addEventListener('mousemove', (e) => {
+    if (dragging) moveWo(e);
+    else if (!pinned) hoverWi(e);
+  });
+  c.addEventListener('click', (e) => { if (!dragging) { pinned = !pinned; hoverWi(e); } });
+}
+function moveWo(e) {
+  const [u, v] = diskFromEvent(e);
+  const d = V.diskDirection(u, v);
+  if (!d) return;
+  state.to = Math.acos(Math.min(1, d[2])) / DEG;
+  state.po = ((Math.atan2(d[1], d[0]) / DEG) + 360) % 360;
+  interactive = true;
+  changed({ slices: false, sphere: false });
+}
+function hoverWi(e) {
+  const [u, v] = diskFromEvent(e);
+  const d = V.diskDirection(u, v);
+  if (!d) return;
+  setCursor([['wi', d.join(',')], ['wo', wo().join(',')]]);
+}
+
+// --- polar plot ------------------------------------------------------------------------------
+let polarCurves = [];
+async function updatePolar() {
+  polarCurves = await Promise.all(specs().map((s, b) => getJson(`polar-${b}`, '/api/polar',
+    [['brdf', s], ['theta_o', state.to], ['phi_o', state.po], ['n', interactive ? 91 : 181]])));
+  drawPolar();
+}
+function drawPolar() {
+  V.drawPolar($('polar'), polarCurves, state.polar, COLOURS, polarCursorAngle());
+}
+function setupPolar() {
+  const svg = $('polar');
+  const pick = (e, click) => {
+    if (pinned && !click) return;
+    const r = svg.getBoundingClientRect();
+    const x = -1.15 + 2.3 * (e.clientX - r.left) / r.width, y = -1.15 + 1.35 * (e.clientY - r.top) / r.height;
+    const t = Math.atan2(x, -y);
+    if (Math.abs(t) > Math.PI / 2) return;
+    if (click) pinned = !pinned;
+    const o = wo(), s = Math.hypot(o[0], o[1]);
+    const c = s > 0 ? [-o[0] / s, -o[1] / s] : [1, 0];
+    setCursor([['wi', [Math.sin(t) * c[0], Math.sin(t) * c[1], Math.cos(t)].join(',')], ['wo', o.join(',')]]);
+  };
+  svg.addEventListener('mousemove', (e) => pick(e, false));
+  svg.addEventListener('click', (e) => pick(e, true));
+}
+
+// --- sphere ----------------------------------------------------------------------------------
+let sphereGeneration = 0;
+const SPHERE = 160, PASSES = 32, SPP = 4;
+function restartSphere() {
+  const gen = ++sphereGeneration;
+  const box = $('spheres');
+  box.replaceChildren();
+  const list = state.b ? [state.a, state.b] : [state.a];
+  list.forEach((s, b) => {
+    const fig = document.createElement('figure');
+    const canvas = document.createElement('canvas');
+    canvas.id = `sphere-${b}`;
+    const cap = document.createElement('figcaption');
+    cap.innerHTML = `<span class="swatch-${b ? 'b' : 'a'}">■</span> ${escapeHtml(s)}`;
+    fig.append(canvas, cap);
+    box.append(fig);
+    const p = sphereLoop(gen, s, b, canvas).catch((e) => { if (!isAbort(e)) setStatus(e.message, true); })
+      .finally(() => spheres.delete(p));
+    spheres.add(p);
+  });
+}
+async function sphereLoop(gen, spec, b, canvas) {
+  const sum = new Float32Array(SPHERE * SPHERE * 3);
+  for (let pass = 0; pass < PASSES && gen === sphereGeneration; ++pass) {
+    const f = await getField(`sphere-${b}`, '/api/render',
+      [['brdf', spec], ['env', state.env], ['size', SPHERE], ['spp', SPP], ['pass', pass]]);
+    if (gen !== sphereGeneration) return;
+    for (let k = 0; k < sum.length; ++k) sum[k] += f.data[k];
+    canvas.dataset.passes = pass + 1;
+    canvas.sum = sum;
+    // The render's row 0 is the top: draw as it is (no flip).
+    V.drawSphere(canvas, sum, pass + 1, SPHERE, SPHERE, state.exposure);
+    $('sphere-note').textContent = `${(pass + 1) * SPP} samples per pixel (${pass + 1} of ${PASSES} passes)`;
+    if (pass === 0) await idleFrame();  // let the other views through first
+  }
+}
+const idleFrame = () => new Promise((r) => setTimeout(r, 30));
+function redrawSpheres() {
+  for (const c of document.querySelectorAll('#spheres canvas'))
+    if (c.sum) V.drawSphere(c, c.sum, Number(c.dataset.passes), SPHERE, SPHERE, state.exposure);
+}
+
+// --- the linked cursor -----------------------------------------------------------------------
+async function setCursor(params) {
+  const brdfs = (state.b ? [state.a, state.b] : [state.a]).map((s) => ['brdf', s]);
+  return track((async () => {
+    cursor = await getJson('point', '/api/point', [...params, ...brdfs]);
+    showCursor();
+    markSlices();
+    drawHemisphere();
+    drawPolar();
+  })());
+}
+const fmt = (x) => (x === null ? '—' : Number(x).toPrecision(9));
+function showCursor() {
+  const c = cursor;
+  if (!c) return;
+  let html = `<p>${c.valid ? '' : 'outside the valid domain'}${pinned ? ' (pinned: click to release)' : ''}</p><table>`;
+  html += row('dirs', ['wi_x', 'wi_y', 'wi_z', 'wo_x', 'wo_y', 'wo_z'], [...c.wi, ...c.wo], 'dirs');
+  for (const f of c.forms) {
+    const fi = formInfo(f.space);
+    html += row(f.space, fi.columns, f.coords, f.space, f.jacobian);
+    html += row(`${f.space} iso`, fi.iso_columns, f.iso, `${f.space}-iso`, f.iso_jacobian);
+  }
+  c.rho.forEach((r, b) => {
+    html += row(`<span class="swatch-${b ? 'b' : 'a'}">ρ</span> ${escapeHtml(r.brdf)}`, ['r', 'g', 'b'], r.rgb, `rho-${b}`);
+  });
+  $('cursor').innerHTML = `${html}</table>`;
+}
+function row(title, names, values, id, jacobian) {
+  let cells = '';
+  values.forEach((v, k) => { cells += `<td title="${names[k]}" id="cur-${id}-${names[k]}">${fmt(v)}</td>`; });
+  if (jacobian !== undefined) cells += `<td title="Jacobian" id="cur-${id}-jacobian">J ${fmt(jacobian)}</td>`;
+  return `<tr><th>${title}</th>${cells}</tr>`;
+}
+const escapeHtml = (s) => s.replace(/[&<>"]/g, (ch) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[ch]));
+
+// The configuration turned about n so that ωo has the current azimuth (the BRDFs are isotropic
+// in the views); whether its θo is the current one.
+function cursorInView() {
+  if (!cursor || !cursor.valid) return null;
+  const [wi, w] = [cursor.wi, cursor.wo];
+  const rot = state.po * DEG - Math.atan2(w[1], w[0]);
+  const c = Math.cos(rot), s = Math.sin(rot);
+  const thetaO = Math.acos(Math.min(1, w[2])) / DEG;
+  return { wi: [c * wi[0] - s * wi[1], s * wi[0] + c * wi[1], wi[2]], exact: Math.abs(thetaO - state.to) < 0.5 };
+}
+function markSlices() {
+  if (!cursor || !cursor.valid) return;
+  for (const f of cursor.forms) {
+    const fi = formInfo(f.space), canvas = sliceCanvases[f.space];
+    if (!canvas || !canvas.width) continue;
+    V.restore(canvas);
+    let d = Math.abs(f.iso[2] - state.az * DEG) % (2 * Math.PI);
+    d = Math.min(d, 2 * Math.PI - d);
+    V.drawMarker(canvas, f.iso[0] / fi.axes[0].max, f.iso[1] / fi.axes[1].max, d < 0.5 * DEG);
+  }
+}
+function markHemisphere() {
+  const v = cursorInView();
+  if (!v) return;
+  const p = V.diskPoint(v.wi);
+  V.drawMarker($('hemisphere'), (p[0] + 1) / 2, (p[1] + 1) / 2, v.exact);
+}
+function polarCursorAngle() {
+  const v = cursorInView();
+  if (!v || !v.exact) return null;
+  const o = wo(), s = Math.hypot(o[0], o[1]);
+  const c = s > 0 ? [-o[0] / s, -o[1] / s] : [1, 0];
+  const across = -c[1] * v.wi[0] + c[0] * v.wi[1];
+  if (Math.abs(across) > 1e-3) return null;
+  return Math.atan2(c[0] * v.wi[0] + c[1] * v.wi[1], v.wi[2]) / DEG;
+}
+
+// --- model sliders -----------------------------------------------------------------------------
+function parseModelSpec(spec) {
+  const arg = /^arg:(\d+)$/.exec(spec);  // a model named on the command line has sliders too
+  if (arg && info.specs[Number(arg[1])] !== undefined) spec = info.specs[Number(arg[1])];
+  if (/^(arg|file|embedded):/.test(spec)) return null;
+  const [name, rest] = spec.split(/:(.*)/s);
+  const model = info.models.find((m) => m.name === name);
+  if (!model) return null;
+  const values = {};
+  (rest || '').split(',').filter((x) => x).forEach((item, k) => {
+    const eq = item.indexOf('=');
+    if (eq < 0 && k === 0 && model.params.length) values[model.params[0].name] = item.trim();
+    else if (eq > 0) values[item.slice(0, eq).trim()] = item.slice(eq + 1).trim();
+  });
+  return { model, values };
+}
+function buildSliders() {
+  const parsed = parseModelSpec(state.a);
+  $('model').hidden = !parsed;
+  if (!parsed) return;
+  const { model, values } = parsed;
+  $('model-name').textContent = `${model.name}: ${model.description}`;
+  const box = $('sliders');
+  box.replaceChildren();
+  for (const p of model.params) {
+    const label = document.createElement('label');
+    label.title = p.description;
+    let input;
+    if (p.choices.length) {
+      input = document.createElement('select');
+      p.choices.forEach((c) => input.append(new Option(c, c)));
+      input.value = values[p.name] ?? p.choices[p.default];
+    } else {
+      input = Object.assign(document.createElement('input'), { type: 'range', min: 0, max: 1000, step: 1 });
+      const map = sliderMap(p);
+      const current = values[p.name] !== undefined ? Number(values[p.name])
+        : p.default_from ? Number(values[p.default_from] ?? model.params.find((q) => q.name === p.default_from).default) : p.default;
+      input.value = map.toSlider(current);
+      input.map = map;
+    }
+    input.dataset.param = p.name;
+    // A parameter that defaults to another (alpha_x to alpha) follows it until it is moved.
+    if (p.default_from && values[p.name] === undefined) input.dataset.follows = p.default_from;
+    const out = document.createElement('output');
+    out.textContent = p.choices.length ? '' : Number(input.map.fromSlider(input.value)).toPrecision(3);
+    input.addEventListener('input', () => {
+      delete input.dataset.follows;
+      if (input.map) out.textContent = Number(input.map.fromSlider(input.value)).toPrecision(3);
+      state.a = sliderSpec(model);
+      ensureOption($('brdf-a'), state.a);
+      interactive = true;
+      changed({ sphere: 'stale' });
+    });
+    input.addEventListener('change', () => { refineSoon(); });
+    label.append(p.name, input, out);
+    box.append(label);
+  }
+}
+// Linear over small ranges, logarithmic over wide ones (a slider position is 0 … 1000).
+function sliderMap(p) {
+  const lo = p.min, hi = p.max;
+  if (hi - lo <= 100 || lo < 0) {
+    return { toSlider: (v) => 1000 * (v - lo) / (hi - lo), fromSlider: (s) => lo + (hi - lo) * s / 1000 };
+  }
+  const a = Math.log10(Math.max(lo, 1e-3)), b = Math.log10(hi);
+  return {
+    toSlider: (v) => 1000 * (Math.log10(Math.max(v, 1e-3)) - a) / (b - a),
+    fromSlider: (s) => (Number(s) === 0 ? lo : Math.pow(10, a + (b - a) * s / 1000)),
+  };
+}
+function sliderSpec(model) {
+  const items = [];
+  for (const input of document.querySelectorAll('#sliders [data-param]')) {
+    if (input.dataset.follows) continue;
+    const v = input.map ? Number(Number(input.map.fromSlider(input.value)).toPrecision(4)) : input.value;
+    items.push(`${input.dataset.param}=${v}`);
+  }
+  return `${model.name}:${items.join(',')}`;
+}
+
+// --- updates ------------------------------------------------------------------------------------
+function changed({ slices = true, sphere = true, sliders = false } = {}) {
+  writeHash();
+  if (slices) track(updateSlices());
+  track(updateHemisphere());
+  track(updatePolar());
+  if (sphere === true) restartSphere();
+  if (sphere === 'stale') sphereStale = true;
+  if (sliders) buildSliders();
+  if (interactive) refineSoon();
+}
+function refineSoon() {
+  clearTimeout(refineTimer);
+  refineTimer = setTimeout(() => {
+    if (dragging) return refineSoon();
+    if (!interactive) return;
+    interactive = false;
+    track(updateSlices());
+    track(updateHemisphere());
+    track(updatePolar());
+    if (sphereStale) {
+      sphereStale = false;
+      restartSphere();
+    }
+  }, 250);
+}
+
+function ensureOption(select, value, label) {
+  if (![...select.options].some((o) => o.value === value)) select.append(new Option(label || value, value));
+  select.value = value;
+}
+function fillSelects() {
+  const groups = [
+    ['command line', info.specs.map((s, i) => [`arg:${i}`, s])],
+    ['models', info.models.map((m) => [m.name, m.name])],
+    ['embedded', info.embedded.map((n) => [`embedded:${n}`, n])],
+    ['files', info.files.map((f) => [`file:${f}`, f])],
+  ];
+  for (const id of ['brdf-a', 'brdf-b']) {
+    const sel = $(id);
+    for (const [title, items] of groups) {
+      if (!items.length) continue;
+      const g = document.createElement('optgroup');
+      g.label = title;
+      for (const [v, l] of items) g.append(new Option(l, v));
+      sel.append(g);
+    }
+  }
+  for (const e of info.environments) $('env').append(new Option(e.replace(/^file:/, ''), e));
+}
+
+function setup() {
+  $('brdf-a').addEventListener('change', (e) => { state.a = e.target.value; changed({ sliders: true }); });
+  $('brdf-b').addEventListener('change', (e) => {
+    state.b = e.target.value;
+    if (state.b && state.mode === 'a') { state.mode = 'diff'; $('mode').value = 'diff'; }
+    changed();
+  });
+  $('mode').addEventListener('change', (e) => { state.mode = e.target.value; changed({ sphere: false }); });
+  $('load-form').addEventListener('submit', (e) => {
+    e.preventDefault();
+    const spec = $('load-spec').value.trim();
+    if (!spec) return;
+    getJson(null, '/api/brdf', [['brdf', spec]]).then((r) => {
+      state.a = spec;
+      ensureOption($('brdf-a'), spec, `${spec} (${r.name})`);
+      setStatus(`loaded ${r.name}`);
+      changed({ sliders: true });
+    }).catch((err) => setStatus(err.message, true));
+  });
+  $('azimuth').addEventListener('input', (e) => {
+    state.az = Number(e.target.value);
+    $('azimuth-value').textContent = `${state.az}°`;
+    interactive = true;
+    writeHash();
+    track(updateSlices());
+    if (cursor) markSlices();
+    refineSoon();
+  });
+  $('scale').addEventListener('change', (e) => { state.scale = e.target.value; writeHash(); drawSlices(); });
+  $('levels').addEventListener('change', (e) => { state.levels = e.target.value || 'auto'; writeHash(); drawSlices(); });
+  $('hemi-colour').addEventListener('change', (e) => { state.hemi = e.target.value; writeHash(); track(updateHemisphere()); });
+  $('polar-scale').addEventListener('change', (e) => { state.polar = e.target.value; writeHash(); drawPolar(); });
+  $('env').addEventListener('change', (e) => { state.env = e.target.value; writeHash(); restartSphere(); });
+  $('exposure').addEventListener('input', (e) => { state.exposure = Number(e.target.value); writeHash(); redrawSpheres(); });
+  setupHemisphere();
+  setupPolar();
+  setupExports();
+}
+
+// --- export ------------------------------------------------------------------------------------
+function download(name, blob) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}
+function targetCanvases(target) {
+  if (target === 'slices') return info.forms.map((f) => sliceCanvases[f.space]);
+  if (target === 'hemisphere') return [$('hemisphere')];
+  return [...document.querySelectorAll('#spheres canvas')];
+}
+function combined(canvases) {
+  const out = document.createElement('canvas');
+  out.width = canvases.reduce((s, c) => s + c.width + 8, -8);
+  out.height = Math.max(...canvases.map((c) => c.height));
+  const ctx = out.getContext('2d');
+  let x = 0;
+  for (const c of canvases) { ctx.drawImage(c, x, 0); x += c.width + 8; }
+  return out;
+}
+function setupExports() {
+  for (const span of document.querySelectorAll('.export')) {
+    const target = span.dataset.target;
+    for (const kind of ['PNG', 'SVG']) {
+      const b = document.createElement('button');
+      b.textContent = kind;
+      b.addEventListener('click', () => exportView(target, kind));
+      span.append(b);
+    }
+  }
+}
+function exportView(target, kind) {
+  const name = `halfback-${target}`;
+  if (target === 'polar') {
+    const text = new XMLSerializer().serializeToString($('polar'));
+    if (kind === 'SVG') return download(`${name}.svg`, new Blob([text], { type: 'image/svg+xml' }));
+    const img = new Image();
+    img.onload = () => {
+      const c = Object.assign(document.createElement('canvas'), { width: 640, height: 376 });
+      c.getContext('2d').drawImage(img, 0, 0, 640, 376);
+      c.toBlob((blob) => download(`${name}.png`, blob));
+    };
+    img.src = `data:image/svg+xml;charset=utf-8,${encodeURIComponent(text)}`;
+    return undefined;
+  }
+  const canvases = targetCanvases(target);
+  if (kind === 'PNG') return combined(canvases).toBlob((blob) => download(`${name}.png`, blob));
+  const titles = target === 'slices' ? info.forms.map((f) => f.space) : [];
+  return download(`${name}.svg`, new Blob([V.canvasSvg(canvases, titles)], { type: 'image/svg+xml' }));
+}
+
+async function main() {
+  readHash();
+  try {
+    info = await getJson(null, '/api/info');
+  } catch (e) {
+    setStatus(e.message, true);
+    return;
+  }
+  if (!state.a) state.a = info.specs.length ? 'arg:0' : 'ggx:alpha=0.2';
+  if (!state.b && info.specs.length > 1 && !location.hash) state.b = '';
+  fillSelects();
+  ensureOption($('brdf-a'), state.a);
+  if (state.b) ensureOption($('brdf-b'), state.b);
+  $('mode').value = state.mode;
+  $('azimuth').value = state.az;
+  $('azimuth-value').textContent = `${state.az}°`;
+  $('scale').value = state.scale;
+  $('levels').value = state.levels === 'auto' ? '' : state.levels;
+  $('hemi-colour').value = state.hemi;
+  $('polar-scale').value = state.polar;
+  ensureOption($('env'), state.env);
+  $('exposure').value = state.exposure;
+  buildSlices();
+  setup();
+  changed({ sliders: true });
+  setStatus('ready');
+}
+main();

@@ -1,0 +1,277 @@
+// Drawing: colour maps, scalar fields with hatching and isolines, markers, the polar plot and
+// the tone-mapped sphere. Fields arrive as float32 RGB with row 0 at the bottom (y up).
+
+const VIRIDIS = [[68, 1, 84], [72, 40, 120], [62, 74, 137], [49, 104, 142], [38, 130, 142],
+  [31, 158, 137], [53, 183, 121], [109, 205, 89], [180, 222, 44], [253, 231, 37]];
+
+function ramp(stops, t) {
+  if (!(t >= 0)) t = 0;
+  if (t > 1) t = 1;
+  const x = t * (stops.length - 1), i = Math.min(Math.floor(x), stops.length - 2), f = x - i;
+  const a = stops[i], b = stops[i + 1];
+  return [a[0] + (b[0] - a[0]) * f, a[1] + (b[1] - a[1]) * f, a[2] + (b[2] - a[2]) * f];
+}
+export const viridis = (t) => ramp(VIRIDIS, t);
+const DIVERGING = [[33, 102, 172], [103, 169, 207], [209, 229, 240], [247, 247, 247],
+  [253, 219, 199], [239, 138, 98], [178, 24, 43]];
+export const diverging = (t) => ramp(DIVERGING, t);
+
+export function luminance(d, k) {
+  return 0.2126 * d[3 * k] + 0.7152 * d[3 * k + 1] + 0.0722 * d[3 * k + 2];
+}
+
+// The scalar a slice shows: the luminance of the first or second BRDF, their difference or ratio.
+export function sliceScalar(a, b, mode) {
+  const n = a.width * a.height, out = new Float32Array(n);
+  for (let k = 0; k < n; ++k) {
+    const ya = luminance(a.data, k), yb = b ? luminance(b.data, k) : NaN;
+    out[k] = mode === 'b' ? yb : mode === 'diff' ? ya - yb : mode === 'ratio' ? ya / yb : ya;
+  }
+  return out;
+}
+
+function percentile(sorted, p) {
+  if (!sorted.length) return NaN;
+  return sorted[Math.min(sorted.length - 1, Math.round(p * (sorted.length - 1)))];
+}
+const sortedOf = (values) => Float64Array.from(values).sort();
+
+// A colour scale shared by several fields: transform (value -> t), range [lo, hi], colour map.
+export function makeScale(fields, mode, kind) {
+  const diverge = mode === 'diff' || mode === 'ratio';
+  // A signed logarithm for differences on the log scale: linear below eps (a tenth of the
+  // median difference), logarithmic above, so that both small and peak differences show.
+  let eps = 1;
+  if (mode === 'diff' && kind === 'log') {
+    const abs = [];
+    for (const f of fields) for (let k = 0; k < f.length; k += 7) if (Number.isFinite(f[k])) abs.push(Math.abs(f[k]));
+    eps = Math.max((percentile(sortedOf(abs), 0.5) || 1) / 10, 1e-12);
+  }
+  const tf = mode === 'ratio' ? (v) => (v > 0 ? Math.log2(v) : NaN)
+    : mode === 'diff' ? (kind === 'log' ? (v) => Math.sign(v) * Math.log10(1 + Math.abs(v) / eps) : (v) => v)
+      : kind === 'log' ? (v) => (v > 0 ? Math.log10(v) : NaN) : (v) => v;
+  const sample = [];
+  for (const f of fields) {
+    const step = Math.max(1, Math.floor(f.length / 4000));  // a sample is enough for a range
+    for (let k = 0; k < f.length; k += step) {
+      const t = tf(f[k]);
+      if (Number.isFinite(t)) sample.push(diverge ? Math.abs(t) : t);
+    }
+  }
+  const sorted = sortedOf(sample);
+  let lo, hi;
+  if (diverge) {
+    hi = percentile(sorted, 0.99) || 1;
+    lo = -hi;
+  } else if (kind === 'log') {
+    hi = percentile(sorted, 0.995);
+    lo = Math.max(percentile(sorted, 0.01), hi - 4);
+  } else {
+    lo = 0;
+    hi = percentile(sorted, 0.995);
+  }
+  if (!(hi > lo)) hi = lo + 1;
+  return { tf, lo, hi, map: diverge ? diverging : viridis, diverge, kind, mode, eps,
+    line: diverge ? [20, 20, 20] : [255, 255, 255] };
+}
+
+// Isoline levels in transformed units: 'none', 'auto' (decades or tenths), or a list of values.
+export function isoLevels(text, scale) {
+  const t = (text || 'auto').trim();
+  if (t === 'none') return [];
+  if (t !== 'auto') {
+    return t.split(',').map(Number).filter(Number.isFinite).map(scale.tf).filter(Number.isFinite);
+  }
+  const out = [];
+  if (scale.kind === 'log' || scale.diverge) {
+    for (let v = Math.ceil(scale.lo); v <= scale.hi; v += 1) out.push(v);
+  } else {
+    for (let k = 1; k < 10; ++k) out.push(scale.lo + (scale.hi - scale.lo) * k / 10);
+  }
+  return out;
+}
+
+// Draws n × n scalars (row 0 at the bottom) into a canvas: colour, hatching where NaN, isolines.
+export function drawScalar(canvas, values, w, h, scale, levels) {
+  canvas.width = w;
+  canvas.height = h;
+  const ctx = canvas.getContext('2d');
+  const img = ctx.createImageData(w, h);
+  const t = new Float32Array(w * h);
+  for (let k = 0; k < w * h; ++k) t[k] = scale.tf(values[k]);
+  for (let j = 0; j < h; ++j) {
+    for (let i = 0; i < w; ++i) {
+      const k = j * w + i, p = 4 * ((h - 1 - j) * w + i);
+      let c;
+      if (Number.isNaN(values[k])) {
+        c = ((i + (h - 1 - j)) % 8) < 2 ? [110, 110, 118] : [40, 40, 46];  // hatched
+      } else {
+        c = scale.map((t[k] - scale.lo) / (scale.hi - scale.lo));
+        if (isIsoline(t, w, h, i, j, levels)) c = scale.line;
+      }
+      img.data[p] = c[0]; img.data[p + 1] = c[1]; img.data[p + 2] = c[2]; img.data[p + 3] = 255;
+    }
+  }
+  ctx.putImageData(img, 0, 0);
+  canvas.base = img;  // markers are drawn over a copy of this
+}
+
+// Puts a canvas' picture back (without the markers drawn on it since).
+export function restore(canvas) {
+  if (canvas.base) canvas.getContext('2d').putImageData(canvas.base, 0, 0);
+}
+
+function isIsoline(t, w, h, i, j, levels) {
+  const v = t[j * w + i];
+  if (!Number.isFinite(v)) return false;
+  const neighbours = [i + 1 < w ? t[j * w + i + 1] : NaN, j + 1 < h ? t[(j + 1) * w + i] : NaN];
+  for (const u of neighbours) {
+    if (!Number.isFinite(u)) continue;
+    for (const L of levels) if ((v - L) * (u - L) < 0) return true;
+  }
+  return false;
+}
+
+// Hemisphere coloured by the first two coordinates (red, green) of a parameterization.
+export function drawCoordinates(canvas, field, axes) {
+  const { width: w, height: h, data } = field;
+  canvas.width = w;
+  canvas.height = h;
+  const ctx = canvas.getContext('2d');
+  const img = ctx.createImageData(w, h);
+  for (let j = 0; j < h; ++j) {
+    for (let i = 0; i < w; ++i) {
+      const k = j * w + i, p = 4 * ((h - 1 - j) * w + i);
+      const a = data[3 * k] / axes[0].max, b = data[3 * k + 1] / axes[1].max;
+      const inside = Number.isFinite(a);
+      img.data[p] = inside ? 255 * a : 0;
+      img.data[p + 1] = inside ? 255 * b : 0;
+      img.data[p + 2] = inside ? 40 : 0;
+      img.data[p + 3] = 255;
+    }
+  }
+  ctx.putImageData(img, 0, 0);
+}
+
+export function colourbar(canvas, scale) {
+  canvas.width = 256;
+  canvas.height = 1;
+  const ctx = canvas.getContext('2d'), img = ctx.createImageData(256, 1);
+  for (let i = 0; i < 256; ++i) {
+    const c = scale.map(i / 255);
+    img.data.set([c[0], c[1], c[2], 255], 4 * i);
+  }
+  ctx.putImageData(img, 0, 0);
+}
+
+// A marker on a canvas at fractional position (x, y) in [0, 1]² (y up): filled when exact,
+// hollow when the configuration lies on another slice.
+export function drawMarker(canvas, x, y, exact, shape = 'circle') {
+  const ctx = canvas.getContext('2d'), w = canvas.width, h = canvas.height;
+  const px = x * w, py = (1 - y) * h, r = Math.max(3, w / 60);
+  ctx.save();
+  ctx.lineWidth = Math.max(1.5, w / 160);
+  ctx.strokeStyle = '#fff';
+  ctx.fillStyle = '#ff3b6b';
+  ctx.beginPath();
+  if (shape === 'cross') {
+    ctx.moveTo(px - r, py - r); ctx.lineTo(px + r, py + r);
+    ctx.moveTo(px - r, py + r); ctx.lineTo(px + r, py - r);
+    ctx.stroke();
+  } else {
+    ctx.arc(px, py, r, 0, 2 * Math.PI);
+    if (exact) ctx.fill();
+    ctx.stroke();
+  }
+  ctx.restore();
+}
+
+// The equal-area projection of the hemisphere seen from above: disk point of a direction.
+export function diskPoint(w) {
+  const psi = Math.acos(Math.max(-1, Math.min(1, w[2])));
+  const r = Math.SQRT2 * Math.sin(psi / 2), s = Math.hypot(w[0], w[1]);
+  return s > 0 ? [r * w[0] / s, r * w[1] / s] : [0, 0];
+}
+export function diskDirection(u, v) {
+  const r = Math.hypot(u, v);
+  if (r > 1) return null;
+  const psi = 2 * Math.asin(r / Math.SQRT2), s = r > 0 ? Math.sin(psi) / r : 0;
+  return [s * u, s * v, Math.cos(psi)];
+}
+
+const SVG = 'http://www.w3.org/2000/svg';
+function el(name, attrs) {
+  const e = document.createElementNS(SVG, name);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  return e;
+}
+
+// The polar plot: per BRDF, ρ along the two curves as the radius (t from the vertical).
+export function drawPolar(svg, curves, kind, colours, cursor) {
+  svg.replaceChildren();
+  svg.append(el('rect', { x: -1.15, y: -1.15, width: 2.3, height: 1.35, fill: '#111217' }));
+  for (const r of [0.25, 0.5, 0.75, 1]) {
+    svg.append(el('path', { d: `M ${-r} 0 A ${r} ${r} 0 0 1 ${r} 0`, fill: 'none', stroke: '#333842', 'stroke-width': 0.005 }));
+  }
+  for (let a = -90; a <= 90; a += 30) {
+    const t = a * Math.PI / 180;
+    svg.append(el('line', { x1: 0, y1: 0, x2: Math.sin(t), y2: -Math.cos(t), stroke: '#333842', 'stroke-width': 0.005 }));
+  }
+  let max = 0, min = Infinity;
+  for (const c of curves) for (const k of ['in_plane', 'across']) for (const v of c[k]) {
+    const y = lum(v);
+    if (y > max) max = y;
+    if (y > 0 && y < min) min = y;
+  }
+  const lo = Math.max(Math.log10(min), Math.log10(max) - 4);
+  const radius = (y) => kind === 'log' ? Math.max(0, (Math.log10(Math.max(y, 1e-30)) - lo) / (Math.log10(max) - lo || 1)) : y / (max || 1);
+  curves.forEach((c, b) => {
+    for (const k of ['in_plane', 'across']) {
+      let d = '';
+      c.angles_deg.forEach((deg, i) => {
+        const t = deg * Math.PI / 180, r = radius(lum(c[k][i]));
+        d += `${i ? 'L' : 'M'} ${(r * Math.sin(t)).toFixed(5)} ${(-r * Math.cos(t)).toFixed(5)} `;
+      });
+      svg.append(el('path', { d, fill: 'none', stroke: colours[b], 'stroke-width': 0.012, 'stroke-dasharray': k === 'across' ? '0.04 0.025' : 'none' }));
+    }
+  });
+  if (cursor !== null && cursor !== undefined) {
+    const t = cursor * Math.PI / 180;
+    svg.append(el('line', { x1: 0, y1: 0, x2: 1.05 * Math.sin(t), y2: -1.05 * Math.cos(t), stroke: '#ff3b6b', 'stroke-width': 0.01 }));
+  }
+  const label = el('text', { x: -1.1, y: 0.13, fill: '#9a9cab', 'font-size': 0.07 });
+  label.textContent = `max ρ (luminance) ${max.toPrecision(3)} sr⁻¹; ← back   mirror →`;
+  svg.append(label);
+}
+const lum = (v) => (v[0] === null ? 0 : 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]);
+
+// Mean of the accumulated passes, exposed and encoded as sRGB.
+export function drawSphere(canvas, sum, passes, w, h, exposure) {
+  canvas.width = w;
+  canvas.height = h;
+  const ctx = canvas.getContext('2d'), img = ctx.createImageData(w, h);
+  const scale = Math.pow(2, exposure) / Math.max(passes, 1);
+  const srgb = (x) => {
+    x = Math.max(0, Math.min(1, x * scale));
+    return 255 * (x <= 0.0031308 ? 12.92 * x : 1.055 * Math.pow(x, 1 / 2.4) - 0.055);
+  };
+  for (let k = 0; k < w * h; ++k) {
+    img.data[4 * k] = srgb(sum[3 * k]);
+    img.data[4 * k + 1] = srgb(sum[3 * k + 1]);
+    img.data[4 * k + 2] = srgb(sum[3 * k + 2]);
+    img.data[4 * k + 3] = 255;
+  }
+  ctx.putImageData(img, 0, 0);
+}
+
+// An SVG holding a canvas' picture (and its size), for the SVG export of raster views.
+export function canvasSvg(canvases, titles) {
+  const w = canvases.reduce((s, c) => s + c.width + 10, 0), h = Math.max(...canvases.map((c) => c.height)) + 20;
+  let x = 0, body = '';
+  canvases.forEach((c, i) => {
+    body += `<text x="${x}" y="12" font-family="sans-serif" font-size="12">${titles[i] || ''}</text>`;
+    body += `<image x="${x}" y="18" width="${c.width}" height="${c.height}" href="${c.toDataURL('image/png')}"/>`;
+    x += c.width + 10;
+  });
+  return `<svg xmlns="http://www.w3.org/2000/svg" width="${w}" height="${h}">${body}</svg>`;
+}

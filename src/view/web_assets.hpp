@@ -1,0 +1,17 @@
+// The page's files (src/view/web/), embedded at build time by cmake/embed_web_assets.cmake into the
+// generated web_assets.cpp.
+#pragma once
+
+#include <span>
+#include <string_view>
+
+namespace halfback::view {
+
+struct WebAsset {
+  std::string_view name;  // file name, e.g. "app.js"
+  std::string_view data;
+};
+
+std::span<const WebAsset> web_assets();
+
+}  // namespace halfback::view
