@@ -7,9 +7,32 @@ dropped and the second azimuth is relative. Conventions and derivations: docs/ma
 
 BRDFs: load(spec) gives a Brdf (analytic models, MERL, RGL, ALTA files, embedded materials) with
 vectorized eval(wi, wo), info, albedo(), resample() and render(); hemisphere() gives the data of
-the paper's Figure 1.
+the paper's Figure 1. study_brdf() studies one BRDF (any engine can map it over a
+database) and merge_study() writes the report of the results (docs/study.md).
 """
 
-from ._core import Brdf, columns, convert, hemisphere, jacobian, load, models, valid
+from ._core import (
+    Brdf,
+    columns,
+    convert,
+    hemisphere,
+    jacobian,
+    load,
+    merge_study,
+    models,
+    study_brdf,
+    valid,
+)
 
-__all__ = ["Brdf", "columns", "convert", "hemisphere", "jacobian", "load", "models", "valid"]
+__all__ = [
+    "Brdf",
+    "columns",
+    "convert",
+    "hemisphere",
+    "jacobian",
+    "load",
+    "merge_study",
+    "models",
+    "study_brdf",
+    "valid",
+]

@@ -81,3 +81,11 @@ def load(spec: str) -> Brdf:
 
 def models() -> list[str]:
     """The analytic models' names."""
+
+StudySettings = Mapping[str, Any]
+
+def study_brdf(spec: str, settings: StudySettings | None = None) -> dict[str, Any]:
+    """The study of one BRDF: tables as CSV text, "settings" and "renderings" (GIL released)."""
+
+def merge_study(out: str, parts: Sequence[Mapping[str, Any] | str]) -> dict[str, Any]:
+    """Writes the report of study_brdf results and study directories into `out`."""

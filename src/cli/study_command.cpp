@@ -194,9 +194,7 @@ study::BrdfResult study_one(const std::string& spec, std::size_t k,
   progress.start(k, spec);
   const double cpu0 = cpu_seconds();
   const BrdfPtr brdf = load_brdf(spec);
-  // Files by their BRDF's name (merl:..., rgl:...), models by their spec, which holds their
-  // parameters (two GGX of different roughness are both named "ggx").
-  const std::string label = std::filesystem::exists(spec, ec) ? brdf->name() : spec;
+  const std::string label = study::study_label(spec, *brdf);
   if (!brdf->isotropic())
     warn("study", label +
                       " is anisotropic: its isotropic metrics see its canonical pose, the 4D "

@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -24,6 +25,7 @@
 #include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
+#include "halfback/study/parts.hpp"
 
 namespace py = pybind11;
 using namespace halfback;
@@ -484,6 +486,142 @@ NAME_fc1.npy of its NumPy form), a model such as "ggx:alpha=0.2" or
       "The names of the analytic models (see `halfback models` for their parameters).");
 }
 
+// ---------------------------------------------------------------------------------------------
+// The study (issue 14): one BRDF at a time, for engines such as Dask, and the merge
+// ---------------------------------------------------------------------------------------------
+
+template <class T>
+T setting(const py::handle& value, const std::string& key) {
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw py::value_error("settings['" + key + "']: expected " + py::type_id<T>() + ", got " +
+                          py::repr(value).cast<std::string>());
+  }
+}
+
+// The settings dict: the options of `halfback study`, '-' spelled '_'.
+study::StudySettings study_settings(const py::object& settings) {
+  study::StudySettings s;
+  if (settings.is_none()) return s;
+  for (const auto& [k, v] : settings.cast<py::dict>()) {
+    const std::string key = py::str(k);
+    if (key == "space") s.space = setting<std::string>(v, key);
+    else if (key == "quick") s.quick = setting<bool>(v, key);
+    else if (key == "no_gonio") s.no_gonio = setting<bool>(v, key);
+    else if (key == "no_images") s.no_images = setting<bool>(v, key);
+    else if (key == "budgets") s.budgets = setting<std::vector<std::size_t>>(v, key);
+    else if (key == "budgets_4d") s.budgets_4d = setting<std::vector<std::size_t>>(v, key);
+    else if (key == "test_pairs") s.test_pairs = setting<std::size_t>(v, key);
+    else if (key == "image_budget") s.image_budget = setting<std::size_t>(v, key);
+    else if (key == "image_size") s.image_size = setting<int>(v, key);
+    else if (key == "image_spp") s.image_spp = setting<int>(v, key);
+    else if (key == "max_theta") s.max_theta = setting<double>(v, key);
+    else if (key == "seed") s.seed = setting<std::uint64_t>(v, key);
+    else if (key == "env") s.environments = setting<std::vector<std::string>>(v, key);
+    else
+      throw py::value_error("settings: unknown key '" + key +
+                            "' (accepted: space, quick, budgets, budgets_4d, test_pairs, env, "
+                            "image_budget, image_size, image_spp, max_theta, seed, no_gonio, "
+                            "no_images)");
+  }
+  return s;
+}
+
+py::dict study_one_brdf(const std::string& spec, const py::object& settings) {
+  const study::StudySettings s = study_settings(settings);
+  study::BrdfResult result;
+  std::string described;
+  {
+    py::gil_scoped_release release;
+    const study::StudyConfig config = study::make_config(s);
+    const BrdfPtr brdf = load_brdf(spec);
+    result = study::study_brdf(*brdf, study::study_label(spec, *brdf), config);
+    described = study::describe_config(config);
+  }
+  py::dict d;
+  for (const auto& [name, table] : study::to_tables(result)) d[py::str(name)] = table;
+  d["settings"] = described;
+  py::list images;
+  for (const render::Image& im : result.example_images) {
+    py::array_t<float> a({py::ssize_t(im.height), py::ssize_t(im.width), py::ssize_t(3)});
+    std::copy(im.rgb.begin(), im.rgb.end(), a.mutable_data());
+    images.append(a);
+  }
+  d["renderings"] = images;
+  return d;
+}
+
+// A result dict of study_one_brdf as a BrdfResult.
+study::BrdfResult result_of(const py::dict& d, const std::string& source) {
+  study::StudyTables tables;
+  for (const char* name : {"brdf", "azimuthal", "separability", "gonio", "image"}) {
+    if (!d.contains(name)) throw py::value_error(source + ": no table '" + name + "'");
+    tables[name] = d[name].cast<std::string>();
+  }
+  study::BrdfResult b = study::from_tables(tables, source);
+  if (d.contains("renderings"))
+    for (const auto& item : d["renderings"].cast<py::list>()) {
+      const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(item);
+      if (!a || a.ndim() != 3 || a.shape(2) != 3)
+        throw py::value_error(source + ": a rendering is not an (H, W, 3) array");
+      render::Image im{int(a.shape(1)), int(a.shape(0)), {}};
+      im.rgb.assign(a.data(), a.data() + a.size());
+      b.example_images.push_back(std::move(im));
+    }
+  return b;
+}
+
+py::dict merge_study(const std::string& out, const py::list& parts) {
+  study::MergedParts merged;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const py::handle item = parts[i];
+    if (py::isinstance<py::dict>(item)) {
+      const py::dict d = item.cast<py::dict>();
+      const std::string source = "parts[" + std::to_string(i) + "]";
+      if (!d.contains("settings")) throw py::value_error(source + ": no 'settings'");
+      study::merge_into(merged, d["settings"].cast<std::string>(), source, {result_of(d, source)});
+    } else {
+      const std::string dir = py::str(py::module_::import("os").attr("fspath")(item));
+      study::MergedParts one = study::read_parts({dir});
+      study::merge_into(merged, one.settings, dir, std::move(one.results));
+    }
+  }
+  if (merged.results.empty()) throw py::value_error("parts: no result to merge");
+  study::StudyOutput written;
+  {
+    py::gil_scoped_release release;
+    std::error_code ec;
+    std::filesystem::create_directories(out, ec);
+    double seconds = 0;
+    for (const study::BrdfResult& b : merged.results) seconds += b.seconds;
+    written = study::write_study(out, merged.results, merged.config, seconds);
+  }
+  py::dict d;
+  d["markdown"] = written.markdown;
+  d["files"] = written.files;
+  return d;
+}
+
+void bind_study(py::module_& m) {
+  m.def("study_brdf", &study_one_brdf, py::arg("spec"), py::arg("settings") = py::none(),
+        R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
+
+spec: a file or model spec, as for load(). settings: a dict of the options of `halfback study`
+with '-' spelled '_': space, quick, budgets, budgets_4d, test_pairs, env (a list), image_budget,
+image_size, image_spp, max_theta, seed, no_gonio, no_images (missing: the defaults).
+Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image"; the
+rows of the CSV files of the study, numbers in exact round-trip form, e.g. for
+pandas.read_csv(io.StringIO(t))), "settings" (the resolved settings, which merge_study checks)
+and "renderings" (the example images, (H, W, 3) float32). Independent of any other BRDF: map it
+over BRDFs with any engine (docs/study.md, "Scaling out").)doc");
+  m.def("merge_study", &merge_study, py::arg("out"), py::arg("parts"),
+        R"doc(Writes the study's report of several results into directory `out` (as
+`halfback study --merge`): parts is a list of result dicts of study_brdf and of output directories
+of `halfback study`, in the order of the report. All must have the same settings, and a BRDF may
+appear once. Returns {"markdown": report.md's text, "files": the files written}.)doc");
+}
+
 }  // namespace
 
 // The class before the functions that return it, so that their signatures name it.
@@ -493,4 +631,5 @@ PYBIND11_MODULE(_core, m) {
   bind_brdf_class(m);
   bind_hemisphere(m);
   bind_loading(m);
+  bind_study(m);
 }

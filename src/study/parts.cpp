@@ -173,6 +173,11 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
   return c;
 }
 
+std::string study_label(std::string_view spec, const Brdf& brdf) {
+  std::error_code ec;
+  return std::filesystem::exists(spec, ec) ? brdf.name() : std::string(spec);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Tables
 // ---------------------------------------------------------------------------------------------
@@ -442,10 +447,25 @@ BrdfResult read_part(const std::filesystem::path& parts, const std::string& key,
   return b;
 }
 
+void merge_into(MergedParts& into, const std::string& settings, const std::string& source,
+                std::vector<BrdfResult> results) {
+  if (into.settings.empty()) {
+    into.config = config_from_description(settings, source);
+    into.settings = settings;
+  } else if (settings != into.settings) {
+    throw std::runtime_error(fmt::format("'{}' and '{}' were run with different settings",
+                                         into.source_of.begin()->second, source));
+  }
+  for (BrdfResult& b : results) {
+    if (const auto [it, fresh] = into.source_of.emplace(b.label, source); !fresh)
+      throw std::runtime_error(
+          fmt::format("'{}' is in both '{}' and '{}'", b.label, it->second, source));
+    into.results.push_back(std::move(b));
+  }
+}
+
 MergedParts read_parts(const std::vector<std::filesystem::path>& dirs) {
   MergedParts merged;
-  std::string settings, settings_source;
-  std::map<std::string, std::string> seen;  // label -> directory
   for (const std::filesystem::path& dir : dirs) {
     std::error_code ec;
     const std::filesystem::path parts =
@@ -454,15 +474,6 @@ MergedParts read_parts(const std::vector<std::filesystem::path>& dirs) {
     if (!std::filesystem::exists(settings_file, ec))
       throw std::runtime_error(fmt::format(
           "'{}': not the output of a study (no parts/settings.txt)", dir.string()));
-    const std::string s = read_text_file(settings_file);
-    if (settings_source.empty()) {
-      settings = s;
-      settings_source = settings_file.string();
-      merged.config = config_from_description(s, settings_source);
-    } else if (s != settings) {
-      throw std::runtime_error(fmt::format("'{}' and '{}' were run with different settings",
-                                           settings_source, settings_file.string()));
-    }
     std::vector<std::pair<std::size_t, BrdfResult>> in_dir;
     for (const auto& entry : std::filesystem::directory_iterator(parts)) {
       if (entry.path().extension() != ".part") continue;
@@ -474,12 +485,9 @@ MergedParts read_parts(const std::vector<std::filesystem::path>& dirs) {
       throw std::runtime_error(fmt::format("'{}': no finished BRDF in it", dir.string()));
     std::stable_sort(in_dir.begin(), in_dir.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (auto& [order, b] : in_dir) {
-      if (const auto [it, fresh] = seen.emplace(b.label, dir.string()); !fresh)
-        throw std::runtime_error(
-            fmt::format("'{}' is in both '{}' and '{}'", b.label, it->second, dir.string()));
-      merged.results.push_back(std::move(b));
-    }
+    std::vector<BrdfResult> results;
+    for (auto& [order, b] : in_dir) results.push_back(std::move(b));
+    merge_into(merged, read_text_file(settings_file), dir.string(), std::move(results));
   }
   return merged;
 }

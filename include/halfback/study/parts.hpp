@@ -43,6 +43,10 @@ std::string describe_config(const StudyConfig& config);
 // line for text that describe_config() did not write.
 StudyConfig config_from_description(std::string_view text, const std::string& source);
 
+// The label of a BRDF in the tables: a file by its BRDF's name (merl:..., rgl:..., nbrdf:...), a
+// model by its spec, which holds its parameters (two GGX of different roughness are both "ggx").
+std::string study_label(std::string_view spec, const Brdf& brdf);
+
 // One BRDF's result as tables of CSV text, keyed "brdf", "azimuthal", "separability", "gonio" and
 // "image": the rows of the study's CSV files (budget.csv is derived from gonio), the numbers
 // written in shortest round-trip form so that reading them back gives the same doubles. The
@@ -65,14 +69,23 @@ void write_part(const std::filesystem::path& parts, const std::string& key,
 BrdfResult read_part(const std::filesystem::path& parts, const std::string& key,
                      std::size_t* order = nullptr);
 
-// The results of the parts of `dirs` (each a study output directory or its parts directory), in
-// the order of the directories and, within one, in the order of its run, and their common
-// configuration. Throws std::runtime_error naming the directory when it has no parts, when two
-// directories were run with different settings, or when a BRDF is in two of them.
+// Results gathered from several runs (directories of parts, or Python's tables) for one report.
 struct MergedParts {
   StudyConfig config;
+  std::string settings;  // describe_config() of the first run added; empty before
   std::vector<BrdfResult> results;
+  std::map<std::string, std::string> source_of;  // label -> the run it came from
 };
+
+// Appends the results of one run (`settings` its describe_config(), `source` its name for errors)
+// to `into`. Throws std::runtime_error when the settings differ from those of the runs added
+// before, or when a BRDF is already there.
+void merge_into(MergedParts& into, const std::string& settings, const std::string& source,
+                std::vector<BrdfResult> results);
+
+// The results of the parts of `dirs` (each a study output directory or its parts directory), in
+// the order of the directories and, within one, in the order of its run. Throws
+// std::runtime_error naming the directory when it has no parts, and as merge_into().
 MergedParts read_parts(const std::vector<std::filesystem::path>& dirs);
 
 }  // namespace halfback::study
