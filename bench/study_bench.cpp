@@ -11,8 +11,8 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <functional>
 #include <filesystem>
+#include <functional>
 #include <numbers>
 #include <random>
 #include <vector>

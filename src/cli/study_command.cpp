@@ -7,8 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <future>
-#include <iterator>
 #include <functional>
 #include <mutex>
 #include <set>
@@ -16,13 +14,12 @@
 #include <vector>
 
 #include "command.hpp"
-#include "halfback/figure/material.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/study/parts.hpp"
 #include "halfback/study/report.hpp"
+#include "halfback/study/study.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/csv.hpp"
-#include "halfback/study/study.hpp"
 
 namespace halfback::cli {
 
@@ -61,9 +58,10 @@ std::vector<std::string> expand_specs(const std::vector<std::string>& specs) {
         detect_brdf_format(spec) == BrdfFileFormat::unknown) {
       const auto files = brdf_files_in(spec);
       if (files.empty())
-        throw UsageError(fmt::format("'{}': no MERL, RGL, ALTA or neural BRDF file in this "
-                                     "directory",
-                                     spec));
+        throw UsageError(
+            fmt::format("'{}': no MERL, RGL, ALTA or neural BRDF file in this "
+                        "directory",
+                        spec));
       for (const auto& f : files) out.push_back(f.string());
     } else if (std::filesystem::exists(spec, ec)) {
       if (detect_brdf_format(spec) == BrdfFileFormat::unknown) load_brdf(spec);  // its error
@@ -258,7 +256,8 @@ Command register_study(CLI::App& parent) {
                   "specs");
   app->add_option("-o,--out", o->out, "Output directory (created if missing)")
       ->capture_default_str();
-  app->add_option("--space", o->settings.space, "Error space: linear, log (log(1 + Y)) or cbrt (Y^(1/3))")
+  app->add_option("--space", o->settings.space,
+                  "Error space: linear, log (log(1 + Y)) or cbrt (Y^(1/3))")
       ->capture_default_str();
   app->add_flag("--quick", o->settings.quick,
                 "A small study: 24 x 24 x 32 grids, budgets 1000,10000, 20000 test pairs, "
@@ -277,18 +276,22 @@ Command register_study(CLI::App& parent) {
   app->add_option("--image-budget", o->settings.image_budget,
                   "The budget whose reconstructions are rendered (one of --budgets; default "
                   "10000)");
-  app->add_option("--image-size", o->settings.image_size, "Width and height of the renderings (default 96)")
+  app->add_option("--image-size", o->settings.image_size,
+                  "Width and height of the renderings (default 96)")
       ->check(CLI::Range(8, 4096));
-  app->add_option("--image-spp", o->settings.image_spp, "Samples per pixel of the renderings (default 16)")
+  app->add_option("--image-spp", o->settings.image_spp,
+                  "Samples per pixel of the renderings (default 16)")
       ->check(CLI::Range(1, 1 << 16));
   app->add_option("--max-theta", o->settings.max_theta,
                   "The gonio-reflectometer's reach: no measurement where a direction is farther "
                   "from the normal (degrees)")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 90.0));
-  app->add_option("--seed", o->settings.seed, "Seed of the test pairs, stratified designs and renderings")
+  app->add_option("--seed", o->settings.seed,
+                  "Seed of the test pairs, stratified designs and renderings")
       ->capture_default_str();
-  app->add_flag("--no-gonio", o->settings.no_gonio, "Metrics 1-2 only (no gonio-reflectometer, no images)");
+  app->add_flag("--no-gonio", o->settings.no_gonio,
+                "Metrics 1-2 only (no gonio-reflectometer, no images)");
   app->add_flag("--no-images", o->settings.no_images, "No image-space error");
   app->add_flag("--resume", o->resume,
                 "Continue an interrupted run in --out: the BRDFs whose results it holds "

@@ -9,9 +9,9 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -506,19 +506,32 @@ study::StudySettings study_settings(const py::object& settings) {
   if (settings.is_none()) return s;
   for (const auto& [k, v] : settings.cast<py::dict>()) {
     const std::string key = py::str(k);
-    if (key == "space") s.space = setting<std::string>(v, key);
-    else if (key == "quick") s.quick = setting<bool>(v, key);
-    else if (key == "no_gonio") s.no_gonio = setting<bool>(v, key);
-    else if (key == "no_images") s.no_images = setting<bool>(v, key);
-    else if (key == "budgets") s.budgets = setting<std::vector<std::size_t>>(v, key);
-    else if (key == "budgets_4d") s.budgets_4d = setting<std::vector<std::size_t>>(v, key);
-    else if (key == "test_pairs") s.test_pairs = setting<std::size_t>(v, key);
-    else if (key == "image_budget") s.image_budget = setting<std::size_t>(v, key);
-    else if (key == "image_size") s.image_size = setting<int>(v, key);
-    else if (key == "image_spp") s.image_spp = setting<int>(v, key);
-    else if (key == "max_theta") s.max_theta = setting<double>(v, key);
-    else if (key == "seed") s.seed = setting<std::uint64_t>(v, key);
-    else if (key == "env") s.environments = setting<std::vector<std::string>>(v, key);
+    if (key == "space")
+      s.space = setting<std::string>(v, key);
+    else if (key == "quick")
+      s.quick = setting<bool>(v, key);
+    else if (key == "no_gonio")
+      s.no_gonio = setting<bool>(v, key);
+    else if (key == "no_images")
+      s.no_images = setting<bool>(v, key);
+    else if (key == "budgets")
+      s.budgets = setting<std::vector<std::size_t>>(v, key);
+    else if (key == "budgets_4d")
+      s.budgets_4d = setting<std::vector<std::size_t>>(v, key);
+    else if (key == "test_pairs")
+      s.test_pairs = setting<std::size_t>(v, key);
+    else if (key == "image_budget")
+      s.image_budget = setting<std::size_t>(v, key);
+    else if (key == "image_size")
+      s.image_size = setting<int>(v, key);
+    else if (key == "image_spp")
+      s.image_spp = setting<int>(v, key);
+    else if (key == "max_theta")
+      s.max_theta = setting<double>(v, key);
+    else if (key == "seed")
+      s.seed = setting<std::uint64_t>(v, key);
+    else if (key == "env")
+      s.environments = setting<std::vector<std::string>>(v, key);
     else
       throw py::value_error("settings: unknown key '" + key +
                             "' (accepted: space, quick, budgets, budgets_4d, test_pairs, env, "

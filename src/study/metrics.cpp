@@ -92,7 +92,7 @@ double weighted_rank_error(const Eigen::MatrixXd& m, const Eigen::MatrixXd& w, i
     const Eigen::MatrixXd rhs = weighted_target * other;
     if (r <= 8)  // the usual ranks: the small systems on the stack
       solve_normal_rows<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>>(normals,
-                                                                                       rhs, side);
+                                                                                        rhs, side);
     else
       solve_normal_rows<Eigen::MatrixXd>(normals, rhs, side);
   };

@@ -6,10 +6,10 @@
 #include <cctype>
 #include <charconv>
 #include <optional>
-#include <type_traits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "halfback/render/image.hpp"
 #include "halfback/util/atomic_file.hpp"
@@ -184,7 +184,9 @@ std::string study_label(std::string_view spec, const Brdf& brdf) {
 
 namespace {
 
-std::string num(double v) { return format_csv_number(v); }
+std::string num(double v) {
+  return format_csv_number(v);
+}
 
 void add_rank_rows(std::string& csv, const std::string& brdf, std::string_view pn,
                    const std::vector<double>& errors, int dims) {
@@ -205,8 +207,8 @@ void add_gonio_rows(std::string& csv, const std::string& brdf, std::string_view 
 StudyTables to_tables(const BrdfResult& b) {
   const std::string brdf = csv_text_field(b.label);
   StudyTables t;
-  t["brdf"] = fmt::format("brdf,isotropic,seconds\n{},{},{}\n", brdf, int(b.isotropic),
-                          num(b.seconds));
+  t["brdf"] =
+      fmt::format("brdf,isotropic,seconds\n{},{},{}\n", brdf, int(b.isotropic), num(b.seconds));
   std::string az = "brdf,parameterization,error,dims\n";
   std::string sep = "brdf,parameterization,rank_index,error,dims\n";
   std::string gonio = "brdf,parameterization,design,samples,error,dims,budget\n";
@@ -224,8 +226,8 @@ StudyTables to_tables(const BrdfResult& b) {
     add_gonio_rows(gonio, brdf, pn, p.gonio_4d, 4);
     for (const ImagePoint& i : p.images)
       image += fmt::format("{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(i.design), i.samples,
-                           csv_text_field(i.environment), num(i.relative_rmse),
-                           num(i.mean_delta_e), num(i.p95_delta_e));
+                           csv_text_field(i.environment), num(i.relative_rmse), num(i.mean_delta_e),
+                           num(i.p95_delta_e));
   }
   t["azimuthal"] = az;
   t["separability"] = sep;
@@ -374,9 +376,9 @@ render::Image strip_of(const std::vector<render::Image>& images) {
   s.rgb.resize(std::size_t(s.width) * std::size_t(s.height) * 3);
   for (std::size_t k = 0; k < images.size(); ++k)
     for (int y = 0; y < s.height; ++y)
-      std::copy_n(images[k].pixel(0, y), std::size_t(images[k].width) * 3,
-                  &s.rgb[3 * (std::size_t(y) * std::size_t(s.width) +
-                              k * std::size_t(images[k].width))]);
+      std::copy_n(
+          images[k].pixel(0, y), std::size_t(images[k].width) * 3,
+          &s.rgb[3 * (std::size_t(y) * std::size_t(s.width) + k * std::size_t(images[k].width))]);
   return s;
 }
 
@@ -393,7 +395,9 @@ std::vector<render::Image> images_of(const render::Image& strip, int size) {
 
 }  // namespace
 
-std::filesystem::path parts_dir(const std::filesystem::path& out) { return out / "parts"; }
+std::filesystem::path parts_dir(const std::filesystem::path& out) {
+  return out / "parts";
+}
 
 std::string part_key(std::string_view spec) {
   std::string name(std::filesystem::path(spec).filename().string());
@@ -472,8 +476,8 @@ MergedParts read_parts(const std::vector<std::filesystem::path>& dirs) {
         std::filesystem::exists(dir / "settings.txt", ec) ? dir : parts_dir(dir);
     const std::filesystem::path settings_file = parts / "settings.txt";
     if (!std::filesystem::exists(settings_file, ec))
-      throw std::runtime_error(fmt::format(
-          "'{}': not the output of a study (no parts/settings.txt)", dir.string()));
+      throw std::runtime_error(
+          fmt::format("'{}': not the output of a study (no parts/settings.txt)", dir.string()));
     std::vector<std::pair<std::size_t, BrdfResult>> in_dir;
     for (const auto& entry : std::filesystem::directory_iterator(parts)) {
       if (entry.path().extension() != ".part") continue;

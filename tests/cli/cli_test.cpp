@@ -1295,9 +1295,9 @@ TEST_F(CliTest, StudyBadInput) {
 
 // The options of the small studies below: a few seconds each, under the sanitizers too.
 std::vector<std::string> tiny_study(const std::string& out, std::vector<std::string> specs) {
-  std::vector<std::string> a{"study", "--quick",      "--test-pairs", "3000", "--budgets",
-                             "300,1000", "--env",     "sky",          "--image-size", "16",
-                             "--image-spp", "2",      "-o",           out};
+  std::vector<std::string> a{"study", "--quick", "--test-pairs", "3000", "--budgets",   "300,1000",
+                             "--env", "sky",     "--image-size", "16",   "--image-spp", "2",
+                             "-o",    out};
   a.insert(a.end(), specs.begin(), specs.end());
   return a;
 }
