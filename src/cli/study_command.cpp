@@ -312,8 +312,11 @@ Command register_study(CLI::App& parent) {
       "  budget.csv        the samples each needs to reach errors of 0.05, 0.02, 0.01\n"
       "  image.csv         brdf,parameterization,design,samples,environment,relative_rmse,\n"
       "                    mean_delta_e2000,p95_delta_e2000\n"
-      "Example:\n"
-      "  halfback study --out study ggx:alpha=0.2 ../shared/data/rgl");
+      "  parts/            each BRDF's results as soon as it is finished (--resume, --merge)\n"
+      "Examples:\n"
+      "  halfback study --out study ggx:alpha=0.2 ../shared/data/rgl\n"
+      "  halfback study --out study --resume ggx:alpha=0.2 ../shared/data/rgl   (after Ctrl-C)\n"
+      "  halfback study --merge run1 run2 --out all");
   return {app, [o] { return o->merge.empty() ? run_study(*o) : run_merge(*o); }};
 }
 
