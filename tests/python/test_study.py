@@ -96,3 +96,27 @@ def test_merge_equals_one_cli_run(local, tmp_path):
     other = halfback.study_brdf("test:G", dict(SETTINGS, seed=2))
     with pytest.raises(RuntimeError, match="different settings"):
         halfback.merge_study(str(tmp_path / "other"), local[:1] + [other])
+
+
+def test_study_brdf_releases_the_gil():
+    # While one thread is inside study_brdf (about a second of work), this thread keeps running
+    # Python code: with the GIL held for the whole call, it could not run until the call returned.
+    import threading
+
+    started = threading.Event()
+    done = []
+
+    def work():
+        started.set()
+        done.append(halfback.study_brdf("embedded:acrylic_felt_green", SETTINGS))
+
+    t = threading.Thread(target=work)
+    t.start()
+    started.wait()
+    turns = 0
+    while t.is_alive() and turns < 1000:
+        turns += 1
+        threading.Event().wait(0.0005)  # yields the GIL, runs again when it gets it back
+    t.join()
+    assert done and done[0]["gonio"].count("\n") == 17
+    assert turns >= 20, "the main thread did not run during study_brdf: the GIL was held"
