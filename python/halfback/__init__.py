@@ -18,11 +18,25 @@ from ._core import (
     hemisphere,
     jacobian,
     load,
-    merge_study,
     models,
-    study_brdf,
     valid,
 )
+from . import _core
+
+
+# Python functions, not the module's built-ins: pickle sends a Python function by its name, so
+# that engines which ship tasks to other processes (Dask workers) can send these; a pybind11
+# built-in cannot be pickled.
+def study_brdf(spec, settings=None):
+    return _core.study_brdf(spec, settings)
+
+
+def merge_study(out, parts):
+    return _core.merge_study(out, parts)
+
+
+study_brdf.__doc__ = _core.study_brdf.__doc__
+merge_study.__doc__ = _core.merge_study.__doc__
 
 __all__ = [
     "Brdf",

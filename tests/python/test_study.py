@@ -1,6 +1,7 @@
 """The study one BRDF at a time (halfback.study_brdf), on Dask distributed, and the merge."""
 
 import os
+import pickle
 import subprocess
 from pathlib import Path
 
@@ -53,6 +54,13 @@ def test_bad_settings_are_clear_errors():
         halfback.study_brdf("lambert", {"space": "sqrt"})
     with pytest.raises(ValueError, match=r"settings\['test_pairs'\]"):
         halfback.study_brdf("lambert", {"test_pairs": "many"})
+
+
+def test_functions_travel_to_other_processes():
+    # Engines pickle the task's function to send it to worker processes (a real cluster): by
+    # name, so these are the same functions on arrival (a pybind11 built-in does not pickle).
+    for f in (halfback.study_brdf, halfback.merge_study):
+        assert pickle.loads(pickle.dumps(f)) is f
 
 
 def test_dask_run_equals_local_run(local, tmp_path):
