@@ -1,11 +1,14 @@
 // Measured-BRDF evaluation throughput (docs/performance.md, "BRDF evaluation"):
-//   MERL nearest-bin and trilinear lookups, one thread and batched over all threads, against a
+//   MERL nearest-bin and trilinear lookups, per pair, batched on one core and batched over all
+//   threads (wall time, and the process's CPU time), against a
 //   straightforward per-pair implementation of the MERL reference lookup (acos-based half/diff
 //   angles, Rodrigues rotations: src/formats/merl_reference.hpp) measured in the same run;
-//   RGL evaluations (../shared/data/rgl, skipped when absent); ALTA scattered-data evaluations.
+//   RGL evaluations (../shared/data/rgl, skipped when absent), against RGL's own loader when the
+//   build is given a checkout of it (-DHALFBACK_RGL_REFERENCE_DIR=...); ALTA scattered data.
 // Every benchmark processes the same 65536 random direction pairs (fixed seed); items/s counts
 // pairs.
 #include <benchmark/benchmark.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -18,6 +21,11 @@
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
+
+#if defined(HALFBACK_RGL_REFERENCE)
+#define POWITACQ_IMPLEMENTATION
+#include <powitacq_rgb.h>
+#endif
 
 namespace {
 
@@ -81,6 +89,18 @@ void run_batch(benchmark::State& state, const Brdf& brdf) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
 }
 
+// eval_batch in a one-thread arena: one core (CPU time = wall time of that thread).
+void run_batch_one_core(benchmark::State& state, const Brdf& brdf) {
+  const auto& p = pairs();
+  std::vector<Rgb> out(p.size());
+  tbb::task_arena one_core(1);
+  for (auto _ : state) {
+    one_core.execute([&] { brdf.eval_batch(p, out); });
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
+}
+
 void BM_MerlReference_OneThread(benchmark::State& state) {
   const auto& p = pairs();
   const double* values = merl_data().values.data();
@@ -103,11 +123,20 @@ void BM_MerlNearest_OneThread(benchmark::State& state) {
 }
 BENCHMARK(BM_MerlNearest_OneThread)->Unit(benchmark::kMillisecond);
 
+void BM_MerlNearest_BatchOneCore(benchmark::State& state) {
+  static const MerlBrdf brdf(merl_data(), {MerlLookup::nearest});
+  run_batch_one_core(state, brdf);
+}
+BENCHMARK(BM_MerlNearest_BatchOneCore)->Unit(benchmark::kMillisecond);
+
 void BM_MerlNearest_Batch(benchmark::State& state) {
   static const MerlBrdf brdf(merl_data(), {MerlLookup::nearest});
   run_batch(state, brdf);
 }
-BENCHMARK(BM_MerlNearest_Batch)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MerlNearest_Batch)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 void BM_MerlTrilinear_OneThread(benchmark::State& state) {
   static const MerlBrdf brdf(merl_data(), {MerlLookup::trilinear});
@@ -115,11 +144,20 @@ void BM_MerlTrilinear_OneThread(benchmark::State& state) {
 }
 BENCHMARK(BM_MerlTrilinear_OneThread)->Unit(benchmark::kMillisecond);
 
+void BM_MerlTrilinear_BatchOneCore(benchmark::State& state) {
+  static const MerlBrdf brdf(merl_data(), {MerlLookup::trilinear});
+  run_batch_one_core(state, brdf);
+}
+BENCHMARK(BM_MerlTrilinear_BatchOneCore)->Unit(benchmark::kMillisecond);
+
 void BM_MerlTrilinear_Batch(benchmark::State& state) {
   static const MerlBrdf brdf(merl_data(), {MerlLookup::trilinear});
   run_batch(state, brdf);
 }
-BENCHMARK(BM_MerlTrilinear_Batch)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MerlTrilinear_Batch)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 std::filesystem::path shared_file(const char* sub) {
   const char* dir = std::getenv("HALFBACK_SHARED_DIR");
@@ -136,6 +174,27 @@ const RglBrdf* rgl() {
   return b.get();
 }
 
+#if defined(HALFBACK_RGL_REFERENCE)
+// RGL's own loader on the same file and pairs (it returns fr·cos θo, in float).
+void BM_RglReference_OneThread(benchmark::State& state) {
+  if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
+  static const powitacq_rgb::BRDF reference(
+      shared_file("rgl/ilm_l3_37_metallic_rgb.bsdf").string());
+  const auto& p = pairs();
+  for (auto _ : state) {
+    float sum = 0;
+    for (const auto& x : p) {
+      const powitacq_rgb::Vector3f wi(float(x.wi.x), float(x.wi.y), float(x.wi.z)),
+          wo(float(x.wo.x), float(x.wo.y), float(x.wo.z));
+      sum += reference.eval(wi, wo)[1];
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
+}
+BENCHMARK(BM_RglReference_OneThread)->Unit(benchmark::kMillisecond);
+#endif
+
 void BM_Rgl_OneThread(benchmark::State& state) {
   if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
   run_single(state, *rgl());
@@ -146,7 +205,13 @@ void BM_Rgl_Batch(benchmark::State& state) {
   if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
   run_batch(state, *rgl());
 }
-BENCHMARK(BM_Rgl_Batch)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Rgl_Batch)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+
+void BM_Rgl_BatchOneCore(benchmark::State& state) {
+  if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
+  run_batch_one_core(state, *rgl());
+}
+BENCHMARK(BM_Rgl_BatchOneCore)->Unit(benchmark::kMillisecond);
 
 const AltaBrdf* alta() {
   static const std::shared_ptr<const AltaBrdf> b = [] {

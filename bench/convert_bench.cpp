@@ -7,7 +7,10 @@
 //   scalar_inverse/P/T      generic interface with std math (the baseline of the speed-up)
 //   stream/6to4/T/threads:k a plain triad moving the same bytes per pair as forward (6 columns
 //   stream/4to6/T/threads:k in, 4 out) or inverse, over arrays of the same size: the memory bound
-// plus, for one conversion, every instruction set (isa/...), and a strided AoS input (aos/...).
+// plus, for one conversion, every instruction set (isa/...), and row-major (N, 6)/(N, 4) input and
+// output against SoA columns in the same run (layout/.../rows vs layout/.../soa).
+// Timing: CPU time of the calling thread for one-thread runs (the machine is shared: wall time
+// would count the other processes), wall time and the process's CPU time for threads:k > 1.
 // Counters: s_per_pair (displayed with an SI prefix, e.g. 2.1n = 2.1 ns per pair) and
 // bytes_per_second (input + output bytes per pair). HALFBACK_BENCH_PAIRS overrides the size.
 #include <benchmark/benchmark.h>
@@ -119,19 +122,34 @@ void bm_convert(benchmark::State& state, Space space, bool forward, unsigned thr
   set_counters<T>(state, d.n, 10);
 }
 
-// dirs given as one row-major (N, 6) array: the gather path.
+// The same conversion with the input and the output as row-major arrays ((N, 6) and (N, 4),
+// NumPy's default C order) or as structure-of-arrays columns, measured in the same run: the
+// transposing path of the engine against its fast layout.
 template <class T>
-void bm_convert_aos(benchmark::State& state, Space space) {
+void bm_layout(benchmark::State& state, Space space, bool forward, bool rows) {
   Data<T>& d = Data<T>::get();
-  std::vector<T> aos(6 * d.n);
-  for (std::size_t r = 0; r < d.n; ++r)
-    for (int c = 0; c < 6; ++c) aos[6 * r + c] = d.dirs[c][r];
+  const Columns<T>& src = forward ? d.dirs : d.coords[static_cast<int>(space) - 1];
+  const std::size_t nin = forward ? 6 : 4, nout = forward ? 4 : 6;
+  std::vector<T> in_rows, out_rows;
   std::vector<ConstColumn<T>> ic;
-  for (int c = 0; c < 6; ++c) ic.push_back({aos.data() + c, 6});
   std::vector<Column<T>> oc;
-  for (std::size_t c = 0; c < 4; ++c) oc.push_back({d.out[c].data(), 1});
+  if (rows) {
+    in_rows.resize(nin * d.n);
+    out_rows.assign(nout * d.n, T(0));
+    for (std::size_t r = 0; r < d.n; ++r)
+      for (std::size_t c = 0; c < nin; ++c) in_rows[nin * r + c] = src[c][r];
+    for (std::size_t c = 0; c < nin; ++c)
+      ic.push_back({in_rows.data() + c, static_cast<std::ptrdiff_t>(nin)});
+    for (std::size_t c = 0; c < nout; ++c)
+      oc.push_back({out_rows.data() + c, static_cast<std::ptrdiff_t>(nout)});
+  } else {
+    for (const auto& c : src) ic.push_back({c.data(), 1});
+    for (std::size_t c = 0; c < nout; ++c) oc.push_back({d.out[c].data(), 1});
+  }
+  const Form dirs{Space::dirs, false}, param{space, false};
   for (auto _ : state) {
-    convert<T>({Space::dirs, false}, {space, false}, ic, d.n, {oc, {}, d.valid.data()}, {1});
+    convert<T>(forward ? dirs : param, forward ? param : dirs, ic, d.n, {oc, {}, d.valid.data()},
+               {1});
     benchmark::ClobberMemory();
   }
   set_counters<T>(state, d.n, 10);
@@ -273,6 +291,15 @@ void bm_stream(benchmark::State& state, bool forward, unsigned threads) {
   set_counters<T>(state, d.n, 10);
 }
 
+// One thread: its CPU time. Several: wall time (the rate), and the process's CPU time beside it.
+void (*timing(unsigned threads))(benchmark::internal::Benchmark*) {
+  if (threads == 1)
+    return [](benchmark::internal::Benchmark* b) { b->Unit(benchmark::kMillisecond); };
+  return [](benchmark::internal::Benchmark* b) {
+    b->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+  };
+}
+
 template <class T>
 void register_all() {
   const std::string t = type_name(T{});
@@ -287,11 +314,9 @@ void register_all() {
         benchmark::RegisterBenchmark(
             (dir + "/" + p + "/" + t + "/threads:" + std::to_string(k)).c_str(),
             [=](benchmark::State& st) { bm_convert<T>(st, s, forward, k); })
-            ->UseRealTime()
-            ->Unit(benchmark::kMillisecond);
+            ->Apply(timing(k));
       benchmark::RegisterBenchmark(("scalar_" + dir + "/" + p + "/" + t).c_str(),
                                    [=](benchmark::State& st) { bm_scalar<T>(st, s, forward); })
-          ->UseRealTime()
           ->Unit(benchmark::kMillisecond);
     }
     for (unsigned k : thread_counts)
@@ -299,8 +324,7 @@ void register_all() {
           ((forward ? "stream/6to4/" : "stream/4to6/") + t + "/threads:" + std::to_string(k))
               .c_str(),
           [=](benchmark::State& st) { bm_stream<T>(st, forward, k); })
-          ->UseRealTime()
-          ->Unit(benchmark::kMillisecond);
+          ->Apply(timing(k));
   }
   for (detail::SimdIsa isa : detail::kAllIsas)
     for (bool forward : {true, false})
@@ -309,12 +333,16 @@ void register_all() {
            std::string(detail::isa_name(isa)))
               .c_str(),
           [=](benchmark::State& st) { bm_isa<T>(st, isa, Space::halfdiff, forward); })
-          ->UseRealTime()
           ->Unit(benchmark::kMillisecond);
-  benchmark::RegisterBenchmark(("aos/forward/halfdiff/" + t + "/threads:1").c_str(),
-                               [](benchmark::State& st) { bm_convert_aos<T>(st, Space::halfdiff); })
-      ->UseRealTime()
-      ->Unit(benchmark::kMillisecond);
+  for (Space s : {Space::halfdiff, Space::hybrid})
+    for (bool forward : {true, false})
+      for (bool rows : {false, true})
+        benchmark::RegisterBenchmark(
+            (std::string("layout/") + (forward ? "forward/" : "inverse/") +
+             std::string(name_of(s)) + "/" + t + (rows ? "/rows" : "/soa"))
+                .c_str(),
+            [=](benchmark::State& st) { bm_layout<T>(st, s, forward, rows); })
+            ->Unit(benchmark::kMillisecond);
 }
 
 }  // namespace

@@ -117,6 +117,9 @@ def main():
     cxx = cxx_ns_per_pair(os.path.join(a.build, "bench", "halfback_bench"),
                           r"^(forward|inverse)/hybrid/(float|double)/threads:[0-9]+/", n)
     threads = os.cpu_count()
+    # halfback_bench's name suffix: wall time and process CPU time for several threads, CPU time
+    # for one.
+    timing = "/process_time/real_time" if threads > 1 else ""
     for dtype, tname in [(np.float64, "double"), (np.float32, "float")]:
         x = random_pairs(n, dtype)
         q = halfback.convert(x, "dirs", "hybrid")
@@ -129,12 +132,12 @@ def main():
             ("dirs -> hybrid", lambda: numpy_hybrid(x), lambda: halfback.convert(x, "dirs", "hybrid"),
              lambda: halfback.convert(x, "dirs", "hybrid", out=out4),
              lambda: halfback.convert(xf, "dirs", "hybrid", out=out4f),
-             f"forward/hybrid/{tname}/threads:{threads}/real_time"),
+             f"forward/hybrid/{tname}/threads:{threads}{timing}"),
             ("hybrid -> dirs", lambda: numpy_hybrid_inverse(q),
              lambda: halfback.convert(q, "hybrid", "dirs"),
              lambda: halfback.convert(q, "hybrid", "dirs", out=out6),
              lambda: halfback.convert(qf, "hybrid", "dirs", out=out6f),
-             f"inverse/hybrid/{tname}/threads:{threads}/real_time")]:
+             f"inverse/hybrid/{tname}/threads:{threads}{timing}")]:
             t_np, t_hb, t_out = best_of(fnp) / n, best_of(fhb) / n, best_of(fout) / n
             t_col = best_of(fcol) / n
             t_cxx = cxx.get(key, float("nan"))

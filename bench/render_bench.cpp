@@ -1,5 +1,5 @@
 // halfback_render_bench: the renderer's speed and the efficiency of its sampling strategies
-// (docs/performance.md, "Rendering"). Prints Markdown tables.
+// (docs/performance.md, "Renderer"). Prints Markdown tables.
 //
 // 1. Time for a 512 × 512 sphere at 256 samples per pixel under the built-in sky, with 1 and all
 //    threads, for an analytic GGX, a MERL-format table (a model tabulated by tabulate_merl, read
@@ -13,7 +13,16 @@
 // 3. Which parameterization the tabulated sampler of measured data should use: equal-time error of
 //    MIS with the table in hybrid, halfdiff and spherical coordinates, for measured materials
 //    and a tabulated glossy model (forced tabulation).
-// --quick shrinks every part (for a smoke run); --part N runs part N only.
+// 4. Throughput (the issue-16 target): pixel samples per second per core of CPU time (user + sys,
+//    the process's CPU clock), set-up included (loading the environment and building its
+//    sampling tables, the BRDF's sampler), for GGX and the RGL metallic file under uffizi.hdr from
+//    ../shared/data (or $HALFBACK_SHARED_DIR/data). The same source builds against an older tree
+//    (the API it uses is unchanged), so the baseline is that build, run alternately with this one
+//    (docs/performance.md, "Renderer"). Options: --size N (512), --spp N (256), --threads N (1),
+//    --material ggx|rgl|all, --repeat N.
+// --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
+#include <time.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -83,14 +92,73 @@ void print_equal_time_error(const render::RenderResult& r, const render::Image& 
   std::printf(" %d spp, %.4f |", r.spp, e);
 }
 
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+struct ThroughputOptions {
+  int size = 512, spp = 256, threads = 1, repeat = 1;
+  std::string material = "all";
+};
+
+// Part 4: one line per material and repetition: CPU seconds of the set-up and of the render,
+// and pixel samples per CPU second.
+void throughput(const ThroughputOptions& o) {
+  const char* shared = std::getenv("HALFBACK_SHARED_DIR");  // as for the tests
+  const std::string data =
+      (shared && *shared ? std::string(shared) : HALFBACK_SOURCE_DIR "/../shared") + "/data/";
+  const std::string env_file = data + "envmaps/uffizi.hdr";
+  struct Timed {
+    std::string key, spec;
+  };
+  const std::vector<Timed> all{{"ggx", "ggx:alpha=0.2,f0=0.9"},
+                               {"rgl", data + "rgl/ilm_l3_37_metallic_rgb.bsdf"}};
+  std::printf("| material | set-up CPU s | render CPU s | wall s | M samples/s per CPU s |\n");
+  std::printf("|---|---|---|---|---|\n");
+  for (int rep = 0; rep < o.repeat; ++rep)
+    for (const Timed& m : all) {
+      if (o.material != "all" && o.material != m.key) continue;
+      const BrdfPtr brdf = load_brdf(m.spec);  // loading the file is not timed
+      const double c0 = cpu_seconds();
+      const auto w0 = std::chrono::steady_clock::now();
+      const render::EnvMap env = render::EnvMap::load(env_file);
+      render::RenderSettings s;
+      s.width = s.height = o.size;
+      s.spp = o.spp;
+      s.threads = o.threads;
+      const double c1 = cpu_seconds();
+      const render::RenderResult r = render::render(*brdf, env, s);
+      const double c2 = cpu_seconds();
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+      const double samples = double(o.size) * o.size * o.spp;
+      std::printf("| %s | %.3f | %.2f | %.2f | %.2f |\n", m.key.c_str(), c1 - c0, c2 - c1, wall,
+                  samples / (c2 - c0) * 1e-6);
+      std::fflush(stdout);
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   bool quick = false;
   int only = 0;
+  ThroughputOptions tp;
   for (int i = 1; i < argc; ++i) {
+    const bool more = i + 1 < argc;
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
-    if (std::strcmp(argv[i], "--part") == 0 && i + 1 < argc) only = std::atoi(argv[++i]);
+    if (std::strcmp(argv[i], "--part") == 0 && more) only = std::atoi(argv[++i]);
+    if (std::strcmp(argv[i], "--size") == 0 && more) tp.size = std::atoi(argv[++i]);
+    if (std::strcmp(argv[i], "--spp") == 0 && more) tp.spp = std::atoi(argv[++i]);
+    if (std::strcmp(argv[i], "--threads") == 0 && more) tp.threads = std::atoi(argv[++i]);
+    if (std::strcmp(argv[i], "--repeat") == 0 && more) tp.repeat = std::atoi(argv[++i]);
+    if (std::strcmp(argv[i], "--material") == 0 && more) tp.material = argv[++i];
+  }
+  if (only == 4) {
+    throughput(tp);
+    return 0;
   }
   const unsigned all = std::max(1u, std::thread::hardware_concurrency());
   const render::EnvMap sky = render::EnvMap::default_sky();

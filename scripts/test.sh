@@ -7,7 +7,19 @@ cd "$(dirname "$0")/.."
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
 export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
 
-cmake --preset release ${CI:+-DHALFBACK_WERROR=ON}
+# RGL's reference loader (rgl-epfl/brdf-loader) for the RGL writer's round-trip test
+# (src/loader/rgl_reference_test.cpp): extracted from a local git mirror into the build tree when
+# there is one, never copied into the repository; without it that test skips.
+brdf_loader_git="${HALFBACK_BRDF_LOADER_GIT:-../.mirror/rgl-epfl+brdf-loader/repo}"
+powitacq_args=()
+if git --git-dir="$brdf_loader_git" rev-parse --verify -q HEAD >/dev/null 2>&1; then
+  mkdir -p build/release/brdf-loader
+  git --git-dir="$brdf_loader_git" archive HEAD powitacq_rgb.h powitacq_rgb.inl LICENSE.md \
+    | tar -x -C build/release/brdf-loader
+  powitacq_args=(-DHALFBACK_POWITACQ_DIR="$PWD/build/release/brdf-loader")
+fi
+
+cmake --preset release ${CI:+-DHALFBACK_WERROR=ON} "${powitacq_args[@]}"
 cmake --build --preset release
 ctest --preset release
 

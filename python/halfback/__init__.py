@@ -19,6 +19,7 @@ from ._core import (
     jacobian,
     load,
     models,
+    ssim,
     valid,
 )
 from . import _core
@@ -35,8 +36,13 @@ def merge_study(out, parts):
     return _core.merge_study(out, parts)
 
 
+def study_profile(spec, settings=None):
+    return _core.study_profile(spec, settings)
+
+
 study_brdf.__doc__ = _core.study_brdf.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
+study_profile.__doc__ = _core.study_profile.__doc__
 
 __all__ = [
     "Brdf",
@@ -47,6 +53,8 @@ __all__ = [
     "load",
     "merge_study",
     "models",
+    "ssim",
     "study_brdf",
+    "study_profile",
     "valid",
 ]

@@ -70,6 +70,28 @@ std::vector<std::string> split_list(const std::string& list, const char* option,
   return items;
 }
 
+std::vector<std::string> environment_list(const std::string& list, const char* option) {
+  std::vector<std::string> specs;
+  for (std::string& item : split_list(list, option, "environment")) {
+    double ignored = 0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), ignored);
+    const bool number = ec == std::errc() && end == item.data() + item.size();
+    if (number && !specs.empty() && specs.back().rfind("constant:", 0) == 0)
+      specs.back() += "," + item;
+    else
+      specs.push_back(std::move(item));
+  }
+  return specs;
+}
+
+void rethrow_environment_error(const char* option, const std::string& spec) {
+  try {
+    throw;
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("{} '{}': {}", option, spec, e.what()));
+  }
+}
+
 double parse_number(std::string_view text, const std::string& what) {
   double v = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);

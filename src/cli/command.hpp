@@ -53,6 +53,7 @@ Command register_info(CLI::App& parent);
 Command register_eval(CLI::App& parent);
 Command register_resample(CLI::App& parent);
 Command register_export_merl(CLI::App& parent);
+Command register_export_rgl(CLI::App& parent);
 Command register_models(CLI::App& parent);
 Command register_study(CLI::App& parent);
 
@@ -93,6 +94,13 @@ void check_writable(const std::string& path);
 std::vector<std::string> split_list(const std::string& list, const char* option, const char* what);
 std::vector<double> number_list(const std::string& list, const char* option, const char* what);
 std::vector<std::size_t> count_list(const std::string& list, const char* option, const char* what);
+// A comma-separated list of environment specs, where "constant:R,G,B" keeps its own commas: an
+// item that is a number continues the constant before it ("constant:0.5,0.2,0.1,studio" -> 2).
+std::vector<std::string> environment_list(const std::string& list, const char* option);
+// Called in a catch block around the loading of an environment given as `option`: a bad spec
+// (std::invalid_argument) becomes a UsageError naming the option; anything else (an unreadable
+// or malformed file: a data error) is rethrown as it is.
+[[noreturn]] void rethrow_environment_error(const char* option, const std::string& spec);
 // One finite number; the message names `what` (e.g. "--range k=0:x").
 double parse_number(std::string_view text, const std::string& what);
 

@@ -7,10 +7,10 @@
 namespace halfback::cli {
 
 namespace {
-constexpr std::array<RegisterCommand, 9> kCommands{
-    &register_convert,  &register_info,        &register_eval,
-    &register_resample, &register_export_merl, &register_models,
-    &register_render,   &register_figure,      &register_study,
+constexpr std::array<RegisterCommand, 10> kCommands{
+    &register_convert,     &register_info,       &register_eval,   &register_resample,
+    &register_export_merl, &register_export_rgl, &register_models, &register_render,
+    &register_figure,      &register_study,
 };
 }  // namespace
 

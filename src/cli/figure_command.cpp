@@ -147,7 +147,14 @@ int run_hemisphere(const HemisphereArgs& a) {
   o.threads = a.threads;
   check_writable(a.out);
   const auto t0 = std::chrono::steady_clock::now();
-  const auto fig = figure::hemisphere_figure(o);
+  // Figure 1 reads no data: whatever its options make impossible is the command line's fault.
+  const auto fig = [&] {
+    try {
+      return figure::hemisphere_figure(o);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+  }();
   finish(fig.scene, a.out, a.scale, since(t0));
   return kExitOk;
 }
@@ -195,14 +202,15 @@ int run_slices(const SliceArgs& a) {
   return kExitOk;
 }
 
-// The environments, each loaded (or built) once; a bad one is a usage error naming it.
-std::vector<render::Environment> environment_list(const std::string& list) {
+// The environments, each loaded (or built) once: a bad spec is a usage error naming it, an
+// unreadable file a data error (as in `halfback render`).
+std::vector<render::Environment> load_environments(const std::string& list) {
   std::vector<render::Environment> envs;
-  for (const std::string& e : split_list(list, "--env", "environment")) {
+  for (const std::string& e : environment_list(list, "--env")) {
     try {
       envs.push_back(render::load_environment(e));
-    } catch (const std::exception& ex) {
-      throw UsageError(fmt::format("--env '{}': {}", e, ex.what()));
+    } catch (...) {
+      rethrow_environment_error("--env", e);
     }
   }
   return envs;
@@ -211,7 +219,7 @@ std::vector<render::Environment> environment_list(const std::string& list) {
 int run_material(const MaterialArgs& a) {
   check_scale(a.scale);
   figure::MaterialFigureOptions o;
-  o.environments = environment_list(a.envs);
+  o.environments = load_environments(a.envs);
   o.slices.params = parameterizations(a.params);
   o.slices.azimuths_deg = number_list(a.azimuths, "--azimuths", "azimuth");
   if (a.colour == "luminance")
@@ -248,7 +256,7 @@ int run_paper(const PaperArgs& a) {
       throw UsageError(fmt::format("--formats: unknown format '{}' (expected png, svg, pdf)", f));
   }
   o.threads = a.threads;
-  o.environments = environment_list(a.envs);
+  o.environments = load_environments(a.envs);
   o.render_pixels = a.render_pixels;
   o.spp = a.spp;
   std::vector<std::string> specs = a.materials;
@@ -371,8 +379,8 @@ Command add_paper(CLI::App& figure) {
                 "each, in name order, instead of the default materials");
   p->add_flag("--no-materials", pa->no_materials, "Figures 1 and 2 only");
   p->add_option("--env", pa->envs,
-                "Environments of the sphere renderings: default, studio, sunset, constant:V or "
-                ".hdr/.exr files, comma-separated")
+                "Environments of the sphere renderings: default, studio, sunset, constant:V, "
+                "constant:R,G,B or .hdr/.exr files, comma-separated")
       ->capture_default_str();
   p->add_option("--render-size", pa->render_pixels, "Pixels of each sphere rendering")
       ->check(CLI::Range(16, 2048))
@@ -394,8 +402,8 @@ Command add_material(CLI::App& figure) {
   m->add_option("--brdf", ma->brdf, "BRDF SPEC: a file (MERL, RGL, ALTA) or a model")->required();
   m->add_option("--title", ma->heading, "Figure title (default: the BRDF's name)");
   m->add_option("--env", ma->envs,
-                "Environments: default, studio, sunset, constant:V or .hdr/.exr files, "
-                "comma-separated")
+                "Environments: default, studio, sunset, constant:V, constant:R,G,B or .hdr/.exr "
+                "files, comma-separated")
       ->capture_default_str();
   m->add_option("--param", ma->params, "Parameterizations, one row of slices each")
       ->capture_default_str();

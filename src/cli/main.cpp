@@ -45,6 +45,23 @@ std::string command_names(const std::vector<Command>& commands) {
   return s;
 }
 
+// CLI11 says only "A subcommand is required" for "halfback figure" and "halfback figure bogus":
+// name the word that is not a subcommand, and the ones there are.
+std::string missing_subcommand_message(const CLI::App& parent, int argc, char** argv) {
+  std::string names;
+  for (const CLI::App* sub : parent.get_subcommands({}))
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  int at = 1;
+  while (at < argc && argv[at] != parent.get_name()) ++at;
+  for (++at; at < argc; ++at) {
+    const std::string word = argv[at];
+    if (!word.empty() && word.front() != '-')
+      return fmt::format("'{}' is not a {} subcommand (the subcommands are: {})", word,
+                         parent.get_name(), names);
+  }
+  return fmt::format("a subcommand is required (one of: {})", names);
+}
+
 int run_command(const std::string& who, const Command& command) {
   try {
     return command.run();
@@ -79,10 +96,17 @@ int run(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::string who = "halfback";
-    for (const CLI::App* sub : app.get_subcommands()) who += " " + sub->get_name();
+    const CLI::App* deepest = &app;
+    while (!deepest->get_subcommands().empty()) {
+      deepest = deepest->get_subcommands().front();
+      who += " " + deepest->get_name();
+    }
     if (who == "halfback" && dynamic_cast<const CLI::ExtrasError*>(&e) && !app.remaining().empty())
       report_error(who, fmt::format("unknown command '{}' (the commands are: {})",
                                     app.remaining().front(), command_names(commands)));
+    else if (dynamic_cast<const CLI::RequiredError*>(&e) && deepest != &app &&
+             !deepest->get_subcommands({}).empty())
+      report_error(who, missing_subcommand_message(*deepest, argc, argv));
     else
       report_error(who, e.what());
     usage_hint(who);

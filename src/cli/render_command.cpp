@@ -56,7 +56,13 @@ int run_render(const RenderOptions& o) {
   s.progress = !o.quiet;  // drawn only when stderr is a terminal
 
   const BrdfPtr brdf = load_brdf(o.brdf);
-  const render::EnvMap env = render::EnvMap::from_spec(o.env, {o.env_rotation, o.env_exposure});
+  const render::EnvMap env = [&] {
+    try {
+      return render::EnvMap::from_spec(o.env, {o.env_rotation, o.env_exposure});
+    } catch (...) {
+      rethrow_environment_error("--env", o.env);
+    }
+  }();
   const render::RenderResult r = render::render(*brdf, env, s);
   if (r.nonfinite_pixels)
     throw std::runtime_error(

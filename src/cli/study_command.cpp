@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "command.hpp"
+#include "halfback/core/parallel.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/study/parts.hpp"
 #include "halfback/study/report.hpp"
@@ -29,6 +30,7 @@ struct StudyOptions {
   std::vector<std::string> specs, merge;
   std::string out = "study";
   std::string budgets, budgets_4d, environments;
+  std::string designs = "own,angle,merl,learned";
   study::StudySettings settings;
   bool resume = false;
 };
@@ -40,6 +42,7 @@ study::StudyConfig make_config(const StudyOptions& o) {
   if (!o.budgets_4d.empty())
     s.budgets_4d = count_list(o.budgets_4d, "--budgets-4d", "sample budget");
   if (!o.environments.empty()) s.environments = split_list(o.environments, "--env", "environment");
+  s.designs = split_list(o.designs, "--designs", "design");
   try {
     return study::make_config(s);
   } catch (const std::invalid_argument& e) {
@@ -204,12 +207,63 @@ study::BrdfResult study_one(const std::string& spec, std::size_t k,
   return study::read_part(parts, key);
 }
 
+// The first pass of the learned design: every BRDF's profile (each file loaded once, one at a
+// time per task), kept in OUT/profiles/SPACE-GRID/ so that --resume reuses them. A duplicate label
+// stops the run here, before any work, as leave-one-out would not know which BRDF to leave out.
+std::vector<study::LabeledProfile> profile_pass(const std::vector<std::string>& specs,
+                                                const std::filesystem::path& out,
+                                                const study::StudyConfig& config, bool resume) {
+  // One directory per error space and grid: a profile depends on them, and --resume with other
+  // settings (refused) must not leave profiles that a later --resume would take for these.
+  const study::IsoGrid& g = config.profile_grid;
+  const std::filesystem::path dir =
+      study::profiles_dir(out) / fmt::format("{}-{}x{}x{}", name_of(config.space), g.a, g.b, g.phi);
+  make_output_dir(dir);
+  std::vector<study::LabeledProfile> profiles(specs.size());
+  std::vector<char> reused(specs.size(), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = cpu_seconds();
+  parallel_for(specs.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::filesystem::path file = dir / (study::part_key(specs[k]) + ".profile");
+      std::error_code ec;
+      if (resume && std::filesystem::exists(file, ec)) {
+        profiles[k] = study::profile_from_text(read_text_file(file), file.string());
+        reused[k] = 1;
+        continue;
+      }
+      const BrdfPtr brdf = load_brdf(specs[k]);
+      profiles[k] = study::study_profile(*brdf, study::study_label(specs[k], *brdf), config);
+      write_file_atomically(file, study::profile_text(profiles[k]));
+    }
+  });
+  std::set<std::string> labels;
+  for (std::size_t k = 0; k < specs.size(); ++k)
+    if (!labels.insert(profiles[k].label).second)
+      throw std::runtime_error(fmt::format(
+          "'{}': a second BRDF named '{}' (the tables would mix them); study it separately",
+          specs[k], profiles[k].label));
+  const auto kept = std::count(reused.begin(), reused.end(), 1);
+  fmt::print(stderr,
+             "halfback study: profiles of {} BRDFs for the learned design in {:.1f} s ({:.1f} CPU "
+             "s){}\n",
+             specs.size(),
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+             cpu_seconds() - cpu0, kept ? fmt::format("; {} kept from the earlier run", kept) : "");
+  return profiles;
+}
+
 int run_study(StudyOptions& o) {
   if (o.specs.empty()) throw UsageError("no BRDF given (files, directories or model specs)");
   study::StudyConfig config = make_config(o);
   const std::vector<std::string> specs = expand_specs(o.specs);
   make_output_dir(o.out);
   check_writable((std::filesystem::path(o.out) / "report.md").string());
+  std::vector<study::LabeledProfile> profiles;
+  if (study::wants_learned(config)) {
+    profiles = profile_pass(specs, o.out, config, o.resume);
+    config.learned_from = study::learned_fingerprint(profiles);
+  }
   const std::filesystem::path parts = prepare_parts(o, config);
 
   Progress progress(specs.size());
@@ -217,6 +271,7 @@ int run_study(StudyOptions& o) {
   std::vector<study::BrdfResult> results;
   std::set<std::string> labels;
   for (std::size_t k = 0; k < specs.size(); ++k) {
+    if (!profiles.empty()) study::set_learned(config, profiles, profiles[k].label);
     results.push_back(study_one(specs[k], k, parts, config, o.resume, progress));
     if (!labels.insert(results.back().label).second)
       throw std::runtime_error(fmt::format(
@@ -256,8 +311,15 @@ Command register_study(CLI::App& parent) {
                   "specs");
   app->add_option("-o,--out", o->out, "Output directory (created if missing)")
       ->capture_default_str();
-  app->add_option("--space", o->settings.space,
-                  "Error space: linear, log (log(1 + Y)) or cbrt (Y^(1/3))")
+  app->add_option("--space,--error-space", o->settings.space,
+                  "Error space: linear, log (ln(1 + Y)), cbrt (Y^(1/3)), nielsen (Nielsen et al. "
+                  "2015's log-relative mapping) or low (Low et al. 2012's cosine-weighted log)")
+      ->capture_default_str();
+  app->add_option("--designs", o->designs,
+                  "Designs of the gonio-reflectometer, comma-separated: own (uniform in the "
+                  "coordinates), angle (sine-like magnitudes through asin), merl (angle, and sqrt "
+                  "of the half-vector angle), learned (warps fitted on the other BRDFs' profiles, "
+                  "computed first and kept in OUT/profiles/)")
       ->capture_default_str();
   app->add_flag("--quick", o->settings.quick,
                 "A small study: 24 x 24 x 32 grids, budgets 1000,10000, 20000 test pairs, "
@@ -307,12 +369,14 @@ Command register_study(CLI::App& parent) {
       "  separability.csv  brdf,parameterization,rank,error,dims: best rank-r approximations of\n"
       "                    the 2D projection (dims 2), the 3D table unfolded along the azimuth\n"
       "                    (3), the 4D table as (a, phi_a) x (b, phi_b) (4)\n"
-      "  gonio.csv         brdf,parameterization,design,samples,error,dims,budget: the virtual\n"
-      "                    gonio-reflectometer (regular and stratified designs)\n"
+      "  gonio.csv         brdf,parameterization,design,samples,error,dims,budget,spacing: the\n"
+      "                    virtual gonio-reflectometer (regular and stratified layouts; the\n"
+      "                    spacing of --designs)\n"
       "  budget.csv        the samples each needs to reach errors of 0.05, 0.02, 0.01\n"
       "  image.csv         brdf,parameterization,design,samples,environment,relative_rmse,\n"
-      "                    mean_delta_e2000,p95_delta_e2000\n"
+      "                    mean_delta_e2000,p95_delta_e2000,mae,rmse,ssim\n"
       "  parts/            each BRDF's results as soon as it is finished (--resume, --merge)\n"
+      "  profiles/         each BRDF's profile for the learned design (--resume reuses them)\n"
       "Examples:\n"
       "  halfback study --out study ggx:alpha=0.2 ../shared/data/rgl\n"
       "  halfback study --out study --resume ggx:alpha=0.2 ../shared/data/rgl   (after Ctrl-C)\n"

@@ -155,12 +155,9 @@ void check_shapes(Form from, Form to, std::size_t n_in, std::size_t n_out) {
     throw std::invalid_argument("convert: dirs has no isotropic form");
 }
 
-constexpr std::size_t kTileBytes = 2048;  // per column: a tile's ~20 columns stay in L1
+using detail::kTileRows;
 // A thread is worth starting only for this many tiles (~10^4 rows, tens of microseconds).
 constexpr std::size_t kMinTilesPerThread = 32;
-
-template <class T>
-constexpr std::size_t kTileRows = kTileBytes / sizeof(T);
 
 // The kernels and the column layout of one convert() call.
 template <class T>
@@ -177,6 +174,10 @@ struct Plan {
   // The measure: of the output coordinates, or of the input ones when `to` is dirs; none (1 for a
   // valid row) when both are dirs.
   typename Stages::JacobianFn jacobian_in = nullptr, jacobian_out = nullptr;
+  // Set when the input (output) columns are the fields of one row-major array of dimension(from)
+  // (dimension(to)) values a row: moved by one vectorized transpose instead of per column.
+  typename Stages::GatherFn gather = nullptr;
+  typename Stages::ScatterFn scatter = nullptr;
 
   Plan(const Stages& k, Form f, Form t, std::span<const ConstColumn<T>> i,
        const ConvertOutput<T>& o)
@@ -194,6 +195,17 @@ struct Plan {
       encode = k.encode[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0];
       if (want_jac) jacobian_out = k.jacobian[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0];
     }
+    if (interleaved(in)) gather = k.gather[dim_in];
+    if (interleaved(std::span<const Column<T>>(o.columns))) scatter = k.scatter[dim_out];
+  }
+
+  // Whether column c is field c of one row-major array of columns.size() values a row.
+  template <class C>
+  static bool interleaved(std::span<const C> columns) {
+    const auto d = static_cast<std::ptrdiff_t>(columns.size());
+    for (std::ptrdiff_t c = 0; c < d; ++c)
+      if (columns[c].stride != d || columns[c].data != columns[0].data + c) return false;
+    return true;
   }
 };
 
@@ -223,9 +235,13 @@ class TileRunner {
     const Plan<T>& p = plan_;
     const auto base = static_cast<std::ptrdiff_t>(r0);
     const T* in[detail::kMaxDim];
+    if (p.gather)
+      p.gather(p.in[0].data + base * static_cast<std::ptrdiff_t>(p.dim_in), column(kInput), m);
     for (std::size_t c = 0; c < p.dim_in; ++c) {
       const ConstColumn<T>& col = p.in[c];
-      if (col.stride == 1) {
+      if (p.gather) {
+        in[c] = column(kInput + c);
+      } else if (col.stride == 1) {
         in[c] = col.data + base;
       } else {
         T* s = column(kInput + c);
@@ -263,12 +279,17 @@ class TileRunner {
     if (jac && p.jacobian_out) p.jacobian_out(out, jac, m);
     if (jac) mask_jacobian(mask, jac, m, !p.jacobian_in && !p.jacobian_out);
 
-    for (std::size_t c = 0; c < p.dim_out; ++c) {
-      const Column<T>& col = p.out->columns[c];
-      if (col.stride == 1) continue;
-      T* dst = col.data + base * col.stride;
-      for (std::size_t i = 0; i < m; ++i)
-        dst[static_cast<std::ptrdiff_t>(i) * col.stride] = out[c][i];
+    if (p.scatter) {
+      p.scatter(column(kOutput),
+                p.out->columns[0].data + base * static_cast<std::ptrdiff_t>(p.dim_out), m);
+    } else {
+      for (std::size_t c = 0; c < p.dim_out; ++c) {
+        const Column<T>& col = p.out->columns[c];
+        if (col.stride == 1) continue;
+        T* dst = col.data + base * col.stride;
+        for (std::size_t i = 0; i < m; ++i)
+          dst[static_cast<std::ptrdiff_t>(i) * col.stride] = out[c][i];
+      }
     }
     if (jac && jcol.stride != 1) {
       T* dst = jcol.data + base * jcol.stride;
@@ -304,8 +325,11 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
   constexpr std::size_t tile = kTileRows<T>;
   const std::size_t tiles = (n + tile - 1) / tile;
   auto run_tiles = [&](std::size_t t0, std::size_t t1) {
-    const std::size_t rows = std::min(tile, n - t0 * tile);
-    TileRunner<T> runner(plan, (rows + 63) / 64 * 64);
+    // The transposes are compiled for scratch columns kTileRows apart; otherwise a small batch
+    // gets a small scratch.
+    const std::size_t rows =
+        plan.gather || plan.scatter ? tile : (std::min(tile, n - t0 * tile) + 63) / 64 * 64;
+    TileRunner<T> runner(plan, rows);
     for (std::size_t t = t0; t < t1; ++t) runner.run(t * tile, std::min(tile, n - t * tile));
   };
 

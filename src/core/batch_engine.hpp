@@ -25,6 +25,11 @@ enum class SimdIsa { scalar, sse2, avx2, avx512 };
 inline constexpr SimdIsa kAllIsas[] = {SimdIsa::scalar, SimdIsa::sse2, SimdIsa::avx2,
                                        SimdIsa::avx512};
 
+// Rows per tile: a tile holds kTileBytes of each column (~20 columns stay in L1).
+inline constexpr std::size_t kTileBytes = 2048;
+template <class T>
+inline constexpr std::size_t kTileRows = kTileBytes / sizeof(T);
+
 template <class T>
 struct StageKernels {
   using CheckFn = void (*)(const T* const* in, T* const* copy, T* mask, std::size_t m);
@@ -36,6 +41,12 @@ struct StageKernels {
   DecodeFn decode[4][2];      // [space - 1][isotropic]
   EncodeFn encode[4][2];      // [space - 1][isotropic]
   JacobianFn jacobian[4][2];  // [space - 1][isotropic]
+  // Transposes between m rows of D values (a row-major (m, D) array, such as a NumPy C-order
+  // array) and D scratch columns spaced kTileRows<T> apart; [D] for D = 3, 4, 6, else null.
+  using GatherFn = void (*)(const T* rows, T* columns, std::size_t m);
+  using ScatterFn = void (*)(const T* columns, T* rows, std::size_t m);
+  GatherFn gather[7];
+  ScatterFn scatter[7];
 };
 
 struct KernelSet {

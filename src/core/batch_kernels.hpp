@@ -165,6 +165,61 @@ HALFBACK_FLATTEN void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<
   for_rows<B, NI, 1>(coords, outs, m, [](const B* q, B* y) { y[0] = jacobian_of<P, B>(Iso, q); });
 }
 
+template <class S, int D, std::size_t Pitch>
+inline void gather_rows_spaced(const S* __restrict rows, S* __restrict columns, std::size_t m) {
+  for (std::size_t i = 0; i < m; ++i)
+    for (int c = 0; c < D; ++c) columns[c * Pitch + i] = rows[D * i + c];
+}
+
+template <class S, int D, std::size_t Pitch>
+inline void scatter_rows_spaced(const S* __restrict columns, S* __restrict rows, std::size_t m) {
+  for (std::size_t i = 0; i < m; ++i)
+    for (int c = 0; c < D; ++c) rows[D * i + c] = columns[c * Pitch + i];
+}
+
+// Row-major (m, D) <-> D columns kTileRows apart. Plain loops with compile-time D and spacing,
+// which GCC vectorizes with this translation unit's permutes (a runtime spacing defeats it, and so
+// does a group of 6: rows of 6 go as 2m rows of 3 and an even/odd split, both vectorized).
+template <class S, int D>
+void gather_rows(const S* __restrict rows, S* __restrict columns, std::size_t m) {
+  constexpr std::size_t pitch = kTileRows<S>;
+  if constexpr (D == 6) {
+    alignas(64) S half[3 * 2 * pitch];  // 3 columns of the 2m half-rows (ωi, ωo, ωi, ...)
+    gather_rows_spaced<S, 3, 2 * pitch>(rows, half, 2 * m);
+    for (int c = 0; c < 3; ++c) {
+      const S* __restrict h = half + c * 2 * pitch;
+      S* __restrict wi = columns + c * pitch;
+      S* __restrict wo = columns + (c + 3) * pitch;
+      for (std::size_t i = 0; i < m; ++i) {
+        wi[i] = h[2 * i];
+        wo[i] = h[2 * i + 1];
+      }
+    }
+  } else {
+    gather_rows_spaced<S, D, pitch>(rows, columns, m);
+  }
+}
+
+template <class S, int D>
+void scatter_rows(const S* __restrict columns, S* __restrict rows, std::size_t m) {
+  constexpr std::size_t pitch = kTileRows<S>;
+  if constexpr (D == 6) {
+    alignas(64) S half[3 * 2 * pitch];
+    for (int c = 0; c < 3; ++c) {
+      S* __restrict h = half + c * 2 * pitch;
+      const S* __restrict wi = columns + c * pitch;
+      const S* __restrict wo = columns + (c + 3) * pitch;
+      for (std::size_t i = 0; i < m; ++i) {
+        h[2 * i] = wi[i];
+        h[2 * i + 1] = wo[i];
+      }
+    }
+    scatter_rows_spaced<S, 3, 2 * pitch>(half, rows, 2 * m);
+  } else {
+    scatter_rows_spaced<S, D, pitch>(columns, rows, m);
+  }
+}
+
 template <class B, class P, int Space>
 constexpr void fill_param(StageKernels<ScalarOf<B>>& k) {
   k.decode[Space][0] = &decode_stage<B, P, false>;
@@ -180,6 +235,13 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   StageKernels<ScalarOf<B>> k{};
   k.width = Lanes<B>::size;
   k.check = &check_stage<B>;
+  using S = ScalarOf<B>;
+  k.gather[3] = &gather_rows<S, 3>;
+  k.gather[4] = &gather_rows<S, 4>;
+  k.gather[6] = &gather_rows<S, 6>;
+  k.scatter[3] = &scatter_rows<S, 3>;
+  k.scatter[4] = &scatter_rows<S, 4>;
+  k.scatter[6] = &scatter_rows<S, 6>;
   // Indices follow Space: spherical = 1, halfdiff = 2, ortho = 3, hybrid = 4.
   fill_param<B, Spherical, 0>(k);
   fill_param<B, HalfDiff, 1>(k);

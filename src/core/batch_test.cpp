@@ -535,6 +535,28 @@ TYPED_TEST(BatchTest, StridedLayoutsGiveTheSameBitsAsSoa) {
         EXPECT_TRUE(same_bits(aos, soa))
             << label << ": AoS (stride " << din << " -> " << row << ")";
 
+        // Row-major input and output of exactly din and dout values a row (NumPy's C order):
+        // the engine's transposing path, over several tiles and a tail (n = 1001).
+        std::vector<T> rows_out(n * dout, T(-7));
+        for (std::size_t c = 0; c < dout; ++c)
+          oc[c] = {rows_out.data() + c, static_cast<std::ptrdiff_t>(dout)};
+        std::vector<std::uint8_t> rows_valid(n, 7);
+        convert<T>(from, to, ic, n, {oc, {}, rows_valid.data()});
+        Result<T> rows{make_table<T>(dout, n), soa.jac, rows_valid};
+        for (std::size_t r = 0; r < n; ++r)
+          for (std::size_t c = 0; c < dout; ++c) rows.cols[c][r] = rows_out[r * dout + c];
+        EXPECT_TRUE(same_bits(rows, soa)) << label << ": rows of " << din << " -> " << dout;
+        if (din == dout) {  // in place: the output overwrites the input array
+          std::vector<T> inout(aos_in);
+          std::vector<ConstColumn<T>> ip(din);
+          for (std::size_t c = 0; c < din; ++c)
+            ip[c] = {inout.data() + c, static_cast<std::ptrdiff_t>(din)};
+          for (std::size_t c = 0; c < dout; ++c)
+            oc[c] = {inout.data() + c, static_cast<std::ptrdiff_t>(dout)};
+          convert<T>(from, to, ip, n, {oc, {}, rows_valid.data()});
+          EXPECT_TRUE(same_bits(inout, rows_out)) << label << ": in place";
+        }
+
         ic.clear();
         for (std::size_t c = 0; c < din; ++c) ic.push_back({in[c].data(), 1});
         ic[0] = {rev.data() + (n - 1), -1};

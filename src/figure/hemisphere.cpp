@@ -9,6 +9,7 @@
 
 #include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
+#include "halfback/figure/render.hpp"
 
 namespace halfback::figure {
 
@@ -312,6 +313,10 @@ HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
   Scene& sc = fig.scene;
   sc.width = snap(left + double(cols) * D + double(cols - 1) * gap + key_gap + key + right);
   sc.height = snap(top + double(rows) * D + double(rows - 1) * vgap + bottom);
+  check_raster_size(sc.width, sc.height, o.pixels_per_point,
+                    fmt::format("fewer elevations ({} given) or parameterizations ({} given), or "
+                                "a lower pixel density",
+                                cols, rows));
   sc.title = "Figure 1: the hemisphere of incoming directions for a fixed outgoing direction";
 
   sc.text({left, 20},

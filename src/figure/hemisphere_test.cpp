@@ -170,6 +170,17 @@ TEST(HemisphereFigure, BadInput) {
   EXPECT_THROW(hemisphere_figure(o), std::invalid_argument);
   o.elevations_deg = {NAN};
   EXPECT_THROW(hemisphere_figure(o), std::invalid_argument);
+  // Too many panels for an image: refused from the layout, before any field is sampled (901
+  // elevations once took 48 s and 5.7 GB before Cairo refused the page).
+  o.elevations_deg.assign(901, 30.0);
+  try {
+    hemisphere_figure(o);
+    ADD_FAILURE() << "no error for 901 elevations";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fewer elevations (901 given)"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("32767 pixels per side"), std::string::npos) << e.what();
+  }
   EXPECT_FALSE(projection_from_name("mercator").has_value());
   EXPECT_EQ(projection_from_name("equal-area"), Projection::equal_area);
   EXPECT_EQ(view_centre_from_name("back"), ViewCentre::back);

@@ -167,6 +167,7 @@ SurfacePtr raster_surface(const Scene& scene, double scale) {
   if (!(scale > 0) || !(scene.width > 0) || !(scene.height > 0))
     throw std::invalid_argument(
         fmt::format("figure of {}x{} pt at scale {}", scene.width, scene.height, scale));
+  check_raster_size(scene.width, scene.height, scale, "a smaller scale");
   const int w = int(std::ceil(scene.width * scale)), h = int(std::ceil(scene.height * scale));
   SurfacePtr s(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, w, h));
   check(cairo_surface_status(s.get()), "PNG surface");
@@ -399,6 +400,15 @@ Raster decode_png(std::string_view png) {
   SurfacePtr s(cairo_image_surface_create_from_png_stream(read_png, &reader));
   check(cairo_surface_status(s.get()), "decoding PNG");
   return raster_of(s.get());
+}
+
+void check_raster_size(double width, double height, double scale, std::string_view hint) {
+  const double w = std::ceil(width * scale), h = std::ceil(height * scale);
+  if (!(w <= kMaxRasterSide && h <= kMaxRasterSide))
+    throw std::invalid_argument(fmt::format(
+        "the figure would be {:.0f} x {:.0f} pixels ({:.0f} x {:.0f} pt at {:g} pixels per point), "
+        "above the {} pixels per side an image can have: ask for {}",
+        w, h, width, height, scale, kMaxRasterSide, hint));
 }
 
 void save(const Scene& scene, const std::filesystem::path& path, const RenderOptions& options) {

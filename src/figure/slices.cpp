@@ -10,6 +10,7 @@
 
 #include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
+#include "halfback/figure/render.hpp"
 
 namespace halfback::figure {
 
@@ -422,6 +423,10 @@ SliceFigure slice_figure(const SliceOptions& o) {
   const std::vector<std::string> subtitle = wrap_text(text.subtitle, sc.width - l.left - 12, 9);
   l.top = 58 + 12 * double(subtitle.size());
   sc.height = snap(l.panels_bottom() + l.bottom);
+  check_raster_size(sc.width, sc.height, o.pixels_per_point,
+                    fmt::format("fewer azimuths ({} given) or parameterizations ({} given), or a "
+                                "lower pixel density",
+                                l.cols, l.rows));
 
   fig.panels = sample_panels(o, l);
   const PanelValues values = generic ? evaluate_panels(o, fig) : PanelValues{};

@@ -98,6 +98,9 @@ AltaData parse_alta(std::string_view text, std::string_view name_view) {
   auto fail = [&](const std::string& problem) -> void {
     throw FormatError(name, "line " + std::to_string(line_no), problem);
   };
+  // Editors on Windows start UTF-8 text with a byte-order mark; it is not part of the header.
+  constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+  if (text.substr(0, kUtf8Bom.size()) == kUtf8Bom) text.remove_prefix(kUtf8Bom.size());
   while (!text.empty()) {
     const std::size_t eol = text.find('\n');
     std::string_view line = text.substr(0, eol);
@@ -109,6 +112,10 @@ AltaData parse_alta(std::string_view text, std::string_view name_view) {
       std::string_view rest = line.substr(1);
       const std::string_view key = next_token(rest);
       const std::string_view value = trim(rest);
+      if (key == "FUNC" || (key == "ALTA" && value.rfind("FUNC", 0) == 0))
+        fail("an ALTA function file (a fitted model, '#" + printable(trim(line.substr(1))) +
+             "'), not ALTA data: halfback reads ALTA data files (#DIM, #PARAM_IN, #PARAM_OUT, "
+             "then one sample per line)");
       if (key == "DIM" || key == "PARAM_IN" || key == "PARAM_OUT" || key == "VS" ||
           key == "FORMAT") {
         if (d.rows() > 0) fail("header entry #" + std::string(key) + " after the first data line");
@@ -225,11 +232,21 @@ struct AltaBrdf::Impl {
 AltaBrdf::AltaBrdf(const AltaData& data, std::string file, std::string label, AltaOptions options)
     : impl_(std::make_unique<Impl>()), label_(std::move(label)), options_(options) {
   Impl& m = *impl_;
+  if (data.param_in.empty())
+    throw FormatError(file, "header",
+                      "no #PARAM_IN line, so the coordinates of the samples are unknown: "
+                      "evaluation supports '#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI' (θl, θv·cos Δφ, "
+                      "θv·sin Δφ)");
   if (data.param_in != "ISOTROPIC_TL_TV_PROJ_DPHI")
     throw FormatError(
         file, "#PARAM_IN",
         "'" + data.param_in +
             "': evaluation supports ISOTROPIC_TL_TV_PROJ_DPHI (θl, θv·cos Δφ, θv·sin Δφ)");
+  if (data.param_out.empty())
+    throw FormatError(file, "header",
+                      "no #PARAM_OUT line, so the unit of the values is unknown: add "
+                      "'#PARAM_OUT INV_STERADIAN' (values are ρ) or '#PARAM_OUT "
+                      "INV_STERADIAN_COSINE_FACTOR' (values are ρ·cos θv)");
   const bool cosine = data.param_out == "INV_STERADIAN_COSINE_FACTOR";
   if (!cosine && data.param_out != "INV_STERADIAN")
     throw FormatError(file, "#PARAM_OUT",

@@ -87,6 +87,23 @@ TEST(AltaParse, ErrorsNameTheLine) {
   EXPECT_FORMAT_ERROR(read_alta("/nonexistent/file.dat"), "/nonexistent/file.dat", "file");
 }
 
+// A byte-order mark is skipped; a fitted-function file is named as such, not as bad numbers.
+TEST(AltaParse, ByteOrderMarkAndFunctionFiles) {
+  const std::string body =
+      "#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN\n0.1 0.2 0.3 1\n";
+  const AltaData d = parse_alta("\xEF\xBB\xBF" + body, "bom.dat");
+  EXPECT_EQ(d.rows(), 1u);
+  EXPECT_EQ(d.dim_in, 3u);
+  EXPECT_FORMAT_ERROR(parse_alta("\xEF\xBB" + body, "half-bom.dat"), "line 1", "data before #DIM");
+  const std::string fit =
+      "#ALTA FUNC HEADER\n#CMD brdf_fit --data x.dat\n#DIM 2 1\n#PARAM_IN RUSIN_TH_TD\n"
+      "#PARAM_OUT INV_STERADIAN\n#ALTA HEADER END\n#FUNC nonlinear_function_lambertian\nkd 0.5\n";
+  EXPECT_FORMAT_ERROR(parse_alta(fit, "fit.brdf"), "fit.brdf", "line 1", "ALTA function file",
+                      "not ALTA data");
+  EXPECT_FORMAT_ERROR(parse_alta("#DIM 2 1\n#FUNC nonlinear_function_lambertian\nkd 0.5\n", "f"),
+                      "line 2", "ALTA function file");
+}
+
 // --------------------------------------------------------------------------------------------
 // Evaluation
 // --------------------------------------------------------------------------------------------
@@ -231,6 +248,10 @@ TEST(AltaEval, RgbAndUnsupportedFiles) {
   EXPECT_FORMAT_ERROR(
       brdf_of("#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT ENERGY\n1 1 1 1\n"),
       "#PARAM_OUT", "'ENERGY'");
+  EXPECT_FORMAT_ERROR(brdf_of("#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n1 1 1 1\n"), "header",
+                      "no #PARAM_OUT line", "INV_STERADIAN_COSINE_FACTOR");
+  EXPECT_FORMAT_ERROR(brdf_of("#DIM 3 1\n#PARAM_OUT INV_STERADIAN\n1 1 1 1\n"), "header",
+                      "no #PARAM_IN line", "ISOTROPIC_TL_TV_PROJ_DPHI");
   EXPECT_FORMAT_ERROR(
       brdf_of("#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN\n"
               "0.5 0 0 1\n0.5 0.1 0 1\n2.0 0 0 1\n"),

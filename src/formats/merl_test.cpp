@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -15,6 +17,7 @@
 #include "formats/binary_io.hpp"
 #include "formats/merl_reference.hpp"
 #include "support/allocation_probe.hpp"
+#include "support/test_brdfs.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback {
@@ -301,6 +304,16 @@ TEST(MerlErrors, SizeHeaderAndValues) {
                       "blue value at bin (theta_h 89, theta_d 89, phi_d 179)", "is infinite");
   EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(1, 0, 0, 0, -INFINITY)), "i"), "green value",
                       "is infinite");
+  // Finite but absurd (1e308, or a big-endian file read as little-endian): named, not integrated
+  // into an infinite albedo. The bound is on ρ, so the largest accepted stored value is per
+  // channel.
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(0, 4, 5, 6, 1e308)), "huge"),
+                      "red value at bin (theta_h 4, theta_d 5, phi_d 6)", "is 1e+308",
+                      "above the 1e+10 sr⁻¹", "little-endian");
+  const double largest_blue = merl::kMaxRho / merl::kScale[2];
+  EXPECT_NO_THROW(parse_merl(bytes_of(poke(2, 4, 5, 6, 0.999 * largest_blue)), "edge"));
+  EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(2, 4, 5, 6, largest_blue * 1.001)), "edge"),
+                      "blue value");
 }
 
 TEST(MerlErrors, Files) {
@@ -427,6 +440,148 @@ class TestLobe final : public Brdf {
   }
 };
 
+// --------------------------------------------------------------------------------------------
+// Batch evaluation (SIMD conversion, prefetched reads)
+// --------------------------------------------------------------------------------------------
+
+// Pairs of every kind the batch path must handle: uniform, near the specular peak, in the plane
+// of incidence, grazing; and rows it leaves to eval(): NaN, below the horizon, not unit length.
+std::vector<DirPair<double>> batch_pairs() {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<DirPair<double>> p;
+  for (int n = 0; n < 20000; ++n)
+    p.push_back({test::uniform_hemisphere(rng), test::uniform_hemisphere(rng)});
+  for (int n = 0; n < 3000; ++n) {
+    const Vec3<double> wi = test::uniform_hemisphere(rng);
+    p.push_back({wi, {-wi.x, -wi.y, wi.z}});
+    p.push_back({test::direction(kPi / 2 * u(rng), 0), test::direction(kPi / 2 * u(rng), kPi)});
+    p.push_back({test::direction(kPi / 2 * (1 - 1e-3 * u(rng)), 2 * kPi * u(rng)),
+                 test::uniform_hemisphere(rng)});
+  }
+  const double nan = std::nan("");
+  p.push_back({{0, 0, nan}, {0, 0, 1}});
+  p.push_back({{0.6, 0, 0.8}, {nan, 0, 1}});
+  p.push_back({{0, 0, 1}, {1, 0, -0.1}});
+  p.push_back({{0.6, 0, -1e-9}, {0, 0.6, 0.8}});  // below by less than the tolerance
+  p.push_back({{0.66, 0, 0.88}, {0, 0.6, 0.8}});  // not unit: eval() takes it as given
+  p.push_back({{1, 0, 0}, {0, 1, 0}});            // both at the horizon
+  std::shuffle(p.begin(), p.end(), rng);          // special rows inside SIMD vectors and blocks
+  return p;
+}
+
+bool same_value(double a, double b) {
+  return a == b || (std::isnan(a) && std::isnan(b));
+}
+
+TEST(MerlBatch, NearestIsEvalButOnBinBoundaries) {
+  const MerlBrdf brdf(parse_merl(bytes_of(index_image()), "index"));
+  const auto pairs = batch_pairs();
+  std::vector<Rgb> batch(pairs.size());
+  brdf.eval_batch(pairs, batch);
+  std::size_t differ = 0, fold = 0;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const Rgb one = brdf.eval(pairs[i]);
+    if (same_value(one.r, batch[i].r) && same_value(one.g, batch[i].g) &&
+        same_value(one.b, batch[i].b))
+      continue;
+    // The SIMD conversion's atan2 may round to the other side of a bin boundary than libm's; the
+    // point must then be on that boundary (within 1e-7 of a bin edge, by the reference's formulas).
+    const auto& [wi, wo] = pairs[i];
+    const auto a = merl_reference::half_diff({wi.x, wi.y, wi.z}, {wo.x, wo.y, wo.z});
+    const merl::BinIndex got = decode(batch[i]), want = decode(one);
+    const double eps = 1e-7;
+    const double xp = merl_reference::phi_d_coordinate(a.phi_d);
+    // In the plane of incidence φd is 0 ≡ π: bins 0 and 179 are the same boundary, which the
+    // reference itself picks by the sign of a rounding residue (IndicesMatchIndependentReference).
+    if (got.theta_h == want.theta_h && got.theta_d == want.theta_d &&
+        (xp < eps || xp > 180 - eps) && (got.phi_d == 0 || got.phi_d == 179)) {
+      ++fold;
+      continue;
+    }
+    ++differ;
+    if (got.theta_h != want.theta_h) {
+      EXPECT_LT(to_boundary(merl_reference::theta_h_coordinate(a.theta_h)), eps) << i;
+    }
+    if (got.theta_d != want.theta_d) {
+      EXPECT_LT(to_boundary(merl_reference::theta_d_coordinate(a.theta_d)), eps) << i;
+    }
+    if (got.phi_d != want.phi_d) {
+      EXPECT_LT(to_boundary(xp), eps) << i << " " << xp;
+    }
+  }
+  EXPECT_LE(differ, 20u) << "of " << pairs.size();
+  EXPECT_LE(fold, 1500u);  // at most half of the 3000 in-plane pairs
+  std::cout << "[ info ] of " << pairs.size() << " pairs, " << differ << " on a bin boundary and "
+            << fold
+            << " in-plane ones on the φd = 0 ≡ π boundary got the neighbouring bin in the batch\n";
+  EXPECT_THROW(brdf.eval_batch(pairs, std::span<Rgb>(batch).first(3)), std::invalid_argument);
+}
+
+TEST(MerlBatch, NearestKeepsTheStoredValuesAndMissingBins) {
+  // Arbitrary values (some unmeasured): a batch value is exactly stored × scale of the bin that
+  // eval() finds, or NaN for an unmeasured bin.
+  const std::string image = merl_image([](int c, std::size_t i) {
+    return i % 97 == 5 ? -1.0 : std::sin(0.37 * double(i) + c) * 1000.0 + 1001.0;
+  });
+  const MerlBrdf brdf(parse_merl(bytes_of(image), "values"));
+  const auto pairs = batch_pairs();
+  std::vector<Rgb> batch(pairs.size());
+  brdf.eval_batch(pairs, batch);
+  std::size_t equal = 0, nan = 0;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const Rgb one = brdf.eval(pairs[i]);
+    if (same_value(one.g, batch[i].g)) ++equal;
+    if (std::isnan(batch[i].g)) ++nan;
+  }
+  EXPECT_GE(equal, pairs.size() - 300);  // 155 in-plane pairs on the φd = 0 ≡ π fold (above)
+  EXPECT_GT(nan, 50u);                   // unmeasured bins and NaN rows
+}
+
+TEST(MerlBatch, TrilinearFollowsEval) {
+  MerlData data;
+  data.values.resize(3 * merl::kBins);
+  for (std::size_t i = 0; i < merl::kBins; ++i)
+    for (int ch = 0; ch < 3; ++ch)
+      data.values[ch * merl::kBins + i] =
+          i % 211 == 3 ? -1.0 : 2.0 + std::sin(1e-3 * double(i) + ch);
+  const MerlBrdf tri(data, {MerlLookup::trilinear});
+  const auto pairs = batch_pairs();
+  std::vector<Rgb> batch(pairs.size());
+  tri.eval_batch(pairs, batch);
+  // The coordinates differ by a few ulps at most (xsimd's atan2 within 2.5 ulp): so do the values,
+  // which are continuous in them.
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const Rgb one = tri.eval(pairs[i]);
+    for (auto [a, b] : {std::pair{one.r, batch[i].r}, {one.g, batch[i].g}, {one.b, batch[i].b}}) {
+      if (std::isnan(a) || a == 0) {
+        EXPECT_TRUE(same_value(a, b)) << i << " " << a << " " << b;
+      } else {
+        EXPECT_NEAR(b, a, 1e-9 * std::abs(a)) << i;
+      }
+    }
+  }
+}
+
+TEST(MerlBatch, SameResultWhateverTheSplit) {
+  // Rows land in other SIMD lanes, blocks and threads when the batch starts elsewhere: their
+  // values must not change.
+  const MerlBrdf brdf(parse_merl(bytes_of(index_image()), "index"), {MerlLookup::trilinear});
+  const auto pairs = batch_pairs();
+  std::vector<Rgb> whole(pairs.size()), parts(pairs.size());
+  brdf.eval_batch(pairs, whole);
+  const std::span<const DirPair<double>> p(pairs);
+  const std::span<Rgb> o(parts);
+  for (auto [b, e] :
+       {std::pair<std::size_t, std::size_t>{0, 3}, {3, 1001}, {1001, 12346}, {12346, pairs.size()}})
+    brdf.eval_batch(p.subspan(b, e - b), o.subspan(b, e - b));
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    EXPECT_TRUE(same_value(whole[i].r, parts[i].r) && same_value(whole[i].g, parts[i].g) &&
+                same_value(whole[i].b, parts[i].b))
+        << i;
+  }
+}
+
 TEST(MerlWriter, RoundTripAtBinCentres) {
   TempDir tmp;
   const auto path = tmp / "lobe.binary";
@@ -517,6 +672,16 @@ TEST(MerlWriter, AtomicReplaceAndErrors) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(tmp.path()),
                           std::filesystem::directory_iterator{}),
             1);
+  // A BRDF whose values no MERL bin can hold is refused by name, and nothing is written.
+  const test::FunctionBrdf spike(
+      [](const DirPair<double>& p) { return p.wi.z > 0.999 && p.wo.z > 0.999 ? 1e12 : 1.0; });
+  try {
+    write_merl(tmp / "spike.binary", spike);
+    ADD_FAILURE() << "no error for ρ = 1e12";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("ρ = 1e+12 sr⁻¹ at θh"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp / "spike.binary"));
   MerlData wrong;
   wrong.values.assign(10, 1.0);
   EXPECT_THROW(write_merl(path, wrong), std::invalid_argument);

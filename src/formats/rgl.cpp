@@ -313,8 +313,7 @@ struct RglBrdf::Impl {
   std::size_t noise_clamped = 0;  // tiny negative ndf, vndf and luminance values set to 0
   std::size_t rgb_negative = 0;   // negative (out-of-gamut) RGB values
 
-  Slices slices(double phi_i, double theta_i, std::size_t channels = 1,
-                std::size_t channel = 0) const {
+  Slices slices(double phi_i, double theta_i) const {
     std::size_t ip, it;
     double tp, tt;
     phi.locate(phi_i, ip, tp);
@@ -328,7 +327,7 @@ struct RglBrdf::Impl {
         const double wb = b ? tt : 1 - tt;
         if (b && theta.stride == 0) break;
         const std::size_t slice = (ip + a) * phi.stride + (it + b) * theta.stride;
-        s.index[s.count] = slice * channels + channel;
+        s.index[s.count] = slice;
         s.weight[s.count] = wa * wb;
         ++s.count;
       }
@@ -598,6 +597,7 @@ Rgb RglBrdf::eval_cosine(const DirPair<double>& pair) const {
   const RglWarpPoint um{theta_to_u(theta_m), um_y};
   const RglWarpPoint uwi{theta_to_u(theta_i), phi_to_u(phi_i)};
 
+  // One search of the incidence grids: the RGB slices of channel ch are 3·slice + ch.
   const Slices slices = m.slices(phi_i, theta_i);
   const RglWarpPoint sample = m.vndf.inverse(slices, um);
 
@@ -608,7 +608,8 @@ Rgb RglBrdf::eval_cosine(const DirPair<double>& pair) const {
   }
   double c[3];
   for (std::size_t ch = 0; ch < 3; ++ch) {
-    const Slices s = m.slices(phi_i, theta_i, 3, ch);
+    Slices s = slices;
+    for (int k = 0; k < s.count; ++k) s.index[k] = 3 * slices.index[k] + ch;
     c[ch] = m.rgb.eval(s, sample.x, sample.y) * scale;
     if (options_.clamp_negative) c[ch] = std::max(c[ch], 0.0);
   }

@@ -270,15 +270,19 @@ std::string exr_of(const ResampledTable& t, const std::filesystem::path& path) {
     attr("brdf", t.brdf_name);
     attr("brdf_description", t.brdf_description);
     attr("metadata", table_metadata_json(t));
-    Imf::OutputFile file(stream, header);
-    Imf::FrameBuffer fb;
-    char* base = reinterpret_cast<char*>(pixels.data());
-    const std::size_t xs = 4 * sizeof(float), ys = xs * width;
-    const char* names[] = {"R", "G", "B", "valid"};
-    for (int c = 0; c < 4; ++c)
-      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
-    file.setFrameBuffer(fb);
-    file.writePixels(int(height));
+    {
+      // The OutputFile writes the scan-line offset table when it is destroyed: the stream is
+      // complete only after this scope.
+      Imf::OutputFile file(stream, header);
+      Imf::FrameBuffer fb;
+      char* base = reinterpret_cast<char*>(pixels.data());
+      const std::size_t xs = 4 * sizeof(float), ys = xs * width;
+      const char* names[] = {"R", "G", "B", "valid"};
+      for (int c = 0; c < 4; ++c)
+        fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+      file.setFrameBuffer(fb);
+      file.writePixels(int(height));
+    }
     return stream.str();
   } catch (const std::exception& e) {
     throw std::runtime_error(

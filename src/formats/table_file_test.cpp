@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "halfback/brdf/test_functions.hpp"
+#include "support/exr_offsets.hpp"
 #include "support/test_brdfs.hpp"
 #include "support/test_support.hpp"
 
@@ -62,6 +63,14 @@ TEST(TableFile, ExrChannelsAndAttributes) {
   const ResampledTable t = resample(Smooth(), g);
   const auto path = dir.path() / "t.exr";
   write_table(path, t);
+  // A complete offset table: every chunk's offset, increasing, inside the file (it was all zeros
+  // when the bytes were taken before the OpenEXR writer had finished).
+  const std::string bytes = test::read_file(path);
+  const std::vector<std::uint64_t> offsets = test::exr_scanline_offsets(bytes);
+  ASSERT_EQ(offsets.size(), 2u) << "24 rows in ZIP chunks of 16 lines";
+  EXPECT_GT(offsets[0], 0u);
+  EXPECT_GT(offsets[1], offsets[0]);
+  EXPECT_LT(offsets[1], bytes.size());
   Imf::InputFile in(path.c_str());
   const auto dw = in.header().dataWindow();
   const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;

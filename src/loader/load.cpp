@@ -126,6 +126,11 @@ std::vector<std::string_view> split_sum(std::string_view spec) {
 
 BrdfPtr load_one(std::string_view spec);
 
+bool path_exists(std::string_view spec) {
+  std::error_code ec;
+  return std::filesystem::exists(std::filesystem::path{std::string(spec)}, ec);
+}
+
 }  // namespace
 
 ModelRegistry& model_registry() {
@@ -145,7 +150,13 @@ std::vector<std::string> embedded_material_names() {
 }
 
 BrdfPtr load_brdf(std::string_view spec) {
+  if (path_exists(spec)) return load_one(spec);  // a file name may contain '+'
   const auto parts = split_sum(spec);
+  const auto empty_term = [](std::string_view p) { return p.empty() || p.back() == '+'; };
+  if (spec.find('+') != std::string_view::npos && std::ranges::any_of(parts, empty_term))
+    throw std::invalid_argument("'" + std::string(spec) +
+                                "': a sum has an empty term (a sum is SPEC+SPEC+..., e.g. "
+                                "lambert:albedo=0.3+ggx:alpha=0.2)");
   if (parts.size() == 1) return load_one(spec);
   std::vector<BrdfPtr> terms;
   for (const auto part : parts) terms.push_back(load_one(part));

@@ -280,6 +280,10 @@ TEST(LoadBrdf, ErrorsForFiles) {
                       "3 numbers, expected 4");
   // A folder is read as the NumPy form of a neural BRDF, which says what is missing.
   EXPECT_FORMAT_ERROR(load_brdf(tmp.path().string()), "folder", "holds no NAME_fc1.npy");
+  // A file whose name contains '+' is that file, not a sum.
+  write_text(tmp / "tape+lambert.dat", kAlta);
+  EXPECT_NE(load_brdf((tmp / "tape+lambert.dat").string())->name().find("tape+lambert"),
+            std::string::npos);
 }
 
 TEST(LoadBrdf, ModelSpecs) {
@@ -343,6 +347,16 @@ TEST(BuiltinModels, SumOfSpecs) {
   // An exponent's sign is not a separator.
   EXPECT_NO_THROW(load_brdf("abc:b=1e+3"));
   EXPECT_THROW(load_brdf("lambert+nosuchmodel"), std::invalid_argument);
+  // An empty term is named as such (not as a model called '').
+  for (const char* spec : {"+ggx", "ggx+", "lambert++ggx", "ggx+lambert+"}) {
+    try {
+      load_brdf(spec);
+      ADD_FAILURE() << "no error for " << spec;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("a sum has an empty term"), std::string::npos)
+          << spec << ": " << e.what();
+    }
+  }
 }
 
 // The embedded materials are the files of data/rgl/ and data/nbrdf/ (same bytes, so the same

@@ -136,7 +136,13 @@ BrdfSample Microfacet::sample(const Vec3<double>& wo, double u1, double u2) cons
     m = normalize({-ax * r * std::cos(phi), -ay * r * std::sin(phi), 1});
   }
   if (!(dot(wo, m) > 0)) return {};
-  return finish(*this, wo, reflect(wo, m));
+  // pdf() of the sample, from the normal just drawn (pdf() would rebuild it from ωi + ωo).
+  const Vec3<double> wi = reflect(wo, m);
+  if (!(wi.z > 0)) return {};
+  const double d = distribution(m);
+  if (params_.distribution == MicrofacetParams::Distribution::ggx)
+    return {wi, d / ((1 + lambda(wo)) * 4 * wo.z)};
+  return {wi, d * m.z / (4 * dot(wo, m))};
 }
 
 double Microfacet::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@
 #include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
+#include "halfback/study/image_metrics.hpp"
 #include "halfback/study/parts.hpp"
 
 namespace py = pybind11;
@@ -218,22 +220,50 @@ GridKind parse_kind(const std::string& kind) {
   throw py::value_error("kind: expected 'full', 'isotropic' or 'slice', got '" + kind + "'");
 }
 
+std::string python_repr(const py::handle& v) {
+  return std::string(py::str(py::type::of(v).attr("__name__"))) + " " + std::string(py::repr(v));
+}
+
+// resample()'s size: an int, or a sequence of ints (one per axis); a clear TypeError otherwise
+// (a str is a sequence too, but of characters).
+std::vector<std::size_t> grid_counts(const py::object& size) {
+  const auto count = [&](const py::handle& v) {
+    if (!py::isinstance<py::int_>(v) || py::isinstance<py::bool_>(v))
+      throw py::type_error(
+          "resample(): size must be an int or a sequence of ints (one per "
+          "axis), got " +
+          python_repr(size));
+    const long c = v.cast<long>();
+    if (c <= 0) throw py::value_error("resample(): size must be positive, got " + python_repr(v));
+    return std::size_t(c);
+  };
+  if (py::isinstance<py::int_>(size)) return {count(size)};
+  if (py::isinstance<py::str>(size) || py::isinstance<py::bytes>(size) ||
+      !py::isinstance<py::sequence>(size))
+    throw py::type_error(
+        "resample(): size must be an int or a sequence of ints (one per axis), "
+        "got " +
+        python_repr(size));
+  std::vector<std::size_t> counts;
+  for (const auto& v : size) counts.push_back(count(v));
+  return counts;
+}
+
+// resample()'s ranges[axis]: a (lo, hi) pair of numbers.
+std::pair<double, double> range_bounds(const py::handle& value, const std::string& axis) {
+  try {
+    if (!py::isinstance<py::str>(value)) return value.cast<std::pair<double, double>>();
+  } catch (const py::cast_error&) {
+  }
+  throw py::type_error("resample(): ranges['" + axis +
+                       "'] must be a (lo, hi) pair of numbers, got " + python_repr(value));
+}
+
 py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::string& kind,
                        const py::object& size, double azimuth_deg, bool nodes,
                        const py::dict& ranges) {
   const Space space = parse_space(param, "param");
-  std::vector<std::size_t> counts;
-  if (py::isinstance<py::int_>(size)) {
-    const long v = size.cast<long>();
-    if (v <= 0) throw py::value_error("size must be positive");
-    counts.push_back(std::size_t(v));
-  } else {
-    for (const auto& v : size) {
-      const long c = v.cast<long>();
-      if (c <= 0) throw py::value_error("size must be positive");
-      counts.push_back(std::size_t(c));
-    }
-  }
+  const std::vector<std::size_t> counts = grid_counts(size);
   const double azimuth = wrap_azimuth_degrees(azimuth_deg, "azimuth");  // as the CLI (class 8)
   GridSpec g = default_grid(space, parse_kind(kind), counts, azimuth * std::numbers::pi / 180);
   g.sampling = nodes ? GridSampling::nodes : GridSampling::centres;
@@ -244,7 +274,7 @@ py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::str
     } catch (const std::invalid_argument& e) {
       throw py::value_error(std::string("ranges: ") + e.what());
     }
-    const auto lohi = value.cast<std::pair<double, double>>();
+    const auto lohi = range_bounds(value, key.cast<std::string>());
     axis->lo = lohi.first;
     axis->hi = lohi.second;
   }
@@ -500,15 +530,28 @@ T setting(const py::handle& value, const std::string& key) {
   }
 }
 
-// The settings dict: the options of `halfback study`, '-' spelled '_'.
-study::StudySettings study_settings(const py::object& settings) {
-  study::StudySettings s;
-  if (settings.is_none()) return s;
+// The settings dict: the options of `halfback study`, '-' spelled '_', and the profiles of the
+// study's BRDFs for the learned design (study_profile()'s texts, in the study's order).
+struct PySettings {
+  study::StudySettings settings;
+  std::vector<std::string> profiles;
+  bool has_profiles = false;
+};
+
+PySettings study_settings(const py::object& settings) {
+  PySettings out;
+  study::StudySettings& s = out.settings;
+  if (settings.is_none()) return out;
   for (const auto& [k, v] : settings.cast<py::dict>()) {
     const std::string key = py::str(k);
-    if (key == "space")
+    if (key == "space" || key == "error_space")
       s.space = setting<std::string>(v, key);
-    else if (key == "quick")
+    else if (key == "designs")
+      s.designs = setting<std::vector<std::string>>(v, key);
+    else if (key == "profiles") {
+      out.profiles = setting<std::vector<std::string>>(v, key);
+      out.has_profiles = true;
+    } else if (key == "quick")
       s.quick = setting<bool>(v, key);
     else if (key == "no_gonio")
       s.no_gonio = setting<bool>(v, key);
@@ -534,22 +577,40 @@ study::StudySettings study_settings(const py::object& settings) {
       s.environments = setting<std::vector<std::string>>(v, key);
     else
       throw py::value_error("settings: unknown key '" + key +
-                            "' (accepted: space, quick, budgets, budgets_4d, test_pairs, env, "
-                            "image_budget, image_size, image_spp, max_theta, seed, no_gonio, "
-                            "no_images)");
+                            "' (accepted: space, designs, profiles, quick, budgets, budgets_4d, "
+                            "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
+                            "seed, no_gonio, no_images)");
   }
-  return s;
+  return out;
+}
+
+// The configuration of the settings for the BRDF labeled `label`: with the learned design, its
+// warps from the profiles of the others.
+study::StudyConfig config_for(const PySettings& s, const std::string& label) {
+  study::StudyConfig config = study::make_config(s.settings);
+  if (!study::wants_learned(config)) return config;
+  if (!s.has_profiles)
+    throw std::invalid_argument(
+        "settings: the learned design needs settings['profiles'], the study_profile() of every "
+        "BRDF of the study in its order (or leave 'learned' out of settings['designs'])");
+  std::vector<study::LabeledProfile> profiles;
+  for (std::size_t i = 0; i < s.profiles.size(); ++i)
+    profiles.push_back(
+        study::profile_from_text(s.profiles[i], "settings['profiles'][" + std::to_string(i) + "]"));
+  study::set_learned(config, profiles, label);
+  return config;
 }
 
 py::dict study_one_brdf(const std::string& spec, const py::object& settings) {
-  const study::StudySettings s = study_settings(settings);
+  const PySettings s = study_settings(settings);
   study::BrdfResult result;
   std::string described;
   {
     py::gil_scoped_release release;
-    const study::StudyConfig config = study::make_config(s);
     const BrdfPtr brdf = load_brdf(spec);
-    result = study::study_brdf(*brdf, study::study_label(spec, *brdf), config);
+    const std::string label = study::study_label(spec, *brdf);
+    const study::StudyConfig config = config_for(s, label);
+    result = study::study_brdf(*brdf, label, config);
     described = study::describe_config(config);
   }
   py::dict d;
@@ -583,6 +644,14 @@ study::BrdfResult result_of(const py::dict& d, const std::string& source) {
       b.example_images.push_back(std::move(im));
     }
   return b;
+}
+
+std::string study_one_profile(const std::string& spec, const py::object& settings) {
+  const PySettings s = study_settings(settings);
+  py::gil_scoped_release release;
+  const study::StudyConfig config = study::make_config(s.settings);
+  const BrdfPtr brdf = load_brdf(spec);
+  return study::profile_text(study::study_profile(*brdf, study::study_label(spec, *brdf), config));
 }
 
 py::dict merge_study(const std::string& out, const py::list& parts) {
@@ -621,18 +690,54 @@ void bind_study(py::module_& m) {
         R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
 
 spec: a file or model spec, as for load(). settings: a dict of the options of `halfback study`
-with '-' spelled '_': space, quick, budgets, budgets_4d, test_pairs, env (a list), image_budget,
-image_size, image_spp, max_theta, seed, no_gonio, no_images (missing: the defaults).
+with '-' spelled '_': space (the error space), designs (a list), quick, budgets, budgets_4d,
+test_pairs, env (a list), image_budget, image_size, image_spp, max_theta, seed, no_gonio,
+no_images (missing: the defaults), and, for the learned design (a default design), profiles: the
+study_profile() texts of every BRDF of the study, this one's included, in the study's order (the
+warps are learned from all but this one's; without them, a ValueError).
 Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image"; the
 rows of the CSV files of the study, numbers in exact round-trip form, e.g. for
 pandas.read_csv(io.StringIO(t))), "settings" (the resolved settings, which merge_study checks)
 and "renderings" (the example images, (H, W, 3) float32). Independent of any other BRDF: map it
 over BRDFs with any engine (docs/study.md, "Scaling out").)doc");
+  m.def("study_profile", &study_one_profile, py::arg("spec"), py::arg("settings") = py::none(),
+        R"doc(The profile of one BRDF for the learned design (as text), the GIL released: what the
+learned warps of the other BRDFs are fitted on. settings: as for study_brdf (its error space
+matters). Map it over the study's BRDFs first, then pass the list as settings["profiles"].)doc");
   m.def("merge_study", &merge_study, py::arg("out"), py::arg("parts"),
         R"doc(Writes the study's report of several results into directory `out` (as
 `halfback study --merge`): parts is a list of result dicts of study_brdf and of output directories
 of `halfback study`, in the order of the report. All must have the same settings, and a BRDF may
 appear once. Returns {"markdown": report.md's text, "files": the files written}.)doc");
+}
+
+// The study's SSIM (Wang et al. 2004), for checking it against other implementations.
+void bind_image_metrics(py::module_& m) {
+  using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  m.def(
+      "ssim",
+      [](const Doubles& x, const Doubles& y, std::optional<Doubles> mask) {
+        if (x.ndim() != 2 || y.ndim() != 2 || x.shape(0) != y.shape(0) || x.shape(1) != y.shape(1))
+          throw py::value_error("ssim: x and y must be 2D arrays of the same shape");
+        const auto h = int(x.shape(0)), w = int(x.shape(1));
+        const std::size_t n = std::size_t(x.size());
+        std::vector<std::uint8_t> selected(n, 1);
+        if (mask) {
+          if (mask->ndim() != 2 || mask->shape(0) != h || mask->shape(1) != w)
+            throw py::value_error("ssim: the mask must have the shape of the images");
+          for (std::size_t k = 0; k < n; ++k) selected[k] = mask->data()[k] != 0;
+        }
+        try {
+          return study::ssim({x.data(), n}, {y.data(), n}, w, h, selected);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+      },
+      py::arg("x"), py::arg("y"), py::arg("mask") = py::none(),
+      R"doc(The structural similarity of two 2D images with values in [0, 1] (Wang et al. 2004:
+11 x 11 Gaussian window of sigma 1.5, K1 = 0.01, K2 = 0.03, L = 1), averaged over the pixels whose
+whole window is inside the image and where mask (same shape; default all) is nonzero. The SSIM of
+`halfback study`'s image-space error (docs/study.md).)doc");
 }
 
 }  // namespace
@@ -645,4 +750,5 @@ PYBIND11_MODULE(_core, m) {
   bind_hemisphere(m);
   bind_loading(m);
   bind_study(m);
+  bind_image_metrics(m);
 }

@@ -12,41 +12,69 @@ namespace {
 constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
 }  // namespace
 
-Distribution1D::Distribution1D(std::span<const double> weights)
-    : weights_(weights.begin(), weights.end()) {
-  if (weights_.empty()) throw std::invalid_argument("Distribution1D: no cells");
-  cdf_.resize(weights_.size() + 1);
-  cdf_[0] = 0;
-  for (std::size_t i = 0; i < weights_.size(); ++i) {
-    const double w = weights_[i];
+Distribution1D::Distribution1D(std::span<const double> weights) {
+  if (weights.empty()) throw std::invalid_argument("Distribution1D: no cells");
+  if (weights.size() > std::size_t(UINT32_MAX))
+    throw std::invalid_argument("Distribution1D: more than 2^32 - 1 cells");
+  const std::size_t n = weights.size();
+  std::vector<double> cdf(n + 1, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double w = weights[i];
     if (!std::isfinite(w) || w < 0)
       throw std::invalid_argument("Distribution1D: weight " + std::to_string(i) +
                                   " is negative or not finite");
-    cdf_[i + 1] = cdf_[i] + w;
+    cdf[i + 1] = cdf[i] + w;
   }
-  total_ = cdf_.back();
+  total_ = cdf.back();
   if (!std::isfinite(total_)) throw std::invalid_argument("Distribution1D: weights overflow");
   if (total_ > 0) {
-    for (double& c : cdf_) c /= total_;
+    for (double& c : cdf) c /= total_;
   } else {
-    for (std::size_t i = 0; i < cdf_.size(); ++i) cdf_[i] = double(i) / double(weights_.size());
+    for (std::size_t i = 0; i <= n; ++i) cdf[i] = double(i) / double(n);
   }
-  cdf_.back() = 1;
+  cdf.back() = 1;
+  cells_.resize(n + 1);
+  for (std::size_t i = 0; i <= n; ++i)
+    cells_[i] = {cdf[i], i < n && total_ > 0 ? weights[i] / total_ : 0.0};
+  // Bucket k starts at the cell a search for u = k / n finds (one pass: both are increasing).
+  guide_.resize(n);
+  std::size_t cell = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double u = double(k) / double(n);
+    while (cell + 1 < n && !(cdf[cell + 1] > u)) ++cell;
+    guide_[k] = std::uint32_t(cell);
+  }
 }
 
 Distribution1D::Sample Distribution1D::sample(double u) const {
-  Sample s;
-  if (total_ <= 0 || weights_.empty()) return s;
-  u = std::clamp(u, 0.0, kOneMinusEpsilon);
+  if (!(total_ > 0)) return {};
+  u = u >= 0 ? std::min(u, kOneMinusEpsilon) : 0.0;  // NaN too: the index below must be valid
+  const std::size_t n = size();
+  std::size_t i = guide_[std::min(std::size_t(u * double(n)), n - 1)];
+  // The first cell whose upper bound exceeds u, as the binary search finds it; the guide may be
+  // one cell ahead when u * n rounded up to the next bucket.
+  while (i > 0 && cells_[i].cdf > u) --i;
+  while (i + 1 < n && !(cells_[i + 1].cdf > u)) ++i;
+  return finish(i, u);
+}
+
+Distribution1D::Sample Distribution1D::sample_by_search(double u) const {
+  if (!(total_ > 0)) return {};
+  u = u >= 0 ? std::min(u, kOneMinusEpsilon) : 0.0;
   // The first cell whose upper bound exceeds u: cells of weight 0 have an empty interval.
-  const auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), u);
-  std::size_t i = std::size_t(it - cdf_.begin()) - 1;
-  i = std::min(i, weights_.size() - 1);
-  while (weights_[i] == 0 && i > 0) --i;  // rounding at the last cell: step back to a live cell
+  const auto it = std::upper_bound(cells_.begin() + 1, cells_.end(), u,
+                                   [](double v, const Cell& c) { return v < c.cdf; });
+  const std::size_t i = std::size_t(it - cells_.begin()) - 1;
+  return finish(std::min(i, size() - 1), u);
+}
+
+Distribution1D::Sample Distribution1D::finish(std::size_t i, double u) const {
+  Sample s;
+  while (cells_[i].probability == 0 && i > 0) --i;  // rounding at the last cell: a live cell
   s.index = i;
-  s.probability = weights_[i] / total_;
-  const double width = cdf_[i + 1] - cdf_[i];
-  s.remapped = width > 0 ? std::clamp((u - cdf_[i]) / width, 0.0, kOneMinusEpsilon) : 0.5;
+  s.probability = cells_[i].probability;
+  const double width = cells_[i + 1].cdf - cells_[i].cdf;
+  s.remapped = width > 0 ? std::clamp((u - cells_[i].cdf) / width, 0.0, kOneMinusEpsilon) : 0.5;
   return s;
 }
 
@@ -76,6 +104,28 @@ Distribution2D::Sample Distribution2D::sample(double u1, double u2) const {
   s.remapped_row = r.remapped;
   s.remapped_col = c.remapped;
   return s;
+}
+
+void Distribution2D::sample(std::span<const double> u1, std::span<const double> u2,
+                            std::span<Sample> out) const {
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const auto r = marginal_.sample(u1[i]);
+    out[i] = Sample{};
+    out[i].row = r.index;
+    out[i].probability = r.probability;
+    out[i].remapped_row = r.remapped;
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    Sample& s = out[i];
+    if (s.probability <= 0) {
+      s = Sample{};
+      continue;
+    }
+    const auto c = conditional_[s.row].sample(u2[i]);
+    s.col = c.index;
+    s.probability *= c.probability;
+    s.remapped_col = c.remapped;
+  }
 }
 
 double Distribution2D::probability(std::size_t row, std::size_t col) const {

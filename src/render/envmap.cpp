@@ -380,11 +380,23 @@ EnvMap::EnvMap(int width, int height, std::vector<float> rgb, std::string name, 
 
   // Pixel probability ∝ luminance × solid angle; within a pixel, uniform in solid angle.
   row_solid_angle_.resize(std::size_t(height));
-  const double dphi = 2 * kPi / width;
-  for (int r = 0; r < height; ++r) {
-    const double c0 = std::cos(kPi * r / height), c1 = std::cos(kPi * (r + 1) / height);
-    row_solid_angle_[std::size_t(r)] = dphi * (c0 - c1);
+  row_cos_.resize(std::size_t(height) + 1);
+  for (int r = 0; r <= height; ++r) row_cos_[std::size_t(r)] = std::cos(kPi * double(r) / height);
+  col_edge_.resize(std::size_t(width));
+  for (int c = 0; c < width; ++c) {
+    const double phi = 2 * kPi * c / width - kPi;
+    col_edge_[std::size_t(c)] = {std::cos(phi), std::sin(phi)};
   }
+  // The row of cos θ = 1 − 2k / n at the top of each of n = 4 × height buckets in cos θ.
+  row_guide_.resize(4 * std::size_t(height));
+  for (std::size_t k = 0, r = 0; k < row_guide_.size(); ++k) {
+    const double c = 1 - 2 * double(k) / double(row_guide_.size());
+    while (r + 1 < std::size_t(height) && !(c > row_cos_[r + 1])) ++r;
+    row_guide_[k] = std::uint32_t(r);
+  }
+  const double dphi = 2 * kPi / width;
+  for (std::size_t r = 0; r < std::size_t(height); ++r)
+    row_solid_angle_[r] = dphi * (row_cos_[r] - row_cos_[r + 1]);
   std::vector<double> weights(std::size_t(width) * std::size_t(height));
   for (std::size_t i = 0; i < weights.size(); ++i) {
     const float* p = &rgb_[3 * i];
@@ -497,13 +509,66 @@ Vec3<double> EnvMap::to_world(const Vec3<double>& m) const {
   return {cos_rot_ * m.x + sin_rot_ * m.z, m.y, -sin_rot_ * m.x + cos_rot_ * m.z};
 }
 
-std::size_t EnvMap::pixel_of(const Vec3<double>& map_dir, std::size_t& row,
-                             std::size_t& col) const {
-  double u, v;
-  map_coordinates(map_dir, u, v);
-  col = std::min(std::size_t(u * width_), std::size_t(width_ - 1));
-  row = std::min(std::size_t(v * height_), std::size_t(height_ - 1));
-  return row * std::size_t(width_) + col;
+namespace {
+
+// atan2(y, x) to within about 1e-5 rad (a minimax polynomial of atan on [0, 1], Abramowitz and
+// Stegun 4.4.49's form), without a library call: a first guess of a pixel, which the exact
+// edge tests of pixel_of then correct.
+double approx_atan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double big = std::max(ax, ay), small = std::min(ax, ay);
+  const double a = big > 0 ? small / big : 0, a2 = a * a;
+  double r = a * (0.99986600 +
+                  a2 * (-0.33029950 + a2 * (0.18014100 + a2 * (-0.08513300 + a2 * 0.02083510))));
+  if (ay > ax) r = kPi / 2 - r;
+  if (x < 0) r = kPi - r;
+  return y < 0 ? -r : r;
+}
+
+}  // namespace
+
+// The pixel of a direction, as map_coordinates() places it, without its two atan2 calls: a guess
+// from approx_atan2, then the row's and the column's edges tested exactly (cos θ against the
+// rows' edges; the side of the columns' edge half-planes), moving at most a pixel or two. A
+// direction the tests cannot place (on the axis, where every column meets) falls back to
+// map_coordinates. Equal to it except within rounding of an edge.
+std::size_t EnvMap::pixel_of(const Vec3<double>& d, std::size_t& row, std::size_t& col) const {
+  const std::size_t w = std::size_t(width_), h = std::size_t(height_);
+  const double rho2 = d.x * d.x + d.z * d.z, len = std::sqrt(rho2 + d.y * d.y);
+  auto exact = [&] {
+    double u, v;
+    map_coordinates(d, u, v);
+    col = std::min(std::size_t(u * width_), w - 1);
+    row = std::min(std::size_t(v * height_), h - 1);
+    return row * w + col;
+  };
+  if (w < 8 || !(rho2 > 1e-300)) return exact();
+  // Row r holds cos θ ∈ (row_cos_[r + 1], row_cos_[r]]; the guide gives the row of the bucket's
+  // top in cos θ.
+  const double t = std::clamp(0.5 * (1 - d.y / len), 0.0, 1.0);
+  const std::size_t buckets = row_guide_.size();
+  std::size_t r = row_guide_[std::min(std::size_t(t * double(buckets)), buckets - 1)];
+  while (r > 0 && d.y > row_cos_[r] * len) --r;
+  while (r + 1 < h && !(d.y > row_cos_[r + 1] * len)) ++r;
+  // Column c holds the directions on or after its left edge and before the next one.
+  const double u = (approx_atan2(d.x, -d.z) + kPi) / (2 * kPi);
+  std::size_t c = std::min(std::size_t(std::max(0.0, u) * double(w)), w - 1);
+  auto after = [&](std::size_t edge) {
+    return d.x * col_edge_[edge].cos + d.z * col_edge_[edge].sin >= 0;
+  };
+  for (int step = 0;; ++step) {
+    if (step == 3) return exact();
+    if (!after(c)) {
+      c = c == 0 ? w - 1 : c - 1;
+    } else if (after(c + 1 == w ? 0 : c + 1)) {
+      c = c + 1 == w ? 0 : c + 1;
+    } else {
+      break;
+    }
+  }
+  row = r;
+  col = c;
+  return row * w + col;
 }
 
 Rgb EnvMap::eval(const Vec3<double>& dir) const {
@@ -514,15 +579,32 @@ Rgb EnvMap::eval(const Vec3<double>& dir) const {
 }
 
 EnvMap::Sample EnvMap::sample(double u1, double u2, bool compensated) const {
+  return sample_in((compensated ? compensated_ : distribution_).sample(u1, u2));
+}
+
+void EnvMap::sample(std::span<const double> u1, std::span<const double> u2, bool compensated,
+                    std::span<Sample> out) const {
+  if (u1.size() != out.size() || u2.size() != out.size())
+    throw std::invalid_argument("EnvMap::sample: the spans' sizes differ");
+  constexpr std::size_t kChunk = 32;
+  Distribution2D::Sample cells[kChunk];
+  const Distribution2D& d = compensated ? compensated_ : distribution_;
+  for (std::size_t begin = 0; begin < out.size(); begin += kChunk) {
+    const std::size_t n = std::min(kChunk, out.size() - begin);
+    d.sample(u1.subspan(begin, n), u2.subspan(begin, n), std::span(cells, n));
+    for (std::size_t i = 0; i < n; ++i) out[begin + i] = sample_in(cells[i]);
+  }
+}
+
+EnvMap::Sample EnvMap::sample_in(const Distribution2D::Sample& cell) const {
   Sample s;
-  const auto cell = (compensated ? compensated_ : distribution_).sample(u1, u2);
   if (cell.probability <= 0) return s;
-  const double c0 = std::cos(kPi * double(cell.row) / height_);
-  const double c1 = std::cos(kPi * double(cell.row + 1) / height_);
+  const double c0 = row_cos_[cell.row], c1 = row_cos_[cell.row + 1];
   const double cos_theta = std::clamp(c0 + (c1 - c0) * cell.remapped_row, -1.0, 1.0);
   const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
-  const double phi = 2 * kPi * (double(cell.col) + cell.remapped_col) / width_ - kPi;
-  const Vec3<double> m{sin_theta * std::sin(phi), cos_theta, -sin_theta * std::cos(phi)};
+  double sin_phi, cos_phi;
+  column_sincos(cell.col, cell.remapped_col, sin_phi, cos_phi);
+  const Vec3<double> m{sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi};
   s.dir = to_world(m);
   const float* p = &rgb_[3 * (cell.row * std::size_t(width_) + cell.col)];
   s.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
@@ -534,6 +616,59 @@ double EnvMap::pdf(const Vec3<double>& dir, bool compensated) const {
   std::size_t row, col;
   pixel_of(to_map(dir), row, col);
   return (compensated ? compensated_ : distribution_).probability(row, col) / row_solid_angle_[row];
+}
+
+// sin φ and cos φ of φ = 2π (col + t) / W − π: the column's left edge turned by δ = 2π t / W,
+// whose sine and cosine are short series when the columns are narrow (δ < 0.1: the terms left out
+// are below 1e-18).
+void EnvMap::column_sincos(std::size_t col, double t, double& sin_phi, double& cos_phi) const {
+  if (width_ < 64) {
+    const double phi = 2 * kPi * (double(col) + t) / width_ - kPi;
+    sin_phi = std::sin(phi);
+    cos_phi = std::cos(phi);
+    return;
+  }
+  const double d = 2 * kPi * t / width_, d2 = d * d;
+  // Taylor coefficients ±1/n!, by Horner's rule.
+  const double sd =
+      d * (1 + d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040 + d2 * (1.0 / 362880)))));
+  const double cd =
+      1 + d2 * (-0.5 + d2 * (1.0 / 24 + d2 * (-1.0 / 720 + d2 * (1.0 / 40320 - d2 / 3628800))));
+  const Edge& e = col_edge_[col];
+  sin_phi = e.sin * cd + e.cos * sd;
+  cos_phi = e.cos * cd - e.sin * sd;
+}
+
+void EnvMap::lookup(std::span<const Vec3<double>> dirs, bool compensated,
+                    std::span<Lookup> out) const {
+  if (dirs.size() != out.size())
+    throw std::invalid_argument("EnvMap::lookup: the spans' sizes differ");
+  // The pixels first, then their values: the loads of different directions overlap.
+  constexpr std::size_t kChunk = 32;
+  std::size_t rows[kChunk], cols[kChunk], index[kChunk];
+  const Distribution2D& d = compensated ? compensated_ : distribution_;
+  for (std::size_t begin = 0; begin < out.size(); begin += kChunk) {
+    const std::size_t n = std::min(kChunk, out.size() - begin);
+    for (std::size_t i = 0; i < n; ++i)
+      index[i] = pixel_of(to_map(dirs[begin + i]), rows[i], cols[i]);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float* p = &rgb_[3 * index[i]];
+      Lookup& l = out[begin + i];
+      l.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
+      l.pdf = d.probability(rows[i], cols[i]) / row_solid_angle_[rows[i]];
+    }
+  }
+}
+
+EnvMap::Lookup EnvMap::lookup(const Vec3<double>& dir, bool compensated) const {
+  std::size_t row, col;
+  const std::size_t i = pixel_of(to_map(dir), row, col);
+  const float* p = &rgb_[3 * i];
+  Lookup l;
+  l.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
+  l.pdf =
+      (compensated ? compensated_ : distribution_).probability(row, col) / row_solid_angle_[row];
+  return l;
 }
 
 // --------------------------------------------------------------------------------------------

@@ -81,15 +81,19 @@ void write_exr(const std::filesystem::path& path, const Image& image) {
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
     for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
-    Imf::OutputFile file(stream, header);
-    Imf::FrameBuffer fb;
-    char* base = const_cast<char*>(reinterpret_cast<const char*>(image.rgb.data()));
-    const std::size_t xs = 3 * sizeof(float), ys = xs * std::size_t(image.width);
-    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
-    file.setFrameBuffer(fb);
-    file.writePixels(image.height);
+    {
+      // The OutputFile writes the scan-line offset table when it is destroyed: the stream is
+      // complete only after this scope.
+      Imf::OutputFile file(stream, header);
+      Imf::FrameBuffer fb;
+      char* base = const_cast<char*>(reinterpret_cast<const char*>(image.rgb.data()));
+      const std::size_t xs = 3 * sizeof(float), ys = xs * std::size_t(image.width);
+      fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+      fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+      fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+      file.setFrameBuffer(fb);
+      file.writePixels(image.height);
+    }
     buffer << stream.str();
   } catch (const std::exception& e) {
     throw std::runtime_error(path.string() + ": OpenEXR: " + e.what());

@@ -10,6 +10,7 @@
 #include <exception>
 #include <mutex>
 #include <numbers>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -118,104 +119,214 @@ class Renderer {
                                             : detail::SequenceKind::random),
         aspect_(double(s.width) / s.height),
         tan_bg_(std::tan(0.5 * s.background_fov_deg * kPi / 180)),
-        tan_persp_(std::tan(0.5 * kPerspectiveFov * kPi / 180)) {}
-
-  // The radiance of one pixel sample.
-  Rgb pixel_sample(int px, int py, std::uint64_t pixel, std::uint32_t index) const {
-    double jx, jy;
-    detail::sample_2d(kind_, s_.seed, pixel, index, 0, jx, jy);
-    const double ndc_x = (2 * (px + jx) / s_.width - 1) * aspect_;
-    const double ndc_y = 1 - 2 * (py + jy) / s_.height;
-    V3 n, wo;
-    if (s_.projection == Projection::orthographic) {
-      const double x = ndc_x * kOrthoHalfHeight, y = ndc_y * kOrthoHalfHeight;
-      const double r2 = x * x + y * y;
-      if (r2 >= 1) return env_.eval(normalize({ndc_x * tan_bg_, ndc_y * tan_bg_, -1}));
-      n = {x, y, std::sqrt(1 - r2)};
-      wo = {0, 0, 1};
-    } else {
-      const V3 d = normalize({ndc_x * tan_persp_, ndc_y * tan_persp_, -1});
-      const V3 o{0, 0, kCameraDistance};
-      const double b = dot(o, d), c = dot(o, o) - 1, disc = b * b - c;
-      if (disc <= 0) return env_.eval(d);
-      const double t = -b - std::sqrt(disc);
-      n = normalize({o.x + t * d.x, o.y + t * d.y, o.z + t * d.z});
-      wo = {-d.x, -d.y, -d.z};
-    }
-    return shade(n, wo, pixel, index);
+        tan_persp_(std::tan(0.5 * kPerspectiveFov * kPi / 180)) {
+    for (std::uint32_t d = 0; d < kPairs; ++d) keys_[d] = detail::dimension_key(s.seed, d);
   }
 
-  Rgb shade(const V3& n, const V3& wo_world, std::uint64_t pixel, std::uint32_t index) const {
-    const Frame f = shading_frame(n);
-    const V3 wo = f.to_local(wo_world);
-    Rgb sum;
-    if (!(wo.z > 0)) return sum;
-    auto add = [&](const Rgb& fr, const Rgb& li, double factor) { sum += fr * li * factor; };
-    auto env_sample = [&](std::uint32_t dim, double share) {
+  // The sequences of one pixel: the pixel position, then two light samples.
+  static constexpr std::uint32_t kPairs = 3;
+  struct PixelSequences {
+    detail::PixelPair pair[kPairs];
+  };
+  PixelSequences sequences(std::uint64_t pixel) const {
+    PixelSequences q;
+    for (std::uint32_t d = 0; d < kPairs; ++d)
+      q.pair[d] = detail::PixelPair(kind_, keys_[d], pixel);
+    return q;
+  }
+
+  // Up to kPacket consecutive samples of one pixel, rendered stage by stage (the camera, then each
+  // light sample for the whole packet): the BRDF is evaluated in batches (Brdf::eval_batch) and
+  // the lookups of different samples, independent, overlap. Each sample's sum adds the same terms
+  // in the same order as one sample at a time would (docs/render.md, "Speed").
+  static constexpr int kPacket = 16;
+  // The light samples of one stage that reach the BRDF: the sample, the pair, the radiance, the
+  // pdf of the strategy that drew it and the other's (MIS).
+  struct Batch {
+    int size = 0;
+    int sample[kPacket];
+    DirPair<double> pair[kPacket];
+    Rgb li[kPacket], fr[kPacket];
+    double pdf[kPacket], other_pdf[kPacket];
+  };
+
+  // The light samples of one stage before the BRDF: numbers, then environment samples, or BRDF
+  // samples and the environment's radiance and pdf in their directions.
+  struct Stage {
+    int size = 0;
+    int sample[kPacket];
+    double u1[kPacket], u2[kPacket];
+    EnvMap::Sample env[kPacket];
+    BrdfSample brdf[kPacket];
+    V3 dir[kPacket];
+    EnvMap::Lookup light[kPacket];
+  };
+  struct Packet {
+    int size = 0;
+    std::uint32_t first = 0;
+    Rgb sum[kPacket];
+    bool shaded[kPacket];  // on the sphere, seen from above its surface
+    Frame frame[kPacket];
+    V3 wo[kPacket];  // in the shading frame
+    Stage stage;     // scratch of the stages
+    Batch batch;
+  };
+  // The camera ray of each sample: the background's radiance, or the shading frame on the sphere.
+  void camera(int px, int py, const PixelSequences& q, Packet& p) const {
+    for (int k = 0; k < p.size; ++k) {
+      p.sum[k] = Rgb{};
+      p.shaded[k] = false;
+      double jx, jy;
+      q.pair[0].point(p.first + std::uint32_t(k), jx, jy);
+      const double ndc_x = (2 * (px + jx) / s_.width - 1) * aspect_;
+      const double ndc_y = 1 - 2 * (py + jy) / s_.height;
+      V3 n, wo;
+      if (s_.projection == Projection::orthographic) {
+        const double x = ndc_x * kOrthoHalfHeight, y = ndc_y * kOrthoHalfHeight;
+        const double r2 = x * x + y * y;
+        if (r2 >= 1) {
+          p.sum[k] = env_.eval(normalize({ndc_x * tan_bg_, ndc_y * tan_bg_, -1}));
+          continue;
+        }
+        n = {x, y, std::sqrt(1 - r2)};
+        wo = {0, 0, 1};
+      } else {
+        const V3 d = normalize({ndc_x * tan_persp_, ndc_y * tan_persp_, -1});
+        const V3 o{0, 0, kCameraDistance};
+        const double b = dot(o, d), c = dot(o, o) - 1, disc = b * b - c;
+        if (disc <= 0) {
+          p.sum[k] = env_.eval(d);
+          continue;
+        }
+        const double t = -b - std::sqrt(disc);
+        n = normalize({o.x + t * d.x, o.y + t * d.y, o.z + t * d.z});
+        wo = {-d.x, -d.y, -d.z};
+      }
+      p.frame[k] = shading_frame(n);
+      p.wo[k] = p.frame[k].to_local(wo);
+      p.shaded[k] = p.wo[k].z > 0;
+    }
+  }
+
+  // ρ of the batch's pairs, then each term fr · li · share · w · cos θi / pdf added to its sample.
+  void add_batch(Batch& b, double share, Packet& p) const {
+    if (b.size == 0) return;
+    brdf_.eval_batch(std::span(b.pair, std::size_t(b.size)), std::span(b.fr, std::size_t(b.size)));
+    const bool mis = s_.strategy == Strategy::mis;
+    for (int j = 0; j < b.size; ++j) {
+      const double w = mis ? weight(s_.heuristic, b.pdf[j], b.other_pdf[j]) : 1;
+      p.sum[b.sample[j]] += b.fr[j] * b.li[j] * (share * w * b.pair[j].wi.z / b.pdf[j]);
+    }
+  }
+
+  // One environment sample per shaded sample (pair `dim` of the sequence).
+  void env_stage(const PixelSequences& q, std::uint32_t dim, double share, Packet& p) const {
+    const bool mis = s_.strategy == Strategy::mis, comp = mis && s_.compensation;
+    Batch& b = p.batch;
+    Stage& st = p.stage;
+    st.size = 0;
+    for (int k = 0; k < p.size; ++k) {
+      if (!p.shaded[k]) continue;
+      q.pair[dim].point(p.first + std::uint32_t(k), st.u1[st.size], st.u2[st.size]);
+      st.sample[st.size++] = k;
+    }
+    const auto n = std::size_t(st.size);
+    env_.sample(std::span(st.u1, n), std::span(st.u2, n), comp, std::span(st.env, n));
+    b.size = 0;
+    for (int i = 0; i < st.size; ++i) {
+      const EnvMap::Sample& es = st.env[i];
+      const int k = st.sample[i];
+      if (!(es.pdf > 0)) continue;
+      const V3 wi = p.frame[k].to_local(es.dir);
+      if (!(wi.z > 0)) continue;
+      const int j = b.size++;
+      b.sample[j] = k;
+      b.pair[j] = {wi, p.wo[k]};
+      b.li[j] = es.radiance;
+      b.pdf[j] = es.pdf;
+    }
+    if (mis)
+      for (int j = 0; j < b.size; ++j) b.other_pdf[j] = brdf_.pdf(b.pair[j].wo, b.pair[j].wi);
+    add_batch(b, share, p);
+  }
+
+  // One BRDF sample per shaded sample (pair `dim` of the sequence).
+  void brdf_stage(const PixelSequences& q, std::uint32_t dim, double share, Packet& p) const {
+    Stage& st = p.stage;
+    st.size = 0;
+    for (int k = 0; k < p.size; ++k) {
+      if (!p.shaded[k]) continue;
       double u1, u2;
-      detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
-      const bool comp = s_.strategy == Strategy::mis && s_.compensation;
-      const EnvMap::Sample es = env_.sample(u1, u2, comp);
-      if (!(es.pdf > 0)) return;
-      const V3 wi = f.to_local(es.dir);
-      if (!(wi.z > 0)) return;
-      const Rgb fr = brdf_.eval({wi, wo});
-      const double w =
-          s_.strategy == Strategy::mis ? weight(s_.heuristic, es.pdf, brdf_.pdf(wo, wi)) : 1;
-      add(fr, es.radiance, share * w * wi.z / es.pdf);
-    };
-    auto brdf_sample = [&](std::uint32_t dim, double share) {
-      double u1, u2;
-      detail::sample_2d(kind_, s_.seed, pixel, index, dim, u1, u2);
-      const BrdfSample bs = brdf_.sample(wo, u1, u2);
-      if (!(bs.pdf > 0 && bs.wi.z > 0)) return;
-      const V3 dir = f.to_world(bs.wi);
-      const Rgb li = env_.eval(dir);
-      if (li.r == 0 && li.g == 0 && li.b == 0) return;
-      const Rgb fr = brdf_.eval({bs.wi, wo});
-      const double w = s_.strategy == Strategy::mis
-                           ? weight(s_.heuristic, bs.pdf, env_.pdf(dir, s_.compensation))
-                           : 1;
-      add(fr, li, share * w * bs.wi.z / bs.pdf);
-    };
+      q.pair[dim].point(p.first + std::uint32_t(k), u1, u2);
+      const BrdfSample bs = brdf_.sample(p.wo[k], u1, u2);
+      if (!(bs.pdf > 0 && bs.wi.z > 0)) continue;
+      st.brdf[st.size] = bs;
+      st.dir[st.size] = p.frame[k].to_world(bs.wi);
+      st.sample[st.size++] = k;
+    }
+    const auto n = std::size_t(st.size);
+    env_.lookup(std::span(st.dir, n), s_.compensation, std::span(st.light, n));
+    Batch& b = p.batch;
+    b.size = 0;
+    for (int i = 0; i < st.size; ++i) {
+      const Rgb& li = st.light[i].radiance;
+      if (li.r == 0 && li.g == 0 && li.b == 0) continue;
+      const int j = b.size++, k = st.sample[i];
+      b.sample[j] = k;
+      b.pair[j] = {st.brdf[i].wi, p.wo[k]};
+      b.li[j] = li;
+      b.pdf[j] = st.brdf[i].pdf;
+      b.other_pdf[j] = st.light[i].pdf;
+    }
+    add_batch(b, share, p);
+  }
+
+  void render_packet(int px, int py, const PixelSequences& q, Packet& p) const {
+    camera(px, py, q, p);
     switch (s_.strategy) {
       case Strategy::mis:
-        env_sample(1, 1);
-        brdf_sample(2, 1);
+        env_stage(q, 1, 1, p);
+        brdf_stage(q, 2, 1, p);
         break;
       case Strategy::env:
-        env_sample(1, 0.5);
-        env_sample(2, 0.5);
+        env_stage(q, 1, 0.5, p);
+        env_stage(q, 2, 0.5, p);
         break;
       case Strategy::brdf:
-        brdf_sample(1, 0.5);
-        brdf_sample(2, 0.5);
+        brdf_stage(q, 1, 0.5, p);
+        brdf_stage(q, 2, 0.5, p);
         break;
     }
-    return sum;
   }
 
   // Adds samples [first, first + count) of the pixels of one tile to `acc`.
   void tile(int tx, int ty, std::uint32_t first, std::uint32_t count, Accum& acc,
             std::atomic<std::uint64_t>& nonfinite) const {
     const int x1 = std::min(tx + kTile, s_.width), y1 = std::min(ty + kTile, s_.height);
+    Packet packet;
     for (int py = ty; py < y1; ++py)
       for (int px = tx; px < x1; ++px) {
         const std::size_t p = std::size_t(py) * std::size_t(s_.width) + std::size_t(px);
         double r = 0, g = 0, b = 0, y = 0, y2 = 0;
         std::uint64_t bad = 0;
-        for (std::uint32_t i = first; i < first + count; ++i) {
-          const Rgb v = pixel_sample(px, py, p, i);
-          if (!(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b))) {
-            ++bad;
-            continue;
+        const PixelSequences q = sequences(p);
+        for (std::uint32_t i = first; i < first + count; i += kPacket) {
+          packet.first = i;
+          packet.size = int(std::min<std::uint32_t>(kPacket, first + count - i));
+          render_packet(px, py, q, packet);
+          for (int k = 0; k < packet.size; ++k) {
+            const Rgb& v = packet.sum[k];
+            if (!(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b))) {
+              ++bad;
+              continue;
+            }
+            r += v.r;
+            g += v.g;
+            b += v.b;
+            const double l = v.luminance();
+            y += l;
+            y2 += l * l;
           }
-          r += v.r;
-          g += v.g;
-          b += v.b;
-          const double l = v.luminance();
-          y += l;
-          y2 += l * l;
         }
         acc.rgb[3 * p] += r;
         acc.rgb[3 * p + 1] += g;
@@ -234,6 +345,7 @@ class Renderer {
   const RenderSettings& s_;
   detail::SequenceKind kind_;
   double aspect_, tan_bg_, tan_persp_;
+  std::uint64_t keys_[kPairs];
 };
 
 void validate(const RenderSettings& s) {

@@ -17,6 +17,7 @@
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/models/analytic.hpp"
+#include "support/exr_offsets.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::render {
@@ -246,6 +247,57 @@ TEST(Renderer, MisOnRealMap) {
   }
 }
 
+// Renders equal in expectation (docs/render.md, "Speed"): the mean of two seeds' MIS images (guide
+// tables, packets, the fast pixel lookup) against an independent reference, a long render by
+// cosine-weighted BRDF sampling alone (no environment sampling tables, no BRDF sampler), pixel by
+// pixel within the three images' own standard errors, and over the whole sphere (where the error
+// is small enough that a bias of 3 % fails it).
+TEST(Renderer, EqualInExpectationToCosineSampledReference) {
+  const EnvMap env = EnvMap::studio({-30, 0});
+  const auto glossy = ggx(0.3, 0.9);
+  const Opaque tabulated(ggx(0.3, 0.9));
+  const models::Lambert lambert({0.6, 0.5, 0.4});
+  for (const Brdf* b : {static_cast<const Brdf*>(glossy.get()),
+                        static_cast<const Brdf*>(&tabulated), static_cast<const Brdf*>(&lambert)}) {
+    RenderSettings s = small(12, 1024);
+    const RenderResult a = render(*b, env, s);
+    s.seed = 2;
+    const RenderResult c = render(*b, env, s);
+    s.seed = 3;
+    s.spp = 65536;
+    s.strategy = Strategy::brdf;
+    const RenderResult ref = render_sampled(*with_cosine_sampling(*b), env, s);
+    double sum_z2 = 0, sum_mean = 0, sum_ref = 0, sum_var = 0;
+    int n = 0, outliers = 0;
+    auto lum = [](const float* p) { return Rgb{p[0], p[1], p[2]}.luminance(); };
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        if (!fully_on_sphere(s, x, y)) continue;
+        const std::size_t i = std::size_t(y * s.width + x);
+        const double mean = 0.5 * (lum(a.image.pixel(x, y)) + lum(c.image.pixel(x, y)));
+        const double var = 0.25 * (a.variance[i] + c.variance[i]) + ref.variance[i];
+        ASSERT_GT(var, 0);
+        const double z = (mean - lum(ref.image.pixel(x, y))) / std::sqrt(var);
+        sum_z2 += z * z;
+        outliers += std::abs(z) > 5;
+        sum_mean += mean;
+        sum_ref += lum(ref.image.pixel(x, y));
+        sum_var += var;
+        ++n;
+      }
+    ASSERT_GT(n, 40);
+    EXPECT_LT(sum_z2 / n, 2.0) << b->describe_sampling();
+    EXPECT_LE(outliers, 1) << b->describe_sampling();
+    // The sphere's total: within 4 standard errors, which are small enough to see a 3 % bias.
+    const double sd = std::sqrt(sum_var) / sum_ref;
+    EXPECT_LT(sd, 0.006) << b->describe_sampling();
+    EXPECT_NEAR(sum_mean / sum_ref, 1, 4 * sd) << b->describe_sampling();
+    RecordProperty(b->name() + "_total_ratio", std::to_string(sum_mean / sum_ref));
+    RecordProperty(b->name() + "_total_sd", std::to_string(sd));
+    RecordProperty(b->name() + "_mean_z2", std::to_string(sum_z2 / n));
+  }
+}
+
 TEST(Renderer, DeterministicAcrossThreadCounts) {
   const auto g = ggx(0.2);
   const EnvMap env = EnvMap::default_sky();
@@ -366,6 +418,14 @@ TEST(Renderer, ImageFiles) {
   const std::filesystem::path& dir = tmp.path();
   write_image(dir / "a.exr", r.image, {});
   EXPECT_EQ(read_exr(dir / "a.exr").rgb, r.image.rgb);
+  // The scan-line offset table is written (readers would otherwise have to rebuild it).
+  const std::string exr = test::read_file(dir / "a.exr");
+  const std::vector<std::uint64_t> offsets = test::exr_scanline_offsets(exr);
+  ASSERT_EQ(offsets.size(), std::size_t(r.image.height + 15) / 16) << "ZIP chunks of 16 lines";
+  for (std::uint64_t o : offsets) {
+    EXPECT_GT(o, 0u);
+    EXPECT_LT(o, exr.size());
+  }
   write_image(dir / "a.PNG", r.image, {1, true});
   std::ifstream png(dir / "a.PNG", std::ios::binary);
   char magic[4] = {};

@@ -34,17 +34,34 @@ GridSpec cells_for(const GonioSetup& s, std::size_t n) {
   return g;
 }
 
-std::size_t cells_inside(const GridSpec& g) {
-  const std::size_t n = g.points();
+// The cells whose centres, mapped back through the warps, are pairs of directions.
+std::size_t cells_inside(const GridSpec& g, const std::vector<AxisWarp>& warps) {
+  const std::size_t n = g.points(), dim = g.axes.size();
+  std::vector<std::vector<double>> coords(dim, std::vector<double>(std::min(n, kBlock)));
   std::vector<DirPair<double>> pairs(std::min(n, kBlock));
   std::vector<std::uint8_t> ok(pairs.size());
   std::size_t inside = 0;
   for (std::size_t begin = 0; begin < n; begin += kBlock) {
     const std::size_t m = std::min(kBlock, n - begin);
-    grid_pairs(g, begin, std::span(pairs).first(m), std::span(ok).first(m));
+    for (std::size_t a = 0, stride = n; a < dim; ++a) {
+      const GridAxis& ax = g.axes[a];
+      stride /= ax.count;
+      const double step = (ax.hi - ax.lo) / double(ax.count);
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::size_t i = (begin + j) / stride % ax.count;
+        coords[a][j] = warps[a].inverse(ax.lo + (double(i) + 0.5) * step);
+      }
+    }
+    std::vector<std::span<const double>> columns;
+    for (const auto& c : coords) columns.emplace_back(c.data(), m);
+    coordinates_to_pairs(g.form(), columns, std::span(pairs).first(m), std::span(ok).first(m));
     inside += std::size_t(std::count(ok.begin(), ok.begin() + std::ptrdiff_t(m), 1));
   }
   return inside;
+}
+
+const LearnedWarps* learned_of(const GonioSetup& s) {
+  return s.learned ? &*s.learned : nullptr;
 }
 
 // A reproducible uniform number in [0, 1) for (seed, cell, try, axis): SplitMix64 of a hash.
@@ -72,14 +89,15 @@ GridSpec gonio_cells(const GonioSetup& s) {
     throw std::invalid_argument("the gonio-reflectometer's reach must be in (0, 90] degrees");
   // A first guess from the fraction of the box inside the domain, then the nearest n.
   const GridSpec probe = cells_for(s, 8);
-  const double fraction = double(cells_inside(probe)) / double(probe.points());
+  const std::vector<AxisWarp> warps = design_warps(probe, s.spacing, learned_of(s));
+  const double fraction = double(cells_inside(probe, warps)) / double(probe.points());
   const double per_n = fraction * double(probe.points()) / std::pow(8.0, double(probe.axes.size()));
   auto n = std::size_t(std::max(
       1.0, std::round(std::pow(double(s.budget) / per_n, 1.0 / double(probe.axes.size())))));
   std::map<std::size_t, std::size_t> counted;  // n -> cells inside: each grid counted once
   auto inside = [&](std::size_t m) {
     const auto [it, fresh] = counted.try_emplace(m, 0);
-    if (fresh) it->second = cells_inside(cells_for(s, m));
+    if (fresh) it->second = cells_inside(cells_for(s, m), warps);
     return it->second;
   };
   while (n > 1 && inside(n - 1) >= s.budget) --n;
@@ -92,7 +110,10 @@ GridSpec gonio_cells(const GonioSetup& s) {
 }
 
 GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& setup)
-    : setup_(setup), cells_(gonio_cells(setup)), truth_name_(truth.name()) {
+    : setup_(setup),
+      cells_(gonio_cells(setup)),
+      warps_(design_warps(cells_, setup.spacing, learned_of(setup))),
+      truth_name_(truth.name()) {
   dim_ = cells_.axes.size();
   for (std::size_t a = dim_, stride = 1; a-- > 0;) {
     periodic_[a] = is_azimuth(cells_.axes[a]);
@@ -155,7 +176,8 @@ void GonioReconstruction::measure_block(const Brdf& truth, std::span<const std::
     for (std::size_t a = 0; a < dim_; ++a) {
       const GridAxis& ax = cells_.axes[a];
       const std::size_t i = cells[j] / stride_[a] % ax.count;
-      coords[a][j] = ax.lo + (double(i) + offsets[j][a]) * (ax.hi - ax.lo) / double(ax.count);
+      coords[a][j] = warps_[a].inverse(ax.lo + (double(i) + offsets[j][a]) * (ax.hi - ax.lo) /
+                                                   double(ax.count));
     }
   }
   std::vector<DirPair<double>> pairs(m);
@@ -251,8 +273,8 @@ void GonioReconstruction::fill_unmeasured(std::vector<std::uint8_t>& filled) {
 }
 
 std::string GonioReconstruction::name() const {
-  return fmt::format("gonio:{}/{}/{}:{}", name_of(setup_.space), name_of(setup_.design), samples_,
-                     truth_name_);
+  return fmt::format("gonio:{}/{}/{}/{}:{}", name_of(setup_.space), name_of(setup_.spacing),
+                     name_of(setup_.design), samples_, truth_name_);
 }
 
 std::string GonioReconstruction::description() const {
@@ -260,9 +282,10 @@ std::string GonioReconstruction::description() const {
   for (const GridAxis& a : cells_.axes)
     counts += fmt::format("{}{} {}", counts.empty() ? "" : " x ", a.count, a.name);
   return fmt::format(
-      "{} measured at {} points of a {} design in the {} {} form ({} cells), reconstructed by {}",
-      truth_name_, samples_, name_of(setup_.design), setup_.isotropic ? "isotropic" : "full",
-      name_of(setup_.space), counts,
+      "{} measured at {} points of a {} layout spaced {} in the {} {} form ({} cells), "
+      "reconstructed by {}",
+      truth_name_, samples_, name_of(setup_.design), name_of(setup_.spacing),
+      setup_.isotropic ? "isotropic" : "full", name_of(setup_.space), counts,
       setup_.design == Design::regular ? "multilinear interpolation" : "local affine fits");
 }
 
@@ -273,7 +296,13 @@ Rgb GonioReconstruction::reconstruct(const double* x) const {
   for (std::size_t a = 0; a < dim_; ++a) {
     const GridAxis& ax = cells_.axes[a];
     const auto len = double(ax.count);
-    double u = (x[a] - ax.lo) / (ax.hi - ax.lo) * len;
+    double xa = x[a];
+    if (periodic_[a]) {  // into [lo, hi) before the warp, which clamps
+      xa = std::fmod(xa - ax.lo, ax.hi - ax.lo);
+      xa += ax.lo + (xa < 0 ? ax.hi - ax.lo : 0.0);
+    }
+    xa = warps_[a].forward(xa);
+    double u = (xa - ax.lo) / (ax.hi - ax.lo) * len;
     if (periodic_[a]) {
       u = std::fmod(u, len);
       if (u < 0) u += len;
@@ -430,7 +459,7 @@ TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t se
     const double y = rho[i].luminance();
     if (!std::isfinite(y)) continue;
     t.pairs.push_back(all[i]);
-    t.truth.push_back(to_error_space(y, es));
+    t.truth.push_back(to_error_space(y, es, all[i].wi.z, all[i].wo.z));
   }
   return t;
 }
@@ -440,7 +469,8 @@ double reconstruction_error(const Brdf& reconstruction, const TestPairs& test) {
   reconstruction.eval_batch(test.pairs, rho);
   double err = 0, norm = 0;
   for (std::size_t i = 0; i < rho.size(); ++i) {
-    const double y = to_error_space(rho[i].luminance(), test.space);
+    const double y =
+        to_error_space(rho[i].luminance(), test.space, test.pairs[i].wi.z, test.pairs[i].wo.z);
     if (!std::isfinite(y))
       throw std::runtime_error(reconstruction.name() + ": a reconstructed value is not finite");
     err += (y - test.truth[i]) * (y - test.truth[i]);

@@ -181,7 +181,7 @@ TEST(Gonio, PairsOutsideTheHemisphereAndBadInput) {
   EXPECT_EQ(below.r, 0.0);
   const Rgb nan = r.eval({{std::nan(""), 0, 1}, dir(0.3, 1)});
   EXPECT_TRUE(std::isnan(nan.r));
-  EXPECT_NE(r.name().find("gonio:ortho/regular/"), std::string::npos);
+  EXPECT_NE(r.name().find("gonio:ortho/own/regular/"), std::string::npos);
   EXPECT_THROW(GonioReconstruction(f, {Space::dirs, true, Design::regular, 1000, 1}),
                std::invalid_argument);
   EXPECT_THROW(GonioReconstruction(f, {Space::hybrid, true, Design::regular, 0, 1}),

@@ -1,6 +1,7 @@
 #include "halfback/study/image_metrics.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -159,6 +160,45 @@ std::vector<std::uint8_t> sphere_mask(int width, int height, double half_height,
   return mask;
 }
 
+namespace {
+
+// A channel of a rendering as displayed: scaled, clamped to [0, 1]; 0 where not finite (only
+// pixels outside the mask can be, and the SSIM window may reach them).
+double displayed(float v, double scale) {
+  return std::isfinite(v) ? std::clamp(double(v) * scale, 0.0, 1.0) : 0.0;
+}
+
+// MAE, RMSE and SSIM of the tone-mapped images (ImageError).
+void add_display_errors(const render::Image& test, const render::Image& reference,
+                        std::span<const std::uint8_t> mask, double scale, ImageError& e) {
+  const std::size_t n = mask.size();
+  std::vector<double> yt(n), yr(n);
+  double abs_sum = 0, sq_sum = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    double t[3], r[3];
+    for (int c = 0; c < 3; ++c) {
+      t[c] = displayed(test.rgb[3 * k + std::size_t(c)], scale);
+      r[c] = displayed(reference.rgb[3 * k + std::size_t(c)], scale);
+      if (mask[k]) {
+        abs_sum += std::abs(t[c] - r[c]);
+        sq_sum += (t[c] - r[c]) * (t[c] - r[c]);
+      }
+    }
+    yt[k] = Rgb{t[0], t[1], t[2]}.luminance();
+    yr[k] = Rgb{r[0], r[1], r[2]}.luminance();
+  }
+  const double values = 3.0 * double(e.pixels);
+  e.mae = abs_sum / values;
+  e.rmse = std::sqrt(sq_sum / values);
+  try {
+    e.ssim = ssim(yt, yr, reference.width, reference.height, mask);
+  } catch (const std::invalid_argument&) {  // an image too small for the window
+    e.ssim = std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+}  // namespace
+
 ImageError compare_images(const render::Image& test, const render::Image& reference,
                           std::span<const std::uint8_t> mask) {
   check_image(test, "test");
@@ -219,7 +259,45 @@ ImageError compare_images(const render::Image& test, const render::Image& refere
   }
   e.mean_delta_e = sum / double(delta_e.size());
   e.p95_delta_e = percentile(delta_e, 95);
+  add_display_errors(test, reference, mask, scale, e);
   return e;
+}
+
+double ssim(std::span<const double> x, std::span<const double> y, int width, int height,
+            std::span<const std::uint8_t> mask) {
+  constexpr int kRadius = 5;  // an 11 × 11 window
+  constexpr double kSigma = 1.5, kC1 = 0.01 * 0.01, kC2 = 0.03 * 0.03;
+  const std::size_t n = std::size_t(std::max(width, 0)) * std::size_t(std::max(height, 0));
+  if (width <= 0 || height <= 0 || x.size() != n || y.size() != n || mask.size() != n)
+    throw std::invalid_argument("ssim: the images and the mask must hold width × height values");
+  std::array<double, 2 * kRadius + 1> g{};
+  double total = 0;
+  for (int i = -kRadius; i <= kRadius; ++i)
+    total += g[std::size_t(i + kRadius)] = std::exp(-i * i / (2 * kSigma * kSigma));
+  for (double& v : g) v /= total;  // the 2D window is g gᵀ, of sum 1
+  double sum = 0;
+  std::size_t count = 0;
+  for (int j = kRadius; j + kRadius < height; ++j)
+    for (int i = kRadius; i + kRadius < width; ++i) {
+      if (!mask[std::size_t(j) * std::size_t(width) + std::size_t(i)]) continue;
+      double mx = 0, my = 0, xx = 0, yy = 0, xy = 0;
+      for (int b = -kRadius; b <= kRadius; ++b)
+        for (int a = -kRadius; a <= kRadius; ++a) {
+          const double w = g[std::size_t(a + kRadius)] * g[std::size_t(b + kRadius)];
+          const std::size_t k = std::size_t(j + b) * std::size_t(width) + std::size_t(i + a);
+          mx += w * x[k];
+          my += w * y[k];
+          xx += w * x[k] * x[k];
+          yy += w * y[k] * y[k];
+          xy += w * x[k] * y[k];
+        }
+      const double vx = xx - mx * mx, vy = yy - my * my, cxy = xy - mx * my;
+      sum += (2 * mx * my + kC1) * (2 * cxy + kC2) / ((mx * mx + my * my + kC1) * (vx + vy + kC2));
+      ++count;
+    }
+  if (count == 0)
+    throw std::invalid_argument("ssim: no masked pixel has its 11 × 11 window inside the image");
+  return sum / double(count);
 }
 
 }  // namespace halfback::study

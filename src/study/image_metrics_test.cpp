@@ -355,5 +355,53 @@ TEST(CompareImages, RejectsInvalidInput) {
   }
 }
 
+// SSIM (Wang et al. 2004) on hand-computed cases; tests/python/test_study_metrics.py checks it
+// against a NumPy port on a fixed pair of images.
+TEST(Ssim, EqualImagesAreOneAndConstantImagesFollowTheLuminanceTerm) {
+  const int w = 15, h = 13;
+  std::vector<double> x(w * h), y(w * h, 0.4);
+  for (std::size_t k = 0; k < x.size(); ++k) x[k] = 0.5 + 0.4 * std::sin(0.7 * double(k));
+  const std::vector<std::uint8_t> all(w * h, 1);
+  EXPECT_NEAR(ssim(x, x, w, h, all), 1.0, 1e-12);
+  // Constant images a and b: σ = 0, so SSIM = (2ab + C1) / (a² + b² + C1), C1 = 0.01².
+  const std::vector<double> a(w * h, 0.2);
+  EXPECT_NEAR(ssim(a, y, w, h, all), (2 * 0.2 * 0.4 + 1e-4) / (0.04 + 0.16 + 1e-4), 1e-12);
+  // A constant against a varying image: the structure term is C2 / (σx² + C2) < 1.
+  EXPECT_LT(ssim(x, y, w, h, all), ssim(a, y, w, h, all));
+}
+
+TEST(Ssim, OnlyMaskedPixelsWithTheirWholeWindowCount) {
+  const int w = 12, h = 11;  // the 11 × 11 window fits at (5, 5) and (6, 5) only
+  std::vector<double> x(w * h, 0.5), y(w * h, 0.5);
+  y[5 * w + 11] = 0.9;  // inside the window of (6, 5) only
+  std::vector<std::uint8_t> mask(w * h, 1);
+  const double both = ssim(x, y, w, h, mask);
+  EXPECT_LT(both, 1.0);
+  mask[5 * w + 6] = 0;  // (6, 5) left out: only (5, 5), which does not see the change
+  EXPECT_NEAR(ssim(x, y, w, h, mask), 1.0, 1e-12);
+  mask[5 * w + 5] = 0;
+  EXPECT_THROW(ssim(x, y, w, h, mask), std::invalid_argument);
+  EXPECT_THROW(ssim(x, y, w, h + 1, mask), std::invalid_argument);
+}
+
+TEST(CompareImages, PublishedMetricsOfToneMappedGreys) {
+  // Reference grey 0.5 everywhere: its 99th percentile is 0.5, so it displays as 1; a test grey
+  // of 0.25 displays as 0.5. MAE = RMSE = 0.5; SSIM of constants (2 · 0.5 + C1) / (1.25 + C1).
+  const int w = 16, h = 16;
+  const render::Image ref = image(w, h, std::vector<float>(w * h * 3, 0.5f));
+  const render::Image test = image(w, h, std::vector<float>(w * h * 3, 0.25f));
+  const std::vector<std::uint8_t> all(w * h, 1);
+  const ImageError e = compare_images(test, ref, all);
+  EXPECT_NEAR(e.mae, 0.5, 1e-12);
+  EXPECT_NEAR(e.rmse, 0.5, 1e-12);
+  EXPECT_NEAR(e.ssim, (1 + 1e-4) / (1.25 + 1e-4), 1e-12);
+  const ImageError same = compare_images(ref, ref, all);
+  EXPECT_EQ(same.mae, 0.0);
+  EXPECT_NEAR(same.ssim, 1.0, 1e-12);
+  // Too small for the window: SSIM is NaN, the other metrics are still there.
+  EXPECT_TRUE(
+      std::isnan(compare_images(pattern(), pattern(), std::vector<std::uint8_t>(48, 1)).ssim));
+}
+
 }  // namespace
 }  // namespace halfback::study

@@ -17,25 +17,43 @@ std::string_view name_of(ErrorSpace s) {
     case ErrorSpace::log:
       return "log";
     case ErrorSpace::cbrt:
+      return "cbrt";
+    case ErrorSpace::nielsen:
+      return "nielsen";
+    case ErrorSpace::low:
       break;
   }
-  return "cbrt";
+  return "low";
+}
+
+std::optional<ErrorSpace> parse_error_space(std::string_view name) {
+  for (ErrorSpace s : kErrorSpaces)
+    if (name_of(s) == name) return s;
+  return std::nullopt;
 }
 
 double IsoSamples::total_weight() const {
   return std::accumulate(weight.begin(), weight.end(), 0.0);
 }
 
-double to_error_space(double y, ErrorSpace es) {
+double to_error_space(double y, ErrorSpace es, double cos_i, double cos_o) {
+  // Nielsen et al.'s constants (their code release): ε and the smallest cosine product.
+  constexpr double kNielsenEpsilon = 0.001, kNielsenMinCosines = 0.01;
   switch (es) {
     case ErrorSpace::linear:
       return y;
     case ErrorSpace::log:
       return std::log1p(std::max(y, 0.0));
     case ErrorSpace::cbrt:
+      return std::cbrt(y);
+    case ErrorSpace::nielsen: {
+      const double c = std::clamp(cos_i * cos_o, kNielsenMinCosines, 1.0);
+      return std::log1p(std::max(y, 0.0) * c / kNielsenEpsilon);
+    }
+    case ErrorSpace::low:
       break;
   }
-  return std::cbrt(y);
+  return std::log1p(std::max(y, 0.0) * std::clamp(cos_i, 0.0, 1.0));
 }
 
 double FullSamples::total_weight() const {
@@ -146,7 +164,7 @@ void sample_grid(const Brdf& brdf, const GridSpec& g, ErrorSpace es, std::vector
     const std::size_t p = where[k];
     const double y = rho[k].luminance();
     if (!std::isfinite(y)) continue;
-    value[p] = to_error_space(y, es);
+    value[p] = to_error_space(y, es, pairs[k].wi.z, pairs[k].wo.z);
     weight[p] = jac[p] * pairs[k].wi.z * pairs[k].wo.z * cell;
   }
 }

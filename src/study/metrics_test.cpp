@@ -109,5 +109,38 @@ TEST(Metrics, BadInput) {
   EXPECT_THROW(separability_2d(x, {-1}), std::invalid_argument);
 }
 
+TEST(Metrics, ErrorSpacesMatchTheirDefinitions) {
+  EXPECT_DOUBLE_EQ(to_error_space(0.5, ErrorSpace::linear, 0.3, 0.2), 0.5);
+  EXPECT_DOUBLE_EQ(to_error_space(std::exp(1.0) - 1, ErrorSpace::log, 0.3, 0.2), 1.0);
+  EXPECT_DOUBLE_EQ(to_error_space(8, ErrorSpace::cbrt, 0.3, 0.2), 2.0);
+  // Nielsen et al. 2015: ln(1 + Y c / ε), c = cos θi cos θo, ε = 0.001; c = 0.8 · 0.5.
+  EXPECT_NEAR(to_error_space(0.5, ErrorSpace::nielsen, 0.8, 0.5), std::log(201.0), 1e-12);
+  // A difference of two values is their log-relative mapping ln((Y c + ε) / (Y_ref c + ε)).
+  const double d = to_error_space(0.7, ErrorSpace::nielsen, 0.6, 0.9) -
+                   to_error_space(0.2, ErrorSpace::nielsen, 0.6, 0.9);
+  EXPECT_NEAR(d, std::log((0.7 * 0.54 + 0.001) / (0.2 * 0.54 + 0.001)), 1e-12);
+  // Their code clamps c to >= 0.01 (grazing pairs): cos 0.05 · 0.1 = 0.005 counts as 0.01.
+  EXPECT_NEAR(to_error_space(1, ErrorSpace::nielsen, 0.05, 0.1), std::log(11.0), 1e-12);
+  // Löw et al. 2012: ln(1 + Y cos θi), whatever cos θo.
+  EXPECT_NEAR(to_error_space(2, ErrorSpace::low, 0.5, 0.9), std::log(2.0), 1e-15);
+  EXPECT_EQ(to_error_space(2, ErrorSpace::low, 0.5, 0.1),
+            to_error_space(2, ErrorSpace::low, 0.5, 1));
+  for (ErrorSpace es : kErrorSpaces) EXPECT_EQ(parse_error_space(name_of(es)), es);
+  EXPECT_EQ(parse_error_space("ln"), std::nullopt);
+}
+
+TEST(Metrics, CosineErrorSpacesSeeEachPairsCosines) {
+  // A constant BRDF: in the Löw space its table is ln(1 + cos θi), not a constant, so dropping
+  // the azimuth of spherical (θi, θo, φ) is still exact but the 2D table is not rank 0.
+  const Fn one([](const DirPair<double>&) { return 1.0; });
+  const IsoSamples s = sample_isotropic(one, Space::spherical, kGrid, ErrorSpace::low);
+  EXPECT_LT(azimuthal_error(s), 1e-12);
+  // θi is the first axis: each row of the table is ln(1 + cos θi) at its cell centre.
+  const double theta = (0.5 + 3) * (std::numbers::pi / 2) / double(kGrid.a);
+  const std::size_t p = (3 * kGrid.b + 5) * kGrid.phi + 2;
+  ASSERT_GT(s.weight[p], 0);
+  EXPECT_NEAR(s.value[p], std::log1p(std::cos(theta)), 1e-12);
+}
+
 }  // namespace
 }  // namespace halfback::study

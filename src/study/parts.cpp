@@ -19,12 +19,6 @@ namespace halfback::study {
 
 namespace {
 
-std::optional<ErrorSpace> error_space_named(std::string_view name) {
-  for (ErrorSpace s : {ErrorSpace::linear, ErrorSpace::log, ErrorSpace::cbrt})
-    if (name_of(s) == name) return s;
-  return std::nullopt;
-}
-
 std::optional<Design> design_named(std::string_view name) {
   for (Design d : kDesigns)
     if (name_of(d) == name) return d;
@@ -47,6 +41,12 @@ void check_ascending(const std::vector<std::size_t>& v, const char* option) {
       throw std::invalid_argument(fmt::format("{}: budgets must be ascending", option));
 }
 
+std::vector<std::string_view> spacing_names(const std::vector<Spacing>& spacings) {
+  std::vector<std::string_view> names;
+  for (Spacing s : spacings) names.push_back(name_of(s));
+  return names;
+}
+
 template <class T>
 std::string joined(const std::vector<T>& v) {
   std::string s;
@@ -58,10 +58,22 @@ std::string joined(const std::vector<T>& v) {
 
 StudyConfig make_config(const StudySettings& o) {
   StudyConfig c;
-  const auto space = error_space_named(o.space);
+  const auto space = parse_error_space(o.space);
   if (!space)
-    throw std::invalid_argument(fmt::format("--space '{}': expected linear, log or cbrt", o.space));
+    throw std::invalid_argument(fmt::format(
+        "--error-space '{}': expected linear, log, cbrt, nielsen or low (docs/study.md)", o.space));
   c.space = *space;
+  c.spacings.clear();
+  for (const std::string& name : o.designs) {
+    const auto spacing = parse_spacing(name);
+    if (!spacing)
+      throw std::invalid_argument(
+          fmt::format("--designs: '{}' is not a design (own, angle, merl or learned)", name));
+    if (std::find(c.spacings.begin(), c.spacings.end(), *spacing) != c.spacings.end())
+      throw std::invalid_argument(fmt::format("--designs: '{}' is given twice", name));
+    c.spacings.push_back(*spacing);
+  }
+  if (c.spacings.empty()) throw std::invalid_argument("--designs: no design given");
   if (o.quick) apply_quick(c);
   check_ascending(o.budgets, "--budgets");
   check_ascending(o.budgets_4d, "--budgets-4d");
@@ -99,11 +111,13 @@ std::string describe_config(const StudyConfig& c) {
   return fmt::format(
       "space = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = {}\nbudgets_4d = {}\n"
       "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
-      "image_size = {}\nimage_spp = {}\n",
+      "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
+      "learned_from = {}\n",
       name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
       joined(std::vector<std::size_t>(c.full_grid.begin(), c.full_grid.end())), joined(c.ranks),
       joined(c.budgets), joined(c.budgets_4d), c.test_pairs, format_csv_number(c.max_theta_deg),
-      c.seed, envs, c.image_budget, c.image_size, c.image_spp);
+      c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(spacing_names(c.spacings)),
+      c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from);
 }
 
 namespace {
@@ -149,7 +163,7 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
   };
   const std::string where = source;
   StudyConfig c;
-  const auto space = error_space_named(get("space"));
+  const auto space = parse_error_space(get("space"));
   if (!space) throw std::runtime_error(fmt::format("{}: unknown error space", source));
   c.space = *space;
   const auto grid = numbers_of<std::size_t>(get("grid"), where);
@@ -170,6 +184,17 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
   c.image_budget = number_of<std::size_t>(get("image_budget"), where);
   c.image_size = number_of<int>(get("image_size"), where);
   c.image_spp = number_of<int>(get("image_spp"), where);
+  c.spacings.clear();
+  for (const std::string& name : split_csv_line(get("designs"))) {
+    const auto spacing = parse_spacing(name);
+    if (!spacing) throw std::runtime_error(fmt::format("{}: unknown design '{}'", source, name));
+    c.spacings.push_back(*spacing);
+  }
+  const auto profile_grid = numbers_of<std::size_t>(get("profile_grid"), where);
+  if (profile_grid.size() != 3)
+    throw std::runtime_error(fmt::format("{}: a grid has the wrong number of axes", source));
+  c.profile_grid = {profile_grid[0], profile_grid[1], profile_grid[2]};
+  c.learned_from = get("learned_from");
   return c;
 }
 
@@ -179,10 +204,111 @@ std::string study_label(std::string_view spec, const Brdf& brdf) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Profiles (the learned design)
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+constexpr std::string_view kProfileMagic = "# halfback study profile 1\n";
+
+std::uint64_t fnv1a(std::string_view s, std::uint64_t h = 1469598103934665603ull) {
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+}  // namespace
+
+bool wants_learned(const StudyConfig& c) {
+  return !c.budgets.empty() &&
+         std::find(c.spacings.begin(), c.spacings.end(), Spacing::learned) != c.spacings.end();
+}
+
+LabeledProfile study_profile(const Brdf& brdf, const std::string& label, const StudyConfig& c) {
+  return {label, design_profile(brdf, kStudied, c.profile_grid, c.space)};
+}
+
+// The label, then per space its name and one line of numbers per axis.
+std::string profile_text(const LabeledProfile& p) {
+  std::string text(kProfileMagic);
+  text += "label = " + csv_text_field(p.label) + "\n";
+  for (const AxisDemand& d : p.profile.spaces) {
+    text += fmt::format("space = {}\n", name_of(d.space));
+    for (const std::vector<double>& axis : d.demand) {
+      for (std::size_t i = 0; i < axis.size(); ++i) {
+        if (i) text += ',';
+        text += format_csv_number(axis[i]);
+      }
+      text += '\n';
+    }
+  }
+  return text;
+}
+
+LabeledProfile profile_from_text(std::string_view text, const std::string& source) {
+  if (text.substr(0, kProfileMagic.size()) != kProfileMagic)
+    throw std::runtime_error(source + ": not a profile of a halfback study");
+  std::istringstream in{std::string(text.substr(kProfileMagic.size()))};
+  std::string line;
+  LabeledProfile p;
+  if (!std::getline(in, line) || line.rfind("label = ", 0) != 0)
+    throw std::runtime_error(source + ": no 'label' line");
+  const auto label = split_csv_line(line.substr(8));
+  if (label.size() != 1) throw std::runtime_error(source + ": a malformed label");
+  p.label = label[0];
+  while (std::getline(in, line)) {
+    if (line.rfind("space = ", 0) != 0)
+      throw std::runtime_error(fmt::format("{}: expected 'space = NAME', got '{}'", source, line));
+    AxisDemand d;
+    const auto space = std::find_if(kStudied.begin(), kStudied.end(),
+                                    [&](Space s) { return name_of(s) == line.substr(8); });
+    if (space == kStudied.end())
+      throw std::runtime_error(fmt::format("{}: unknown space '{}'", source, line.substr(8)));
+    d.space = *space;
+    for (std::vector<double>& axis : d.demand) {
+      if (!std::getline(in, line))
+        throw std::runtime_error(source + ": the profile ends inside a space");
+      axis = numbers_of<double>(line, source);
+    }
+    p.profile.spaces.push_back(std::move(d));
+  }
+  return p;
+}
+
+std::string learned_fingerprint(std::span<const LabeledProfile> profiles) {
+  std::uint64_t h = fnv1a(std::to_string(profiles.size()));
+  for (const LabeledProfile& p : profiles) h = fnv1a(profile_text(p), h);
+  return fmt::format("{} profiles, {:016x}", profiles.size(), h);
+}
+
+void set_learned(StudyConfig& c, std::span<const LabeledProfile> profiles,
+                 const std::string& label) {
+  const auto it = std::find_if(profiles.begin(), profiles.end(),
+                               [&](const LabeledProfile& p) { return p.label == label; });
+  if (it == profiles.end())
+    throw std::invalid_argument(fmt::format(
+        "the learned design: no profile of '{}' among the profiles given (they must be those of "
+        "every BRDF of the study, this one's included, so that it is left out)",
+        label));
+  std::vector<DesignProfile> plain;
+  for (const LabeledProfile& p : profiles) plain.push_back(p.profile);
+  c.learned.clear();
+  if (profiles.size() > 1)
+    c.learned = learn_warps(plain, std::size_t(std::distance(profiles.begin(), it)));
+  c.learned_from = learned_fingerprint(profiles);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Tables
 // ---------------------------------------------------------------------------------------------
 
 namespace {
+
+// The columns of gonio.csv and image.csv (report.cpp writes the same).
+constexpr std::string_view kGonioHeader =
+    "brdf,parameterization,design,samples,error,dims,budget,spacing";
+constexpr std::string_view kImageHeader =
+    "brdf,parameterization,design,samples,environment,relative_rmse,mean_delta_e2000,"
+    "p95_delta_e2000,mae,rmse,ssim";
 
 std::string num(double v) {
   return format_csv_number(v);
@@ -198,8 +324,8 @@ void add_rank_rows(std::string& csv, const std::string& brdf, std::string_view p
 void add_gonio_rows(std::string& csv, const std::string& brdf, std::string_view pn,
                     const std::vector<GonioPoint>& pts, int dims) {
   for (const GonioPoint& g : pts)
-    csv += fmt::format("{},{},{},{},{},{},{}\n", brdf, pn, name_of(g.design), g.samples,
-                       num(g.error), dims, g.budget);
+    csv += fmt::format("{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(g.design), g.samples,
+                       num(g.error), dims, g.budget, name_of(g.spacing));
 }
 
 }  // namespace
@@ -211,10 +337,8 @@ StudyTables to_tables(const BrdfResult& b) {
       fmt::format("brdf,isotropic,seconds\n{},{},{}\n", brdf, int(b.isotropic), num(b.seconds));
   std::string az = "brdf,parameterization,error,dims\n";
   std::string sep = "brdf,parameterization,rank_index,error,dims\n";
-  std::string gonio = "brdf,parameterization,design,samples,error,dims,budget\n";
-  std::string image =
-      "brdf,parameterization,design,samples,environment,relative_rmse,mean_delta_e2000,"
-      "p95_delta_e2000\n";
+  std::string gonio = std::string(kGonioHeader) + "\n";
+  std::string image = std::string(kImageHeader) + "\n";
   for (const ParamResult& p : b.params) {
     const std::string_view pn = name_of(p.space);
     az += fmt::format("{},{},{},3\n", brdf, pn, num(p.azimuthal));
@@ -225,9 +349,10 @@ StudyTables to_tables(const BrdfResult& b) {
     add_gonio_rows(gonio, brdf, pn, p.gonio, 3);
     add_gonio_rows(gonio, brdf, pn, p.gonio_4d, 4);
     for (const ImagePoint& i : p.images)
-      image += fmt::format("{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(i.design), i.samples,
-                           csv_text_field(i.environment), num(i.relative_rmse), num(i.mean_delta_e),
-                           num(i.p95_delta_e));
+      image +=
+          fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(i.design), i.samples,
+                      csv_text_field(i.environment), num(i.relative_rmse), num(i.mean_delta_e),
+                      num(i.p95_delta_e), num(i.mae), num(i.rmse), num(i.ssim));
   }
   t["azimuthal"] = az;
   t["separability"] = sep;
@@ -311,27 +436,26 @@ void read_metric_tables(const StudyTables& t, const std::string& source, BrdfRes
 }
 
 void read_gonio_tables(const StudyTables& t, const std::string& source, BrdfResult& b) {
-  const TableReader g =
-      read_table(t, "gonio", "brdf,parameterization,design,samples,error,dims,budget", source);
+  const TableReader g = read_table(t, "gonio", kGonioHeader, source);
   for (std::size_t i = 0; i < g.rows.size(); ++i) {
     const auto& f = g.rows[i];
     const std::string w = g.where(i);
     ParamResult& p = param_named(b, f[1], w);
+    const auto spacing = parse_spacing(f[7]);
+    if (!spacing) throw std::runtime_error(fmt::format("{}: unknown spacing '{}'", w, f[7]));
     (f[5] == "4" ? p.gonio_4d : p.gonio)
         .push_back({design_of(f[2], w), number_of<std::size_t>(f[6], w),
-                    number_of<std::size_t>(f[3], w), number_of<double>(f[4], w)});
+                    number_of<std::size_t>(f[3], w), number_of<double>(f[4], w), *spacing});
   }
-  const TableReader im = read_table(t, "image",
-                                    "brdf,parameterization,design,samples,environment,"
-                                    "relative_rmse,mean_delta_e2000,p95_delta_e2000",
-                                    source);
+  const TableReader im = read_table(t, "image", kImageHeader, source);
   for (std::size_t i = 0; i < im.rows.size(); ++i) {
     const auto& f = im.rows[i];
     const std::string w = im.where(i);
     param_named(b, f[1], w)
         .images.push_back({design_of(f[2], w), number_of<std::size_t>(f[3], w), f[4],
                            number_of<double>(f[5], w), number_of<double>(f[6], w),
-                           number_of<double>(f[7], w)});
+                           number_of<double>(f[7], w), number_of<double>(f[8], w),
+                           number_of<double>(f[9], w), number_of<double>(f[10], w)});
   }
 }
 
@@ -360,13 +484,7 @@ BrdfResult from_tables(const StudyTables& t, const std::string& source) {
 
 namespace {
 
-constexpr std::string_view kPartMagic = "# halfback study part 1\n";
-
-std::uint64_t fnv1a(std::string_view s) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
-  return h;
-}
+constexpr std::string_view kPartMagic = "# halfback study part 2\n";
 
 // The example renderings side by side in one image (they share their size).
 render::Image strip_of(const std::vector<render::Image>& images) {
@@ -397,6 +515,10 @@ std::vector<render::Image> images_of(const render::Image& strip, int size) {
 
 std::filesystem::path parts_dir(const std::filesystem::path& out) {
   return out / "parts";
+}
+
+std::filesystem::path profiles_dir(const std::filesystem::path& out) {
+  return out / "profiles";
 }
 
 std::string part_key(std::string_view spec) {
@@ -457,8 +579,18 @@ void merge_into(MergedParts& into, const std::string& settings, const std::strin
     into.config = config_from_description(settings, source);
     into.settings = settings;
   } else if (settings != into.settings) {
-    throw std::runtime_error(fmt::format("'{}' and '{}' were run with different settings",
-                                         into.source_of.begin()->second, source));
+    const StudyConfig other = config_from_description(settings, source);
+    const bool learned_only = [&] {
+      StudyConfig a = into.config;
+      a.learned_from = other.learned_from;
+      return describe_config(a) == settings;
+    }();
+    throw std::runtime_error(fmt::format(
+        "'{}' and '{}' were run with different settings{}", into.source_of.begin()->second, source,
+        learned_only ? " (their learned designs come from different sets of BRDFs: run the "
+                       "study over all of them, or pass every profile to study_brdf, or leave "
+                       "out the learned design with --designs own,angle,merl)"
+                     : ""));
   }
   for (BrdfResult& b : results) {
     if (const auto [it, fresh] = into.source_of.emplace(b.label, source); !fresh)

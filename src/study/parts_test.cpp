@@ -8,6 +8,7 @@
 #include <fstream>
 #include <numbers>
 
+#include "halfback/loader/load.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::study {
@@ -28,7 +29,10 @@ BrdfResult fake(const std::string& label, bool isotropic, double k) {
     for (Design d : kDesigns)
       for (std::size_t n : {1000u, 10000u})
         p.gonio.push_back({d, n, n - 3, k * std::exp(-double(n) / 7777)});
-    p.images.push_back({Design::stratified, 997, "a \"quoted\", env", k / 3, k / 9, k / 27});
+    p.gonio.push_back({Design::regular, 1000, 997, k / 37, Spacing::learned});
+    p.gonio.push_back({Design::regular, 1000, 996, k / 41, Spacing::merl});
+    p.images.push_back({Design::stratified, 997, "a \"quoted\", env", k / 3, k / 9, k / 27, k / 43,
+                        k / 47, 1 - k / 53});
     if (!isotropic) {
       p.azimuthal_4d = k / 23;
       p.separability_4d = {k / 29};
@@ -59,6 +63,7 @@ void expect_same(const BrdfResult& a, const BrdfResult& b) {
       EXPECT_EQ(p.gonio[k].budget, q.gonio[k].budget);
       EXPECT_EQ(p.gonio[k].samples, q.gonio[k].samples);
       EXPECT_EQ(p.gonio[k].error, q.gonio[k].error);
+      EXPECT_EQ(p.gonio[k].spacing, q.gonio[k].spacing);
     }
     EXPECT_EQ(p.gonio_4d.size(), q.gonio_4d.size());
     ASSERT_EQ(p.images.size(), q.images.size());
@@ -66,6 +71,9 @@ void expect_same(const BrdfResult& a, const BrdfResult& b) {
       EXPECT_EQ(p.images[k].environment, q.images[k].environment);
       EXPECT_EQ(p.images[k].relative_rmse, q.images[k].relative_rmse);
       EXPECT_EQ(p.images[k].p95_delta_e, q.images[k].p95_delta_e);
+      EXPECT_EQ(p.images[k].mae, q.images[k].mae);
+      EXPECT_EQ(p.images[k].rmse, q.images[k].rmse);
+      EXPECT_EQ(p.images[k].ssim, q.images[k].ssim);
     }
   }
 }
@@ -79,15 +87,18 @@ TEST(StudyParts, TablesRoundTripExactly) {
 
 TEST(StudyParts, MalformedTablesNameTheProblem) {
   StudyTables t = to_tables(fake("x", true, 1));
-  t["gonio"] += "x,hybrid,regular,10,abc,3,10\n";
+  t["gonio"] += "x,hybrid,regular,10,abc,3,10,own\n";
   try {
     from_tables(t, "src");
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("src: table gonio, line 18: 'abc' is not a number"),
+    EXPECT_NE(std::string(e.what()).find("src: table gonio, line 26: 'abc' is not a number"),
               std::string::npos)
         << e.what();
   }
+  t = to_tables(fake("x", true, 1));
+  t["gonio"] += "x,hybrid,regular,10,0.5,3,10,sqrt\n";
+  EXPECT_THROW(from_tables(t, "src"), std::runtime_error);
   t = to_tables(fake("x", true, 1));
   t.erase("image");
   EXPECT_THROW(from_tables(t, "src"), std::runtime_error);
@@ -103,7 +114,10 @@ TEST(StudyParts, SettingsRoundTrip) {
   s.seed = 7;
   s.max_theta = 80.5;
   s.environments = {"sky", "studio"};
-  const StudyConfig c = make_config(s);
+  s.space = "nielsen";
+  s.designs = {"merl", "own", "learned"};
+  StudyConfig c = make_config(s);
+  c.learned_from = "3 profiles, 0123456789abcdef";
   const std::string text = describe_config(c);
   const StudyConfig back = config_from_description(text, "test");
   EXPECT_EQ(describe_config(back), text);
@@ -112,9 +126,17 @@ TEST(StudyParts, SettingsRoundTrip) {
   EXPECT_EQ(back.max_theta_deg, 80.5);
   ASSERT_EQ(back.environments.size(), 2u);
   EXPECT_EQ(back.environments[1].label, "studio (built-in)");
+  EXPECT_EQ(back.space, ErrorSpace::nielsen);
+  EXPECT_EQ(back.spacings, (std::vector<Spacing>{Spacing::merl, Spacing::own, Spacing::learned}));
+  EXPECT_EQ(back.learned_from, c.learned_from);
   // A setting that changes the results changes the description.
   s.seed = 8;
   EXPECT_NE(describe_config(make_config(s)), text);
+  s.designs = {"own", "sqrt"};
+  EXPECT_THROW(make_config(s), std::invalid_argument);
+  s.designs = {"own", "own"};
+  EXPECT_THROW(make_config(s), std::invalid_argument);
+  s.designs = {"own"};
   s.space = "sqrt";
   EXPECT_THROW(make_config(s), std::invalid_argument);
   EXPECT_THROW(config_from_description("space = log\n", "f"), std::runtime_error);
@@ -154,6 +176,61 @@ TEST(StudyParts, PartFilesAndTheirMerge) {
   other.seed = 2;
   std::ofstream(parts_dir(b) / "settings.txt") << describe_config(other);
   EXPECT_THROW(read_parts({a, b}), std::runtime_error);
+}
+
+// Profiles of three models on a small grid (cheap, yet not uniform).
+std::vector<LabeledProfile> model_profiles(const StudyConfig& c) {
+  std::vector<LabeledProfile> out;
+  for (const char* spec : {"ggx:alpha=0.1", "ggx:alpha=0.4", "lambert"})
+    out.push_back(study_profile(*load_brdf(spec), spec, c));
+  return out;
+}
+
+TEST(StudyParts, ProfilesRoundTripExactly) {
+  StudyConfig c;
+  c.profile_grid = {8, 8, 8};
+  const LabeledProfile p = model_profiles(c)[0];
+  const LabeledProfile back = profile_from_text(profile_text(p), "test");
+  EXPECT_EQ(back.label, p.label);
+  ASSERT_EQ(back.profile.spaces.size(), p.profile.spaces.size());
+  for (std::size_t i = 0; i < p.profile.spaces.size(); ++i) {
+    EXPECT_EQ(back.profile.spaces[i].space, p.profile.spaces[i].space);
+    EXPECT_EQ(back.profile.spaces[i].demand, p.profile.spaces[i].demand);  // the same doubles
+  }
+  EXPECT_THROW(profile_from_text("space = hybrid\n", "f"), std::runtime_error);
+  std::string cut = profile_text(p);
+  cut.resize(cut.rfind('\n', cut.size() - 2) + 1);  // the last axis line removed
+  EXPECT_THROW(profile_from_text(cut, "f"), std::runtime_error);
+}
+
+TEST(StudyParts, LearnedWarpsLeaveTheirBrdfOut) {
+  StudyConfig c;
+  c.profile_grid = {8, 8, 8};
+  std::vector<LabeledProfile> profiles = model_profiles(c);
+  StudyConfig a = c;
+  set_learned(a, profiles, "lambert");
+  ASSERT_EQ(a.learned.size(), kStudied.size());
+  EXPECT_EQ(a.learned,
+            learn_warps(std::vector<DesignProfile>{profiles[0].profile, profiles[1].profile,
+                                                   profiles[2].profile},
+                        2));
+  EXPECT_EQ(a.learned_from, learned_fingerprint(profiles));
+  // Another profile for the held-out BRDF: the same warps, another fingerprint (the run differs).
+  profiles[2] = study_profile(*load_brdf("ggx:alpha=0.7"), "lambert", c);
+  StudyConfig b = c;
+  set_learned(b, profiles, "lambert");
+  EXPECT_EQ(b.learned, a.learned);
+  EXPECT_NE(b.learned_from, a.learned_from);
+  // ... but another BRDF's warps change.
+  StudyConfig d = c, e = c;
+  set_learned(d, profiles, "ggx:alpha=0.1");
+  profiles[2] = model_profiles(c)[2];
+  set_learned(e, profiles, "ggx:alpha=0.1");
+  EXPECT_NE(d.learned, e.learned);
+  EXPECT_THROW(set_learned(d, profiles, "ggx:alpha=0.9"), std::invalid_argument);
+  // One BRDF has none to learn from: no learned warps (the learned design has no rows).
+  set_learned(d, std::span(profiles).first(1), "ggx:alpha=0.1");
+  EXPECT_TRUE(d.learned.empty());
 }
 
 }  // namespace

@@ -55,9 +55,11 @@ struct Wins {
   }
 };
 
-const GonioPoint* find_point(const std::vector<GonioPoint>& pts, Design d, std::size_t budget) {
+// Without a spacing: the own one (the tables of section 3 are those of the own design).
+const GonioPoint* find_point(const std::vector<GonioPoint>& pts, Design d, std::size_t budget,
+                             Spacing spacing = Spacing::own) {
   for (const GonioPoint& p : pts)
-    if (p.design == d && p.budget == budget) return &p;
+    if (p.spacing == spacing && p.design == d && p.budget == budget) return &p;
   return nullptr;
 }
 
@@ -72,10 +74,11 @@ std::string design_cells(const std::vector<GonioPoint>& pts, std::size_t budget)
 }
 
 std::pair<std::vector<double>, std::vector<double>> curve(const std::vector<GonioPoint>& pts,
-                                                          Design d) {
+                                                          Design d,
+                                                          Spacing spacing = Spacing::own) {
   std::vector<double> n, e;
   for (const GonioPoint& p : pts)
-    if (p.design == d) {
+    if (p.spacing == spacing && p.design == d) {
       n.push_back(double(p.samples));
       e.push_back(p.error);
     }
@@ -189,11 +192,11 @@ Contents contents_of(const std::vector<BrdfResult>& results) {
 struct CsvTables {
   std::string azimuthal = "brdf,parameterization,error,dims\n";
   std::string separability = "brdf,parameterization,rank,error,dims\n";
-  std::string gonio = "brdf,parameterization,design,samples,error,dims,budget\n";
-  std::string budget = "brdf,parameterization,design,dims,target_error,samples,note\n";
+  std::string gonio = "brdf,parameterization,design,samples,error,dims,budget,spacing\n";
+  std::string budget = "brdf,parameterization,design,dims,target_error,samples,note,spacing\n";
   std::string image =
       "brdf,parameterization,design,samples,environment,relative_rmse,mean_delta_e2000,"
-      "p95_delta_e2000\n";
+      "p95_delta_e2000,mae,rmse,ssim\n";
 };
 
 void add_separability_rows(std::string& csv, const std::string& brdf, std::string_view pn,
@@ -207,20 +210,22 @@ void add_separability_rows(std::string& csv, const std::string& brdf, std::strin
 void add_gonio_rows(CsvTables& t, const std::string& brdf, std::string_view pn,
                     const std::vector<GonioPoint>& pts, int dims) {
   for (const GonioPoint& g : pts)
-    t.gonio += fmt::format("{},{},{},{},{:.6g},{},{}\n", brdf, pn, name_of(g.design), g.samples,
-                           g.error, dims, g.budget);
-  for (Design d : kDesigns) {
-    const auto [n, e] = curve(pts, d);
-    if (n.empty()) continue;
-    for (double target : kTargetErrors) {
-      const double s = samples_to_reach(n, e, target);
-      t.budget += fmt::format("{},{},{},{},{},{},{}\n", brdf, pn, name_of(d), dims, target,
-                              s == 0 || std::isinf(s) ? std::string() : fmt::format("{:.0f}", s),
-                              s == 0          ? "below_range"
-                              : std::isinf(s) ? "not_reached"
-                                              : "reached");
+    t.gonio += fmt::format("{},{},{},{},{:.6g},{},{},{}\n", brdf, pn, name_of(g.design), g.samples,
+                           g.error, dims, g.budget, name_of(g.spacing));
+  for (Spacing spacing : kSpacings)
+    for (Design d : kDesigns) {
+      const auto [n, e] = curve(pts, d, spacing);
+      if (n.empty()) continue;
+      for (double target : kTargetErrors) {
+        const double s = samples_to_reach(n, e, target);
+        t.budget += fmt::format("{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(d), dims, target,
+                                s == 0 || std::isinf(s) ? std::string() : fmt::format("{:.0f}", s),
+                                s == 0          ? "below_range"
+                                : std::isinf(s) ? "not_reached"
+                                                : "reached",
+                                name_of(spacing));
+      }
     }
-  }
 }
 
 CsvTables csv_tables(const std::vector<BrdfResult>& results, const StudyConfig& config) {
@@ -238,9 +243,10 @@ CsvTables csv_tables(const std::vector<BrdfResult>& results, const StudyConfig& 
       add_gonio_rows(t, brdf, pn, p.gonio, 3);
       add_gonio_rows(t, brdf, pn, p.gonio_4d, 4);
       for (const ImagePoint& i : p.images)
-        t.image += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g}\n", brdf, pn, name_of(i.design),
-                               i.samples, csv_text_field(i.environment), i.relative_rmse,
-                               i.mean_delta_e, i.p95_delta_e);
+        t.image +=
+            fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", brdf, pn,
+                        name_of(i.design), i.samples, csv_text_field(i.environment),
+                        i.relative_rmse, i.mean_delta_e, i.p95_delta_e, i.mae, i.rmse, i.ssim);
     }
   }
   return t;
@@ -266,19 +272,23 @@ void write_csv_files(const std::filesystem::path& dir, const CsvTables& t, const
 struct MeanImageError {
   double relative_rmse = INFINITY, delta_e = INFINITY;
   int count = 0;
+  double mae = INFINITY, rmse = INFINITY, ssim = 0;  // Sztrajman et al. 2021's protocol
 };
 
 MeanImageError mean_image_error(const std::vector<ImagePoint>& images, Design d) {
-  double r = 0, e = 0;
+  double r = 0, e = 0, mae = 0, rmse = 0, ssim = 0;
   int n = 0;
   for (const ImagePoint& p : images)
     if (p.design == d) {
       r += p.relative_rmse;
       e += p.mean_delta_e;
+      mae += p.mae;
+      rmse += p.rmse;
+      ssim += p.ssim;
       ++n;
     }
   if (n == 0) return {};
-  return {r / n, e / n, n};
+  return {r / n, e / n, n, mae / n, rmse / n, ssim / n};
 }
 
 bool has_images(const BrdfResult& b) {
@@ -336,8 +346,10 @@ figure::BarChart image_chart(const std::vector<BrdfResult>& results, const Study
 // The plots, in the order they are written. Some may have nothing to draw (every curve exact, no
 // rendering): the report links only those that are written.
 struct ReportPlots {
-  figure::Scene azimuthal, separability, gonio, gonio4d, image, renderings;
+  figure::Scene azimuthal, separability, gonio, gonio4d, designs, image, renderings;
 };
+
+figure::Scene designs_plot(const std::vector<BrdfResult>& results, const StudyConfig& config);
 
 ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
                          const Contents& has) {
@@ -347,6 +359,7 @@ ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConf
   p.separability = figure::bar_chart(separability_chart(results, es));
   if (has.gonio) p.gonio = gonio_chart(results, false, config);
   if (has.gonio && has.anisotropic) p.gonio4d = gonio_chart(results, true, config);
+  if (has.gonio) p.designs = designs_plot(results, config);
   if (has.images) {
     p.image = figure::bar_chart(image_chart(results, config));
     p.renderings = examples_chart(results, config);
@@ -360,6 +373,7 @@ void save_plots(const ReportPlots& p, const std::filesystem::path& dir,
   save_plot(p.separability, dir, "separability", files);
   save_plot(p.gonio, dir, "gonio", files);
   save_plot(p.gonio4d, dir, "gonio4d", files);
+  save_plot(p.designs, dir, "designs", files);
   save_plot(p.image, dir, "image", files);
   save_plot(p.renderings, dir, "renderings", files);
 }
@@ -597,6 +611,233 @@ std::string gonio_4d_table(const std::vector<BrdfResult>& results, const StudyCo
   return md;
 }
 
+// Section 3b. A design: a spacing in a layout (the own spacing in both layouts, the others in
+// the regular one; study.hpp).
+struct DesignKey {
+  Spacing spacing = Spacing::own;
+  Design layout = Design::regular;
+};
+
+std::string design_name(const DesignKey& k) {
+  return k.spacing == Spacing::own ? fmt::format("own {}", name_of(k.layout))
+                                   : std::string(name_of(k.spacing));
+}
+
+// The designs measured at budget `ref` for some isotropic BRDF, in the order of kSpacings.
+std::vector<DesignKey> designs_measured(const std::vector<BrdfResult>& results, std::size_t ref) {
+  std::vector<DesignKey> keys;
+  for (Spacing spacing : kSpacings)
+    for (Design d : kDesigns) {
+      bool any = false;
+      for (const BrdfResult& b : results)
+        for (const ParamResult& p : b.params)
+          any |= find_point(p.gonio, d, ref, spacing) != nullptr;
+      if (any) keys.push_back({spacing, d});
+    }
+  return keys;
+}
+
+double design_error(const ParamResult& p, const DesignKey& k, std::size_t ref) {
+  const GonioPoint* g = find_point(p.gonio, k.layout, ref, k.spacing);
+  return g ? g->error : INFINITY;
+}
+
+// The BRDFs measured in every design by every parameterization at `ref` (compared like with
+// like), each parameterization's median error per design over them, and its best design.
+struct DesignComparison {
+  std::vector<DesignKey> keys;
+  std::vector<const BrdfResult*> brdfs;
+  std::string exact;  // BRDFs left out: some design reconstructs them exactly (no winner)
+  std::array<std::vector<double>, kStudied.size()> median;  // per design
+  std::array<std::size_t, kStudied.size()> best{};          // index into keys
+};
+
+DesignComparison compare_designs(const std::vector<BrdfResult>& results, std::size_t ref) {
+  DesignComparison c;
+  c.keys = designs_measured(results, ref);
+  for (const BrdfResult& b : results) {
+    bool complete = b.params.size() == kStudied.size();
+    double lowest = INFINITY;
+    for (const ParamResult& p : b.params)
+      for (const DesignKey& k : c.keys) {
+        complete &= std::isfinite(design_error(p, k, ref));
+        lowest = std::min(lowest, design_error(p, k, ref));
+      }
+    if (complete && lowest <= 1e-12) c.exact += (c.exact.empty() ? "" : ", ") + b.label;
+    if (complete && lowest > 1e-12) c.brdfs.push_back(&b);
+  }
+  for (std::size_t i = 0; i < kStudied.size() && !c.brdfs.empty(); ++i) {
+    for (const DesignKey& k : c.keys) {
+      std::vector<double> e;
+      for (const BrdfResult* b : c.brdfs) e.push_back(design_error(b->params[i], k, ref));
+      c.median[i].push_back(median(e));
+    }
+    c.best[i] =
+        std::size_t(std::min_element(c.median[i].begin(), c.median[i].end()) - c.median[i].begin());
+  }
+  return c;
+}
+
+figure::Scene designs_chart(const DesignComparison& c, std::size_t ref, ErrorSpace es) {
+  if (c.brdfs.empty() || c.keys.size() < 2) return {};
+  figure::BarChart chart;
+  chart.title =
+      fmt::format("Designs: median relative error ({} space) at N = {}", name_of(es), ref);
+  chart.x_label =
+      fmt::format("median over {} BRDFs of the reconstruction's relative error", c.brdfs.size());
+  for (const DesignKey& k : c.keys) chart.series.push_back(design_name(k));
+  for (std::size_t i = 0; i < kStudied.size(); ++i) {
+    chart.rows.emplace_back(name_of(kStudied[i]));
+    chart.values.push_back(c.median[i]);
+  }
+  figure::BarChartLayout layout;
+  layout.label_width = 110;  // the rows are parameterization names
+  return figure::bar_chart(chart, layout);
+}
+
+figure::Scene designs_plot(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const std::size_t ref = reference_budget(config);
+  return designs_chart(compare_designs(results, ref), ref, config.space);
+}
+
+// Which parameterization has the lowest error for each BRDF, with each parameterization in
+// `design[i]` (an index into c.keys).
+std::vector<std::size_t> winners(const DesignComparison& c, std::size_t ref,
+                                 const std::array<std::size_t, kStudied.size()>& design) {
+  std::vector<std::size_t> w;
+  for (const BrdfResult* b : c.brdfs) {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < kStudied.size(); ++i)
+      if (design_error(b->params[i], c.keys[design[i]], ref) <
+          design_error(b->params[best], c.keys[design[best]], ref))
+        best = i;
+    w.push_back(best);
+  }
+  return w;
+}
+
+std::string win_counts(const std::vector<std::size_t>& w) {
+  std::array<int, kStudied.size()> n{};
+  for (std::size_t i : w) ++n[i];
+  std::string s;
+  for (std::size_t i = 0; i < kStudied.size(); ++i)
+    s += fmt::format("{}{} {}", i ? ", " : "", name_of(kStudied[i]), n[i]);
+  return s;
+}
+
+std::size_t most_wins(const std::vector<std::size_t>& w) {
+  std::array<int, kStudied.size()> n{};
+  for (std::size_t i : w) ++n[i];
+  return std::size_t(std::max_element(n.begin(), n.end()) - n.begin());
+}
+
+// The table of each parameterization's median error per design, with its best design.
+std::string design_median_table(const DesignComparison& c) {
+  std::string md = "| parameterization |", rule = "|---|";
+  for (const DesignKey& k : c.keys) {
+    md += " " + design_name(k) + " |";
+    rule += "---|";
+  }
+  md += " best |\n" + rule + "---|\n";
+  for (std::size_t i = 0; i < kStudied.size(); ++i) {
+    md += fmt::format("| {} |", name_of(kStudied[i]));
+    for (std::size_t k = 0; k < c.keys.size(); ++k)
+      md += k == c.best[i] ? fmt::format(" **{:.4f}** |", c.median[i][k])
+                           : fmt::format(" {:.4f} |", c.median[i][k]);
+    md += " " + design_name(c.keys[c.best[i]]) + " |\n";
+  }
+  return md;
+}
+
+// What changes between the comparison in the own regular design and best against best.
+// The index in c.keys of a design, or c.keys.size() when it was not measured.
+std::size_t key_index(const DesignComparison& c, Spacing spacing, Design layout) {
+  for (std::size_t k = 0; k < c.keys.size(); ++k)
+    if (c.keys[k].spacing == spacing && c.keys[k].layout == layout) return k;
+  return c.keys.size();
+}
+
+// The paper's question in one line per parameterization whose angle design differs from its own
+// (ortho, hybrid): the same iso-surfaces with halfdiff's spacing of the magnitudes.
+std::string angle_line(const DesignComparison& c) {
+  const std::size_t own = key_index(c, Spacing::own, Design::regular);
+  const std::size_t angle = key_index(c, Spacing::angle, Design::regular);
+  if (own == c.keys.size() || angle == c.keys.size()) return {};
+  std::string md;
+  for (std::size_t i = 0; i < kStudied.size(); ++i)
+    if (!same_as_own(kStudied[i], true, Spacing::angle))
+      md += fmt::format("{}{} {:.4f} → {:.4f} (×{:.2f})", md.empty() ? "" : "; ",
+                        name_of(kStudied[i]), c.median[i][own], c.median[i][angle],
+                        c.median[i][angle] / c.median[i][own]);
+  return md.empty() ? md
+                    : "Uniform in angle instead of their own coordinates (median error, own "
+                      "regular → angle): " +
+                          md + ".\n\n";
+}
+
+// What changes between the comparison in the own regular design and best against best.
+std::string design_conclusions(const DesignComparison& c, std::size_t ref) {
+  const std::vector<std::size_t> after = winners(c, ref, c.best);
+  const std::size_t own_key = key_index(c, Spacing::own, Design::regular);
+  if (own_key == c.keys.size())  // nothing to compare with
+    return fmt::format("\nLowest error, best against best (BRDFs): {}.\n\n", win_counts(after));
+  std::array<std::size_t, kStudied.size()> own{};
+  own.fill(own_key);
+  const std::vector<std::size_t> before = winners(c, ref, own);
+  std::string changed;
+  int n_changed = 0;
+  for (std::size_t j = 0; j < c.brdfs.size(); ++j)
+    if (before[j] != after[j]) {
+      changed += fmt::format("{}{} ({} → {})", changed.empty() ? "" : ", ", c.brdfs[j]->label,
+                             name_of(kStudied[before[j]]), name_of(kStudied[after[j]]));
+      ++n_changed;
+    }
+  const std::size_t top_before = most_wins(before), top_after = most_wins(after);
+  std::string md = fmt::format(
+      "\nLowest error, each parameterization in the own regular design (BRDFs): {}.\n"
+      "Lowest error, best against best (each in its best design above): {}.\n\n",
+      win_counts(before), win_counts(after));
+  md += top_before == top_after
+            ? fmt::format("**The parameterization with the most wins does not change: {}.** ",
+                          name_of(kStudied[top_after]))
+            : fmt::format("**The parameterization with the most wins changes, from {} to {}.** ",
+                          name_of(kStudied[top_before]), name_of(kStudied[top_after]));
+  md += n_changed == 0 ? std::string("No BRDF changes its best parameterization.\n\n")
+                       : fmt::format("{} of {} BRDFs change their best parameterization: {}.\n\n",
+                                     n_changed, c.brdfs.size(), changed);
+  return md + angle_line(c);
+}
+
+// 3b. Designs: the coordinates against the spacing of the samples.
+std::string designs_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                            const ReportPlots& plots) {
+  const std::size_t ref = reference_budget(config);
+  const DesignComparison c = compare_designs(results, ref);
+  if (c.keys.size() < 2 || c.brdfs.empty()) return {};
+  std::string md = fmt::format(
+      "## 3b. Designs: coordinates against spacing\n\nThe same gonio-reflectometer at N = {} in "
+      "each design (docs/study.md, “Designs”): the cells uniform in the parameterization's own "
+      "coordinates (regular or stratified), in angle (the sine-like magnitudes through their "
+      "arcsine), in MERL's spacing (angle, and √ of the half-vector angle), or in warps learned "
+      "from the other BRDFs (leave-one-out). Median relative error over the {} isotropic BRDFs "
+      "measured in every design; the lowest of each parameterization in bold, its best "
+      "design:\n\n",
+      ref, c.brdfs.size());
+  md += design_median_table(c);
+  md += "\nBest against best, per BRDF (each parameterization in its best design):\n\n" +
+        table_header("BRDF");
+  for (const BrdfResult* b : c.brdfs) {
+    md += "| " + md_cell(b->label) + " |";
+    for (std::size_t i = 0; i < kStudied.size(); ++i)
+      md += fmt::format(" {:.4f} |", design_error(b->params[i], c.keys[c.best[i]], ref));
+    md += "\n";
+  }
+  md += design_conclusions(c, ref);
+  if (!c.exact.empty())
+    md += "Left out, reconstructed exactly by some design: " + c.exact + ".\n\n";
+  return md + plot_link(plots.designs, "Designs", "designs");
+}
+
 // 3. Gonio-reflectometer.
 std::string gonio_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
                           bool any_aniso, const ReportPlots& plots) {
@@ -634,6 +875,32 @@ ImageRows image_rows(const BrdfResult& b) {
           m.count ? fmt::format(" {:.4f} / {:.2f} |", m.relative_rmse, m.delta_e) : " – |";
     }
   return rows;
+}
+
+// The image-space protocol of Sztrajman et al. 2021 on the same renderings (regular design).
+std::string published_image_table(const std::vector<BrdfResult>& results) {
+  std::string md =
+      "The protocol of Sztrajman et al. 2021 on the same renderings (regular design, mean over "
+      "the environments): MAE / RMSE / SSIM of the tone-mapped images (values in [0, 1]; SSIM "
+      "of their luminance with the constants of Wang et al. 2004; docs/study.md):\n\n" +
+      table_header("BRDF");
+  Wins mae, ssim;
+  for (const BrdfResult& b : results) {
+    if (!has_images(b)) continue;
+    md += "| " + md_cell(b.label) + " |";
+    std::array<double, kStudied.size()> m{}, one_minus_ssim{};
+    for (std::size_t i = 0; i < b.params.size(); ++i) {
+      const MeanImageError e = mean_image_error(b.params[i].images, Design::regular);
+      m[i] = e.mae;
+      one_minus_ssim[i] = e.count ? 1 - e.ssim : INFINITY;
+      md += e.count ? fmt::format(" {:.4f} / {:.4f} / {:.4f} |", e.mae, e.rmse, e.ssim) : " – |";
+    }
+    mae.add(m);
+    ssim.add(one_minus_ssim);
+    md += "\n";
+  }
+  return md +
+         fmt::format("\nLowest MAE (BRDFs): {}; highest SSIM: {}.\n\n", mae.text(), ssim.text());
 }
 
 // 4. Image-space error.
@@ -676,6 +943,7 @@ std::string image_section(const std::vector<BrdfResult>& results, const StudyCon
             "![Image-space error](image.png)\n\n",
             rmse_wins[1].text(), de_wins[1].text()) +
         plot_link(plots.renderings, "Renderings of the reconstructions", "renderings");
+  md += published_image_table(results);
   if (!no_images.empty())
     md += "Not rendered (the BRDF has no value somewhere, so there is no ground-truth image): " +
           no_images + ".\n\n";
@@ -794,7 +1062,9 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
   std::string md = report_header(results, config, has.anisotropic, seconds) +
                    azimuthal_section(results, has.anisotropic) +
                    separability_section(results, config, has.anisotropic);
-  if (has.gonio) md += gonio_section(results, config, has.anisotropic, plots);
+  if (has.gonio)
+    md += gonio_section(results, config, has.anisotropic, plots) +
+          designs_section(results, config, plots);
   if (has.images) md += image_section(results, config, plots);
   md += files_and_networks_section(results, config);
   md += files_paragraph(out.files);

@@ -33,7 +33,8 @@ BrdfResult fake(const std::string& label, bool isotropic) {
     for (Design d : {Design::regular, Design::stratified})
       for (std::size_t n : {1000u, 1000000u})
         p.gonio.push_back({d, n, n, 0.5 * k * std::pow(n / 1000.0, -2.0 / 3)});
-    p.images.push_back({Design::regular, 1000, "sky", 0.03 * k, 1.5 * k, 3 * k});
+    p.images.push_back(
+        {Design::regular, 1000, "sky", 0.03 * k, 1.5 * k, 3 * k, 0.1 * k, 0.2 * k, 0.4 * k});
     if (!isotropic) {
       p.azimuthal_4d = 0.3 * k;
       p.separability_4d = p.separability_2d;
@@ -69,15 +70,16 @@ TEST(Report, FilesRepeatTheResults) {
   EXPECT_NE(sep.find("aniso,hybrid,8,0.03,4\n"), std::string::npos);
   const std::string gon = slurp(dir / "gonio.csv");
   EXPECT_EQ(gon.rfind("brdf,parameterization,design,samples,error,", 0), 0u);
-  EXPECT_NE(gon.find("aniso,spherical,stratified,1000000,0.02,4,1000000\n"), std::string::npos);
+  EXPECT_NE(gon.find("aniso,spherical,stratified,1000000,0.02,4,1000000,own\n"), std::string::npos);
   const std::string bud = slurp(dir / "budget.csv");
-  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.02,125000,reached\n"), std::string::npos) << bud;
-  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.01,353553,reached\n"), std::string::npos);
-  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.05,31623,reached\n"), std::string::npos);
+  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.02,125000,reached,own\n"), std::string::npos)
+      << bud;
+  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.01,353553,reached,own\n"), std::string::npos);
+  EXPECT_NE(bud.find("aniso,halfdiff,regular,3,0.05,31623,reached,own\n"), std::string::npos);
   // ortho (k = 2) reaches 0.05 at 1000 · 20^(3/2); spherical (k = 4) is 0.02 at 10^6.
-  EXPECT_NE(bud.find("aniso,ortho,stratified,4,0.05,89443,reached\n"), std::string::npos);
-  EXPECT_NE(bud.find("aniso,spherical,regular,3,0.01,,not_reached\n"), std::string::npos);
-  EXPECT_NE(slurp(dir / "image.csv").find("aniso,ortho,regular,1000,sky,0.06,3,6\n"),
+  EXPECT_NE(bud.find("aniso,ortho,stratified,4,0.05,89443,reached,own\n"), std::string::npos);
+  EXPECT_NE(bud.find("aniso,spherical,regular,3,0.01,,not_reached,own\n"), std::string::npos);
+  EXPECT_NE(slurp(dir / "image.csv").find("aniso,ortho,regular,1000,sky,0.06,3,6,0.2,0.4,0.8\n"),
             std::string::npos);
   // The report counts halfdiff (the lowest numbers) as the winner everywhere.
   EXPECT_NE(out.markdown.find("halfdiff 2, ortho 0, hybrid 0, spherical 0"), std::string::npos);
@@ -88,6 +90,55 @@ TEST(Report, FilesRepeatTheResults) {
   EXPECT_NE(html.find("<img alt=\"Virtual gonio-reflectometer\" src=\"data:image/png;base64,"),
             std::string::npos);
   EXPECT_EQ(html.find("](gonio.png)"), std::string::npos);
+}
+
+TEST(Report, DesignsSectionComparesBestAgainstBest) {
+  // In the own design halfdiff wins (k = 1); in the learned design hybrid's error is a tenth of
+  // its own, below halfdiff's, and the angle design is worse for everyone.
+  const test::TempDir tmp;
+  StudyConfig c;
+  c.budgets = {1000, 1000000};
+  c.image_budget = 1000;
+  std::vector<BrdfResult> results{fake("x", true), fake("y", true)};
+  for (BrdfResult& b : results)
+    for (ParamResult& p : b.params) {
+      const std::vector<GonioPoint> own = p.gonio;
+      for (const GonioPoint& g : own) {
+        if (g.design != Design::regular) continue;
+        const double learned = p.space == Space::hybrid ? 0.1 : 1.0;
+        p.gonio.push_back({g.design, g.budget, g.samples, g.error * 2, Spacing::angle});
+        p.gonio.push_back({g.design, g.budget, g.samples, g.error * learned, Spacing::learned});
+      }
+    }
+  const StudyOutput out = write_study(tmp.path(), results, c, 1);
+  const std::string& md = out.markdown;
+  EXPECT_NE(md.find("## 3b. Designs"), std::string::npos);
+  // hybrid (k = 3) at N = 1000: 1.5 own, 3 angle, 0.15 learned; its best is learned.
+  EXPECT_NE(md.find("| hybrid | 1.5000 | 1.5000 | 3.0000 | **0.1500** | learned |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| halfdiff | **0.5000** | 0.5000 | 1.0000 | 0.5000 | own regular |"),
+            std::string::npos);
+  EXPECT_NE(md.find("changes, from halfdiff to hybrid"), std::string::npos);
+  EXPECT_NE(md.find("2 of 2 BRDFs change their best parameterization"), std::string::npos);
+  // The angle design doubles ortho's (k = 2) and hybrid's (k = 3) errors at N = 1000.
+  EXPECT_NE(md.find("ortho 1.0000 → 2.0000 (×2.00); hybrid 1.5000 → 3.0000 (×2.00)"),
+            std::string::npos)
+      << md;
+  // Without the own design, best against best only.
+  StudyConfig no_own = c;
+  std::vector<BrdfResult> without = results;
+  for (BrdfResult& b : without)
+    for (ParamResult& p : b.params)
+      std::erase_if(p.gonio, [](const GonioPoint& g) { return g.spacing == Spacing::own; });
+  const test::TempDir tmp2;
+  const std::string md2 = write_study(tmp2.path(), without, no_own, 1).markdown;
+  EXPECT_NE(md2.find("Lowest error, best against best (BRDFs): halfdiff 0, ortho 0, hybrid 2"),
+            std::string::npos)
+      << md2;
+  EXPECT_NE(slurp(tmp.path() / "gonio.csv").find("x,hybrid,regular,1000,0.15,3,1000,learned\n"),
+            std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() / "designs.png"));
 }
 
 TEST(Report, OnlyWhatWasComputedIsWrittenAndLinked) {

@@ -47,6 +47,12 @@ void StudyConfig::validate() const {
             "study: the sample budget {} is above the maximum of {}", (*b)[i], kMaxSampleBudget));
     }
   }
+  if (spacings.empty()) throw std::invalid_argument("study: at least one design (spacing)");
+  for (std::size_t i = 0; i < spacings.size(); ++i)
+    if (std::find(spacings.begin(), spacings.begin() + std::ptrdiff_t(i), spacings[i]) !=
+        spacings.begin() + std::ptrdiff_t(i))
+      throw std::invalid_argument(
+          fmt::format("study: the design '{}' is given twice", name_of(spacings[i])));
   if (test_pairs < 100) throw std::invalid_argument("study: at least 100 test pairs");
   if (test_pairs > kMaxTestPairs)
     throw std::invalid_argument(
@@ -81,6 +87,46 @@ render::RenderSettings image_settings(const StudyConfig& c) {
   return s;
 }
 
+// One reconstruction of the gonio-reflectometer: the own spacing in every layout, then the other
+// spacings in the regular layout, each at every budget (designs that are the own one for this
+// parameterization copy its rows; the learned one only where warps were learned).
+struct GonioRun {
+  GonioSetup setup;
+  bool copy_of_own = false;
+};
+
+std::vector<GonioRun> gonio_runs(Space s, bool iso, const StudyConfig& config) {
+  const auto& budgets = iso ? config.budgets : config.budgets_4d;
+  const auto learned = std::find_if(config.learned.begin(), config.learned.end(),
+                                    [&](const LearnedWarps& w) { return w.space == s; });
+  const bool own = std::find(config.spacings.begin(), config.spacings.end(), Spacing::own) !=
+                   config.spacings.end();
+  std::vector<GonioRun> runs;
+  auto add = [&](Spacing spacing, Design d) {
+    if (spacing == Spacing::learned && learned == config.learned.end()) return;
+    const bool copy = own && spacing != Spacing::own && same_as_own(s, iso, spacing);
+    for (std::size_t budget : budgets) {
+      GonioRun run;
+      run.copy_of_own = copy;
+      run.setup.space = s;
+      run.setup.isotropic = iso;
+      run.setup.design = d;
+      run.setup.budget = budget;
+      run.setup.seed = config.seed;
+      run.setup.max_theta_deg = config.max_theta_deg;
+      run.setup.spacing = spacing;
+      if (spacing == Spacing::learned) run.setup.learned = *learned;
+      runs.push_back(std::move(run));
+      if (copy) break;  // one marker copies every budget
+    }
+  };
+  if (own)
+    for (Design d : kDesigns) add(Spacing::own, d);
+  for (Spacing spacing : config.spacings)
+    if (spacing != Spacing::own) add(spacing, Design::regular);
+  return runs;
+}
+
 }  // namespace
 
 BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyConfig& config) {
@@ -110,18 +156,24 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
     t.r.separability_2d = separability_2d(x, config.ranks);
     t.r.separability_3d = separability_unfolded(x, config.ranks);
     const bool iso = brdf.isotropic();
-    const auto& budgets = iso ? config.budgets : config.budgets_4d;
-    if (gonio)
-      for (Design d : kDesigns)
-        for (std::size_t budget : budgets) {
-          GonioSetup setup{s, iso, d, budget, config.seed};
-          setup.max_theta_deg = config.max_theta_deg;
-          auto rec = std::make_unique<GonioReconstruction>(brdf, setup);
-          (iso ? t.r.gonio : t.r.gonio_4d)
-              .push_back({d, budget, rec->samples(), reconstruction_error(*rec, test)});
-          if (budget == config.image_budget && !config.environments.empty())
-            t.for_images.push_back(std::move(rec));
+    if (gonio) {
+      std::vector<GonioPoint>& points = iso ? t.r.gonio : t.r.gonio_4d;
+      for (const GonioRun& run : gonio_runs(s, iso, config)) {
+        if (run.copy_of_own) {  // the same cells as own: the same numbers
+          for (std::size_t k = 0, own = points.size(); k < own; ++k)
+            if (points[k].spacing == Spacing::own && points[k].design == run.setup.design)
+              points.push_back({points[k].design, points[k].budget, points[k].samples,
+                                points[k].error, run.setup.spacing});
+          continue;
         }
+        auto rec = std::make_unique<GonioReconstruction>(brdf, run.setup);
+        points.push_back({run.setup.design, run.setup.budget, rec->samples(),
+                          reconstruction_error(*rec, test), run.setup.spacing});
+        if (run.setup.spacing == Spacing::own && run.setup.budget == config.image_budget &&
+            !config.environments.empty())
+          t.for_images.push_back(std::move(rec));
+      }
+    }
     if (!iso) {
       const FullSamples f = sample_full(brdf, s, config.full_grid, config.space);
       t.r.azimuthal_4d = azimuthal_error(f);
@@ -155,7 +207,7 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
           if (first && rec->setup().design == Design::regular) result.example_images.push_back(img);
           const ImageError e = compare_images(img, truth, mask);
           t.r.images.push_back({rec->setup().design, rec->samples(), env.label, e.relative_rmse,
-                                e.mean_delta_e, e.p95_delta_e});
+                                e.mean_delta_e, e.p95_delta_e, e.mae, e.rmse, e.ssim});
         }
       say(fmt::format("images {}", env.label));
     }

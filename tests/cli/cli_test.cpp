@@ -932,6 +932,53 @@ TEST_F(CliTest, ExportMerlBadInputKeepsTheOutput) {
   EXPECT_EQ(entries(), (std::vector<std::string>{"x.binary"}));
 }
 
+TEST_F(CliTest, ExportRglWritesAFileTheReaderReads) {
+  Result r = run({"export-rgl", "--brdf", "ggx:alpha=0.3,f0=0.5", "-o", "ggx.bsdf", "--theta-i",
+                  "6", "--resolution", "16", "--vndf-resolution", "64"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("ggx.bsdf written (6 incidence elevations, 16x16"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("incidence slice"), std::string::npos) << r.err;  // no terminal here
+  r = run({"info", "ggx.bsdf"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* s : {"RGL tensor_file", "6 θi × 1 φi", "16 × 16 samples", "2 × 64",
+                        "exported by halfback export-rgl from 'ggx:alpha=0.3,f0=0.5'"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+  r = run({"export-rgl", "--brdf", "lambert", "-o", "l.bsdf", "-q", "--description", "grey"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  r = run({"info", "l.bsdf"});
+  EXPECT_NE(r.out.find("material:              grey"), std::string::npos) << r.out;
+}
+
+TEST_F(CliTest, ExportRglBadInputKeepsTheOutput) {
+  put(path("x.bsdf"), "old");
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    const char* message;
+  };
+  const Case cases[] = {
+      {{"--brdf", "ggx:alpha_x=0.1,alpha_y=0.3"}, 1, "anisotropic"},
+      {{"--brdf", "lambert:albedo=0"}, 1, "zero in every backscattering direction"},
+      {{"--brdf", "nope"}, 1, "nope"},
+      {{"--brdf", "lambert", "--theta-i", "1"}, 2, "--theta-i"},
+      {{"--brdf", "lambert", "--resolution", "1"}, 2, "--resolution"},
+      {{"--brdf", "lambert", "--vndf-resolution", "x"}, 2, "--vndf-resolution"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"export-rgl", "-o", "x.bsdf"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const Result r = run(args);
+    EXPECT_EQ(r.status, c.status) << c.message << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(path("x.bsdf")), "old");
+  }
+  const Result r = run({"export-rgl", "--brdf", "lambert", "-o", "-"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"x.bsdf"}));
+}
+
 TEST_F(CliTest, ResampleWritesEachFormatAndRejectsBadGrids) {
   for (const char* f : {"t.exr", "t.npz", "t.npy"}) {
     const Result r = run({"resample", "--brdf", "test:S", "--param", "hybrid", "--kind", "slice",
@@ -1166,8 +1213,8 @@ TEST_F(CliTest, FigureBadInputLeavesNothing) {
             std::string::npos)
       << r.err;
   r = run({"figure", "paper", "--out", "figs", "--env", "default,missing.hdr"});
-  EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("--env 'missing.hdr'"), std::string::npos) << r.err;
+  EXPECT_EQ(r.status, 1);  // a file that cannot be read: a data error, as in `halfback render`
+  EXPECT_NE(r.err.find("missing.hdr: file: cannot open"), std::string::npos) << r.err;
   r = run({"figure", "material", "--brdf", "lambert", "--azimuths", "", "-o", "m.png"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--azimuths: no azimuth given"), std::string::npos) << r.err;
@@ -1177,6 +1224,55 @@ TEST_F(CliTest, FigureBadInputLeavesNothing) {
   r = run({"figure", "paper", "--out", "figs", "--no-materials", "--material", "lambert"});
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(entries(), std::vector<std::string>{});
+}
+
+// Class 12 of docs/reliability.md: each message names the option or file, the problem and what
+// is accepted, and the exit status says whose fault it is (2 the command line, 1 the data).
+TEST_F(CliTest, MessagesNameTheProblemAndExitCodesAgree) {
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    std::vector<std::string> parts;
+  };
+  put(path("pairs.csv"), std::string(kDirsHeader) + "0,0,1,0,0,1\n");
+  const Case cases[] = {
+      {{"figure", "bogus"},
+       2,
+       {"halfback figure: error: 'bogus' is not a figure subcommand (the subcommands are: "
+        "hemisphere, slices, paper, material)"}},
+      {{"figure"}, 2, {"a subcommand is required (one of: hemisphere, slices"}},
+      {{"eval", "--brdf", "+ggx", "-i", "pairs.csv"},
+       1,
+       {"'+ggx': a sum has an empty term (a sum is SPEC+SPEC+..."}},
+      {{"render", "--brdf", "ggx", "--env", "missing.hdr", "-o", "r.exr"},
+       1,
+       {"missing.hdr: file: cannot open"}},
+      {{"figure", "material", "--brdf", "ggx", "--env", "missing.hdr", "-o", "m.png"},
+       1,
+       {"missing.hdr: file: cannot open"}},
+      {{"render", "--brdf", "ggx", "--env", "constant:1,x", "-o", "r.exr"},
+       2,
+       {"--env 'constant:1,x'", "'x' is not a number"}},
+      {{"figure", "material", "--brdf", "ggx", "--env", "constant:0.5,0.2", "-o", "m.png"},
+       2,
+       {"--env 'constant:0.5,0.2'", "expected constant:V or constant:R,G,B"}},
+  };
+  for (const Case& c : cases) {
+    const Result r = run(c.args);
+    EXPECT_EQ(r.status, c.status) << c.args[0] << " " << c.args[1] << ": " << r.err;
+    for (const std::string& part : c.parts) EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+  }
+  // 901 elevations: refused from the figure's layout, before any sampling.
+  std::string many = "0";
+  for (int i = 1; i <= 900; ++i) (many += ',') += std::to_string(i * 0.1);
+  Result r = run({"figure", "hemisphere", "--elevations", many, "-o", "h.png"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("fewer elevations (901 given)"), std::string::npos) << r.err;
+  // constant:R,G,B keeps its commas in a list of environments.
+  r = run({"figure", "material", "--brdf", "lambert", "--env", "constant:0.5,0.2,0.1,studio",
+           "--render-size", "16", "--spp", "1", "-o", "m.png"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(entries(), std::vector<std::string>({"m.png", "pairs.csv"}));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1217,11 +1313,14 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
   const std::vector<std::vector<std::string>> gonio = csv_rows(slurp(path("st") / "gonio.csv"));
   ASSERT_FALSE(gonio.empty());
   EXPECT_EQ(gonio[0], (std::vector<std::string>{"brdf", "parameterization", "design", "samples",
-                                                "error", "dims", "budget"}));
+                                                "error", "dims", "budget", "spacing"}));
   std::map<std::string, std::map<std::string, double>> g_error;  // param/design -> budget -> e
   int four_d = 0, s_exact = 0;
+  std::map<std::string, int> spacings;  // the other designs (issue 14): rows of each spacing
   for (std::size_t i = 1; i < gonio.size(); ++i) {
-    ASSERT_EQ(gonio[i].size(), 7u);
+    ASSERT_EQ(gonio[i].size(), 8u);
+    ++spacings[gonio[i][7]];
+    if (gonio[i][7] != "own") continue;  // the checks below are those of the own design
     if (gonio[i][0] == "test:G")
       g_error[gonio[i][1] + "/" + gonio[i][2]][gonio[i][6]] = std::stod(gonio[i][4]);
     if (gonio[i][0] == "test:S" && gonio[i][2] == "regular" &&
@@ -1239,10 +1338,14 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
     EXPECT_LT(e.at("10000"), 0.05) << key;
   }
   EXPECT_EQ(four_d, 16);
+  // angle, merl and learned rows (learned from the three other BRDFs), in the regular layout:
+  // for each BRDF, 4 parameterizations x 2 budgets each (the copies of own included).
+  for (const char* spacing : {"angle", "merl", "learned"})
+    EXPECT_EQ(spacings[spacing], 4 * 4 * 2) << spacing;
   // Measured data too: the felt's reconstruction improves with the budget.
   std::map<std::string, double> felt;
   for (const auto& row : gonio)
-    if (row[0] == "embedded:acrylic_felt_green" && row[2] == "regular")
+    if (row[0] == "embedded:acrylic_felt_green" && row[2] == "regular" && row[7] == "own")
       felt[row[1] + row[6]] = std::stod(row[4]);
   ASSERT_EQ(felt.size(), 8u);
   for (const char* p : {"halfdiff", "ortho", "hybrid", "spherical"})
@@ -1251,19 +1354,22 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
   const std::vector<std::vector<std::string>> image = csv_rows(slurp(path("st") / "image.csv"));
   ASSERT_GT(image.size(), 1u);
   EXPECT_EQ(image[0][5], "relative_rmse");
+  EXPECT_EQ(image[0].back(), "ssim");
   for (std::size_t i = 1; i < image.size(); ++i)
     if (image[i][0] == "test:S") {
       EXPECT_LT(std::stod(image[i][5]), 0.05) << image[i][1];
     }
 
   const std::string report = slurp(path("st") / "report.md");
-  for (const char* h : {"## 1. Azimuthal dependence", "## 2. Separability",
-                        "## 3. Virtual gonio-reflectometer", "## 4. Image-space error"})
+  for (const char* h :
+       {"## 1. Azimuthal dependence", "## 2. Separability", "## 3. Virtual gonio-reflectometer",
+        "## 3b. Designs", "## 4. Image-space error"})
     EXPECT_NE(report.find(h), std::string::npos) << h;
   EXPECT_NE(slurp(path("st") / "report.html").find("src=\"data:image/png;base64,"),
             std::string::npos);
-  for (const char* f : {"azimuthal.png", "azimuthal.svg", "separability.png", "separability.svg",
-                        "gonio.png", "gonio.svg", "gonio4d.png", "image.png", "budget.csv"})
+  for (const char* f :
+       {"azimuthal.png", "azimuthal.svg", "separability.png", "separability.svg", "gonio.png",
+        "gonio.svg", "gonio4d.png", "image.png", "budget.csv", "designs.png"})
     EXPECT_GT(fs::file_size(path("st") / f), 100u) << f;
 }
 
@@ -1273,7 +1379,12 @@ TEST_F(CliTest, StudyBadInput) {
   EXPECT_NE(r.err.find("'nope' is neither"), std::string::npos) << r.err;
   r = run({"study", "--space", "sqrt", "lambert"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("--space 'sqrt'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--error-space 'sqrt': expected linear, log, cbrt, nielsen or low"),
+            std::string::npos)
+      << r.err;
+  r = run({"study", "--designs", "own,uniform", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("'uniform' is not a design"), std::string::npos) << r.err;
   fs::create_directories(path("empty"));
   r = run({"study", "-o", "st", "empty"});
   EXPECT_EQ(r.status, 2);
@@ -1365,13 +1476,26 @@ TEST_F(CliTest, StudyResumeAfterAKillGivesTheSameTables) {
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("other settings"), std::string::npos) << bad.err;
   EXPECT_EQ(parts(), kTinyPanel.size());
+  // Nor can another set of BRDFs: the learned design of each would come from other profiles.
+  std::vector<std::string> fewer = tiny_study("cut", {kTinyPanel[0], kTinyPanel[1]});
+  fewer.insert(fewer.begin() + 1, "--resume");
+  const Result bad_set = run(fewer);
+  EXPECT_EQ(bad_set.status, 2);
+  EXPECT_NE(bad_set.err.find("other settings"), std::string::npos) << bad_set.err;
+  EXPECT_EQ(parts(), kTinyPanel.size());
 }
 
 // Two runs over halves of the BRDFs, merged, write the tables of one run over all of them.
+// The learned design makes a BRDF's results depend on the other BRDFs of the run: runs over
+// halves merge into the whole run only without it (with it, their merge is refused).
 TEST_F(CliTest, StudyMergeOfTwoRunsIsOneRun) {
-  ASSERT_EQ(run(tiny_study("whole", kTinyPanel)).status, 0);
-  ASSERT_EQ(run(tiny_study("a", {kTinyPanel[0], kTinyPanel[1]})).status, 0);
-  ASSERT_EQ(run(tiny_study("b", {kTinyPanel[2], kTinyPanel[3]})).status, 0);
+  const auto no_learned = [](std::vector<std::string> a) {
+    a.insert(a.begin() + 1, {"--designs", "own,angle,merl"});
+    return a;
+  };
+  ASSERT_EQ(run(no_learned(tiny_study("whole", kTinyPanel))).status, 0);
+  ASSERT_EQ(run(no_learned(tiny_study("a", {kTinyPanel[0], kTinyPanel[1]}))).status, 0);
+  ASSERT_EQ(run(no_learned(tiny_study("b", {kTinyPanel[2], kTinyPanel[3]}))).status, 0);
   Result r = run({"study", "--merge", "a", "b", "-o", "merged"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(study_csvs(path("merged")), study_csvs(path("whole")));
@@ -1387,12 +1511,18 @@ TEST_F(CliTest, StudyMergeOfTwoRunsIsOneRun) {
   r = run({"study", "--merge", "a", "nowhere", "-o", "m2"});
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("'nowhere': not the output of a study"), std::string::npos) << r.err;
-  std::vector<std::string> other = tiny_study("c", {"test:G"});
-  other[3] = "4000";
+  std::vector<std::string> other = no_learned(tiny_study("c", {"test:G"}));
+  other[5] = "4000";  // --test-pairs
   ASSERT_EQ(run(other).status, 0);
   r = run({"study", "--merge", "a", "c", "-o", "m2"});
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("different settings"), std::string::npos) << r.err;
+  ASSERT_EQ(run(tiny_study("la", {kTinyPanel[0], kTinyPanel[1]})).status, 0);
+  ASSERT_EQ(run(tiny_study("lb", {kTinyPanel[2], kTinyPanel[3]})).status, 0);
+  r = run({"study", "--merge", "la", "lb", "-o", "m2"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("learned designs come from different sets of BRDFs"), std::string::npos)
+      << r.err;
   r = run({"study", "lambert", "--merge", "a", "-o", "m2"});
   EXPECT_EQ(r.status, 2);
   EXPECT_FALSE(fs::exists(path("m2")));

@@ -185,6 +185,17 @@ def test_bad_grids_and_render_settings_raise():
         b.resample("hybrid", ranges={"k": (0, float("nan"))})
     with pytest.raises(ValueError, match="param"):
         b.resample("spectral")
+    # Wrong types are named with what was given and what is accepted (not pybind's cast error).
+    with pytest.raises(TypeError, match=r"size must be an int or a sequence of ints .* str 'abc'"):
+        b.resample("hybrid", size="abc")
+    with pytest.raises(TypeError, match=r"size must be an int .* float 2\.5"):
+        b.resample("hybrid", size=2.5)
+    with pytest.raises(TypeError, match=r"size must be an int .* list \[4, 'x', 4\]"):
+        b.resample("hybrid", size=[4, "x", 4])
+    with pytest.raises(TypeError, match=r"ranges\['k'\] must be a \(lo, hi\) pair .* str 'ab'"):
+        b.resample("hybrid", ranges={"k": "ab"})
+    with pytest.raises(TypeError, match=r"ranges\['k'\] must be a \(lo, hi\) pair"):
+        b.resample("hybrid", ranges={"k": (0, 1, 2)})
     with pytest.raises(ValueError):
         b.render(width=0)
     with pytest.raises(ValueError, match="pixels"):

@@ -10,8 +10,10 @@ import pytest
 
 import halfback
 
-# Small settings: a few seconds per BRDF.
+# Small settings: a few seconds per BRDF. Without the learned design, each BRDF's study is
+# independent of the others (LEARNED below: with it, from the profiles of all of them).
 SETTINGS = {
+    "designs": ["own", "angle", "merl"],
     "quick": True,
     "test_pairs": 3000,
     "budgets": [300, 1000],
@@ -37,9 +39,11 @@ def test_tables_of_one_brdf(local):
     felt = local[3]
     assert felt["brdf"].splitlines()[1].startswith("embedded:acrylic_felt_green,1,")
     rows = felt["gonio"].splitlines()
-    assert rows[0] == "brdf,parameterization,design,samples,error,dims,budget"
-    # 4 parameterizations x 2 designs x 2 budgets, numbers that parse as floats.
-    assert len(rows) == 1 + 16
+    assert rows[0] == "brdf,parameterization,design,samples,error,dims,budget,spacing"
+    # 4 parameterizations x (own in 2 layouts, angle and merl in the regular one) x 2 budgets,
+    # numbers that parse as floats.
+    assert len(rows) == 1 + 4 * 4 * 2
+    assert sorted({r.split(",")[7] for r in rows[1:]}) == ["angle", "merl", "own"]
     errors = [float(r.split(",")[4]) for r in rows[1:]]
     assert all(0 < e < 1 for e in errors)
     assert len(felt["renderings"]) == 5
@@ -50,8 +54,16 @@ def test_tables_of_one_brdf(local):
 def test_bad_settings_are_clear_errors():
     with pytest.raises(ValueError, match="unknown key 'budget'"):
         halfback.study_brdf("lambert", {"budget": [100]})
-    with pytest.raises(ValueError, match="--space 'sqrt'"):
+    with pytest.raises(ValueError, match="--error-space 'sqrt'"):
         halfback.study_brdf("lambert", {"space": "sqrt"})
+    with pytest.raises(ValueError, match="--designs: 'sqrt' is not a design"):
+        halfback.study_brdf("lambert", {"designs": ["own", "sqrt"]})
+    # The learned design (a default one) without the profiles it learns from.
+    with pytest.raises(ValueError, match=r"learned design needs settings\['profiles'\]"):
+        halfback.study_brdf("lambert", {"quick": True})
+    with pytest.raises(ValueError, match="no profile of 'lambert'"):
+        profile = halfback.study_profile("test:S", {"quick": True})
+        halfback.study_brdf("lambert", {"quick": True, "profiles": [profile]})
     with pytest.raises(ValueError, match=r"settings\['test_pairs'\]"):
         halfback.study_brdf("lambert", {"test_pairs": "many"})
 
@@ -59,7 +71,7 @@ def test_bad_settings_are_clear_errors():
 def test_functions_travel_to_other_processes():
     # Engines pickle the task's function to send it to worker processes (a real cluster): by
     # name, so these are the same functions on arrival (a pybind11 built-in does not pickle).
-    for f in (halfback.study_brdf, halfback.merge_study):
+    for f in (halfback.study_brdf, halfback.merge_study, halfback.study_profile):
         assert pickle.loads(pickle.dumps(f)) is f
 
 
@@ -84,11 +96,12 @@ def test_dask_run_equals_local_run(local, tmp_path):
     assert merged_local["markdown"].count("| embedded:acrylic_felt_green |") >= 1
 
 
-def cli_study(out, specs):
+def cli_study(out, specs, designs="own,angle,merl"):
     cli = os.environ.get("HALFBACK_CLI")
     if not cli:
         pytest.skip("HALFBACK_CLI is not set (ctest sets it)")
     args = [cli, "study", "--quick", "--test-pairs", "3000", "--budgets", "300,1000"]
+    args += ["--designs", designs]
     args += ["--env", "sky", "--image-size", "16", "--image-spp", "2", "-o", str(out)] + specs
     subprocess.run(args, check=True, capture_output=True)
 
@@ -126,5 +139,31 @@ def test_study_brdf_releases_the_gil():
         turns += 1
         threading.Event().wait(0.0005)  # yields the GIL, runs again when it gets it back
     t.join()
-    assert done and done[0]["gonio"].count("\n") == 17
+    assert done and done[0]["gonio"].count("\n") == 33
     assert turns >= 20, "the main thread did not run during study_brdf: the GIL was held"
+
+
+def test_learned_design_on_dask_equals_the_cli_run(tmp_path):
+    # The learned design: the profiles of every BRDF first (a map), then each BRDF's study with
+    # all of them (a second map); the same tables as one CLI run, which learns from the same
+    # profiles in the same order.
+    distributed = pytest.importorskip("distributed")
+    settings = {k: v for k, v in SETTINGS.items() if k != "designs"}  # the default: all four
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        profiles = client.gather(
+            client.map(halfback.study_profile, SPECS, settings=settings, pure=False)
+        )
+        with_profiles = dict(settings, profiles=profiles)
+        remote = client.gather(
+            client.map(halfback.study_brdf, SPECS, settings=with_profiles, pure=False)
+        )
+    for r in remote:
+        assert ",learned" in r["gonio"]
+        assert "learned_from = 4 profiles," in r["settings"]
+    cli_study(tmp_path / "cli", SPECS, designs="own,angle,merl,learned")
+    profile_files = sorted((tmp_path / "cli" / "profiles").rglob("*.profile"))
+    assert sorted(p.read_text() for p in profile_files) == sorted(profiles)
+    halfback.merge_study(str(tmp_path / "dask"), remote)
+    assert csvs(tmp_path / "dask") == csvs(tmp_path / "cli")

@@ -26,6 +26,13 @@ struct RenderOptions {
   double png_scale = 2.0;
 };
 
+// Cairo's image surfaces have at most this many pixels per side.
+inline constexpr int kMaxRasterSide = 32767;
+// Throws std::invalid_argument when a page of width × height points at `scale` pixels per point
+// is wider or taller than kMaxRasterSide pixels; `hint` says what makes the page smaller. Figures
+// call it with their layout, before sampling any raster, so an oversized request costs nothing.
+void check_raster_size(double width, double height, double scale, std::string_view hint);
+
 // The file content of the scene in the given format (binary for PNG and PDF).
 std::string render(const Scene& scene, Format format, const RenderOptions& options = {});
 

@@ -12,6 +12,7 @@
 // constant in direction, which is exactly the function the sampler importance samples.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <span>
@@ -78,8 +79,20 @@ class EnvMap {
   // directions that this density leaves out (pdf 0). The same as the plain density when the map
   // is constant.
   Sample sample(double u1, double u2, bool compensated = false) const;
+  // sample() of each (u1[i], u2[i]), equal to it; the table lookups of different samples overlap.
+  // Throws std::invalid_argument when the sizes differ.
+  void sample(std::span<const double> u1, std::span<const double> u2, bool compensated,
+              std::span<Sample> out) const;
   // The density of sample() at `dir`, per unit solid angle.
   double pdf(const Vec3<double>& dir, bool compensated = false) const;
+  // eval(dir) and pdf(dir, compensated) from one lookup of the pixel (equal to both, bit for bit).
+  struct Lookup {
+    Rgb radiance;
+    double pdf = 0;
+  };
+  Lookup lookup(const Vec3<double>& dir, bool compensated = false) const;
+  // lookup() of each direction, equal to it (throws std::invalid_argument when the sizes differ).
+  void lookup(std::span<const Vec3<double>> dirs, bool compensated, std::span<Lookup> out) const;
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -103,7 +116,15 @@ class EnvMap {
   std::string name_;
   EnvOptions options_;
   double scale_ = 1, cos_rot_ = 1, sin_rot_ = 0;
-  std::vector<double> row_solid_angle_;  // of one pixel of each row
+  std::vector<double> row_solid_angle_;   // of one pixel of each row
+  std::vector<double> row_cos_;           // cos θ of the rows' edges, height + 1 of them
+  std::vector<std::uint32_t> row_guide_;  // the row at the top of each bucket of cos θ
+  struct Edge {
+    double cos = 1, sin = 0;
+  };
+  std::vector<Edge> col_edge_;  // of φ at each column's left edge
+  Sample sample_in(const Distribution2D::Sample& cell) const;
+  void column_sincos(std::size_t col, double t, double& sin_phi, double& cos_phi) const;
   Distribution2D distribution_, compensated_;
   std::size_t noise_clamped_ = 0;
 };

@@ -2,13 +2,16 @@
 // at N points laid out in one parameterization, reconstructed everywhere by interpolation in that
 // parameterization, and compared with the ground truth over the whole space of direction pairs.
 //
-// Designs. Both divide the bounding box of the parameterization's isotropic form (a, b, φ) — or
-// of its full form (a, φa, b, φb) for anisotropic BRDFs — into cells, n per magnitude axis and 2n
-// per azimuth (which spans [0, 2π)), n chosen so that the number of cells inside the domain is
-// nearest the budget N (in ratio):
+// Layouts (the `Design` of the code). Both divide the bounding box of the parameterization's
+// isotropic form (a, b, φ) — or of its full form (a, φa, b, φb) for anisotropic BRDFs — into cells,
+// n per magnitude axis and 2n per azimuth (which spans [0, 2π)), n chosen so that the number of
+// cells inside the domain is nearest the budget N (in ratio):
 //   regular     one measurement at the centre of every cell inside the domain;
 //   stratified  one at a uniformly random point of every cell (redrawn up to 8 times until it
 //               falls inside the domain; a cell that never does has no measurement).
+// The cells are uniform in the warped coordinates of the setup's spacing (design.hpp): own, the
+// default, leaves the coordinates as they are. Measurements, reconstruction and the count of
+// cells inside the domain all work in the warped coordinates u = F(x).
 // Pairs beyond the instrument's reach (max_theta_deg) are not measured.
 // No symmetry is assumed (neither reciprocity nor the mirror symmetry φ → −φ): every
 // parameterization measures the same space, so budgets compare like with like.
@@ -46,6 +49,7 @@
 #include "halfback/brdf/brdf.hpp"
 #include "halfback/brdf/resample.hpp"
 #include "halfback/core/space.hpp"
+#include "halfback/study/design.hpp"
 #include "halfback/study/metrics.hpp"
 
 namespace halfback::study {
@@ -64,6 +68,10 @@ struct GonioSetup {
   // (those cells are filled by dilation). Real gonio-reflectometers stop short of grazing, and
   // measured data are least reliable there (RGL's ρ grows like 1/cos θo past ~87°).
   double max_theta_deg = 90;
+  // The spacing of the cells along each axis (design.hpp); `learned` holds the warps of the
+  // learned spacing for this space (required by it, ignored by the others).
+  Spacing spacing = Spacing::own;
+  std::optional<LearnedWarps> learned{};
 };
 
 // The cells of a setup: default_grid()'s ranges with n cells per magnitude axis and 2n per
@@ -86,7 +94,8 @@ class GonioReconstruction final : public Brdf {
   void eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const override;
 
   const GonioSetup& setup() const { return setup_; }
-  const GridSpec& cells() const { return cells_; }
+  const GridSpec& cells() const { return cells_; }  // in the warped coordinates
+  const std::vector<AxisWarp>& warps() const { return warps_; }
   std::size_t samples() const { return samples_; }  // measurements taken (finite values)
 
  private:
@@ -109,6 +118,7 @@ class GonioReconstruction final : public Brdf {
 
   GonioSetup setup_;
   GridSpec cells_;
+  std::vector<AxisWarp> warps_;  // one per axis of cells_
   std::string truth_name_;
   std::size_t dim_ = 3;
   std::size_t samples_ = 0;

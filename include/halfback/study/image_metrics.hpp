@@ -51,7 +51,22 @@ struct ImageError {
   double mean_delta_e;
   double p95_delta_e;
   std::size_t pixels;  // the number of masked pixels
+  // The image-space protocol of Sztrajman et al. 2021 (docs/study.md), on the tone-mapped images
+  // (the same tone mapping as ΔE00, values in [0, 1]): the mean absolute and root-mean-square
+  // differences over the masked pixels and the three channels, and ssim() of their luminances
+  // (NaN when no masked pixel has its whole window inside the image).
+  double mae = 0, rmse = 0, ssim = 0;
 };
+
+// The structural similarity of Wang, Bovik, Sheikh & Simoncelli 2004 of two width × height
+// single-channel images (row-major) with values in [0, 1]: the local statistics under their
+// 11 × 11 Gaussian window of σ = 1.5 (normalized to sum 1), C1 = (0.01)², C2 = (0.03)² (K1 =
+// 0.01, K2 = 0.03, L = 1), SSIM(p) = (2 μx μy + C1)(2 σxy + C2) / ((μx² + μy² + C1)(σx² + σy² +
+// C2)) at each pixel p whose whole window lies inside the image, averaged over those where mask is
+// nonzero. 1 for equal images. Throws std::invalid_argument when the sizes do not match or no
+// masked pixel has its whole window inside the image.
+double ssim(std::span<const double> x, std::span<const double> y, int width, int height,
+            std::span<const std::uint8_t> mask);
 
 // Compares `test` with `reference` over the pixels where mask is nonzero. For ΔE00 both images
 // are tone mapped the same way: scaled by 1 / (the 99th percentile of the reference's luminance

@@ -5,14 +5,20 @@
 // Measure: dμ = cos θi cos θo dωi dωo (the projected solid angles: the weight of a pair in
 // rendering), written in each parameterization's isotropic coordinates (a, b, φ) with the core's
 // Jacobian, dωi dωo = J₃(a, b, φ) da db dφ (batch.hpp, jacobian of an isotropic form).
-// Values: the luminance Y = 0.2126 r + 0.7152 g + 0.0722 b of ρ, in an error space:
-// linear (Y), log (log(1 + Y), the log-relative space of Nielsen et al. 2015) or cube root (Y^⅓).
+// Values: the luminance Y = 0.2126 r + 0.7152 g + 0.0722 b of ρ, in an error space T
+// (docs/study.md, "Error spaces"): linear (Y), log (ln(1 + Y)), cube root (Y^⅓), or two published
+// ones that also see the pair's cosines:
+//   nielsen  ln(1 + Y c / ε), c = max(cos θi cos θo, 0.01), ε = 0.001: a difference of two values
+//            is Nielsen et al. 2015's log-relative mapping ln((Y c + ε)/(Y_ref c + ε)) (the clamp
+//            of c and ε are those of their code release);
+//   low      ln(1 + Y cos θi): the cosine-weighted log of Löw et al. 2012.
 // Quadrature: the midpoint rule on a regular grid of cell centres of (a, b, φ) over the ranges of
 // resample.hpp's default grids; cells outside the domain have weight 0.
 #pragma once
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -21,11 +27,15 @@
 
 namespace halfback::study {
 
-enum class ErrorSpace { linear, log, cbrt };
+enum class ErrorSpace { linear, log, cbrt, nielsen, low };
+inline constexpr std::array<ErrorSpace, 5> kErrorSpaces{
+    ErrorSpace::linear, ErrorSpace::log, ErrorSpace::cbrt, ErrorSpace::nielsen, ErrorSpace::low};
 std::string_view name_of(ErrorSpace s);
+std::optional<ErrorSpace> parse_error_space(std::string_view name);
 
-// The value every metric compares: the luminance of ρ (Rgb::luminance) mapped to the error space.
-double to_error_space(double luminance, ErrorSpace es);
+// The value every metric compares: the luminance of ρ (Rgb::luminance) at a pair whose
+// directions have the cosines cos_i = cos θi and cos_o = cos θo, mapped to the error space.
+double to_error_space(double luminance, ErrorSpace es, double cos_i, double cos_o);
 
 struct IsoGrid {
   std::size_t a = 64, b = 64, phi = 64;  // cells of the two magnitudes and of the azimuth

@@ -8,10 +8,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "halfback/study/design.hpp"
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
 
@@ -20,7 +22,9 @@ namespace halfback::study {
 // The options of `halfback study` that decide the results (the Python settings dict has the same
 // keys, '-' spelled '_'). Zero or empty: the default (or --quick's).
 struct StudySettings {
-  std::string space = "log";
+  std::string space = "log";  // --error-space: parse_error_space()
+  // --designs: parse_spacing() names. `learned` needs the profiles of the study's BRDFs (below).
+  std::vector<std::string> designs{"own", "angle", "merl", "learned"};
   bool quick = false, no_gonio = false, no_images = false;
   std::vector<std::size_t> budgets, budgets_4d;
   std::size_t test_pairs = 0, image_budget = 0;
@@ -31,8 +35,33 @@ struct StudySettings {
 };
 
 // The configuration of the settings (environments loaded). Throws std::invalid_argument naming
-// the option (--space, --budgets, ...) and what it accepts.
+// the option (--error-space, --designs, --budgets, ...) and what it accepts.
 StudyConfig make_config(const StudySettings& settings);
+
+// Whether `config` asks for the learned design (then each BRDF needs the others' profiles).
+bool wants_learned(const StudyConfig& config);
+
+// The learned design (design.hpp) makes a BRDF's study depend on the other BRDFs, through their
+// profiles only: the warps of held-out BRDF k are learn_warps(profiles, k), a deterministic
+// function of the profiles in their order. A run computes every profile first (each BRDF loaded
+// once), keeps them as text (exact round trip) and gives each BRDF's study the warps and the
+// fingerprint of the whole list, which describe_config() records.
+struct LabeledProfile {
+  std::string label;  // study_label() of the BRDF
+  DesignProfile profile;
+};
+LabeledProfile study_profile(const Brdf& brdf, const std::string& label, const StudyConfig& config);
+std::string profile_text(const LabeledProfile& profile);
+// Throws std::runtime_error naming `source` on text that profile_text() did not write.
+LabeledProfile profile_from_text(std::string_view text, const std::string& source);
+// A hash of the profiles' texts in order (their count, too).
+std::string learned_fingerprint(std::span<const LabeledProfile> profiles);
+// Sets config.learned and config.learned_from for the BRDF labeled `label`, which must be one of
+// `profiles` (std::invalid_argument otherwise: leave-one-out needs to know which to leave out).
+// Fewer than two profiles: no learned warps (the learned design then has no rows), as one BRDF
+// has no other to learn from.
+void set_learned(StudyConfig& config, std::span<const LabeledProfile> profiles,
+                 const std::string& label);
 
 // Every setting of `config` that the results depend on, as "key = value" lines in a fixed order:
 // two runs whose descriptions are equal give the same tables for the same BRDF.
@@ -62,6 +91,9 @@ BrdfResult from_tables(const StudyTables& tables, const std::string& source);
 std::filesystem::path parts_dir(const std::filesystem::path& out);
 // The file stem of a BRDF spec: readable, and distinct for distinct specs (a hash of the spec).
 std::string part_key(std::string_view spec);
+// A run's profiles: DIR/profiles/SPACE-GRID/KEY.profile (the CLI's), written atomically so that
+// --resume reuses them.
+std::filesystem::path profiles_dir(const std::filesystem::path& out);
 void write_part(const std::filesystem::path& parts, const std::string& key,
                 const BrdfResult& result, std::size_t order);
 // The part of `key` (with its example renderings when their file is there). Throws

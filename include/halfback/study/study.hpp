@@ -53,6 +53,19 @@ struct StudyConfig {
   std::vector<render::Environment> environments;  // empty: no image-space error
   std::size_t image_budget = 10000;
   int image_size = 96, image_spp = 16;
+  // Designs (design.hpp; issue 14): the spacings of the gonio-reflectometer's cells. The own
+  // spacing runs in both layouts (regular and stratified), the others in the regular layout only;
+  // a spacing identical to own for a parameterization (angle in halfdiff) copies its results.
+  // The learned spacing uses the warps in `learned` (learn_warps(), leave-one-out: set them for
+  // each BRDF from the profiles of the others, taken on `profile_grid`); a parameterization
+  // without learned warps has no learned rows.
+  std::vector<Spacing> spacings{Spacing::own, Spacing::angle, Spacing::merl, Spacing::learned};
+  std::vector<LearnedWarps> learned;
+  IsoGrid profile_grid{32, 32, 32};
+  // A fingerprint of the profiles the learned warps come from (parts.hpp: learned_fingerprint),
+  // empty without them: part of the settings of a run, so that parts learned from other BRDFs
+  // are never resumed or merged with these.
+  std::string learned_from;
   // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.
   std::function<void(std::string_view stage)> progress;
 
@@ -62,9 +75,10 @@ struct StudyConfig {
 };
 
 struct GonioPoint {
-  Design design = Design::regular;
+  Design design = Design::regular;  // the layout
   std::size_t budget = 0, samples = 0;
   double error = 0;
+  Spacing spacing = Spacing::own;
 };
 
 struct ImagePoint {
@@ -72,6 +86,7 @@ struct ImagePoint {
   std::size_t samples = 0;
   std::string environment;
   double relative_rmse = 0, mean_delta_e = 0, p95_delta_e = 0;
+  double mae = 0, rmse = 0, ssim = 0;  // Sztrajman et al. 2021's protocol (ImageError)
 };
 
 struct ParamResult {

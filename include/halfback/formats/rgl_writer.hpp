@@ -1,0 +1,59 @@
+// Writing any isotropic BRDF as an RGL "tensor_file" material (the format of Dupuy & Jakob 2018,
+// RGB variant: read by RGL's reference loader and by Mitsuba 3's `measured` plugin in its RGB
+// variants; the spectral variant is not written). The microfacet distribution is recovered from the
+// BRDF's backscattering by power iteration (Dupuy, Heitz, Iehl, Poulin & Ostromoukhov 2015); the
+// visible-normal distributions and their warps follow from it, and the RGB and luminance tables are
+// ρ sampled through the warps. docs/formats.md ("RGL writer") derives every field.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/formats/rgl.hpp"
+
+namespace halfback {
+
+struct RglExportOptions {
+  int theta_i = 8;            // incident elevations, 0 to 90°, evenly spaced in σ (as published)
+  int resolution = 32;        // luminance and RGB tables: resolution × resolution samples
+  int vndf_resolution = 128;  // the VNDF tables (N × N) and the NDF and σ tables (2 × N)
+  std::string description;    // the `description` field; empty: says what the source was
+  int threads = 0;            // parallel_for's convention: 0 all cores, 1 the calling thread
+  // Called after each incidence slice is tabulated (from the calling thread), e.g. for a
+  // progress display.
+  std::function<void(int done, int total)> progress;
+};
+
+// The isotropic microfacet distribution D(θm) recovered from a BRDF, on the nodes of the NDF
+// table: u_k = k/(N-1), θ_k = u_k² π/2 (the format's u = √(2θ/π)); linear in u between nodes.
+struct RecoveredNdf {
+  std::vector<double> ndf;  // D(θ_k), normalized so that ∫ D(m) cos θm dωm = 1
+  std::vector<double> sigma;  // σ(θ_k) = ∫ D(m) max(0, ω_k·m) dωm, the projected area; σ(0) = 1
+  int iterations = 0;         // power iterations until convergence
+  double change = 0;          // the last iteration's largest change, relative to max D
+};
+
+// Power iteration on D = ρ(ω, ω) cos θ σ_D(ω) (the backscattering of a microfacet BRDF with
+// G(ω, ω) = G1(ω)). Uses the luminance of ρ. Throws std::invalid_argument when ρ(ω, ω) is NaN or
+// infinite somewhere, or zero at every node, or when nodes < 2.
+RecoveredNdf recover_ndf(const Brdf& brdf, int nodes, int threads = 0);
+
+// σ(θ) of an NDF table (nodes as above, linear in u), by the quadrature the power iteration uses.
+double projected_area(const std::vector<double>& ndf, double theta);
+
+// The fields of the RGL file of `brdf`, in the order of the published files: version,
+// description, phi_i, theta_i, sigma, ndf, vndf, luminance, rgb, jacobian. Isotropic BRDFs only.
+// Throws std::invalid_argument for an anisotropic BRDF, options out of range (naming the option
+// and the accepted range), or a BRDF that is NaN, infinite or zero where the tables sample it.
+std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions& options = {});
+
+// The fields above written as a tensor file, atomically (util/atomic_file.hpp): on any error
+// nothing is written and an existing file is left as it was.
+void write_rgl(const std::filesystem::path& path, const Brdf& brdf,
+               const RglExportOptions& options = {});
+
+}  // namespace halfback

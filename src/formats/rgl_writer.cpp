@@ -1,0 +1,355 @@
+// The RGL writer (docs/formats.md, "RGL writer"): power iteration for the NDF, σ, the VNDF
+// tables, and ρ sampled through the VNDF warp of halfback's own reader.
+#include "halfback/formats/rgl_writer.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "binary_io.hpp"
+#include "halfback/core/parallel.hpp"
+#include "halfback/util/atomic_file.hpp"
+
+namespace halfback {
+
+namespace {
+
+using io_detail::store_le;
+
+constexpr double kPi = std::numbers::pi;
+
+double u_to_theta(double u) {
+  return u * u * (kPi / 2);
+}
+double node_u(std::size_t k, std::size_t n) {
+  return double(k) / double(n - 1);
+}
+
+// ∫_0^{2π} max(0, ω·m) dφm for ω at elevation θ and m at elevation θm: the azimuthal integral of
+// the projected-area kernel, in closed form (docs/formats.md, "σ").
+double azimuthal_kernel(double theta, double theta_m) {
+  const double a = std::cos(theta) * std::cos(theta_m);
+  const double b = std::sin(theta) * std::sin(theta_m);
+  if (a >= b) return 2 * kPi * a;
+  if (a <= -b) return 0;
+  const double phi0 = std::acos(-a / b);
+  return 2 * (a * phi0 + b * std::sin(phi0));
+}
+
+// Weights w with σ(θ) = Σ_j w_j D_j for D linear in u between the nodes: 6-point Gauss–Legendre
+// on every interval of ∫_0^1 D(u) K(θ, θm(u)) sin θm π u du.
+std::vector<double> sigma_weights(double theta, std::size_t nodes) {
+  static constexpr std::array<double, 6> x = {-0.9324695142031521, -0.6612093864662645,
+                                              -0.2386191860831969, 0.2386191860831969,
+                                              0.6612093864662645,  0.9324695142031521};
+  static constexpr std::array<double, 6> w = {0.1713244923791704, 0.3607615730481386,
+                                              0.4679139345726910, 0.4679139345726910,
+                                              0.3607615730481386, 0.1713244923791704};
+  std::vector<double> out(nodes, 0.0);
+  const double h = 1.0 / double(nodes - 1);
+  for (std::size_t j = 0; j + 1 < nodes; ++j) {
+    for (std::size_t q = 0; q < x.size(); ++q) {
+      const double t = 0.5 * (x[q] + 1);
+      const double u = (double(j) + t) * h;
+      const double theta_m = u_to_theta(u);
+      const double f =
+          0.5 * w[q] * h * azimuthal_kernel(theta, theta_m) * std::sin(theta_m) * kPi * u;
+      out[j] += (1 - t) * f;
+      out[j + 1] += t * f;
+    }
+  }
+  return out;
+}
+
+double dot(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+  return s;
+}
+
+Vec3<double> direction(double theta, double phi) {
+  return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+}
+
+std::string format_dir(const Vec3<double>& v) {
+  return fmt::format("({:.6g}, {:.6g}, {:.6g})", v.x, v.y, v.z);
+}
+
+// ρ(ω, ω) cos θ at the NDF nodes, the power iteration's weight; refuses NaN/∞ and all-zero.
+std::vector<double> backscatter_weights(const Brdf& brdf, std::size_t nodes, int threads) {
+  std::vector<double> f(nodes);
+  std::vector<Rgb> rho(nodes);
+  parallel_for(
+      nodes, 8,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) {
+          const Vec3<double> w = direction(u_to_theta(node_u(k, nodes)), 0);
+          rho[k] = brdf.eval({w, w});
+        }
+      },
+      threads);
+  for (std::size_t k = 0; k < nodes; ++k) {
+    const double theta = u_to_theta(node_u(k, nodes));
+    if (!rho[k].finite())
+      throw std::invalid_argument(
+          fmt::format("{}: ρ(ω, ω) is not finite at ω = {} (θ = {:.4g}°): cannot recover a "
+                      "microfacet distribution",
+                      brdf.name(), format_dir(direction(theta, 0)), theta * 180 / kPi));
+    f[k] = std::max(rho[k].luminance(), 0.0) * std::cos(theta);
+  }
+  if (std::all_of(f.begin(), f.end(), [](double v) { return !(v > 0); }))
+    throw std::invalid_argument(brdf.name() +
+                                ": ρ(ω, ω) is zero in every backscattering direction: there is no "
+                                "microfacet distribution to recover (an RGL file needs one)");
+  return f;
+}
+
+}  // namespace
+
+double projected_area(const std::vector<double>& ndf, double theta) {
+  return dot(sigma_weights(theta, ndf.size()), ndf);
+}
+
+RecoveredNdf recover_ndf(const Brdf& brdf, int nodes_int, int threads) {
+  if (nodes_int < 2) throw std::invalid_argument("recover_ndf: at least 2 nodes are needed");
+  const auto nodes = static_cast<std::size_t>(nodes_int);
+  const std::vector<double> f = backscatter_weights(brdf, nodes, threads);
+  std::vector<std::vector<double>> a(nodes);  // σ = A·D
+  parallel_for(
+      nodes, 4,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k)
+          a[k] = sigma_weights(u_to_theta(node_u(k, nodes)), nodes);
+      },
+      threads);
+
+  RecoveredNdf r;
+  r.ndf.assign(nodes, 1.0);
+  std::vector<double> next(nodes);
+  constexpr int kMaxIterations = 10000;
+  constexpr double kTolerance = 1e-10;
+  for (r.iterations = 1; r.iterations <= kMaxIterations; ++r.iterations) {
+    for (std::size_t k = 0; k < nodes; ++k) next[k] = f[k] * dot(a[k], r.ndf);
+    const double norm = dot(a[0], next);  // σ(0) = ∫ D cos θm dωm
+    if (!(norm > 0) || !std::isfinite(norm))
+      throw std::invalid_argument(brdf.name() + ": the power iteration for the NDF collapsed to " +
+                                  "zero (ρ(ω, ω) is zero where the distribution has its mass)");
+    double change = 0, largest = 0;
+    for (std::size_t k = 0; k < nodes; ++k) {
+      next[k] /= norm;
+      change = std::max(change, std::abs(next[k] - r.ndf[k]));
+      largest = std::max(largest, next[k]);
+    }
+    r.ndf.swap(next);
+    r.change = change / largest;
+    if (r.change < kTolerance) break;
+  }
+  r.iterations = std::min(r.iterations, kMaxIterations);
+  r.sigma.resize(nodes);
+  for (std::size_t k = 0; k < nodes; ++k) r.sigma[k] = dot(a[k], r.ndf);
+  return r;
+}
+
+namespace {
+
+TensorFieldData float_field(std::string name, std::vector<std::uint64_t> shape,
+                            const std::vector<double>& values) {
+  TensorFieldData f{std::move(name), TensorDtype::float32, std::move(shape), {}};
+  f.data.resize(values.size() * 4);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    store_le<float>(f.data.data() + 4 * i, static_cast<float>(values[i]));
+  return f;
+}
+
+TensorFieldData byte_field(std::string name, std::string_view bytes) {
+  TensorFieldData f{std::move(name), TensorDtype::uint8, {bytes.size()}, {}};
+  for (char c : bytes) f.data.push_back(static_cast<std::byte>(c));
+  return f;
+}
+
+void check_option(const char* name, int value, int lo, int hi) {
+  if (value < lo || value > hi)
+    throw std::invalid_argument(
+        fmt::format("{} is {}: must be an integer from {} to {}", name, value, lo, hi));
+}
+
+// The incident elevations: θ0 = 0, θ_{n-1} = π/2 and evenly spaced values of σ between, as in
+// the published files (σ decreases with θ; the first crossing of each level in the σ table,
+// linear in u). Falls back to even spacing in θ where σ is not decreasing.
+std::vector<double> incidence_grid(const std::vector<double>& sigma, int count) {
+  const std::size_t nodes = sigma.size();
+  const auto n = static_cast<std::size_t>(count);
+  std::vector<double> theta(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const double level = sigma[0] + (sigma[nodes - 1] - sigma[0]) * double(t) / double(n - 1);
+    double u = node_u(t, n);  // fallback
+    for (std::size_t k = 0; k + 1 < nodes; ++k) {
+      if (sigma[k] >= level && sigma[k + 1] <= level && sigma[k] > sigma[k + 1]) {
+        u = node_u(k, nodes) + (sigma[k] - level) / (sigma[k] - sigma[k + 1]) / double(nodes - 1);
+        break;
+      }
+    }
+    theta[t] = t == 0 ? 0 : t + 1 == n ? kPi / 2 : u_to_theta(u);
+  }
+  for (std::size_t t = 1; t < n; ++t)
+    if (!(theta[t] > theta[t - 1]))
+      for (std::size_t s = 0; s < n; ++s) theta[s] = kPi / 2 * double(s) / double(n - 1);
+  return theta;
+}
+
+// The visible normals' density on the unit square of (u, v), slice by slice:
+// D(m) max(0, ωi·m) / σ(ωi) · 2π² u sin θm, divided by the table size as in the published files.
+std::vector<double> vndf_tables(const std::vector<double>& ndf,
+                                const std::vector<double>& theta_i) {
+  const std::size_t n = ndf.size();
+  std::vector<double> out(theta_i.size() * n * n);
+  for (std::size_t s = 0; s < theta_i.size(); ++s) {
+    const double sigma = projected_area(ndf, theta_i[s]);
+    const Vec3<double> wi = direction(theta_i[s], 0);
+    for (std::size_t j = 0; j < n; ++j) {
+      const double phi = (2 * node_u(j, n) - 1) * kPi;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double u = node_u(i, n), theta_m = u_to_theta(u);
+        const Vec3<double> m = direction(theta_m, phi);
+        const double cos_im = std::max(0.0, wi.x * m.x + wi.y * m.y + wi.z * m.z);
+        out[(s * n + j) * n + i] =
+            ndf[i] * cos_im / sigma * 2 * kPi * kPi * u * std::sin(theta_m) / double(n * n);
+      }
+    }
+  }
+  return out;
+}
+
+struct Geometry {
+  std::vector<TensorFieldData> fields;  // everything but luminance and rgb
+  std::vector<double> theta_i;
+  std::vector<double> ndf, sigma;  // the tables' values as stored (rounded to float)
+};
+
+std::vector<double> rounded_to_float(const std::vector<double>& v) {
+  std::vector<double> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) out[i] = static_cast<float>(v[i]);
+  return out;
+}
+
+// A table over u in [0, 1] (nodes k/(N-1)), linear between nodes, as the readers interpolate it.
+double table_at(const std::vector<double>& t, double u) {
+  const double x = std::clamp(u, 0.0, 1.0) * double(t.size() - 1);
+  const std::size_t i = std::min(static_cast<std::size_t>(x), t.size() - 2);
+  return t[i] + (x - double(i)) * (t[i + 1] - t[i]);
+}
+
+Geometry geometry_fields(const Brdf& brdf, const RglExportOptions& o, const std::string& desc) {
+  const RecoveredNdf ndf = recover_ndf(brdf, o.vndf_resolution, o.threads);
+  Geometry g;
+  g.theta_i = incidence_grid(ndf.sigma, o.theta_i);
+  g.ndf = rounded_to_float(ndf.ndf);
+  g.sigma = rounded_to_float(ndf.sigma);
+  const auto n = static_cast<std::uint64_t>(o.vndf_resolution);
+  std::vector<double> two_rows(ndf.ndf), sigma_rows(ndf.sigma);
+  two_rows.insert(two_rows.end(), ndf.ndf.begin(), ndf.ndf.end());
+  sigma_rows.insert(sigma_rows.end(), ndf.sigma.begin(), ndf.sigma.end());
+  TensorFieldData version{"version", TensorDtype::uint32, {2}, std::vector<std::byte>(8)};
+  store_le<std::uint32_t>(version.data.data(), 1);
+  g.fields.push_back(std::move(version));
+  g.fields.push_back(byte_field("description", desc));
+  g.fields.push_back(float_field("phi_i", {1}, {0.0}));
+  g.fields.push_back(float_field("theta_i", {g.theta_i.size()}, g.theta_i));
+  g.fields.push_back(float_field("sigma", {2, n}, sigma_rows));
+  g.fields.push_back(float_field("ndf", {2, n}, two_rows));
+  g.fields.push_back(
+      float_field("vndf", {1, g.theta_i.size(), n, n}, vndf_tables(ndf.ndf, g.theta_i)));
+  return g;
+}
+
+// ρ cos θo · 4σ(ωi)/D(m) at the sample nodes of one incidence slice, through the VNDF warp of
+// `warp` (the file being written, read by halfback's reader), with D and σ interpolated from the
+// stored tables as every reader does.
+void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, std::size_t slice,
+                    std::size_t res, int threads, double* rgb, double* luminance) {
+  const double theta_i = g.theta_i[slice];
+  const Vec3<double> wi = direction(theta_i, 0);
+  const double sigma = table_at(g.sigma, std::sqrt(theta_i * (2 / kPi)));
+  parallel_for(
+      res * res, 16,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t node = begin; node < end; ++node) {
+          const std::size_t i = node % res, j = node / res;
+          const RglWarpPoint um = warp.vndf_forward({node_u(i, res), node_u(j, res)}, theta_i, 0.0);
+          const Vec3<double> m = direction(u_to_theta(um.x), (2 * um.y - 1) * kPi);
+          const double c = wi.x * m.x + wi.y * m.y + wi.z * m.z;
+          const Vec3<double> wo{2 * c * m.x - wi.x, 2 * c * m.y - wi.y, 2 * c * m.z - wi.z};
+          Rgb value;
+          if (c > 0 && wo.z > 0) {
+            const Rgb rho = brdf.eval({wi, wo});
+            if (!rho.finite())
+              throw std::invalid_argument(
+                  fmt::format("{}: ρ is not finite at ωi = {}, ωo = {}: cannot tabulate it",
+                              brdf.name(), format_dir(wi), format_dir(wo)));
+            const double scale = table_at(g.ndf, um.x) / (4 * sigma);
+            if (scale > 0) value = rho * (wo.z / scale);
+          }
+          rgb[node] = value.r;
+          rgb[res * res + node] = value.g;
+          rgb[2 * res * res + node] = value.b;
+          luminance[node] = std::max(value.luminance(), 0.0);
+        }
+      },
+      threads);
+}
+
+}  // namespace
+
+std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions& o) {
+  if (!brdf.isotropic())
+    throw std::invalid_argument(brdf.name() +
+                                " is anisotropic: the RGL writer supports isotropic BRDFs only "
+                                "(one φi slice)");
+  check_option("--theta-i", o.theta_i, 2, 90);
+  check_option("--resolution", o.resolution, 2, 512);
+  check_option("--vndf-resolution", o.vndf_resolution, 2, 1024);
+  const std::string desc =
+      o.description.empty() ? fmt::format("{}: {} (exported by halfback; NDF by power iteration)",
+                                          brdf.name(), brdf.description())
+                            : o.description;
+  Geometry g = geometry_fields(brdf, o, desc);
+
+  const auto res = static_cast<std::size_t>(o.resolution);
+  const std::size_t slices = g.theta_i.size();
+  std::vector<TensorFieldData> probe = g.fields;
+  probe.push_back(float_field("luminance", {1, slices, res, res},
+                              std::vector<double>(slices * res * res, 1.0)));
+  probe.push_back(float_field("rgb", {1, slices, 3, res, res},
+                              std::vector<double>(slices * 3 * res * res, 1.0)));
+  TensorFieldData jacobian{"jacobian", TensorDtype::uint8, {1}, {std::byte{1}}};
+  probe.push_back(jacobian);
+  const RglBrdf warp(parse_tensor_file(serialize_tensor_file(probe), "export"), "export",
+                     RglOptions{.clamp_negative = false});
+
+  std::vector<double> rgb(slices * 3 * res * res), luminance(slices * res * res);
+  for (std::size_t s = 0; s < slices; ++s) {
+    tabulate_slice(brdf, warp, g, s, res, o.threads, rgb.data() + s * 3 * res * res,
+                   luminance.data() + s * res * res);
+    if (o.progress) o.progress(int(s + 1), int(slices));
+  }
+  g.fields.push_back(float_field("luminance", {1, slices, res, res}, luminance));
+  g.fields.push_back(float_field("rgb", {1, slices, 3, res, res}, rgb));
+  g.fields.push_back(std::move(jacobian));
+  return std::move(g.fields);
+}
+
+void write_rgl(const std::filesystem::path& path, const Brdf& brdf,
+               const RglExportOptions& options) {
+  AtomicFile file(path);  // an unwritable destination fails before the work
+  const std::vector<std::byte> bytes = serialize_tensor_file(rgl_fields(brdf, options));
+  file.write({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
+  file.commit();
+}
+
+}  // namespace halfback
