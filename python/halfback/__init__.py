@@ -7,9 +7,54 @@ dropped and the second azimuth is relative. Conventions and derivations: docs/ma
 
 BRDFs: load(spec) gives a Brdf (analytic models, MERL, RGL, ALTA files, embedded materials) with
 vectorized eval(wi, wo), info, albedo(), resample() and render(); hemisphere() gives the data of
-the paper's Figure 1.
+the paper's Figure 1. study_brdf() studies one BRDF (any engine can map it over a
+database) and merge_study() writes the report of the results (docs/study.md).
 """
 
-from ._core import Brdf, columns, convert, hemisphere, jacobian, load, models, ssim, valid
+from ._core import (
+    Brdf,
+    columns,
+    convert,
+    hemisphere,
+    jacobian,
+    load,
+    models,
+    ssim,
+    valid,
+)
+from . import _core
 
-__all__ = ["Brdf", "columns", "convert", "hemisphere", "jacobian", "load", "models", "ssim", "valid"]
+
+# Python functions, not the module's built-ins: pickle sends a Python function by its name, so
+# that engines which ship tasks to other processes (Dask workers) can send these; a pybind11
+# built-in cannot be pickled.
+def study_brdf(spec, settings=None):
+    return _core.study_brdf(spec, settings)
+
+
+def merge_study(out, parts):
+    return _core.merge_study(out, parts)
+
+
+def study_profile(spec, settings=None):
+    return _core.study_profile(spec, settings)
+
+
+study_brdf.__doc__ = _core.study_brdf.__doc__
+merge_study.__doc__ = _core.merge_study.__doc__
+study_profile.__doc__ = _core.study_profile.__doc__
+
+__all__ = [
+    "Brdf",
+    "columns",
+    "convert",
+    "hemisphere",
+    "jacobian",
+    "load",
+    "merge_study",
+    "models",
+    "ssim",
+    "study_brdf",
+    "study_profile",
+    "valid",
+]

@@ -82,6 +82,17 @@ def load(spec: str) -> Brdf:
 def models() -> list[str]:
     """The analytic models' names."""
 
+StudySettings = Mapping[str, Any]
+
+def study_brdf(spec: str, settings: StudySettings | None = None) -> dict[str, Any]:
+    """The study of one BRDF: tables as CSV text, "settings" and "renderings" (GIL released)."""
+
+def study_profile(spec: str, settings: StudySettings | None = None) -> str:
+    """The profile of one BRDF for the learned design, as text (settings["profiles"])."""
+
+def merge_study(out: str, parts: Sequence[Mapping[str, Any] | str]) -> dict[str, Any]:
+    """Writes the report of study_brdf results and study directories into `out`."""
+
 def ssim(
     x: npt.ArrayLike, y: npt.ArrayLike, mask: npt.ArrayLike | None = None
 ) -> float:

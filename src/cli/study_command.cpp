@@ -1,182 +1,299 @@
 // `halfback study`: the quantitative comparison of the parameterizations on a set of BRDFs
 // (include/halfback/study/, docs/study.md): options to a StudyConfig, progress, the files.
 #include <fmt/format.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <future>
-#include <iterator>
+#include <functional>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "command.hpp"
 #include "halfback/core/parallel.hpp"
-#include "halfback/figure/material.hpp"
 #include "halfback/loader/load.hpp"
+#include "halfback/study/parts.hpp"
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
+#include "halfback/util/atomic_file.hpp"
+#include "halfback/util/csv.hpp"
 
 namespace halfback::cli {
 
 namespace {
 
 struct StudyOptions {
-  std::vector<std::string> specs;
+  std::vector<std::string> specs, merge;
   std::string out = "study";
-  std::string space = "log";
   std::string budgets, budgets_4d, environments;
-  std::string designs = "own,angle,merl,learned";  // issue 14: designs and error spaces
-  std::size_t test_pairs = 0, image_budget = 0;
-  int image_size = 0, image_spp = 0;
-  double max_theta = 85;
-  std::uint64_t seed = 1;
-  bool quick = false, no_gonio = false, no_images = false;
+  std::string designs = "own,angle,merl,learned";
+  study::StudySettings settings;
+  bool resume = false;
 };
 
-// The BRDFs of the specs: files, every BRDF file of a directory (by content), or models.
-std::vector<std::pair<std::string, BrdfPtr>> load_all(const std::vector<std::string>& specs) {
-  std::vector<std::pair<std::string, BrdfPtr>> brdfs;
-  for (const std::string& spec : specs) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(spec, ec)) {
-      const auto files = brdf_files_in(spec);
-      if (files.empty())
-        throw UsageError(fmt::format("'{}': no MERL, RGL or ALTA file in this directory", spec));
-      for (const auto& f : files) brdfs.emplace_back(f.string(), load_brdf(f.string()));
-    } else {
-      brdfs.emplace_back(spec, load_brdf(spec));
-    }
-  }
-  return brdfs;
-}
-
+// The configuration of the options; a bad value is a usage error.
 study::StudyConfig make_config(const StudyOptions& o) {
-  study::StudyConfig c;
-  const auto space = study::parse_error_space(o.space);
-  if (!space)
-    throw UsageError(fmt::format(
-        "--error-space '{}': expected linear, log, cbrt, nielsen or low (docs/study.md)", o.space));
-  c.space = *space;
-  c.spacings.clear();
-  for (const std::string& name : split_list(o.designs, "--designs", "design")) {
-    const auto spacing = study::parse_spacing(name);
-    if (!spacing)
-      throw UsageError(
-          fmt::format("--designs: '{}' is not a design (own, angle, merl or learned)", name));
-    c.spacings.push_back(*spacing);
-  }
-  if (o.quick) {
-    c.grid = {24, 24, 32};
-    c.full_grid = {8, 16, 8, 16};
-    c.budgets = {1000, 10000};
-    c.budgets_4d = {1000, 10000};
-    c.test_pairs = 20000;
-    c.image_size = 48;
-    c.image_spp = 8;
-  }
-  auto ascending = [](std::vector<std::size_t> v, const char* option) {
-    for (std::size_t i = 1; i < v.size(); ++i)
-      if (v[i] <= v[i - 1]) throw UsageError(fmt::format("{}: budgets must be ascending", option));
-    return v;
-  };
-  if (!o.budgets.empty())
-    c.budgets = ascending(count_list(o.budgets, "--budgets", "sample budget"), "--budgets");
+  study::StudySettings s = o.settings;
+  if (!o.budgets.empty()) s.budgets = count_list(o.budgets, "--budgets", "sample budget");
   if (!o.budgets_4d.empty())
-    c.budgets_4d =
-        ascending(count_list(o.budgets_4d, "--budgets-4d", "sample budget"), "--budgets-4d");
-  if (o.test_pairs) c.test_pairs = o.test_pairs;
-  if (o.image_size) c.image_size = o.image_size;
-  if (o.image_spp) c.image_spp = o.image_spp;
-  c.seed = o.seed;
-  c.max_theta_deg = o.max_theta;
-  // The image budget: as asked, else 10^4 if it is a budget, else the middle budget.
-  if (o.image_budget) {
-    c.image_budget = o.image_budget;
-  } else if (std::find(c.budgets.begin(), c.budgets.end(), c.image_budget) == c.budgets.end()) {
-    c.image_budget = c.budgets[c.budgets.size() / 2];
-  }
-  if (o.no_gonio) c.budgets.clear();
-  if (!o.no_gonio && !o.no_images) {
-    if (o.environments.empty()) {
-      c.environments = render::default_environments();
-    } else {
-      for (const std::string& spec : split_list(o.environments, "--env", "environment")) {
-        c.environments.push_back(render::load_environment(spec));
-      }
-    }
-  }
+    s.budgets_4d = count_list(o.budgets_4d, "--budgets-4d", "sample budget");
+  if (!o.environments.empty()) s.environments = split_list(o.environments, "--env", "environment");
+  s.designs = split_list(o.designs, "--designs", "design");
   try {
-    c.validate();
+    return study::make_config(s);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  return c;
 }
 
-int run_study(const StudyOptions& o) {
-  if (o.specs.empty()) throw UsageError("no BRDF given (files, directories or model specs)");
-  study::StudyConfig config = make_config(o);
-  const auto brdfs = load_all(o.specs);
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec || !std::filesystem::is_directory(o.out))
-    throw std::runtime_error(fmt::format("cannot create the output directory '{}': {}", o.out,
-                                         ec ? ec.message() : "a file of that name exists"));
-  check_writable((std::filesystem::path(o.out) / "report.md").string());
-
-  // Progress: a line per BRDF; on a terminal, also the stage each task has reached.
-  const bool tty = isatty(fileno(stderr));
-  std::mutex progress_mutex;
-  std::string current;
-  const auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  };
-  if (tty)
-    config.progress = [&](std::string_view stage) {
-      const std::lock_guard lock(progress_mutex);
-      fmt::print(stderr, "\r\x1b[K{}: {} ({:.0f} s)", current, stage, elapsed());
-    };
-  // The learned design: each BRDF's profile first, then per BRDF the warps of all the others.
-  std::vector<study::DesignProfile> profiles;
-  const bool learned = std::find(config.spacings.begin(), config.spacings.end(),
-                                 study::Spacing::learned) != config.spacings.end();
-  if (learned && !config.budgets.empty() && brdfs.size() > 1) {
-    fmt::print(stderr, "halfback study: profiles of {} BRDFs for the learned design\n",
-               brdfs.size());
-    profiles.resize(brdfs.size());
-    parallel_for(brdfs.size(), 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k)
-        profiles[k] = study::design_profile(*brdfs[k].second, study::kStudied, config.profile_grid,
-                                            config.space);
-    });
-  }
-  std::vector<study::BrdfResult> results;
-  for (std::size_t k = 0; k < brdfs.size(); ++k) {
-    if (!profiles.empty()) config.learned = study::learn_warps(profiles, k);
-    const auto& [spec, brdf] = brdfs[k];
-    // Files by their BRDF's name (merl:..., rgl:...), models by their spec, which holds their
-    // parameters (two GGX of different roughness are both named "ggx").
-    const std::string label = std::filesystem::exists(spec, ec) ? brdf->name() : spec;
-    {
-      const std::lock_guard lock(progress_mutex);
-      current = fmt::format("halfback study: [{}/{}] {}", k + 1, brdfs.size(), label);
+// The specs of the BRDFs: files (every BRDF file of a directory, by content) and models. Files
+// are read one at a time as they are studied (a MERL file is 33 MB); their format is checked
+// here, models are created here, so that a bad spec stops the run before any work.
+std::vector<std::string> expand_specs(const std::vector<std::string>& specs) {
+  std::vector<std::string> out;
+  for (const std::string& spec : specs) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(spec, ec) &&
+        detect_brdf_format(spec) == BrdfFileFormat::unknown) {
+      const auto files = brdf_files_in(spec);
+      if (files.empty())
+        throw UsageError(
+            fmt::format("'{}': no MERL, RGL, ALTA or neural BRDF file in this "
+                        "directory",
+                        spec));
+      for (const auto& f : files) out.push_back(f.string());
+    } else if (std::filesystem::exists(spec, ec)) {
+      if (detect_brdf_format(spec) == BrdfFileFormat::unknown) load_brdf(spec);  // its error
+      out.push_back(spec);
+    } else {
+      load_brdf(spec);
+      out.push_back(spec);
     }
-    if (!tty) fmt::print(stderr, "{}\n", current);
-    if (!brdf->isotropic())
-      warn("study", label +
-                        " is anisotropic: its isotropic metrics see its canonical pose, the "
-                        "4D metrics all of it");
-    results.push_back(study::study_brdf(*brdf, label, config));
-    if (tty) fmt::print(stderr, "\r\x1b[K{}: done in {:.1f} s\n", current, results.back().seconds);
   }
-  const study::StudyOutput out = study::write_study(o.out, results, config, elapsed());
+  return out;
+}
+
+void make_output_dir(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw std::runtime_error(fmt::format("cannot create the output directory '{}': {}",
+                                         dir.string(),
+                                         ec ? ec.message() : "a file of that name exists"));
+}
+
+// The parts directory of a run: with --resume, the settings must be those of the run resumed;
+// without, the parts of an earlier run are removed (its CSV files are replaced anyway).
+std::filesystem::path prepare_parts(const StudyOptions& o, const study::StudyConfig& config) {
+  const std::filesystem::path parts = study::parts_dir(o.out);
+  make_output_dir(parts);
+  const std::filesystem::path settings = parts / "settings.txt";
+  const std::string described = study::describe_config(config);
+  std::error_code ec;
+  const bool earlier = std::filesystem::exists(settings, ec);
+  if (o.resume && earlier && read_text_file(settings) != described)
+    throw UsageError(fmt::format(
+        "--resume: '{}' was run with other settings (its {}); run with the same options, or "
+        "without --resume to start over",
+        o.out, settings.string()));
+  if (!o.resume) {
+    std::size_t removed = 0;
+    for (const auto& e : std::filesystem::directory_iterator(parts)) {
+      const auto ext = e.path().extension();
+      if (ext == ".part" || ext == ".exr") removed += std::filesystem::remove(e.path(), ec);
+    }
+    if (removed)
+      warn("study", fmt::format("starting over: the results of an earlier run in '{}' are "
+                                "replaced (--resume continues a run)",
+                                parts.string()));
+  }
+  write_file_atomically(settings, described);
+  return parts;
+}
+
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+std::string duration_text(double s) {
+  if (s < 90) return fmt::format("{:.0f} s", s);
+  if (s < 5400) return fmt::format("{:.0f} min", s / 60);
+  return fmt::format("{:.1f} h", s / 3600);
+}
+
+// Progress: a line per BRDF with the time it took and an estimate of the time left (the mean of
+// the BRDFs studied in this run, times those left); on a terminal, also each task's stage.
+class Progress {
+ public:
+  explicit Progress(std::size_t total) : total_(total), tty_(isatty(fileno(stderr))) {}
+
+  std::function<void(std::string_view)> stage_callback() {
+    if (!tty_) return {};
+    return [this](std::string_view stage) {
+      const std::lock_guard lock(mutex_);
+      fmt::print(stderr, "\r\x1b[K{}: {} ({:.0f} s)", current_, stage, elapsed());
+    };
+  }
+  void start(std::size_t k, const std::string& spec) {
+    const std::lock_guard lock(mutex_);
+    current_ = fmt::format("halfback study: [{}/{}] {}", k + 1, total_, spec);
+    if (!tty_) fmt::print(stderr, "{}\n", current_);
+  }
+  void resumed(std::size_t k, const std::string& label) {
+    ++done_;
+    if (tty_ || k + 1 == total_ || done_ % 20 == 1)
+      fmt::print(stderr, "{}halfback study: [{}/{}] {}: kept from the earlier run\n",
+                 tty_ ? "\r\x1b[K" : "", k + 1, total_, label);
+  }
+  void finished(double seconds, double cpu) {
+    ++done_;
+    ++studied_;
+    spent_ += seconds;
+    const double left = spent_ / double(studied_) * double(total_ - done_);
+    const std::lock_guard lock(mutex_);
+    fmt::print(stderr, "{}{}: done in {:.1f} s ({:.1f} CPU s){}\n", tty_ ? "\r\x1b[K" : "",
+               current_, seconds, cpu,
+               done_ < total_ ? fmt::format("; about {} left", duration_text(left)) : "");
+  }
+  double elapsed() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+  }
+
+ private:
+  std::size_t total_, done_ = 0, studied_ = 0;
+  double spent_ = 0;
+  bool tty_;
+  std::mutex mutex_;
+  std::string current_;
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+};
+
+void print_written(const study::StudyOutput& out, const std::string& dir) {
   std::string files;
   for (const std::string& f : out.files) files += (files.empty() ? "" : ", ") + f;
-  fmt::print("{}\nwritten in {}: {}\n", out.markdown, o.out, files);
+  fmt::print("{}\nwritten in {}: {}\n", out.markdown, dir, files);
+}
+
+// The BRDF of a spec, studied, its part written; or the part of an earlier run (--resume).
+study::BrdfResult study_one(const std::string& spec, std::size_t k,
+                            const std::filesystem::path& parts, const study::StudyConfig& config,
+                            bool resume, Progress& progress) {
+  const std::string key = study::part_key(spec);
+  std::error_code ec;
+  if (resume && std::filesystem::exists(parts / (key + ".part"), ec)) {
+    study::BrdfResult kept = study::read_part(parts, key);
+    progress.resumed(k, kept.label);
+    return kept;
+  }
+  progress.start(k, spec);
+  const double cpu0 = cpu_seconds();
+  const BrdfPtr brdf = load_brdf(spec);
+  const std::string label = study::study_label(spec, *brdf);
+  if (!brdf->isotropic())
+    warn("study", label +
+                      " is anisotropic: its isotropic metrics see its canonical pose, the 4D "
+                      "metrics all of it");
+  const study::BrdfResult result = study::study_brdf(*brdf, label, config);
+  study::write_part(parts, key, result, k);
+  progress.finished(result.seconds, cpu_seconds() - cpu0);
+  // Read back, so that a run and its resumption write the report from the same numbers.
+  return study::read_part(parts, key);
+}
+
+// The first pass of the learned design: every BRDF's profile (each file loaded once, one at a
+// time per task), kept in OUT/profiles/SPACE-GRID/ so that --resume reuses them. A duplicate label
+// stops the run here, before any work, as leave-one-out would not know which BRDF to leave out.
+std::vector<study::LabeledProfile> profile_pass(const std::vector<std::string>& specs,
+                                                const std::filesystem::path& out,
+                                                const study::StudyConfig& config, bool resume) {
+  // One directory per error space and grid: a profile depends on them, and --resume with other
+  // settings (refused) must not leave profiles that a later --resume would take for these.
+  const study::IsoGrid& g = config.profile_grid;
+  const std::filesystem::path dir =
+      study::profiles_dir(out) / fmt::format("{}-{}x{}x{}", name_of(config.space), g.a, g.b, g.phi);
+  make_output_dir(dir);
+  std::vector<study::LabeledProfile> profiles(specs.size());
+  std::vector<char> reused(specs.size(), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = cpu_seconds();
+  parallel_for(specs.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::filesystem::path file = dir / (study::part_key(specs[k]) + ".profile");
+      std::error_code ec;
+      if (resume && std::filesystem::exists(file, ec)) {
+        profiles[k] = study::profile_from_text(read_text_file(file), file.string());
+        reused[k] = 1;
+        continue;
+      }
+      const BrdfPtr brdf = load_brdf(specs[k]);
+      profiles[k] = study::study_profile(*brdf, study::study_label(specs[k], *brdf), config);
+      write_file_atomically(file, study::profile_text(profiles[k]));
+    }
+  });
+  std::set<std::string> labels;
+  for (std::size_t k = 0; k < specs.size(); ++k)
+    if (!labels.insert(profiles[k].label).second)
+      throw std::runtime_error(fmt::format(
+          "'{}': a second BRDF named '{}' (the tables would mix them); study it separately",
+          specs[k], profiles[k].label));
+  const auto kept = std::count(reused.begin(), reused.end(), 1);
+  fmt::print(stderr,
+             "halfback study: profiles of {} BRDFs for the learned design in {:.1f} s ({:.1f} CPU "
+             "s){}\n",
+             specs.size(),
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+             cpu_seconds() - cpu0, kept ? fmt::format("; {} kept from the earlier run", kept) : "");
+  return profiles;
+}
+
+int run_study(StudyOptions& o) {
+  if (o.specs.empty()) throw UsageError("no BRDF given (files, directories or model specs)");
+  study::StudyConfig config = make_config(o);
+  const std::vector<std::string> specs = expand_specs(o.specs);
+  make_output_dir(o.out);
+  check_writable((std::filesystem::path(o.out) / "report.md").string());
+  std::vector<study::LabeledProfile> profiles;
+  if (study::wants_learned(config)) {
+    profiles = profile_pass(specs, o.out, config, o.resume);
+    config.learned_from = study::learned_fingerprint(profiles);
+  }
+  const std::filesystem::path parts = prepare_parts(o, config);
+
+  Progress progress(specs.size());
+  config.progress = progress.stage_callback();
+  std::vector<study::BrdfResult> results;
+  std::set<std::string> labels;
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    if (!profiles.empty()) study::set_learned(config, profiles, profiles[k].label);
+    results.push_back(study_one(specs[k], k, parts, config, o.resume, progress));
+    if (!labels.insert(results.back().label).second)
+      throw std::runtime_error(fmt::format(
+          "'{}': a second BRDF named '{}' (the tables would mix them); study it separately",
+          specs[k], results.back().label));
+  }
+  const study::StudyOutput out = study::write_study(o.out, results, config, progress.elapsed());
+  print_written(out, o.out);
+  return kExitOk;
+}
+
+// --merge: the report of the parts of several runs, as one run over all their BRDFs would write.
+int run_merge(const StudyOptions& o) {
+  if (!o.specs.empty())
+    throw UsageError("--merge takes result directories, not BRDFs: run them, then merge");
+  std::vector<std::filesystem::path> dirs(o.merge.begin(), o.merge.end());
+  const study::MergedParts merged = study::read_parts(dirs);
+  make_output_dir(o.out);
+  check_writable((std::filesystem::path(o.out) / "report.md").string());
+  double seconds = 0;
+  for (const study::BrdfResult& b : merged.results) seconds += b.seconds;
+  print_written(study::write_study(o.out, merged.results, merged.config, seconds), o.out);
   return kExitOk;
 }
 
@@ -189,20 +306,22 @@ Command register_study(CLI::App& parent) {
       "Compare the parameterizations on BRDFs: azimuthal dependence, separability, a virtual "
       "gonio-reflectometer and the image-space error of its reconstructions (CSV, plots, "
       "Markdown and HTML reports)");
-  app->add_option("specs", o->specs, "BRDFs: files, directories of files, or model specs")
-      ->required();
+  app->add_option("specs", o->specs,
+                  "BRDFs: files (MERL, RGL, ALTA, neural BRDF .h5), directories of files, or model "
+                  "specs");
   app->add_option("-o,--out", o->out, "Output directory (created if missing)")
       ->capture_default_str();
-  app->add_option("--space,--error-space", o->space,
+  app->add_option("--space,--error-space", o->settings.space,
                   "Error space: linear, log (ln(1 + Y)), cbrt (Y^(1/3)), nielsen (Nielsen et al. "
                   "2015's log-relative mapping) or low (Low et al. 2012's cosine-weighted log)")
       ->capture_default_str();
   app->add_option("--designs", o->designs,
                   "Designs of the gonio-reflectometer, comma-separated: own (uniform in the "
                   "coordinates), angle (sine-like magnitudes through asin), merl (angle, and sqrt "
-                  "of the half-vector angle), learned (warps fitted on the other BRDFs)")
+                  "of the half-vector angle), learned (warps fitted on the other BRDFs' profiles, "
+                  "computed first and kept in OUT/profiles/)")
       ->capture_default_str();
-  app->add_flag("--quick", o->quick,
+  app->add_flag("--quick", o->settings.quick,
                 "A small study: 24 x 24 x 32 grids, budgets 1000,10000, 20000 test pairs, "
                 "48^2 images");
   app->add_option("--budgets", o->budgets,
@@ -210,28 +329,39 @@ Command register_study(CLI::App& parent) {
   app->add_option("--budgets-4d", o->budgets_4d,
                   "Budgets of the 4D gonio-reflectometer of anisotropic BRDFs "
                   "(default 1000,10000,100000,1000000)");
-  app->add_option("--test-pairs", o->test_pairs,
+  app->add_option("--test-pairs", o->settings.test_pairs,
                   "Pairs the reconstructions are checked at (default 200000)")
       ->check(CLI::Range(std::size_t(100), study::kMaxTestPairs));
   app->add_option("--env", o->environments,
                   "Environments of the image-space error, comma-separated: built-in names "
                   "(default, sky, studio, sunset) or .hdr/.exr files (default: the built-ins)");
-  app->add_option("--image-budget", o->image_budget,
+  app->add_option("--image-budget", o->settings.image_budget,
                   "The budget whose reconstructions are rendered (one of --budgets; default "
                   "10000)");
-  app->add_option("--image-size", o->image_size, "Width and height of the renderings (default 96)")
+  app->add_option("--image-size", o->settings.image_size,
+                  "Width and height of the renderings (default 96)")
       ->check(CLI::Range(8, 4096));
-  app->add_option("--image-spp", o->image_spp, "Samples per pixel of the renderings (default 16)")
+  app->add_option("--image-spp", o->settings.image_spp,
+                  "Samples per pixel of the renderings (default 16)")
       ->check(CLI::Range(1, 1 << 16));
-  app->add_option("--max-theta", o->max_theta,
+  app->add_option("--max-theta", o->settings.max_theta,
                   "The gonio-reflectometer's reach: no measurement where a direction is farther "
                   "from the normal (degrees)")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 90.0));
-  app->add_option("--seed", o->seed, "Seed of the test pairs, stratified designs and renderings")
+  app->add_option("--seed", o->settings.seed,
+                  "Seed of the test pairs, stratified designs and renderings")
       ->capture_default_str();
-  app->add_flag("--no-gonio", o->no_gonio, "Metrics 1-2 only (no gonio-reflectometer, no images)");
-  app->add_flag("--no-images", o->no_images, "No image-space error");
+  app->add_flag("--no-gonio", o->settings.no_gonio,
+                "Metrics 1-2 only (no gonio-reflectometer, no images)");
+  app->add_flag("--no-images", o->settings.no_images, "No image-space error");
+  app->add_flag("--resume", o->resume,
+                "Continue an interrupted run in --out: the BRDFs whose results it holds "
+                "(OUT/parts/) are not studied again (same options required)");
+  app->add_option("--merge", o->merge,
+                  "Write the report of the results of several runs (their --out directories, "
+                  "with the same options) into --out, instead of studying BRDFs")
+      ->expected(1, -1);
   app->footer(
       "Metrics (docs/study.md), under the measure cos(theta_i) cos(theta_o) dwi dwo:\n"
       "  azimuthal.csv     brdf,parameterization,error,dims: the error of dropping the relative\n"
@@ -245,9 +375,13 @@ Command register_study(CLI::App& parent) {
       "  budget.csv        the samples each needs to reach errors of 0.05, 0.02, 0.01\n"
       "  image.csv         brdf,parameterization,design,samples,environment,relative_rmse,\n"
       "                    mean_delta_e2000,p95_delta_e2000,mae,rmse,ssim\n"
-      "Example:\n"
-      "  halfback study --out study ggx:alpha=0.2 ../shared/data/rgl");
-  return {app, [o] { return run_study(*o); }};
+      "  parts/            each BRDF's results as soon as it is finished (--resume, --merge)\n"
+      "  profiles/         each BRDF's profile for the learned design (--resume reuses them)\n"
+      "Examples:\n"
+      "  halfback study --out study ggx:alpha=0.2 ../shared/data/rgl\n"
+      "  halfback study --out study --resume ggx:alpha=0.2 ../shared/data/rgl   (after Ctrl-C)\n"
+      "  halfback study --merge run1 run2 --out all");
+  return {app, [o] { return o->merge.empty() ? run_study(*o) : run_merge(*o); }};
 }
 
 }  // namespace halfback::cli

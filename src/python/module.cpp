@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -26,6 +27,7 @@
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/study/image_metrics.hpp"
+#include "halfback/study/parts.hpp"
 
 namespace py = pybind11;
 using namespace halfback;
@@ -514,6 +516,201 @@ NAME_fc1.npy of its NumPy form), a model such as "ggx:alpha=0.2" or
       "The names of the analytic models (see `halfback models` for their parameters).");
 }
 
+// ---------------------------------------------------------------------------------------------
+// The study (issue 14): one BRDF at a time, for engines such as Dask, and the merge
+// ---------------------------------------------------------------------------------------------
+
+template <class T>
+T setting(const py::handle& value, const std::string& key) {
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw py::value_error("settings['" + key + "']: expected " + py::type_id<T>() + ", got " +
+                          py::repr(value).cast<std::string>());
+  }
+}
+
+// The settings dict: the options of `halfback study`, '-' spelled '_', and the profiles of the
+// study's BRDFs for the learned design (study_profile()'s texts, in the study's order).
+struct PySettings {
+  study::StudySettings settings;
+  std::vector<std::string> profiles;
+  bool has_profiles = false;
+};
+
+PySettings study_settings(const py::object& settings) {
+  PySettings out;
+  study::StudySettings& s = out.settings;
+  if (settings.is_none()) return out;
+  for (const auto& [k, v] : settings.cast<py::dict>()) {
+    const std::string key = py::str(k);
+    if (key == "space" || key == "error_space")
+      s.space = setting<std::string>(v, key);
+    else if (key == "designs")
+      s.designs = setting<std::vector<std::string>>(v, key);
+    else if (key == "profiles") {
+      out.profiles = setting<std::vector<std::string>>(v, key);
+      out.has_profiles = true;
+    } else if (key == "quick")
+      s.quick = setting<bool>(v, key);
+    else if (key == "no_gonio")
+      s.no_gonio = setting<bool>(v, key);
+    else if (key == "no_images")
+      s.no_images = setting<bool>(v, key);
+    else if (key == "budgets")
+      s.budgets = setting<std::vector<std::size_t>>(v, key);
+    else if (key == "budgets_4d")
+      s.budgets_4d = setting<std::vector<std::size_t>>(v, key);
+    else if (key == "test_pairs")
+      s.test_pairs = setting<std::size_t>(v, key);
+    else if (key == "image_budget")
+      s.image_budget = setting<std::size_t>(v, key);
+    else if (key == "image_size")
+      s.image_size = setting<int>(v, key);
+    else if (key == "image_spp")
+      s.image_spp = setting<int>(v, key);
+    else if (key == "max_theta")
+      s.max_theta = setting<double>(v, key);
+    else if (key == "seed")
+      s.seed = setting<std::uint64_t>(v, key);
+    else if (key == "env")
+      s.environments = setting<std::vector<std::string>>(v, key);
+    else
+      throw py::value_error("settings: unknown key '" + key +
+                            "' (accepted: space, designs, profiles, quick, budgets, budgets_4d, "
+                            "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
+                            "seed, no_gonio, no_images)");
+  }
+  return out;
+}
+
+// The configuration of the settings for the BRDF labeled `label`: with the learned design, its
+// warps from the profiles of the others.
+study::StudyConfig config_for(const PySettings& s, const std::string& label) {
+  study::StudyConfig config = study::make_config(s.settings);
+  if (!study::wants_learned(config)) return config;
+  if (!s.has_profiles)
+    throw std::invalid_argument(
+        "settings: the learned design needs settings['profiles'], the study_profile() of every "
+        "BRDF of the study in its order (or leave 'learned' out of settings['designs'])");
+  std::vector<study::LabeledProfile> profiles;
+  for (std::size_t i = 0; i < s.profiles.size(); ++i)
+    profiles.push_back(
+        study::profile_from_text(s.profiles[i], "settings['profiles'][" + std::to_string(i) + "]"));
+  study::set_learned(config, profiles, label);
+  return config;
+}
+
+py::dict study_one_brdf(const std::string& spec, const py::object& settings) {
+  const PySettings s = study_settings(settings);
+  study::BrdfResult result;
+  std::string described;
+  {
+    py::gil_scoped_release release;
+    const BrdfPtr brdf = load_brdf(spec);
+    const std::string label = study::study_label(spec, *brdf);
+    const study::StudyConfig config = config_for(s, label);
+    result = study::study_brdf(*brdf, label, config);
+    described = study::describe_config(config);
+  }
+  py::dict d;
+  for (const auto& [name, table] : study::to_tables(result)) d[py::str(name)] = table;
+  d["settings"] = described;
+  py::list images;
+  for (const render::Image& im : result.example_images) {
+    py::array_t<float> a({py::ssize_t(im.height), py::ssize_t(im.width), py::ssize_t(3)});
+    std::copy(im.rgb.begin(), im.rgb.end(), a.mutable_data());
+    images.append(a);
+  }
+  d["renderings"] = images;
+  return d;
+}
+
+// A result dict of study_one_brdf as a BrdfResult.
+study::BrdfResult result_of(const py::dict& d, const std::string& source) {
+  study::StudyTables tables;
+  for (const char* name : {"brdf", "azimuthal", "separability", "gonio", "image"}) {
+    if (!d.contains(name)) throw py::value_error(source + ": no table '" + name + "'");
+    tables[name] = d[name].cast<std::string>();
+  }
+  study::BrdfResult b = study::from_tables(tables, source);
+  if (d.contains("renderings"))
+    for (const auto& item : d["renderings"].cast<py::list>()) {
+      const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(item);
+      if (!a || a.ndim() != 3 || a.shape(2) != 3)
+        throw py::value_error(source + ": a rendering is not an (H, W, 3) array");
+      render::Image im{int(a.shape(1)), int(a.shape(0)), {}};
+      im.rgb.assign(a.data(), a.data() + a.size());
+      b.example_images.push_back(std::move(im));
+    }
+  return b;
+}
+
+std::string study_one_profile(const std::string& spec, const py::object& settings) {
+  const PySettings s = study_settings(settings);
+  py::gil_scoped_release release;
+  const study::StudyConfig config = study::make_config(s.settings);
+  const BrdfPtr brdf = load_brdf(spec);
+  return study::profile_text(study::study_profile(*brdf, study::study_label(spec, *brdf), config));
+}
+
+py::dict merge_study(const std::string& out, const py::list& parts) {
+  study::MergedParts merged;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const py::handle item = parts[i];
+    if (py::isinstance<py::dict>(item)) {
+      const py::dict d = item.cast<py::dict>();
+      const std::string source = "parts[" + std::to_string(i) + "]";
+      if (!d.contains("settings")) throw py::value_error(source + ": no 'settings'");
+      study::merge_into(merged, d["settings"].cast<std::string>(), source, {result_of(d, source)});
+    } else {
+      const std::string dir = py::str(py::module_::import("os").attr("fspath")(item));
+      study::MergedParts one = study::read_parts({dir});
+      study::merge_into(merged, one.settings, dir, std::move(one.results));
+    }
+  }
+  if (merged.results.empty()) throw py::value_error("parts: no result to merge");
+  study::StudyOutput written;
+  {
+    py::gil_scoped_release release;
+    std::error_code ec;
+    std::filesystem::create_directories(out, ec);
+    double seconds = 0;
+    for (const study::BrdfResult& b : merged.results) seconds += b.seconds;
+    written = study::write_study(out, merged.results, merged.config, seconds);
+  }
+  py::dict d;
+  d["markdown"] = written.markdown;
+  d["files"] = written.files;
+  return d;
+}
+
+void bind_study(py::module_& m) {
+  m.def("study_brdf", &study_one_brdf, py::arg("spec"), py::arg("settings") = py::none(),
+        R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
+
+spec: a file or model spec, as for load(). settings: a dict of the options of `halfback study`
+with '-' spelled '_': space (the error space), designs (a list), quick, budgets, budgets_4d,
+test_pairs, env (a list), image_budget, image_size, image_spp, max_theta, seed, no_gonio,
+no_images (missing: the defaults), and, for the learned design (a default design), profiles: the
+study_profile() texts of every BRDF of the study, this one's included, in the study's order (the
+warps are learned from all but this one's; without them, a ValueError).
+Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image"; the
+rows of the CSV files of the study, numbers in exact round-trip form, e.g. for
+pandas.read_csv(io.StringIO(t))), "settings" (the resolved settings, which merge_study checks)
+and "renderings" (the example images, (H, W, 3) float32). Independent of any other BRDF: map it
+over BRDFs with any engine (docs/study.md, "Scaling out").)doc");
+  m.def("study_profile", &study_one_profile, py::arg("spec"), py::arg("settings") = py::none(),
+        R"doc(The profile of one BRDF for the learned design (as text), the GIL released: what the
+learned warps of the other BRDFs are fitted on. settings: as for study_brdf (its error space
+matters). Map it over the study's BRDFs first, then pass the list as settings["profiles"].)doc");
+  m.def("merge_study", &merge_study, py::arg("out"), py::arg("parts"),
+        R"doc(Writes the study's report of several results into directory `out` (as
+`halfback study --merge`): parts is a list of result dicts of study_brdf and of output directories
+of `halfback study`, in the order of the report. All must have the same settings, and a BRDF may
+appear once. Returns {"markdown": report.md's text, "files": the files written}.)doc");
+}
+
 // The study's SSIM (Wang et al. 2004), for checking it against other implementations.
 void bind_image_metrics(py::module_& m) {
   using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
@@ -552,5 +749,6 @@ PYBIND11_MODULE(_core, m) {
   bind_brdf_class(m);
   bind_hemisphere(m);
   bind_loading(m);
+  bind_study(m);
   bind_image_metrics(m);
 }

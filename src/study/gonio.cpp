@@ -345,29 +345,37 @@ Rgb GonioReconstruction::reconstruct(const double* x) const {
     return {std::max(v.r, 0.0), std::max(v.g, 0.0), std::max(v.b, 0.0)};
   }
 
-  // Affine least squares in cell units about x: the constant term is the value at x.
-  using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;
-  using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 5, 3>;
-  const auto m = Eigen::Index(dim_ + 1);
-  Mat normal = Mat::Zero(m, m);
-  Rhs rhs = Rhs::Zero(m, 3);
-  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 5, 1> row(m);
-  for (unsigned k = 0; k < corners; ++k) {
-    row(0) = 1;
-    for (std::size_t a = 0; a < dim_; ++a)
-      row(Eigen::Index(a + 1)) =
-          double(lower[a] + long((k >> a) & 1u)) + offset_[cell[k]][a] - xn[a];
-    normal.noalias() += row * row.transpose();
-    const Rgb& v = value_[cell[k]];
-    for (Eigen::Index r = 0; r < m; ++r) {
-      rhs(r, 0) += row(r) * v.r;
-      rhs(r, 1) += row(r) * v.g;
-      rhs(r, 2) += row(r) * v.b;
+  // Affine least squares in cell units about x: the constant term is the value at x. M = d + 1
+  // unknowns, a fixed size (d is 3 or 4) so that the small system needs no dynamic sizes.
+  auto affine_fit = [&]<int M>() -> std::optional<Eigen::Matrix<double, M, 3>> {
+    Eigen::Matrix<double, M, M> normal = Eigen::Matrix<double, M, M>::Zero();
+    Eigen::Matrix<double, M, 3> rhs = Eigen::Matrix<double, M, 3>::Zero();
+    Eigen::Matrix<double, M, 1> row;
+    for (unsigned k = 0; k < corners; ++k) {
+      row(0) = 1;
+      for (std::size_t a = 0; a < dim_; ++a)
+        row(Eigen::Index(a + 1)) =
+            double(lower[a] + long((k >> a) & 1u)) + offset_[cell[k]][a] - xn[a];
+      normal.noalias() += row * row.transpose();
+      const Rgb& v = value_[cell[k]];
+      rhs.col(0) += row * v.r;
+      rhs.col(1) += row * v.g;
+      rhs.col(2) += row * v.b;
     }
+    const Eigen::LDLT<Eigen::Matrix<double, M, M>> ldlt(normal);
+    if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-9)) return std::nullopt;
+    return Eigen::Matrix<double, M, 3>(ldlt.solve(rhs));
+  };
+  double c[3];
+  if (dim_ == 3) {
+    const auto fit = affine_fit.template operator()<4>();
+    if (!fit) return multilinear();
+    for (int ch = 0; ch < 3; ++ch) c[ch] = (*fit)(0, ch);
+  } else {
+    const auto fit = affine_fit.template operator()<5>();
+    if (!fit) return multilinear();
+    for (int ch = 0; ch < 3; ++ch) c[ch] = (*fit)(0, ch);
   }
-  const Eigen::LDLT<Mat> ldlt(normal);
-  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-9)) return multilinear();
-  const Rhs c = ldlt.solve(rhs);
   // Limited to the range of the measurements used: an affine fit through a narrow peak would
   // otherwise overshoot (and undershoot below 0) around it.
   Rgb lo = value_[cell[0]], hi = lo;
@@ -376,8 +384,8 @@ Rgb GonioReconstruction::reconstruct(const double* x) const {
     lo = {std::min(lo.r, v.r), std::min(lo.g, v.g), std::min(lo.b, v.b)};
     hi = {std::max(hi.r, v.r), std::max(hi.g, v.g), std::max(hi.b, v.b)};
   }
-  return Rgb{std::clamp(c(0, 0), lo.r, hi.r), std::clamp(c(0, 1), lo.g, hi.g),
-             std::clamp(c(0, 2), lo.b, hi.b)};
+  return Rgb{std::clamp(c[0], lo.r, hi.r), std::clamp(c[1], lo.g, hi.g),
+             std::clamp(c[2], lo.b, hi.b)};
 }
 
 Rgb GonioReconstruction::outside(const DirPair<double>& p) {

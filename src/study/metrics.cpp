@@ -62,6 +62,26 @@ double FullSamples::total_weight() const {
 
 namespace {
 
+// Row i of `side` from the symmetric system whose upper triangle is row i of `normals` (packed
+// row by row) and whose right-hand side is row i of `rhs`; a row without weight is 0.
+template <class Small>
+void solve_normal_rows(const Eigen::MatrixXd& normals, const Eigen::MatrixXd& rhs,
+                       Eigen::MatrixXd& side) {
+  const auto r = rhs.cols();
+  Small n(r, r);
+  for (Eigen::Index i = 0; i < normals.rows(); ++i) {
+    for (Eigen::Index a = 0, c = 0; a < r; ++a)
+      for (Eigen::Index b = a; b < r; ++b, ++c) n(a, b) = n(b, a) = normals(i, c);
+    const double trace = n.trace();
+    if (!(trace > 0)) {  // no weight in this row: it does not count
+      side.row(i).setZero();
+      continue;
+    }
+    n.diagonal().array() += 1e-14 * trace;
+    side.row(i) = n.ldlt().solve(rhs.row(i).transpose()).transpose();
+  }
+}
+
 // The relative error of the best rank-r approximation of M in the weighted norm
 // Σ w_ij (M_ij − (U Vᵀ)_ij)², by alternating weighted least squares started from the SVD of
 // √w ∘ M (the exact answer when the weights are separable). Entries of weight 0 do not count, so a
@@ -78,25 +98,21 @@ double weighted_rank_error(const Eigen::MatrixXd& m, const Eigen::MatrixXd& w, i
   Eigen::MatrixXd v = svd.matrixV().leftCols(r);
   auto error = [&] { return (w.array() * (m - u * v.transpose()).array().square()).sum(); };
   // One side given the other: an r × r weighted normal system per row (or column), all their
-  // matrices from one product W · (v_j v_jᵀ)_j and right-hand sides from (W ∘ M) · V.
+  // matrices from one product W · (v_a v_b)_{a <= b} (the systems are symmetric: r(r+1)/2
+  // columns, not r²) and right-hand sides from (W ∘ M) · V.
   const Eigen::MatrixXd wm = w.cwiseProduct(m), wt = w.transpose(), wmt = wm.transpose();
   auto solve = [&](const Eigen::MatrixXd& weights, const Eigen::MatrixXd& weighted_target,
                    const Eigen::MatrixXd& other, Eigen::MatrixXd& side) {
-    Eigen::MatrixXd outer(other.rows(), r * r);
-    for (int a = 0; a < r; ++a)
-      for (int b = 0; b < r; ++b) outer.col(a * r + b) = other.col(a).cwiseProduct(other.col(b));
+    Eigen::MatrixXd outer(other.rows(), r * (r + 1) / 2);
+    for (int a = 0, c = 0; a < r; ++a)
+      for (int b = a; b < r; ++b) outer.col(c++) = other.col(a).cwiseProduct(other.col(b));
     const Eigen::MatrixXd normals = weights * outer;
     const Eigen::MatrixXd rhs = weighted_target * other;
-    for (Eigen::Index i = 0; i < weights.rows(); ++i) {
-      Eigen::MatrixXd n = normals.row(i).reshaped(r, r);
-      const double trace = n.trace();
-      if (!(trace > 0)) {  // no weight in this row: it does not count
-        side.row(i).setZero();
-        continue;
-      }
-      n.diagonal().array() += 1e-14 * trace;
-      side.row(i) = n.ldlt().solve(rhs.row(i).transpose()).transpose();
-    }
+    if (r <= 8)  // the usual ranks: the small systems on the stack
+      solve_normal_rows<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>>(normals,
+                                                                                        rhs, side);
+    else
+      solve_normal_rows<Eigen::MatrixXd>(normals, rhs, side);
   };
   double last = error();
   for (int it = 0; it < 200 && last > 1e-30 * norm; ++it) {

@@ -950,6 +950,98 @@ std::string image_section(const std::vector<BrdfResult>& results, const StudyCon
   return md;
 }
 
+// Measured files beside the neural BRDFs fitted to them: "rgl:NAME" or "merl:NAME" with
+// "nbrdf:NAME" (the same material), as (file, network) indices into the results.
+std::vector<std::pair<std::size_t, std::size_t>> file_network_pairs(
+    const std::vector<BrdfResult>& results) {
+  std::map<std::string, std::size_t> networks;
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (results[i].label.rfind("nbrdf:", 0) == 0) networks[results[i].label.substr(6)] = i;
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const std::string& l = results[i].label;
+    for (const char* prefix : {"rgl:", "merl:"})
+      if (l.rfind(prefix, 0) == 0)
+        if (const auto it = networks.find(l.substr(std::string_view(prefix).size()));
+            it != networks.end())
+          pairs.emplace_back(i, it->second);
+  }
+  return pairs;
+}
+
+// The parameterization with the lowest value ("–" when none is finite).
+std::string lowest_of(const std::array<double, kStudied.size()>& v) {
+  std::size_t best = v.size();
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (std::isfinite(v[i]) && (best == v.size() || v[i] < v[best])) best = i;
+  return best == v.size() ? "–" : std::string(name_of(kStudied[best]));
+}
+
+// Per metric, the values of the parameterizations for one BRDF (INFINITY where not measured).
+std::array<std::array<double, kStudied.size()>, 4> metric_values(const BrdfResult& b,
+                                                                 std::size_t ref) {
+  std::array<std::array<double, kStudied.size()>, 4> v{};
+  for (auto& row : v) row.fill(INFINITY);
+  for (std::size_t i = 0; i < b.params.size() && i < kStudied.size(); ++i) {
+    const ParamResult& p = b.params[i];
+    v[0][i] = p.azimuthal;
+    if (!p.separability_2d.empty()) v[1][i] = p.separability_2d[0];
+    if (const GonioPoint* g = find_point(p.gonio, Design::regular, ref)) v[2][i] = g->error;
+    v[3][i] = mean_image_error(p.images, Design::regular).relative_rmse;
+  }
+  return v;
+}
+
+// 5. The same materials as measured files and as their neural fits, side by side: does the
+// network representation change which parameterization wins?
+std::string files_and_networks_section(const std::vector<BrdfResult>& results,
+                                       const StudyConfig& config) {
+  const auto pairs = file_network_pairs(results);
+  if (pairs.empty()) return {};
+  const std::size_t ref = config.budgets.empty() ? 0 : reference_budget(config);
+  const char* metrics[] = {"azimuthal", "separability", "gonio", "image"};
+  std::string md = fmt::format(
+      "## 5. Measured files and their neural BRDFs\n\nThe same materials as measured files and "
+      "as the neural BRDFs fitted to them (Sztrajman et al. 2021): the parameterization with the "
+      "lowest error under each metric (azimuthal dependence; rank-1 separability of the 2D "
+      "projection; gonio-reflectometer error of the regular design at N = {}; image-space "
+      "relative RMSE), file / network.\n\n| material | azimuthal | separability | gonio | "
+      "image |\n|---|---|---|---|---|\n",
+      ref);
+  std::array<int, 4> agree{}, compared{};
+  for (const auto& [f, n] : pairs) {
+    const auto vf = metric_values(results[f], ref), vn = metric_values(results[n], ref);
+    md += "| " + md_cell(results[n].label.substr(6)) + " |";
+    for (std::size_t m = 0; m < 4; ++m) {
+      const std::string a = lowest_of(vf[m]), b = lowest_of(vn[m]);
+      md += fmt::format(" {} / {} |", a, b);
+      if (a != "–" && b != "–") {
+        ++compared[m];
+        agree[m] += a == b;
+      }
+    }
+    md += "\n";
+  }
+  md += "\nThe same winner for file and network: ";
+  for (std::size_t m = 0; m < 4; ++m)
+    md += fmt::format("{}{} {} of {}", m ? ", " : "", metrics[m], agree[m], compared[m]);
+  md += ".\n\n";
+  if (ref == 0) return md;
+  md += fmt::format("Gonio-reflectometer error at N = {} (regular design), file then network:\n\n",
+                    ref) +
+        table_header("material");
+  for (const auto& [f, n] : pairs)
+    for (const std::size_t k : {f, n}) {
+      md += "| " + md_cell(results[k].label) + " |";
+      for (const ParamResult& p : results[k].params) {
+        const GonioPoint* g = find_point(p.gonio, Design::regular, ref);
+        md += g ? fmt::format(" {:.4f} |", g->error) : " – |";
+      }
+      md += "\n";
+    }
+  return md + "\n";
+}
+
 // The closing line: the CSV files written so far, then what always follows them.
 std::string files_paragraph(const std::vector<std::string>& csv_files) {
   std::string md = "Files: ";
@@ -974,6 +1066,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
     md += gonio_section(results, config, has.anisotropic, plots) +
           designs_section(results, config, plots);
   if (has.images) md += image_section(results, config, plots);
+  md += files_and_networks_section(results, config);
   md += files_paragraph(out.files);
 
   // The plots before report.html, which embeds them.

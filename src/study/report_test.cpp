@@ -184,5 +184,37 @@ TEST(Report, MarkdownToHtml) {
   EXPECT_NE(html.find("<a href=\"missing.png\">gone</a>"), std::string::npos);
 }
 
+// A measured file and the network fitted to it, side by side (section 5): the file's lowest
+// errors are halfdiff's, the network's spherical's (its values in the reverse order).
+TEST(Report, FilesBesideTheirNetworks) {
+  const test::TempDir tmp;
+  StudyConfig c;
+  c.budgets = {1000, 1000000};
+  c.image_budget = 1000;
+  c.environments.push_back({"sky", nullptr});
+  const BrdfResult file = fake("rgl:felt_rgb", true);
+  BrdfResult network = file;
+  network.label = "nbrdf:felt_rgb";
+  for (std::size_t i = 0; i < kStudied.size(); ++i) {
+    network.params[i] = file.params[kStudied.size() - 1 - i];
+    network.params[i].space = kStudied[i];
+  }
+  const StudyOutput out = write_study(tmp.path(), {file, fake("lambert", true), network}, c, 1.0);
+  const std::string& md = out.markdown;
+  EXPECT_NE(md.find("## 5. Measured files and their neural BRDFs"), std::string::npos) << md;
+  EXPECT_NE(md.find("| felt_rgb | halfdiff / spherical | halfdiff / spherical | halfdiff / "
+                    "spherical | halfdiff / spherical |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("azimuthal 0 of 1, separability 0 of 1, gonio 0 of 1, image 0 of 1"),
+            std::string::npos)
+      << md;
+  // The gonio errors at the reference budget, file then network: 0.5 k at N = 1000.
+  EXPECT_NE(md.find("| rgl:felt_rgb | 0.5000 | 1.0000 | 1.5000 | 2.0000 |"), std::string::npos);
+  EXPECT_NE(md.find("| nbrdf:felt_rgb | 2.0000 | 1.5000 | 1.0000 | 0.5000 |"), std::string::npos);
+  // Without a pair, no section.
+  EXPECT_EQ(write_study(tmp.path(), {file}, c, 1.0).markdown.find("## 5."), std::string::npos);
+}
+
 }  // namespace
 }  // namespace halfback::study

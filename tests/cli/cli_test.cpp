@@ -1394,7 +1394,7 @@ TEST_F(CliTest, StudyBadInput) {
   fs::create_directories(path("empty"));
   r = run({"study", "-o", "st", "empty"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("no MERL, RGL or ALTA file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no MERL, RGL, ALTA or neural BRDF file"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("st")));
   r = run({"study", "--budgets", "1000,100", "lambert"});
   EXPECT_EQ(r.status, 2);
@@ -1408,6 +1408,130 @@ TEST_F(CliTest, StudyBadInput) {
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("nowhere.hdr"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("study")));
+}
+
+// The options of the small studies below: a few seconds each, under the sanitizers too.
+std::vector<std::string> tiny_study(const std::string& out, std::vector<std::string> specs) {
+  std::vector<std::string> a{"study", "--quick", "--test-pairs", "3000", "--budgets",   "300,1000",
+                             "--env", "sky",     "--image-size", "16",   "--image-spp", "2",
+                             "-o",    out};
+  a.insert(a.end(), specs.begin(), specs.end());
+  return a;
+}
+
+const std::vector<std::string> kTinyPanel{"lambert", "ggx:alpha=0.3", "test:S",
+                                          "embedded:acrylic_felt_green"};
+
+std::vector<std::string> study_csvs(const fs::path& dir) {
+  std::vector<std::string> t;
+  for (const char* f :
+       {"azimuthal.csv", "separability.csv", "gonio.csv", "budget.csv", "image.csv"})
+    t.push_back(slurp(dir / f));
+  return t;
+}
+
+// Killed outright (SIGKILL: no clean-up at all) after its first finished BRDF, a run continued
+// with --resume writes the same CSV files as a run that was never interrupted; the BRDFs finished
+// before the kill are not studied again.
+TEST_F(CliTest, StudyResumeAfterAKillGivesTheSameTables) {
+  ASSERT_EQ(run(tiny_study("whole", kTinyPanel)).status, 0);
+  const auto parts = [&] {
+    std::size_t n = 0;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(path("cut") / "parts", ec))
+      n += e.path().extension() == ".part";
+    return n;
+  };
+  std::vector<std::string> args = tiny_study("cut", kTinyPanel);
+  args.insert(args.begin(), HALFBACK_CLI_PATH);
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 2, path("err").c_str(), O_WRONLY | O_CREAT, 0644);
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir_.path());
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, HALFBACK_CLI_PATH, &actions, nullptr, argv.data(), environ);
+  fs::current_path(cwd);
+  posix_spawn_file_actions_destroy(&actions);
+  ASSERT_EQ(rc, 0);
+  for (int i = 0; i < 60000 && parts() < 1; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  const std::size_t kept = parts();
+  ASSERT_GE(kept, 1u);
+  ASSERT_LT(kept, kTinyPanel.size()) << "the run ended before the kill: nothing to resume";
+  EXPECT_FALSE(fs::exists(path("cut") / "report.md"));
+
+  std::vector<std::string> resume = tiny_study("cut", kTinyPanel);
+  resume.insert(resume.begin() + 1, "--resume");
+  const Result r = run(resume);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("kept from the earlier run"), std::string::npos) << r.err;
+  EXPECT_EQ(study_csvs(path("cut")), study_csvs(path("whole")));
+
+  // Other settings cannot resume the run: a usage error, the results untouched.
+  std::vector<std::string> other = tiny_study("cut", kTinyPanel);
+  other[3] = "4000";  // --test-pairs
+  other.insert(other.begin() + 1, "--resume");
+  const Result bad = run(other);
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("other settings"), std::string::npos) << bad.err;
+  EXPECT_EQ(parts(), kTinyPanel.size());
+  // Nor can another set of BRDFs: the learned design of each would come from other profiles.
+  std::vector<std::string> fewer = tiny_study("cut", {kTinyPanel[0], kTinyPanel[1]});
+  fewer.insert(fewer.begin() + 1, "--resume");
+  const Result bad_set = run(fewer);
+  EXPECT_EQ(bad_set.status, 2);
+  EXPECT_NE(bad_set.err.find("other settings"), std::string::npos) << bad_set.err;
+  EXPECT_EQ(parts(), kTinyPanel.size());
+}
+
+// Two runs over halves of the BRDFs, merged, write the tables of one run over all of them.
+// The learned design makes a BRDF's results depend on the other BRDFs of the run: runs over
+// halves merge into the whole run only without it (with it, their merge is refused).
+TEST_F(CliTest, StudyMergeOfTwoRunsIsOneRun) {
+  const auto no_learned = [](std::vector<std::string> a) {
+    a.insert(a.begin() + 1, {"--designs", "own,angle,merl"});
+    return a;
+  };
+  ASSERT_EQ(run(no_learned(tiny_study("whole", kTinyPanel))).status, 0);
+  ASSERT_EQ(run(no_learned(tiny_study("a", {kTinyPanel[0], kTinyPanel[1]}))).status, 0);
+  ASSERT_EQ(run(no_learned(tiny_study("b", {kTinyPanel[2], kTinyPanel[3]}))).status, 0);
+  Result r = run({"study", "--merge", "a", "b", "-o", "merged"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(study_csvs(path("merged")), study_csvs(path("whole")));
+  const std::string report = slurp(path("merged") / "report.md");
+  EXPECT_NE(report.find("## 4. Image-space error"), std::string::npos);
+  EXPECT_TRUE(fs::exists(path("merged") / "renderings.png"));
+
+  // A BRDF in two of the runs, a directory that is not a study, different settings, BRDFs
+  // given with --merge: each a clear error, and nothing written.
+  r = run({"study", "--merge", "a", "whole", "-o", "m2"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("'lambert' is in both"), std::string::npos) << r.err;
+  r = run({"study", "--merge", "a", "nowhere", "-o", "m2"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("'nowhere': not the output of a study"), std::string::npos) << r.err;
+  std::vector<std::string> other = no_learned(tiny_study("c", {"test:G"}));
+  other[5] = "4000";  // --test-pairs
+  ASSERT_EQ(run(other).status, 0);
+  r = run({"study", "--merge", "a", "c", "-o", "m2"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("different settings"), std::string::npos) << r.err;
+  ASSERT_EQ(run(tiny_study("la", {kTinyPanel[0], kTinyPanel[1]})).status, 0);
+  ASSERT_EQ(run(tiny_study("lb", {kTinyPanel[2], kTinyPanel[3]})).status, 0);
+  r = run({"study", "--merge", "la", "lb", "-o", "m2"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("learned designs come from different sets of BRDFs"), std::string::npos)
+      << r.err;
+  r = run({"study", "lambert", "--merge", "a", "-o", "m2"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_FALSE(fs::exists(path("m2")));
 }
 
 // ---------------------------------------------------------------------------------------------

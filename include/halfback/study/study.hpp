@@ -62,6 +62,10 @@ struct StudyConfig {
   std::vector<Spacing> spacings{Spacing::own, Spacing::angle, Spacing::merl, Spacing::learned};
   std::vector<LearnedWarps> learned;
   IsoGrid profile_grid{32, 32, 32};
+  // A fingerprint of the profiles the learned warps come from (parts.hpp: learned_fingerprint),
+  // empty without them: part of the settings of a run, so that parts learned from other BRDFs
+  // are never resumed or merged with these.
+  std::string learned_from;
   // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.
   std::function<void(std::string_view stage)> progress;
 

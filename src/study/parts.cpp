@@ -1,0 +1,631 @@
+#include "halfback/study/parts.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+
+#include "halfback/render/image.hpp"
+#include "halfback/util/atomic_file.hpp"
+#include "halfback/util/csv.hpp"
+
+namespace halfback::study {
+
+namespace {
+
+std::optional<Design> design_named(std::string_view name) {
+  for (Design d : kDesigns)
+    if (name_of(d) == name) return d;
+  return std::nullopt;
+}
+
+void apply_quick(StudyConfig& c) {
+  c.grid = {24, 24, 32};
+  c.full_grid = {8, 16, 8, 16};
+  c.budgets = {1000, 10000};
+  c.budgets_4d = {1000, 10000};
+  c.test_pairs = 20000;
+  c.image_size = 48;
+  c.image_spp = 8;
+}
+
+void check_ascending(const std::vector<std::size_t>& v, const char* option) {
+  for (std::size_t i = 1; i < v.size(); ++i)
+    if (v[i] <= v[i - 1])
+      throw std::invalid_argument(fmt::format("{}: budgets must be ascending", option));
+}
+
+std::vector<std::string_view> spacing_names(const std::vector<Spacing>& spacings) {
+  std::vector<std::string_view> names;
+  for (Spacing s : spacings) names.push_back(name_of(s));
+  return names;
+}
+
+template <class T>
+std::string joined(const std::vector<T>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += fmt::format("{}{}", i ? "," : "", v[i]);
+  return s;
+}
+
+}  // namespace
+
+StudyConfig make_config(const StudySettings& o) {
+  StudyConfig c;
+  const auto space = parse_error_space(o.space);
+  if (!space)
+    throw std::invalid_argument(fmt::format(
+        "--error-space '{}': expected linear, log, cbrt, nielsen or low (docs/study.md)", o.space));
+  c.space = *space;
+  c.spacings.clear();
+  for (const std::string& name : o.designs) {
+    const auto spacing = parse_spacing(name);
+    if (!spacing)
+      throw std::invalid_argument(
+          fmt::format("--designs: '{}' is not a design (own, angle, merl or learned)", name));
+    if (std::find(c.spacings.begin(), c.spacings.end(), *spacing) != c.spacings.end())
+      throw std::invalid_argument(fmt::format("--designs: '{}' is given twice", name));
+    c.spacings.push_back(*spacing);
+  }
+  if (c.spacings.empty()) throw std::invalid_argument("--designs: no design given");
+  if (o.quick) apply_quick(c);
+  check_ascending(o.budgets, "--budgets");
+  check_ascending(o.budgets_4d, "--budgets-4d");
+  if (!o.budgets.empty()) c.budgets = o.budgets;
+  if (!o.budgets_4d.empty()) c.budgets_4d = o.budgets_4d;
+  if (o.test_pairs) c.test_pairs = o.test_pairs;
+  if (o.image_size) c.image_size = o.image_size;
+  if (o.image_spp) c.image_spp = o.image_spp;
+  c.seed = o.seed;
+  c.max_theta_deg = o.max_theta;
+  // The image budget: as asked, else 10^4 if it is a budget, else the middle budget.
+  if (o.image_budget)
+    c.image_budget = o.image_budget;
+  else if (!c.budgets.empty() &&
+           std::find(c.budgets.begin(), c.budgets.end(), c.image_budget) == c.budgets.end())
+    c.image_budget = c.budgets[c.budgets.size() / 2];
+  if (o.no_gonio) c.budgets.clear();
+  if (!o.no_gonio && !o.no_images) {
+    if (o.environments.empty())
+      c.environments = render::default_environments();
+    else
+      for (const std::string& spec : o.environments)
+        c.environments.push_back(render::load_environment(spec));
+  }
+  c.validate();
+  return c;
+}
+
+std::string describe_config(const StudyConfig& c) {
+  std::string envs;
+  for (const render::Environment& e : c.environments) {
+    if (!envs.empty()) envs += ',';
+    envs += csv_text_field(e.label);
+  }
+  return fmt::format(
+      "space = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = {}\nbudgets_4d = {}\n"
+      "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
+      "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
+      "learned_from = {}\n",
+      name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
+      joined(std::vector<std::size_t>(c.full_grid.begin(), c.full_grid.end())), joined(c.ranks),
+      joined(c.budgets), joined(c.budgets_4d), c.test_pairs, format_csv_number(c.max_theta_deg),
+      c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(spacing_names(c.spacings)),
+      c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from);
+}
+
+namespace {
+
+template <class T>
+T number_of(std::string_view text, const std::string& where) {
+  T v{};
+  if constexpr (std::is_floating_point_v<T>) {
+    if (parse_csv_number(text, v, false).empty()) return v;
+  } else {
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec == std::errc() && end == text.data() + text.size()) return v;
+  }
+  throw std::runtime_error(fmt::format("{}: '{}' is not a number", where, text));
+}
+
+template <class T>
+std::vector<T> numbers_of(std::string_view text, const std::string& where) {
+  std::vector<T> v;
+  if (text.empty()) return v;
+  for (const std::string& f : split_csv_line(text)) v.push_back(number_of<T>(f, where));
+  return v;
+}
+
+}  // namespace
+
+StudyConfig config_from_description(std::string_view text, const std::string& source) {
+  std::map<std::string, std::string> kv;
+  std::istringstream in{std::string(text)};
+  std::size_t line_no = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++line_no;
+    const std::size_t eq = line.find(" = ");
+    if (line.empty()) continue;
+    if (eq == std::string::npos)
+      throw std::runtime_error(fmt::format("{}:{}: expected 'key = value'", source, line_no));
+    kv[line.substr(0, eq)] = line.substr(eq + 3);
+  }
+  auto get = [&](const char* key) -> std::string {
+    const auto it = kv.find(key);
+    if (it == kv.end()) throw std::runtime_error(fmt::format("{}: no '{}' line", source, key));
+    return it->second;
+  };
+  const std::string where = source;
+  StudyConfig c;
+  const auto space = parse_error_space(get("space"));
+  if (!space) throw std::runtime_error(fmt::format("{}: unknown error space", source));
+  c.space = *space;
+  const auto grid = numbers_of<std::size_t>(get("grid"), where);
+  const auto full = numbers_of<std::size_t>(get("full_grid"), where);
+  if (grid.size() != 3 || full.size() != 4)
+    throw std::runtime_error(fmt::format("{}: a grid has the wrong number of axes", source));
+  c.grid = {grid[0], grid[1], grid[2]};
+  std::copy(full.begin(), full.end(), c.full_grid.begin());
+  c.ranks = numbers_of<int>(get("ranks"), where);
+  c.budgets = numbers_of<std::size_t>(get("budgets"), where);
+  c.budgets_4d = numbers_of<std::size_t>(get("budgets_4d"), where);
+  c.test_pairs = number_of<std::size_t>(get("test_pairs"), where);
+  c.max_theta_deg = number_of<double>(get("max_theta_deg"), where);
+  c.seed = number_of<std::uint64_t>(get("seed"), where);
+  const std::string envs = get("environments");
+  if (!envs.empty())
+    for (const std::string& label : split_csv_line(envs)) c.environments.push_back({label, {}});
+  c.image_budget = number_of<std::size_t>(get("image_budget"), where);
+  c.image_size = number_of<int>(get("image_size"), where);
+  c.image_spp = number_of<int>(get("image_spp"), where);
+  c.spacings.clear();
+  for (const std::string& name : split_csv_line(get("designs"))) {
+    const auto spacing = parse_spacing(name);
+    if (!spacing) throw std::runtime_error(fmt::format("{}: unknown design '{}'", source, name));
+    c.spacings.push_back(*spacing);
+  }
+  const auto profile_grid = numbers_of<std::size_t>(get("profile_grid"), where);
+  if (profile_grid.size() != 3)
+    throw std::runtime_error(fmt::format("{}: a grid has the wrong number of axes", source));
+  c.profile_grid = {profile_grid[0], profile_grid[1], profile_grid[2]};
+  c.learned_from = get("learned_from");
+  return c;
+}
+
+std::string study_label(std::string_view spec, const Brdf& brdf) {
+  std::error_code ec;
+  return std::filesystem::exists(spec, ec) ? brdf.name() : std::string(spec);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Profiles (the learned design)
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+constexpr std::string_view kProfileMagic = "# halfback study profile 1\n";
+
+std::uint64_t fnv1a(std::string_view s, std::uint64_t h = 1469598103934665603ull) {
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+}  // namespace
+
+bool wants_learned(const StudyConfig& c) {
+  return !c.budgets.empty() &&
+         std::find(c.spacings.begin(), c.spacings.end(), Spacing::learned) != c.spacings.end();
+}
+
+LabeledProfile study_profile(const Brdf& brdf, const std::string& label, const StudyConfig& c) {
+  return {label, design_profile(brdf, kStudied, c.profile_grid, c.space)};
+}
+
+// The label, then per space its name and one line of numbers per axis.
+std::string profile_text(const LabeledProfile& p) {
+  std::string text(kProfileMagic);
+  text += "label = " + csv_text_field(p.label) + "\n";
+  for (const AxisDemand& d : p.profile.spaces) {
+    text += fmt::format("space = {}\n", name_of(d.space));
+    for (const std::vector<double>& axis : d.demand) {
+      for (std::size_t i = 0; i < axis.size(); ++i) {
+        if (i) text += ',';
+        text += format_csv_number(axis[i]);
+      }
+      text += '\n';
+    }
+  }
+  return text;
+}
+
+LabeledProfile profile_from_text(std::string_view text, const std::string& source) {
+  if (text.substr(0, kProfileMagic.size()) != kProfileMagic)
+    throw std::runtime_error(source + ": not a profile of a halfback study");
+  std::istringstream in{std::string(text.substr(kProfileMagic.size()))};
+  std::string line;
+  LabeledProfile p;
+  if (!std::getline(in, line) || line.rfind("label = ", 0) != 0)
+    throw std::runtime_error(source + ": no 'label' line");
+  const auto label = split_csv_line(line.substr(8));
+  if (label.size() != 1) throw std::runtime_error(source + ": a malformed label");
+  p.label = label[0];
+  while (std::getline(in, line)) {
+    if (line.rfind("space = ", 0) != 0)
+      throw std::runtime_error(fmt::format("{}: expected 'space = NAME', got '{}'", source, line));
+    AxisDemand d;
+    const auto space = std::find_if(kStudied.begin(), kStudied.end(),
+                                    [&](Space s) { return name_of(s) == line.substr(8); });
+    if (space == kStudied.end())
+      throw std::runtime_error(fmt::format("{}: unknown space '{}'", source, line.substr(8)));
+    d.space = *space;
+    for (std::vector<double>& axis : d.demand) {
+      if (!std::getline(in, line))
+        throw std::runtime_error(source + ": the profile ends inside a space");
+      axis = numbers_of<double>(line, source);
+    }
+    p.profile.spaces.push_back(std::move(d));
+  }
+  return p;
+}
+
+std::string learned_fingerprint(std::span<const LabeledProfile> profiles) {
+  std::uint64_t h = fnv1a(std::to_string(profiles.size()));
+  for (const LabeledProfile& p : profiles) h = fnv1a(profile_text(p), h);
+  return fmt::format("{} profiles, {:016x}", profiles.size(), h);
+}
+
+void set_learned(StudyConfig& c, std::span<const LabeledProfile> profiles,
+                 const std::string& label) {
+  const auto it = std::find_if(profiles.begin(), profiles.end(),
+                               [&](const LabeledProfile& p) { return p.label == label; });
+  if (it == profiles.end())
+    throw std::invalid_argument(fmt::format(
+        "the learned design: no profile of '{}' among the profiles given (they must be those of "
+        "every BRDF of the study, this one's included, so that it is left out)",
+        label));
+  std::vector<DesignProfile> plain;
+  for (const LabeledProfile& p : profiles) plain.push_back(p.profile);
+  c.learned.clear();
+  if (profiles.size() > 1)
+    c.learned = learn_warps(plain, std::size_t(std::distance(profiles.begin(), it)));
+  c.learned_from = learned_fingerprint(profiles);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tables
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+// The columns of gonio.csv and image.csv (report.cpp writes the same).
+constexpr std::string_view kGonioHeader =
+    "brdf,parameterization,design,samples,error,dims,budget,spacing";
+constexpr std::string_view kImageHeader =
+    "brdf,parameterization,design,samples,environment,relative_rmse,mean_delta_e2000,"
+    "p95_delta_e2000,mae,rmse,ssim";
+
+std::string num(double v) {
+  return format_csv_number(v);
+}
+
+void add_rank_rows(std::string& csv, const std::string& brdf, std::string_view pn,
+                   const std::vector<double>& errors, int dims) {
+  // The rank itself is the position: the ranks of the run's configuration.
+  for (std::size_t i = 0; i < errors.size(); ++i)
+    csv += fmt::format("{},{},{},{},{}\n", brdf, pn, i, num(errors[i]), dims);
+}
+
+void add_gonio_rows(std::string& csv, const std::string& brdf, std::string_view pn,
+                    const std::vector<GonioPoint>& pts, int dims) {
+  for (const GonioPoint& g : pts)
+    csv += fmt::format("{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(g.design), g.samples,
+                       num(g.error), dims, g.budget, name_of(g.spacing));
+}
+
+}  // namespace
+
+StudyTables to_tables(const BrdfResult& b) {
+  const std::string brdf = csv_text_field(b.label);
+  StudyTables t;
+  t["brdf"] =
+      fmt::format("brdf,isotropic,seconds\n{},{},{}\n", brdf, int(b.isotropic), num(b.seconds));
+  std::string az = "brdf,parameterization,error,dims\n";
+  std::string sep = "brdf,parameterization,rank_index,error,dims\n";
+  std::string gonio = std::string(kGonioHeader) + "\n";
+  std::string image = std::string(kImageHeader) + "\n";
+  for (const ParamResult& p : b.params) {
+    const std::string_view pn = name_of(p.space);
+    az += fmt::format("{},{},{},3\n", brdf, pn, num(p.azimuthal));
+    if (!b.isotropic) az += fmt::format("{},{},{},4\n", brdf, pn, num(p.azimuthal_4d));
+    add_rank_rows(sep, brdf, pn, p.separability_2d, 2);
+    add_rank_rows(sep, brdf, pn, p.separability_3d, 3);
+    if (!b.isotropic) add_rank_rows(sep, brdf, pn, p.separability_4d, 4);
+    add_gonio_rows(gonio, brdf, pn, p.gonio, 3);
+    add_gonio_rows(gonio, brdf, pn, p.gonio_4d, 4);
+    for (const ImagePoint& i : p.images)
+      image +=
+          fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(i.design), i.samples,
+                      csv_text_field(i.environment), num(i.relative_rmse), num(i.mean_delta_e),
+                      num(i.p95_delta_e), num(i.mae), num(i.rmse), num(i.ssim));
+  }
+  t["azimuthal"] = az;
+  t["separability"] = sep;
+  t["gonio"] = gonio;
+  t["image"] = image;
+  return t;
+}
+
+namespace {
+
+// The rows of one table after its header, which must be `header`; each row of `columns` fields.
+struct TableReader {
+  const std::string& source;
+  std::string name;
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::size_t> lines;
+
+  std::string where(std::size_t row) const {
+    return fmt::format("{}: table {}, line {}", source, name, lines[row]);
+  }
+};
+
+TableReader read_table(const StudyTables& t, const char* name, std::string_view header,
+                       const std::string& source) {
+  TableReader r{source, name, {}, {}};
+  const auto it = t.find(name);
+  if (it == t.end()) throw std::runtime_error(fmt::format("{}: no table '{}'", source, name));
+  std::istringstream in(it->second);
+  std::string line;
+  if (!std::getline(in, line) || line != header)
+    throw std::runtime_error(
+        fmt::format("{}: table {}: the header is not '{}'", source, name, header));
+  const std::size_t columns = split_csv_line(header).size();
+  for (std::size_t n = 2; std::getline(in, line); ++n) {
+    if (line.empty()) continue;
+    std::vector<std::string> f;
+    try {
+      f = split_csv_line(line);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(fmt::format("{}: table {}, line {}: {}", source, name, n, e.what()));
+    }
+    if (f.size() != columns)
+      throw std::runtime_error(fmt::format("{}: table {}, line {}: {} fields, expected {}", source,
+                                           name, n, f.size(), columns));
+    r.rows.push_back(std::move(f));
+    r.lines.push_back(n);
+  }
+  return r;
+}
+
+ParamResult& param_named(BrdfResult& b, const std::string& name, const std::string& where) {
+  for (ParamResult& p : b.params)
+    if (name_of(p.space) == name) return p;
+  throw std::runtime_error(fmt::format("{}: unknown parameterization '{}'", where, name));
+}
+
+Design design_of(const std::string& name, const std::string& where) {
+  const auto d = design_named(name);
+  if (!d) throw std::runtime_error(fmt::format("{}: unknown design '{}'", where, name));
+  return *d;
+}
+
+void read_metric_tables(const StudyTables& t, const std::string& source, BrdfResult& b) {
+  const TableReader az = read_table(t, "azimuthal", "brdf,parameterization,error,dims", source);
+  for (std::size_t i = 0; i < az.rows.size(); ++i) {
+    const auto& f = az.rows[i];
+    ParamResult& p = param_named(b, f[1], az.where(i));
+    (f[3] == "4" ? p.azimuthal_4d : p.azimuthal) = number_of<double>(f[2], az.where(i));
+  }
+  const TableReader sep =
+      read_table(t, "separability", "brdf,parameterization,rank_index,error,dims", source);
+  for (std::size_t i = 0; i < sep.rows.size(); ++i) {
+    const auto& f = sep.rows[i];
+    ParamResult& p = param_named(b, f[1], sep.where(i));
+    const int dims = number_of<int>(f[4], sep.where(i));
+    auto& v = dims == 2 ? p.separability_2d : dims == 3 ? p.separability_3d : p.separability_4d;
+    if (number_of<std::size_t>(f[2], sep.where(i)) != v.size())
+      throw std::runtime_error(sep.where(i) + ": the ranks are not in order");
+    v.push_back(number_of<double>(f[3], sep.where(i)));
+  }
+}
+
+void read_gonio_tables(const StudyTables& t, const std::string& source, BrdfResult& b) {
+  const TableReader g = read_table(t, "gonio", kGonioHeader, source);
+  for (std::size_t i = 0; i < g.rows.size(); ++i) {
+    const auto& f = g.rows[i];
+    const std::string w = g.where(i);
+    ParamResult& p = param_named(b, f[1], w);
+    const auto spacing = parse_spacing(f[7]);
+    if (!spacing) throw std::runtime_error(fmt::format("{}: unknown spacing '{}'", w, f[7]));
+    (f[5] == "4" ? p.gonio_4d : p.gonio)
+        .push_back({design_of(f[2], w), number_of<std::size_t>(f[6], w),
+                    number_of<std::size_t>(f[3], w), number_of<double>(f[4], w), *spacing});
+  }
+  const TableReader im = read_table(t, "image", kImageHeader, source);
+  for (std::size_t i = 0; i < im.rows.size(); ++i) {
+    const auto& f = im.rows[i];
+    const std::string w = im.where(i);
+    param_named(b, f[1], w)
+        .images.push_back({design_of(f[2], w), number_of<std::size_t>(f[3], w), f[4],
+                           number_of<double>(f[5], w), number_of<double>(f[6], w),
+                           number_of<double>(f[7], w), number_of<double>(f[8], w),
+                           number_of<double>(f[9], w), number_of<double>(f[10], w)});
+  }
+}
+
+}  // namespace
+
+BrdfResult from_tables(const StudyTables& t, const std::string& source) {
+  const TableReader head = read_table(t, "brdf", "brdf,isotropic,seconds", source);
+  if (head.rows.size() != 1)
+    throw std::runtime_error(fmt::format("{}: table brdf: expected one row", source));
+  BrdfResult b;
+  b.label = head.rows[0][0];
+  b.isotropic = head.rows[0][1] == "1";
+  b.seconds = number_of<double>(head.rows[0][2], head.where(0));
+  for (Space s : kStudied) {
+    b.params.emplace_back();
+    b.params.back().space = s;
+  }
+  read_metric_tables(t, source, b);
+  read_gonio_tables(t, source, b);
+  return b;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Part files
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+constexpr std::string_view kPartMagic = "# halfback study part 2\n";
+
+// The example renderings side by side in one image (they share their size).
+render::Image strip_of(const std::vector<render::Image>& images) {
+  render::Image s;
+  s.width = images.front().width * int(images.size());
+  s.height = images.front().height;
+  s.rgb.resize(std::size_t(s.width) * std::size_t(s.height) * 3);
+  for (std::size_t k = 0; k < images.size(); ++k)
+    for (int y = 0; y < s.height; ++y)
+      std::copy_n(
+          images[k].pixel(0, y), std::size_t(images[k].width) * 3,
+          &s.rgb[3 * (std::size_t(y) * std::size_t(s.width) + k * std::size_t(images[k].width))]);
+  return s;
+}
+
+std::vector<render::Image> images_of(const render::Image& strip, int size) {
+  std::vector<render::Image> out;
+  for (int x0 = 0; size > 0 && x0 + size <= strip.width; x0 += size) {
+    render::Image im{size, strip.height, {}};
+    for (int y = 0; y < strip.height; ++y)
+      im.rgb.insert(im.rgb.end(), strip.pixel(x0, y), strip.pixel(x0, y) + std::size_t(size) * 3);
+    out.push_back(std::move(im));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::filesystem::path parts_dir(const std::filesystem::path& out) {
+  return out / "parts";
+}
+
+std::filesystem::path profiles_dir(const std::filesystem::path& out) {
+  return out / "profiles";
+}
+
+std::string part_key(std::string_view spec) {
+  std::string name(std::filesystem::path(spec).filename().string());
+  if (name.empty()) name = std::string(spec);
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  if (name.size() > 60) name.resize(60);
+  return fmt::format("{}-{:016x}", name, fnv1a(spec));
+}
+
+void write_part(const std::filesystem::path& parts, const std::string& key,
+                const BrdfResult& result, std::size_t order) {
+  if (!result.example_images.empty())
+    render::write_exr(parts / (key + ".exr"), strip_of(result.example_images));
+  std::string text(kPartMagic);
+  text += fmt::format("order = {}\n", order);
+  for (const auto& [name, table] : to_tables(result)) text += "[" + name + "]\n" + table;
+  write_file_atomically(parts / (key + ".part"), text);
+}
+
+BrdfResult read_part(const std::filesystem::path& parts, const std::string& key,
+                     std::size_t* order) {
+  const std::filesystem::path file = parts / (key + ".part");
+  const std::string text = read_text_file(file);
+  const std::string source = file.string();
+  if (text.rfind(kPartMagic, 0) != 0)
+    throw std::runtime_error(source + ": not a part of a halfback study");
+  std::istringstream in(text.substr(kPartMagic.size()));
+  std::string line;
+  std::getline(in, line);
+  if (line.rfind("order = ", 0) != 0) throw std::runtime_error(source + ": no 'order' line");
+  const auto at = number_of<std::size_t>(line.substr(8), source);
+  if (order) *order = at;
+  StudyTables tables;
+  std::string* current = nullptr;
+  while (std::getline(in, line)) {
+    if (line.size() > 2 && line.front() == '[' && line.back() == ']')
+      current = &tables[line.substr(1, line.size() - 2)];
+    else if (current)
+      *current += line + "\n";
+    else
+      throw std::runtime_error(source + ": a row before the first table");
+  }
+  BrdfResult b = from_tables(tables, source);
+  const std::filesystem::path exr = parts / (key + ".exr");
+  std::error_code ec;
+  if (std::filesystem::exists(exr, ec)) {
+    const render::Image strip = render::read_exr(exr);
+    b.example_images = images_of(strip, strip.height);  // square renderings
+  }
+  return b;
+}
+
+void merge_into(MergedParts& into, const std::string& settings, const std::string& source,
+                std::vector<BrdfResult> results) {
+  if (into.settings.empty()) {
+    into.config = config_from_description(settings, source);
+    into.settings = settings;
+  } else if (settings != into.settings) {
+    const StudyConfig other = config_from_description(settings, source);
+    const bool learned_only = [&] {
+      StudyConfig a = into.config;
+      a.learned_from = other.learned_from;
+      return describe_config(a) == settings;
+    }();
+    throw std::runtime_error(fmt::format(
+        "'{}' and '{}' were run with different settings{}", into.source_of.begin()->second, source,
+        learned_only ? " (their learned designs come from different sets of BRDFs: run the "
+                       "study over all of them, or pass every profile to study_brdf, or leave "
+                       "out the learned design with --designs own,angle,merl)"
+                     : ""));
+  }
+  for (BrdfResult& b : results) {
+    if (const auto [it, fresh] = into.source_of.emplace(b.label, source); !fresh)
+      throw std::runtime_error(
+          fmt::format("'{}' is in both '{}' and '{}'", b.label, it->second, source));
+    into.results.push_back(std::move(b));
+  }
+}
+
+MergedParts read_parts(const std::vector<std::filesystem::path>& dirs) {
+  MergedParts merged;
+  for (const std::filesystem::path& dir : dirs) {
+    std::error_code ec;
+    const std::filesystem::path parts =
+        std::filesystem::exists(dir / "settings.txt", ec) ? dir : parts_dir(dir);
+    const std::filesystem::path settings_file = parts / "settings.txt";
+    if (!std::filesystem::exists(settings_file, ec))
+      throw std::runtime_error(
+          fmt::format("'{}': not the output of a study (no parts/settings.txt)", dir.string()));
+    std::vector<std::pair<std::size_t, BrdfResult>> in_dir;
+    for (const auto& entry : std::filesystem::directory_iterator(parts)) {
+      if (entry.path().extension() != ".part") continue;
+      std::size_t order = 0;
+      BrdfResult b = read_part(parts, entry.path().stem().string(), &order);
+      in_dir.emplace_back(order, std::move(b));
+    }
+    if (in_dir.empty())
+      throw std::runtime_error(fmt::format("'{}': no finished BRDF in it", dir.string()));
+    std::stable_sort(in_dir.begin(), in_dir.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<BrdfResult> results;
+    for (auto& [order, b] : in_dir) results.push_back(std::move(b));
+    merge_into(merged, read_text_file(settings_file), dir.string(), std::move(results));
+  }
+  return merged;
+}
+
+}  // namespace halfback::study
