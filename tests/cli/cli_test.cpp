@@ -1434,6 +1434,10 @@ std::vector<std::string> study_csvs(const fs::path& dir) {
 // with --resume writes the same CSV files as a run that was never interrupted; the BRDFs finished
 // before the kill are not studied again.
 TEST_F(CliTest, StudyResumeAfterAKillGivesTheSameTables) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "whole studies take minutes under AddressSanitizer; the study code runs "
+                  "under it in StudyWritesItsCsvFilesAndReport, this orchestration in release";
+#endif
   ASSERT_EQ(run(tiny_study("whole", kTinyPanel)).status, 0);
   const auto parts = [&] {
     std::size_t n = 0;
@@ -1495,6 +1499,10 @@ TEST_F(CliTest, StudyResumeAfterAKillGivesTheSameTables) {
 // The learned design makes a BRDF's results depend on the other BRDFs of the run: runs over
 // halves merge into the whole run only without it (with it, their merge is refused).
 TEST_F(CliTest, StudyMergeOfTwoRunsIsOneRun) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "whole studies take minutes under AddressSanitizer; the study code runs "
+                  "under it in StudyWritesItsCsvFilesAndReport, this orchestration in release";
+#endif
   const auto no_learned = [](std::vector<std::string> a) {
     a.insert(a.begin() + 1, {"--designs", "own,angle,merl"});
     return a;

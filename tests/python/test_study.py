@@ -30,6 +30,15 @@ def csvs(directory):
     return {name: (Path(directory) / name).read_text() for name in CSVS}
 
 
+# Whole studies run about 30 times slower under AddressSanitizer: the orchestration tests (Dask,
+# merges, the GIL) run in the release build's suite only; the study code itself runs under the
+# sanitizers in test_tables_of_one_brdf and in the C++ tests.
+slow_under_sanitizers = pytest.mark.skipif(
+    os.environ.get("HALFBACK_SANITIZED") == "1",
+    reason="whole studies under AddressSanitizer: run by the release build's suite",
+)
+
+
 @pytest.fixture(scope="module")
 def local():
     return [halfback.study_brdf(spec, SETTINGS) for spec in SPECS]
@@ -75,6 +84,7 @@ def test_functions_travel_to_other_processes():
         assert pickle.loads(pickle.dumps(f)) is f
 
 
+@slow_under_sanitizers
 def test_dask_run_equals_local_run(local, tmp_path):
     distributed = pytest.importorskip("distributed")
     # Threads, not processes: the workers share this process's module (a real cluster's workers
@@ -106,6 +116,7 @@ def cli_study(out, specs, designs="own,angle,merl"):
     subprocess.run(args, check=True, capture_output=True)
 
 
+@slow_under_sanitizers
 def test_merge_equals_one_cli_run(local, tmp_path):
     # The Python results, merged with a CLI run's directory, are the CLI's run over all of them.
     cli_study(tmp_path / "whole", SPECS)
@@ -119,6 +130,7 @@ def test_merge_equals_one_cli_run(local, tmp_path):
         halfback.merge_study(str(tmp_path / "other"), local[:1] + [other])
 
 
+@slow_under_sanitizers
 def test_study_brdf_releases_the_gil():
     # While one thread is inside study_brdf (about a second of work), this thread keeps running
     # Python code: with the GIL held for the whole call, it could not run until the call returned.
@@ -143,6 +155,7 @@ def test_study_brdf_releases_the_gil():
     assert turns >= 20, "the main thread did not run during study_brdf: the GIL was held"
 
 
+@slow_under_sanitizers
 def test_learned_design_on_dask_equals_the_cli_run(tmp_path):
     # The learned design: the profiles of every BRDF first (a map), then each BRDF's study with
     # all of them (a second map); the same tables as one CLI run, which learns from the same
