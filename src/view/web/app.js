@@ -262,7 +262,7 @@ function restartSphere() {
     const canvas = document.createElement('canvas');
     canvas.id = `sphere-${b}`;
     const cap = document.createElement('figcaption');
-    cap.innerHTML = `<span class="swatch-${b ? 'b' : 'a'}">■</span> ${escapeHtml(s)}`;
+    cap.innerHTML = `<span class="swatch-${b ? 'b' : 'a'}">■</span> ${escapeHtml(specLabel(s))}`;
     fig.append(canvas, cap);
     box.append(fig);
     const p = sphereLoop(gen, s, b, canvas).catch((e) => { if (!isAbort(e)) setStatus(e.message, true); })
@@ -361,6 +361,12 @@ function polarCursorAngle() {
   const across = -c[1] * v.wi[0] + c[0] * v.wi[1];
   if (Math.abs(across) > 1e-3) return null;
   return Math.atan2(c[0] * v.wi[0] + c[1] * v.wi[1], v.wi[2]) / DEG;
+}
+
+// What a user recognizes: a BRDF named on the command line by its spec, not by its "arg:N" id.
+function specLabel(spec) {
+  const arg = /^arg:(\d+)$/.exec(spec);
+  return arg && info && info.specs[Number(arg[1])] !== undefined ? info.specs[Number(arg[1])] : spec;
 }
 
 // --- model sliders -----------------------------------------------------------------------------
