@@ -21,6 +21,7 @@
 #include "halfback/study/study.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/csv.hpp"
+#include "halfback/util/output_dir.hpp"
 
 namespace halfback::cli {
 
@@ -77,20 +78,11 @@ std::vector<std::string> expand_specs(const std::vector<std::string>& specs) {
   return out;
 }
 
-void make_output_dir(const std::filesystem::path& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    throw std::runtime_error(fmt::format("cannot create the output directory '{}': {}",
-                                         dir.string(),
-                                         ec ? ec.message() : "a file of that name exists"));
-}
-
 // The parts directory of a run: with --resume, the settings must be those of the run resumed;
 // without, the parts of an earlier run are removed (its CSV files are replaced anyway).
 std::filesystem::path prepare_parts(const StudyOptions& o, const study::StudyConfig& config) {
   const std::filesystem::path parts = study::parts_dir(o.out);
-  make_output_dir(parts);
+  create_output_directory(parts);
   const std::filesystem::path settings = parts / "settings.txt";
   const std::string described = study::describe_config(config);
   std::error_code ec;
@@ -218,7 +210,7 @@ std::vector<study::LabeledProfile> profile_pass(const std::vector<std::string>& 
   const study::IsoGrid& g = config.profile_grid;
   const std::filesystem::path dir =
       study::profiles_dir(out) / fmt::format("{}-{}x{}x{}", name_of(config.space), g.a, g.b, g.phi);
-  make_output_dir(dir);
+  create_output_directory(dir);
   std::vector<study::LabeledProfile> profiles(specs.size());
   std::vector<char> reused(specs.size(), 0);
   const auto t0 = std::chrono::steady_clock::now();
@@ -257,7 +249,7 @@ int run_study(StudyOptions& o) {
   if (o.specs.empty()) throw UsageError("no BRDF given (files, directories or model specs)");
   study::StudyConfig config = make_config(o);
   const std::vector<std::string> specs = expand_specs(o.specs);
-  make_output_dir(o.out);
+  create_output_directory(o.out);
   check_writable((std::filesystem::path(o.out) / "report.md").string());
   std::vector<study::LabeledProfile> profiles;
   if (study::wants_learned(config)) {
@@ -289,7 +281,7 @@ int run_merge(const StudyOptions& o) {
     throw UsageError("--merge takes result directories, not BRDFs: run them, then merge");
   std::vector<std::filesystem::path> dirs(o.merge.begin(), o.merge.end());
   const study::MergedParts merged = study::read_parts(dirs);
-  make_output_dir(o.out);
+  create_output_directory(o.out);
   check_writable((std::filesystem::path(o.out) / "report.md").string());
   double seconds = 0;
   for (const study::BrdfResult& b : merged.results) seconds += b.seconds;

@@ -12,6 +12,7 @@
 #include "halfback/figure/render.hpp"
 #include "halfback/figure/slices.hpp"
 #include "halfback/loader/load.hpp"
+#include "halfback/util/output_dir.hpp"
 
 namespace halfback::figure {
 
@@ -59,12 +60,7 @@ std::vector<PaperMaterial> default_paper_materials() {
 
 std::vector<WrittenFigure> write_paper_figures(const std::filesystem::path& dir,
                                                const PaperFigureOptions& o) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    throw std::runtime_error(fmt::format("cannot create the output directory '{}': {}",
-                                         dir.string(),
-                                         ec ? ec.message() : "a file of that name exists"));
+  create_output_directory(dir);
   std::vector<WrittenFigure> written;
   for (const auto& [centre, stem, what] :
        {std::tuple{ViewCentre::normal, "fig1-hemisphere",

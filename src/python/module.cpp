@@ -28,6 +28,7 @@
 #include "halfback/render/renderer.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/parts.hpp"
+#include "halfback/util/output_dir.hpp"
 
 namespace py = pybind11;
 using namespace halfback;
@@ -673,8 +674,7 @@ py::dict merge_study(const std::string& out, const py::list& parts) {
   study::StudyOutput written;
   {
     py::gil_scoped_release release;
-    std::error_code ec;
-    std::filesystem::create_directories(out, ec);
+    create_output_directory(out);
     double seconds = 0;
     for (const study::BrdfResult& b : merged.results) seconds += b.seconds;
     written = study::write_study(out, merged.results, merged.config, seconds);

@@ -1,4 +1,5 @@
 #include "halfback/util/atomic_file.hpp"
+#include "halfback/util/output_dir.hpp"
 
 #include "support/fifo_reader.hpp"
 
@@ -292,6 +293,25 @@ TEST_F(AtomicFileTest, DirectoryIsRefusedAndKept) {
   EXPECT_THROW(write_file_atomically(dir_ / "sub", "y"), std::system_error);
   EXPECT_EQ(slurp(dir_ / "sub" / "inside"), "x");
   EXPECT_EQ(entries(), (std::vector<std::string>{"sub"}));
+}
+
+// A folder for several outputs: parents created, an existing folder kept, and a file in the way
+// named (not replaced).
+TEST_F(AtomicFileTest, OutputDirectoryIsCreatedOrTheObstacleNamed) {
+  const fs::path nested = dir_ / "a" / "b";
+  create_output_directory(nested);
+  EXPECT_TRUE(fs::is_directory(nested));
+  create_output_directory(nested);  // already there: fine
+  put(dir_ / "file", "keep");
+  try {
+    create_output_directory(dir_ / "file");
+    ADD_FAILURE() << "no error for a file in the way";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot create the output directory"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("file"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(slurp(dir_ / "file"), "keep");
 }
 
 }  // namespace
