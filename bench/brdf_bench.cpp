@@ -17,6 +17,7 @@
 #include <random>
 #include <vector>
 
+#include "bench_brdfs.hpp"
 #include "formats/merl_reference.hpp"
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
@@ -48,24 +49,8 @@ const std::vector<DirPair<double>>& pairs() {
   return v;
 }
 
-// An isotropic analytic lobe, tabulated once into MERL data.
-class Lobe final : public Brdf {
- public:
-  std::string name() const override { return "lobe"; }
-  std::string description() const override { return "bench lobe"; }
-  bool isotropic() const override { return true; }
-  bool reciprocal() const override { return true; }
-  Rgb eval(const DirPair<double>& p) const override {
-    const double hz = p.wi.z + p.wo.z, hx = p.wi.x + p.wo.x, hy = p.wi.y + p.wo.y;
-    const double c = hz / std::sqrt(hx * hx + hy * hy + hz * hz);
-    const double lobe = 5 * std::pow(c, 40.0);
-    return {0.1 + lobe, 0.2 + lobe, 0.3 + lobe};
-  }
-  using Brdf::eval;
-};
-
 const MerlData& merl_data() {
-  static const MerlData d = tabulate_merl(Lobe{});
+  static const MerlData d = tabulate_merl(bench::Lobe{});
   return d;
 }
 

@@ -13,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "bench_brdfs.hpp"
 #include "halfback/formats/nbrdf.hpp"
 #include "halfback/loader/load.hpp"
 
@@ -38,16 +39,7 @@ const std::vector<DirPair<double>>& pairs() {
 }
 
 const Brdf& network() {
-  static const BrdfPtr brdf = [] {
-    const char* shared = std::getenv("HALFBACK_SHARED_DIR");
-    const std::filesystem::path file =
-        std::filesystem::path(shared && *shared ? shared : HALFBACK_SOURCE_DIR "/../shared") /
-        "data/nbrdf/merl_nbrdf/blue-acrylic.h5";
-    std::error_code ec;
-    return std::filesystem::exists(file, ec) ? BrdfPtr(load_nbrdf(file))
-                                             : load_brdf("embedded:gold-metallic-paint3");
-  }();
-  return *brdf;
+  return bench::neural_brdf(HALFBACK_SOURCE_DIR);
 }
 
 void BM_NbrdfBatchOneCore(benchmark::State& state) {

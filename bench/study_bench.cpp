@@ -17,6 +17,7 @@
 #include <random>
 #include <vector>
 
+#include "bench_brdfs.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/study/study.hpp"
 
@@ -25,16 +26,7 @@ namespace {
 using namespace halfback;
 
 const Brdf& network() {
-  static const BrdfPtr brdf = [] {
-    const char* shared = std::getenv("HALFBACK_SHARED_DIR");
-    const std::filesystem::path file =
-        std::filesystem::path(shared && *shared ? shared : HALFBACK_SOURCE_DIR "/../shared") /
-        "data/nbrdf/merl_nbrdf/blue-acrylic.h5";
-    std::error_code ec;
-    return std::filesystem::exists(file, ec) ? load_brdf(file.string())
-                                             : load_brdf("embedded:gold-metallic-paint3");
-  }();
-  return *brdf;
+  return bench::neural_brdf(HALFBACK_SOURCE_DIR);
 }
 
 void on_one_core(benchmark::State& state, const std::function<void()>& work) {

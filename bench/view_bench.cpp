@@ -18,6 +18,7 @@
 #include <string_view>
 #include <vector>
 
+#include "bench_brdfs.hpp"
 #include "halfback/figure/coordinates.hpp"
 #include "halfback/figure/slices.hpp"
 #include "halfback/formats/merl.hpp"
@@ -33,27 +34,12 @@ using namespace halfback;
 constexpr std::size_t kSide = 256;
 constexpr double kAzimuth = 40 * 3.14159265358979323846 / 180;  // radians
 
-// A smooth isotropic lobe, for the in-memory MERL table.
-class Lobe final : public Brdf {
- public:
-  std::string name() const override { return "lobe"; }
-  std::string description() const override { return "bench lobe"; }
-  bool isotropic() const override { return true; }
-  bool reciprocal() const override { return true; }
-  Rgb eval(const DirPair<double>& p) const override {
-    const double hz = p.wi.z + p.wo.z, hx = p.wi.x + p.wo.x, hy = p.wi.y + p.wo.y;
-    const double c = hz / std::sqrt(hx * hx + hy * hy + hz * hz);
-    const double lobe = 5 * std::pow(c, 40.0);
-    return {0.1 + lobe, 0.2 + lobe, 0.3 + lobe};
-  }
-};
-
 BrdfPtr brdf_of(int which) {
   switch (which) {
     case 0:
       return load_brdf("ggx:alpha=0.2,f0=0.9");
     case 1:
-      return std::make_shared<MerlBrdf>(tabulate_merl(Lobe{}));
+      return std::make_shared<MerlBrdf>(tabulate_merl(bench::Lobe{}));
     case 2:
       return load_brdf("embedded:acrylic_felt_green");
     default:
