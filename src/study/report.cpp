@@ -346,15 +346,18 @@ figure::BarChart image_chart(const std::vector<BrdfResult>& results, const Study
 // The plots, in the order they are written. Some may have nothing to draw (every curve exact, no
 // rendering): the report links only those that are written.
 struct ReportPlots {
-  figure::Scene azimuthal, separability, gonio, gonio4d, designs, image, renderings;
+  figure::Scene summary, azimuthal, separability, gonio, gonio4d, designs, image, renderings;
 };
 
 figure::Scene designs_plot(const std::vector<BrdfResult>& results, const StudyConfig& config);
+figure::Scene summary_plot(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                           const Contents& has);
 
 ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
                          const Contents& has) {
   const std::string es(name_of(config.space));
   ReportPlots p;
+  p.summary = summary_plot(results, config, has);
   p.azimuthal = figure::bar_chart(azimuthal_chart(results, es));
   p.separability = figure::bar_chart(separability_chart(results, es));
   if (has.gonio) p.gonio = gonio_chart(results, false, config);
@@ -369,6 +372,7 @@ ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConf
 
 void save_plots(const ReportPlots& p, const std::filesystem::path& dir,
                 std::vector<std::string>& files) {
+  save_plot(p.summary, dir, "summary", files);
   save_plot(p.azimuthal, dir, "azimuthal", files);
   save_plot(p.separability, dir, "separability", files);
   save_plot(p.gonio, dir, "gonio", files);
@@ -1042,6 +1046,163 @@ std::string files_and_networks_section(const std::vector<BrdfResult>& results,
   return md + "\n";
 }
 
+// ---------------------------------------------------------------------------------------------
+// Summary: the metrics per kind of BRDF (neural, measured files, models), for whole databases
+// whose per-BRDF tables are too long to read.
+// ---------------------------------------------------------------------------------------------
+
+// The kind of a BRDF, from its label: a file's label starts with its reader's prefix, a model's
+// is its spec.
+std::string kind_of(const std::string& label) {
+  static constexpr std::pair<std::string_view, std::string_view> kKinds[] = {
+      {"nbrdf:", "neural BRDFs"},
+      {"merl:", "MERL files"},
+      {"rgl:", "RGL files"},
+      {"alta:", "ALTA files"}};
+  for (const auto& [prefix, kind] : kKinds)
+    if (label.starts_with(prefix)) return std::string(kind);
+  return "models";
+}
+
+// One metric: its value for each BRDF (in the order of the results) and parameterization,
+// INFINITY where it was not measured.
+struct SummaryMetric {
+  std::string name;
+  std::vector<std::array<double, kStudied.size()>> values;
+};
+
+std::vector<SummaryMetric> summary_metrics(const std::vector<BrdfResult>& results,
+                                           const StudyConfig& config, const Contents& has) {
+  const std::size_t ref = has.gonio ? reference_budget(config) : 0;
+  std::vector<SummaryMetric> m(3);
+  m[0].name = "azimuthal dependence";
+  m[1].name = "separability (rank 1, 2D projection)";
+  m[2].name = fmt::format("gonio-reflectometer, N = {}, own regular design", ref);
+  for (const BrdfResult& b : results) {
+    const auto v = metric_values(b, ref);
+    for (std::size_t k = 0; k < 3; ++k) m[k].values.push_back(v[k]);
+  }
+  if (!has.gonio) m.pop_back();
+  const DesignComparison c = has.gonio ? compare_designs(results, ref) : DesignComparison{};
+  if (c.keys.size() >= 2 && !c.brdfs.empty()) {
+    SummaryMetric best{fmt::format("gonio-reflectometer, N = {}, each in its best design", ref),
+                       {}};
+    for (const BrdfResult& b : results) {
+      best.values.emplace_back();
+      best.values.back().fill(INFINITY);
+      if (std::find(c.brdfs.begin(), c.brdfs.end(), &b) != c.brdfs.end())
+        for (std::size_t i = 0; i < kStudied.size(); ++i)
+          best.values.back()[i] = design_error(b.params[i], c.keys[c.best[i]], ref);
+    }
+    m.push_back(std::move(best));
+  }
+  if (has.images) {
+    SummaryMetric image{"image-space relative RMSE (regular design)", {}};
+    for (const BrdfResult& b : results) image.values.push_back(metric_values(b, ref)[3]);
+    m.push_back(std::move(image));
+  }
+  return m;
+}
+
+// The kinds in the order they first appear, each with the indices of its BRDFs; "all" last when
+// there is more than one kind.
+std::vector<std::pair<std::string, std::vector<std::size_t>>> kinds_of(
+    const std::vector<BrdfResult>& results) {
+  std::vector<std::pair<std::string, std::vector<std::size_t>>> kinds;
+  for (std::size_t j = 0; j < results.size(); ++j) {
+    const std::string kind = kind_of(results[j].label);
+    auto it =
+        std::find_if(kinds.begin(), kinds.end(), [&](const auto& k) { return k.first == kind; });
+    if (it == kinds.end()) it = kinds.insert(kinds.end(), {kind, {}});
+    it->second.push_back(j);
+  }
+  if (kinds.size() > 1) {
+    std::vector<std::size_t> all(results.size());
+    for (std::size_t j = 0; j < all.size(); ++j) all[j] = j;
+    kinds.emplace_back("all", std::move(all));
+  }
+  return kinds;
+}
+
+// Each parameterization's median over the BRDFs of `rows` measured in all four (NaN: none), and
+// the number of those BRDFs.
+std::pair<std::array<double, kStudied.size()>, std::size_t> medians(
+    const SummaryMetric& m, const std::vector<std::size_t>& rows) {
+  std::array<std::vector<double>, kStudied.size()> v;
+  for (std::size_t j : rows) {
+    const auto& x = m.values[j];
+    if (std::all_of(x.begin(), x.end(), [](double e) { return std::isfinite(e); }))
+      for (std::size_t i = 0; i < kStudied.size(); ++i) v[i].push_back(x[i]);
+  }
+  std::array<double, kStudied.size()> med;
+  for (std::size_t i = 0; i < kStudied.size(); ++i) med[i] = v[i].empty() ? NAN : median(v[i]);
+  return {med, v[0].size()};
+}
+
+std::string summary_table(
+    const SummaryMetric& m,
+    const std::vector<std::pair<std::string, std::vector<std::size_t>>>& kinds) {
+  std::string md = "**" + m.name + "**\n\n| kind | BRDFs |", rule = "|---|---|";
+  for (Space s : kStudied) {
+    md += fmt::format(" {} |", name_of(s));
+    rule += "---|";
+  }
+  md += "\n" + rule + "\n";
+  for (const auto& [kind, rows] : kinds) {
+    const auto [med, n] = medians(m, rows);
+    if (n == 0) continue;
+    Wins wins;
+    for (std::size_t j : rows) wins.add(m.values[j]);
+    const double lowest = *std::min_element(med.begin(), med.end());
+    md += fmt::format("| {} | {} |", kind, n);
+    for (std::size_t i = 0; i < kStudied.size(); ++i)
+      md += med[i] == lowest ? fmt::format(" **{:.4f}** ({}) |", med[i], wins.count[i])
+                             : fmt::format(" {:.4f} ({}) |", med[i], wins.count[i]);
+    md += "\n";
+  }
+  return md + "\n";
+}
+
+// The gonio-reflectometer's median per kind, in the own regular design and in the best ones.
+figure::Scene summary_plot(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                           const Contents& has) {
+  if (!has.gonio) return {};
+  const std::vector<SummaryMetric> metrics = summary_metrics(results, config, has);
+  figure::BarChart chart;
+  chart.title = fmt::format("Gonio-reflectometer at N = {}: median relative error per kind",
+                            reference_budget(config));
+  chart.x_label = "median over the BRDFs of the kind (own regular design; each in its best design)";
+  for (Space s : kStudied) chart.series.emplace_back(name_of(s));
+  for (const auto& [kind, rows] : kinds_of(results))
+    for (const SummaryMetric& m : metrics) {
+      if (!m.name.starts_with("gonio")) continue;
+      const auto [med, n] = medians(m, rows);
+      if (n == 0) continue;
+      const bool best = m.name.ends_with("best design");
+      chart.rows.push_back(fmt::format("{} ({}), {}", kind, n, best ? "best" : "own"));
+      chart.values.emplace_back(med.begin(), med.end());
+    }
+  if (chart.rows.empty()) return {};
+  figure::BarChartLayout layout;
+  layout.label_width = 200;
+  return figure::bar_chart(chart, layout);
+}
+
+// The summary section: per metric, each kind's median error and wins per parameterization.
+std::string summary_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                            const Contents& has, const ReportPlots& plots) {
+  const auto kinds = kinds_of(results);
+  std::string md =
+      "## Summary\n\nFor each kind of BRDF and each metric below: the median relative error of "
+      "each parameterization over the BRDFs of that kind measured in all four, and in "
+      "parentheses the number of BRDFs on which it has the lowest error (ties count for each). "
+      "The lowest median is in bold. The kind comes from the label (the reader's prefix for a "
+      "file; a model's spec is a model).\n\n";
+  for (const SummaryMetric& m : summary_metrics(results, config, has))
+    md += summary_table(m, kinds);
+  return md + plot_link(plots.summary, "Summary", "summary");
+}
+
 // The closing line: the CSV files written so far, then what always follows them.
 std::string files_paragraph(const std::vector<std::string>& csv_files) {
   std::string md = "Files: ";
@@ -1060,6 +1221,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
 
   const ReportPlots plots = report_plots(results, config, has);
   std::string md = report_header(results, config, has.anisotropic, seconds) +
+                   summary_section(results, config, has, plots) +
                    azimuthal_section(results, has.anisotropic) +
                    separability_section(results, config, has.anisotropic);
   if (has.gonio)

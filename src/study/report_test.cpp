@@ -216,5 +216,38 @@ TEST(Report, FilesBesideTheirNetworks) {
   EXPECT_EQ(write_study(tmp.path(), {file}, c, 1.0).markdown.find("## 5."), std::string::npos);
 }
 
+TEST(Report, SummaryGroupsTheBrdfsByKind) {
+  // A file where halfdiff wins, its network where spherical wins (the parameterizations' numbers
+  // reversed), and a model like the file: per kind and over all, the medians and the wins.
+  const test::TempDir tmp;
+  StudyConfig c;
+  c.budgets = {1000, 1000000};
+  c.image_budget = 1000;
+  c.environments.push_back({"sky", nullptr});
+  const BrdfResult file = fake("rgl:felt_rgb", true);
+  BrdfResult network = file;
+  network.label = "nbrdf:felt_rgb";
+  for (std::size_t i = 0; i < kStudied.size(); ++i) {
+    network.params[i] = file.params[kStudied.size() - 1 - i];
+    network.params[i].space = kStudied[i];
+  }
+  const StudyOutput out = write_study(tmp.path(), {file, fake("ggx", true), network}, c, 1.0);
+  const std::string& md = out.markdown;
+  const std::size_t summary = md.find("## Summary"), azimuthal = md.find("## 1.");
+  ASSERT_LT(summary, azimuthal) << md;
+  const std::string s = md.substr(summary, azimuthal - summary);
+  for (const char* row :
+       {"| RGL files | 1 | **0.1000** (1) | 0.2000 (0) | 0.3000 (0) | 0.4000 (0) |",
+        "| models | 1 | **0.1000** (1) |",
+        "| neural BRDFs | 1 | 0.4000 (0) | 0.3000 (0) | 0.2000 (0) | **0.1000** (1) |",
+        "| all | 3 | **0.1000** (2) | 0.2000 (0) | 0.3000 (0) | 0.4000 (1) |",
+        // the gonio-reflectometer at N = 1000: 0.5 k
+        "| all | 3 | **0.5000** (2) | 1.0000 (0) | 1.5000 (0) | 2.0000 (1) |"})
+    EXPECT_NE(s.find(row), std::string::npos) << row << "\n" << s;
+  EXPECT_LT(s.find("| RGL files"), s.find("| models"));  // kinds in the order they first appear
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() / "summary.png"));
+  EXPECT_NE(s.find("![Summary](summary.png)"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace halfback::study
