@@ -213,6 +213,7 @@ def measure_slider(driver, steps):
     """Azimuth slider moves, each one waited for: updates per second (in the page's clock, from
     the input event to the four slices drawn), and the mean time of the requests and of drawing."""
     total = fetch = draw = 0.0
+    sides = []
     cpu0, server0 = cpu_seconds(), cpu_seconds(SERVER["pid"])
     for k in range(steps):
         t = driver.execute_async_script("""
@@ -221,12 +222,15 @@ def measure_slider(driver, steps):
             const s = document.getElementById('azimuth');
             s.value = value; s.dispatchEvent(new Event('input'));
             window.halfback.idle().then(() => done([performance.now() - t0,
-                window.halfback.stats.sliceFetchMs, window.halfback.stats.sliceDrawMs]));""",
+                window.halfback.stats.sliceFetchMs, window.halfback.stats.sliceDrawMs,
+                window.halfback.stats.sliceSide ?? 128]));""",
                                         (5 * k) % 360)
         total, fetch, draw = total + t[0], fetch + t[1], draw + t[2]
+        sides.append(t[3])
     cpu, server = cpu_seconds() - cpu0, cpu_seconds(SERVER["pid"]) - server0
     print(f"measure: slider update {total / steps:.1f} ms mean: requests {fetch / steps:.1f} ms, "
-          f"drawing {draw / steps:.1f} ms; CPU time per update {1000 * cpu / steps:.1f} ms "
+          f"drawing {draw / steps:.1f} ms; slices {min(sides)}…{max(sides)} pixels a side "
+          f"(median {sorted(sides)[len(sides) // 2]}); CPU time per update {1000 * cpu / steps:.1f} ms "
           f"(server {1000 * server / steps:.1f} ms, browser and test the rest)")
     return 1000 * steps / total
 

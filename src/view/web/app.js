@@ -8,7 +8,14 @@ import * as V from './views.js';
 const $ = (id) => document.getElementById(id);
 const DEG = Math.PI / 180;
 const COLOURS = ['#ff9a3c', '#3cc8ff'];
-const FULL = 256, DRAG = 128;  // slice resolution at rest and while dragging
+const FULL = 256, DRAG = 128;  // slice resolution at rest and (at most) while dragging
+// While a slider moves, the slices' side adapts (64 … 128): smaller when an update (request and
+// drawing) took longer than 45 ms, larger again below 25 ms.
+let dragSide = DRAG;
+function adaptDragSide(ms) {
+  if (ms > 45) dragSide = Math.max(64, dragSide - 32);
+  else if (ms < 25) dragSide = Math.min(DRAG, dragSide + 32);
+}
 
 const state = {
   a: '', b: '', mode: 'a', az: 0, scale: 'log', levels: 'auto', to: 45, po: 180,
@@ -31,7 +38,17 @@ function readHash() {
     state[k] = typeof state[k] === 'number' ? Number(h.get(k)) : h.get(k);
   }
 }
+// At most ten writes a second (the last one always made): a moving slider sends ~60 input events
+// a second, and Chromium throttles history.replaceState (each one a message to the browser).
+let hashTimer = 0, lastHashWrite = -Infinity;
 function writeHash() {
+  clearTimeout(hashTimer);
+  const wait = lastHashWrite + 100 - performance.now();
+  if (wait > 0) {
+    hashTimer = setTimeout(writeHash, wait);
+    return;
+  }
+  lastHashWrite = performance.now();
   const h = new URLSearchParams();
   for (const [k, v] of Object.entries(state)) h.set(k, String(v));
   history.replaceState(null, '', `${location.pathname}${location.search}#${h}`);
@@ -118,7 +135,7 @@ const axisMax = (a) => (a.angle ? '90°' : '1');
 let sliceFields = {};  // per form: [field of the first BRDF, of the second]
 // The four forms' slices of every BRDF shown, in one request (/api/slices).
 const updateSlices = coalesced(async () => {
-  const list = specs(), n = interactive ? DRAG : FULL;
+  const list = specs(), moving = interactive, n = moving ? dragSide : FULL;
   const t0 = performance.now();
   const { fields, headers } = await getFields(null, '/api/slices',
     [...list.map((s) => ['brdf', s]), ['azimuth', state.az], ['n', n], ['values', 'luminance']]);
@@ -130,6 +147,8 @@ const updateSlices = coalesced(async () => {
   stats.sliceFetchMs = t1 - t0;  // the request (server and transfer)
   stats.sliceDrawMs = performance.now() - t1;  // colours, isolines, markers
   stats.sliceDraws += 1;
+  stats.sliceSide = n;
+  if (moving) adaptDragSide(performance.now() - t0);
 });
 function drawSlices() {
   const scalars = {};
