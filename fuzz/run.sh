@@ -20,7 +20,9 @@ mkdir -p "$corpus"
 mkdir -p "$corpus/view"
 k=0
 for seed in "/api/info?token=t" "/?token=t" "/static/app.js?token=t" \
-    "/api/slice?token=t&brdf=arg:0&form=halfdiff&azimuth=30&n=16" \
+    "/api/slices?token=t&brdf=arg:0&forms=halfdiff&azimuth=30&n=16" \
+    "/api/slices?token=t&brdf=arg:0&brdf=arg:1&azimuth=-20&n=8" \
+    "/api/slices?token=t&brdf=lambert&forms=hybrid,spherical,ortho&n=4" \
     "/api/hemisphere?token=t&brdf=arg:1&colour=rho&theta_o=40&phi_o=180&n=8" \
     "/api/hemisphere?token=t&colour=ortho&n=8" "/api/polar?token=t&brdf=ggx:alpha=0.2&n=19" \
     "/api/point?token=t&brdf=arg:0&wi=0,0,1&wo=0.6,0,0.8" \
@@ -42,8 +44,10 @@ for target in merl rgl alta npy view; do
     npy)  max_len=4096 ;;
     view) max_len=2048 ;;
   esac
+  dict=()
+  [ -f "fuzz/$target.dict" ] && dict=("-dict=fuzz/$target.dict")
   echo "== ${target}_fuzz: ${seconds}s"
-  if ! "$build/fuzz/${target}_fuzz" "$corpus/$target" -max_total_time="$seconds" \
+  if ! "$build/fuzz/${target}_fuzz" "$corpus/$target" "${dict[@]}" -max_total_time="$seconds" \
       -max_len="$max_len" -timeout=20 -rss_limit_mb=2560 -print_final_stats=1 \
       -artifact_prefix="$artifacts/${target}-" 2>"$build/${target}_fuzz.log"; then
     echo "${target}_fuzz FAILED; see $build/${target}_fuzz.log and $artifacts/" >&2

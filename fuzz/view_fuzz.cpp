@@ -1,5 +1,5 @@
 // libFuzzer target for the request handler of `halfback view` (see fuzz/run.sh). The input is a
-// request as text: the first line the target ("/api/slice?brdf=...&token=t"), optionally
+// request as text: the first line the target ("/api/slices?brdf=...&token=t"), optionally
 // preceded by a method ("POST /x"), then "name: value" header lines. A valid Host header comes
 // first (the input may replace it), so that the fuzzer reaches the endpoints behind the checks.
 // Every response must be a status in [200, 600) with a body; a 4xx must be JSON.

@@ -217,7 +217,7 @@ std::optional<Response> asset(std::string_view name) {
     if (a.name != name) continue;
     Response r;
     r.content_type = std::string(content_type_of(name));
-    r.body = std::string(a.data);
+    r.body.assign(reinterpret_cast<const char*>(a.bytes.data()), a.bytes.size());
     return r;
   }
   return std::nullopt;
@@ -236,7 +236,7 @@ Response route(const Catalog& catalog, const Request& r, const ApiConfig& c) {
     if (auto a = asset(std::string_view(p).substr(8))) return *a;
   if (p == "/api/info") return info_response(catalog);
   if (p == "/api/brdf") return brdf_response(catalog, r);
-  if (p == "/api/slice") return slice_response(catalog, r, c.threads);
+  if (p == "/api/slices") return slices_response(catalog, r, c.threads);
   if (p == "/api/hemisphere") return hemisphere_response(catalog, r, c.threads);
   if (p == "/api/polar") return polar_response(catalog, r);
   if (p == "/api/point") return point_response(catalog, r);

@@ -206,12 +206,12 @@ TEST(ViewApi, ManyBrdfsStayWithinTheCache) {
   EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "ggx:alpha=0.01"}})).status, 200);
 }
 
-TEST(ViewApi, SliceIsRhoAtTheCanonicalPoseOfEachPixel) {
+TEST(ViewApi, SlicesAreRhoAtTheCanonicalPoseOfEachPixel) {
   Api api(config());
   const BrdfPtr brdf = load_brdf(kSpec);
   const std::size_t n = 16;
-  const Response r = api.handle(
-      get("/api/slice", {{"brdf", "arg:0"}, {"form", "halfdiff"}, {"azimuth", "0"}, {"n", "16"}}));
+  const Response r = api.handle(get(
+      "/api/slices", {{"brdf", "arg:0"}, {"forms", "halfdiff"}, {"azimuth", "0"}, {"n", "16"}}));
   ASSERT_EQ(r.status, 200);
   EXPECT_EQ(r.content_type, "application/octet-stream");
   const std::vector<float> v = floats_of(r);
@@ -239,24 +239,116 @@ TEST(ViewApi, SliceIsRhoAtTheCanonicalPoseOfEachPixel) {
   EXPECT_GT(invalid, 0);  // at φd = 0 the pairs with θh + θd > 90° are outside the domain
 }
 
-TEST(ViewApi, SliceRefusesBadParameters) {
+std::string header_of(const Response& r, std::string_view name) {
+  for (const auto& [k, v] : r.headers)
+    if (k == name) return v;
+  return "";
+}
+
+// One request, every (BRDF, form): the blocks in the documented order (BRDF-major, then the
+// forms as asked), each the answer of its own single-form request; the valid domain is the
+// form's whatever the BRDF, and a Lambertian BRDF is constant over it.
+TEST(ViewApi, SlicesOfTwoBrdfsAndFourFormsInOneAnswer) {
   Api api(config());
-  const auto slice = [&](std::vector<std::pair<std::string, std::string>> extra) {
-    std::vector<std::pair<std::string, std::string>> q{{"brdf", "arg:0"}, {"form", "ortho"}};
-    for (auto& e : extra) q.insert(q.begin(), e);  // first value wins
-    return api.handle(get("/api/slice", q));
+  const std::size_t n = 12, block = n * n * 3;
+  const auto slices = [&](std::vector<std::pair<std::string, std::string>> q) {
+    q.emplace_back("azimuth", "70");
+    q.emplace_back("n", std::to_string(n));
+    return api.handle(get("/api/slices", q));
   };
-  EXPECT_EQ(slice({{"n", "513"}}).status, 400);
-  EXPECT_EQ(slice({{"n", "1"}}).status, 400);
-  EXPECT_EQ(slice({{"n", "2.5"}}).status, 400);
-  EXPECT_EQ(slice({{"n", "1e9"}}).status, 400);
-  EXPECT_EQ(slice({{"n", "abc"}}).status, 400);
-  EXPECT_EQ(slice({{"azimuth", "nan"}}).status, 400);
-  EXPECT_EQ(slice({{"azimuth", "inf"}}).status, 400);
-  EXPECT_EQ(slice({{"form", "dirs"}}).status, 400);
-  EXPECT_EQ(slice({{"form", "polar"}}).status, 400);
-  EXPECT_EQ(slice({{"n", "8"}, {"azimuth", "-45"}}).status, 200);
-  EXPECT_EQ(api.handle(get("/api/slice", {{"form", "ortho"}})).status, 400);
+  const Response both = slices({{"brdf", "arg:0"}, {"brdf", "lambert"}});
+  ASSERT_EQ(both.status, 200) << both.body;
+  EXPECT_EQ(header_of(both, "X-Halfback-Forms"), "spherical,halfdiff,ortho,hybrid");
+  EXPECT_EQ(header_of(both, "X-Halfback-Brdfs"), "2");
+  EXPECT_EQ(header_of(both, "X-Halfback-Width"), std::to_string(n));
+  const std::vector<float> v = floats_of(both);
+  ASSERT_EQ(v.size(), 2 * 4 * block);
+  const double lambert = load_brdf("lambert")->eval({{0, 0, 1}, {0, 0, 1}}).g;
+  for (std::size_t f = 0; f < 4; ++f) {
+    const std::string form(name_of(kParameterizations[f]));
+    for (const auto& [b, spec] :
+         {std::pair<std::size_t, std::string>{0, "arg:0"}, {1, "lambert"}}) {
+      const Response one = slices({{"brdf", spec}, {"forms", form}});
+      ASSERT_EQ(one.status, 200);
+      EXPECT_EQ(both.body.substr((b * 4 + f) * block * sizeof(float), block * sizeof(float)),
+                one.body)
+          << form << " " << spec;
+    }
+    std::size_t valid = 0;
+    for (std::size_t k = 0; k < n * n; ++k) {
+      const float ggx = v[f * block + 3 * k], flat = v[(4 + f) * block + 3 * k + 1];
+      ASSERT_EQ(std::isnan(ggx), std::isnan(flat)) << form << " pixel " << k;
+      if (std::isnan(flat)) continue;
+      ++valid;
+      EXPECT_NEAR(flat, lambert, 1e-6) << form << " pixel " << k;
+    }
+    EXPECT_GT(valid, n * n / 4) << form;
+  }
+  // Forms in the order asked.
+  const Response two = slices({{"brdf", "arg:0"}, {"forms", "hybrid,spherical"}});
+  ASSERT_EQ(two.status, 200);
+  EXPECT_EQ(header_of(two, "X-Halfback-Forms"), "hybrid,spherical");
+  EXPECT_EQ(two.body.substr(0, block * sizeof(float)),
+            both.body.substr(3 * block * sizeof(float), block * sizeof(float)));
+}
+
+// values=luminance: one float per pixel, the luminance (Rec. 709 weights) of the RGB answer's.
+TEST(ViewApi, SlicesAndHemisphereInLuminance) {
+  Api api(config());
+  for (const std::string path : {"/api/slices", "/api/hemisphere"}) {
+    const auto field = [&](std::string values) {
+      return api.handle(get(path, {{"brdf", "arg:0"}, {"n", "10"}, {"values", values}}));
+    };
+    const Response rgb = field("rgb"), y = field("luminance");
+    ASSERT_EQ(rgb.status, 200) << path;
+    ASSERT_EQ(y.status, 200) << path;
+    EXPECT_EQ(header_of(y, "X-Halfback-Channels"), "1");
+    const std::vector<float> c = floats_of(rgb), v = floats_of(y);
+    ASSERT_EQ(c.size(), 3 * v.size()) << path;
+    std::size_t finite = 0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      ASSERT_EQ(std::isnan(v[k]), std::isnan(c[3 * k])) << path << " " << k;
+      if (std::isnan(v[k])) continue;
+      ++finite;
+      const double expected = 0.2126 * c[3 * k] + 0.7152 * c[3 * k + 1] + 0.0722 * c[3 * k + 2];
+      EXPECT_NEAR(v[k], expected, 1e-6 * std::max(1.0, expected)) << path << " " << k;
+    }
+    EXPECT_GT(finite, v.size() / 4) << path;
+    EXPECT_TRUE(has_error(field("xyz"), 400, "'values'")) << path;
+  }
+}
+
+TEST(ViewApi, SlicesRefuseBadParameters) {
+  Api api(config());
+  const auto slices = [&](std::vector<std::pair<std::string, std::string>> extra) {
+    std::vector<std::pair<std::string, std::string>> q{{"brdf", "arg:0"}, {"forms", "ortho"}};
+    for (auto& e : extra) q.insert(q.begin(), e);  // first value wins
+    return api.handle(get("/api/slices", q));
+  };
+  EXPECT_TRUE(has_error(slices({{"n", "513"}}), 400, "'n'"));
+  EXPECT_EQ(slices({{"n", "1"}}).status, 400);
+  EXPECT_EQ(slices({{"n", "2.5"}}).status, 400);
+  EXPECT_EQ(slices({{"n", "1e9"}}).status, 400);
+  EXPECT_EQ(slices({{"n", "abc"}}).status, 400);
+  EXPECT_TRUE(has_error(slices({{"azimuth", "nan"}}), 400, "azimuth"));
+  EXPECT_EQ(slices({{"azimuth", "inf"}}).status, 400);
+  EXPECT_EQ(slices({{"azimuth", "721"}}).status, 400);
+  EXPECT_TRUE(has_error(slices({{"forms", "dirs"}}), 400, "forms"));
+  EXPECT_EQ(slices({{"forms", "polar"}}).status, 400);
+  EXPECT_EQ(slices({{"forms", ""}}).status, 400);
+  EXPECT_EQ(slices({{"forms", "ortho,"}}).status, 400);
+  EXPECT_EQ(slices({{"forms", ",ortho"}}).status, 400);
+  EXPECT_TRUE(has_error(slices({{"forms", "ortho,hybrid,ortho"}}), 400, "twice"));
+  EXPECT_EQ(slices({{"n", "8"}, {"azimuth", "-45"}}).status, 200);
+  EXPECT_EQ(slices({{"n", "8"}, {"forms", "spherical,halfdiff,ortho,hybrid"}}).status, 200);
+  EXPECT_TRUE(has_error(api.handle(get("/api/slices", {{"forms", "ortho"}})), 400,
+                        "missing query parameter 'brdf'"));
+  EXPECT_TRUE(has_error(
+      api.handle(get("/api/slices",
+                     {{"brdf", "arg:0"}, {"brdf", "lambert"}, {"brdf", "arg:0"}, {"n", "8"}})),
+      413, "at most 2"));
+  EXPECT_EQ(slices({{"brdf", "arg:7"}}).status, 404);  // the first brdf= is the unknown one
+  EXPECT_EQ(api.handle(get("/api/slice", {{"brdf", "arg:0"}, {"form", "ortho"}})).status, 404);
 }
 
 TEST(ViewApi, HemisphereIsRhoOfTheEqualAreaDirection) {
@@ -405,7 +497,7 @@ TEST(ViewApi, LoadsAFileUnderARoot) {
   EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "file:felt.bsdf"}})).status, 200);
   EXPECT_NE(api.handle(get("/api/info")).body.find("\"felt.bsdf\""), std::string::npos);
   const Response s =
-      api.handle(get("/api/slice", {{"brdf", "file:felt.bsdf"}, {"form", "hybrid"}, {"n", "8"}}));
+      api.handle(get("/api/slices", {{"brdf", "file:felt.bsdf"}, {"forms", "hybrid"}, {"n", "8"}}));
   EXPECT_EQ(s.status, 200);
 }
 

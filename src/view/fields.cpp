@@ -16,22 +16,27 @@ namespace {
 
 constexpr float kNanF = std::numeric_limits<float>::quiet_NaN();
 
-// ρ of the pairs whose flag is set, as float RGB (NaN elsewhere).
+// ρ of the pairs whose flag is set, as float RGB or luminance (NaN elsewhere).
 std::vector<float> eval_where(const Brdf& brdf, const std::vector<DirPair<double>>& pairs,
-                              const std::vector<std::uint8_t>& valid) {
+                              const std::vector<std::uint8_t>& valid, RhoValues values) {
   std::vector<DirPair<double>> packed;
   packed.reserve(pairs.size());
   for (std::size_t k = 0; k < pairs.size(); ++k)
     if (valid[k]) packed.push_back(pairs[k]);
   std::vector<Rgb> rho(packed.size());
   brdf.eval_batch(packed, rho);
-  std::vector<float> out(3 * pairs.size(), kNanF);
+  const std::size_t channels = channels_of(values);
+  std::vector<float> out(channels * pairs.size(), kNanF);
   std::size_t m = 0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     if (!valid[k]) continue;
-    out[3 * k] = float(rho[m].r);
-    out[3 * k + 1] = float(rho[m].g);
-    out[3 * k + 2] = float(rho[m].b);
+    if (values == RhoValues::luminance) {
+      out[k] = float(rho[m].luminance());
+    } else {
+      out[3 * k] = float(rho[m].r);
+      out[3 * k + 1] = float(rho[m].g);
+      out[3 * k + 2] = float(rho[m].b);
+    }
     ++m;
   }
   return out;
@@ -52,7 +57,7 @@ void mirror_azimuth(const Vec3<double>& wo, double& cx, double& cy) {
 }  // namespace
 
 std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, std::size_t n,
-                               int threads) {
+                               int threads, RhoValues values) {
   // The grid of figure/slices.hpp (pixel centres), converted to direction pairs by the core's
   // batch engine (SIMD, with the domain mask): the same pairs as figure::sample_slice, which
   // converts one tuple at a time and costs several times more (docs/performance.md, "Viewer").
@@ -76,11 +81,11 @@ std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, st
   BatchOptions options;
   options.threads = threads;
   convert<double>(Form{space, true}, Form{Space::dirs, false}, in, grid.size(), out, options);
-  return eval_where(brdf, pairs, valid);
+  return eval_where(brdf, pairs, valid, values);
 }
 
 std::vector<float> hemisphere_field(const Brdf* brdf, Space space, const Vec3<double>& wo,
-                                    std::size_t n, int threads) {
+                                    std::size_t n, int threads, RhoValues values) {
   const auto view = figure::HemisphereView::around({0, 0, 1}, figure::Projection::equal_area);
   const figure::Grid grid = figure::Grid::pixel_centres(n, n, -1, 1, -1, 1);
   std::vector<DirPair<double>> pairs(grid.size());
@@ -98,7 +103,7 @@ std::vector<float> hemisphere_field(const Brdf* brdf, Space space, const Vec3<do
           }
       },
       threads);
-  if (space == Space::dirs) return eval_where(*brdf, pairs, inside);
+  if (space == Space::dirs) return eval_where(*brdf, pairs, inside, values);
   // The coordinates, through the batch engine (the numbers `halfback convert` gives).
   std::vector<double> wi_x(grid.size()), wi_y(grid.size()), wi_z(grid.size());
   for (std::size_t k = 0; k < grid.size(); ++k) {

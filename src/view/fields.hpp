@@ -1,6 +1,7 @@
 // The numbers behind the view's pictures, computed for one BRDF (docs/view.md, "API"). Each field
-// is float32 RGB, row-major, row 0 at the bottom of the picture (y grows with the row), NaN
-// where the picture has no value (outside the valid domain, outside the disk).
+// is float32 RGB (or the luminance of ρ alone, where asked), row-major, row 0 at the bottom of the
+// picture (y grows with the row), NaN where the picture has no value (outside the valid domain,
+// outside the disk).
 #pragma once
 
 #include <cstddef>
@@ -11,17 +12,25 @@
 
 namespace halfback::view {
 
+// What a field of ρ holds per pixel: its RGB, or its luminance (Rgb::luminance) alone, which is
+// all the page draws (a third of the bytes to send).
+enum class RhoValues { rgb, luminance };
+inline std::size_t channels_of(RhoValues v) {
+  return v == RhoValues::rgb ? 3 : 1;
+}
+
 // ρ on an n × n slice of an isotropic form at relative azimuth `azimuth` (radians, in [0, 2π)):
 // x the first isotropic coordinate over [0, max], y the second (figure/slices.hpp; the pixel
 // centres of figure::Grid::pixel_centres).
 std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, std::size_t n,
-                               int threads);
+                               int threads, RhoValues values = RhoValues::rgb);
 
 // The hemisphere of ωi for a given ωo, seen from above (x right, y up) in the equal-area
 // projection r = √2 sin(θi/2), on the n × n pixel centres of [−1, 1]²: ρ(ωi, ωo) when `space`
-// is dirs, else the three isotropic coordinates of (ωi, ωo) in that parameterization.
+// is dirs (as `values` says), else the three isotropic coordinates of (ωi, ωo) in that
+// parameterization.
 std::vector<float> hemisphere_field(const Brdf* brdf, Space space, const Vec3<double>& wo,
-                                    std::size_t n, int threads);
+                                    std::size_t n, int threads, RhoValues values = RhoValues::rgb);
 
 // ρ along two great half-circles of ωi through the zenith side, for angles t from −90° to 90°
 // (n samples): in the plane of incidence (t > 0 towards the mirror direction of ωo) and across

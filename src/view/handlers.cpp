@@ -2,13 +2,16 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <span>
 
 #include "fields.hpp"
 #include "halfback/core/batch.hpp"
+#include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/renderer.hpp"
@@ -96,16 +99,67 @@ Response json(const JsonWriter& w) {
   return res;
 }
 
-Response floats(const std::vector<float>& values, std::size_t width, std::size_t height,
+// Float32 fields, one after the other in the body, each width × height × channels.
+Response floats(std::span<const std::vector<float>> fields, std::size_t width, std::size_t height,
                 std::size_t channels) {
   Response res;
   res.content_type = "application/octet-stream";
-  res.body.resize(values.size() * sizeof(float));
-  if (!values.empty()) std::memcpy(res.body.data(), values.data(), res.body.size());
+  std::size_t bytes = 0;
+  for (const auto& f : fields) bytes += f.size() * sizeof(float);
+  res.body.resize(bytes);
+  std::size_t offset = 0;
+  for (const auto& f : fields) {
+    if (!f.empty()) std::memcpy(res.body.data() + offset, f.data(), f.size() * sizeof(float));
+    offset += f.size() * sizeof(float);
+  }
   res.headers.emplace_back("X-Halfback-Width", std::to_string(width));
   res.headers.emplace_back("X-Halfback-Height", std::to_string(height));
   res.headers.emplace_back("X-Halfback-Channels", std::to_string(channels));
   return res;
+}
+
+Response floats(const std::vector<float>& values, std::size_t width, std::size_t height,
+                std::size_t channels) {
+  return floats({&values, 1}, width, height, channels);
+}
+
+// Every value of a repeated key (brdf=...), in order.
+std::vector<const std::string*> all_params(const Request& r, std::string_view key) {
+  std::vector<const std::string*> out;
+  for (const auto& [k, v] : r.query)
+    if (k == key) out.push_back(&v);
+  return out;
+}
+
+// `values=`: rgb (the default) or luminance.
+RhoValues values_param(const Request& r) {
+  const std::string* v = r.param("values");
+  if (!v || *v == "rgb") return RhoValues::rgb;
+  if (*v == "luminance") return RhoValues::luminance;
+  throw RequestError(
+      400, fmt::format("parameter 'values': '{}' is not rgb or luminance", v->substr(0, 64)));
+}
+
+// The isotropic forms of `forms=` (comma-separated, each at most once); all four by default.
+std::vector<Space> forms_param(const Request& r) {
+  const std::string* text = r.param("forms");
+  if (!text) return {kParameterizations.begin(), kParameterizations.end()};
+  std::vector<Space> forms;
+  std::string_view rest = *text;
+  while (true) {
+    const std::size_t comma = rest.find(',');
+    const std::string_view name = rest.substr(0, comma);
+    const auto s = space_from_name(name);
+    if (!s || *s == Space::dirs)
+      throw RequestError(400, fmt::format("parameter 'forms': '{}' is not one of spherical, "
+                                          "halfdiff, ortho, hybrid (comma-separated)",
+                                          name.substr(0, 64)));
+    if (std::find(forms.begin(), forms.end(), *s) != forms.end())
+      throw RequestError(400, fmt::format("parameter 'forms': '{}' is named twice", name));
+    forms.push_back(*s);
+    if (comma == std::string_view::npos) return forms;
+    rest = rest.substr(comma + 1);
+  }
 }
 
 void write_models(JsonWriter& w) {
@@ -186,15 +240,40 @@ Response brdf_response(const Catalog& catalog, const Request& request) {
   return json(w);
 }
 
-Response slice_response(const Catalog& catalog, const Request& request, int threads) {
-  const Space space = space_param(request, "form", false);
+Response slices_response(const Catalog& catalog, const Request& request, int threads) {
+  const std::vector<Space> forms = forms_param(request);
   double azimuth = std::fmod(number(request, "azimuth", 0, -360, 720), 360.0);
   if (azimuth < 0) azimuth += 360.0;
   double radians = azimuth * kDegree;
   if (radians >= 2 * std::numbers::pi) radians = 0;
   const std::size_t n = whole(request, "n", 256, 2, kMaxGridSide);
-  const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
-  return floats(slice_field(*brdf, space, radians, n, threads), n, n, 3);
+  const RhoValues values = values_param(request);
+  const std::vector<const std::string*> specs = all_params(request, "brdf");
+  if (specs.empty()) throw RequestError(400, "missing query parameter 'brdf'");
+  if (specs.size() > kMaxBrdfsPerSlices)
+    throw RequestError(413, fmt::format("at most {} brdf= per /api/slices request (got {})",
+                                        kMaxBrdfsPerSlices, specs.size()));
+  std::vector<BrdfPtr> brdfs;
+  for (const std::string* s : specs) brdfs.push_back(catalog.brdf(*s));
+  // One field per (BRDF, form), computed in parallel: a slider update is one request.
+  std::vector<std::vector<float>> fields(brdfs.size() * forms.size());
+  parallel_for(
+      fields.size(), 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k)
+          fields[k] = slice_field(*brdfs[k / forms.size()], forms[k % forms.size()], radians, n,
+                                  threads, values);
+      },
+      threads);
+  Response res = floats(fields, n, n, channels_of(values));
+  std::string names;
+  for (const Space s : forms) {
+    if (!names.empty()) names += ',';
+    names += name_of(s);
+  }
+  res.headers.emplace_back("X-Halfback-Forms", names);
+  res.headers.emplace_back("X-Halfback-Brdfs", std::to_string(brdfs.size()));
+  return res;
 }
 
 Response hemisphere_response(const Catalog& catalog, const Request& request, int threads) {
@@ -203,9 +282,11 @@ Response hemisphere_response(const Catalog& catalog, const Request& request, int
   if (colour && *colour != "rho") space = space_param(request, "colour", true);
   const std::size_t n = whole(request, "n", 128, 2, kMaxGridSide);
   const Vec3<double> wo = outgoing(request);
+  const RhoValues values = space == Space::dirs ? values_param(request) : RhoValues::rgb;
   BrdfPtr brdf;
   if (space == Space::dirs) brdf = catalog.brdf(required(request, "brdf"));
-  return floats(hemisphere_field(brdf.get(), space, wo, n, threads), n, n, 3);
+  return floats(hemisphere_field(brdf.get(), space, wo, n, threads, values), n, n,
+                channels_of(values));
 }
 
 Response polar_response(const Catalog& catalog, const Request& request) {
@@ -275,9 +356,7 @@ void write_coordinates(JsonWriter& w, const DirPair<double>& pair, bool valid) {
 
 Response point_response(const Catalog& catalog, const Request& request) {
   std::vector<BrdfPtr> brdfs;
-  std::vector<const std::string*> specs;
-  for (const auto& [k, v] : request.query)
-    if (k == "brdf") specs.push_back(&v);
+  const std::vector<const std::string*> specs = all_params(request, "brdf");
   if (specs.size() > kMaxBrdfsPerRequest)
     throw RequestError(413, fmt::format("at most {} brdf= per request", kMaxBrdfsPerRequest));
   for (const std::string* s : specs) brdfs.push_back(catalog.brdf(*s));

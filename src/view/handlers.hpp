@@ -10,7 +10,7 @@ namespace halfback::view {
 
 Response info_response(const Catalog& catalog);
 Response brdf_response(const Catalog& catalog, const Request& request);
-Response slice_response(const Catalog& catalog, const Request& request, int threads);
+Response slices_response(const Catalog& catalog, const Request& request, int threads);
 Response hemisphere_response(const Catalog& catalog, const Request& request, int threads);
 Response polar_response(const Catalog& catalog, const Request& request);
 Response point_response(const Catalog& catalog, const Request& request);

@@ -1,4 +1,4 @@
-// The page's files (src/view/web/), embedded at build time by cmake/embed_web_assets.cmake into the
+// The page's files (src/view/web/), embedded at build time by cmake/embed_files.cmake into the
 // generated web_assets.cpp.
 #pragma once
 
@@ -9,7 +9,7 @@ namespace halfback::view {
 
 struct WebAsset {
   std::string_view name;  // file name, e.g. "app.js"
-  std::string_view data;
+  std::span<const unsigned char> bytes;
 };
 
 std::span<const WebAsset> web_assets();

@@ -6,9 +6,11 @@ hemisphere, hovers a slice and the hemisphere, and checks that the numbers the p
 ones `halfback eval` and `halfback convert` print for the same configuration. Checks that a request
 without the token, with a foreign Origin, or for a path outside the roots is refused. Saves
 screenshots (--screenshots DIR, view-*.png) and measures the update rate of slider moves and
-hemisphere drags (printed; docs/performance.md, "Viewer").
+hemisphere drags (printed; docs/performance.md, "Viewer"). With --measure-only it only loads the
+page and measures (for timing runs of several builds one after the other, e.g. before and after a
+change, on the same machine).
 
-Usage: view_test.py --halfback PATH [--screenshots DIR] [--root DIR]
+Usage: view_test.py --halfback PATH [--screenshots DIR] [--measure-only]
 """
 import argparse
 import csv
@@ -46,6 +48,35 @@ def check(condition, message):
         FAILURES.append(message)
 
 
+def cpu_seconds(root_pid=None):
+    """User + system CPU time of a process and all its descendants (by default this script's: the
+    server, chromedriver and Chromium's processes), from /proc: a cost that the load of a shared
+    machine does not change, unlike the wall-clock rates."""
+    root_pid = root_pid or os.getpid()
+    stats = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        stats[int(entry)] = (int(fields[1]), int(fields[11]) + int(fields[12]))  # ppid, ticks
+    children = {}
+    for pid, (ppid, _) in stats.items():
+        children.setdefault(ppid, []).append(pid)
+    total, todo = 0, [root_pid]
+    while todo:
+        pid = todo.pop()
+        total += stats.get(pid, (0, 0))[1]
+        todo.extend(children.get(pid, []))
+    return total / os.sysconf("SC_CLK_TCK")
+
+
+SERVER = {}
+
+
 def start_server(halfback, specs, root):
     proc = subprocess.Popen([halfback, "view", *specs, "--root", root, "--port", "0",
                              "--threads", "1"],
@@ -55,6 +86,7 @@ def start_server(halfback, specs, root):
     if not match:
         proc.kill()
         sys.exit(f"no URL in the server's first line: {line!r} {proc.stderr.read()}")
+    SERVER["pid"] = proc.pid
     return proc, match.group(1), match.group(2)
 
 
@@ -135,6 +167,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--halfback", required=True)
     ap.add_argument("--screenshots", default=".")
+    ap.add_argument("--measure-only", action="store_true")
     args = ap.parse_args()
     missing = [p for p in ["/usr/bin/chromium", "/usr/bin/chromedriver"] if not os.path.exists(p)]
     if webdriver is None:
@@ -148,8 +181,11 @@ def main():
         spec = "ggx:alpha=0.3,f0=0.9"
         proc, base, token = start_server(args.halfback, [spec, "embedded:pink-felt"], root)
         try:
-            check_refusals(base, token)
-            browser_checks(args, base, token, spec)
+            if args.measure_only:
+                measure_only(base, token)
+            else:
+                check_refusals(base, token)
+                browser_checks(args, base, token, spec)
         finally:
             proc.send_signal(2)  # Ctrl-C
             try:
@@ -177,6 +213,8 @@ def measure_slider(driver, steps):
     """Azimuth slider moves, each one waited for: updates per second (in the page's clock, from
     the input event to the four slices drawn), and the mean time of the requests and of drawing."""
     total = fetch = draw = 0.0
+    sides = []
+    cpu0, server0 = cpu_seconds(), cpu_seconds(SERVER["pid"])
     for k in range(steps):
         t = driver.execute_async_script("""
             const [value, done] = arguments;
@@ -184,12 +222,42 @@ def measure_slider(driver, steps):
             const s = document.getElementById('azimuth');
             s.value = value; s.dispatchEvent(new Event('input'));
             window.halfback.idle().then(() => done([performance.now() - t0,
-                window.halfback.stats.sliceFetchMs, window.halfback.stats.sliceDrawMs]));""",
+                window.halfback.stats.sliceFetchMs, window.halfback.stats.sliceDrawMs,
+                window.halfback.stats.sliceSide ?? 128]));""",
                                         (5 * k) % 360)
         total, fetch, draw = total + t[0], fetch + t[1], draw + t[2]
+        sides.append(t[3])
+    cpu, server = cpu_seconds() - cpu0, cpu_seconds(SERVER["pid"]) - server0
     print(f"measure: slider update {total / steps:.1f} ms mean: requests {fetch / steps:.1f} ms, "
-          f"drawing {draw / steps:.1f} ms")
+          f"drawing {draw / steps:.1f} ms; slices {min(sides)}…{max(sides)} pixels a side "
+          f"(median {sorted(sides)[len(sides) // 2]}); CPU time per update {1000 * cpu / steps:.1f} ms "
+          f"(server {1000 * server / steps:.1f} ms, browser and test the rest)")
     return 1000 * steps / total
+
+
+def measure_slider_continuous(driver, seconds=3.0, interval_ms=16):
+    """The azimuth slider moved without waiting, as a hand drags it: an input event every 16 ms
+    (60 per second) for 3 s. Returns the slices drawn per second in that time (the page's
+    stats.sliceDraws, or for a page without it its completed updates) and the events sent."""
+    drawn, elapsed, events = driver.execute_async_script("""
+        const [seconds, interval, done] = arguments;
+        const s = document.getElementById('azimuth'), stats = window.halfback.stats;
+        const count = () => stats.sliceDraws ?? stats.updates;
+        const c0 = count(), t0 = performance.now();
+        let k = 0;
+        const timer = setInterval(() => {
+          s.value = (7 + 2 * k++) % 360; s.dispatchEvent(new Event('input'));
+          if (performance.now() - t0 < 1000 * seconds) return;
+          clearInterval(timer);
+          const t1 = performance.now(), c1 = count();
+          window.halfback.idle().then(() => done([c1 - c0, t1 - t0, k]));
+        }, interval);""", seconds, interval_ms)
+    rate = 1000 * drawn / elapsed
+    print(f"measure: continuous slider: {events} input events in {elapsed / 1000:.2f} s, "
+          f"{drawn} slice pictures drawn: {rate:.1f} per second")
+    time.sleep(0.4)  # the full-resolution refinement after the move
+    wait_idle(driver)
+    return rate
 
 
 def measure_drag(driver, steps):
@@ -212,6 +280,66 @@ def measure_drag(driver, steps):
             window.halfback.idle().then(() => done(performance.now() - t0));""", k)
     driver.execute_script("window.dispatchEvent(new MouseEvent('mouseup'));")
     return 1000 * steps / total
+
+
+def measure_all(driver):
+    """The three rates, measured with the sphere finished (its passes would compete for the same
+    cores)."""
+    driver.execute_async_script("window.halfback.spheresDone().then(arguments[0]);")
+    wait_idle(driver)
+    fps_slider = measure_slider(driver, 40)
+    fps_continuous = measure_slider_continuous(driver)
+    fps_drag = measure_drag(driver, 40)
+    load = os.getloadavg()[0]
+    print(f"measure: azimuth slider {fps_slider:.1f} updates/s (each waited for), "
+          f"{fps_continuous:.1f} pictures/s (moved continuously), hemisphere drag "
+          f"{fps_drag:.1f} updates/s (load average {load:.1f} on {os.cpu_count()} cores)")
+    check(fps_slider > 0 and fps_drag > 0, "updates measured")
+
+
+def measure_only(base, token):
+    driver = make_driver()
+    driver.set_script_timeout(300)
+    try:
+        driver.get(f"{base}?token={token}")
+        WebDriverWait(driver, 60).until(lambda d: d.find_element(By.ID, "status").text == "ready")
+        wait_idle(driver)
+        measure_all(driver)
+    finally:
+        driver.quit()
+
+
+def slider_values(driver, names):
+    """Each model slider's position, shown number and the parameter it follows ('' if none)."""
+    return driver.execute_script("""
+        return arguments[0].map((n) => {
+          const s = document.querySelector(`#sliders input[data-param="${n}"]`);
+          return [s.value, s.parentElement.querySelector('output').textContent,
+                  s.dataset.follows || ''];
+        });""", names)
+
+
+def move_model_slider(driver, name, position):
+    driver.execute_script("""const s = document.querySelector(`#sliders input[data-param="${arguments[0]}"]`);
+        s.value = arguments[1]; s.dispatchEvent(new Event('input'));""", name, position)
+    wait_idle(driver)
+
+
+def check_following_sliders(driver):
+    """alpha_x and alpha_y default to alpha: their sliders move with it until moved themselves."""
+    (a, ax, ay) = slider_values(driver, ["alpha", "alpha_x", "alpha_y"])
+    check(ax == [a[0], a[1], "alpha"] and ay == [a[0], a[1], "alpha"],
+          f"alpha_x and alpha_y show alpha's value while they follow it ({a} {ax} {ay})")
+    move_model_slider(driver, "alpha_x", "700")
+    move_model_slider(driver, "alpha", "250")
+    (a, ax, ay) = slider_values(driver, ["alpha", "alpha_x", "alpha_y"])
+    check(ay == [a[0], a[1], "alpha"] and a[0] == "250",
+          f"alpha_y still follows alpha ({a} {ay})")
+    check(ax[0] == "700" and ax[2] == "" and ax[1] != a[1],
+          f"alpha_x, once moved, keeps its own value ({ax})")
+    spec_now = driver.execute_script("return window.halfback.state.a;")
+    check("alpha_x=" in spec_now and "alpha_y=" not in spec_now,
+          f"the spec names the moved parameter only ({spec_now})")
 
 
 def browser_checks(args, base, token, spec):
@@ -267,6 +395,7 @@ def browser_checks(args, base, token, spec):
         spec_now = driver.execute_script("return window.halfback.state.a;")
         check(spec_now.startswith("ggx:alpha=") and spec_now != spec,
               f"moving the alpha slider changes the BRDF ({spec_now})")
+        check_following_sliders(driver)
         driver.execute_script("""const s = document.getElementById('brdf-a');
             s.value = 'arg:0'; s.dispatchEvent(new Event('change'));""")
         wait_idle(driver)
@@ -279,14 +408,7 @@ def browser_checks(args, base, token, spec):
         driver.execute_script("""const s = document.getElementById('mode');
             s.value = 'a'; s.dispatchEvent(new Event('change'));""")
         wait_idle(driver)
-        # Measured with the sphere finished (its passes would compete for the same cores).
-        driver.execute_async_script("window.halfback.spheresDone().then(arguments[0]);")
-        fps_slider = measure_slider(driver, 40)
-        fps_drag = measure_drag(driver, 40)
-        load = os.getloadavg()[0]
-        print(f"measure: azimuth slider {fps_slider:.1f} updates/s, hemisphere drag "
-              f"{fps_drag:.1f} updates/s (load average {load:.1f} on {os.cpu_count()} cores)")
-        check(fps_slider > 0 and fps_drag > 0, "updates measured")
+        measure_all(driver)
         # A reload from the shared URL restores the state.
         url = driver.current_url
         driver.get(url)

@@ -32,6 +32,7 @@ inline constexpr std::size_t kMaxPolarSamples = 2001;  // polar plot samples per
 inline constexpr int kMaxRenderSide = 512;             // sphere render side
 inline constexpr int kMaxRenderSpp = 64;               // samples per pixel of one pass
 inline constexpr std::size_t kMaxBrdfsPerRequest = 8;  // brdf= repeated in /api/point
+inline constexpr std::size_t kMaxBrdfsPerSlices = 2;   // brdf= repeated in /api/slices
 inline constexpr std::size_t kMaxCachedBrdfs = 32;     // loaded BRDFs kept (least recent dropped)
 
 struct Request {

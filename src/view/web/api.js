@@ -1,6 +1,7 @@
 // Requests to the halfback view server. Every request carries the token of the page's URL (the
-// server also accepts the cookie that the first load set), and a newer request of the same kind
-// cancels the older one, so that dragging never queues stale work.
+// server also accepts the cookie that the first load set). A request given a slot cancels the
+// older one of the same slot (the sphere's passes, the hovered point); the views that follow a
+// slider or a drag are coalesced in app.js instead (one in flight, one waiting).
 const token = new URLSearchParams(location.search).get('token') || '';
 
 function url(path, params) {
@@ -38,16 +39,23 @@ export async function getJson(slot, path, params = []) {
   return (await request(slot, path, params)).json();
 }
 
-// A float32 field: { width, height, channels, data: Float32Array }.
-export async function getField(slot, path, params) {
+// Float32 fields, one after the other in the body, all of the same size: { fields: [{ width,
+// height, channels, data: Float32Array }], headers }. /api/slices answers several at once.
+export async function getFields(slot, path, params) {
   const r = await request(slot, path, params);
   const buffer = await r.arrayBuffer();
-  return {
-    width: Number(r.headers.get('X-Halfback-Width')),
-    height: Number(r.headers.get('X-Halfback-Height')),
-    channels: Number(r.headers.get('X-Halfback-Channels')),
-    data: new Float32Array(buffer),
-  };
+  const width = Number(r.headers.get('X-Halfback-Width'));
+  const height = Number(r.headers.get('X-Halfback-Height'));
+  const channels = Number(r.headers.get('X-Halfback-Channels'));
+  const size = width * height * channels, fields = [];
+  for (let offset = 0; size > 0 && offset + 4 * size <= buffer.byteLength; offset += 4 * size)
+    fields.push({ width, height, channels, data: new Float32Array(buffer, offset, size) });
+  return { fields, headers: r.headers };
+}
+
+// One float32 field: { width, height, channels, data: Float32Array }.
+export async function getField(slot, path, params) {
+  return (await getFields(slot, path, params)).fields[0];
 }
 
 export function isAbort(e) {

@@ -2,13 +2,20 @@
 // requests. Views: slices of the four isotropic forms, the hemisphere of ωi, the polar plot, the
 // lit sphere; a configuration (ωi, ωo) hovered or clicked in one is marked in all of them and
 // listed in every parameterization (the server's numbers, the same as `halfback convert/eval`).
-import { getJson, getField, isAbort } from './api.js';
+import { getJson, getField, getFields, isAbort } from './api.js';
 import * as V from './views.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = Math.PI / 180;
 const COLOURS = ['#ff9a3c', '#3cc8ff'];
-const FULL = 256, DRAG = 128;  // slice resolution at rest and while dragging
+const FULL = 256, DRAG = 128;  // slice resolution at rest and (at most) while dragging
+// While a slider moves, the slices' side adapts (64 … 128): smaller when an update (request and
+// drawing) took longer than 45 ms, larger again below 25 ms.
+let dragSide = DRAG;
+function adaptDragSide(ms) {
+  if (ms > 45) dragSide = Math.max(64, dragSide - 32);
+  else if (ms < 25) dragSide = Math.min(DRAG, dragSide + 32);
+}
 
 const state = {
   a: '', b: '', mode: 'a', az: 0, scale: 'log', levels: 'auto', to: 45, po: 180,
@@ -21,7 +28,7 @@ let interactive = false;  // while dragging: lower resolution
 let refineTimer = 0;
 let sphereStale = false;  // the sphere waits for the end of a slider's drag
 const pending = new Set();
-const stats = { updates: 0, lastUpdateMs: 0 };
+const stats = { updates: 0, lastUpdateMs: 0, sliceDraws: 0 };
 
 // --- state <-> URL ------------------------------------------------------------------------
 function readHash() {
@@ -31,7 +38,17 @@ function readHash() {
     state[k] = typeof state[k] === 'number' ? Number(h.get(k)) : h.get(k);
   }
 }
+// At most ten writes a second (the last one always made): a moving slider sends ~60 input events
+// a second, and Chromium throttles history.replaceState (each one a message to the browser).
+let hashTimer = 0, lastHashWrite = -Infinity;
 function writeHash() {
+  clearTimeout(hashTimer);
+  const wait = lastHashWrite + 100 - performance.now();
+  if (wait > 0) {
+    hashTimer = setTimeout(writeHash, wait);
+    return;
+  }
+  lastHashWrite = performance.now();
   const h = new URLSearchParams();
   for (const [k, v] of Object.entries(state)) h.set(k, String(v));
   history.replaceState(null, '', `${location.pathname}${location.search}#${h}`);
@@ -53,6 +70,31 @@ function track(promise) {
   }).finally(() => pending.delete(p));
   pending.add(p);
   return p;
+}
+// At most one update of a kind in flight and one waiting: while a slider moves, a newer value
+// replaces the waiting update (only the latest matters), and the one in flight is not cancelled,
+// so that a continuous drag shows a picture every round trip. `run` reads the state when it
+// starts; every caller's promise settles when a run that started after its call has finished.
+function coalesced(run) {
+  let running = null, waiting = null;
+  const schedule = () => {
+    if (!running) {
+      running = run().finally(() => {
+        running = null;
+        if (!waiting) return;
+        const w = waiting;
+        waiting = null;
+        w.resolve(schedule());
+      });
+      return running;
+    }
+    if (!waiting) {
+      waiting = {};
+      waiting.promise = new Promise((resolve) => { waiting.resolve = resolve; });
+    }
+    return waiting.promise;
+  };
+  return schedule;
 }
 async function idle() {
   while (pending.size) await Promise.allSettled([...pending]);
@@ -90,28 +132,34 @@ function buildSlices() {
 const plain = (label) => label.replace(/_/g, '').replace(/[{}]/g, '');
 const axisMax = (a) => (a.angle ? '90°' : '1');
 
-let sliceFields = {};
-async function updateSlices() {
-  const n = interactive ? DRAG : FULL;
+let sliceFields = {};  // per form: [field of the first BRDF, of the second]
+// The four forms' slices of every BRDF shown, in one request (/api/slices).
+const updateSlices = coalesced(async () => {
+  const list = specs(), moving = interactive, n = moving ? dragSide : FULL;
   const t0 = performance.now();
-  const fields = await Promise.all(info.forms.map(async (f) => Promise.all(specs().map((s, b) =>
-    getField(`slice-${f.space}-${b}`, '/api/slice',
-      [['brdf', s], ['form', f.space], ['azimuth', state.az], ['n', n]])))));
+  const { fields, headers } = await getFields(null, '/api/slices',
+    [...list.map((s) => ['brdf', s]), ['azimuth', state.az], ['n', n], ['values', 'luminance']]);
+  const forms = headers.get('X-Halfback-Forms').split(',');
   sliceFields = {};
-  info.forms.forEach((f, k) => { sliceFields[f.space] = fields[k]; });
+  forms.forEach((space, f) => { sliceFields[space] = list.map((_, b) => fields[b * forms.length + f]); });
   const t1 = performance.now();
   drawSlices();
-  stats.sliceFetchMs = t1 - t0;  // the four requests (server and transfer)
+  stats.sliceFetchMs = t1 - t0;  // the request (server and transfer)
   stats.sliceDrawMs = performance.now() - t1;  // colours, isolines, markers
-}
+  stats.sliceDraws += 1;
+  stats.sliceSide = n;
+  if (moving) adaptDragSide(performance.now() - t0);
+});
 function drawSlices() {
   const scalars = {};
+  let mode = 'a';
   for (const f of info.forms) {
     const [a, b] = sliceFields[f.space] || [];
     if (!a) return;
-    scalars[f.space] = V.sliceScalar(a, b, specs().length > 1 ? state.mode : 'a');
+    mode = b ? state.mode : 'a';
+    scalars[f.space] = V.sliceScalar(a, b, mode);
   }
-  const scale = V.makeScale(Object.values(scalars), specs().length > 1 ? state.mode : 'a', state.scale);
+  const scale = V.makeScale(Object.values(scalars), mode, state.scale);
   const levels = V.isoLevels(state.levels, scale);
   for (const f of info.forms) {
     const field = sliceFields[f.space][0];
@@ -144,26 +192,26 @@ function pointerOnSlice(e, f, click) {
 const wo = () => [Math.sin(state.to * DEG) * Math.cos(state.po * DEG),
   Math.sin(state.to * DEG) * Math.sin(state.po * DEG), Math.cos(state.to * DEG)];
 let hemiField = null;
-async function updateHemisphere() {
+const updateHemisphere = coalesced(async () => {
   const n = interactive ? DRAG : FULL;
   const common = [['theta_o', state.to], ['phi_o', state.po], ['n', n]];
   if (state.hemi === 'rho') {
-    const fields = await Promise.all(specs().map((s, b) => getField(`hemi-${b}`, '/api/hemisphere',
-      [['brdf', s], ['colour', 'rho'], ...common])));
+    const fields = await Promise.all(specs().map((s) => getField(null, '/api/hemisphere',
+      [['brdf', s], ['colour', 'rho'], ['values', 'luminance'], ...common])));
     hemiField = { rho: fields };
   } else {
-    hemiField = { coords: await getField('hemi-0', '/api/hemisphere', [['colour', state.hemi], ...common]) };
+    hemiField = { coords: await getField(null, '/api/hemisphere', [['colour', state.hemi], ...common]) };
   }
   drawHemisphere();
-}
+});
 function drawHemisphere() {
   const canvas = $('hemisphere');
   if (!hemiField) return;
   if (hemiField.rho) {
     const [a, b] = hemiField.rho;
-    const mode = specs().length > 1 ? state.mode : 'a';
-    const s = V.sliceScalar(a, b, mode);
-    for (let k = 0; k < s.length; ++k) if (!Number.isFinite(a.data[3 * k])) s[k] = NaN;
+    const mode = b ? state.mode : 'a';
+    const s = Float32Array.from(V.sliceScalar(a, b, mode));
+    for (let k = 0; k < s.length; ++k) if (!Number.isFinite(a.data[a.channels * k])) s[k] = NaN;
     V.drawScalar(canvas, s, a.width, a.height, V.makeScale([s], mode, 'log'), []);
     blackOutside(canvas);
   } else {
@@ -224,11 +272,11 @@ function hoverWi(e) {
 
 // --- polar plot ------------------------------------------------------------------------------
 let polarCurves = [];
-async function updatePolar() {
-  polarCurves = await Promise.all(specs().map((s, b) => getJson(`polar-${b}`, '/api/polar',
+const updatePolar = coalesced(async () => {
+  polarCurves = await Promise.all(specs().map((s) => getJson(null, '/api/polar',
     [['brdf', s], ['theta_o', state.to], ['phi_o', state.po], ['n', interactive ? 91 : 181]])));
   drawPolar();
-}
+});
 function drawPolar() {
   V.drawPolar($('polar'), polarCurves, state.polar, COLOURS, polarCursorAngle());
 }
@@ -414,9 +462,14 @@ function buildSliders() {
     if (p.default_from && values[p.name] === undefined) input.dataset.follows = p.default_from;
     const out = document.createElement('output');
     out.textContent = p.choices.length ? '' : Number(input.map.fromSlider(input.value)).toPrecision(3);
+    input.out = out;
     input.addEventListener('input', () => {
-      delete input.dataset.follows;
-      if (input.map) out.textContent = Number(input.map.fromSlider(input.value)).toPrecision(3);
+      delete input.dataset.follows;  // moved by the user: it has its own value from now on
+      if (input.map) {
+        const value = input.map.fromSlider(input.value);
+        out.textContent = Number(value).toPrecision(3);
+        moveFollowers(p.name, value);
+      }
       state.a = sliderSpec(model);
       ensureOption($('brdf-a'), state.a);
       interactive = true;
@@ -425,6 +478,15 @@ function buildSliders() {
     input.addEventListener('change', () => { refineSoon(); });
     label.append(p.name, input, out);
     box.append(label);
+  }
+}
+// The parameters that default to `name` and were not moved (alpha_x, alpha_y of alpha) take its
+// value: their sliders and numbers show it (sliderSpec leaves them out, so the server agrees).
+function moveFollowers(name, value) {
+  for (const f of document.querySelectorAll('#sliders [data-follows]')) {
+    if (f.dataset.follows !== name || !f.map) continue;
+    f.value = f.map.toSlider(value);
+    f.out.textContent = Number(value).toPrecision(3);
   }
 }
 // Linear over small ranges, logarithmic over wide ones (a slider position is 0 … 1000).

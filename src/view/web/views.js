@@ -16,17 +16,23 @@ const DIVERGING = [[33, 102, 172], [103, 169, 207], [209, 229, 240], [247, 247, 
   [253, 219, 199], [239, 138, 98], [178, 24, 43]];
 export const diverging = (t) => ramp(DIVERGING, t);
 
-export function luminance(d, k) {
-  return 0.2126 * d[3 * k] + 0.7152 * d[3 * k + 1] + 0.0722 * d[3 * k + 2];
+// The luminance of ρ per pixel: a field of RGB, or of the luminance alone (values=luminance).
+export function luminanceOf(field) {
+  const { data: d, channels } = field;
+  if (channels === 1) return d;
+  const n = field.width * field.height, y = new Float32Array(n);
+  for (let k = 0; k < n; ++k) y[k] = 0.2126 * d[3 * k] + 0.7152 * d[3 * k + 1] + 0.0722 * d[3 * k + 2];
+  return y;
 }
 
 // The scalar a slice shows: the luminance of the first or second BRDF, their difference or ratio.
 export function sliceScalar(a, b, mode) {
+  const ya = luminanceOf(a);
+  if (!b || mode === 'a') return ya;
+  const yb = luminanceOf(b);
+  if (mode === 'b') return yb;
   const n = a.width * a.height, out = new Float32Array(n);
-  for (let k = 0; k < n; ++k) {
-    const ya = luminance(a.data, k), yb = b ? luminance(b.data, k) : NaN;
-    out[k] = mode === 'b' ? yb : mode === 'diff' ? ya - yb : mode === 'ratio' ? ya / yb : ya;
-  }
+  for (let k = 0; k < n; ++k) out[k] = mode === 'diff' ? ya[k] - yb[k] : ya[k] / yb[k];
   return out;
 }
 
@@ -91,25 +97,46 @@ export function isoLevels(text, scale) {
   return out;
 }
 
+// A colour map tabulated at 1024 points (RGB bytes): drawing looks each pixel up instead of
+// interpolating the stops (a 256² slice is 65 536 pixels; the table's steps are below a byte).
+const TABLE = 1024;
+const tables = new Map();
+function colourTable(map) {
+  let table = tables.get(map);
+  if (!table) {
+    table = new Uint8ClampedArray(3 * TABLE);
+    for (let k = 0; k < TABLE; ++k) table.set(map(k / (TABLE - 1)).map(Math.round), 3 * k);
+    tables.set(map, table);
+  }
+  return table;
+}
+
 // Draws n × n scalars (row 0 at the bottom) into a canvas: colour, hatching where NaN, isolines.
 export function drawScalar(canvas, values, w, h, scale, levels) {
-  canvas.width = w;
-  canvas.height = h;
+  if (canvas.width !== w) canvas.width = w;
+  if (canvas.height !== h) canvas.height = h;
   const ctx = canvas.getContext('2d');
-  const img = ctx.createImageData(w, h);
+  const img = ctx.createImageData(w, h), px = img.data;
   const t = new Float32Array(w * h);
   for (let k = 0; k < w * h; ++k) t[k] = scale.tf(values[k]);
+  const table = colourTable(scale.map), last = TABLE - 1;
+  const lo = scale.lo, inv = 1 / (scale.hi - scale.lo), line = scale.line;
   for (let j = 0; j < h; ++j) {
+    const y = h - 1 - j;
     for (let i = 0; i < w; ++i) {
-      const k = j * w + i, p = 4 * ((h - 1 - j) * w + i);
-      let c;
+      const k = j * w + i, p = 4 * (y * w + i);
       if (Number.isNaN(values[k])) {
-        c = ((i + (h - 1 - j)) % 8) < 2 ? [110, 110, 118] : [40, 40, 46];  // hatched
+        const light = ((i + y) % 8) < 2;  // hatched
+        px[p] = px[p + 1] = light ? 110 : 40;
+        px[p + 2] = light ? 118 : 46;
+      } else if (isIsoline(t, w, h, i, j, levels)) {
+        px[p] = line[0]; px[p + 1] = line[1]; px[p + 2] = line[2];
       } else {
-        c = scale.map((t[k] - scale.lo) / (scale.hi - scale.lo));
-        if (isIsoline(t, w, h, i, j, levels)) c = scale.line;
+        const x = (t[k] - lo) * inv;  // NaN (ρ ≤ 0 on a log scale) takes the first colour
+        const e = 3 * (x > 0 ? Math.min(last, Math.round(x * last)) : 0);
+        px[p] = table[e]; px[p + 1] = table[e + 1]; px[p + 2] = table[e + 2];
       }
-      img.data[p] = c[0]; img.data[p + 1] = c[1]; img.data[p + 2] = c[2]; img.data[p + 3] = 255;
+      px[p + 3] = 255;
     }
   }
   ctx.putImageData(img, 0, 0);
@@ -121,15 +148,17 @@ export function restore(canvas) {
   if (canvas.base) canvas.getContext('2d').putImageData(canvas.base, 0, 0);
 }
 
+function crosses(v, u, levels) {
+  if (!Number.isFinite(u)) return false;
+  for (const L of levels) if ((v - L) * (u - L) < 0) return true;
+  return false;
+}
 function isIsoline(t, w, h, i, j, levels) {
+  if (!levels.length) return false;
   const v = t[j * w + i];
   if (!Number.isFinite(v)) return false;
-  const neighbours = [i + 1 < w ? t[j * w + i + 1] : NaN, j + 1 < h ? t[(j + 1) * w + i] : NaN];
-  for (const u of neighbours) {
-    if (!Number.isFinite(u)) continue;
-    for (const L of levels) if ((v - L) * (u - L) < 0) return true;
-  }
-  return false;
+  return (i + 1 < w && crosses(v, t[j * w + i + 1], levels)) ||
+    (j + 1 < h && crosses(v, t[(j + 1) * w + i], levels));
 }
 
 // Hemisphere coloured by the first two coordinates (red, green) of a parameterization.
