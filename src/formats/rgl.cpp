@@ -38,11 +38,13 @@ double phi_to_u(double phi) {
   return (phi + kPi) * (0.5 / kPi);
 }
 
-// floor(u) for |u| < 2³¹ without a libm call (SSE2 has no rounding instruction), in a form that
-// loops vectorize.
+// floor(u) for |u| < 1e9 without a libm call (SSE2 has no rounding instruction), in a form that
+// loops vectorize; 0 for NaN and larger values (the conversion to int would be undefined), which
+// the azimuths of finite directions never reach, and u - 0 keeps a NaN.
 double floor_small(double u) {
-  const double t = static_cast<double>(static_cast<int>(u));
-  return t > u ? t - 1 : t;
+  const double c = std::abs(u) < 1e9 ? u : 0.0;
+  const double t = static_cast<double>(static_cast<int>(c));
+  return t > c ? t - 1 : t;
 }
 
 // The half vector's azimuth on the unit square of the VNDF and NDF tables, in [0, 1]: relative to
@@ -739,9 +741,9 @@ Rgb RglBrdf::eval(const DirPair<double>& pair) const {
 
 // One block: the angles of every row by the batch engine's SIMD conversion (ωi and the unit half
 // vector as a pair of directions, to spherical coordinates), the table coordinates of every row,
-// then the values. Rows that eval() treats apart go
-// through it: NaN, at or below the horizon, not unit (the conversion rejects them), ωi or the half
-// vector along the normal (whose azimuth is atan2(±0, ±0)), an azimuth within kSeam of a seam.
+// then the values. Rows that eval() treats apart go through it: NaN, at or below the horizon, not
+// unit (the conversion rejects them), ωi or the half vector along the normal (whose azimuth is
+// atan2(±0, ±0)), an azimuth within kSeam of a seam.
 void RglBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
   const Impl& m = *impl_;
   const std::size_t n = pairs.size();

@@ -326,6 +326,16 @@ TEST(RglEval, NonFiniteInputIsSafe) {
   EXPECT_TRUE(std::isfinite(b.vndf_density({-inf, nan}, 0.5, 0)));
   const Rgb v = b.eval({{inf, 0, 1}, {-inf, 0, 1}});  // h = NaN
   EXPECT_TRUE(std::isnan(v.r) || v.r >= 0);
+  // The batch gives rows with infinite components (which its conversion rejects) to eval().
+  const std::vector<DirPair<double>> odd{
+      {{inf, 0, 1}, {-inf, 0, 1}}, {{0.6, 0, 0.8}, {0, inf, 1}}, {{inf, inf, 1}, {0, 0, 1}}};
+  std::vector<Rgb> batch(odd.size());
+  b.eval_batch(odd, batch);
+  for (std::size_t i = 0; i < odd.size(); ++i) {
+    const Rgb one = b.eval(odd[i]);
+    for (auto [x, y] : {std::pair{one.r, batch[i].r}, {one.g, batch[i].g}, {one.b, batch[i].b}})
+      EXPECT_TRUE(x == y || (std::isnan(x) && std::isnan(y))) << i << ": " << x << " " << y;
+  }
   (void)b.sample({inf, inf, 1}, nan, 0.5);
   EXPECT_FALSE(b.pdf({inf, inf, 1}, {0, 0, 1}) > 0);
 }
