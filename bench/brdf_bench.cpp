@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <numbers>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "bench_brdfs.hpp"
@@ -197,6 +198,20 @@ void BM_Rgl_BatchOneCore(benchmark::State& state) {
   run_batch_one_core(state, *rgl());
 }
 BENCHMARK(BM_Rgl_BatchOneCore)->Unit(benchmark::kMillisecond);
+
+// eval_batch on 16 pairs at a time, as the renderer calls it (one core).
+void BM_Rgl_BatchOf16(benchmark::State& state) {
+  if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
+  const std::span<const DirPair<double>> p(pairs());
+  std::vector<Rgb> out(p.size());
+  for (auto _ : state) {
+    for (std::size_t i = 0; i < p.size(); i += 16)
+      rgl()->eval_batch(p.subspan(i, 16), std::span(out).subspan(i, 16));
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
+}
+BENCHMARK(BM_Rgl_BatchOf16)->Unit(benchmark::kMillisecond);
 
 const AltaBrdf* alta() {
   static const std::shared_ptr<const AltaBrdf> b = [] {
