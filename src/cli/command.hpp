@@ -10,6 +10,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstddef>
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -28,6 +29,11 @@ namespace halfback::cli {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitDataError = 1;
 inline constexpr int kExitUsageError = 2;
+
+// Rows per block of the streaming commands (convert, eval): the input is read, checked, processed
+// and written a block at a time, so that memory stays bounded on inputs of any length
+// (docs/performance.md, "Streaming").
+inline constexpr std::size_t kBlockRows = std::size_t{1} << 16;
 
 class UsageError : public std::runtime_error {
  public:

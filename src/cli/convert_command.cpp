@@ -97,10 +97,6 @@ std::string pair_problem(PairStatus status, const DirPair<double>& p) {
   }
 }
 
-// Rows per block: the input is read, checked, converted and written a block at a time, so that
-// memory stays bounded on inputs of any length (docs/performance.md, "Streaming").
-constexpr std::size_t kBlockRows = std::size_t{1} << 16;
-
 // The bad rows of the input so far: how many, and the message of the first.
 struct BadRows {
   std::size_t count = 0;

@@ -22,9 +22,6 @@ struct EvalOptions {
   std::string brdf, input = "-", output = "-";
 };
 
-// Rows per block: read, checked, evaluated and written a block at a time (bounded memory).
-constexpr std::size_t kBlockRows = std::size_t{1} << 16;
-
 // ρ at the pairs of one block, written as r,g,b rows.
 void eval_block(const Brdf& brdf, const CsvTable& block, const std::string& source,
                 const CsvSink& sink) {
