@@ -110,48 +110,62 @@ double Sheen::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
 
 BrdfSample Microfacet::sample(const Vec3<double>& wo, double u1, double u2) const {
   if (!(wo.z > 0)) return {};
+  if (params_.distribution == MicrofacetParams::Distribution::ggx) return sample_ggx(wo, u1, u2);
   const double ax = params_.alpha_x, ay = params_.alpha_y;
-  Vec3<double> m;
-  if (params_.distribution == MicrofacetParams::Distribution::ggx) {
-    // The view direction in the hemisphere configuration (roughness stretched to 1).
-    const Vec3<double> vh = normalize({ax * wo.x, ay * wo.y, wo.z});
-    const double len2 = vh.x * vh.x + vh.y * vh.y;
-    const Vec3<double> t1 = len2 > 0
-                                ? Vec3<double>{-vh.y / std::sqrt(len2), vh.x / std::sqrt(len2), 0}
-                                : Vec3<double>{1, 0, 0};
-    const Vec3<double> t2{vh.y * t1.z - vh.z * t1.y, vh.z * t1.x - vh.x * t1.z,
-                          vh.x * t1.y - vh.y * t1.x};
-    // A point on the projected hemisphere: a disk, half of it squashed by the view's slope.
-    const double r = std::sqrt(u1), phi = 2 * kPi * u2;
-    const double p1 = r * std::cos(phi);
-    double p2 = r * std::sin(phi);
-    const double s = 0.5 * (1 + vh.z);
-    p2 = (1 - s) * std::sqrt(std::max(0.0, 1 - p1 * p1)) + s * p2;
-    const double pz = std::sqrt(std::max(0.0, 1 - p1 * p1 - p2 * p2));
-    const Vec3<double> nh{p1 * t1.x + p2 * t2.x + pz * vh.x, p1 * t1.y + p2 * t2.y + pz * vh.y,
-                          p1 * t1.z + p2 * t2.z + pz * vh.z};
-    m = normalize({ax * nh.x, ay * nh.y, std::max(1e-300, nh.z)});
-  } else {
-    const double r = std::sqrt(-std::log1p(-u1)), phi = 2 * kPi * u2;
-    m = normalize({-ax * r * std::cos(phi), -ay * r * std::sin(phi), 1});
-  }
+  const double r = std::sqrt(-std::log1p(-u1)), phi = 2 * kPi * u2;
+  const Vec3<double> m = normalize({-ax * r * std::cos(phi), -ay * r * std::sin(phi), 1});
   if (!(dot(wo, m) > 0)) return {};
-  // pdf() of the sample, from the normal just drawn (pdf() would rebuild it from ωi + ωo).
   const Vec3<double> wi = reflect(wo, m);
   if (!(wi.z > 0)) return {};
-  const double d = distribution(m);
-  if (params_.distribution == MicrofacetParams::Distribution::ggx)
-    return {wi, d / ((1 + lambda(wo)) * 4 * wo.z)};
-  return {wi, d * m.z / (4 * dot(wo, m))};
+  return {wi, distribution(m) * m.z / (4 * dot(wo, m))};
 }
 
+// The stretched view s = (αx ωo_x, αy ωo_y, ωo_z), of length L, gives both the hemisphere
+// configuration's view ŝ and 1 + Λ(ωo) = (1 + L/cos θo)/2; the normal drawn there, n, stretches
+// back to m = t/‖t‖ with t = (αx n_x, αy n_y, n_z), where D(m) = (‖t‖²/‖n‖²)² / (π αx αy).
+// The pdf D(m)/((1 + Λ(ωo)) 4 cos θo) is then D(m) / (2 (cos θo + L)) (docs/models.md).
+BrdfSample Microfacet::sample_ggx(const Vec3<double>& wo, double u1, double u2) const {
+  const double ax = params_.alpha_x, ay = params_.alpha_y;
+  const double sx = ax * wo.x, sy = ay * wo.y, len2 = sx * sx + sy * sy;
+  const double l = std::sqrt(len2 + wo.z * wo.z), inv_l = 1 / l;
+  const Vec3<double> vh{sx * inv_l, sy * inv_l, wo.z * inv_l};
+  const double inv_t = len2 > 0 ? 1 / std::sqrt(len2) : 0;
+  const Vec3<double> t1 =
+      len2 > 0 ? Vec3<double>{-sy * inv_t, sx * inv_t, 0} : Vec3<double>{1, 0, 0};
+  const Vec3<double> t2{-vh.z * t1.y, vh.z * t1.x, vh.x * t1.y - vh.y * t1.x};
+  // A point on the projected hemisphere: a disk, half of it squashed by the view's slope.
+  double cos_phi, sin_phi;
+  detail::sincos_turns(u2, sin_phi, cos_phi);
+  const double r = std::sqrt(u1), p1 = r * cos_phi, s = 0.5 * (1 + vh.z);
+  const double p2 = (1 - s) * std::sqrt(std::max(0.0, 1 - p1 * p1)) + s * (r * sin_phi);
+  const double pz = std::sqrt(std::max(0.0, 1 - p1 * p1 - p2 * p2));
+  const double nx = p1 * t1.x + p2 * t2.x + pz * vh.x, ny = p1 * t1.y + p2 * t2.y + pz * vh.y;
+  const double nz = std::max(1e-300, p2 * t2.z + pz * vh.z);
+  const double tx = ax * nx, ty = ay * ny, tt = tx * tx + ty * ty + nz * nz;
+  const double inv_len = 1 / std::sqrt(tt);
+  const Vec3<double> m{tx * inv_len, ty * inv_len, nz * inv_len};
+  const double cos_om = dot(wo, m);
+  if (!(cos_om > 0)) return {};
+  const Vec3<double> wi{2 * cos_om * m.x - wo.x, 2 * cos_om * m.y - wo.y, 2 * cos_om * m.z - wo.z};
+  if (!(wi.z > 0)) return {};
+  const double ratio = tt / (nx * nx + ny * ny + nz * nz);
+  return {wi, ratio * ratio * inv_pi_axay_ / (2 * (wo.z + l))};
+}
+
+// GGX: with h = ωi + ωo, D(ĥ) = ‖h‖⁴ / (π αx αy Q²), Q = h_x²/αx² + h_y²/αy² + h_z² (no
+// normalization; docs/models.md).
 double Microfacet::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
   if (!(wo.z > 0 && wi.z > 0)) return 0;
+  if (params_.distribution == MicrofacetParams::Distribution::ggx) {
+    const double hx = wi.x + wo.x, hy = wi.y + wo.y, hz = wi.z + wo.z;
+    const double h2 = hx * hx + hy * hy + hz * hz;
+    const double q = hx * hx * inv_ax2_ + hy * hy * inv_ay2_ + hz * hz;
+    const double ax = params_.alpha_x, ay = params_.alpha_y;
+    const double l = std::sqrt(ax * ax * wo.x * wo.x + ay * ay * wo.y * wo.y + wo.z * wo.z);
+    return h2 * h2 * inv_pi_axay_ / (2 * q * q * (wo.z + l));
+  }
   const Vec3<double> m = normalize({wi.x + wo.x, wi.y + wo.y, wi.z + wo.z});
-  const double d = distribution(m);
-  if (params_.distribution == MicrofacetParams::Distribution::ggx)
-    return d / ((1 + lambda(wo)) * 4 * wo.z);
-  return d * m.z / (4 * dot(wo, m));
+  return distribution(m) * m.z / (4 * dot(wo, m));
 }
 
 // --- ABC
