@@ -53,15 +53,15 @@ inline std::size_t pick_lobe(std::span<const double> w, double& u) {
   return j;
 }
 
-// sin and cos of 2πu for u in [0, 1] without libm: the octant k = ⌊8u⌋ and the angle t from the
-// octant's middle (2k + 1)π/8, |t| ≤ π/8, whose sine and cosine series to t¹³ and t¹⁴ leave a
-// remainder below 10⁻¹⁸; then the angle-sum formulas with the middles' tabulated sine and cosine.
+// sin and cos of 2πu for u in [0, 1] without libm or tables (so that loops over it vectorize):
+// the octant k = ⌊8u⌋ and the angle t from the octant's middle (2k + 1)π/8, |t| ≤ π/8, whose
+// sine and cosine series to t¹³ and t¹⁴ leave a remainder below 10⁻¹⁸; then the angle-sum
+// formulas with the middle's sine and cosine, ±sin(π/8) or ±cos(π/8) by the octant.
 // 8u − k − 1/2 is exact, so the only error is the rounding of about twenty operations.
-inline void sincos_turns(double u, double& sin_out, double& cos_out) {
+[[gnu::always_inline]] inline void sincos_turns(double u, double& sin_out, double& cos_out) {
   constexpr double s8 = 0.38268343236508977173, c8 = 0.92387953251128675613;  // of π/8
-  static constexpr double kSin[8] = {s8, c8, c8, s8, -s8, -c8, -c8, -s8};
-  static constexpr double kCos[8] = {c8, s8, -s8, -c8, -c8, -s8, s8, c8};
-  const int k = std::clamp(int(8 * u), 0, 7);
+  const int octant = int(8 * u);
+  const double k = octant < 0 ? 0.0 : octant > 7 ? 7.0 : double(octant);
   const double t = (8 * u - k - 0.5) * (std::numbers::pi / 4), t2 = t * t;
   const double st =
       t * (1 - t2 * (1.0 / 6) *
@@ -77,8 +77,13 @@ inline void sincos_turns(double u, double& sin_out, double& cos_out) {
                             (1 - t2 * (1.0 / 56) *
                                      (1 - t2 * (1.0 / 90) *
                                               (1 - t2 * (1.0 / 132) * (1 - t2 * (1.0 / 182)))))));
-  sin_out = kSin[k] * ct + kCos[k] * st;
-  cos_out = kCos[k] * ct - kSin[k] * st;
+  // The middle's angle is within π/4 of the y axis in octants 1, 2, 5, 6; sin < 0 in the lower
+  // half (k ≥ 4), cos < 0 in the left half (2 ≤ k < 6).
+  const bool near_y = (k == 1) | (k == 2) | (k == 5) | (k == 6);
+  const double ms = (near_y ? c8 : s8) * (k >= 4 ? -1.0 : 1.0);
+  const double mc = (near_y ? s8 : c8) * ((k >= 2) & (k < 6) ? -1.0 : 1.0);
+  sin_out = ms * ct + mc * st;
+  cos_out = mc * ct - ms * st;
 }
 
 }  // namespace halfback::models::detail

@@ -9,6 +9,8 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -186,6 +188,35 @@ TEST(ModelSampling, SincosTurnsMatchesLibm) {
   }
   // 2πu itself rounds by up to 4·10⁻¹⁶ near u = 1 in the reference.
   EXPECT_LT(worst, 2e-15);
+}
+
+// sample_batch() returns sample()'s numbers bit for bit (GGX's own batch, the others' default),
+// and refuses spans of different sizes.
+TEST(ModelSampling, BatchEqualsOneAtATime) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3<double>> wo;
+  std::vector<double> u1, u2;
+  for (int k = 0; k < 1000; ++k) {
+    wo.push_back(dir(90 * u(rng) + (k % 50 == 0 ? 95 : 0), 360 * u(rng)));  // some below
+    u1.push_back(u(rng));
+    u2.push_back(u(rng));
+  }
+  wo.push_back({0, 0, 1});  // the view along n: the frame's fallback
+  u1.push_back(0.3);
+  u2.push_back(0.7);
+  for (const Case& c : cases()) {
+    std::vector<BrdfSample> out(wo.size());
+    c.brdf->sample_batch(wo, u1, u2, out);
+    for (std::size_t i = 0; i < wo.size(); ++i) {
+      const BrdfSample one = c.brdf->sample(wo[i], u1[i], u2[i]);
+      ASSERT_TRUE(one.pdf == out[i].pdf && one.wi.x == out[i].wi.x && one.wi.y == out[i].wi.y &&
+                  one.wi.z == out[i].wi.z)
+          << c.name << " " << i;
+    }
+    EXPECT_THROW(c.brdf->sample_batch(wo, u1, std::span(u2).first(3), out), std::invalid_argument)
+        << c.name;
+  }
 }
 
 TEST(ModelSampling, SumMixesItsTerms) {

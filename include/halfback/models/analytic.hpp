@@ -63,6 +63,9 @@ class Microfacet final : public Brdf {
   // One thread, no call through std::function for the renderer's batches (≤ 4096 pairs).
   void eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const override;
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
+  // GGX: the visible normals of a batch in SIMD lanes, equal to sample() bit for bit.
+  void sample_batch(std::span<const Vec3<double>> wo, std::span<const double> u1,
+                    std::span<const double> u2, std::span<BrdfSample> out) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
   bool has_importance_sampling() const override { return true; }
 
