@@ -21,6 +21,16 @@ void Brdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out
   });
 }
 
+void Brdf::sample_batch(std::span<const Vec3<double>> wo, std::span<const double> u1,
+                        std::span<const double> u2, std::span<BrdfSample> out) const {
+  if (wo.size() != out.size() || u1.size() != out.size() || u2.size() != out.size())
+    throw std::invalid_argument("Brdf::sample_batch: the spans' sizes differ (" +
+                                std::to_string(wo.size()) + " directions, " +
+                                std::to_string(u1.size()) + " and " + std::to_string(u2.size()) +
+                                " numbers, " + std::to_string(out.size()) + " outputs)");
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = sample(wo[i], u1[i], u2[i]);
+}
+
 BrdfSample Brdf::sample(const Vec3<double>& wo, double u1, double u2) const {
   if (!(wo.z > 0)) return {};
   const Vec3<double> wi = sample_cosine_hemisphere(u1, u2);

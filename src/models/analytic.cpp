@@ -85,6 +85,9 @@ Microfacet::Microfacet(const MicrofacetParams& params) : params_(params) {
   require_range(model, "alpha_x", params.alpha_x, 0, 10, true);
   require_range(model, "alpha_y", params.alpha_y, 0, 10, true);
   validate_fresnel(model, params.fresnel);
+  inv_ax2_ = 1 / (params.alpha_x * params.alpha_x);
+  inv_ay2_ = 1 / (params.alpha_y * params.alpha_y);
+  inv_pi_axay_ = 1 / (kPi * params.alpha_x * params.alpha_y);
 }
 
 std::string Microfacet::name() const {
@@ -122,11 +125,39 @@ double Microfacet::lambda(const Vec3<double>& w) const {
 
 Rgb Microfacet::eval(const DirPair<double>& pair) const {
   if (below_horizon(pair)) return {};
+  if (params_.distribution == MicrofacetParams::Distribution::ggx) return eval_ggx(pair);
   const Vec3<double> m = half_vector(pair);
   const double cos_d = pair.wi.x * m.x + pair.wi.y * m.y + pair.wi.z * m.z;
   const double g2 = 1 / (1 + lambda(pair.wi) + lambda(pair.wo));
   const double scalar = distribution(m) * g2 / (4 * pair.wi.z * pair.wo.z);
   return params_.fresnel.eval(cos_d) * scalar;
+}
+
+// GGX in closed form (docs/models.md, "GGX without normalizing"): with h = ωi + ωo (not
+// normalized), Q = h_x²/αx² + h_y²/αy² + h_z² and L(ω) = ‖(αx ω_x, αy ω_y, ω_z)‖,
+// D(ĥ) = ‖h‖⁴ / (π αx αy Q²) and 1 + Λ(ω) = (1 + L(ω)/ω_z)/2, so
+// ρ = F(ωi·ĥ) ‖h‖⁴ / (2 π αx αy Q² (L(ωi) cos θo + L(ωo) cos θi)): three square roots and one
+// division where distribution() and lambda() take three and seven. Both z > 0 here.
+Rgb Microfacet::eval_ggx(const DirPair<double>& pair) const {
+  const Vec3<double>&wi = pair.wi, &wo = pair.wo;
+  const double ax = params_.alpha_x, ay = params_.alpha_y;
+  const double hx = wi.x + wo.x, hy = wi.y + wo.y, hz = wi.z + wo.z;
+  const double h2 = hx * hx + hy * hy + hz * hz;
+  const double q = hx * hx * inv_ax2_ + hy * hy * inv_ay2_ + hz * hz;
+  const double li = std::sqrt(ax * ax * wi.x * wi.x + ay * ay * wi.y * wi.y + wi.z * wi.z);
+  const double lo = std::sqrt(ax * ax * wo.x * wo.x + ay * ay * wo.y * wo.y + wo.z * wo.z);
+  const double len = std::sqrt(h2);
+  const double cos_d = (wi.x * hx + wi.y * hy + wi.z * hz) / len;
+  const double scalar = h2 * h2 * inv_pi_axay_ / (2 * q * q * (li * wo.z + lo * wi.z));
+  return params_.fresnel.eval(cos_d) * scalar;
+}
+
+void Microfacet::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
+  if (out.size() != pairs.size() || pairs.size() > 4096) {
+    Brdf::eval_batch(pairs, out);  // the size check, and threads for a large batch
+    return;
+  }
+  for (std::size_t i = 0; i < pairs.size(); ++i) out[i] = eval(pairs[i]);
 }
 
 // --- ABC -----------------------------------------------------------------------------------

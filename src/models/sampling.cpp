@@ -110,48 +110,95 @@ double Sheen::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
 
 BrdfSample Microfacet::sample(const Vec3<double>& wo, double u1, double u2) const {
   if (!(wo.z > 0)) return {};
+  if (params_.distribution == MicrofacetParams::Distribution::ggx) return sample_ggx(wo, u1, u2);
   const double ax = params_.alpha_x, ay = params_.alpha_y;
-  Vec3<double> m;
-  if (params_.distribution == MicrofacetParams::Distribution::ggx) {
-    // The view direction in the hemisphere configuration (roughness stretched to 1).
-    const Vec3<double> vh = normalize({ax * wo.x, ay * wo.y, wo.z});
-    const double len2 = vh.x * vh.x + vh.y * vh.y;
-    const Vec3<double> t1 = len2 > 0
-                                ? Vec3<double>{-vh.y / std::sqrt(len2), vh.x / std::sqrt(len2), 0}
-                                : Vec3<double>{1, 0, 0};
-    const Vec3<double> t2{vh.y * t1.z - vh.z * t1.y, vh.z * t1.x - vh.x * t1.z,
-                          vh.x * t1.y - vh.y * t1.x};
-    // A point on the projected hemisphere: a disk, half of it squashed by the view's slope.
-    const double r = std::sqrt(u1), phi = 2 * kPi * u2;
-    const double p1 = r * std::cos(phi);
-    double p2 = r * std::sin(phi);
-    const double s = 0.5 * (1 + vh.z);
-    p2 = (1 - s) * std::sqrt(std::max(0.0, 1 - p1 * p1)) + s * p2;
-    const double pz = std::sqrt(std::max(0.0, 1 - p1 * p1 - p2 * p2));
-    const Vec3<double> nh{p1 * t1.x + p2 * t2.x + pz * vh.x, p1 * t1.y + p2 * t2.y + pz * vh.y,
-                          p1 * t1.z + p2 * t2.z + pz * vh.z};
-    m = normalize({ax * nh.x, ay * nh.y, std::max(1e-300, nh.z)});
-  } else {
-    const double r = std::sqrt(-std::log1p(-u1)), phi = 2 * kPi * u2;
-    m = normalize({-ax * r * std::cos(phi), -ay * r * std::sin(phi), 1});
-  }
+  const double r = std::sqrt(-std::log1p(-u1)), phi = 2 * kPi * u2;
+  const Vec3<double> m = normalize({-ax * r * std::cos(phi), -ay * r * std::sin(phi), 1});
   if (!(dot(wo, m) > 0)) return {};
-  // pdf() of the sample, from the normal just drawn (pdf() would rebuild it from ωi + ωo).
   const Vec3<double> wi = reflect(wo, m);
   if (!(wi.z > 0)) return {};
-  const double d = distribution(m);
-  if (params_.distribution == MicrofacetParams::Distribution::ggx)
-    return {wi, d / ((1 + lambda(wo)) * 4 * wo.z)};
-  return {wi, d * m.z / (4 * dot(wo, m))};
+  return {wi, distribution(m) * m.z / (4 * dot(wo, m))};
 }
 
+namespace {
+
+// One GGX visible-normal sample, with selects rather than early returns; a sample that fails (ωo or
+// ωi below the horizon, ωo·m ≤ 0) comes back as BrdfSample{}. The stretched view s = (αx ωo_x, αy
+// ωo_y, ωo_z), of length L, gives both the hemisphere configuration's view ŝ and 1 + Λ(ωo) = (1 +
+// L/cos θo)/2; the normal drawn there, n, stretches back to m = t/‖t‖ with t = (αx n_x, αy n_y,
+// n_z), where D(m) = (‖t‖²/‖n‖²)² / (π αx αy). The pdf D(m)/((1 + Λ(ωo)) 4 cos θo) is then D(m) /
+// (2 (cos θo + L)) (docs/models.md).
+struct GgxShape {
+  double ax, ay, inv_pi_axay;
+};
+[[gnu::always_inline]] inline BrdfSample ggx_visible_normal_sample(const GgxShape& g,
+                                                                   const Vec3<double>& wo,
+                                                                   double u1, double u2) {
+  const double sx = g.ax * wo.x, sy = g.ay * wo.y, len2 = sx * sx + sy * sy;
+  const double l = std::sqrt(len2 + wo.z * wo.z), inv_l = 1 / l;
+  const double vx = sx * inv_l, vy = sy * inv_l, vz = wo.z * inv_l;
+  const bool tilted = len2 > 0;
+  const double inv_t = 1 / std::sqrt(tilted ? len2 : 1.0);
+  const double t1x = tilted ? -sy * inv_t : 1.0, t1y = tilted ? sx * inv_t : 0.0;
+  const double t2x = -vz * t1y, t2y = vz * t1x, t2z = vx * t1y - vy * t1x;  // ŝ × t1
+  // A point on the projected hemisphere: a disk, half of it squashed by the view's slope.
+  double sin_phi, cos_phi;
+  detail::sincos_turns(u2, sin_phi, cos_phi);
+  const double r = std::sqrt(u1), p1 = r * cos_phi, s = 0.5 * (1 + vz);
+  const double p2 = (1 - s) * std::sqrt(std::max(0.0, 1 - p1 * p1)) + s * (r * sin_phi);
+  const double pz = std::sqrt(std::max(0.0, 1 - p1 * p1 - p2 * p2));
+  const double nx = p1 * t1x + p2 * t2x + pz * vx, ny = p1 * t1y + p2 * t2y + pz * vy;
+  const double nz = std::max(1e-300, p2 * t2z + pz * vz);
+  const double tx = g.ax * nx, ty = g.ay * ny, tt = tx * tx + ty * ty + nz * nz;
+  const double inv_len = 1 / std::sqrt(tt);
+  const double mx = tx * inv_len, my = ty * inv_len, mz = nz * inv_len;
+  const double cos_om = wo.x * mx + wo.y * my + wo.z * mz;
+  const double wix = 2 * cos_om * mx - wo.x, wiy = 2 * cos_om * my - wo.y;
+  const double wiz = 2 * cos_om * mz - wo.z;
+  const double ratio = tt / (nx * nx + ny * ny + nz * nz);
+  const double pdf = ratio * ratio * g.inv_pi_axay / (2 * (wo.z + l));
+  const bool ok = (wo.z > 0) & (cos_om > 0) & (wiz > 0);  // no branches
+  return {{ok ? wix : 0.0, ok ? wiy : 0.0, ok ? wiz : 0.0}, ok ? pdf : 0.0};
+}
+
+// The batch: no virtual call per sample, and the samples' independent square roots and divisions
+// overlap in the processor.
+void ggx_visible_normal_batch(const GgxShape g, const Vec3<double>* wo, const double* u1,
+                              const double* u2, BrdfSample* out, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) out[i] = ggx_visible_normal_sample(g, wo[i], u1[i], u2[i]);
+}
+
+}  // namespace
+
+BrdfSample Microfacet::sample_ggx(const Vec3<double>& wo, double u1, double u2) const {
+  return ggx_visible_normal_sample({params_.alpha_x, params_.alpha_y, inv_pi_axay_}, wo, u1, u2);
+}
+
+void Microfacet::sample_batch(std::span<const Vec3<double>> wo, std::span<const double> u1,
+                              std::span<const double> u2, std::span<BrdfSample> out) const {
+  if (params_.distribution != MicrofacetParams::Distribution::ggx || wo.size() != out.size() ||
+      u1.size() != out.size() || u2.size() != out.size()) {
+    Brdf::sample_batch(wo, u1, u2, out);  // one at a time, and the size check
+    return;
+  }
+  ggx_visible_normal_batch({params_.alpha_x, params_.alpha_y, inv_pi_axay_}, wo.data(), u1.data(),
+                           u2.data(), out.data(), out.size());
+}
+
+// GGX: with h = ωi + ωo, D(ĥ) = ‖h‖⁴ / (π αx αy Q²), Q = h_x²/αx² + h_y²/αy² + h_z² (no
+// normalization; docs/models.md).
 double Microfacet::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
   if (!(wo.z > 0 && wi.z > 0)) return 0;
+  if (params_.distribution == MicrofacetParams::Distribution::ggx) {
+    const double hx = wi.x + wo.x, hy = wi.y + wo.y, hz = wi.z + wo.z;
+    const double h2 = hx * hx + hy * hy + hz * hz;
+    const double q = hx * hx * inv_ax2_ + hy * hy * inv_ay2_ + hz * hz;
+    const double ax = params_.alpha_x, ay = params_.alpha_y;
+    const double l = std::sqrt(ax * ax * wo.x * wo.x + ay * ay * wo.y * wo.y + wo.z * wo.z);
+    return h2 * h2 * inv_pi_axay_ / (2 * q * q * (wo.z + l));
+  }
   const Vec3<double> m = normalize({wi.x + wo.x, wi.y + wo.y, wi.z + wo.z});
-  const double d = distribution(m);
-  if (params_.distribution == MicrofacetParams::Distribution::ggx)
-    return d / ((1 + lambda(wo)) * 4 * wo.z);
-  return d * m.z / (4 * dot(wo, m));
+  return distribution(m) * m.z / (4 * dot(wo, m));
 }
 
 // --- ABC

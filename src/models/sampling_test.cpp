@@ -4,15 +4,19 @@
 // the directional albedo otherwise).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <numbers>
 #include <random>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/models/analytic.hpp"
+#include "sampling_detail.hpp"
 #include "support/test_stats.hpp"
 
 namespace halfback::models {
@@ -164,6 +168,54 @@ TEST(ModelSampling, SampledAlbedoMatchesDirectionalAlbedo) {
       EXPECT_NEAR(mean, ref_l, 5 * ref_se + 2e-3 * ref_l + 1e-4)
           << c.name << " θo=" << std::acos(wo.z);
     }
+  }
+}
+
+// The polynomial sine and cosine of GGX's sampling against libm: at the octants' edges and
+// middles, 0, 1 − 2⁻⁵³, 1 and random numbers, within a few rounding errors.
+TEST(ModelSampling, SincosTurnsMatchesLibm) {
+  std::vector<double> us{0, 0x1.fffffffffffffp-1, 1};
+  for (int k = 0; k <= 16; ++k) us.push_back(k / 16.0);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int k = 0; k < 100000; ++k) us.push_back(u(rng));
+  double worst = 0;
+  for (double x : us) {
+    double s, c;
+    detail::sincos_turns(x, s, c);
+    const double phi = 2 * std::numbers::pi * x;
+    worst = std::max({worst, std::abs(s - std::sin(phi)), std::abs(c - std::cos(phi))});
+  }
+  // 2πu itself rounds by up to 4·10⁻¹⁶ near u = 1 in the reference.
+  EXPECT_LT(worst, 2e-15);
+}
+
+// sample_batch() returns sample()'s numbers bit for bit (GGX's own batch, the others' default),
+// and refuses spans of different sizes.
+TEST(ModelSampling, BatchEqualsOneAtATime) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3<double>> wo;
+  std::vector<double> u1, u2;
+  for (int k = 0; k < 1000; ++k) {
+    wo.push_back(dir(90 * u(rng) + (k % 50 == 0 ? 95 : 0), 360 * u(rng)));  // some below
+    u1.push_back(u(rng));
+    u2.push_back(u(rng));
+  }
+  wo.push_back({0, 0, 1});  // the view along n: the frame's fallback
+  u1.push_back(0.3);
+  u2.push_back(0.7);
+  for (const Case& c : cases()) {
+    std::vector<BrdfSample> out(wo.size());
+    c.brdf->sample_batch(wo, u1, u2, out);
+    for (std::size_t i = 0; i < wo.size(); ++i) {
+      const BrdfSample one = c.brdf->sample(wo[i], u1[i], u2[i]);
+      ASSERT_TRUE(one.pdf == out[i].pdf && one.wi.x == out[i].wi.x && one.wi.y == out[i].wi.y &&
+                  one.wi.z == out[i].wi.z)
+          << c.name << " " << i;
+    }
+    EXPECT_THROW(c.brdf->sample_batch(wo, u1, std::span(u2).first(3), out), std::invalid_argument)
+        << c.name;
   }
 }
 

@@ -156,6 +156,7 @@ class Renderer {
     int size = 0;
     int sample[kPacket];
     double u1[kPacket], u2[kPacket];
+    V3 wo[kPacket];
     EnvMap::Sample env[kPacket];
     BrdfSample brdf[kPacket];
     V3 dir[kPacket];
@@ -256,14 +257,22 @@ class Renderer {
     st.size = 0;
     for (int k = 0; k < p.size; ++k) {
       if (!p.shaded[k]) continue;
-      double u1, u2;
-      q.pair[dim].point(p.first + std::uint32_t(k), u1, u2);
-      const BrdfSample bs = brdf_.sample(p.wo[k], u1, u2);
-      if (!(bs.pdf > 0 && bs.wi.z > 0)) continue;
-      st.brdf[st.size] = bs;
-      st.dir[st.size] = p.frame[k].to_world(bs.wi);
+      q.pair[dim].point(p.first + std::uint32_t(k), st.u1[st.size], st.u2[st.size]);
+      st.wo[st.size] = p.wo[k];
       st.sample[st.size++] = k;
     }
+    brdf_.sample_batch(
+        std::span(st.wo, std::size_t(st.size)), std::span(st.u1, std::size_t(st.size)),
+        std::span(st.u2, std::size_t(st.size)), std::span(st.brdf, std::size_t(st.size)));
+    int kept = 0;  // the samples with a direction, in order
+    for (int i = 0; i < st.size; ++i) {
+      const BrdfSample& bs = st.brdf[i];
+      if (!(bs.pdf > 0 && bs.wi.z > 0)) continue;
+      st.brdf[kept] = bs;
+      st.dir[kept] = p.frame[st.sample[i]].to_world(bs.wi);
+      st.sample[kept++] = st.sample[i];
+    }
+    st.size = kept;
     const auto n = std::size_t(st.size);
     env_.lookup(std::span(st.dir, n), s_.compensation, std::span(st.light, n));
     Batch& b = p.batch;

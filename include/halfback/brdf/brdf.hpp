@@ -53,6 +53,10 @@ class Brdf {
   // that follows its own lobes overrides all three.
   virtual BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const;
   virtual double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const;
+  // sample() of a batch: out[i] = sample(wo[i], u1[i], u2[i]), the same numbers (all four spans
+  // the same size, else std::invalid_argument). A model whose sampling vectorizes overrides it.
+  virtual void sample_batch(std::span<const Vec3<double>> wo, std::span<const double> u1,
+                            std::span<const double> u2, std::span<BrdfSample> out) const;
   // Whether sample() follows ρ (true) or is the cosine default (false; the renderer then
   // tabulates ρ to sample it, render/brdf_sampler.hpp).
   virtual bool has_importance_sampling() const { return false; }
