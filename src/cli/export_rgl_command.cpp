@@ -35,8 +35,9 @@ int run_export_rgl(ExportRglOptions& o) {
   const BrdfPtr brdf = load_brdf(o.brdf);
   o.table.description =
       o.description.empty()
-          ? fmt::format("{} (exported by halfback export-rgl from '{}'; NDF by power iteration)",
-                        brdf->description(), o.brdf)
+          ? fmt::format("{} (exported by halfback export-rgl from '{}'; NDF by power iteration{})",
+                        brdf->description(), o.brdf,
+                        o.table.variant == RglVariant::rgb ? "" : "; spectra upsampled from RGB")
           : o.description;
   const bool terminal = !o.quiet && isatty(fileno(stderr));
   if (terminal)

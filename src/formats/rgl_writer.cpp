@@ -343,9 +343,11 @@ std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions
   check_option("--resolution", o.resolution, 2, 512);
   check_option("--vndf-resolution", o.vndf_resolution, 2, 1024);
   const std::string desc =
-      o.description.empty() ? fmt::format("{}: {} (exported by halfback; NDF by power iteration)",
-                                          brdf.name(), brdf.description())
-                            : o.description;
+      o.description.empty()
+          ? fmt::format("{}: {} (exported by halfback; NDF by power iteration{})", brdf.name(),
+                        brdf.description(),
+                        o.variant == RglVariant::rgb ? "" : "; spectra upsampled from RGB")
+          : o.description;
   Geometry g = geometry_fields(brdf, o, desc);
 
   const auto res = static_cast<std::size_t>(o.resolution);

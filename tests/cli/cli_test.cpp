@@ -973,6 +973,7 @@ TEST_F(CliTest, ExportRglSpectralVariant) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("spectral variant (95 wavelengths, integrated to RGB)"), std::string::npos)
       << r.out;
+  EXPECT_NE(r.out.find("spectra upsampled from RGB"), std::string::npos) << r.out;
 }
 
 TEST_F(CliTest, ExportRglBadInputKeepsTheOutput) {
