@@ -1,5 +1,5 @@
 // Writes small valid inputs for the fuzzers into DIR/{merl,rgl,alta}/ (see fuzz/run.sh): a
-// synthetic RGL material with tiny grids, ALTA files, and MERL headers.
+// synthetic RGL material with tiny grids (RGB and spectral), ALTA files, and MERL headers.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -28,8 +28,9 @@ void write(const fs::path& p, const void* data, std::size_t n) {
       .write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
 }
 
+// `spectral`: the spectral variant, `wavelengths` and `spectra` (3 wavelengths) instead of `rgb`.
 std::vector<std::byte> rgl_material(std::size_t n_theta, std::size_t w, std::size_t r,
-                                    std::vector<float> phi_i) {
+                                    std::vector<float> phi_i, bool spectral = false) {
   std::vector<float> theta(n_theta);
   for (std::size_t i = 0; i < n_theta; ++i) theta[i] = float(1.5 * double(i) / double(n_theta));
   const std::size_t np = phi_i.size(), slices = np * n_theta;
@@ -42,7 +43,7 @@ std::vector<std::byte> rgl_material(std::size_t n_theta, std::size_t w, std::siz
   const std::string desc = "seed";
   std::vector<std::byte> d(desc.size());
   std::memcpy(d.data(), desc.data(), desc.size());
-  const std::vector<TensorFieldData> fields{
+  std::vector<TensorFieldData> fields{
       {"description", TensorDtype::uint8, {desc.size()}, d},
       {"phi_i", TensorDtype::float32, {np}, le(phi_i)},
       {"theta_i", TensorDtype::float32, {n_theta}, le(theta)},
@@ -53,6 +54,11 @@ std::vector<std::byte> rgl_material(std::size_t n_theta, std::size_t w, std::siz
       {"rgb", TensorDtype::float32, {np, n_theta, 3, r, r}, le(rgb)},
       {"jacobian", TensorDtype::uint8, {1}, {std::byte{1}}},
   };
+  if (spectral) {  // the same numbers, read as 3 wavelengths
+    fields[7] = {"wavelengths", TensorDtype::float32, {3}, le(std::vector<float>{400, 550, 700})};
+    fields.insert(fields.begin() + 8,
+                  {"spectra", TensorDtype::float32, {np, n_theta, 3, r, r}, le(rgb)});
+  }
   return serialize_tensor_file(fields);
 }
 
@@ -70,6 +76,8 @@ int main(int argc, char** argv) {
   write(dir / "rgl" / "iso.bsdf", iso.data(), iso.size());
   const auto aniso = rgl_material(2, 3, 2, {-3.14159265f, -1.5707963f, 0.0f});
   write(dir / "rgl" / "aniso.bsdf", aniso.data(), aniso.size());
+  const auto spectral = rgl_material(3, 4, 2, {0.0f}, true);
+  write(dir / "rgl" / "spectral.bsdf", spectral.data(), spectral.size());
 
   const std::string alta =
       "#DIM 3 1\n#VS 0\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT "

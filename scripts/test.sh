@@ -7,14 +7,16 @@ cd "$(dirname "$0")/.."
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
 export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
 
-# RGL's reference loader (rgl-epfl/brdf-loader) for the RGL writer's round-trip test
-# (src/loader/rgl_reference_test.cpp): extracted from a local git mirror into the build tree when
-# there is one, never copied into the repository; without it that test skips.
+# RGL's reference loaders (rgl-epfl/brdf-loader: RGB and spectral) for the RGL writer's round-trip
+# tests (src/loader/rgl_reference_test.cpp, rgl_spectral_reference_test.cpp): extracted from a
+# local git mirror into the build tree when there is one, never copied into the repository;
+# without them those tests skip.
 brdf_loader_git="${HALFBACK_BRDF_LOADER_GIT:-../.mirror/rgl-epfl+brdf-loader/repo}"
 powitacq_args=()
 if git --git-dir="$brdf_loader_git" rev-parse --verify -q HEAD >/dev/null 2>&1; then
   mkdir -p build/release/brdf-loader
-  git --git-dir="$brdf_loader_git" archive HEAD powitacq_rgb.h powitacq_rgb.inl LICENSE.md \
+  git --git-dir="$brdf_loader_git" archive HEAD powitacq_rgb.h powitacq_rgb.inl \
+    powitacq.h powitacq.inl LICENSE.md \
     | tar -x -C build/release/brdf-loader
   powitacq_args=(-DHALFBACK_POWITACQ_DIR="$PWD/build/release/brdf-loader")
 fi

@@ -15,6 +15,7 @@
 #include "binary_io.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/core/parallel.hpp"
+#include "halfback/core/spectrum.hpp"
 #include "halfback/util/format_error.hpp"
 
 namespace halfback {
@@ -60,13 +61,7 @@ class Validator {
 
   const TensorField& field(std::string_view name, TensorDtype dtype, std::size_t ndim) const {
     const TensorField* f = tf_.find(name);
-    if (!f) {
-      if (name == "rgb" && tf_.find("spectra"))
-        fail(name,
-             "missing: this is the spectral variant of the format, only the RGB variant "
-             "(field 'rgb') is supported");
-      fail(name, "missing (required by the RGL material format)");
-    }
+    if (!f) fail(name, "missing (required by the RGL material format)");
     if (f->dtype != dtype)
       fail(name, "has dtype " + std::string(name_of(f->dtype)) + ", expected " +
                      std::string(name_of(dtype)));
@@ -420,6 +415,7 @@ struct RglBrdf::Impl {
   std::size_t n_slices = 1;
   std::size_t noise_clamped = 0;  // tiny negative ndf, vndf and luminance values set to 0
   std::size_t rgb_negative = 0;   // negative (out-of-gamut) RGB values
+  std::size_t wavelengths = 0;    // the spectral variant: its wavelengths, integrated to RGB
 
   Slices slices(double phi_i, double theta_i) const {
     std::size_t ip, it;
@@ -463,6 +459,49 @@ struct RglBrdf::Impl {
     return {c[0], c[1], c[2]};
   }
 };
+
+namespace {
+
+// The spectral variant's `spectra` [φi, θi, wavelengths, h, w] integrated to RGB tables
+// (core/spectrum.hpp: the CIE 1931 observer under the illuminant the writer upsamples with), so
+// that spectral files read like RGB ones. docs/formats.md, "Spectra".
+Table spectra_as_rgb(const Validator& v, const TensorField& lum, std::size_t n_phi,
+                     std::size_t n_theta, std::size_t& n_wavelengths) {
+  const TensorField& wl = v.field("wavelengths", TensorDtype::float32, 1);
+  v.require_at_least(wl, 0, 2);
+  std::vector<double> lambda = v.floats(wl);
+  for (std::size_t k = 0; k < lambda.size(); ++k)
+    if (!(lambda[k] > 0) || (k > 0 && !(lambda[k] > lambda[k - 1])))
+      v.fail("wavelengths", fmt::format("value {} is {:g} nm: wavelengths must be positive and "
+                                        "strictly increasing",
+                                        k, lambda[k]));
+  const TensorField& f = v.field("spectra", TensorDtype::float32, 5);
+  v.require_dim(f, 0, n_phi, "number of phi_i values");
+  v.require_dim(f, 1, n_theta, "number of theta_i values");
+  v.require_dim(f, 2, lambda.size(), "number of wavelengths");
+  v.require_dim(f, 3, lum.shape[2], "the luminance grid's resolution");
+  v.require_dim(f, 4, lum.shape[3], "the luminance grid's resolution");
+  const spectral::SpectrumToRgb to_rgb(lambda);
+  const std::vector<double> values = v.floats(f);
+  Table t;
+  t.h = static_cast<std::size_t>(f.shape[3]);
+  t.w = static_cast<std::size_t>(f.shape[4]);
+  const std::size_t n = t.h * t.w, nl = lambda.size();
+  t.v.assign(n_phi * n_theta * 3 * n, 0.0);
+  std::vector<double> spectrum(nl);
+  for (std::size_t s = 0; s < n_phi * n_theta; ++s)
+    for (std::size_t node = 0; node < n; ++node) {
+      for (std::size_t k = 0; k < nl; ++k) spectrum[k] = values[(s * nl + k) * n + node];
+      const Rgb c = to_rgb(spectrum);
+      t.v[(s * 3 + 0) * n + node] = c.r;
+      t.v[(s * 3 + 1) * n + node] = c.g;
+      t.v[(s * 3 + 2) * n + node] = c.b;
+    }
+  n_wavelengths = nl;
+  return t;
+}
+
+}  // namespace
 
 RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     : impl_(std::make_unique<Impl>()), label_(std::move(label)), options_(options) {
@@ -546,7 +585,13 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     m.noise_clamped += v.clamp_noise(lum, luminance);
   }
 
-  {
+  std::vector<double> planar;  // slices of 3 channels of h·w; may be slightly negative (gamut)
+  if (!tf.find("rgb") && tf.find("spectra")) {
+    Table t = spectra_as_rgb(v, lum, n_phi, n_theta, m.wavelengths);
+    m.rgb.h = t.h;
+    m.rgb.w = t.w;
+    planar = std::move(t.v);
+  } else {
     const TensorField& f = v.field("rgb", TensorDtype::float32, 5);
     v.require_dim(f, 0, n_phi, "number of phi_i values");
     v.require_dim(f, 1, n_theta, "number of theta_i values");
@@ -555,11 +600,11 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     v.require_dim(f, 4, lum.shape[3], "the luminance grid's resolution");
     m.rgb.h = static_cast<std::size_t>(f.shape[3]);
     m.rgb.w = static_cast<std::size_t>(f.shape[4]);
-    const std::vector<double> planar = v.floats(f);  // may be slightly negative (out of gamut)
-    m.rgb.assign(planar, m.n_slices);
-    m.rgb_negative = static_cast<std::size_t>(
-        std::count_if(planar.begin(), planar.end(), [](double x) { return x < 0; }));
+    planar = v.floats(f);  // see RglOptions for the negative values
   }
+  m.rgb.assign(planar, m.n_slices);
+  m.rgb_negative = static_cast<std::size_t>(
+      std::count_if(planar.begin(), planar.end(), [](double x) { return x < 0; }));
 
   {
     const TensorField& f = v.field("jacobian", TensorDtype::uint8, 1);
@@ -584,7 +629,11 @@ std::string RglBrdf::description() const {
 std::vector<Brdf::Fact> RglBrdf::facts() const {
   const Impl& m = *impl_;
   std::vector<Fact> f;
-  f.push_back({"format", "RGL tensor_file (Dupuy & Jakob 2018), RGB variant"});
+  f.push_back({"format", m.wavelengths == 0
+                             ? std::string("RGL tensor_file (Dupuy & Jakob 2018), RGB variant")
+                             : fmt::format("RGL tensor_file (Dupuy & Jakob 2018), spectral variant "
+                                           "({} wavelengths, integrated to RGB)",
+                                           m.wavelengths)});
   f.push_back({"material", m.description});
   f.push_back({"incidence grid",
                fmt::format("{} θi × {} φi{}", m.theta_i_raw.size(), m.phi_i_raw.size(),

@@ -134,8 +134,17 @@ TEST(TensorFileErrors, MaterialFields) {
     auto fs = base();
     fs.erase(fs.begin() + 8);  // rgb
     EXPECT_FORMAT_ERROR(brdf_of(fs), "m.bsdf", "field 'rgb'", "missing");
+    // The spectral variant: `spectra` needs its `wavelengths`, increasing, one per spectrum sample.
     fs.push_back(f32("spectra", {1, 4, 2, 8, 8}, std::vector<float>(512, 1.0f)));
-    EXPECT_FORMAT_ERROR(brdf_of(fs), "field 'rgb'", "spectral variant");
+    EXPECT_FORMAT_ERROR(brdf_of(fs), "field 'wavelengths'", "missing");
+    fs.push_back(f32("wavelengths", {2}, {500.0f, 400.0f}));
+    EXPECT_FORMAT_ERROR(brdf_of(fs), "field 'wavelengths'", "value 1 is 400 nm", "increasing");
+    *find(fs, "wavelengths") = f32("wavelengths", {3}, {400.0f, 500.0f, 600.0f});
+    EXPECT_FORMAT_ERROR(brdf_of(fs), "field 'spectra'", "dimension 2 is 2, expected 3",
+                        "number of wavelengths");
+    *find(fs, "wavelengths") = f32("wavelengths", {2}, {400.0f, 600.0f});
+    find(fs, "spectra")->data = test::le_bytes(std::vector<float>(512, NAN));
+    EXPECT_FORMAT_ERROR(brdf_of(fs), "field 'spectra'", "NaN");
   }
   {
     auto fs = base();
@@ -377,6 +386,36 @@ TEST(RglNoise, TinyNegativeDensitiesLoadAsZero) {
     EXPECT_NE(what.find("value 64 is -0.0123,"), std::string::npos) << what;
     EXPECT_EQ(what.find("0.000000"), std::string::npos) << what;
   }
+}
+
+TEST(RglEval, SpectralVariantReadsAsItsRgb) {
+  // Grey spectra (the same value at every wavelength) are that grey in RGB: the spectral file
+  // evaluates like the RGB file whose three channels hold the spectra's values.
+  test::Synthetic grey;
+  grey.rgb = [](std::size_t s, auto, std::size_t y, std::size_t x) {
+    return 0.05f * float(s + 1) + 0.01f * float(x + 2 * y);
+  };
+  const RglBrdf rgb = grey.brdf();
+  auto fs = grey.fields();
+  const std::vector<float> lambda{360, 450, 451, 700, 830};
+  std::vector<float> spectra;
+  for (std::size_t s = 0; s < 4; ++s)
+    for (std::size_t k = 0; k < lambda.size(); ++k)
+      for (std::size_t y = 0; y < 8; ++y)
+        for (std::size_t x = 0; x < 8; ++x) spectra.push_back(grey.rgb(s, 0, y, x));
+  fs.erase(fs.begin() + 8);  // rgb
+  fs.insert(fs.begin() + 8, f32("wavelengths", {lambda.size()}, lambda));
+  fs.insert(fs.begin() + 9, f32("spectra", {1, 4, lambda.size(), 8, 8}, spectra));
+  const RglBrdf spectral = brdf_of(fs);
+  std::mt19937_64 rng(3);
+  for (int k = 0; k < 500; ++k) {
+    const Vec3<double> wi = test::uniform_hemisphere(rng), wo = test::uniform_hemisphere(rng);
+    const Rgb a = rgb.eval({wi, wo}), b = spectral.eval({wi, wo});
+    EXPECT_NEAR(b.r, a.r, 1e-9 * (1 + a.r));
+    EXPECT_NEAR(b.g, a.g, 1e-9 * (1 + a.g));
+    EXPECT_NEAR(b.b, a.b, 1e-9 * (1 + a.b));
+  }
+  EXPECT_NE(spectral.facts()[0].value.find("spectral variant (5 wavelengths"), std::string::npos);
 }
 
 TEST(RglEval, NegativeRgbIsClampedByDefault) {

@@ -14,6 +14,7 @@
 
 #include "binary_io.hpp"
 #include "halfback/core/parallel.hpp"
+#include "halfback/core/spectrum.hpp"
 #include "halfback/util/atomic_file.hpp"
 
 namespace halfback {
@@ -304,6 +305,29 @@ void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, st
       threads);
 }
 
+// The spectra of the RGB tables (slices × 3 × res², channel-major per slice), one sigmoid
+// spectrum fitted per entry, as slices × wavelengths × res² (docs/formats.md, "Spectra").
+std::vector<double> spectra_of_rgb(const std::vector<double>& rgb, std::size_t slices,
+                                   std::size_t res, const std::vector<double>& wavelengths,
+                                   int threads) {
+  const spectral::RgbToSpectrum upsample(wavelengths);
+  const std::size_t n = res * res, nl = wavelengths.size();
+  std::vector<double> out(slices * nl * n);
+  parallel_for(
+      slices * n, 64,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t e = begin; e < end; ++e) {
+          const std::size_t s = e / n, node = e % n;
+          const double* in = rgb.data() + s * 3 * n + node;
+          const spectral::SpectrumFit f = upsample.fit({in[0], in[n], in[2 * n]});
+          for (std::size_t k = 0; k < nl; ++k)
+            out[(s * nl + k) * n + node] = f.spectrum.scale > 0 ? f.spectrum(wavelengths[k]) : 0;
+        }
+      },
+      threads);
+  return out;
+}
+
 }  // namespace
 
 std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions& o) {
@@ -311,13 +335,19 @@ std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions
     throw std::invalid_argument(brdf.name() +
                                 " is anisotropic: the RGL writer supports isotropic BRDFs only "
                                 "(one φi slice)");
+  if (o.variant != RglVariant::rgb && o.variant != RglVariant::spectral &&
+      o.variant != RglVariant::both)
+    throw std::invalid_argument(
+        fmt::format("--variant is {}: must be rgb, spectral or both", static_cast<int>(o.variant)));
   check_option("--theta-i", o.theta_i, 2, 90);
   check_option("--resolution", o.resolution, 2, 512);
   check_option("--vndf-resolution", o.vndf_resolution, 2, 1024);
   const std::string desc =
-      o.description.empty() ? fmt::format("{}: {} (exported by halfback; NDF by power iteration)",
-                                          brdf.name(), brdf.description())
-                            : o.description;
+      o.description.empty()
+          ? fmt::format("{}: {} (exported by halfback; NDF by power iteration{})", brdf.name(),
+                        brdf.description(),
+                        o.variant == RglVariant::rgb ? "" : "; spectra upsampled from RGB")
+          : o.description;
   Geometry g = geometry_fields(brdf, o, desc);
 
   const auto res = static_cast<std::size_t>(o.resolution);
@@ -339,7 +369,14 @@ std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions
     if (o.progress) o.progress(int(s + 1), int(slices));
   }
   g.fields.push_back(float_field("luminance", {1, slices, res, res}, luminance));
-  g.fields.push_back(float_field("rgb", {1, slices, 3, res, res}, rgb));
+  if (o.variant != RglVariant::spectral)
+    g.fields.push_back(float_field("rgb", {1, slices, 3, res, res}, rgb));
+  if (o.variant != RglVariant::rgb) {
+    const std::vector<double> wavelengths = spectral::default_wavelengths();
+    g.fields.push_back(float_field("wavelengths", {wavelengths.size()}, wavelengths));
+    g.fields.push_back(float_field("spectra", {1, slices, wavelengths.size(), res, res},
+                                   spectra_of_rgb(rgb, slices, res, wavelengths, o.threads)));
+  }
   g.fields.push_back(std::move(jacobian));
   return std::move(g.fields);
 }

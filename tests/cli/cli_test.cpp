@@ -27,6 +27,7 @@
 #include "halfback/core/batch.hpp"
 #include "halfback/core/space.hpp"
 #include "halfback/formats/merl.hpp"
+#include "halfback/formats/rgl.hpp"
 #include "halfback/util/csv.hpp"
 #include "support/fifo_reader.hpp"
 #include "support/test_support.hpp"
@@ -942,7 +943,8 @@ TEST_F(CliTest, ExportRglWritesAFileTheReaderReads) {
   Result r = run({"export-rgl", "--brdf", "ggx:alpha=0.3,f0=0.5", "-o", "ggx.bsdf", "--theta-i",
                   "6", "--resolution", "16", "--vndf-resolution", "64"});
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("ggx.bsdf written (6 incidence elevations, 16x16"), std::string::npos)
+  EXPECT_NE(r.err.find("ggx.bsdf written (rgb variant, 6 incidence elevations, 16x16"),
+            std::string::npos)
       << r.err;
   EXPECT_EQ(r.err.find("incidence slice"), std::string::npos) << r.err;  // no terminal here
   r = run({"info", "ggx.bsdf"});
@@ -955,6 +957,23 @@ TEST_F(CliTest, ExportRglWritesAFileTheReaderReads) {
   EXPECT_EQ(r.err, "");
   r = run({"info", "l.bsdf"});
   EXPECT_NE(r.out.find("material:              grey"), std::string::npos) << r.out;
+}
+
+TEST_F(CliTest, ExportRglSpectralVariant) {
+  Result r = run({"export-rgl", "--brdf", "ggx:alpha=0.3,f0_r=0.9,f0_g=0.5,f0_b=0.2", "-o",
+                  "s.bsdf", "--variant", "spectral", "--theta-i", "4", "--resolution", "8",
+                  "--vndf-resolution", "32"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("s.bsdf written (spectral variant"), std::string::npos) << r.err;
+  const TensorFile tf = read_tensor_file(path("s.bsdf"));
+  EXPECT_EQ(tf.find("rgb"), nullptr);
+  ASSERT_NE(tf.find("spectra"), nullptr);
+  EXPECT_EQ(tf.find("spectra")->shape, (std::vector<std::uint64_t>{1, 4, 95, 8, 8}));
+  r = run({"info", "s.bsdf"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("spectral variant (95 wavelengths, integrated to RGB)"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("spectra upsampled from RGB"), std::string::npos) << r.out;
 }
 
 TEST_F(CliTest, ExportRglBadInputKeepsTheOutput) {
@@ -971,6 +990,7 @@ TEST_F(CliTest, ExportRglBadInputKeepsTheOutput) {
       {{"--brdf", "lambert", "--theta-i", "1"}, 2, "--theta-i"},
       {{"--brdf", "lambert", "--resolution", "1"}, 2, "--resolution"},
       {{"--brdf", "lambert", "--vndf-resolution", "x"}, 2, "--vndf-resolution"},
+      {{"--brdf", "lambert", "--variant", "xyz"}, 2, "--variant"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args{"export-rgl", "-o", "x.bsdf"};

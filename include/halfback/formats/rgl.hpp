@@ -151,7 +151,8 @@ class RglBrdf final : public Brdf {
   RglOptions options_;
 };
 
-// Reads an RGL .bsdf file (the RGB variant); the BRDF's name is "rgl:STEM".
+// Reads an RGL .bsdf file (the RGB variant, or the spectral one with its spectra integrated to RGB:
+// core/spectrum.hpp); the BRDF's name is "rgl:STEM".
 std::shared_ptr<const RglBrdf> load_rgl(const std::filesystem::path& path, RglOptions options = {});
 
 }  // namespace halfback

@@ -1,9 +1,11 @@
 // Writing any isotropic BRDF as an RGL "tensor_file" material (the format of Dupuy & Jakob 2018,
-// RGB variant: read by RGL's reference loader and by Mitsuba 3's `measured` plugin in its RGB
-// variants; the spectral variant is not written). The microfacet distribution is recovered from the
-// BRDF's backscattering by power iteration (Dupuy, Heitz, Iehl, Poulin & Ostromoukhov 2015); the
-// visible-normal distributions and their warps follow from it, and the RGB and luminance tables are
-// ρ sampled through the warps. docs/formats.md ("RGL writer") derives every field.
+// in its RGB variant, read by RGL's reference loader powitacq_rgb.h and Mitsuba 3's `measured`
+// plugin in its RGB variants, or its spectral variant, read by powitacq.h, pbrt-v4's `measured`
+// material and Mitsuba 3's spectral variants, or both in one file). The microfacet distribution is
+// recovered from the BRDF's backscattering by power iteration (Dupuy, Heitz, Iehl, Poulin &
+// Ostromoukhov 2015); the visible-normal distributions and their warps follow from it, and the RGB
+// and luminance tables are ρ sampled through the warps. docs/formats.md ("RGL writer") derives
+// every field.
 #pragma once
 
 #include <cstddef>
@@ -17,12 +19,19 @@
 
 namespace halfback {
 
+// Which colour fields a file holds: `rgb` (3 channels), `spectral` (`wavelengths` and `spectra`,
+// upsampled from the RGB tables: core/spectrum.hpp), or `both` (every field of the two; read by
+// pbrt-v4, both reference loaders and halfback, but refused by Mitsuba 3's RGB variants, which
+// take a file with `wavelengths` for a spectral one).
+enum class RglVariant { rgb, spectral, both };
+
 struct RglExportOptions {
   int theta_i = 8;            // incident elevations, 0 to 90°, evenly spaced in σ (as published)
   int resolution = 32;        // luminance and RGB tables: resolution × resolution samples
   int vndf_resolution = 128;  // the VNDF tables (N × N) and the NDF and σ tables (2 × N)
   std::string description;    // the `description` field; empty: says what the source was
-  int threads = 0;            // parallel_for's convention: 0 all cores, 1 the calling thread
+  RglVariant variant = RglVariant::rgb;
+  int threads = 0;  // parallel_for's convention: 0 all cores, 1 the calling thread
   // Called after each incidence slice is tabulated (from the calling thread), e.g. for a
   // progress display.
   std::function<void(int done, int total)> progress;
@@ -46,7 +55,9 @@ RecoveredNdf recover_ndf(const Brdf& brdf, int nodes, int threads = 0);
 double projected_area(const std::vector<double>& ndf, double theta);
 
 // The fields of the RGL file of `brdf`, in the order of the published files: version,
-// description, phi_i, theta_i, sigma, ndf, vndf, luminance, rgb, jacobian. Isotropic BRDFs only.
+// description, phi_i, theta_i, sigma, ndf, vndf, luminance, rgb (variants rgb and both),
+// wavelengths and spectra (variants spectral and both: float32, nm, spectral::default_wavelengths,
+// and [1, θi, wavelengths, resolution, resolution]), jacobian. Isotropic BRDFs only.
 // Throws std::invalid_argument for an anisotropic BRDF, options out of range (naming the option
 // and the accepted range), or a BRDF that is NaN, infinite or zero where the tables sample it.
 std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions& options = {});
