@@ -1593,7 +1593,14 @@ TEST_F(CliTest, RenderTimeBudgetEndsALargeFirstPass) {
   EXPECT_NE(r.err.find("the time budget of 0.2 s ran out before every pixel had one sample"),
             std::string::npos)
       << r.err;
-  EXPECT_LT(cpu, 2.0);
+  // Start-up and the environment's tables cost ~1 s of CPU in release and ~2 s under
+  // AddressSanitizer, where the full pass also costs several times its release 7.5 s.
+#if defined(__SANITIZE_ADDRESS__)
+  constexpr double kBound = 6.0;
+#else
+  constexpr double kBound = 2.0;
+#endif
+  EXPECT_LT(cpu, kBound);
   EXPECT_FALSE(fs::exists(path("a.exr")));
 }
 
