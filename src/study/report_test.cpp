@@ -46,6 +46,27 @@ BrdfResult fake(const std::string& label, bool isotropic) {
   return b;
 }
 
+// The settings the fakes were "studied" with (the report reads budgets and environments).
+StudyConfig config_of_fakes() {
+  StudyConfig c;
+  c.budgets = {1000, 1000000};
+  c.image_budget = 1000;
+  c.environments.push_back({"sky", nullptr});  // only its label is used by the report
+  return c;
+}
+
+// The network fitted to a measured file: the same material, its parameterizations' numbers in
+// the reverse order (so that its lowest errors are spherical's where the file's are halfdiff's).
+BrdfResult network_of(const BrdfResult& file) {
+  BrdfResult network = file;
+  network.label = "nbrdf:" + file.label.substr(file.label.find(':') + 1);
+  for (std::size_t i = 0; i < kStudied.size(); ++i) {
+    network.params[i] = file.params[kStudied.size() - 1 - i];
+    network.params[i].space = kStudied[i];
+  }
+  return network;
+}
+
 TEST(Report, FilesRepeatTheResults) {
   const test::TempDir tmp;
   const std::filesystem::path& dir = tmp.path();
@@ -188,17 +209,8 @@ TEST(Report, MarkdownToHtml) {
 // errors are halfdiff's, the network's spherical's (its values in the reverse order).
 TEST(Report, FilesBesideTheirNetworks) {
   const test::TempDir tmp;
-  StudyConfig c;
-  c.budgets = {1000, 1000000};
-  c.image_budget = 1000;
-  c.environments.push_back({"sky", nullptr});
-  const BrdfResult file = fake("rgl:felt_rgb", true);
-  BrdfResult network = file;
-  network.label = "nbrdf:felt_rgb";
-  for (std::size_t i = 0; i < kStudied.size(); ++i) {
-    network.params[i] = file.params[kStudied.size() - 1 - i];
-    network.params[i].space = kStudied[i];
-  }
+  const StudyConfig c = config_of_fakes();
+  const BrdfResult file = fake("rgl:felt_rgb", true), network = network_of(file);
   const StudyOutput out = write_study(tmp.path(), {file, fake("lambert", true), network}, c, 1.0);
   const std::string& md = out.markdown;
   EXPECT_NE(md.find("## 5. Measured files and their neural BRDFs"), std::string::npos) << md;
@@ -220,17 +232,8 @@ TEST(Report, SummaryGroupsTheBrdfsByKind) {
   // A file where halfdiff wins, its network where spherical wins (the parameterizations' numbers
   // reversed), and a model like the file: per kind and over all, the medians and the wins.
   const test::TempDir tmp;
-  StudyConfig c;
-  c.budgets = {1000, 1000000};
-  c.image_budget = 1000;
-  c.environments.push_back({"sky", nullptr});
-  const BrdfResult file = fake("rgl:felt_rgb", true);
-  BrdfResult network = file;
-  network.label = "nbrdf:felt_rgb";
-  for (std::size_t i = 0; i < kStudied.size(); ++i) {
-    network.params[i] = file.params[kStudied.size() - 1 - i];
-    network.params[i].space = kStudied[i];
-  }
+  const StudyConfig c = config_of_fakes();
+  const BrdfResult file = fake("rgl:felt_rgb", true), network = network_of(file);
   const StudyOutput out = write_study(tmp.path(), {file, fake("ggx", true), network}, c, 1.0);
   const std::string& md = out.markdown;
   const std::size_t summary = md.find("## Summary"), azimuthal = md.find("## 1.");
