@@ -350,14 +350,11 @@ struct ReportPlots {
 };
 
 figure::Scene designs_plot(const std::vector<BrdfResult>& results, const StudyConfig& config);
-figure::Scene summary_plot(const std::vector<BrdfResult>& results, const StudyConfig& config,
-                           const Contents& has);
 
 ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
                          const Contents& has) {
   const std::string es(name_of(config.space));
   ReportPlots p;
-  p.summary = summary_plot(results, config, has);
   p.azimuthal = figure::bar_chart(azimuthal_chart(results, es));
   p.separability = figure::bar_chart(separability_chart(results, es));
   if (has.gonio) p.gonio = gonio_chart(results, false, config);
@@ -1068,25 +1065,30 @@ std::string kind_of(const std::string& label) {
 // INFINITY where it was not measured.
 struct SummaryMetric {
   std::string name;
+  std::string chart_row;  // the metric's rows in the summary plot ("own", "best"); empty: none
   std::vector<std::array<double, kStudied.size()>> values;
 };
 
 std::vector<SummaryMetric> summary_metrics(const std::vector<BrdfResult>& results,
                                            const StudyConfig& config, const Contents& has) {
   const std::size_t ref = has.gonio ? reference_budget(config) : 0;
-  std::vector<SummaryMetric> m(3);
-  m[0].name = "azimuthal dependence";
-  m[1].name = "separability (rank 1, 2D projection)";
-  m[2].name = fmt::format("gonio-reflectometer, N = {}, own regular design", ref);
+  SummaryMetric azimuthal{"azimuthal dependence", "", {}},
+      separability{"separability (rank 1, 2D projection)", "", {}},
+      own{fmt::format("gonio-reflectometer, N = {}, own regular design", ref), "own", {}},
+      image{"image-space relative RMSE (regular design)", "", {}};
   for (const BrdfResult& b : results) {
     const auto v = metric_values(b, ref);
-    for (std::size_t k = 0; k < 3; ++k) m[k].values.push_back(v[k]);
+    azimuthal.values.push_back(v[0]);
+    separability.values.push_back(v[1]);
+    own.values.push_back(v[2]);
+    image.values.push_back(v[3]);
   }
-  if (!has.gonio) m.pop_back();
+  std::vector<SummaryMetric> m{std::move(azimuthal), std::move(separability)};
+  if (has.gonio) m.push_back(std::move(own));
   const DesignComparison c = has.gonio ? compare_designs(results, ref) : DesignComparison{};
   if (c.keys.size() >= 2 && !c.brdfs.empty()) {
-    SummaryMetric best{fmt::format("gonio-reflectometer, N = {}, each in its best design", ref),
-                       {}};
+    SummaryMetric best{
+        fmt::format("gonio-reflectometer, N = {}, each in its best design", ref), "best", {}};
     for (const BrdfResult& b : results) {
       best.values.emplace_back();
       best.values.back().fill(INFINITY);
@@ -1096,11 +1098,7 @@ std::vector<SummaryMetric> summary_metrics(const std::vector<BrdfResult>& result
     }
     m.push_back(std::move(best));
   }
-  if (has.images) {
-    SummaryMetric image{"image-space relative RMSE (regular design)", {}};
-    for (const BrdfResult& b : results) image.values.push_back(metric_values(b, ref)[3]);
-    m.push_back(std::move(image));
-  }
+  if (has.images) m.push_back(std::move(image));
   return m;
 }
 
@@ -1164,10 +1162,10 @@ std::string summary_table(
 }
 
 // The gonio-reflectometer's median per kind, in the own regular design and in the best ones.
-figure::Scene summary_plot(const std::vector<BrdfResult>& results, const StudyConfig& config,
+figure::Scene summary_plot(const std::vector<BrdfResult>& results,
+                           const std::vector<SummaryMetric>& metrics, const StudyConfig& config,
                            const Contents& has) {
   if (!has.gonio) return {};
-  const std::vector<SummaryMetric> metrics = summary_metrics(results, config, has);
   figure::BarChart chart;
   chart.title = fmt::format("Gonio-reflectometer at N = {}: median relative error per kind",
                             reference_budget(config));
@@ -1175,11 +1173,10 @@ figure::Scene summary_plot(const std::vector<BrdfResult>& results, const StudyCo
   for (Space s : kStudied) chart.series.emplace_back(name_of(s));
   for (const auto& [kind, rows] : kinds_of(results))
     for (const SummaryMetric& m : metrics) {
-      if (!m.name.starts_with("gonio")) continue;
+      if (m.chart_row.empty()) continue;
       const auto [med, n] = medians(m, rows);
       if (n == 0) continue;
-      const bool best = m.name.ends_with("best design");
-      chart.rows.push_back(fmt::format("{} ({}), {}", kind, n, best ? "best" : "own"));
+      chart.rows.push_back(fmt::format("{} ({}), {}", kind, n, m.chart_row));
       chart.values.emplace_back(med.begin(), med.end());
     }
   if (chart.rows.empty()) return {};
@@ -1189,8 +1186,8 @@ figure::Scene summary_plot(const std::vector<BrdfResult>& results, const StudyCo
 }
 
 // The summary section: per metric, each kind's median error and wins per parameterization.
-std::string summary_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
-                            const Contents& has, const ReportPlots& plots) {
+std::string summary_section(const std::vector<BrdfResult>& results,
+                            const std::vector<SummaryMetric>& metrics, const ReportPlots& plots) {
   const auto kinds = kinds_of(results);
   std::string md =
       "## Summary\n\nFor each kind of BRDF and each metric below: the median relative error of "
@@ -1198,8 +1195,7 @@ std::string summary_section(const std::vector<BrdfResult>& results, const StudyC
       "parentheses the number of BRDFs on which it has the lowest error (ties count for each). "
       "The lowest median is in bold. The kind comes from the label (the reader's prefix for a "
       "file; a model's spec is a model).\n\n";
-  for (const SummaryMetric& m : summary_metrics(results, config, has))
-    md += summary_table(m, kinds);
+  for (const SummaryMetric& m : metrics) md += summary_table(m, kinds);
   return md + plot_link(plots.summary, "Summary", "summary");
 }
 
@@ -1219,9 +1215,11 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
   const Contents has = contents_of(results);
   write_csv_files(dir, csv_tables(results, config), has, out.files);
 
-  const ReportPlots plots = report_plots(results, config, has);
+  const std::vector<SummaryMetric> summary = summary_metrics(results, config, has);
+  ReportPlots plots = report_plots(results, config, has);
+  plots.summary = summary_plot(results, summary, config, has);
   std::string md = report_header(results, config, has.anisotropic, seconds) +
-                   summary_section(results, config, has, plots) +
+                   summary_section(results, summary, plots) +
                    azimuthal_section(results, has.anisotropic) +
                    separability_section(results, config, has.anisotropic);
   if (has.gonio)
