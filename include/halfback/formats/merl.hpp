@@ -136,13 +136,18 @@ class MerlBrdf final : public Brdf {
   const MerlOptions& options() const { return options_; }
 
  private:
-  struct Corners;  // the 8 bins around a point and their trilinear weights
   Rgb nearest(double theta_h, double theta_d, double phi_d) const;
   Rgb nearest_at(std::size_t bin) const;
-  Corners corners(double theta_h, double theta_d, double phi_d) const;
-  Rgb blend(const Corners& c) const;
   Rgb trilinear(double theta_h, double theta_d, double phi_d) const;
   void eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const;
+  struct Coordinates {  // of a block's rows; `apart`: the row goes through eval()
+    const double *theta_h, *theta_d, *phi_d;
+    const bool* apart;
+  };
+  void nearest_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
+                     const Coordinates& c) const;
+  void trilinear_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
+                       const Coordinates& c) const;
 
   MerlData data_;
   std::unique_ptr<merl::BinValues[], merl::FreeBinTable> bins_;  // data_.values, one slot a bin
