@@ -369,88 +369,117 @@ Rgb MerlBrdf::eval(const DirPair<double>& pair) const {
 }
 
 namespace {
+
 // Rows per block of eval_batch: the coordinates, bins and cells of a block stay in L1/L2 while
 // its table reads are in flight.
 constexpr std::size_t kBlock = 256;
-// Rows per chunk of the trilinear reads: the lines of the next chunk are prefetched while a chunk
-// is blended (32 rows, up to 256 lines: they stay in L1 until read).
-constexpr std::size_t kChunk = 32;
 constexpr std::uint32_t kScalarRow = 0xffffffffu;  // a row left to eval()
-}  // namespace
 
-// One block: the isotropic halfdiff coordinates (θh, θd, φd) of every pair by the SIMD conversion
-// (the φh that the lookups do not use is not computed), then the lookups. Rows the conversion
-// rejects (NaN, not unit) or below the horizon go through eval(), which gives them its exact
-// values (NaN or 0); so do pairs with ωi + ωo along the normal, whose φd the isotropic form sets to
-// 0 (eval() keeps the full form's).
-void MerlBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
+// The isotropic halfdiff coordinates (θh, θd, φd) of a block's rows, and which rows go through
+// eval().
+struct Coordinates {
+  alignas(64) double q[3][kBlock];
+  bool apart[kBlock];
+};
+
+// The coordinates by the SIMD conversion (the φh that the lookups do not use is not computed).
+// Rows the conversion rejects (NaN, not unit) or below the horizon are left to eval(), which
+// gives them its exact values (NaN or 0); so are pairs with ωi + ωo along the normal, whose φd the
+// isotropic form sets to 0 (eval() keeps the full form's).
+void convert_block(std::span<const DirPair<double>> pairs, Coordinates& c) {
   static_assert(sizeof(DirPair<double>) == 6 * sizeof(double), "pairs are rows of 6 doubles");
   const std::size_t m = pairs.size();
   const double* rows = &pairs[0].wi.x;
   const ConstColumn<double> in[6] = {{rows, 6},     {rows + 1, 6}, {rows + 2, 6},
                                      {rows + 3, 6}, {rows + 4, 6}, {rows + 5, 6}};
-  alignas(64) double q[3][kBlock];
   alignas(64) std::uint8_t valid[kBlock];
-  const Column<double> cols[3] = {{q[0], 1}, {q[1], 1}, {q[2], 1}};
+  const Column<double> cols[3] = {{c.q[0], 1}, {c.q[1], 1}, {c.q[2], 1}};
   convert<double>(Form{Space::dirs}, Form{Space::halfdiff, true}, in, m,
                   ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
-  bool apart[kBlock];
   for (std::size_t i = 0; i < m; ++i) {
     const DirPair<double>& p = pairs[i];
-    apart[i] =
+    c.apart[i] =
         !valid[i] || p.wi.z < 0 || p.wo.z < 0 || (p.wi.x + p.wo.x == 0 && p.wi.y + p.wo.y == 0);
   }
-  const Coordinates c{q[0], q[1], q[2], apart};
-  if (options_.lookup == MerlLookup::nearest)
-    nearest_block(pairs, out, c);
-  else
-    trilinear_block(pairs, out, c);
 }
 
-// The bins of every row, their table reads prefetched in a loop of their own (interleaved with
-// the index arithmetic, the prefetches stalled it: 2.2x slower), then the values.
-void MerlBrdf::nearest_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
-                             const Coordinates& c) const {
-  const std::size_t m = pairs.size();
-  std::uint32_t bin[kBlock];
-  for (std::size_t i = 0; i < m; ++i) {
-    if (c.apart[i]) {
-      bin[i] = kScalarRow;
-      continue;
-    }
-    const merl::BinIndex b = merl::bin_of(c.theta_h[i], c.theta_d[i], c.phi_d[i]);
-    bin[i] = static_cast<std::uint32_t>(merl::bin(b.theta_h, b.theta_d, b.phi_d));
-  }
-  for (std::size_t i = 0; i < m; ++i)
-    if (bin[i] != kScalarRow) __builtin_prefetch(&bins_[bin[i]]);
-  for (std::size_t i = 0; i < m; ++i)
-    out[i] = bin[i] == kScalarRow ? eval(pairs[i]) : nearest_at(bin[i]);
-}
-
-// The cells of every row, their corners prefetched in a loop of their own, then the blends.
-void MerlBrdf::trilinear_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
-                               const Coordinates& c) const {
-  const std::size_t m = pairs.size();
+// A block of the trilinear pipeline: its rows, their cells, which rows go through eval().
+struct TrilinearBlock {
+  std::size_t first = 0, m = 0;
   Cell cell[kBlock];
-  for (std::size_t i = 0; i < m; ++i)
-    cell[i] = cell_of(c.theta_h[i], c.theta_d[i], c.phi_d[i]);  // in range even for NaN
+  bool apart[kBlock];
+};
+
+}  // namespace
+
+// Per block: the bins of every row, their table reads prefetched in a loop of their own
+// (interleaved with the index arithmetic, the prefetches stalled it: 2.2x slower), then the values.
+void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
+                              std::size_t begin, std::size_t end) const {
+  Coordinates c;
+  std::uint32_t bin[kBlock];
+  for (std::size_t b = begin; b < end; ++b) {
+    const std::size_t first = b * kBlock, m = std::min(kBlock, pairs.size() - first);
+    convert_block(pairs.subspan(first, m), c);
+    for (std::size_t i = 0; i < m; ++i) {
+      const merl::BinIndex k = merl::bin_of(c.q[0][i], c.q[1][i], c.q[2][i]);
+      bin[i] = c.apart[i] ? kScalarRow
+                          : static_cast<std::uint32_t>(merl::bin(k.theta_h, k.theta_d, k.phi_d));
+    }
+    for (std::size_t i = 0; i < m; ++i)
+      if (bin[i] != kScalarRow) __builtin_prefetch(&bins_[bin[i]]);
+    for (std::size_t i = 0; i < m; ++i)
+      out[first + i] = bin[i] == kScalarRow ? eval(pairs[first + i]) : nearest_at(bin[i]);
+  }
+}
+
+// Blocks in a pipeline: the corners of a block are prefetched row by row between the blends of
+// the previous block, so that the blends' arithmetic (and the next block's conversion) runs while
+// the table reads are in flight.
+void MerlBrdf::trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
+                                std::size_t begin, std::size_t end) const {
   const merl::BinValues* table = bins_.get();
-  prefetch_cells(table, cell, c.apart, 0, m);
-  for (std::size_t i = 0; i < m; ++i) out[i] = c.apart[i] ? eval(pairs[i]) : blend(table, cell[i]);
+  Coordinates c;
+  TrilinearBlock stage[2];
+  const TrilinearBlock* previous = nullptr;
+  auto finish = [&](const TrilinearBlock& t, std::size_t i) {
+    const std::size_t row = t.first + i;
+    out[row] = t.apart[i] ? eval(pairs[row]) : blend(table, t.cell[i]);
+  };
+  for (std::size_t b = begin; b < end; ++b) {
+    TrilinearBlock& t = stage[(b - begin) % 2];
+    t.first = b * kBlock;
+    t.m = std::min(kBlock, pairs.size() - t.first);
+    convert_block(pairs.subspan(t.first, t.m), c);
+    for (std::size_t i = 0; i < t.m; ++i) {
+      t.apart[i] = c.apart[i];
+      t.cell[i] = cell_of(c.q[0][i], c.q[1][i], c.q[2][i]);  // in range even for NaN
+    }
+    const std::size_t mp = previous ? previous->m : 0;
+    for (std::size_t i = 0; i < std::max(t.m, mp); ++i) {
+      if (i < t.m) prefetch_cells(table, t.cell, t.apart, i, i + 1);
+      if (i < mp) finish(*previous, i);
+    }
+    previous = &t;
+  }
+  if (previous)
+    for (std::size_t i = 0; i < previous->m; ++i) finish(*previous, i);
 }
 
 void MerlBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
   if (out.size() != pairs.size())
     throw std::invalid_argument("MerlBrdf::eval_batch: " + std::to_string(pairs.size()) +
                                 " pairs but " + std::to_string(out.size()) + " outputs");
-  // Tasks of 16 blocks (tens of microseconds, well above the start-up of a thread); blocks start
-  // at multiples of kBlock whatever the split, as the batch engine's tiles do.
+  // Tasks of 4 blocks at most (1024 rows, 50-90 µs on a core: well above the cost of a task, and
+  // fine enough that the last task leaves the other thread idle for a few percent of a 65536-row
+  // batch at most; 16 blocks left it up to 12 %). Blocks start at multiples of kBlock whatever
+  // the split, as the batch engine's tiles do.
   const std::size_t n = pairs.size(), blocks = (n + kBlock - 1) / kBlock;
-  parallel_for(blocks, 16, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t b = begin; b < end; ++b) {
-      const std::size_t first = b * kBlock, m = std::min(kBlock, n - first);
-      eval_block(pairs.subspan(first, m), out.subspan(first, m));
-    }
+  parallel_for(blocks, 4, [&](std::size_t begin, std::size_t end) {
+    if (options_.lookup == MerlLookup::nearest)
+      nearest_blocks(pairs, out, begin, end);
+    else
+      trilinear_blocks(pairs, out, begin, end);
   });
 }
 

@@ -139,15 +139,11 @@ class MerlBrdf final : public Brdf {
   Rgb nearest(double theta_h, double theta_d, double phi_d) const;
   Rgb nearest_at(std::size_t bin) const;
   Rgb trilinear(double theta_h, double theta_d, double phi_d) const;
-  void eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const;
-  struct Coordinates {  // of a block's rows; `apart`: the row goes through eval()
-    const double *theta_h, *theta_d, *phi_d;
-    const bool* apart;
-  };
-  void nearest_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
-                     const Coordinates& c) const;
-  void trilinear_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
-                       const Coordinates& c) const;
+  // eval_batch over blocks [begin, end) of kBlock rows (merl.cpp).
+  void nearest_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out, std::size_t begin,
+                      std::size_t end) const;
+  void trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
+                        std::size_t begin, std::size_t end) const;
 
   MerlData data_;
   std::unique_ptr<merl::BinValues[], merl::FreeBinTable> bins_;  // data_.values, one slot a bin
