@@ -410,27 +410,44 @@ struct TrilinearBlock {
   bool apart[kBlock];
 };
 
+// A block of the nearest-bin pipeline: its rows and their bins (kScalarRow: through eval()).
+struct NearestBlock {
+  std::size_t first = 0, m = 0;
+  std::uint32_t bin[kBlock];
+};
+
 }  // namespace
 
-// Per block: the bins of every row, their table reads prefetched in a loop of their own
-// (interleaved with the index arithmetic, the prefetches stalled it: 2.2x slower), then the values.
+// Blocks in a pipeline, as trilinear_blocks below: a block's slots are prefetched row by row
+// between the reads of the previous block's values.
 void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                               std::size_t begin, std::size_t end) const {
   Coordinates c;
-  std::uint32_t bin[kBlock];
+  NearestBlock stage[2];
+  const NearestBlock* previous = nullptr;
+  auto finish = [&](const NearestBlock& t, std::size_t i) {
+    const std::size_t row = t.first + i;
+    out[row] = t.bin[i] == kScalarRow ? eval(pairs[row]) : nearest_at(t.bin[i]);
+  };
   for (std::size_t b = begin; b < end; ++b) {
-    const std::size_t first = b * kBlock, m = std::min(kBlock, pairs.size() - first);
-    convert_block(pairs.subspan(first, m), c);
-    for (std::size_t i = 0; i < m; ++i) {
-      const merl::BinIndex k = merl::bin_of(c.q[0][i], c.q[1][i], c.q[2][i]);
-      bin[i] = c.apart[i] ? kScalarRow
-                          : static_cast<std::uint32_t>(merl::bin(k.theta_h, k.theta_d, k.phi_d));
+    NearestBlock& t = stage[(b - begin) % 2];
+    t.first = b * kBlock;
+    t.m = std::min(kBlock, pairs.size() - t.first);
+    convert_block(pairs.subspan(t.first, t.m), c);
+    for (std::size_t i = 0; i < t.m; ++i) {
+      const std::size_t k =
+          merl::bin(theta_h_index(c.q[0][i]), theta_d_index(c.q[1][i]), phi_d_index(c.q[2][i]));
+      t.bin[i] = c.apart[i] ? kScalarRow : static_cast<std::uint32_t>(k);
     }
-    for (std::size_t i = 0; i < m; ++i)
-      if (bin[i] != kScalarRow) __builtin_prefetch(&bins_[bin[i]]);
-    for (std::size_t i = 0; i < m; ++i)
-      out[first + i] = bin[i] == kScalarRow ? eval(pairs[first + i]) : nearest_at(bin[i]);
+    const std::size_t mp = previous ? previous->m : 0;
+    for (std::size_t i = 0; i < std::max(t.m, mp); ++i) {
+      if (i < t.m && t.bin[i] != kScalarRow) __builtin_prefetch(&bins_[t.bin[i]]);
+      if (i < mp) finish(*previous, i);
+    }
+    previous = &t;
   }
+  if (previous)
+    for (std::size_t i = 0; i < previous->m; ++i) finish(*previous, i);
 }
 
 // Blocks in a pipeline: the corners of a block are prefetched row by row between the blends of
