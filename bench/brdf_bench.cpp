@@ -1,17 +1,21 @@
-// Measured-BRDF evaluation throughput (docs/performance.md, "BRDF evaluation"):
-//   MERL nearest-bin and trilinear lookups, per pair, batched on one core and batched over all
-//   threads (wall time, and the process's CPU time), against a
+// Measured-BRDF evaluation throughput (docs/performance.md, "Measured lookups"):
+//   MERL nearest-bin and trilinear lookups, per pair, and batched on one core, against a
 //   straightforward per-pair implementation of the MERL reference lookup (acos-based half/diff
 //   angles, Rodrigues rotations: src/formats/merl_reference.hpp) measured in the same run;
 //   RGL evaluations (../shared/data/rgl, skipped when absent), against RGL's own loader when the
 //   build is given a checkout of it (-DHALFBACK_RGL_REFERENCE_DIR=...); ALTA scattered data.
+//   The *_Threads/1 and /2 benchmarks run eval_batch in an arena of 1 or 2 threads and report wall
+//   time (and the process's CPU time, and their ratio: the threads kept busy), for the 2-thread
+//   speed-up: only meaningful on an otherwise idle machine (--benchmark_filter='_Threads/').
 // Every benchmark processes the same 65536 random direction pairs (fixed seed); items/s counts
 // pairs.
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <numbers>
 #include <random>
@@ -65,13 +69,28 @@ void run_single(benchmark::State& state, const Brdf& brdf) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
 }
 
-void run_batch(benchmark::State& state, const Brdf& brdf) {
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// eval_batch in an arena of state.range(0) threads, for wall time (UseRealTime). The counter
+// "busy_threads" is the process's CPU time over the wall time of the loop: about 2 when two
+// threads share the work on an idle machine, less when the machine's load delays one of them.
+void run_threads(benchmark::State& state, const Brdf& brdf) {
   const auto& p = pairs();
   std::vector<Rgb> out(p.size());
+  tbb::task_arena arena(static_cast<int>(state.range(0)));
+  const double cpu0 = process_cpu_seconds();
+  const auto wall0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
-    brdf.eval_batch(p, out);
+    arena.execute([&] { brdf.eval_batch(p, out); });
     benchmark::DoNotOptimize(out.data());
   }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  state.counters["busy_threads"] = wall > 0 ? (process_cpu_seconds() - cpu0) / wall : 0;
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
 }
 
@@ -115,11 +134,13 @@ void BM_MerlNearest_BatchOneCore(benchmark::State& state) {
 }
 BENCHMARK(BM_MerlNearest_BatchOneCore)->Unit(benchmark::kMillisecond);
 
-void BM_MerlNearest_Batch(benchmark::State& state) {
+void BM_MerlNearest_Threads(benchmark::State& state) {
   static const MerlBrdf brdf(merl_data(), {MerlLookup::nearest});
-  run_batch(state, brdf);
+  run_threads(state, brdf);
 }
-BENCHMARK(BM_MerlNearest_Batch)
+BENCHMARK(BM_MerlNearest_Threads)
+    ->Arg(1)
+    ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
@@ -136,11 +157,13 @@ void BM_MerlTrilinear_BatchOneCore(benchmark::State& state) {
 }
 BENCHMARK(BM_MerlTrilinear_BatchOneCore)->Unit(benchmark::kMillisecond);
 
-void BM_MerlTrilinear_Batch(benchmark::State& state) {
+void BM_MerlTrilinear_Threads(benchmark::State& state) {
   static const MerlBrdf brdf(merl_data(), {MerlLookup::trilinear});
-  run_batch(state, brdf);
+  run_threads(state, brdf);
 }
-BENCHMARK(BM_MerlTrilinear_Batch)
+BENCHMARK(BM_MerlTrilinear_Threads)
+    ->Arg(1)
+    ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
@@ -187,11 +210,16 @@ void BM_Rgl_OneThread(benchmark::State& state) {
 }
 BENCHMARK(BM_Rgl_OneThread)->Unit(benchmark::kMillisecond);
 
-void BM_Rgl_Batch(benchmark::State& state) {
+void BM_Rgl_Threads(benchmark::State& state) {
   if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");
-  run_batch(state, *rgl());
+  run_threads(state, *rgl());
 }
-BENCHMARK(BM_Rgl_Batch)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+BENCHMARK(BM_Rgl_Threads)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 void BM_Rgl_BatchOneCore(benchmark::State& state) {
   if (!rgl()) return state.SkipWithError("../shared/data/rgl not found");

@@ -563,6 +563,65 @@ TEST(MerlBatch, TrilinearFollowsEval) {
   }
 }
 
+// Pairs at given (θh, θd, φd), φh random: the ends of the clamped axes and the φd wrap, where the
+// trilinear cell's corners are chosen differently from the interior.
+std::vector<DirPair<double>> pairs_at_the_ends() {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<DirPair<double>> p;
+  const double eps = 1e-9, top = kPi / 2;
+  for (double th : {0.0, 1e-12, 0.5 * std::pow(0.5 / 90, 2) * top, 0.3, top * (1 - 1e-4)})
+    for (double td : {0.0, 1e-12, 0.25 / 90 * top, 0.4, top * (89.6 / 90)})
+      for (double pd : {0.0, eps, 0.5 / 180 * kPi, kPi - eps, kPi, kPi + eps, 2 * kPi - eps}) {
+        const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{th, 2 * kPi * u(rng), td, pd});
+        if (s.in_domain && s.pair.wi.z >= 0 && s.pair.wo.z >= 0) p.push_back(s.pair);
+      }
+  return p;
+}
+
+TEST(MerlBatch, TrilinearAtTheEndsWithHolesAndWithoutData) {
+  MerlData data;
+  data.values.resize(3 * merl::kBins);
+  for (std::size_t i = 0; i < merl::kBins; ++i)
+    for (int ch = 0; ch < 3; ++ch)
+      data.values[ch * merl::kBins + i] = 2.0 + std::sin(1e-3 * double(i) + ch);
+  const MerlBrdf tri(data, {MerlLookup::trilinear});
+  const auto ends = pairs_at_the_ends();
+  ASSERT_GT(ends.size(), 100u);
+  std::vector<Rgb> batch(ends.size());
+  tri.eval_batch(ends, batch);
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    const Rgb one = tri.eval(ends[i]);
+    EXPECT_NEAR(batch[i].r, one.r, 1e-9 * std::abs(one.r)) << i;
+    EXPECT_NEAR(batch[i].b, one.b, 1e-9 * std::abs(one.b)) << i;
+  }
+  // A constant with holes stays constant through the batch's renormalized weights; a table with
+  // no measured bin gives missing values (NaN), not its negative stored ones.
+  MerlData holes;
+  holes.values.assign(3 * merl::kBins, 1500.0);
+  for (std::size_t i = 0; i < merl::kBins; i += 3) holes.values[merl::kBins + i] = -1;  // green
+  const MerlBrdf with_holes(holes, {MerlLookup::trilinear});
+  MerlData empty;
+  empty.values.assign(3 * merl::kBins, -2.0);
+  const MerlBrdf no_data(empty, {MerlLookup::trilinear});
+  auto pairs = batch_pairs();
+  pairs.insert(pairs.end(), ends.begin(), ends.end());
+  std::vector<Rgb> a(pairs.size()), b(pairs.size());
+  with_holes.eval_batch(pairs, a);
+  no_data.eval_batch(pairs, b);
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const bool nan = std::isnan(pairs[i].wi.z + pairs[i].wi.x + pairs[i].wi.y + pairs[i].wo.x +
+                                pairs[i].wo.y + pairs[i].wo.z);
+    if (nan || pairs[i].wi.z < 0 || pairs[i].wo.z < 0) continue;
+    ++checked;
+    EXPECT_NEAR(a[i].r, 1.0, 1e-12) << i;
+    EXPECT_NEAR(a[i].g, 1.15, 1e-12) << i;
+    EXPECT_TRUE(std::isnan(b[i].r) && std::isnan(b[i].g) && std::isnan(b[i].b)) << i;
+  }
+  EXPECT_GT(checked, 20000u);
+}
+
 TEST(MerlBatch, SameResultWhateverTheSplit) {
   // Rows land in other SIMD lanes, blocks and threads when the batch starts elsewhere: their
   // values must not change.

@@ -136,13 +136,14 @@ class MerlBrdf final : public Brdf {
   const MerlOptions& options() const { return options_; }
 
  private:
-  struct Corners;  // the 8 bins around a point and their trilinear weights
   Rgb nearest(double theta_h, double theta_d, double phi_d) const;
   Rgb nearest_at(std::size_t bin) const;
-  Corners corners(double theta_h, double theta_d, double phi_d) const;
-  Rgb blend(const Corners& c) const;
   Rgb trilinear(double theta_h, double theta_d, double phi_d) const;
-  void eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const;
+  // eval_batch over blocks [begin, end) of kBlock rows (merl.cpp).
+  void nearest_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out, std::size_t begin,
+                      std::size_t end) const;
+  void trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
+                        std::size_t begin, std::size_t end) const;
 
   MerlData data_;
   std::unique_ptr<merl::BinValues[], merl::FreeBinTable> bins_;  // data_.values, one slot a bin
