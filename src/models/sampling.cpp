@@ -201,6 +201,14 @@ double Microfacet::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
   return distribution(m) * m.z / (4 * dot(wo, m));
 }
 
+void Microfacet::pdf_batch(std::span<const DirPair<double>> pairs, std::span<double> out) const {
+  if (out.size() != pairs.size()) {
+    Brdf::pdf_batch(pairs, out);  // the size check
+    return;
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Microfacet::pdf(pairs[i].wo, pairs[i].wi);
+}
+
 // --- ABC
 // ------------------------------------------------------------------------------------------ The
 // specular lobe is S(f), f = ‖ωi_xy + ωo_xy‖: in the plane of projected directions it is a radial
