@@ -505,7 +505,8 @@ void EnvMap::map_coordinates(const Vec3<double>& d, double& u, double& v) {
 }
 
 // The map is turned by +rotation about +y, so a world direction is looked up turned by −rotation.
-Vec3<double> EnvMap::to_map(const Vec3<double>& w) const {
+// Inline: the loops of pixels_of vectorize with them.
+[[gnu::always_inline]] inline Vec3<double> EnvMap::to_map(const Vec3<double>& w) const {
   return {cos_rot_ * w.x - sin_rot_ * w.z, w.y, sin_rot_ * w.x + cos_rot_ * w.z};
 }
 Vec3<double> EnvMap::to_world(const Vec3<double>& m) const {
@@ -533,7 +534,7 @@ namespace {
 
 // The guess: the bucket of cos θ in the rows' guide table, φ by approx_atan2 as a fractional
 // column. No branches.
-EnvMap::Guess EnvMap::guess(const Vec3<double>& d) const {
+[[gnu::always_inline]] inline EnvMap::Guess EnvMap::guess(const Vec3<double>& d) const {
   const double rho2 = d.x * d.x + d.z * d.z, len = std::sqrt(rho2 + d.y * d.y);
   const double t = 0.5 * (1 - d.y / len);
   Guess g;

@@ -415,8 +415,9 @@ TEST(Renderer, UniformBackgroundPixelsAreExact) {
         ++mixed;
         EXPECT_NEAR(value, mean, 0.15 * (hi - lo)) << x << "," << y;
         // A straddling pixel is not one map value alone, unless that value dominates the mean.
-        if (std::min(mean - lo, hi - mean) > 0.2 * (hi - lo))
+        if (std::min(mean - lo, hi - mean) > 0.2 * (hi - lo)) {
           EXPECT_TRUE(std::abs(value - lo) > 1e-6 && std::abs(value - hi) > 1e-6) << x << "," << y;
+        }
       }
     }
   EXPECT_GT(uniform, 300);
