@@ -283,6 +283,13 @@ struct Warp {
   // starting from a guide's bucket and stepping.
   template <class Value>
   static std::size_t step_from(std::size_t k, std::size_t last, double x, Value value) {
+    // Mostly the answer is among k .. k + 3: counted without branches (the values are
+    // non-decreasing, so those below x are a prefix) and checked; else, the steps.
+    if (k + 4 <= last) {
+      const std::size_t i = k + std::size_t(value(k + 1) < x) + std::size_t(value(k + 2) < x) +
+                            std::size_t(value(k + 3) < x);
+      if (((k == 0) | (value(k) < x)) && !(value(i + 1) < x)) return i;
+    }
     while (k + 1 <= last && value(k + 1) < x) ++k;
     while (k > 0 && !(value(k) < x)) --k;
     return k;
@@ -330,7 +337,11 @@ struct Warp {
       }
       return a;
     };
-    const std::size_t k = search(lo, hi);
+    // A bound range of up to 3 values (the common case) is counted without branches.
+    const std::size_t k = hi - lo <= 2
+                              ? lo + std::size_t((lo + 1 <= hi) & (f(std::min(lo + 1, hi)) < x)) +
+                                    std::size_t((lo + 2 <= hi) & (f(std::min(lo + 2, hi)) < x))
+                              : search(lo, hi);
     if ((k == 0 || f(k) < x) && (k == last || !(f(k + 1) < x))) return k;
     return search(0, last);
   }
