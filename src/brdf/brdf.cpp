@@ -31,6 +31,13 @@ void Brdf::sample_batch(std::span<const Vec3<double>> wo, std::span<const double
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = sample(wo[i], u1[i], u2[i]);
 }
 
+void Brdf::pdf_batch(std::span<const DirPair<double>> pairs, std::span<double> out) const {
+  if (out.size() != pairs.size())
+    throw std::invalid_argument("Brdf::pdf_batch: " + std::to_string(pairs.size()) + " pairs but " +
+                                std::to_string(out.size()) + " outputs");
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = pdf(pairs[i].wo, pairs[i].wi);
+}
+
 BrdfSample Brdf::sample(const Vec3<double>& wo, double u1, double u2) const {
   if (!(wo.z > 0)) return {};
   const Vec3<double> wi = sample_cosine_hemisphere(u1, u2);

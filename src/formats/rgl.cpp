@@ -248,6 +248,12 @@ struct Warp {
   std::size_t w = 0, h = 0;
   std::vector<Node> node;  // h·w per slice
   std::vector<Row> row;    // h per slice
+  // Guide tables (Chen and Asau 1974) of each slice's own CDFs: bucket k of the marginal's h
+  // buckets holds the last row j with M(j) < k/h, bucket k of a row's w buckets the last column i
+  // with C(j, i) < (k/w) R(j). They bound forward()'s searches of the blended CDFs (below).
+  std::vector<std::uint16_t> row_guide;  // h per slice
+  std::vector<std::uint16_t> col_guide;  // h·w per slice
+  bool guided = false;                   // w and h fit the guides' 16 bits
 
   // Builds the CDFs of slice values `data`; returns false when a slice integrates to 0.
   bool build(const std::vector<double>& data, std::size_t slices) {
@@ -269,7 +275,75 @@ struct Warp {
       for (std::size_t k = 0; k < w * h; ++k) node[s * w * h + k] = {in[k] / total, c[k] / total};
       for (std::size_t j = 0; j < h; ++j) row[s * h + j] = {m[j] / total, c[j * w + w - 1] / total};
     }
+    build_guides(slices);
     return true;
+  }
+
+  // The last k in [0, last] with value(k) < x (0 when there is none) for a non-decreasing value,
+  // starting from a guide's bucket and stepping.
+  template <class Value>
+  static std::size_t step_from(std::size_t k, std::size_t last, double x, Value value) {
+    // Mostly the answer is among k .. k + 3: counted without branches (the values are
+    // non-decreasing, so those below x are a prefix) and checked; else, the steps.
+    if (k + 4 <= last) {
+      const std::size_t i = k + std::size_t(value(k + 1) < x) + std::size_t(value(k + 2) < x) +
+                            std::size_t(value(k + 3) < x);
+      if (((k == 0) | (value(k) < x)) && !(value(i + 1) < x)) return i;
+    }
+    while (k + 1 <= last && value(k + 1) < x) ++k;
+    while (k > 0 && !(value(k) < x)) --k;
+    return k;
+  }
+
+  void build_guides(std::size_t slices) {
+    guided = w - 1 <= UINT16_MAX && h - 1 <= UINT16_MAX;
+    if (!guided) return;
+    row_guide.resize(slices * h);
+    col_guide.resize(slices * h * w);
+    for (std::size_t s = 0; s < slices; ++s) {
+      const Row* r = &row[s * h];
+      for (std::size_t k = 0, j = 0; k < h; ++k) {
+        j = step_from(j, h - 2, double(k) / double(h), [&](std::size_t q) { return r[q].m; });
+        row_guide[s * h + k] = std::uint16_t(j);
+      }
+      for (std::size_t j = 0; j < h; ++j) {
+        const Node* a = &node[(s * h + j) * w];
+        for (std::size_t k = 0, i = 0; k < w; ++k) {
+          i = step_from(i, w - 2, double(k) / double(w) * r[j].r,
+                        [&](std::size_t q) { return a[q].c; });
+          col_guide[(s * h + j) * w + k] = std::uint16_t(i);
+        }
+      }
+    }
+  }
+
+  // Bucket of u in [0, 1] among n.
+  static std::size_t bucket(double u, std::size_t n) {
+    return std::min(static_cast<std::size_t>(u * double(n)), n - 1);
+  }
+
+  // The last k in [0, last] with f(k) < x (0 when none), f non-decreasing: binary search in [lo,
+  // hi], where the slices' own answers put it, then a check of the answer's neighbours; should the
+  // bounds miss it by rounding, a search of everything. Returns what a search of [0, last] returns.
+  template <class F>
+  static std::size_t last_below(F f, double x, std::size_t lo, std::size_t hi, std::size_t last) {
+    auto search = [&](std::size_t a, std::size_t b) {
+      while (a < b) {
+        const std::size_t mid = (a + b + 1) / 2;
+        if (f(mid) < x)
+          a = mid;
+        else
+          b = mid - 1;
+      }
+      return a;
+    };
+    // A bound range of up to 3 values (the common case) is counted without branches.
+    const std::size_t k = hi - lo <= 2
+                              ? lo + std::size_t((lo + 1 <= hi) & (f(std::min(lo + 1, hi)) < x)) +
+                                    std::size_t((lo + 2 <= hi) & (f(std::min(lo + 2, hi)) < x))
+                              : search(lo, hi);
+    if ((k == 0 || f(k) < x) && (k == last || !(f(k + 1) < x))) return k;
+    return search(0, last);
   }
 
   double F(const Slices& s, std::size_t j, std::size_t i) const {
@@ -333,20 +407,53 @@ struct Warp {
     return u;
   }
 
-  // Sample -> point: inverts the marginal CDF in y, then the conditional CDF in x.
-  RglWarpPoint forward(const Slices& s, RglWarpPoint u) const {
+  // The bounds of the blended row search: each slice's own last row with M(j) < u.y (a blend of
+  // non-decreasing CDFs with weights summing to 1 crosses u.y between its slices' crossings).
+  void row_bounds(const Slices& s, double uy, std::size_t& lo, std::size_t& hi) const {
+    lo = h - 2;
+    hi = 0;
+    for (int n = 0; n < s.count; ++n) {
+      if (!(s.weight[n] > 0)) continue;
+      const Row* r = &row[s.index[n] * h];
+      const std::size_t j = step_from(row_guide[s.index[n] * h + bucket(uy, h)], h - 2, uy,
+                                      [&](std::size_t q) { return r[q].m; });
+      lo = std::min(lo, j);
+      hi = std::max(hi, j);
+    }
+    if (lo > hi) lo = 0, hi = h - 2;
+  }
+
+  // The same for the columns of rows j and j + 1 blended with weights 1 - ty and ty: each row's
+  // and slice's own last column with C(j, i) < u.x R(j).
+  void column_bounds(const Slices& s, std::size_t j, double ty, double ux, std::size_t& lo,
+                     std::size_t& hi) const {
+    lo = w - 2;
+    hi = 0;
+    for (int n = 0; n < s.count; ++n)
+      for (std::size_t d = 0; d < 2; ++d) {
+        if (!(s.weight[n] * (d ? ty : 1 - ty) > 0)) continue;
+        const std::size_t rj = s.index[n] * h + j + d;
+        const Node* a = &node[rj * w];
+        const double x = ux * row[rj].r;
+        const std::size_t i = step_from(col_guide[rj * w + bucket(ux, w)], w - 2, x,
+                                        [&](std::size_t q) { return a[q].c; });
+        lo = std::min(lo, i);
+        hi = std::max(hi, i);
+      }
+    if (lo > hi) lo = 0, hi = w - 2;
+  }
+
+  // Sample -> point: inverts the marginal CDF in y, then the conditional CDF in x. The searches
+  // find what binary searches of [0, h-2] and [0, w-2] find, within the slices' guided bounds.
+  // `use_guides` false: plain binary searches (the reference the tests compare with).
+  RglWarpPoint forward(const Slices& s, RglWarpPoint u, bool use_guides = true) const {
+    const bool guides = guided && use_guides;
     u.x = unit(u.x);
     u.y = unit(u.y);
     // Row: the last j in [0, h-2] with M(j) < u.y.
     std::size_t lo = 0, hi = h - 2;
-    while (lo < hi) {
-      const std::size_t mid = (lo + hi + 1) / 2;
-      if (M(s, mid) < u.y)
-        lo = mid;
-      else
-        hi = mid - 1;
-    }
-    const std::size_t j = lo;
+    if (guides) row_bounds(s, u.y, lo, hi);
+    const std::size_t j = last_below([&](std::size_t q) { return M(s, q); }, u.y, lo, hi, h - 2);
     const double r0 = R(s, j), r1 = R(s, j + 1);
     const double ty = solve_linear_density(r0, r1, u.y - M(s, j));
     // Column: the last i in [0, w-2] with C_ty(i) < u.x · R(ty).
@@ -354,14 +461,8 @@ struct Warp {
     auto ct = [&](std::size_t i) { return (1 - ty) * C(s, j, i) + ty * C(s, j + 1, i); };
     lo = 0;
     hi = w - 2;
-    while (lo < hi) {
-      const std::size_t mid = (lo + hi + 1) / 2;
-      if (ct(mid) < target)
-        lo = mid;
-      else
-        hi = mid - 1;
-    }
-    const std::size_t i = lo;
+    if (guides) column_bounds(s, j, ty, u.x, lo, hi);
+    const std::size_t i = last_below(ct, target, lo, hi, w - 2);
     const double c0 = (1 - ty) * F(s, j, i) + ty * F(s, j + 1, i);
     const double c1 = (1 - ty) * F(s, j, i + 1) + ty * F(s, j + 1, i + 1);
     const double sx = solve_linear_density(c0, c1, target - ct(i));
@@ -675,6 +776,10 @@ RglWarpPoint RglBrdf::vndf_forward(RglWarpPoint u, double theta_i, double phi_i)
   return impl_->vndf.forward(impl_->slices(phi_i, theta_i), u);
 }
 
+RglWarpPoint RglBrdf::vndf_forward_by_search(RglWarpPoint u, double theta_i, double phi_i) const {
+  return impl_->vndf.forward(impl_->slices(phi_i, theta_i), u, false);
+}
+
 double RglBrdf::vndf_density(RglWarpPoint p, double theta_i, double phi_i) const {
   return impl_->vndf.density(impl_->slices(phi_i, theta_i), p);
 }
@@ -849,6 +954,157 @@ void RglBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> 
       eval_block(pairs.subspan(first, count), out.subspan(first, count));
     }
   });
+}
+
+namespace {
+
+// Rows per block of sample_batch and pdf_batch (the renderer's batches are at most 16).
+constexpr std::size_t kSampleBlock = 64;
+
+// The spherical angles (θ, φ) of directions a and b, φ in (-π, π] as atan2 gives it, by the batch
+// engine's SIMD conversion; valid[k] = 0 where the pair is not one it accepts (not unit, below
+// the horizon).
+void angles_of(double (&dirs)[6][kSampleBlock], std::size_t n, double (&angle)[4][kSampleBlock],
+               std::uint8_t* valid) {
+  const ConstColumn<double> in[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
+                                     {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
+  const Column<double> cols[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
+  convert<double>(Form{Space::dirs}, Form{Space::spherical}, in, n,
+                  ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
+}
+
+// An azimuth near ±π, where the SIMD azimuth and atan2's may fall on either side of the seam (the
+// slices' weights jump there for data with several φi).
+bool near_pi(double phi) {
+  return std::abs(phi) > kPi - 1e-9;
+}
+
+}  // namespace
+
+void RglBrdf::sample_batch(std::span<const Vec3<double>> wo, std::span<const double> u1,
+                           std::span<const double> u2, std::span<BrdfSample> out) const {
+  if (wo.size() != out.size() || u1.size() != out.size() || u2.size() != out.size()) {
+    Brdf::sample_batch(wo, u1, u2, out);  // the size check
+    return;
+  }
+  for (std::size_t first = 0; first < out.size(); first += kSampleBlock) {
+    const std::size_t n = std::min(kSampleBlock, out.size() - first);
+    sample_block(wo.subspan(first, n), u1.subspan(first, n), u2.subspan(first, n),
+                 out.subspan(first, n));
+  }
+}
+
+// One block of sample(): the angles of ωo (flipped into the data's range) by the SIMD conversion,
+// the warps, then the normals' directions by the inverse conversion (spherical to directions).
+// Rows that sample() treats apart go through it: ωo at or below the horizon or along the normal,
+// not accepted by the conversion, an azimuth at the seam.
+void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const double> u1,
+                           std::span<const double> u2, std::span<BrdfSample> out) const {
+  const Impl& m = *impl_;
+  const std::size_t n = wo.size();
+  alignas(64) double dirs[6][kSampleBlock];
+  alignas(64) double angle[4][kSampleBlock];
+  alignas(64) std::uint8_t valid[kSampleBlock];
+  bool apart[kSampleBlock];
+  Flips flips[kSampleBlock];
+  for (std::size_t k = 0; k < n; ++k) {
+    flips[k] = flips_for(m.reduction, wo[k]);
+    const Vec3<double> g = flips[k].apply(wo[k]);
+    apart[k] = !(g.z > 0) || (g.x == 0 && g.y == 0);
+    dirs[0][k] = dirs[3][k] = g.x;
+    dirs[1][k] = dirs[4][k] = g.y;
+    dirs[2][k] = dirs[5][k] = g.z;
+  }
+  angles_of(dirs, n, angle, valid);
+  double pdf_u[kSampleBlock] = {}, um_x[kSampleBlock] = {};
+  for (std::size_t k = 0; k < n; ++k) {
+    const double phi_g = angle[1][k] > kPi ? angle[1][k] - 2 * kPi : angle[1][k];
+    apart[k] = apart[k] || !valid[k] || near_pi(phi_g);
+    if (apart[k]) continue;
+    const Slices s = m.slices(phi_g, angle[0][k]);
+    const RglWarpPoint um = m.vndf.forward(s, {u1[k], u2[k]});
+    pdf_u[k] = m.vndf.density(s, um);
+    um_x[k] = um.x;
+    // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
+    const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g : 0.0);
+    angle[0][k] = angle[2][k] = um.x * um.x * (kPi / 2);
+    angle[1][k] = angle[3][k] = phi_m < 0 ? phi_m + 2 * kPi : phi_m >= 2 * kPi ? 0.0 : phi_m;
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    if (apart[k]) angle[0][k] = angle[1][k] = angle[2][k] = angle[3][k] = 0;  // any valid angles
+  {
+    const ConstColumn<double> in[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
+    const Column<double> cols[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
+                                    {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
+    convert<double>(Form{Space::spherical}, Form{Space::dirs}, in, n,
+                    ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    if (apart[k] || !valid[k]) {
+      out[k] = sample(wo[k], u1[k], u2[k]);
+      continue;
+    }
+    const Vec3<double> g = flips[k].apply(wo[k]);
+    const Vec3<double> nm{dirs[0][k], dirs[1][k], dirs[2][k]};
+    const double dot = g.x * nm.x + g.y * nm.y + g.z * nm.z;
+    const Vec3<double> wi =
+        flips[k].apply({2 * dot * nm.x - g.x, 2 * dot * nm.y - g.y, 2 * dot * nm.z - g.z});
+    // sin θm = ‖nm_xy‖; the Jacobian of reflection_jacobian().
+    const double jacobian =
+        2 * kPi * kPi * um_x[k] * std::sqrt(nm.x * nm.x + nm.y * nm.y) * 4 * std::abs(dot);
+    out[k] = {wi, jacobian > 0 && wi.z > 0 ? pdf_u[k] / jacobian : 0.0};
+  }
+}
+
+void RglBrdf::pdf_batch(std::span<const DirPair<double>> pairs, std::span<double> out) const {
+  if (out.size() != pairs.size()) {
+    Brdf::pdf_batch(pairs, out);  // the size check
+    return;
+  }
+  for (std::size_t first = 0; first < out.size(); first += kSampleBlock) {
+    const std::size_t n = std::min(kSampleBlock, out.size() - first);
+    pdf_block(pairs.subspan(first, n), out.subspan(first, n));
+  }
+}
+
+// One block of pdf(): the angles of ωo and of the half vector (both flipped into the data's
+// range) by one SIMD conversion, then the density of the warp. Rows that pdf() treats apart go
+// through it: a direction at or below the horizon, ωo or the half vector along the normal, not
+// accepted by the conversion, an azimuth at a seam.
+void RglBrdf::pdf_block(std::span<const DirPair<double>> pairs, std::span<double> out) const {
+  const Impl& m = *impl_;
+  const std::size_t n = pairs.size();
+  alignas(64) double dirs[6][kSampleBlock];
+  alignas(64) double angle[4][kSampleBlock];
+  alignas(64) std::uint8_t valid[kSampleBlock];
+  bool apart[kSampleBlock];
+  for (std::size_t k = 0; k < n; ++k) {
+    const Flips flips = flips_for(m.reduction, pairs[k].wo);
+    const Vec3<double> g = flips.apply(pairs[k].wo), d = flips.apply(pairs[k].wi);
+    const double hx = g.x + d.x, hy = g.y + d.y, hz = g.z + d.z;
+    const double inverse_len = 1 / std::sqrt(hx * hx + hy * hy + hz * hz);
+    apart[k] = !(g.z > 0) || !(d.z > 0) || (g.x == 0 && g.y == 0) || (hx == 0 && hy == 0);
+    dirs[0][k] = g.x, dirs[1][k] = g.y, dirs[2][k] = g.z;
+    dirs[3][k] = hx * inverse_len, dirs[4][k] = hy * inverse_len, dirs[5][k] = hz * inverse_len;
+  }
+  angles_of(dirs, n, angle, valid);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double phi_g = angle[1][k] > kPi ? angle[1][k] - 2 * kPi : angle[1][k];
+    const double phi_m = angle[3][k] > kPi ? angle[3][k] - 2 * kPi : angle[3][k];
+    const double v = azimuth_u(phi_m, phi_g, m.isotropic);
+    if (apart[k] || !valid[k] || near_pi(phi_g) || near_seam(v)) {
+      out[k] = pdf(pairs[k].wo, pairs[k].wi);
+      continue;
+    }
+    const double theta_m = angle[2][k];
+    const RglWarpPoint um{std::sqrt(theta_m / (kPi / 2)), v};
+    const double pdf_u = m.vndf.density(m.slices(phi_g, angle[0][k]), um);
+    const double sin_m = std::sqrt(dirs[3][k] * dirs[3][k] + dirs[4][k] * dirs[4][k]);
+    const double cos_gm =
+        dirs[0][k] * dirs[3][k] + dirs[1][k] * dirs[4][k] + dirs[2][k] * dirs[5][k];
+    const double jacobian = 2 * kPi * kPi * um.x * sin_m * 4 * std::abs(cos_gm);
+    out[k] = jacobian > 0 && std::isfinite(pdf_u) ? pdf_u / jacobian : 0;
+  }
 }
 
 std::shared_ptr<const RglBrdf> load_rgl(const std::filesystem::path& path, RglOptions options) {

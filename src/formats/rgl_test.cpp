@@ -17,6 +17,7 @@
 #include "formats/binary_io.hpp"
 #include "formats/rgl_synthetic.hpp"
 #include "support/allocation_probe.hpp"
+#include "support/test_stats.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback {
@@ -812,6 +813,143 @@ TEST(RglBatch, EqualsEvalOnPublishedData) {
     const auto b = load_rgl(dir / (std::string(m) + "_rgb.bsdf"));
     // Most rows are bit-identical: the SIMD atan2 usually rounds as libm's does.
     EXPECT_GT(expect_batch_is_eval(*b, pairs), pairs.size() / 10) << m;
+  }
+}
+
+// --------------------------------------------------------------------------------------------
+// Batched sampling (the renderer's path): the guided warp, sample_batch, pdf_batch
+// --------------------------------------------------------------------------------------------
+
+Vec3<double> unit_direction(double theta, double phi) {
+  return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+}
+
+// The forward warp started from the slices' guide tables returns the point of the plain binary
+// searches bit for bit: random numbers, the ends 0 and 1 and grid values, any incidence.
+void expect_guided_warp_is_search(const RglBrdf& b, int n) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  int differ = 0;
+  for (int k = 0; k < n; ++k) {
+    const double theta = u(rng) * kPi / 2, phi = (2 * u(rng) - 1) * kPi;
+    RglWarpPoint p{u(rng), u(rng)};
+    if (k % 8 == 0) p = {double(k % 9) / 8, double(k % 5) / 4};
+    const RglWarpPoint a = b.vndf_forward(p, theta, phi);
+    const RglWarpPoint r = b.vndf_forward_by_search(p, theta, phi);
+    differ += a.x != r.x || a.y != r.y;
+  }
+  EXPECT_EQ(differ, 0) << b.name();
+}
+
+TEST(RglSampling, GuidedWarpEqualsBinarySearch) {
+  Synthetic s;  // several φi slices (anisotropic), tables varying everywhere, zero rows
+  s.phi_i = {float(-kPi), float(-kPi / 2), 0.0f};
+  s.theta_i = {0.0f, 0.4f, 0.9f, 1.5f};
+  s.vndf = [](std::size_t slice, std::size_t y, std::size_t x) {
+    if (y == 2) return 0.0f;
+    return float(std::pow(std::sin(0.3 * double(x * (slice + 1)) + 0.2 * double(y)), 4));
+  };
+  expect_guided_warp_is_search(s.brdf(), 20000);
+  HALFBACK_REQUIRE_SHARED(dir, "rgl");
+  for (const char* m : {"ilm_l3_37_metallic", "chm_mint", "paper_white", "irid_flake_paint2"})
+    expect_guided_warp_is_search(*load_rgl(dir / (std::string(m) + "_rgb.bsdf")), 20000);
+}
+
+// sample_batch and pdf_batch (the SIMD angles) against sample and pdf one at a time: the same
+// directions and densities up to rounding; rows at the seam, on the axis, at or below the horizon
+// or not unit go through sample and pdf and are equal exactly.
+void expect_batches_are_one_at_a_time(const RglBrdf& b) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3<double>> wo;
+  std::vector<double> u1, u2;
+  for (int k = 0; k < 3000; ++k) {
+    const double theta = k % 50 == 0 ? 0.0 : std::acos(u(rng)), phi = (2 * u(rng) - 1) * kPi;
+    wo.push_back(k % 37 == 0 ? Vec3<double>{-std::sin(theta), 0.0, std::cos(theta)}  // φ = π
+                             : unit_direction(theta, phi));
+    u1.push_back(u(rng));
+    u2.push_back(u(rng));
+  }
+  wo.push_back({0, 0, -1});
+  u1.push_back(0.5);
+  u2.push_back(0.5);
+  std::vector<BrdfSample> batch(wo.size());
+  b.sample_batch(wo, u1, u2, batch);
+  std::vector<DirPair<double>> pairs;
+  int mismatched = 0;
+  for (std::size_t k = 0; k < wo.size(); ++k) {
+    const BrdfSample one = b.sample(wo[k], u1[k], u2[k]);
+    const bool both = one.pdf > 0 && batch[k].pdf > 0;
+    if (!both) {  // only at the horizon may rounding decide differently
+      mismatched += (one.pdf > 0) != (batch[k].pdf > 0);
+      continue;
+    }
+    EXPECT_NEAR(batch[k].pdf, one.pdf, 1e-9 * one.pdf) << k;
+    EXPECT_NEAR(batch[k].wi.x, one.wi.x, 1e-12) << k;
+    EXPECT_NEAR(batch[k].wi.y, one.wi.y, 1e-12) << k;
+    EXPECT_NEAR(batch[k].wi.z, one.wi.z, 1e-12) << k;
+    pairs.push_back({one.wi, wo[k]});
+    pairs.push_back({unit_direction(std::acos(u(rng)), 2 * kPi * u(rng)), wo[k]});
+  }
+  EXPECT_LE(mismatched, 2) << b.name();
+  pairs.push_back({{0, 0, 1}, {0, 0, 1}});            // both along the normal
+  pairs.push_back({{0.6, 0, 0.8}, {-0.6, 0, 0.8}});   // the half vector along the normal
+  pairs.push_back({{0.6, 0, 0.8}, {0.6, 0, -0.8}});   // below the horizon
+  pairs.push_back({{0.66, 0, 0.88}, {0, 0.6, 0.8}});  // not unit
+  pairs.push_back({{0, 0, std::nan("")}, {0, 0, 1}});
+  std::vector<double> pdfs(pairs.size());
+  b.pdf_batch(pairs, pdfs);
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const double one = b.pdf(pairs[k].wo, pairs[k].wi);
+    if (!(one > 0) || !std::isfinite(one))
+      EXPECT_TRUE(pdfs[k] == one || (std::isnan(one) && std::isnan(pdfs[k]))) << k;
+    else
+      EXPECT_NEAR(pdfs[k], one, 1e-9 * one) << k;
+  }
+  EXPECT_THROW(b.pdf_batch(pairs, std::span(pdfs).first(1)), std::invalid_argument);
+  EXPECT_THROW(b.sample_batch(wo, u1, std::span(u2).first(1), batch), std::invalid_argument);
+}
+
+TEST(RglSampling, BatchesEqualOneAtATime) {
+  Synthetic s;
+  s.phi_i = {float(-kPi), float(-kPi / 2), 0.0f};  // anisotropic, a half-turn symmetry
+  s.theta_i = {0.0f, 0.4f, 0.9f, 1.5f};
+  s.vndf = [](std::size_t slice, std::size_t y, std::size_t x) {
+    return float(1 + slice + 0.5 * std::sin(0.7 * double(x) + 0.3 * double(y)));
+  };
+  expect_batches_are_one_at_a_time(s.brdf());
+  HALFBACK_REQUIRE_SHARED(dir, "rgl");
+  for (const char* m : {"ilm_l3_37_metallic", "chm_mint", "paper_white"})
+    expect_batches_are_one_at_a_time(*load_rgl(dir / (std::string(m) + "_rgb.bsdf")));
+}
+
+// The batched sampler's directions follow the batched pdf: χ² over (cos θ, φ) cells, the cells
+// within 10° of the mirror direction (where the pdf has an integrable singularity, from the warp's
+// u = √(2θm/π)) pooled with the failed samples.
+TEST(RglSampling, BatchSamplerChiSquare) {
+  HALFBACK_REQUIRE_SHARED(dir, "rgl");
+  for (const char* m : {"ilm_l3_37_metallic", "paper_white"}) {
+    const auto b = load_rgl(dir / (std::string(m) + "_rgb.bsdf"));
+    for (double theta_o : {0.3, 1.0}) {
+      const Vec3<double> wo = unit_direction(theta_o, 0.7);
+      const auto r = render::testing::chi2_test(
+          [&](double u1, double u2) {
+            BrdfSample x;
+            b->sample_batch(std::span(&wo, 1), std::span(&u1, 1), std::span(&u2, 1),
+                            std::span(&x, 1));
+            return render::testing::DirSample{x.wi, x.pdf};
+          },
+          [&](const Vec3<double>& wi) {
+            double p;
+            const DirPair<double> pair{wi, wo};
+            b->pdf_batch(std::span(&pair, 1), std::span(&p, 1));
+            return p;
+          },
+          100000, false, 16, 32, 24, 7, {-wo.x, -wo.y, wo.z}, 10);
+      EXPECT_LE(r.integral, 1.02) << m << " θo " << theta_o;
+      EXPECT_NEAR(r.integral, r.valid_fraction, 0.02) << m << " θo " << theta_o;
+      EXPECT_LT(r.z, 4.5) << m << " θo " << theta_o << " χ² " << r.chi2 << " dof " << r.dof;
+    }
   }
 }
 

@@ -161,11 +161,28 @@ struct GgxShape {
   return {{ok ? wix : 0.0, ok ? wiy : 0.0, ok ? wiz : 0.0}, ok ? pdf : 0.0};
 }
 
-// The batch: no virtual call per sample, and the samples' independent square roots and divisions
-// overlap in the processor.
+// The batch: no virtual call per sample, and the samples in SIMD lanes: the directions are copied
+// into columns (structure of arrays) so that the loop of the branch-free sample vectorizes (the
+// layer is compiled with -fno-trapping-math, which lets the compiler evaluate both sides of a
+// select), then copied back. The lanes' arithmetic is IEEE per element, so the numbers are
+// sample()'s bit for bit.
 void ggx_visible_normal_batch(const GgxShape g, const Vec3<double>* wo, const double* u1,
                               const double* u2, BrdfSample* out, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) out[i] = ggx_visible_normal_sample(g, wo[i], u1[i], u2[i]);
+  constexpr std::size_t kLanes = 16;
+  for (std::size_t first = 0; first < n; first += kLanes) {
+    const std::size_t m = std::min(kLanes, n - first);
+    double x[kLanes], y[kLanes], z[kLanes], a[kLanes], b[kLanes];
+    double ox[kLanes], oy[kLanes], oz[kLanes], op[kLanes];
+    for (std::size_t i = 0; i < m; ++i) {
+      x[i] = wo[first + i].x, y[i] = wo[first + i].y, z[i] = wo[first + i].z;
+      a[i] = u1[first + i], b[i] = u2[first + i];
+    }
+    for (std::size_t i = 0; i < m; ++i) {
+      const BrdfSample s = ggx_visible_normal_sample(g, {x[i], y[i], z[i]}, a[i], b[i]);
+      ox[i] = s.wi.x, oy[i] = s.wi.y, oz[i] = s.wi.z, op[i] = s.pdf;
+    }
+    for (std::size_t i = 0; i < m; ++i) out[first + i] = {{ox[i], oy[i], oz[i]}, op[i]};
+  }
 }
 
 }  // namespace
@@ -199,6 +216,14 @@ double Microfacet::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
   }
   const Vec3<double> m = normalize({wi.x + wo.x, wi.y + wo.y, wi.z + wo.z});
   return distribution(m) * m.z / (4 * dot(wo, m));
+}
+
+void Microfacet::pdf_batch(std::span<const DirPair<double>> pairs, std::span<double> out) const {
+  if (out.size() != pairs.size()) {
+    Brdf::pdf_batch(pairs, out);  // the size check
+    return;
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Microfacet::pdf(pairs[i].wo, pairs[i].wi);
 }
 
 // --- ABC

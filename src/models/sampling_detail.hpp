@@ -60,8 +60,11 @@ inline std::size_t pick_lobe(std::span<const double> w, double& u) {
 // 8u − k − 1/2 is exact, so the only error is the rounding of about twenty operations.
 [[gnu::always_inline]] inline void sincos_turns(double u, double& sin_out, double& cos_out) {
   constexpr double s8 = 0.38268343236508977173, c8 = 0.92387953251128675613;  // of π/8
-  const int octant = int(8 * u);
-  const double k = octant < 0 ? 0.0 : octant > 7 ? 7.0 : double(octant);
+  // k = ⌊8u⌋ clamped to [0, 7] (0 for NaN), by comparisons rather than a conversion to int, so
+  // that loops over it vectorize.
+  const double v = 8 * u;
+  const double k = double(v >= 1) + double(v >= 2) + double(v >= 3) + double(v >= 4) +
+                   double(v >= 5) + double(v >= 6) + double(v >= 7);
   const double t = (8 * u - k - 0.5) * (std::numbers::pi / 4), t2 = t * t;
   const double st =
       t * (1 - t2 * (1.0 / 6) *

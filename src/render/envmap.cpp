@@ -397,6 +397,9 @@ EnvMap::EnvMap(int width, int height, std::vector<float> rgb, std::string name, 
   const double dphi = 2 * kPi / width;
   for (std::size_t r = 0; r < std::size_t(height); ++r)
     row_solid_angle_[r] = dphi * (row_cos_[r] - row_cos_[r + 1]);
+  row_inverse_solid_angle_.resize(row_solid_angle_.size());
+  for (std::size_t r = 0; r < row_solid_angle_.size(); ++r)
+    row_inverse_solid_angle_[r] = 1 / row_solid_angle_[r];
   std::vector<double> weights(std::size_t(width) * std::size_t(height));
   for (std::size_t i = 0; i < weights.size(); ++i) {
     const float* p = &rgb_[3 * i];
@@ -502,7 +505,8 @@ void EnvMap::map_coordinates(const Vec3<double>& d, double& u, double& v) {
 }
 
 // The map is turned by +rotation about +y, so a world direction is looked up turned by −rotation.
-Vec3<double> EnvMap::to_map(const Vec3<double>& w) const {
+// Inline: the loops of pixels_of vectorize with them.
+[[gnu::always_inline]] inline Vec3<double> EnvMap::to_map(const Vec3<double>& w) const {
   return {cos_rot_ * w.x - sin_rot_ * w.z, w.y, sin_rot_ * w.x + cos_rot_ * w.z};
 }
 Vec3<double> EnvMap::to_world(const Vec3<double>& m) const {
@@ -512,29 +516,43 @@ Vec3<double> EnvMap::to_world(const Vec3<double>& m) const {
 namespace {
 
 // atan2(y, x) to within about 1e-5 rad (a minimax polynomial of atan on [0, 1], Abramowitz and
-// Stegun 4.4.49's form), without a library call: a first guess of a pixel, which the exact
-// edge tests of pixel_of then correct.
-double approx_atan2(double y, double x) {
+// Stegun 4.4.49's form), without a library call or a branch (loops over it vectorize): a first
+// guess of a pixel, which the exact edge tests of EnvMap::place then correct.
+[[gnu::always_inline]] inline double approx_atan2(double y, double x) {
   const double ax = std::abs(x), ay = std::abs(y);
   const double big = std::max(ax, ay), small = std::min(ax, ay);
-  const double a = big > 0 ? small / big : 0, a2 = a * a;
-  double r = a * (0.99986600 +
-                  a2 * (-0.33029950 + a2 * (0.18014100 + a2 * (-0.08513300 + a2 * 0.02083510))));
-  if (ay > ax) r = kPi / 2 - r;
-  if (x < 0) r = kPi - r;
-  return y < 0 ? -r : r;
+  const double a = small / (big > 0 ? big : 1.0), a2 = a * a;
+  const double r0 =
+      a *
+      (0.99986600 + a2 * (-0.33029950 + a2 * (0.18014100 + a2 * (-0.08513300 + a2 * 0.02083510))));
+  const double r1 = kPi / 2 - r0, q1 = ay > ax ? r1 : r0;
+  const double r2 = kPi - q1, q2 = x < 0 ? r2 : q1;
+  return y < 0 ? -q2 : q2;
 }
 
 }  // namespace
 
-// The pixel of a direction, as map_coordinates() places it, without its two atan2 calls: a guess
-// from approx_atan2, then the row's and the column's edges tested exactly (cos θ against the
-// rows' edges; the side of the columns' edge half-planes), moving at most a pixel or two. A
+// The guess: the bucket of cos θ in the rows' guide table, φ by approx_atan2 as a fractional
+// column. No branches.
+[[gnu::always_inline]] inline EnvMap::Guess EnvMap::guess(const Vec3<double>& d) const {
+  const double rho2 = d.x * d.x + d.z * d.z, len = std::sqrt(rho2 + d.y * d.y);
+  const double t = 0.5 * (1 - d.y / len);
+  Guess g;
+  g.rho2 = rho2;
+  g.len = len;
+  g.row = (t > 0 ? (t < 1 ? t : 1.0) : 0.0) * double(row_guide_.size());
+  g.col = (approx_atan2(d.x, -d.z) + kPi) * (double(width_) / (2 * kPi));
+  return g;
+}
+
+// The pixel of a direction, as map_coordinates() places it, from the guess: the row's and the
+// column's edges tested exactly (cos θ against the rows' edges; the side of the columns' edge
+// half-planes), moving a pixel when the guess was within approx_atan2's error of an edge. A
 // direction the tests cannot place (on the axis, where every column meets) falls back to
 // map_coordinates. Equal to it except within rounding of an edge.
-std::size_t EnvMap::pixel_of(const Vec3<double>& d, std::size_t& row, std::size_t& col) const {
+std::size_t EnvMap::place(const Vec3<double>& d, const Guess& g, std::size_t& row,
+                          std::size_t& col) const {
   const std::size_t w = std::size_t(width_), h = std::size_t(height_);
-  const double rho2 = d.x * d.x + d.z * d.z, len = std::sqrt(rho2 + d.y * d.y);
   auto exact = [&] {
     double u, v;
     map_coordinates(d, u, v);
@@ -542,17 +560,16 @@ std::size_t EnvMap::pixel_of(const Vec3<double>& d, std::size_t& row, std::size_
     row = std::min(std::size_t(v * height_), h - 1);
     return row * w + col;
   };
-  if (w < 8 || !(rho2 > 1e-300)) return exact();
+  if (w < 8 || !(g.rho2 > 1e-300)) return exact();
   // Row r holds cos θ ∈ (row_cos_[r + 1], row_cos_[r]]; the guide gives the row of the bucket's
   // top in cos θ.
-  const double t = std::clamp(0.5 * (1 - d.y / len), 0.0, 1.0);
+  const double len = g.len;
   const std::size_t buckets = row_guide_.size();
-  std::size_t r = row_guide_[std::min(std::size_t(t * double(buckets)), buckets - 1)];
+  std::size_t r = row_guide_[std::min(std::size_t(g.row), buckets - 1)];
   while (r > 0 && d.y > row_cos_[r] * len) --r;
   while (r + 1 < h && !(d.y > row_cos_[r + 1] * len)) ++r;
   // Column c holds the directions on or after its left edge and before the next one.
-  const double u = (approx_atan2(d.x, -d.z) + kPi) / (2 * kPi);
-  std::size_t c = std::min(std::size_t(std::max(0.0, u) * double(w)), w - 1);
+  std::size_t c = std::min(std::size_t(std::max(0.0, g.col)), w - 1);
   auto after = [&](std::size_t edge) {
     return d.x * col_edge_[edge].cos + d.z * col_edge_[edge].sin >= 0;
   };
@@ -571,6 +588,22 @@ std::size_t EnvMap::pixel_of(const Vec3<double>& d, std::size_t& row, std::size_
   return row * w + col;
 }
 
+std::size_t EnvMap::pixel_of(const Vec3<double>& d, std::size_t& row, std::size_t& col) const {
+  return place(d, guess(d), row, col);
+}
+
+// The pixels of n world directions: all the map directions and guesses first, in a loop without
+// branches that the compiler vectorizes, then the exact tests.
+void EnvMap::pixels_of(const Vec3<double>* world, std::size_t n, Vec3<double>* map,
+                       std::size_t* row, std::size_t* col, std::size_t* index) const {
+  Guess g[kChunk];
+  for (std::size_t i = 0; i < n; ++i) {
+    map[i] = to_map(world[i]);
+    g[i] = guess(map[i]);
+  }
+  for (std::size_t i = 0; i < n; ++i) index[i] = place(map[i], g[i], row[i], col[i]);
+}
+
 Rgb EnvMap::eval(const Vec3<double>& dir) const {
   std::size_t row, col;
   const std::size_t i = pixel_of(to_map(dir), row, col);
@@ -586,7 +619,6 @@ void EnvMap::sample(std::span<const double> u1, std::span<const double> u2, bool
                     std::span<Sample> out) const {
   if (u1.size() != out.size() || u2.size() != out.size())
     throw std::invalid_argument("EnvMap::sample: the spans' sizes differ");
-  constexpr std::size_t kChunk = 32;
   Distribution2D::Sample cells[kChunk];
   const Distribution2D& d = compensated ? compensated_ : distribution_;
   for (std::size_t begin = 0; begin < out.size(); begin += kChunk) {
@@ -608,14 +640,15 @@ EnvMap::Sample EnvMap::sample_in(const Distribution2D::Sample& cell) const {
   s.dir = to_world(m);
   const float* p = &rgb_[3 * (cell.row * std::size_t(width_) + cell.col)];
   s.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
-  s.pdf = cell.probability / row_solid_angle_[cell.row];
+  s.pdf = cell.probability * row_inverse_solid_angle_[cell.row];
   return s;
 }
 
 double EnvMap::pdf(const Vec3<double>& dir, bool compensated) const {
   std::size_t row, col;
   pixel_of(to_map(dir), row, col);
-  return (compensated ? compensated_ : distribution_).probability(row, col) / row_solid_angle_[row];
+  return (compensated ? compensated_ : distribution_).probability(row, col) *
+         row_inverse_solid_angle_[row];
 }
 
 // sin φ and cos φ of φ = 2π (col + t) / W − π: the column's left edge turned by δ = 2π t / W,
@@ -639,23 +672,49 @@ void EnvMap::column_sincos(std::size_t col, double t, double& sin_phi, double& c
   cos_phi = e.cos * cd - e.sin * sd;
 }
 
+void EnvMap::eval(std::span<const Vec3<double>> dirs, std::span<Rgb> out) const {
+  if (dirs.size() != out.size())
+    throw std::invalid_argument("EnvMap::eval: the spans' sizes differ");
+  Vec3<double> map[kChunk];
+  std::size_t rows[kChunk], cols[kChunk], index[kChunk];
+  for (std::size_t begin = 0; begin < out.size(); begin += kChunk) {
+    const std::size_t n = std::min(kChunk, out.size() - begin);
+    pixels_of(dirs.data() + begin, n, map, rows, cols, index);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float* p = &rgb_[3 * index[i]];
+      out[begin + i] = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
+    }
+  }
+}
+
+bool EnvMap::uniform(std::span<const Vec3<double>> dirs, Rgb& radiance) const {
+  Vec3<double> map[kChunk];
+  std::size_t rows[kChunk], cols[kChunk], index[kChunk];
+  if (dirs.empty() || dirs.size() > kChunk) return false;
+  pixels_of(dirs.data(), dirs.size(), map, rows, cols, index);
+  for (std::size_t i = 1; i < dirs.size(); ++i)
+    if (index[i] != index[0]) return false;
+  const float* p = &rgb_[3 * index[0]];
+  radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
+  return true;
+}
+
 void EnvMap::lookup(std::span<const Vec3<double>> dirs, bool compensated,
                     std::span<Lookup> out) const {
   if (dirs.size() != out.size())
     throw std::invalid_argument("EnvMap::lookup: the spans' sizes differ");
   // The pixels first, then their values: the loads of different directions overlap.
-  constexpr std::size_t kChunk = 32;
+  Vec3<double> map[kChunk];
   std::size_t rows[kChunk], cols[kChunk], index[kChunk];
   const Distribution2D& d = compensated ? compensated_ : distribution_;
   for (std::size_t begin = 0; begin < out.size(); begin += kChunk) {
     const std::size_t n = std::min(kChunk, out.size() - begin);
-    for (std::size_t i = 0; i < n; ++i)
-      index[i] = pixel_of(to_map(dirs[begin + i]), rows[i], cols[i]);
+    pixels_of(dirs.data() + begin, n, map, rows, cols, index);
     for (std::size_t i = 0; i < n; ++i) {
       const float* p = &rgb_[3 * index[i]];
       Lookup& l = out[begin + i];
       l.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
-      l.pdf = d.probability(rows[i], cols[i]) / row_solid_angle_[rows[i]];
+      l.pdf = d.probability(rows[i], cols[i]) * row_inverse_solid_angle_[rows[i]];
     }
   }
 }
@@ -666,8 +725,8 @@ EnvMap::Lookup EnvMap::lookup(const Vec3<double>& dir, bool compensated) const {
   const float* p = &rgb_[3 * i];
   Lookup l;
   l.radiance = {p[0] * scale_, p[1] * scale_, p[2] * scale_};
-  l.pdf =
-      (compensated ? compensated_ : distribution_).probability(row, col) / row_solid_angle_[row];
+  l.pdf = (compensated ? compensated_ : distribution_).probability(row, col) *
+          row_inverse_solid_angle_[row];
   return l;
 }
 

@@ -31,8 +31,8 @@ using V3 = Vec3<double>;
 using Clock = std::chrono::steady_clock;
 
 V3 normalize(const V3& v) {
-  const double l = std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-  return {v.x / l, v.y / l, v.z / l};
+  const double inv = 1 / std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  return {v.x * inv, v.y * inv, v.z * inv};
 }
 double dot(const V3& a, const V3& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
@@ -52,15 +52,21 @@ struct Frame {
 // t along the parallels (+y × n), b = n × t; at the poles, where +y × n vanishes, t = +x.
 Frame shading_frame(const V3& n) {
   V3 t{n.z, 0, -n.x};
-  const double l = std::sqrt(t.x * t.x + t.z * t.z);
-  t = l > 1e-12 ? V3{t.x / l, 0, t.z / l} : V3{1, 0, 0};
+  const double l = std::sqrt(t.x * t.x + t.z * t.z), inv = 1 / l;
+  t = l > 1e-12 ? V3{t.x * inv, 0, t.z * inv} : V3{1, 0, 0};
   return {t, cross(n, t), n};
 }
 
-double weight(Heuristic h, double a, double b) {
-  if (!(b > 0)) return 1;
+// The MIS weight over the strategy's density, w(a, b)/a, with one division: 1/(a + b) for the
+// balance heuristic, a/(a² + b²) for the power heuristic (the ratio form where the squares
+// would overflow or vanish), 1/a when the other density is 0.
+double weight_over_pdf(Heuristic h, double a, double b) {
+  if (!(b > 0)) return 1 / a;
+  if (h == Heuristic::balance) return 1 / (a + b);
+  const double d = a * a + b * b;
+  if (d > 1e-300 && d < 1e300) return a / d;
   const double r = b / a;
-  return h == Heuristic::balance ? 1 / (1 + r) : 1 / (1 + r * r);
+  return 1 / ((1 + r * r) * a);
 }
 
 struct Accum {
@@ -118,6 +124,8 @@ class Renderer {
         kind_(s.sequence == Sequence::sobol ? detail::SequenceKind::sobol
                                             : detail::SequenceKind::random),
         aspect_(double(s.width) / s.height),
+        two_over_width_(2.0 / s.width),
+        two_over_height_(2.0 / s.height),
         tan_bg_(std::tan(0.5 * s.background_fov_deg * kPi / 180)),
         tan_persp_(std::tan(0.5 * kPerspectiveFov * kPi / 180)) {
     for (std::uint32_t d = 0; d < kPairs; ++d) keys_[d] = detail::dimension_key(s.seed, d);
@@ -138,8 +146,9 @@ class Renderer {
   // Up to kPacket consecutive samples of one pixel, rendered stage by stage (the camera, then each
   // light sample for the whole packet): the BRDF is evaluated in batches (Brdf::eval_batch) and
   // the lookups of different samples, independent, overlap. Each sample's sum adds the same terms
-  // in the same order as one sample at a time would (docs/render.md, "Speed").
-  static constexpr int kPacket = 16;
+  // in the same order as one sample at a time would (docs/render.md, "Speed"). 64 rather than 16:
+  // fewer calls per sample into the BRDF's batches (RGL's run the batch engine's conversions).
+  static constexpr int kPacket = 64;
   // The light samples of one stage that reach the BRDF: the sample, the pair, the radiance, the
   // pdf of the strategy that drew it and the other's (MIS).
   struct Batch {
@@ -165,6 +174,7 @@ class Renderer {
   struct Packet {
     int size = 0;
     std::uint32_t first = 0;
+    std::uint32_t reversed[kPacket];  // reverse_bits of each sample's index (the sequences')
     Rgb sum[kPacket];
     bool shaded[kPacket];  // on the sphere, seen from above its surface
     Frame frame[kPacket];
@@ -173,20 +183,26 @@ class Renderer {
     Batch batch;
   };
   // The camera ray of each sample: the background's radiance, or the shading frame on the sphere.
+  // The background samples' radiance in one EnvMap::eval call (the lookups overlap).
   void camera(int px, int py, const PixelSequences& q, Packet& p) const {
+    Stage& bg = p.stage;  // the background's directions, before the stages use it
+    bg.size = 0;
     for (int k = 0; k < p.size; ++k) {
       p.sum[k] = Rgb{};
       p.shaded[k] = false;
       double jx, jy;
-      q.pair[0].point(p.first + std::uint32_t(k), jx, jy);
-      const double ndc_x = (2 * (px + jx) / s_.width - 1) * aspect_;
-      const double ndc_y = 1 - 2 * (py + jy) / s_.height;
+      const std::uint32_t index = p.first + std::uint32_t(k);
+      p.reversed[k] = detail::reverse_bits(index);
+      q.pair[0].point(index, p.reversed[k], jx, jy);
+      const double ndc_x = ((px + jx) * two_over_width_ - 1) * aspect_;
+      const double ndc_y = 1 - (py + jy) * two_over_height_;
       V3 n, wo;
       if (s_.projection == Projection::orthographic) {
         const double x = ndc_x * kOrthoHalfHeight, y = ndc_y * kOrthoHalfHeight;
         const double r2 = x * x + y * y;
         if (r2 >= 1) {
-          p.sum[k] = env_.eval(normalize({ndc_x * tan_bg_, ndc_y * tan_bg_, -1}));
+          bg.dir[bg.size] = normalize({ndc_x * tan_bg_, ndc_y * tan_bg_, -1});
+          bg.sample[bg.size++] = k;
           continue;
         }
         n = {x, y, std::sqrt(1 - r2)};
@@ -196,7 +212,8 @@ class Renderer {
         const V3 o{0, 0, kCameraDistance};
         const double b = dot(o, d), c = dot(o, o) - 1, disc = b * b - c;
         if (disc <= 0) {
-          p.sum[k] = env_.eval(d);
+          bg.dir[bg.size] = d;
+          bg.sample[bg.size++] = k;
           continue;
         }
         const double t = -b - std::sqrt(disc);
@@ -207,6 +224,11 @@ class Renderer {
       p.wo[k] = p.frame[k].to_local(wo);
       p.shaded[k] = p.wo[k].z > 0;
     }
+    if (bg.size == 0) return;
+    Rgb radiance[kPacket];
+    const auto n = std::size_t(bg.size);
+    env_.eval(std::span(bg.dir, n), std::span(radiance, n));
+    for (int i = 0; i < bg.size; ++i) p.sum[bg.sample[i]] = radiance[i];
   }
 
   // ρ of the batch's pairs, then each term fr · li · share · w · cos θi / pdf added to its sample.
@@ -215,8 +237,8 @@ class Renderer {
     brdf_.eval_batch(std::span(b.pair, std::size_t(b.size)), std::span(b.fr, std::size_t(b.size)));
     const bool mis = s_.strategy == Strategy::mis;
     for (int j = 0; j < b.size; ++j) {
-      const double w = mis ? weight(s_.heuristic, b.pdf[j], b.other_pdf[j]) : 1;
-      p.sum[b.sample[j]] += b.fr[j] * b.li[j] * (share * w * b.pair[j].wi.z / b.pdf[j]);
+      const double w = mis ? weight_over_pdf(s_.heuristic, b.pdf[j], b.other_pdf[j]) : 1 / b.pdf[j];
+      p.sum[b.sample[j]] += b.fr[j] * b.li[j] * (share * b.pair[j].wi.z * w);
     }
   }
 
@@ -228,7 +250,7 @@ class Renderer {
     st.size = 0;
     for (int k = 0; k < p.size; ++k) {
       if (!p.shaded[k]) continue;
-      q.pair[dim].point(p.first + std::uint32_t(k), st.u1[st.size], st.u2[st.size]);
+      q.pair[dim].point(p.first + std::uint32_t(k), p.reversed[k], st.u1[st.size], st.u2[st.size]);
       st.sample[st.size++] = k;
     }
     const auto n = std::size_t(st.size);
@@ -247,7 +269,8 @@ class Renderer {
       b.pdf[j] = es.pdf;
     }
     if (mis)
-      for (int j = 0; j < b.size; ++j) b.other_pdf[j] = brdf_.pdf(b.pair[j].wo, b.pair[j].wi);
+      brdf_.pdf_batch(std::span(b.pair, std::size_t(b.size)),
+                      std::span(b.other_pdf, std::size_t(b.size)));
     add_batch(b, share, p);
   }
 
@@ -257,7 +280,7 @@ class Renderer {
     st.size = 0;
     for (int k = 0; k < p.size; ++k) {
       if (!p.shaded[k]) continue;
-      q.pair[dim].point(p.first + std::uint32_t(k), st.u1[st.size], st.u2[st.size]);
+      q.pair[dim].point(p.first + std::uint32_t(k), p.reversed[k], st.u1[st.size], st.u2[st.size]);
       st.wo[st.size] = p.wo[k];
       st.sample[st.size++] = k;
     }
@@ -290,7 +313,37 @@ class Renderer {
     add_batch(b, share, p);
   }
 
-  void render_packet(int px, int py, const PixelSequences& q, Packet& p) const {
+  // Orthographic view: whether every sample of pixel (px, py) shows the background in one and
+  // the same map pixel, and then its radiance. The pixel's square lies outside the sphere's disk,
+  // and the directions that bound it fall in one map pixel: its corners (a map column is a convex
+  // wedge, and the directions of the square a convex set) and, when the square straddles the
+  // vertical ndc_x = 0, the middles of its top and bottom edges (cos θ of a direction is monotonic
+  // in ndc_y, and in |ndc_x| at fixed ndc_y, so its extremes over the square are among these).
+  // Such a pixel's samples all get that radiance, as a lookup of each would give them, except
+  // within rounding of a map pixel's edge (docs/render.md, "Speed").
+  bool uniform_background(int px, int py, Rgb& radiance) const {
+    if (s_.projection != Projection::orthographic) return false;
+    const double x0 = (px * two_over_width_ - 1) * aspect_;
+    const double x1 = ((px + 1) * two_over_width_ - 1) * aspect_;
+    const double y0 = 1 - py * two_over_height_, y1 = 1 - (py + 1) * two_over_height_;
+    const double cx = std::clamp(0.0, x0, x1) * kOrthoHalfHeight;
+    const double cy = std::clamp(0.0, y1, y0) * kOrthoHalfHeight;
+    if (cx * cx + cy * cy < 1 + 1e-9) return false;  // the disk, with a margin for rounding
+    V3 d[6];
+    int n = 0;
+    for (double x : {x0, x1})
+      for (double y : {y0, y1}) d[n++] = normalize({x * tan_bg_, y * tan_bg_, -1});
+    if (x0 < 0 && x1 > 0)
+      for (double y : {y0, y1}) d[n++] = normalize({0, y * tan_bg_, -1});
+    return env_.uniform(std::span(d, std::size_t(n)), radiance);
+  }
+
+  void render_packet(int px, int py, const PixelSequences& q, Packet& p,
+                     const Rgb* background) const {
+    if (background) {  // every sample shows this background radiance
+      for (int k = 0; k < p.size; ++k) p.sum[k] = *background;
+      return;
+    }
     camera(px, py, q, p);
     switch (s_.strategy) {
       case Strategy::mis:
@@ -318,11 +371,13 @@ class Renderer {
         const std::size_t p = std::size_t(py) * std::size_t(s_.width) + std::size_t(px);
         double r = 0, g = 0, b = 0, y = 0, y2 = 0;
         std::uint64_t bad = 0;
-        const PixelSequences q = sequences(p);
+        Rgb radiance;
+        const Rgb* background = uniform_background(px, py, radiance) ? &radiance : nullptr;
+        const PixelSequences q = background ? PixelSequences{} : sequences(p);
         for (std::uint32_t i = first; i < first + count; i += kPacket) {
           packet.first = i;
           packet.size = int(std::min<std::uint32_t>(kPacket, first + count - i));
-          render_packet(px, py, q, packet);
+          render_packet(px, py, q, packet, background);
           for (int k = 0; k < packet.size; ++k) {
             const Rgb& v = packet.sum[k];
             if (!(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b))) {
@@ -353,7 +408,7 @@ class Renderer {
   const EnvMap& env_;
   const RenderSettings& s_;
   detail::SequenceKind kind_;
-  double aspect_, tan_bg_, tan_persp_;
+  double aspect_, two_over_width_, two_over_height_, tan_bg_, tan_persp_;
   std::uint64_t keys_[kPairs];
 };
 

@@ -123,6 +123,10 @@ class PixelPair {
     scramble1_ = hash32(key, pixel, 0xb5297a4d);
   }
   void point(std::uint32_t index, double& u1, double& u2) const {
+    point(index, reverse_bits(index), u1, u2);
+  }
+  // The same with reversed = reverse_bits(index), which the pairs of one sample share.
+  void point(std::uint32_t index, std::uint32_t reversed, double& u1, double& u2) const {
     if (kind_ == SequenceKind::random) {
       const std::uint64_t h = mix64(key_ ^ index);
       u1 = double(h >> 11) * 0x1p-53;
@@ -131,7 +135,7 @@ class PixelPair {
     }
     // owen_scramble(x, s) = reverse(laine_karras(reverse(x), s)) and sobol_dim0 = reverse, so
     // the shuffled index, reversed, feeds both dimensions' hashes directly.
-    const std::uint32_t shuffled = reverse_bits(laine_karras(reverse_bits(index), shuffle_));
+    const std::uint32_t shuffled = reverse_bits(laine_karras(reversed, shuffle_));
     u1 = to_unit(reverse_bits(laine_karras(shuffled, scramble0_)));
     u2 = to_unit(reverse_bits(laine_karras(kSobolDim1Reversed(shuffled), scramble1_)));
   }

@@ -57,6 +57,10 @@ class Brdf {
   // the same size, else std::invalid_argument). A model whose sampling vectorizes overrides it.
   virtual void sample_batch(std::span<const Vec3<double>> wo, std::span<const double> u1,
                             std::span<const double> u2, std::span<BrdfSample> out) const;
+  // pdf() of a batch: out[i] = pdf(pairs[i].wo, pairs[i].wi), the same numbers up to rounding
+  // (out.size() == pairs.size(), else std::invalid_argument). The default calls pdf() one at a
+  // time; a model whose pdf vectorizes overrides it (the renderer's MIS weights use it).
+  virtual void pdf_batch(std::span<const DirPair<double>> pairs, std::span<double> out) const;
   // Whether sample() follows ρ (true) or is the cosine default (false; the renderer then
   // tabulates ρ to sample it, render/brdf_sampler.hpp).
   virtual bool has_importance_sampling() const { return false; }

@@ -67,6 +67,8 @@ class Microfacet final : public Brdf {
   void sample_batch(std::span<const Vec3<double>> wo, std::span<const double> u1,
                     std::span<const double> u2, std::span<BrdfSample> out) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
+  // pdf() of each pair without a virtual call per pair, equal to it bit for bit.
+  void pdf_batch(std::span<const DirPair<double>> pairs, std::span<double> out) const override;
   bool has_importance_sampling() const override { return true; }
 
   // The distribution of normals D(m) (∫ D(m) (m·n) dm = 1) and Smith's Λ(ω).

@@ -65,6 +65,10 @@ class EnvMap {
 
   // Radiance arriving from world direction `dir` (unit), scaled by the exposure.
   Rgb eval(const Vec3<double>& dir) const;
+  // eval() of each direction, equal to it (throws std::invalid_argument when the sizes differ).
+  void eval(std::span<const Vec3<double>> dirs, std::span<Rgb> out) const;
+  // Whether the directions (1 to 32) all fall in one map pixel, and then its radiance (eval()).
+  bool uniform(std::span<const Vec3<double>> dirs, Rgb& radiance) const;
 
   struct Sample {
     Vec3<double> dir;  // world direction towards the light
@@ -110,19 +114,31 @@ class EnvMap {
   Vec3<double> to_map(const Vec3<double>& world) const;
   Vec3<double> to_world(const Vec3<double>& map) const;
   std::size_t pixel_of(const Vec3<double>& map_dir, std::size_t& row, std::size_t& col) const;
+  // pixel_of in two steps: a guess without branches, then the exact edge tests.
+  struct Guess {
+    double rho2, len, row, col;  // x² + z², the length, the guide's bucket, the column
+  };
+  Guess guess(const Vec3<double>& map_dir) const;
+  std::size_t place(const Vec3<double>& map_dir, const Guess& g, std::size_t& row,
+                    std::size_t& col) const;
+  static constexpr std::size_t kChunk = 32;  // directions per pass of the span lookups
+  // pixel_of(to_map(world[i])) for n <= kChunk directions; map[i] = to_map(world[i]).
+  void pixels_of(const Vec3<double>* world, std::size_t n, Vec3<double>* map, std::size_t* row,
+                 std::size_t* col, std::size_t* index) const;
 
   int width_ = 0, height_ = 0;
   std::vector<float> rgb_;
   std::string name_;
   EnvOptions options_;
   double scale_ = 1, cos_rot_ = 1, sin_rot_ = 0;
-  std::vector<double> row_solid_angle_;   // of one pixel of each row
-  std::vector<double> row_cos_;           // cos θ of the rows' edges, height + 1 of them
-  std::vector<std::uint32_t> row_guide_;  // the row at the top of each bucket of cos θ
+  std::vector<double> row_solid_angle_;          // of one pixel of each row
+  std::vector<double> row_inverse_solid_angle_;  // 1 / row_solid_angle_ (the pdfs multiply)
+  std::vector<double> row_cos_;                  // cos θ of the rows' edges, height + 1 of them
   struct Edge {
     double cos = 1, sin = 0;
   };
-  std::vector<Edge> col_edge_;  // of φ at each column's left edge
+  std::vector<std::uint32_t> row_guide_;  // the row at the top of each bucket of cos θ
+  std::vector<Edge> col_edge_;            // of φ at each column's left edge
   Sample sample_in(const Distribution2D::Sample& cell) const;
   void column_sincos(std::size_t col, double t, double& sin_phi, double& cos_phi) const;
   Distribution2D distribution_, compensated_;
