@@ -144,8 +144,9 @@ bool same_bits(const Result<T>& a, const Result<T>& b) {
 //
 // The batch kernels evaluate the same param.hpp formulas with the same arithmetic as the scalar
 // reference (the kernel TUs are compiled with -ffp-contract=off): only atan2, sin and cos differ,
-// xsimd against libm. Measured (BatchLaneOps tests below): xsimd's atan2 is within 2.5 ulp of the
-// exact value and its sin/cos within 1.5 ulp; libm is within 0.5 (double) or 1.5 (float) ulp.
+// batch_simd.hpp's against libm. Measured (BatchLaneOps tests below): the SIMD atan2 is within
+// 2.5 ulp of the exact value and xsimd's sin/cos within 1.5 ulp; libm is within 0.5 (double) or
+// 1.5 (float) ulp.
 // The tolerances, per valid row (ε of the precision T):
 //
 // - dirs -> P (encode only; the two sides see the same input and the same arithmetic up to the
@@ -991,7 +992,7 @@ TYPED_TEST(BatchLaneOps, MathFunctionsAreAccurate) {
       worst_cos = std::max(worst_cos, ulps<S>(vc[k], cosl(a[k])));
     }
   }
-  std::printf("  xsimd accuracy (ulp): atan2 %.2f, sin %.2f, cos %.2f\n", worst_atan2, worst_sin,
+  std::printf("  SIMD accuracy (ulp): atan2 %.2f, sin %.2f, cos %.2f\n", worst_atan2, worst_sin,
               worst_cos);
   EXPECT_LE(worst_atan2, 3.0);
   EXPECT_LE(worst_sin, 2.0);
