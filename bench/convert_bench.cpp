@@ -5,6 +5,10 @@
 //   inverse/P/T/threads:k   convert(P -> dirs)
 //   scalar_forward/P/T      a straightforward per-pair loop through a virtual, parameterization-
 //   scalar_inverse/P/T      generic interface with std math (the baseline of the speed-up)
+//   plainstores/DIR/P/T     forward/inverse on one thread with the outputs' non-temporal stores
+//   ntstores/DIR/P/T        forced off / on (by default: on for outputs of >= 16 MiB)
+//   packets/forward/spherical/T/k  the first 65536 rows in calls of k rows (16: the renderer's
+//                           packets; 65536: one call)
 //   stream/6to4/T/threads:k a plain triad moving the same bytes per pair as forward (6 columns
 //   stream/4to6/T/threads:k in, 4 out) or inverse, over arrays of the same size: the memory bound
 // plus, for one conversion, every instruction set (isa/...), and row-major (N, 6)/(N, 4) input and
@@ -19,6 +23,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -153,6 +158,36 @@ void bm_layout(benchmark::State& state, Space space, bool forward, bool rows) {
     benchmark::ClobberMemory();
   }
   set_counters<T>(state, d.n, 10);
+}
+
+// The same with the outputs' non-temporal stores forced off (on) whatever the size: what they
+// change, measured in the same run (by default they are on from kStreamingBytes of output).
+template <class T>
+void bm_stores(benchmark::State& state, Space space, bool forward, bool streaming) {
+  detail::set_streaming_stores(streaming);
+  bm_convert<T>(state, space, forward, 1);
+  detail::set_streaming_stores(std::nullopt);
+}
+
+// The first 65536 rows (SoA, forward) converted in calls of `packet` rows, as the renderer and the
+// RGL lookups do with 16: the per-call cost against one call over all of them (packet = 65536).
+template <class T>
+void bm_packets(benchmark::State& state, Space space, std::size_t packet) {
+  Data<T>& d = Data<T>::get();
+  const std::size_t n = std::min<std::size_t>(d.n, 65536);
+  const Form dirs{Space::dirs, false}, param{space, false};
+  for (auto _ : state) {
+    for (std::size_t r0 = 0; r0 < n; r0 += packet) {
+      const std::size_t m = std::min(packet, n - r0);
+      ConstColumn<T> ic[6];
+      for (int c = 0; c < 6; ++c) ic[c] = {d.dirs[c].data() + r0, 1};
+      Column<T> oc[4];
+      for (int c = 0; c < 4; ++c) oc[c] = {d.out[c].data() + r0, 1};
+      convert<T>(dirs, param, ic, m, {oc, {}, d.valid.data() + r0}, {1});
+    }
+    benchmark::ClobberMemory();
+  }
+  set_counters<T>(state, n, 10);
 }
 
 template <class T>
@@ -315,6 +350,11 @@ void register_all() {
             (dir + "/" + p + "/" + t + "/threads:" + std::to_string(k)).c_str(),
             [=](benchmark::State& st) { bm_convert<T>(st, s, forward, k); })
             ->Apply(timing(k));
+      for (bool streaming : {false, true})
+        benchmark::RegisterBenchmark(
+            ((streaming ? "ntstores/" : "plainstores/") + dir + "/" + p + "/" + t).c_str(),
+            [=](benchmark::State& st) { bm_stores<T>(st, s, forward, streaming); })
+            ->Apply(timing(1));
       benchmark::RegisterBenchmark(("scalar_" + dir + "/" + p + "/" + t).c_str(),
                                    [=](benchmark::State& st) { bm_scalar<T>(st, s, forward); })
           ->Unit(benchmark::kMillisecond);
@@ -334,6 +374,11 @@ void register_all() {
               .c_str(),
           [=](benchmark::State& st) { bm_isa<T>(st, isa, Space::halfdiff, forward); })
           ->Unit(benchmark::kMillisecond);
+  for (std::size_t packet : {std::size_t{16}, std::size_t{65536}})
+    benchmark::RegisterBenchmark(
+        ("packets/forward/spherical/" + t + "/" + std::to_string(packet)).c_str(),
+        [=](benchmark::State& st) { bm_packets<T>(st, Space::spherical, packet); })
+        ->Apply(timing(1));
   for (Space s : {Space::halfdiff, Space::hybrid})
     for (bool forward : {true, false})
       for (bool rows : {false, true})

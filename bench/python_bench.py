@@ -3,8 +3,10 @@
 batch path, measured in the same run (docs/performance.md, "Through Python").
 
     PYTHONPATH=build/release/python /usr/bin/python3 bench/python_bench.py [--pairs N]
+        [--conversions-only]
 
-Conversions dirs -> hybrid and hybrid -> dirs on N pairs (default 10^7), float64 and float32;
+Conversions dirs -> hybrid and hybrid -> dirs on N pairs (default 10^7), float64 and float32,
+C-order (NumPy's default) and Fortran-order arrays, a new result and out=, alternated;
 BRDF evaluation of a MERL table (nearest bin; NumPy: the reference lookup written with arrays)
 and of an RGL material. The C++ figures come from build/release/bench/halfback_bench and
 halfback_brdf_bench run by this script.
@@ -26,11 +28,12 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def best_of(f, repeat=3):
+    # Process CPU time (all threads): on a shared machine, wall time counts the other processes.
     times = []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         f()
-        times.append(time.perf_counter() - t0)
+        times.append(time.process_time() - t0)
     return min(times)
 
 
@@ -108,12 +111,13 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--pairs", type=int, default=10_000_000)
     ap.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
+    ap.add_argument("--conversions-only", action="store_true", help="skip the BRDF evaluations")
     a = ap.parse_args()
     n = a.pairs
     print(f"# halfback through Python, {n} pairs, {os.cpu_count()} cores\n")
-    print("| operation | NumPy | halfback (Python) | halfback, out= | column-major, out= | "
-          "C++ batch (SoA) | vs NumPy | column-major vs C++ |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| operation | NumPy | C order | C order, out= | F order | F order, out= | "
+          "C++ batch (SoA) | vs NumPy | C / F order | C / F order, out= |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     cxx = cxx_ns_per_pair(os.path.join(a.build, "bench", "halfback_bench"),
                           r"^(forward|inverse)/hybrid/(float|double)/threads:[0-9]+/", n)
     threads = os.cpu_count()
@@ -123,28 +127,33 @@ def main():
     for dtype, tname in [(np.float64, "double"), (np.float32, "float")]:
         x = random_pairs(n, dtype)
         q = halfback.convert(x, "dirs", "hybrid")
-        out4 = np.empty((n, 4), dtype)
-        out6 = np.empty((n, 6), dtype)
+        # C order (NumPy's default): rows of 6 and 4 values, the engine's transposing path.
         # Column-major (Fortran-order) arrays hand the engine contiguous columns: its SoA path.
         xf, qf = np.asfortranarray(x), np.asfortranarray(q)
-        out4f, out6f = np.empty((n, 4), dtype, order="F"), np.empty((n, 6), dtype, order="F")
-        for label, fnp, fhb, fout, fcol, key in [
-            ("dirs -> hybrid", lambda: numpy_hybrid(x), lambda: halfback.convert(x, "dirs", "hybrid"),
-             lambda: halfback.convert(x, "dirs", "hybrid", out=out4),
-             lambda: halfback.convert(xf, "dirs", "hybrid", out=out4f),
-             f"forward/hybrid/{tname}/threads:{threads}{timing}"),
-            ("hybrid -> dirs", lambda: numpy_hybrid_inverse(q),
-             lambda: halfback.convert(q, "hybrid", "dirs"),
-             lambda: halfback.convert(q, "hybrid", "dirs", out=out6),
-             lambda: halfback.convert(qf, "hybrid", "dirs", out=out6f),
-             f"inverse/hybrid/{tname}/threads:{threads}{timing}")]:
-            t_np, t_hb, t_out = best_of(fnp) / n, best_of(fhb) / n, best_of(fout) / n
-            t_col = best_of(fcol) / n
+        cases = [("dirs -> hybrid", x, xf, "dirs", "hybrid", 4, lambda: numpy_hybrid(x),
+                  f"forward/hybrid/{tname}/threads:{threads}{timing}"),
+                 ("hybrid -> dirs", q, qf, "hybrid", "dirs", 6, lambda: numpy_hybrid_inverse(q),
+                  f"inverse/hybrid/{tname}/threads:{threads}{timing}")]
+        for label, xc, xfo, src, dst, dim, fnp, key in cases:
+            outc, outf = np.empty((n, dim), dtype), np.empty((n, dim), dtype, order="F")
+            t_np = best_of(fnp) / n
+            # The two layouts alternate, so that they share the machine's varying load.
+            t = {"c": [], "c_out": [], "f": [], "f_out": []}
+            for _ in range(3):
+                t["c"].append(best_of(lambda: halfback.convert(xc, src, dst), 1))
+                t["f"].append(best_of(
+                    lambda: halfback.convert(xfo, src, dst, out=np.empty((n, dim), dtype, order="F")), 1))
+                t["c_out"].append(best_of(lambda: halfback.convert(xc, src, dst, out=outc), 1))
+                t["f_out"].append(best_of(lambda: halfback.convert(xfo, src, dst, out=outf), 1))
+            t = {k: min(v) / n for k, v in t.items()}
             t_cxx = cxx.get(key, float("nan"))
-            print(f"| {label}, {tname} | {t_np * 1e9:.1f} ns | {t_hb * 1e9:.1f} ns | "
-                  f"{t_out * 1e9:.1f} ns | {t_col * 1e9:.1f} ns | {t_cxx * 1e9:.1f} ns | "
-                  f"{t_np / t_hb:.1f}× faster | {t_col / t_cxx:.2f}× |")
+            print(f"| {label}, {tname} | {t_np * 1e9:.1f} ns | {t['c'] * 1e9:.1f} ns | "
+                  f"{t['c_out'] * 1e9:.1f} ns | {t['f'] * 1e9:.1f} ns | {t['f_out'] * 1e9:.1f} ns | "
+                  f"{t_cxx * 1e9:.1f} ns | {t_np / t['c']:.1f}× faster | {t['c'] / t['f']:.2f}× | "
+                  f"{t['c_out'] / t['f_out']:.2f}× |")
         del x, q, xf, qf
+    if a.conversions_only:
+        return 0
     # BRDF evaluation.
     x = random_pairs(n, np.float64)
     with tempfile.TemporaryDirectory() as tmp:
@@ -157,13 +166,13 @@ def main():
         t_np = best_of(lambda: numpy_merl_nearest(raw, x), 1) / n
         t_hb = best_of(lambda: merl.eval(x), 1) / n
         agree = np.abs(numpy_merl_nearest(raw, x[:100000]) - merl.eval(x[:100000]))
-        print(f"| MERL nearest bin | {t_np * 1e9:.1f} ns | {t_hb * 1e9:.1f} ns | | | | "
-              f"{t_np / t_hb:.1f}× faster | |")
+        print(f"| MERL nearest bin | {t_np * 1e9:.1f} ns | {t_hb * 1e9:.1f} ns | | | | | "
+              f"{t_np / t_hb:.1f}× faster | | |")
         print(f"\n(The NumPy MERL lookup and halfback's give different values on "
               f"{(agree.max(axis=1) > 0).mean():.3%} of 10^5 pairs.)")
     rgl = halfback.load("embedded:ilm_l3_37_metallic")
     t_hb = best_of(lambda: rgl.eval(x), 1) / n
-    print(f"| RGL metallic paint | — | {t_hb * 1e9:.1f} ns | | | | | |")
+    print(f"| RGL metallic paint | — | {t_hb * 1e9:.1f} ns | | | | | | | |")
 
 
 if __name__ == "__main__":

@@ -15,9 +15,16 @@
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <atomic>
+#include <cstddef>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <new>
@@ -124,6 +131,21 @@ const KernelSet& active_kernels() {
   return k ? *k : default_kernels();
 }
 
+namespace {
+std::atomic<int> g_streaming{-1};  // -1: by size, 0: off, 1: on
+}  // namespace
+
+void set_streaming_stores(std::optional<bool> on) {
+  g_streaming.store(on ? int(*on) : -1, std::memory_order_release);
+}
+
+// Whether convert() writes an output of this size with non-temporal stores.
+bool streaming_stores(std::size_t output_bytes);
+bool streaming_stores(std::size_t output_bytes) {
+  const int forced = g_streaming.load(std::memory_order_acquire);
+  return forced < 0 ? output_bytes >= kStreamingBytes : forced == 1;
+}
+
 bool set_batch_isa(std::optional<SimdIsa> isa) {
   if (!isa) {
     g_override.store(nullptr, std::memory_order_release);
@@ -179,9 +201,18 @@ struct Plan {
   typename Stages::GatherFn gather = nullptr;
   typename Stages::ScatterFn scatter = nullptr;
 
+  // Outputs written with non-temporal stores (through scratch).
+  bool stream;
+
   Plan(const Stages& k, Form f, Form t, std::span<const ConstColumn<T>> i,
-       const ConvertOutput<T>& o)
-      : from(f), to(t), dim_in(dimension(f)), dim_out(dimension(t)), in(i), out(&o) {
+       const ConvertOutput<T>& o, bool streaming_stores)
+      : from(f),
+        to(t),
+        dim_in(dimension(f)),
+        dim_out(dimension(t)),
+        in(i),
+        out(&o),
+        stream(streaming_stores) {
     want_jac = o.jacobian.data != nullptr;
     const bool to_dirs = t.space == Space::dirs;
     if (f.space == Space::dirs) {
@@ -216,20 +247,84 @@ void mask_jacobian(const T* mask, T* jac, std::size_t m, bool unit) {
   for (std::size_t i = 0; i < m; ++i) jac[i] = mask[i] > T(0) ? (unit ? T(1) : jac[i]) : nan;
 }
 
-template <class T>
-struct AlignedDelete {
-  void operator()(T* p) const { ::operator delete[](p, std::align_val_t{64}); }
+// Scratch of one thread, reused by every call on it: allocating it per call cost ~0.3 µs, which
+// the renderer's and the RGL lookups' packets of 16 pairs paid each time. A call nested in another
+// on the same thread (not done today: the tile loop calls nothing that could) gets its own.
+class ScratchLease {
+ public:
+  static constexpr std::size_t kBytes = 20 * detail::kTileBytes;  // TileRunner's columns
+
+  ScratchLease() {
+    Slot& slot = this_thread();
+    if (slot.busy) {
+      spare_.reset(allocate());
+      data_ = spare_.get();
+      return;
+    }
+    if (!slot.buffer) slot.buffer.reset(allocate());
+    slot.busy = true;
+    held_ = &slot;
+    data_ = slot.buffer.get();
+  }
+  ~ScratchLease() {
+    if (held_) held_->busy = false;
+  }
+  ScratchLease(const ScratchLease&) = delete;
+  ScratchLease& operator=(const ScratchLease&) = delete;
+
+  std::byte* data() const { return data_; }
+
+ private:
+  struct Delete {
+    void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t{64}); }
+  };
+  using Buffer = std::unique_ptr<std::byte[], Delete>;
+  struct Slot {
+    Buffer buffer;
+    bool busy = false;
+  };
+  static std::byte* allocate() {
+    return static_cast<std::byte*>(::operator new[](kBytes, std::align_val_t{64}));
+  }
+  static Slot& this_thread() {
+    thread_local Slot slot;
+    return slot;
+  }
+
+  Slot* held_ = nullptr;
+  Buffer spare_;
+  std::byte* data_ = nullptr;
 };
 
-// Scratch and loop over the tiles of one chunk.
+// Copies n values with non-temporal stores where the destination's alignment allows (past the
+// caches, without first reading the lines written); the caller fences (stream_fence) at the end.
+template <class T>
+void stream_copy(const T* src, T* dst, std::size_t n) {
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  constexpr std::size_t per = 16 / sizeof(T);
+  if (reinterpret_cast<std::uintptr_t>(dst) % sizeof(T) == 0) {
+    for (; i < n && reinterpret_cast<std::uintptr_t>(dst + i) % 16 != 0; ++i) dst[i] = src[i];
+    for (; i + per <= n; i += per)
+      _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i),
+                       _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i)));
+  }
+#endif
+  if (i < n) std::memcpy(dst + i, src + i, (n - i) * sizeof(T));
+}
+
+void stream_fence() {
+#if defined(__SSE2__)
+  _mm_sfence();
+#endif
+}
+
+// The loop over the tiles of one chunk, on the thread's scratch.
 template <class T>
 class TileRunner {
  public:
-  TileRunner(const Plan<T>& plan, std::size_t rows) : plan_(plan), rows_(rows) {
-    // Columns: 6 gathered inputs, 6 outputs to scatter, 6 directions, mask, jacobian.
-    const std::size_t count = kColumns * rows_;
-    scratch_.reset(static_cast<T*>(::operator new[](count * sizeof(T), std::align_val_t{64})));
-  }
+  explicit TileRunner(const Plan<T>& plan)
+      : plan_(plan), scratch_(reinterpret_cast<T*>(lease_.data())) {}
 
   void run(std::size_t r0, std::size_t m) {
     const Plan<T>& p = plan_;
@@ -250,15 +345,32 @@ class TileRunner {
         in[c] = s;
       }
     }
+    // With non-temporal stores, every output is assembled in scratch first.
+    const bool direct = !p.stream;
     T* out[detail::kMaxDim];
     for (std::size_t c = 0; c < p.dim_out; ++c) {
       const Column<T>& col = p.out->columns[c];
-      out[c] = col.stride == 1 ? col.data + base : column(kOutput + c);
+      out[c] = col.stride == 1 && direct ? col.data + base : column(kOutput + c);
     }
     const Column<T>& jcol = p.out->jacobian;
-    T* jac = p.want_jac ? (jcol.stride == 1 ? jcol.data + base : column(kJacobian)) : nullptr;
+    T* jac = nullptr;
+    if (p.want_jac) jac = jcol.stride == 1 && direct ? jcol.data + base : column(kJacobian);
     T* mask = column(kMask);
 
+    run_stages(in, out, jac, mask, m);
+    write_outputs(out, jac, mask, r0, m);
+  }
+
+ private:
+  // Columns: 6 gathered inputs (also the staging of non-temporal row stores, once the stages have
+  // read them), 6 outputs to scatter, 6 directions, mask, jacobian.
+  static constexpr std::size_t kInput = 0, kOutput = 6, kDirs = 12, kMask = 18, kJacobian = 19,
+                               kColumns = 20;
+  static_assert(kColumns * detail::kTileBytes <= ScratchLease::kBytes);
+  T* column(std::size_t c) { return scratch_ + c * kTileRows<T>; }
+
+  void run_stages(const T* const* in, T* const* out, T* jac, T* mask, std::size_t m) {
+    const Plan<T>& p = plan_;
     // The input's measure before decoding: `out` may share memory with `in`.
     if (jac && p.jacobian_in) p.jacobian_in(in, jac, m);
     if (p.check && !p.encode) {
@@ -278,37 +390,43 @@ class TileRunner {
     }
     if (jac && p.jacobian_out) p.jacobian_out(out, jac, m);
     if (jac) mask_jacobian(mask, jac, m, !p.jacobian_in && !p.jacobian_out);
+  }
 
+  void write_outputs(T* const* out, const T* jac, const T* mask, std::size_t r0, std::size_t m) {
+    const Plan<T>& p = plan_;
+    const auto base = static_cast<std::ptrdiff_t>(r0);
     if (p.scatter) {
-      p.scatter(column(kOutput),
-                p.out->columns[0].data + base * static_cast<std::ptrdiff_t>(p.dim_out), m);
-    } else {
-      for (std::size_t c = 0; c < p.dim_out; ++c) {
-        const Column<T>& col = p.out->columns[c];
-        if (col.stride == 1) continue;
-        T* dst = col.data + base * col.stride;
-        for (std::size_t i = 0; i < m; ++i)
-          dst[static_cast<std::ptrdiff_t>(i) * col.stride] = out[c][i];
+      T* rows = p.out->columns[0].data + base * static_cast<std::ptrdiff_t>(p.dim_out);
+      if (p.stream) {
+        p.scatter(column(kOutput), column(kInput), m);
+        stream_copy(column(kInput), rows, m * p.dim_out);
+      } else {
+        p.scatter(column(kOutput), rows, m);
       }
+    } else {
+      for (std::size_t c = 0; c < p.dim_out; ++c) write_column(p.out->columns[c], out[c], base, m);
     }
-    if (jac && jcol.stride != 1) {
-      T* dst = jcol.data + base * jcol.stride;
-      for (std::size_t i = 0; i < m; ++i)
-        dst[static_cast<std::ptrdiff_t>(i) * jcol.stride] = jac[i];
-    }
+    if (jac) write_column(p.out->jacobian, jac, base, m);
     if (std::uint8_t* valid = p.out->valid) {
       for (std::size_t i = 0; i < m; ++i) valid[r0 + i] = mask[i] > T(0) ? 1 : 0;
     }
   }
 
- private:
-  static constexpr std::size_t kInput = 0, kOutput = 6, kDirs = 12, kMask = 18, kJacobian = 19,
-                               kColumns = 20;
-  T* column(std::size_t c) { return scratch_.get() + c * rows_; }
+  // A column computed in scratch to its place (nothing to do when it was computed in place).
+  void write_column(const Column<T>& col, const T* values, std::ptrdiff_t base, std::size_t m) {
+    T* dst = col.data + base * col.stride;
+    if (dst == values) return;
+    if (col.stride == 1) {
+      stream_copy(values, dst, m);
+      return;
+    }
+    for (std::size_t i = 0; i < m; ++i)
+      dst[static_cast<std::ptrdiff_t>(i) * col.stride] = values[i];
+  }
 
   const Plan<T>& plan_;
-  std::size_t rows_;
-  std::unique_ptr<T[], AlignedDelete<T>> scratch_;
+  ScratchLease lease_;
+  T* scratch_;
 };
 
 // Threads available to this process (TBB reads the affinity mask); more would only oversubscribe.
@@ -320,20 +438,21 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
              const ConvertOutput<T>& out, const BatchOptions& options) {
   check_shapes(from, to, in.size(), out.columns.size());
   if (n == 0) return;
-  const Plan<T> plan(detail::active_kernels().stages<T>(), from, to, in, out);
+  const Plan<T> plan(detail::active_kernels().stages<T>(), from, to, in, out,
+                     detail::streaming_stores(n * dimension(to) * sizeof(T)));
 
   constexpr std::size_t tile = kTileRows<T>;
   const std::size_t tiles = (n + tile - 1) / tile;
   auto run_tiles = [&](std::size_t t0, std::size_t t1) {
-    // The transposes are compiled for scratch columns kTileRows apart; otherwise a small batch
-    // gets a small scratch.
-    const std::size_t rows =
-        plan.gather || plan.scatter ? tile : (std::min(tile, n - t0 * tile) + 63) / 64 * 64;
-    TileRunner<T> runner(plan, rows);
+    TileRunner<T> runner(plan);
     for (std::size_t t = t0; t < t1; ++t) runner.run(t * tile, std::min(tile, n - t * tile));
+    if (plan.stream) stream_fence();  // this thread's non-temporal stores, before it returns
   };
 
-  const std::size_t requested = static_cast<std::size_t>(thread_count(options.threads));
+  // A small batch (the renderer's packets) stays on this thread without asking oneTBB.
+  const std::size_t requested = tiles < 2 * kMinTilesPerThread && options.threads >= 0
+                                    ? 1
+                                    : static_cast<std::size_t>(thread_count(options.threads));
   const std::size_t threads = std::min(requested, tiles / kMinTilesPerThread);
   if (threads <= 1) {
     run_tiles(0, tiles);

@@ -85,4 +85,13 @@ const KernelSet& active_kernels();
 // false, changing nothing, when `isa` is not available here. Not meant to race with convert().
 bool set_batch_isa(std::optional<SimdIsa> isa);
 
+// Outputs of at least this many bytes (all output columns of one call) are written with
+// non-temporal stores: they would not stay in cache, and a plain store first reads the line it
+// writes (for a forward conversion, 4 of the 14 values moved per pair).
+inline constexpr std::size_t kStreamingBytes = std::size_t{16} << 20;
+
+// For tests and benchmarks: forces non-temporal output stores on (true) or off (false) whatever
+// the size; nullopt: by size (kStreamingBytes). Not meant to race with convert().
+void set_streaming_stores(std::optional<bool> on);
+
 }  // namespace halfback::detail

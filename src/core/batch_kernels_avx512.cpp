@@ -15,15 +15,156 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
 
+#include <immintrin.h>
+
+#include <array>
+#include <cstdint>
+
 #include "batch_kernels.hpp"
 #include "batch_simd.hpp"
 
 namespace halfback::detail {
+namespace {
+
+// Transposes between W rows of D values (D = 4 or 6: D registers) and D columns, in registers.
+// The W rows are two groups of W/2 rows (D/2 registers each). For a pair of columns (c, c + 1), a
+// group makes one "half" register [column c of its rows | column c + 1 of them] with two-source
+// permutes (one for D = 4; two for D = 6, whose group spans three registers); the two groups'
+// halves then make the two columns with one 128-bit-lane shuffle each, and back. GCC's
+// vectorization of the plain loops (batch_kernels.hpp) took about twice as many instructions.
+template <class S>
+struct Zmm;
+template <>
+struct Zmm<float> {
+  using V = __m512;
+  using Index = std::int32_t;
+  static constexpr int W = 16;
+  static V load(const float* p) { return _mm512_loadu_ps(p); }
+  static void store(float* p, V v) { _mm512_storeu_ps(p, v); }
+  static V permute2(V a, __m512i idx, V b) { return _mm512_permutex2var_ps(a, idx, b); }
+  static V low_halves(V a, V b) { return _mm512_shuffle_f32x4(a, b, 0x44); }
+  static V high_halves(V a, V b) { return _mm512_shuffle_f32x4(a, b, 0xEE); }
+};
+template <>
+struct Zmm<double> {
+  using V = __m512d;
+  using Index = std::int64_t;
+  static constexpr int W = 8;
+  static V load(const double* p) { return _mm512_loadu_pd(p); }
+  static void store(double* p, V v) { _mm512_storeu_pd(p, v); }
+  static V permute2(V a, __m512i idx, V b) { return _mm512_permutex2var_pd(a, idx, b); }
+  static V low_halves(V a, V b) { return _mm512_shuffle_f64x2(a, b, 0x44); }
+  static V high_halves(V a, V b) { return _mm512_shuffle_f64x2(a, b, 0xEE); }
+};
+
+// The permutes' indices (element e of a two-source permute: e < W from the first, else the
+// second). Gather, half p of a group: value `pos` of the group's rows, first from its registers
+// 0-1 (a), then 2 (b, D = 6). Scatter, register r of a group: from halves 0-1 (a), then 2 (b).
+template <class I, int W, int D>
+struct TransposeIndices {
+  static constexpr int P = D / 2;
+  std::array<std::array<I, W>, P> gather_a{}, gather_b{}, scatter_a{}, scatter_b{};
+  constexpr TransposeIndices() {
+    for (int p = 0; p < P; ++p)
+      for (int e = 0; e < W; ++e) {
+        const int pos = D * (e % (W / 2)) + 2 * p + e / (W / 2);
+        gather_a[p][e] = static_cast<I>(pos < 2 * W ? pos : 0);
+        gather_b[p][e] = static_cast<I>(pos < 2 * W ? e : W + pos - 2 * W);
+      }
+    for (int r = 0; r < P; ++r)
+      for (int e = 0; e < W; ++e) {
+        const int pos = r * W + e, row = pos / D, col = pos % D, half = col / 2;
+        const int at = (col % 2) * (W / 2) + row;  // in the half
+        scatter_a[r][e] = static_cast<I>(half < 2 ? half * W + at : 0);
+        scatter_b[r][e] = static_cast<I>(half < 2 ? e : W + at);
+      }
+  }
+};
+
+template <class S, int D>
+void gather_zmm(const S* __restrict rows, S* __restrict columns, std::size_t m) {
+  using Z = Zmm<S>;
+  constexpr int W = Z::W, P = D / 2;
+  constexpr std::size_t pitch = kTileRows<S>;
+  static constexpr TransposeIndices<typename Z::Index, W, D> idx;
+  __m512i ia[P], ib[P];
+  for (int p = 0; p < P; ++p) {
+    ia[p] = _mm512_loadu_si512(idx.gather_a[p].data());
+    ib[p] = _mm512_loadu_si512(idx.gather_b[p].data());
+  }
+  std::size_t i = 0;
+  for (; i + W <= m; i += W) {
+    typename Z::V half[2][P];
+    for (int g = 0; g < 2; ++g) {
+      const S* src = rows + D * i + g * P * W;
+      typename Z::V r[P];
+      for (int k = 0; k < P; ++k) r[k] = Z::load(src + k * W);
+      for (int p = 0; p < P; ++p) {
+        half[g][p] = Z::permute2(r[0], ia[p], r[1]);
+        if constexpr (D == 6) half[g][p] = Z::permute2(half[g][p], ib[p], r[2]);
+      }
+    }
+    for (int p = 0; p < P; ++p) {
+      Z::store(columns + 2 * p * pitch + i, Z::low_halves(half[0][p], half[1][p]));
+      Z::store(columns + (2 * p + 1) * pitch + i, Z::high_halves(half[0][p], half[1][p]));
+    }
+  }
+  for (; i < m; ++i)
+    for (int c = 0; c < D; ++c) columns[c * pitch + i] = rows[D * i + c];
+}
+
+template <class S, int D>
+void scatter_zmm(const S* __restrict columns, S* __restrict rows, std::size_t m) {
+  using Z = Zmm<S>;
+  constexpr int W = Z::W, P = D / 2;
+  constexpr std::size_t pitch = kTileRows<S>;
+  static constexpr TransposeIndices<typename Z::Index, W, D> idx;
+  __m512i ia[P], ib[P];
+  for (int r = 0; r < P; ++r) {
+    ia[r] = _mm512_loadu_si512(idx.scatter_a[r].data());
+    ib[r] = _mm512_loadu_si512(idx.scatter_b[r].data());
+  }
+  std::size_t i = 0;
+  for (; i + W <= m; i += W) {
+    typename Z::V half[2][P];
+    for (int p = 0; p < P; ++p) {
+      const typename Z::V a = Z::load(columns + 2 * p * pitch + i);
+      const typename Z::V b = Z::load(columns + (2 * p + 1) * pitch + i);
+      half[0][p] = Z::low_halves(a, b);
+      half[1][p] = Z::high_halves(a, b);
+    }
+    for (int g = 0; g < 2; ++g) {
+      S* dst = rows + D * i + g * P * W;
+      for (int r = 0; r < P; ++r) {
+        typename Z::V v = Z::permute2(half[g][0], ia[r], half[g][1]);
+        if constexpr (D == 6) v = Z::permute2(v, ib[r], half[g][2]);
+        Z::store(dst + r * W, v);
+      }
+    }
+  }
+  for (; i < m; ++i)
+    for (int c = 0; c < D; ++c) rows[D * i + c] = columns[c * pitch + i];
+}
+
+constexpr KernelSet make_avx512_set() {
+  using A = xsimd::avx512f;
+  KernelSet k =
+      make_kernel_set<xsimd::batch<float, A>, xsimd::batch<double, A>>(SimdIsa::avx512, "avx512");
+  k.f32.gather[4] = &gather_zmm<float, 4>;
+  k.f32.gather[6] = &gather_zmm<float, 6>;
+  k.f32.scatter[4] = &scatter_zmm<float, 4>;
+  k.f32.scatter[6] = &scatter_zmm<float, 6>;
+  k.f64.gather[4] = &gather_zmm<double, 4>;
+  k.f64.gather[6] = &gather_zmm<double, 6>;
+  k.f64.scatter[4] = &scatter_zmm<double, 4>;
+  k.f64.scatter[6] = &scatter_zmm<double, 6>;
+  return k;
+}
+
+}  // namespace
 
 const KernelSet& kernels_avx512() {
-  using A = xsimd::avx512f;
-  static constexpr KernelSet k =
-      make_kernel_set<xsimd::batch<float, A>, xsimd::batch<double, A>>(SimdIsa::avx512, "avx512");
+  static constexpr KernelSet k = make_avx512_set();
   return k;
 }
 

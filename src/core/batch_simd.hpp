@@ -5,8 +5,8 @@
 // flags; see batch_kernels.hpp.
 //
 // The mapping follows the scalar LaneOps<float/double> (std math) wherever the two could differ:
-//   - atan2: xsimd computes atan(|y/x|), which is NaN for (±0, ±0) and (±∞, ±∞); those lanes get
-//     the IEEE values of std::atan2 (±0 or ±π, ±π/4 or ±3π/4).
+//   - atan2: our own, with one division (xsimd's takes four in double); (±0, ±0) and (±∞, ±∞)
+//     get the IEEE values of std::atan2 (±0 or ±π, ±π/4 or ±3π/4).
 //   - min/max: SSE/AVX min/max return the second operand when either is NaN; std::fmin/fmax
 //     return the other, non-NaN, operand. Ties (including ±0) return the second operand in both.
 //   - sincos: xsimd chooses its range reduction by testing all lanes at once, so one huge or NaN
@@ -15,10 +15,12 @@
 //     neighbours in the vector.
 //   - Never use operator!= of xsimd 8.1 for NaN tests: it is unordered on SSE2 (NaN != x is true,
 //     as in IEEE) but ordered (_CMP_NEQ_OQ, false) on AVX and AVX-512. param.hpp does not use it.
-// Accuracy (measured, tests/batch_test.cpp and docs/performance.md): xsimd's atan2 is within
-// 2.5 ulp of the exact value, sin/cos within 1.5 ulp, sqrt is exact.
+// Accuracy (measured, tests/batch_test.cpp and docs/performance.md): atan2 (ours) within 2.4 ulp
+// of the exact value, xsimd's sin/cos within 1.5 ulp, sqrt is exact.
 #pragma once
 
+#include <cstddef>
+#include <iterator>
 #include <numbers>
 
 // xsimd 8's large-argument reduction (__kernel_rem_pio2) trips GCC 12's -Wmaybe-uninitialized when
@@ -38,6 +40,33 @@
 
 namespace halfback {
 
+// The constants of LaneOps::atan2 below: π/4, π/2, π as a rounded value and its remainder, and the
+// polynomial g(z) ≈ (atan(√z)/√z - 1)/z on [0, tan²(π/8)], highest degree first: Chebyshev
+// least-squares fits (mpmath, 50 digits; 11 terms for double, 5 for float), whose error on
+// atan(r) is below 6e-18 and 3e-9 relative, under the types' rounding.
+template <class S>
+struct Atan2Constants;
+template <>
+struct Atan2Constants<double> {
+  static constexpr double tan_pi_8 = 0.41421356237309503, huge = 0x1p1000;
+  static constexpr double pi_hi = 0x1.921fb54442d18p1, pi_lo = 0x1.1a62633145c07p-53;
+  static constexpr double half_pi_hi = pi_hi / 2, half_pi_lo = pi_lo / 2;
+  static constexpr double quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
+  static constexpr double g[] = {
+      -0x1.39b571eaf17abp-6, 0x1.412ff8ed2a9c8p-5, -0x1.a0880440d55f1p-5, 0x1.dfe2ebe99b2b4p-5,
+      -0x1.10fa460dd6e79p-4, 0x1.3b125f7f3f520p-4, -0x1.745d0b01be884p-4, 0x1.c71c71844817bp-4,
+      -0x1.2492492434992p-3, 0x1.999999999932ep-3, -0x1.5555555555555p-2};
+};
+template <>
+struct Atan2Constants<float> {
+  static constexpr float tan_pi_8 = 0.41421356f, huge = 0x1p100f;
+  static constexpr float pi_hi = 0x1.921fb6p1f, pi_lo = -0x1.777a5cp-24f;
+  static constexpr float half_pi_hi = pi_hi / 2, half_pi_lo = pi_lo / 2;
+  static constexpr float quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
+  static constexpr float g[] = {-0x1.08197cp-4f, 0x1.b802fp-4f, -0x1.241f98p-3f, 0x1.99972cp-3f,
+                                -0x1.555554p-2f};
+};
+
 template <class S, class A>
 struct LaneOps<xsimd::batch<S, A>> {
   using T = xsimd::batch<S, A>;
@@ -48,15 +77,42 @@ struct LaneOps<xsimd::batch<S, A>> {
   static T sqrt(const T& x) { return xsimd::sqrt(x); }
   static T abs(const T& x) { return xsimd::abs(x); }
 
+  // atan2 with one division (xsimd's takes four in double and three in float, the most costly
+  // part of a forward conversion). With a = |y|, b = |x|, the angle in [0, π/2] is folded onto
+  // r in [-tan(π/8), tan(π/8)]: r = a/b (offset 0), (a - b)/(a + b) (offset π/4) or -b/a (offset
+  // π/2); atan(r) = r + r z g(z) with z = r² and g a polynomial fitted to (atan(r)/r - 1)/z
+  // (docs/performance.md, "Conversions"); then π minus that for x < 0, and the sign of y. Zero
+  // over zero and infinity over infinity get the IEEE values of std::atan2.
   static T atan2(const T& y, const T& x) {
-    const T r = xsimd::atan2(y, x);
+    using C = Atan2Constants<S>;
+    const T a = xsimd::abs(y), b = xsimd::abs(x);
+    // Beyond 2^1000 a + b could overflow: scale both (exactly) by 1/4.
+    const T scale = xsimd::select(a > T(C::huge) || b > T(C::huge), T(S(0.25)), T(S(1)));
+    const T as = a * scale, bs = b * scale;
+    const auto low = a <= b * T(C::tan_pi_8);  // |y/x| <= tan(π/8)
+    const auto high = a * T(C::tan_pi_8) > b;  // |x/y| < tan(π/8)
+    const T num = xsimd::select(low, as, xsimd::select(high, -bs, as - bs));
+    const T den = xsimd::select(low, bs, xsimd::select(high, as, as + bs));
+    const T r = num / den;
+    const T z = r * r;
+    T g(C::g[0]);
+    for (std::size_t i = 1; i < std::size(C::g); ++i) g = xsimd::fma(g, z, T(C::g[i]));
+    const T at = xsimd::fma(r * z, g, r);
+    const T off_hi =
+        xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_hi), T(C::quarter_pi_hi)));
+    const T off_lo =
+        xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_lo), T(C::quarter_pi_lo)));
+    // x < 0 (or -0): π - (off + at) = (π_hi - off_hi) + ((π_lo - off_lo) - at).
+    const auto left = xsimd::copysign(T(S(1)), x) < T(S(0));
+    const T base = xsimd::select(left, T(C::pi_hi) - off_hi, off_hi);
+    const T rest = xsimd::select(left, (T(C::pi_lo) - off_lo) - at, at + off_lo);
+    const T angle = base + rest;
     const auto zero = (y == T(S(0))) && (x == T(S(0)));
     const auto both_inf = xsimd::isinf(y) && xsimd::isinf(x);
-    const auto x_negative = xsimd::copysign(T(S(1)), x) < T(S(0));  // true for -0
     constexpr S pi = std::numbers::pi_v<S>;
-    const T special = xsimd::select(zero, xsimd::select(x_negative, T(pi), T(S(0))),
-                                    xsimd::select(x_negative, T(S(0.75) * pi), T(S(0.25) * pi)));
-    return xsimd::select(zero || both_inf, xsimd::copysign(special, y), r);
+    const T special = xsimd::select(zero, xsimd::select(left, T(pi), T(S(0))),
+                                    xsimd::select(left, T(S(0.75) * pi), T(S(0.25) * pi)));
+    return xsimd::copysign(xsimd::select(zero || both_inf, special, angle), y);
   }
 
   static T min(const T& a, const T& b) {

@@ -144,8 +144,9 @@ bool same_bits(const Result<T>& a, const Result<T>& b) {
 //
 // The batch kernels evaluate the same param.hpp formulas with the same arithmetic as the scalar
 // reference (the kernel TUs are compiled with -ffp-contract=off): only atan2, sin and cos differ,
-// xsimd against libm. Measured (BatchLaneOps tests below): xsimd's atan2 is within 2.5 ulp of the
-// exact value and its sin/cos within 1.5 ulp; libm is within 0.5 (double) or 1.5 (float) ulp.
+// batch_simd.hpp's against libm. Measured (BatchLaneOps tests below): the SIMD atan2 is within
+// 2.5 ulp of the exact value and xsimd's sin/cos within 1.5 ulp; libm is within 0.5 (double) or
+// 1.5 (float) ulp.
 // The tolerances, per valid row (ε of the precision T):
 //
 // - dirs -> P (encode only; the two sides see the same input and the same arithmetic up to the
@@ -579,6 +580,74 @@ TYPED_TEST(BatchTest, StridedLayoutsGiveTheSameBitsAsSoa) {
   }
 }
 
+// Forces the outputs' non-temporal stores on or off for the lifetime of the guard.
+class StreamingGuard {
+ public:
+  explicit StreamingGuard(bool on) { detail::set_streaming_stores(on); }
+  ~StreamingGuard() { detail::set_streaming_stores(std::nullopt); }
+  StreamingGuard(const StreamingGuard&) = delete;
+  StreamingGuard& operator=(const StreamingGuard&) = delete;
+};
+
+// Non-temporal output stores (through scratch, for outputs that do not fit in cache) write the
+// same bits as plain ones: SoA columns starting off a 16-byte boundary (the copy's unaligned head
+// and tail), row-major outputs, in place, strided ones and the Jacobian, over several tiles.
+TYPED_TEST(BatchTest, StreamingStoresGiveTheSameBits) {
+  using T = TypeParam;
+  auto pairs = test_pairs(1500, 21);
+  pairs.push_back({{0, 0, 2}, {0, 0, 1}});  // invalid
+  const std::size_t n = pairs.size();
+  for (SimdIsa isa : available_isas()) {
+    IsaGuard guard(isa);
+    for (Form from : all_forms()) {
+      const Table<T> in = inputs_for<T>(from, pairs);
+      const std::size_t din = dimension(from);
+      std::vector<T> in_rows(n * din);
+      for (std::size_t r = 0; r < n; ++r)
+        for (std::size_t c = 0; c < din; ++c) in_rows[r * din + c] = in[c][r];
+      for (Form to : all_forms()) {
+        const std::size_t dout = dimension(to);
+        const std::string label =
+            pair_name(from, to) + " [" + std::string(detail::isa_name(isa)) + "]";
+        // SoA outputs one element past an aligned start, the Jacobian with stride 2.
+        auto soa_run = [&](bool streaming) {
+          StreamingGuard s(streaming);
+          std::vector<T> buf(dout * (n + 1) + 2 * n, T(-3));
+          std::vector<Column<T>> oc;
+          for (std::size_t c = 0; c < dout; ++c) oc.push_back({buf.data() + c * (n + 1) + 1, 1});
+          std::vector<ConstColumn<T>> ic;
+          for (const auto& c : in) ic.push_back({c.data(), 1});
+          std::vector<std::uint8_t> valid(n, 7);
+          convert<T>(from, to, ic, n, {oc, {buf.data() + dout * (n + 1), 2}, valid.data()});
+          buf.insert(buf.end(), valid.begin(), valid.end());
+          return buf;
+        };
+        EXPECT_TRUE(same_bits(soa_run(true), soa_run(false))) << label << ": SoA";
+        auto rows_run = [&](bool streaming, bool in_place) {
+          StreamingGuard s(streaming);
+          std::vector<T> buf = in_place ? in_rows : std::vector<T>(n * dout, T(-3));
+          std::vector<ConstColumn<T>> ic;
+          for (std::size_t c = 0; c < din; ++c)
+            ic.push_back(
+                {(in_place ? buf.data() : in_rows.data()) + c, static_cast<std::ptrdiff_t>(din)});
+          std::vector<Column<T>> oc;
+          for (std::size_t c = 0; c < dout; ++c)
+            oc.push_back({buf.data() + c, static_cast<std::ptrdiff_t>(dout)});
+          std::vector<T> jac(n);
+          convert<T>(from, to, ic, n, {oc, {jac.data(), 1}, nullptr});
+          buf.insert(buf.end(), jac.begin(), jac.end());
+          return buf;
+        };
+        EXPECT_TRUE(same_bits(rows_run(true, false), rows_run(false, false))) << label << ": rows";
+        if (din == dout) {
+          EXPECT_TRUE(same_bits(rows_run(true, true), rows_run(false, true)))
+              << label << ": rows in place";
+        }
+      }
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Invalid rows
 // ---------------------------------------------------------------------------------------------
@@ -923,7 +992,7 @@ TYPED_TEST(BatchLaneOps, MathFunctionsAreAccurate) {
       worst_cos = std::max(worst_cos, ulps<S>(vc[k], cosl(a[k])));
     }
   }
-  std::printf("  xsimd accuracy (ulp): atan2 %.2f, sin %.2f, cos %.2f\n", worst_atan2, worst_sin,
+  std::printf("  SIMD accuracy (ulp): atan2 %.2f, sin %.2f, cos %.2f\n", worst_atan2, worst_sin,
               worst_cos);
   EXPECT_LE(worst_atan2, 3.0);
   EXPECT_LE(worst_sin, 2.0);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "halfback/core/space.hpp"
 
@@ -23,20 +24,33 @@ inline MaskOf<T> pair_is_valid(const DirPair<T>& p) {
                      L::mask_and(p.wi.z >= -horizon_tol, p.wo.z >= -horizon_tol));
 }
 
+// Whether a mask is true in every lane (xsimd's all() for packs, found by argument lookup).
+template <class M>
+inline bool all_lanes(const M& m) {
+  if constexpr (std::is_same_v<M, bool>)
+    return m;
+  else
+    return all(m);
+}
+
 // An accepted direction onto the unit upper hemisphere: a z below the horizon (within the
 // tolerance) onto it, then unit length. The tolerances let through directions off unit length by
 // up to 1e-6, whose coordinates would leave their range (‖h̄‖ = 1.0000004) and not convert back.
 // A direction already unit to rounding (‖ω‖² within 4ε of 1, z >= 0) is kept bit for bit:
-// dividing it by its norm would only round it again.
+// dividing it by its norm would only round it again. That is almost every direction, so the
+// square root and the division (slow in SIMD lanes, double above all) are skipped when every lane
+// keeps its own: the same bits either way.
 template <class T>
 inline Vec3<T> onto_unit_hemisphere(const Vec3<T>& w) {
   using L = LaneOps<T>;
   using S = ScalarOf<T>;
   const T z = L::max(w.z, T(0));
   const T n2 = w.x * w.x + w.y * w.y + z * z;
-  const T inv = T(1) / L::sqrt(n2);
   const T e = n2 - T(1), unit_tol(S(4) * std::numeric_limits<S>::epsilon());
   const auto keep = L::mask_and(L::mask_and(e <= unit_tol, e >= -unit_tol), w.z >= T(0));
+  if (all_lanes(keep)) [[likely]]
+    return w;
+  const T inv = T(1) / L::sqrt(n2);
   return {L::select(keep, w.x, w.x * inv), L::select(keep, w.y, w.y * inv),
           L::select(keep, w.z, z * inv)};
 }

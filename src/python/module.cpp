@@ -77,9 +77,15 @@ struct Outputs {
   py::object result, valid, jacobian;
 };
 
+// What a call returns: the converted tuples, the validity mask, the measure.
+struct Wanted {
+  bool result = false, valid = false, jacobian = false;
+};
+
 template <class T>
-Outputs run(const py::array& x_any, Form from, Form to, bool want_result, bool want_jacobian,
+Outputs run(const py::array& x_any, Form from, Form to, Wanted want,
             const py::object& out_obj = py::none()) {
+  const bool want_result = want.result, want_jacobian = want.jacobian;
   // A view when x is already an aligned array of T with element-multiple strides; else one copy.
   const auto x = py::array_t<T>::ensure(x_any);
   if (!x) throw py::type_error("x must be convertible to a floating-point array");
@@ -106,7 +112,9 @@ Outputs run(const py::array& x_any, Form from, Form to, bool want_result, bool w
   } else {
     result = py::array_t<T>({static_cast<py::ssize_t>(n), want_result ? dim_out : py::ssize_t(0)});
   }
-  py::array_t<bool> valid(static_cast<py::ssize_t>(n));
+  // Only when asked for: convert() returns rows that are NaN where invalid, and the mask would be
+  // one more array to allocate and write.
+  py::array_t<bool> valid(want.valid ? static_cast<py::ssize_t>(n) : py::ssize_t(0));
   py::array_t<T> jacobian(want_jacobian ? static_cast<py::ssize_t>(n) : py::ssize_t(0));
   // When only the mask or J is wanted, the engine still needs somewhere to put the tuples.
   std::vector<T> scratch(want_result ? 0 : n * std::size_t(dim_out));
@@ -122,25 +130,25 @@ Outputs run(const py::array& x_any, Form from, Form to, bool want_result, bool w
   }
   ConvertOutput<T> o{out};
   static_assert(sizeof(bool) == sizeof(std::uint8_t));
-  o.valid = reinterpret_cast<std::uint8_t*>(valid.mutable_data());
+  if (want.valid) o.valid = reinterpret_cast<std::uint8_t*>(valid.mutable_data());
   if (want_jacobian) o.jacobian = {jacobian.mutable_data(), 1};
   {
     py::gil_scoped_release release;
     convert<T>(from, to, in, n, o);
   }
-  return {want_result ? py::object(result) : py::none(), valid,
+  return {want_result ? py::object(result) : py::none(),
+          want.valid ? py::object(valid) : py::none(),
           want_jacobian ? py::object(jacobian) : py::none()};
 }
 
-Outputs dispatch(const py::object& obj, Form from, Form to, bool want_result, bool want_jacobian,
+Outputs dispatch(const py::object& obj, Form from, Form to, Wanted want,
                  const py::object& out = py::none()) {
   // Anything np.asarray accepts (lists, array-likes); arrays pass through untouched.
   const py::array x = py::module_::import("numpy").attr("asarray")(obj);
   check_input(x, from);
-  if (x.dtype().is(py::dtype::of<float>()))
-    return run<float>(x, from, to, want_result, want_jacobian, out);
+  if (x.dtype().is(py::dtype::of<float>())) return run<float>(x, from, to, want, out);
   if (x.dtype().kind() == 'f' || x.dtype().kind() == 'i' || x.dtype().kind() == 'u')
-    return run<double>(x, from, to, want_result, want_jacobian, out);
+    return run<double>(x, from, to, want, out);
   throw py::type_error("x must be a float32 or float64 array (got dtype " +
                        std::string(py::str(x.dtype())) + ")");
 }
@@ -382,7 +390,7 @@ void bind_conversions(py::module_& m) {
         const Form from = parse_form(src, isotropic, "src"), to = parse_form(dst, isotropic, "dst");
         if (isotropic && from.space == Space::dirs && to.space == Space::dirs)  // as the CLI
           throw py::value_error("isotropic needs a parameterization on one side (src or dst)");
-        return dispatch(x, from, to, true, false, out).result;
+        return dispatch(x, from, to, {.result = true}, out).result;
       },
       py::arg("x"), py::arg("src"), py::arg("dst"), py::arg("isotropic") = false,
       py::arg("out") = py::none(),
@@ -401,7 +409,7 @@ many batches without allocating.)doc");
       [](const py::object& x, const std::string& param, bool isotropic) {
         const Form form = parse_form(param, isotropic, "param");
         const Form other = form.space == Space::dirs ? Form{Space::hybrid} : Form{Space::dirs};
-        return dispatch(x, form, other, false, false).valid;
+        return dispatch(x, form, other, {.valid = true}).valid;
       },
       py::arg("x"), py::arg("param"), py::arg("isotropic") = false,
       R"doc(Boolean mask of the rows of x that are valid in `param`: inside the parameterization's
@@ -413,7 +421,7 @@ domain, or unit directions above the horizon for "dirs".)doc");
         const Form form = parse_form(param, isotropic, "param");
         if (form.space == Space::dirs)
           throw py::value_error("param: the Jacobian is defined for a parameterization, not dirs");
-        return dispatch(x, form, Form{Space::dirs}, false, true).jacobian;
+        return dispatch(x, form, Form{Space::dirs}, {.jacobian = true}).jacobian;
       },
       py::arg("x"), py::arg("param"), py::arg("isotropic") = false,
       R"doc(J with d(wi) d(wo) = J d(params) at each row of x (NaN where invalid). For isotropic
