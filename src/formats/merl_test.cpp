@@ -549,7 +549,7 @@ TEST(MerlBatch, TrilinearFollowsEval) {
   const auto pairs = batch_pairs();
   std::vector<Rgb> batch(pairs.size());
   tri.eval_batch(pairs, batch);
-  // The coordinates differ by a few ulps at most (xsimd's atan2 within 2.5 ulp): so do the values,
+  // The coordinates differ by a few ulps at most (the SIMD atan2 within 2.4 ulp): so do the values,
   // which are continuous in them.
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const Rgb one = tri.eval(pairs[i]);
