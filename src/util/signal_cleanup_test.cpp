@@ -71,6 +71,9 @@ TEST(SignalCleanup, SignalRemovesTheTemporaryAndKillsWithTheSignal) {
     ASSERT_GE(pid, 0);
     if (pid == 0) {
       ::close(ready[0]);
+      // A shell's background job inherits SIGINT ignored, and the handlers rightly keep an
+      // ignored signal ignored: start from the default so that the test means the same anywhere.
+      ::signal(sig, SIG_DFL);
       install_temporary_cleanup_handlers();
       AtomicFile f(dir / "out.bin");
       f.write("partial");

@@ -17,6 +17,7 @@ import csv
 import io
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
@@ -80,7 +81,10 @@ SERVER = {}
 def start_server(halfback, specs, root):
     proc = subprocess.Popen([halfback, "view", *specs, "--root", root, "--port", "0",
                              "--threads", "1"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            # a shell's background job inherits SIGINT ignored, which the server
+                            # would keep: start it with the default so that Ctrl-C is tested
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     line = proc.stdout.readline()
     match = re.search(r"(http://[^ ]+/)\?token=([0-9a-f]+)", line)
     if not match:
@@ -187,7 +191,7 @@ def main():
                 check_refusals(base, token)
                 browser_checks(args, base, token, spec)
         finally:
-            proc.send_signal(2)  # Ctrl-C
+            proc.send_signal(signal.SIGINT)  # Ctrl-C
             try:
                 code = proc.wait(timeout=10)
                 check(code == 0, f"Ctrl-C stops the server cleanly (exit {code})")
