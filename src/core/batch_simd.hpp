@@ -19,6 +19,7 @@
 // of the exact value, xsimd's sin/cos within 1.5 ulp, sqrt is exact.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <iterator>
 #include <numbers>
@@ -52,7 +53,7 @@ struct Atan2Constants<double> {
   static constexpr double pi_hi = 0x1.921fb54442d18p1, pi_lo = 0x1.1a62633145c07p-53;
   static constexpr double half_pi_hi = pi_hi / 2, half_pi_lo = pi_lo / 2;
   static constexpr double quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
-  static constexpr double g[] = {
+  static constexpr std::array<double, 11> g = {
       -0x1.39b571eaf17abp-6, 0x1.412ff8ed2a9c8p-5, -0x1.a0880440d55f1p-5, 0x1.dfe2ebe99b2b4p-5,
       -0x1.10fa460dd6e79p-4, 0x1.3b125f7f3f520p-4, -0x1.745d0b01be884p-4, 0x1.c71c71844817bp-4,
       -0x1.2492492434992p-3, 0x1.999999999932ep-3, -0x1.5555555555555p-2};
@@ -63,8 +64,8 @@ struct Atan2Constants<float> {
   static constexpr float pi_hi = 0x1.921fb6p1f, pi_lo = -0x1.777a5cp-24f;
   static constexpr float half_pi_hi = pi_hi / 2, half_pi_lo = pi_lo / 2;
   static constexpr float quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
-  static constexpr float g[] = {-0x1.08197cp-4f, 0x1.b802fp-4f, -0x1.241f98p-3f, 0x1.99972cp-3f,
-                                -0x1.555554p-2f};
+  static constexpr std::array<float, 5> g = {-0x1.08197cp-4f, 0x1.b802fp-4f, -0x1.241f98p-3f,
+                                             0x1.99972cp-3f, -0x1.555554p-2f};
 };
 
 template <class S, class A>
@@ -95,8 +96,11 @@ struct LaneOps<xsimd::batch<S, A>> {
     const T den = xsimd::select(low, bs, xsimd::select(high, as, as + bs));
     const T r = num / den;
     const T z = r * r;
-    T g(C::g[0]);
-    for (std::size_t i = 1; i < std::size(C::g); ++i) g = xsimd::fma(g, z, T(C::g[i]));
+    // A local copy: the loop then reads no symbol that every instruction set's kernel file would
+    // share (halfback_isa_symbols forbids weak symbols common to two of them).
+    constexpr auto coefficients = C::g;
+    T g(coefficients[0]);
+    for (std::size_t i = 1; i < coefficients.size(); ++i) g = xsimd::fma(g, z, T(coefficients[i]));
     const T at = xsimd::fma(r * z, g, r);
     const T off_hi =
         xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_hi), T(C::quarter_pi_hi)));
