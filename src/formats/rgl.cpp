@@ -870,6 +870,22 @@ Rgb over_cosine(Rgb r, const Vec3<double>& wo) {
 // table reads are in flight.
 constexpr std::size_t kBlock = 64;
 
+// Row k of a block's directions: `given`, the direction whose azimuth indexes the tables, and the
+// unit half vector of the pair, both after the flips that bring `given` into the range the data
+// covers. True when the row must go through the one-pair path: a direction at or below the
+// horizon, `given` or the half vector along the normal (azimuth atan2(±0, ±0)).
+template <std::size_t N>
+bool put_direction_and_half_vector(int reduction, const Vec3<double>& given,
+                                   const Vec3<double>& other, double (&dirs)[6][N], std::size_t k) {
+  const Flips flips = flips_for(reduction, given);
+  const Vec3<double> g = flips.apply(given), d = flips.apply(other);
+  const double hx = g.x + d.x, hy = g.y + d.y, hz = g.z + d.z;
+  const double inverse_len = 1 / std::sqrt(hx * hx + hy * hy + hz * hz);
+  dirs[0][k] = g.x, dirs[1][k] = g.y, dirs[2][k] = g.z;
+  dirs[3][k] = hx * inverse_len, dirs[4][k] = hy * inverse_len, dirs[5][k] = hz * inverse_len;
+  return !(g.z > 0) || !(d.z > 0) || (g.x == 0 && g.y == 0) || (hx == 0 && hy == 0);
+}
+
 // How close (in units of the unit square) an azimuth coordinate may come to the seam 0 ≡ 1 of the
 // tables before the row goes to eval(): there the table value jumps, and the batch's azimuth,
 // a few ulps from eval()'s, could fall on the other side.
@@ -905,15 +921,8 @@ void RglBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> 
   alignas(64) double angle[4][kBlock];
   alignas(64) std::uint8_t valid[kBlock];
   bool apart[kBlock];
-  for (std::size_t k = 0; k < n; ++k) {
-    const Flips flips = flips_for(m.reduction, pairs[k].wi);
-    const Vec3<double> wi = flips.apply(pairs[k].wi), wo = flips.apply(pairs[k].wo);
-    const double hx = wi.x + wo.x, hy = wi.y + wo.y, hz = wi.z + wo.z;
-    const double inverse_len = 1 / std::sqrt(hx * hx + hy * hy + hz * hz);
-    apart[k] = !(wi.z > 0) || !(wo.z > 0) || (wi.x == 0 && wi.y == 0) || (hx == 0 && hy == 0);
-    dirs[0][k] = wi.x, dirs[1][k] = wi.y, dirs[2][k] = wi.z;
-    dirs[3][k] = hx * inverse_len, dirs[4][k] = hy * inverse_len, dirs[5][k] = hz * inverse_len;
-  }
+  for (std::size_t k = 0; k < n; ++k)
+    apart[k] = put_direction_and_half_vector(m.reduction, pairs[k].wi, pairs[k].wo, dirs, k);
   const ConstColumn<double> in[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
                                      {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
   const Column<double> cols[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
@@ -1078,15 +1087,8 @@ void RglBrdf::pdf_block(std::span<const DirPair<double>> pairs, std::span<double
   alignas(64) double angle[4][kSampleBlock];
   alignas(64) std::uint8_t valid[kSampleBlock];
   bool apart[kSampleBlock];
-  for (std::size_t k = 0; k < n; ++k) {
-    const Flips flips = flips_for(m.reduction, pairs[k].wo);
-    const Vec3<double> g = flips.apply(pairs[k].wo), d = flips.apply(pairs[k].wi);
-    const double hx = g.x + d.x, hy = g.y + d.y, hz = g.z + d.z;
-    const double inverse_len = 1 / std::sqrt(hx * hx + hy * hy + hz * hz);
-    apart[k] = !(g.z > 0) || !(d.z > 0) || (g.x == 0 && g.y == 0) || (hx == 0 && hy == 0);
-    dirs[0][k] = g.x, dirs[1][k] = g.y, dirs[2][k] = g.z;
-    dirs[3][k] = hx * inverse_len, dirs[4][k] = hy * inverse_len, dirs[5][k] = hz * inverse_len;
-  }
+  for (std::size_t k = 0; k < n; ++k)
+    apart[k] = put_direction_and_half_vector(m.reduction, pairs[k].wo, pairs[k].wi, dirs, k);
   angles_of(dirs, n, angle, valid);
   for (std::size_t k = 0; k < n; ++k) {
     const double phi_g = angle[1][k] > kPi ? angle[1][k] - 2 * kPi : angle[1][k];

@@ -301,19 +301,16 @@ TEST(Renderer, EqualInExpectationToCosineSampledReference) {
   }
 }
 
-// A BRDF's own sampling one sample at a time: sample() and pdf() through the defaults of
-// sample_batch() and pdf_batch(), which hides a model's batched sampler (the renderer's old path).
-class OneAtATime final : public Brdf {
+// A BRDF that forwards evaluation and its model's own one-pair sampling (sample, pdf) to another;
+// the batch functions are Brdf's defaults (through eval, sample and pdf) unless a test overrides
+// them. No tabulation before the first pass.
+class ForwardingBrdf : public Brdf {
  public:
-  explicit OneAtATime(BrdfPtr b) : b_(std::move(b)) {}
-  std::string name() const override { return "one-at-a-time"; }
+  explicit ForwardingBrdf(BrdfPtr b) : b_(std::move(b)) {}
   std::string description() const override { return b_->description(); }
   bool isotropic() const override { return b_->isotropic(); }
   bool reciprocal() const override { return b_->reciprocal(); }
   Rgb eval(const DirPair<double>& p) const override { return b_->eval(p); }
-  void eval_batch(std::span<const DirPair<double>> p, std::span<Rgb> out) const override {
-    b_->eval_batch(p, out);
-  }
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override {
     return b_->sample(wo, u1, u2);
   }
@@ -322,8 +319,19 @@ class OneAtATime final : public Brdf {
   }
   bool has_importance_sampling() const override { return b_->has_importance_sampling(); }
 
- private:
+ protected:
   BrdfPtr b_;
+};
+
+// A BRDF's own sampling one sample at a time: sample() and pdf() through the defaults of
+// sample_batch() and pdf_batch(), which hides a model's batched sampler (the renderer's old path).
+class OneAtATime final : public ForwardingBrdf {
+ public:
+  using ForwardingBrdf::ForwardingBrdf;
+  std::string name() const override { return "one-at-a-time"; }
+  void eval_batch(std::span<const DirPair<double>> p, std::span<Rgb> out) const override {
+    b_->eval_batch(p, out);
+  }
 };
 
 // The batched samplers (RGL's: SIMD angles and the guided warp; GGX's) render, with the same seed,
@@ -453,29 +461,15 @@ TEST(Renderer, TimeBudgetStopsEarly) {
 // checked only between passes: 16384² ran past 40 s with a 1 s budget).
 // A BRDF that costs about a microsecond an evaluation on any current CPU, so that one pass of the
 // renderer costs far more CPU time than the budget, however fast the renderer becomes.
-class Costly final : public Brdf {
+class Costly final : public ForwardingBrdf {
  public:
-  explicit Costly(BrdfPtr b) : b_(std::move(b)) {}
+  using ForwardingBrdf::ForwardingBrdf;
   std::string name() const override { return "costly"; }
-  std::string description() const override { return b_->description(); }
-  bool isotropic() const override { return b_->isotropic(); }
-  bool reciprocal() const override { return b_->reciprocal(); }
   Rgb eval(const DirPair<double>& p) const override {
     volatile double x = p.wi.z;
     for (int i = 0; i < 400; ++i) x = std::sqrt(x * x + 1e-3);
     return b_->eval(p);
   }
-  // The model's own sampler: no tabulation before the first pass.
-  BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override {
-    return b_->sample(wo, u1, u2);
-  }
-  double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override {
-    return b_->pdf(wo, wi);
-  }
-  bool has_importance_sampling() const override { return b_->has_importance_sampling(); }
-
- private:
-  BrdfPtr b_;
 };
 
 double process_cpu_seconds() {
