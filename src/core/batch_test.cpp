@@ -94,6 +94,16 @@ Table<T> inputs_for(Form from, const std::vector<DirPair<double>>& pairs) {
   return t;
 }
 
+// The table as one row-major (N, columns) array: NumPy's default layout.
+template <class T>
+std::vector<T> row_major(const Table<T>& t) {
+  const std::size_t d = t.size(), n = t.empty() ? 0 : t[0].size();
+  std::vector<T> rows(n * d);
+  for (std::size_t r = 0; r < n; ++r)
+    for (std::size_t c = 0; c < d; ++c) rows[r * d + c] = t[c][r];
+  return rows;
+}
+
 template <class T>
 Result<T> run_batch(Form from, Form to, const Table<T>& in, bool jac, int threads = 1) {
   const std::size_t n = in.empty() ? 0 : in[0].size();
@@ -505,9 +515,7 @@ TYPED_TEST(BatchTest, StridedLayoutsGiveTheSameBitsAsSoa) {
       const Table<T> in = inputs_for<T>(from, pairs);
       const std::size_t din = dimension(from);
       // AoS input.
-      std::vector<T> aos_in(n * din);
-      for (std::size_t r = 0; r < n; ++r)
-        for (std::size_t c = 0; c < din; ++c) aos_in[r * din + c] = in[c][r];
+      const std::vector<T> aos_in = row_major(in);
       // Mixed input: column 0 reversed in memory (stride -1), column 1 with stride 3, rest SoA.
       std::vector<T> rev(in[0].rbegin(), in[0].rend()), spaced(3 * n);
       for (std::size_t r = 0; r < n; ++r) spaced[3 * r] = in[1][r];
@@ -602,9 +610,7 @@ TYPED_TEST(BatchTest, StreamingStoresGiveTheSameBits) {
     for (Form from : all_forms()) {
       const Table<T> in = inputs_for<T>(from, pairs);
       const std::size_t din = dimension(from);
-      std::vector<T> in_rows(n * din);
-      for (std::size_t r = 0; r < n; ++r)
-        for (std::size_t c = 0; c < din; ++c) in_rows[r * din + c] = in[c][r];
+      const std::vector<T> in_rows = row_major(in);
       for (Form to : all_forms()) {
         const std::size_t dout = dimension(to);
         const std::string label =

@@ -866,8 +866,8 @@ Rgb over_cosine(Rgb r, const Vec3<double>& wo) {
   return r;
 }
 
-// Rows per block of eval_batch: the columns, angles and lookups of a block stay in L1 while its
-// table reads are in flight.
+// Rows per block of eval_batch, sample_batch and pdf_batch: the columns, angles and lookups of a
+// block stay in L1 while its table reads are in flight.
 constexpr std::size_t kBlock = 64;
 
 // Row k of a block's directions: `given`, the direction whose azimuth indexes the tables, and the
@@ -900,6 +900,18 @@ double signed_azimuth(double phi) {
   return phi > kPi ? phi - 2 * kPi : phi;
 }
 
+// The spherical angles (θ, φ) of the two directions of each row (the columns of dirs), φ in
+// [0, 2π) as the spherical form gives it, by the batch engine's SIMD conversion; valid[k] = 0
+// where the row is not one it accepts (not unit, below the horizon).
+void angles_of(double (&dirs)[6][kBlock], std::size_t n, double (&angle)[4][kBlock],
+               std::uint8_t* valid) {
+  const ConstColumn<double> in[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
+                                     {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
+  const Column<double> cols[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
+  convert<double>(Form{Space::dirs}, Form{Space::spherical}, in, n,
+                  ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
+}
+
 }  // namespace
 
 Rgb RglBrdf::eval(const DirPair<double>& pair) const {
@@ -923,11 +935,7 @@ void RglBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> 
   bool apart[kBlock];
   for (std::size_t k = 0; k < n; ++k)
     apart[k] = put_direction_and_half_vector(m.reduction, pairs[k].wi, pairs[k].wo, dirs, k);
-  const ConstColumn<double> in[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
-                                     {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
-  const Column<double> cols[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
-  convert<double>(Form{Space::dirs}, Form{Space::spherical}, in, n,
-                  ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
+  angles_of(dirs, n, angle, valid);
 
   // The table coordinates of every row, in a loop without calls that the compiler vectorizes.
   alignas(64) double um_x[kBlock], um_y[kBlock], uwi_x[kBlock], uwi_y[kBlock];
@@ -967,21 +975,6 @@ void RglBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> 
 
 namespace {
 
-// Rows per block of sample_batch and pdf_batch (the renderer's batches are at most 16).
-constexpr std::size_t kSampleBlock = 64;
-
-// The spherical angles (θ, φ) of directions a and b, φ in (-π, π] as atan2 gives it, by the batch
-// engine's SIMD conversion; valid[k] = 0 where the pair is not one it accepts (not unit, below
-// the horizon).
-void angles_of(double (&dirs)[6][kSampleBlock], std::size_t n, double (&angle)[4][kSampleBlock],
-               std::uint8_t* valid) {
-  const ConstColumn<double> in[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
-                                     {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
-  const Column<double> cols[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
-  convert<double>(Form{Space::dirs}, Form{Space::spherical}, in, n,
-                  ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
-}
-
 // An azimuth near ±π, where the SIMD azimuth and atan2's may fall on either side of the seam (the
 // slices' weights jump there for data with several φi).
 bool near_pi(double phi) {
@@ -996,8 +989,8 @@ void RglBrdf::sample_batch(std::span<const Vec3<double>> wo, std::span<const dou
     Brdf::sample_batch(wo, u1, u2, out);  // the size check
     return;
   }
-  for (std::size_t first = 0; first < out.size(); first += kSampleBlock) {
-    const std::size_t n = std::min(kSampleBlock, out.size() - first);
+  for (std::size_t first = 0; first < out.size(); first += kBlock) {
+    const std::size_t n = std::min(kBlock, out.size() - first);
     sample_block(wo.subspan(first, n), u1.subspan(first, n), u2.subspan(first, n),
                  out.subspan(first, n));
   }
@@ -1011,11 +1004,11 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
                            std::span<const double> u2, std::span<BrdfSample> out) const {
   const Impl& m = *impl_;
   const std::size_t n = wo.size();
-  alignas(64) double dirs[6][kSampleBlock];
-  alignas(64) double angle[4][kSampleBlock];
-  alignas(64) std::uint8_t valid[kSampleBlock];
-  bool apart[kSampleBlock];
-  Flips flips[kSampleBlock];
+  alignas(64) double dirs[6][kBlock];
+  alignas(64) double angle[4][kBlock];
+  alignas(64) std::uint8_t valid[kBlock];
+  bool apart[kBlock];
+  Flips flips[kBlock];
   for (std::size_t k = 0; k < n; ++k) {
     flips[k] = flips_for(m.reduction, wo[k]);
     const Vec3<double> g = flips[k].apply(wo[k]);
@@ -1025,9 +1018,9 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
     dirs[2][k] = dirs[5][k] = g.z;
   }
   angles_of(dirs, n, angle, valid);
-  double pdf_u[kSampleBlock] = {}, um_x[kSampleBlock] = {};
+  double pdf_u[kBlock] = {}, um_x[kBlock] = {};
   for (std::size_t k = 0; k < n; ++k) {
-    const double phi_g = angle[1][k] > kPi ? angle[1][k] - 2 * kPi : angle[1][k];
+    const double phi_g = signed_azimuth(angle[1][k]);
     apart[k] = apart[k] || !valid[k] || near_pi(phi_g);
     if (apart[k]) continue;
     const Slices s = m.slices(phi_g, angle[0][k]);
@@ -1070,8 +1063,8 @@ void RglBrdf::pdf_batch(std::span<const DirPair<double>> pairs, std::span<double
     Brdf::pdf_batch(pairs, out);  // the size check
     return;
   }
-  for (std::size_t first = 0; first < out.size(); first += kSampleBlock) {
-    const std::size_t n = std::min(kSampleBlock, out.size() - first);
+  for (std::size_t first = 0; first < out.size(); first += kBlock) {
+    const std::size_t n = std::min(kBlock, out.size() - first);
     pdf_block(pairs.subspan(first, n), out.subspan(first, n));
   }
 }
@@ -1083,16 +1076,16 @@ void RglBrdf::pdf_batch(std::span<const DirPair<double>> pairs, std::span<double
 void RglBrdf::pdf_block(std::span<const DirPair<double>> pairs, std::span<double> out) const {
   const Impl& m = *impl_;
   const std::size_t n = pairs.size();
-  alignas(64) double dirs[6][kSampleBlock];
-  alignas(64) double angle[4][kSampleBlock];
-  alignas(64) std::uint8_t valid[kSampleBlock];
-  bool apart[kSampleBlock];
+  alignas(64) double dirs[6][kBlock];
+  alignas(64) double angle[4][kBlock];
+  alignas(64) std::uint8_t valid[kBlock];
+  bool apart[kBlock];
   for (std::size_t k = 0; k < n; ++k)
     apart[k] = put_direction_and_half_vector(m.reduction, pairs[k].wo, pairs[k].wi, dirs, k);
   angles_of(dirs, n, angle, valid);
   for (std::size_t k = 0; k < n; ++k) {
-    const double phi_g = angle[1][k] > kPi ? angle[1][k] - 2 * kPi : angle[1][k];
-    const double phi_m = angle[3][k] > kPi ? angle[3][k] - 2 * kPi : angle[3][k];
+    const double phi_g = signed_azimuth(angle[1][k]);
+    const double phi_m = signed_azimuth(angle[3][k]);
     const double v = azimuth_u(phi_m, phi_g, m.isotropic);
     if (apart[k] || !valid[k] || near_pi(phi_g) || near_seam(v)) {
       out[k] = pdf(pairs[k].wo, pairs[k].wi);
