@@ -7,11 +7,13 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <random>
 #include <stdexcept>
 
 #include "formats/rgl_synthetic.hpp"
+#include "loader/embedded.hpp"
 #include "halfback/brdf/registry.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/formats/alta.hpp"
@@ -356,6 +358,24 @@ TEST(BuiltinModels, SumOfSpecs) {
       EXPECT_NE(std::string(e.what()).find("a sum has an empty term"), std::string::npos)
           << spec << ": " << e.what();
     }
+  }
+}
+
+// The assembler's .incbin (cmake/embed_files.cmake) put every file's exact bytes, 16-aligned.
+TEST(Embedded, BytesAreTheFilesBytes) {
+  const auto files = detail::embedded_files();
+  ASSERT_EQ(files.size(), 6u);
+  for (const detail::EmbeddedFile& f : files) {
+    const bool rgl = f.name.find('-') == std::string_view::npos;
+    const std::string path = std::string(HALFBACK_SOURCE_DIR) +
+                             (rgl ? "/data/rgl/" + std::string(f.name) + "_rgb.bsdf"
+                                  : "/data/nbrdf/" + std::string(f.name) + ".h5");
+    std::ifstream in(path, std::ios::binary);
+    ASSERT_TRUE(in) << path;
+    const std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in), {}};
+    ASSERT_EQ(f.bytes.size(), bytes.size()) << f.name;
+    EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), f.bytes.begin())) << f.name;
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(f.bytes.data()) % 16, 0u) << f.name;
   }
 }
 
