@@ -13,13 +13,13 @@
 #include <stdexcept>
 
 #include "formats/rgl_synthetic.hpp"
-#include "loader/embedded.hpp"
 #include "halfback/brdf/registry.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
 #include "halfback/models/analytic.hpp"
+#include "loader/embedded.hpp"
 #include "support/test_brdfs.hpp"
 #include "support/test_support.hpp"
 
@@ -367,9 +367,9 @@ TEST(Embedded, BytesAreTheFilesBytes) {
   ASSERT_EQ(files.size(), 6u);
   for (const detail::EmbeddedFile& f : files) {
     const bool rgl = f.name.find('-') == std::string_view::npos;
-    const std::string path = std::string(HALFBACK_SOURCE_DIR) +
-                             (rgl ? "/data/rgl/" + std::string(f.name) + "_rgb.bsdf"
-                                  : "/data/nbrdf/" + std::string(f.name) + ".h5");
+    const std::string path =
+        std::string(HALFBACK_SOURCE_DIR) + (rgl ? "/data/rgl/" + std::string(f.name) + "_rgb.bsdf"
+                                                : "/data/nbrdf/" + std::string(f.name) + ".h5");
     std::ifstream in(path, std::ios::binary);
     ASSERT_TRUE(in) << path;
     const std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in), {}};
