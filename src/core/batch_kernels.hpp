@@ -104,8 +104,8 @@ inline B mask_to_lanes(const MaskOf<B>& m) {
 // dirs input: the pair_is_valid() mask and the accepted pair, onto the unit upper hemisphere
 // (accepted_pair(); NaN where invalid), which the encode stage reads.
 template <class B>
-void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy,
-                                  ScalarOf<B>* mask, std::size_t m) {
+void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy, ScalarOf<B>* mask,
+                 std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   S* outs[7] = {copy[0], copy[1], copy[2], copy[3], copy[4], copy[5], mask};
@@ -121,8 +121,8 @@ void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy,
 
 // P input: the pair (NaN where invalid) and the domain mask.
 template <class B, class P, bool Iso>
-void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs,
-                                   ScalarOf<B>* mask, std::size_t m) {
+void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, ScalarOf<B>* mask,
+                  std::size_t m) {
   using S = ScalarOf<B>;
   constexpr int NI = Iso ? 3 : 4;
   constexpr int NO = 6 + 1;
@@ -144,8 +144,8 @@ void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs,
 // P output: the coordinates of the pair (NaN where the mask is 0), onto the unit hemisphere first
 // as convert_row() does: a decoded pair is unit only to rounding.
 template <class B, class P, bool Iso>
-void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask,
-                                   ScalarOf<B>* const* out, std::size_t m) {
+void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask, ScalarOf<B>* const* out,
+                  std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int kDim = Iso ? 3 : 4;
@@ -164,8 +164,7 @@ void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask,
 // row is invalid. (decode and encode computed it from the same q in the same lanes before, so the
 // bits are those of convert_one.)
 template <class B, class P, bool Iso>
-void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<B>* jac,
-                                     std::size_t m) {
+void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<B>* jac, std::size_t m) {
   using S = ScalarOf<B>;
   constexpr int NI = Iso ? 3 : 4;
   S* outs[1] = {jac};
