@@ -166,7 +166,7 @@ struct Cell {
   double tx, ty;
 };
 
-Cell cell_of(double x, double y, std::size_t w, std::size_t h) {
+[[gnu::always_inline]] inline Cell cell_of(double x, double y, std::size_t w, std::size_t h) {
   x = unit(x) * double(w - 1);
   y = unit(y) * double(h - 1);
   // Through a signed integer: x, y >= 0, and one instruction converts a double to it.
@@ -214,11 +214,13 @@ struct RgbTable {
     return v.data() + ((slice * h + j) * w + i) * kSlot;
   }
 
-  // The same arithmetic, channel by channel, as Table::eval on a channel's own table.
+  // The same arithmetic, channel by channel, as Table::eval on a channel's own table; N is
+  // s.count.
+  template <int N>
   std::array<double, 3> eval(const Slices& s, double x, double y) const {
     const Cell c = cell_of(x, y, w, h);
     std::array<double, 3> r{0, 0, 0};
-    for (int k = 0; k < s.count; ++k) {
+    for (int k = 0; k < N; ++k) {
       const double* p = slot(s.index[k], c.j, c.i);
       const double* q = p + w * kSlot;  // the row above
       for (std::size_t ch = 0; ch < 3; ++ch) {
@@ -346,32 +348,76 @@ struct Warp {
     return search(0, last);
   }
 
-  double F(const Slices& s, std::size_t j, std::size_t i) const {
-    double r = 0;
-    for (int n = 0; n < s.count; ++n) r += s.weight[n] * node[(s.index[n] * h + j) * w + i].f;
-    return r;
-  }
-  double C(const Slices& s, std::size_t j, std::size_t i) const {
-    double r = 0;
-    for (int n = 0; n < s.count; ++n) r += s.weight[n] * node[(s.index[n] * h + j) * w + i].c;
-    return r;
-  }
-  double M(const Slices& s, std::size_t j) const {
-    double r = 0;
-    for (int n = 0; n < s.count; ++n) r += s.weight[n] * row[s.index[n] * h + j].m;
-    return r;
-  }
-  double R(const Slices& s, std::size_t j) const {
-    double r = 0;
-    for (int n = 0; n < s.count; ++n) r += s.weight[n] * row[s.index[n] * h + j].r;
-    return r;
+  // The slices of a blend as pointers to their nodes and rows, with the count N (1, 2 or 4, as
+  // Impl::slices() gives) a constant: the loops unroll and the index arithmetic is done once.
+  // Each sum adds the slices in the order of s.index, as a loop over s.count would.
+  template <int N>
+  struct Blend {
+    const Node* node[N];  // the slice's h·w nodes
+    const Row* row[N];    // its h rows
+    const std::uint16_t* row_guide[N];
+    const std::uint16_t* col_guide[N];
+    double weight[N];
+    Blend(const Warp& wp, const Slices& s) {
+      for (int n = 0; n < N; ++n) {
+        const std::size_t first_row = s.index[n] * wp.h;
+        node[n] = wp.node.data() + first_row * wp.w;
+        row[n] = wp.row.data() + first_row;
+        row_guide[n] = wp.guided ? wp.row_guide.data() + first_row : nullptr;
+        col_guide[n] = wp.guided ? wp.col_guide.data() + first_row * wp.w : nullptr;
+        weight[n] = s.weight[n];
+      }
+    }
+    // F and C at node k = j·w + i, M and R at row j, blended.
+    double F(std::size_t k) const {
+      double r = 0;
+      for (int n = 0; n < N; ++n) r += weight[n] * node[n][k].f;
+      return r;
+    }
+    double C(std::size_t k) const {
+      double r = 0;
+      for (int n = 0; n < N; ++n) r += weight[n] * node[n][k].c;
+      return r;
+    }
+    double M(std::size_t j) const {
+      double r = 0;
+      for (int n = 0; n < N; ++n) r += weight[n] * row[n][j].m;
+      return r;
+    }
+    double R(std::size_t j) const {
+      double r = 0;
+      for (int n = 0; n < N; ++n) r += weight[n] * row[n][j].r;
+      return r;
+    }
+  };
+
+  // Calls f(Blend<N>) for the count of s.
+  template <class Fn>
+  decltype(auto) with_blend(const Slices& s, Fn f) const {
+    switch (s.count) {
+      case 1:
+        return f(Blend<1>(*this, s));
+      case 2:
+        return f(Blend<2>(*this, s));
+      default:
+        return f(Blend<4>(*this, s));
+    }
   }
 
   // Density on the unit square at p (the blended, normalized grid values, bilinear).
   double density(const Slices& s, RglWarpPoint p) const {
-    const Cell g = cell_of(p.x, p.y, w, h);
-    const double c0 = (1 - g.ty) * F(s, g.j, g.i) + g.ty * F(s, g.j + 1, g.i);
-    const double c1 = (1 - g.ty) * F(s, g.j, g.i + 1) + g.ty * F(s, g.j + 1, g.i + 1);
+    return with_blend(s, [&](const auto& b) { return density(b, p); });
+  }
+  template <int N>
+  double density(const Blend<N>& b, RglWarpPoint p) const {
+    return density(b, cell_of(p.x, p.y, w, h));
+  }
+  // The same in cell g.
+  template <int N>
+  double density(const Blend<N>& b, const Cell& g) const {
+    const std::size_t k = g.j * w + g.i;
+    const double c0 = (1 - g.ty) * b.F(k) + g.ty * b.F(k + w);
+    const double c1 = (1 - g.ty) * b.F(k + 1) + g.ty * b.F(k + w + 1);
     return ((1 - g.tx) * c0 + g.tx * c1) * double(w - 1) * double(h - 1);
   }
 
@@ -379,12 +425,17 @@ struct Warp {
   // values around p's cell (F at its corners, C at its left ones, R and M of its rows) are blended
   // over the slices in one pass, each sum in the order of F(), C(), R() and M().
   RglWarpPoint inverse(const Slices& s, RglWarpPoint p) const {
+    return with_blend(s, [&](const auto& b) { return inverse(b, p); });
+  }
+  template <int N>
+  RglWarpPoint inverse(const Blend<N>& b, RglWarpPoint p) const {
     const Cell g = cell_of(p.x, p.y, w, h);
+    const std::size_t k = g.j * w + g.i;
     double f00 = 0, f01 = 0, f10 = 0, f11 = 0, c00 = 0, c10 = 0, r0 = 0, r1 = 0, m0 = 0;
-    for (int n = 0; n < s.count; ++n) {
-      const double wn = s.weight[n];
-      const Node* a = &node[(s.index[n] * h + g.j) * w + g.i];
-      const Row* r = &row[s.index[n] * h + g.j];
+    for (int n = 0; n < N; ++n) {
+      const double wn = b.weight[n];
+      const Node* a = b.node[n] + k;
+      const Row* r = b.row[n] + g.j;
       f00 += wn * a[0].f;
       f01 += wn * a[1].f;
       f10 += wn * a[w].f;
@@ -409,14 +460,16 @@ struct Warp {
 
   // The bounds of the blended row search: each slice's own last row with M(j) < u.y (a blend of
   // non-decreasing CDFs with weights summing to 1 crosses u.y between its slices' crossings).
-  void row_bounds(const Slices& s, double uy, std::size_t& lo, std::size_t& hi) const {
+  template <int N>
+  void row_bounds(const Blend<N>& b, double uy, std::size_t& lo, std::size_t& hi) const {
     lo = h - 2;
     hi = 0;
-    for (int n = 0; n < s.count; ++n) {
-      if (!(s.weight[n] > 0)) continue;
-      const Row* r = &row[s.index[n] * h];
-      const std::size_t j = step_from(row_guide[s.index[n] * h + bucket(uy, h)], h - 2, uy,
-                                      [&](std::size_t q) { return r[q].m; });
+    const std::size_t k = bucket(uy, h);
+    for (int n = 0; n < N; ++n) {
+      if (!(b.weight[n] > 0)) continue;
+      const Row* r = b.row[n];
+      const std::size_t j =
+          step_from(b.row_guide[n][k], h - 2, uy, [&](std::size_t q) { return r[q].m; });
       lo = std::min(lo, j);
       hi = std::max(hi, j);
     }
@@ -425,17 +478,18 @@ struct Warp {
 
   // The same for the columns of rows j and j + 1 blended with weights 1 - ty and ty: each row's
   // and slice's own last column with C(j, i) < u.x R(j).
-  void column_bounds(const Slices& s, std::size_t j, double ty, double ux, std::size_t& lo,
+  template <int N>
+  void column_bounds(const Blend<N>& b, std::size_t j, double ty, double ux, std::size_t& lo,
                      std::size_t& hi) const {
     lo = w - 2;
     hi = 0;
-    for (int n = 0; n < s.count; ++n)
+    const std::size_t k = bucket(ux, w);
+    for (int n = 0; n < N; ++n)
       for (std::size_t d = 0; d < 2; ++d) {
-        if (!(s.weight[n] * (d ? ty : 1 - ty) > 0)) continue;
-        const std::size_t rj = s.index[n] * h + j + d;
-        const Node* a = &node[rj * w];
-        const double x = ux * row[rj].r;
-        const std::size_t i = step_from(col_guide[rj * w + bucket(ux, w)], w - 2, x,
+        if (!(b.weight[n] * (d ? ty : 1 - ty) > 0)) continue;
+        const Node* a = b.node[n] + (j + d) * w;
+        const double x = ux * b.row[n][j + d].r;
+        const std::size_t i = step_from(b.col_guide[n][(j + d) * w + k], w - 2, x,
                                         [&](std::size_t q) { return a[q].c; });
         lo = std::min(lo, i);
         hi = std::max(hi, i);
@@ -447,26 +501,66 @@ struct Warp {
   // find what binary searches of [0, h-2] and [0, w-2] find, within the slices' guided bounds.
   // `use_guides` false: plain binary searches (the reference the tests compare with).
   RglWarpPoint forward(const Slices& s, RglWarpPoint u, bool use_guides = true) const {
+    return with_blend(s, [&](const auto& b) { return forward(b, u, use_guides); });
+  }
+  template <int N>
+  RglWarpPoint forward(const Blend<N>& b, RglWarpPoint u, bool use_guides = true) const {
+    const Cell c = forward_cell(b, u, use_guides);
+    return {(double(c.i) + c.tx) / double(w - 1), (double(c.j) + c.ty) / double(h - 1)};
+  }
+  // The same as a cell and the position in it.
+  template <int N>
+  Cell forward_cell(const Blend<N>& b, RglWarpPoint u, bool use_guides) const {
     const bool guides = guided && use_guides;
     u.x = unit(u.x);
     u.y = unit(u.y);
     // Row: the last j in [0, h-2] with M(j) < u.y.
     std::size_t lo = 0, hi = h - 2;
-    if (guides) row_bounds(s, u.y, lo, hi);
-    const std::size_t j = last_below([&](std::size_t q) { return M(s, q); }, u.y, lo, hi, h - 2);
-    const double r0 = R(s, j), r1 = R(s, j + 1);
-    const double ty = solve_linear_density(r0, r1, u.y - M(s, j));
+    if (guides) row_bounds(b, u.y, lo, hi);
+    const std::size_t j = last_below([&](std::size_t q) { return b.M(q); }, u.y, lo, hi, h - 2);
+    const double r0 = b.R(j), r1 = b.R(j + 1);
+    const double ty = solve_linear_density(r0, r1, u.y - b.M(j));
     // Column: the last i in [0, w-2] with C_ty(i) < u.x · R(ty).
     const double target = u.x * ((1 - ty) * r0 + ty * r1);
-    auto ct = [&](std::size_t i) { return (1 - ty) * C(s, j, i) + ty * C(s, j + 1, i); };
+    const std::size_t row0 = j * w, row1 = row0 + w;
+    auto ct = [&](std::size_t i) { return (1 - ty) * b.C(row0 + i) + ty * b.C(row1 + i); };
     lo = 0;
     hi = w - 2;
-    if (guides) column_bounds(s, j, ty, u.x, lo, hi);
+    if (guides) column_bounds(b, j, ty, u.x, lo, hi);
     const std::size_t i = last_below(ct, target, lo, hi, w - 2);
-    const double c0 = (1 - ty) * F(s, j, i) + ty * F(s, j + 1, i);
-    const double c1 = (1 - ty) * F(s, j, i + 1) + ty * F(s, j + 1, i + 1);
-    const double sx = solve_linear_density(c0, c1, target - ct(i));
-    return {(double(i) + sx) / double(w - 1), (double(j) + ty) / double(h - 1)};
+    const double c0 = (1 - ty) * b.F(row0 + i) + ty * b.F(row1 + i);
+    const double c1 = (1 - ty) * b.F(row0 + i + 1) + ty * b.F(row1 + i + 1);
+    return {i, j, solve_linear_density(c0, c1, target - ct(i)), ty};
+  }
+
+  // A point drawn from the blend's density, and its density (density(s, point) up to rounding):
+  // a slice n chosen with probability s.weight[n], then that slice's own CDFs inverted. The
+  // blend's density is the mixture Σ w_n p_n (the bilinear interpolant is linear in the grid
+  // values), so this samples what forward() samples, by another map of u: one slice's searches
+  // instead of the blend's (docs/formats.md, "Sampling"). u.x chooses the slice and is rescaled
+  // to its share.
+  struct Drawn {
+    RglWarpPoint point;
+    double density;
+  };
+  Drawn draw(const Slices& s, RglWarpPoint u) const {
+    const double x = unit(u.x);
+    int pick = -1;
+    double below = 0, share = 1, sum = 0;
+    for (int n = 0; n < s.count; ++n) {
+      if (!(s.weight[n] > 0)) continue;
+      pick = n, below = sum, share = s.weight[n];
+      sum += s.weight[n];
+      if (x < sum) break;  // the last slice of positive weight also takes x >= Σ w (rounding)
+    }
+    if (pick < 0) {  // no positive weight (a NaN incidence): the blend's answer
+      const RglWarpPoint p = forward(s, u);
+      return {p, density(s, p)};
+    }
+    const Slices one{{s.index[pick], 0, 0, 0}, {1, 0, 0, 0}, 1};
+    const Cell c = forward_cell(Blend<1>(*this, one), {(x - below) / share, u.y}, true);
+    return {{(double(c.i) + c.tx) / double(w - 1), (double(c.j) + c.ty) / double(h - 1)},
+            with_blend(s, [&](const auto& b) { return density(b, c); })};
   }
 
   // t in [0, 1] with ∫_0^t ((1-τ) a + τ b) dτ = a t + (b - a) t²/2 = area, in the form that stays
@@ -545,13 +639,19 @@ struct RglBrdf::Impl {
   // VNDF warp gives um, times the NDF over 4 sigma when the file asks for that Jacobian; negative
   // values clamped to 0 on request.
   Rgb value(const Slices& s, RglWarpPoint um, RglWarpPoint uwi, bool clamp_negative) const {
-    const RglWarpPoint sample = vndf.inverse(s, um);
+    return vndf.with_blend(
+        s, [&]<int N>(const Warp::Blend<N>& b) { return value(s, b, um, uwi, clamp_negative); });
+  }
+  template <int N>
+  Rgb value(const Slices& s, const Warp::Blend<N>& b, RglWarpPoint um, RglWarpPoint uwi,
+            bool clamp_negative) const {
+    const RglWarpPoint sample = vndf.inverse(b, um);
     double scale = 1;
     if (jacobian) {
       const Slices none{{0, 0, 0, 0}, {1, 0, 0, 0}, 1};
       scale = ndf.eval(none, um.x, um.y) / (4 * sigma.eval(none, uwi.x, uwi.y));
     }
-    const std::array<double, 3> rgb_at = rgb.eval(s, sample.x, sample.y);
+    const std::array<double, 3> rgb_at = rgb.eval<N>(s, sample.x, sample.y);
     double c[3];
     for (std::size_t ch = 0; ch < 3; ++ch) {
       c[ch] = rgb_at[ch] * scale;
@@ -801,8 +901,7 @@ BrdfSample RglBrdf::sample(const Vec3<double>& wo, double u1, double u2) const {
   const double theta_g = std::atan2(std::hypot(g.x, g.y), g.z);
   const double phi_g = std::atan2(g.y, g.x);
   const Slices s = m.slices(phi_g, theta_g);
-  const RglWarpPoint um = m.vndf.forward(s, {u1, u2});
-  const double pdf_u = m.vndf.density(s, um);
+  const auto [um, pdf_u] = m.vndf.draw(s, {u1, u2});
   const double theta_m = um.x * um.x * (kPi / 2);
   const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g : 0.0);
   const Vec3<double> n{std::sin(theta_m) * std::cos(phi_m), std::sin(theta_m) * std::sin(phi_m),
@@ -1024,8 +1123,8 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
     apart[k] = apart[k] || !valid[k] || near_pi(phi_g);
     if (apart[k]) continue;
     const Slices s = m.slices(phi_g, angle[0][k]);
-    const RglWarpPoint um = m.vndf.forward(s, {u1[k], u2[k]});
-    pdf_u[k] = m.vndf.density(s, um);
+    const auto [um, density] = m.vndf.draw(s, {u1[k], u2[k]});
+    pdf_u[k] = density;
     um_x[k] = um.x;
     // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
     const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g : 0.0);
