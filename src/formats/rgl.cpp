@@ -214,6 +214,18 @@ struct RgbTable {
     return v.data() + ((slice * h + j) * w + i) * kSlot;
   }
 
+  // Asks for the lines that eval(s, x, y) reads.
+  void prefetch(const Slices& s, double x, double y) const {
+    const Cell c = cell_of(x, y, w, h);
+    for (int k = 0; k < s.count; ++k) {
+      const double* p = slot(s.index[k], c.j, c.i);
+      __builtin_prefetch(p);
+      __builtin_prefetch(p + kSlot);
+      __builtin_prefetch(p + w * kSlot);
+      __builtin_prefetch(p + (w + 1) * kSlot);
+    }
+  }
+
   // The same arithmetic, channel by channel, as Table::eval on a channel's own table; N is
   // s.count.
   template <int N>
@@ -235,21 +247,24 @@ struct RgbTable {
 
 // A 2D distribution with the density bilinear in its grid values (a table per slice), sampled by
 // inverting its marginal CDF in y and its conditional CDF in x (docs/formats.md). The density and
-// the conditional CDF of a grid point are side by side (one 16-byte node), and so are the marginal
-// CDF and the total of a row: the inverse warp at a point reads two or three cache lines per
-// slice instead of seven.
+// the conditional CDF of a grid point are side by side (one 8-byte node of two floats: the file's
+// float32 value and its running sum, not normalized, so that the tables of a 128 × 128 file take
+// 1 MB rather than 2 and stay in a core's L2 cache), and so are the marginal CDF and the total of
+// a row: the inverse warp at a point reads one or two cache lines per slice. A slice's
+// normalization 1/total is applied to the blend's weights (Blend::scaled).
 struct Warp {
   struct Node {
-    double f;  // density grid value, each slice normalized (index units)
-    double c;  // C(j, i) = ∫_0^i f(s, j) ds (trapezoids)
+    float f;  // density grid value, as the file stores it
+    float c;  // C(j, i) = ∫_0^i f(s, j) ds (trapezoids, rounded to float)
   };
   struct Row {
-    double m;  // M(j) = ∫_0^j R(t) dt; M(h-1) = 1
-    double r;  // R(j) = C(j, w-1)
+    double m;  // M(j) = ∫_0^j R(t) dt / total: normalized, M(h-1) = 1
+    double r;  // R(j) = C(j, w-1), not normalized
   };
   std::size_t w = 0, h = 0;
-  std::vector<Node> node;  // h·w per slice
-  std::vector<Row> row;    // h per slice
+  std::vector<Node> node;         // h·w per slice
+  std::vector<Row> row;           // h per slice
+  std::vector<double> inv_total;  // 1 / ∫∫ f per slice
   // Guide tables (Chen and Asau 1974) of each slice's own CDFs: bucket k of the marginal's h
   // buckets holds the last row j with M(j) < k/h, bucket k of a row's w buckets the last column i
   // with C(j, i) < (k/w) R(j). They bound forward()'s searches of the blended CDFs (below).
@@ -261,6 +276,7 @@ struct Warp {
   bool build(const std::vector<double>& data, std::size_t slices) {
     node.resize(data.size());
     row.resize(slices * h);
+    inv_total.resize(slices);
     std::vector<double> c(w * h), m(h);
     for (std::size_t s = 0; s < slices; ++s) {
       const double* in = data.data() + s * w * h;
@@ -269,13 +285,17 @@ struct Warp {
         for (std::size_t i = 0; i + 1 < w; ++i)
           c[j * w + i + 1] = c[j * w + i] + 0.5 * (in[j * w + i] + in[j * w + i + 1]);
       }
+      // The sums as stored (float), and the marginal from the stored row totals: the inverse and
+      // forward warps then read one consistent set of values.
+      for (std::size_t k = 0; k < w * h; ++k) c[k] = double(float(c[k]));
       m[0] = 0;
       for (std::size_t j = 0; j + 1 < h; ++j)
         m[j + 1] = m[j] + 0.5 * (c[j * w + w - 1] + c[(j + 1) * w + w - 1]);
       const double total = m[h - 1];
-      if (!(total > 0)) return false;
-      for (std::size_t k = 0; k < w * h; ++k) node[s * w * h + k] = {in[k] / total, c[k] / total};
-      for (std::size_t j = 0; j < h; ++j) row[s * h + j] = {m[j] / total, c[j * w + w - 1] / total};
+      if (!(total > 0) || !std::isfinite(total)) return false;
+      for (std::size_t k = 0; k < w * h; ++k) node[s * w * h + k] = {float(in[k]), float(c[k])};
+      for (std::size_t j = 0; j < h; ++j) row[s * h + j] = {m[j] / total, c[j * w + w - 1]};
+      inv_total[s] = 1 / total;
     }
     build_guides(slices);
     return true;
@@ -357,7 +377,8 @@ struct Warp {
     const Row* row[N];    // its h rows
     const std::uint16_t* row_guide[N];
     const std::uint16_t* col_guide[N];
-    double weight[N];
+    double weight[N];  // of the normalized M
+    double scaled[N];  // weight / total: of F, C and R, stored without normalization
     Blend(const Warp& wp, const Slices& s) {
       for (int n = 0; n < N; ++n) {
         const std::size_t first_row = s.index[n] * wp.h;
@@ -366,17 +387,18 @@ struct Warp {
         row_guide[n] = wp.guided ? wp.row_guide.data() + first_row : nullptr;
         col_guide[n] = wp.guided ? wp.col_guide.data() + first_row * wp.w : nullptr;
         weight[n] = s.weight[n];
+        scaled[n] = s.weight[n] * wp.inv_total[s.index[n]];
       }
     }
     // F and C at node k = j·w + i, M and R at row j, blended.
     double F(std::size_t k) const {
       double r = 0;
-      for (int n = 0; n < N; ++n) r += weight[n] * node[n][k].f;
+      for (int n = 0; n < N; ++n) r += scaled[n] * double(node[n][k].f);
       return r;
     }
     double C(std::size_t k) const {
       double r = 0;
-      for (int n = 0; n < N; ++n) r += weight[n] * node[n][k].c;
+      for (int n = 0; n < N; ++n) r += scaled[n] * double(node[n][k].c);
       return r;
     }
     double M(std::size_t j) const {
@@ -386,7 +408,7 @@ struct Warp {
     }
     double R(std::size_t j) const {
       double r = 0;
-      for (int n = 0; n < N; ++n) r += weight[n] * row[n][j].r;
+      for (int n = 0; n < N; ++n) r += scaled[n] * row[n][j].r;
       return r;
     }
   };
@@ -421,6 +443,17 @@ struct Warp {
     return ((1 - g.tx) * c0 + g.tx * c1) * double(w - 1) * double(h - 1);
   }
 
+  // Asks for the lines that inverse(s, p) reads (a block's lookups then overlap).
+  void prefetch(const Slices& s, RglWarpPoint p) const {
+    const Cell g = cell_of(p.x, p.y, w, h);
+    for (int n = 0; n < s.count; ++n) {
+      const Node* a = &node[(s.index[n] * h + g.j) * w + g.i];
+      __builtin_prefetch(a);
+      __builtin_prefetch(a + w);
+      __builtin_prefetch(&row[s.index[n] * h + g.j]);
+    }
+  }
+
   // Point p of the unit square -> sample (the CDFs at p): the inverse of the warp. The grid
   // values around p's cell (F at its corners, C at its left ones, R and M of its rows) are blended
   // over the slices in one pass, each sum in the order of F(), C(), R() and M().
@@ -433,16 +466,16 @@ struct Warp {
     const std::size_t k = g.j * w + g.i;
     double f00 = 0, f01 = 0, f10 = 0, f11 = 0, c00 = 0, c10 = 0, r0 = 0, r1 = 0, m0 = 0;
     for (int n = 0; n < N; ++n) {
-      const double wn = b.weight[n];
+      const double wn = b.scaled[n];
       const Node* a = b.node[n] + k;
       const Row* r = b.row[n] + g.j;
-      f00 += wn * a[0].f;
-      f01 += wn * a[1].f;
-      f10 += wn * a[w].f;
-      f11 += wn * a[w + 1].f;
-      c00 += wn * a[0].c;
-      c10 += wn * a[w].c;
-      m0 += wn * r[0].m;
+      f00 += wn * double(a[0].f);
+      f01 += wn * double(a[1].f);
+      f10 += wn * double(a[w].f);
+      f11 += wn * double(a[w + 1].f);
+      c00 += wn * double(a[0].c);
+      c10 += wn * double(a[w].c);
+      m0 += b.weight[n] * r[0].m;
       r0 += wn * r[0].r;
       r1 += wn * r[1].r;
     }
@@ -477,16 +510,17 @@ struct Warp {
   }
 
   // The same for the columns of rows j and j + 1 blended with weights 1 - ty and ty: each row's
-  // and slice's own last column with C(j, i) < u.x R(j).
+  // and slice's own last column with C(j, i) < u.x R(j). Both rows whatever ty (a row of weight
+  // 0 only widens the bounds), so that these loads need not wait for ty's square root.
   template <int N>
-  void column_bounds(const Blend<N>& b, std::size_t j, double ty, double ux, std::size_t& lo,
+  void column_bounds(const Blend<N>& b, std::size_t j, double ux, std::size_t& lo,
                      std::size_t& hi) const {
     lo = w - 2;
     hi = 0;
     const std::size_t k = bucket(ux, w);
     for (int n = 0; n < N; ++n)
       for (std::size_t d = 0; d < 2; ++d) {
-        if (!(b.weight[n] * (d ? ty : 1 - ty) > 0)) continue;
+        if (!(b.weight[n] > 0)) continue;
         const Node* a = b.node[n] + (j + d) * w;
         const double x = ux * b.row[n][j + d].r;
         const std::size_t i = step_from(b.col_guide[n][(j + d) * w + k], w - 2, x,
@@ -514,20 +548,27 @@ struct Warp {
     const bool guides = guided && use_guides;
     u.x = unit(u.x);
     u.y = unit(u.y);
-    // Row: the last j in [0, h-2] with M(j) < u.y.
+    return forward_column(b, u, forward_row(b, u.y, guides), guides);
+  }
+  // Its row: the last j in [0, h-2] with M(j) < u.y.
+  template <int N>
+  std::size_t forward_row(const Blend<N>& b, double uy, bool guides) const {
     std::size_t lo = 0, hi = h - 2;
-    if (guides) row_bounds(b, u.y, lo, hi);
-    const std::size_t j = last_below([&](std::size_t q) { return b.M(q); }, u.y, lo, hi, h - 2);
+    if (guides) row_bounds(b, uy, lo, hi);
+    return last_below([&](std::size_t q) { return b.M(q); }, uy, lo, hi, h - 2);
+  }
+  // The rest, in row j (u in the unit square).
+  template <int N>
+  Cell forward_column(const Blend<N>& b, RglWarpPoint u, std::size_t j, bool guides) const {
+    std::size_t col_lo = 0, col_hi = w - 2;
+    if (guides) column_bounds(b, j, u.x, col_lo, col_hi);
     const double r0 = b.R(j), r1 = b.R(j + 1);
     const double ty = solve_linear_density(r0, r1, u.y - b.M(j));
     // Column: the last i in [0, w-2] with C_ty(i) < u.x · R(ty).
     const double target = u.x * ((1 - ty) * r0 + ty * r1);
     const std::size_t row0 = j * w, row1 = row0 + w;
     auto ct = [&](std::size_t i) { return (1 - ty) * b.C(row0 + i) + ty * b.C(row1 + i); };
-    lo = 0;
-    hi = w - 2;
-    if (guides) column_bounds(b, j, ty, u.x, lo, hi);
-    const std::size_t i = last_below(ct, target, lo, hi, w - 2);
+    const std::size_t i = last_below(ct, target, col_lo, col_hi, w - 2);
     const double c0 = (1 - ty) * b.F(row0 + i) + ty * b.F(row1 + i);
     const double c1 = (1 - ty) * b.F(row0 + i + 1) + ty * b.F(row1 + i + 1);
     return {i, j, solve_linear_density(c0, c1, target - ct(i)), ty};
@@ -543,7 +584,18 @@ struct Warp {
     RglWarpPoint point;
     double density;
   };
-  Drawn draw(const Slices& s, RglWarpPoint u) const {
+  Drawn draw(const Slices& s, RglWarpPoint u) const { return draw_column(s, draw_row(s, u)); }
+
+  // draw() in steps, so that a block's column searches find the lines that the steps before ask
+  // for: the slice and the row (the column guides of rows j and j + 1 prefetched), the nodes at
+  // the guides prefetched (prefetch_nodes), then the rest.
+  struct Drawing {
+    Slices one;  // the drawn slice
+    RglWarpPoint u;
+    std::size_t j = 0;
+    bool blend = false;  // no slice of positive weight: forward() of the blend
+  };
+  Drawing draw_row(const Slices& s, RglWarpPoint u) const {
     const double x = unit(u.x);
     int pick = -1;
     double below = 0, share = 1, sum = 0;
@@ -553,12 +605,28 @@ struct Warp {
       sum += s.weight[n];
       if (x < sum) break;  // the last slice of positive weight also takes x >= Σ w (rounding)
     }
-    if (pick < 0) {  // no positive weight (a NaN incidence): the blend's answer
-      const RglWarpPoint p = forward(s, u);
+    if (pick < 0) return {s, u, 0, true};  // no positive weight (a NaN incidence)
+    Drawing d{{{s.index[pick], 0, 0, 0}, {1, 0, 0, 0}, 1}, {unit((x - below) / share), unit(u.y)}};
+    d.j = forward_row(Blend<1>(*this, d.one), d.u.y, guided);
+    if (guided) {
+      const std::uint16_t* g = &col_guide[(d.one.index[0] * h + d.j) * w + bucket(d.u.x, w)];
+      __builtin_prefetch(g);
+      __builtin_prefetch(g + w);
+    }
+    return d;
+  }
+  void prefetch_nodes(const Drawing& d) const {
+    if (d.blend || !guided) return;
+    const std::size_t first = (d.one.index[0] * h + d.j) * w, k = bucket(d.u.x, w);
+    __builtin_prefetch(&node[first + col_guide[first + k]]);
+    __builtin_prefetch(&node[first + w + col_guide[first + w + k]]);
+  }
+  Drawn draw_column(const Slices& s, const Drawing& d) const {
+    if (d.blend) {
+      const RglWarpPoint p = forward(s, d.u);
       return {p, density(s, p)};
     }
-    const Slices one{{s.index[pick], 0, 0, 0}, {1, 0, 0, 0}, 1};
-    const Cell c = forward_cell(Blend<1>(*this, one), {(x - below) / share, u.y}, true);
+    const Cell c = forward_column(Blend<1>(*this, d.one), d.u, d.j, guided);
     return {{(double(c.i) + c.tx) / double(w - 1), (double(c.j) + c.ty) / double(h - 1)},
             with_blend(s, [&](const auto& b) { return density(b, c); })};
   }
@@ -639,13 +707,23 @@ struct RglBrdf::Impl {
   // VNDF warp gives um, times the NDF over 4 sigma when the file asks for that Jacobian; negative
   // values clamped to 0 on request.
   Rgb value(const Slices& s, RglWarpPoint um, RglWarpPoint uwi, bool clamp_negative) const {
-    return vndf.with_blend(
-        s, [&]<int N>(const Warp::Blend<N>& b) { return value(s, b, um, uwi, clamp_negative); });
+    return shade(s, vndf.inverse(s, um), um, uwi, clamp_negative);
+  }
+  // value() from the inverse warp's sample: the RGB tables there, the Jacobian.
+  Rgb shade(const Slices& s, RglWarpPoint sample, RglWarpPoint um, RglWarpPoint uwi,
+            bool clamp_negative) const {
+    switch (s.count) {
+      case 1:
+        return shade<1>(s, sample, um, uwi, clamp_negative);
+      case 2:
+        return shade<2>(s, sample, um, uwi, clamp_negative);
+      default:
+        return shade<4>(s, sample, um, uwi, clamp_negative);
+    }
   }
   template <int N>
-  Rgb value(const Slices& s, const Warp::Blend<N>& b, RglWarpPoint um, RglWarpPoint uwi,
+  Rgb shade(const Slices& s, RglWarpPoint sample, RglWarpPoint um, RglWarpPoint uwi,
             bool clamp_negative) const {
-    const RglWarpPoint sample = vndf.inverse(b, um);
     double scale = 1;
     if (jacobian) {
       const Slices none{{0, 0, 0, 0}, {1, 0, 0, 0}, 1};
@@ -773,7 +851,8 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     m.vndf.w = static_cast<std::size_t>(f.shape[3]);
     std::vector<double> data = v.floats(f);
     m.noise_clamped += v.clamp_noise(f, data);
-    if (!m.vndf.build(data, m.n_slices)) v.fail("vndf", "a slice integrates to zero");
+    if (!m.vndf.build(data, m.n_slices))
+      v.fail("vndf", "a slice integrates to zero (or beyond the float range)");
   }
 
   const TensorField& lum = v.field("luminance", TensorDtype::float32, 4);
@@ -1049,12 +1128,22 @@ void RglBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> 
   Slices slices[kBlock];
   for (std::size_t k = 0; k < n; ++k) {
     apart[k] = apart[k] || !valid[k] || near_seam(um_y[k]) || near_seam(uwi_y[k]);
-    if (!apart[k]) slices[k] = m.slices(angle[1][k], angle[0][k]);
+    if (!apart[k]) {
+      slices[k] = m.slices(angle[1][k], angle[0][k]);
+      m.vndf.prefetch(slices[k], {um_x[k], um_y[k]});
+    }
   }
+  // Impl::value() in two passes over the block, each prefetching what the next one reads.
+  RglWarpPoint sample[kBlock];
+  for (std::size_t k = 0; k < n; ++k)
+    if (!apart[k]) {
+      sample[k] = m.vndf.inverse(slices[k], {um_x[k], um_y[k]});
+      m.rgb.prefetch(slices[k], sample[k].x, sample[k].y);
+    }
   for (std::size_t k = 0; k < n; ++k)
     out[k] = apart[k] ? eval(pairs[k])
-                      : over_cosine(m.value(slices[k], {um_x[k], um_y[k]}, {uwi_x[k], uwi_y[k]},
-                                            options_.clamp_negative),
+                      : over_cosine(m.shade(slices[k], sample[k], {um_x[k], um_y[k]},
+                                            {uwi_x[k], uwi_y[k]}, options_.clamp_negative),
                                     pairs[k].wo);
 }
 
@@ -1118,12 +1207,21 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
   }
   angles_of(dirs, n, angle, valid);
   double pdf_u[kBlock] = {}, um_x[kBlock] = {};
+  // The warp's draws in steps over the block (Warp::draw_row), each prefetching for the next.
+  Slices slices[kBlock];
+  Warp::Drawing drawing[kBlock];
   for (std::size_t k = 0; k < n; ++k) {
-    const double phi_g = signed_azimuth(angle[1][k]);
-    apart[k] = apart[k] || !valid[k] || near_pi(phi_g);
+    apart[k] = apart[k] || !valid[k] || near_pi(signed_azimuth(angle[1][k]));
     if (apart[k]) continue;
-    const Slices s = m.slices(phi_g, angle[0][k]);
-    const auto [um, density] = m.vndf.draw(s, {u1[k], u2[k]});
+    slices[k] = m.slices(signed_azimuth(angle[1][k]), angle[0][k]);
+    drawing[k] = m.vndf.draw_row(slices[k], {u1[k], u2[k]});
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    if (!apart[k]) m.vndf.prefetch_nodes(drawing[k]);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (apart[k]) continue;
+    const double phi_g = signed_azimuth(angle[1][k]);
+    const auto [um, density] = m.vndf.draw_column(slices[k], drawing[k]);
     pdf_u[k] = density;
     um_x[k] = um.x;
     // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
