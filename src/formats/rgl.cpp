@@ -390,6 +390,9 @@ struct Warp {
         scaled[n] = s.weight[n] * wp.inv_total[s.index[n]];
       }
     }
+    // One slice of weight 1.
+    Blend(const Warp& wp, std::size_t slice) requires(N == 1)
+        : Blend(wp, Slices{{slice, 0, 0, 0}, {1, 0, 0, 0}, 1}) {}
     // F and C at node k = j·w + i, M and R at row j, blended.
     double F(std::size_t k) const {
       double r = 0;
@@ -590,7 +593,7 @@ struct Warp {
   // for: the slice and the row (the column guides of rows j and j + 1 prefetched), the nodes at
   // the guides prefetched (prefetch_nodes), then the rest.
   struct Drawing {
-    Slices one;  // the drawn slice
+    std::size_t slice = 0;  // the drawn one
     RglWarpPoint u;
     std::size_t j = 0;
     bool blend = false;  // no slice of positive weight: forward() of the blend
@@ -605,11 +608,11 @@ struct Warp {
       sum += s.weight[n];
       if (x < sum) break;  // the last slice of positive weight also takes x >= Σ w (rounding)
     }
-    if (pick < 0) return {s, u, 0, true};  // no positive weight (a NaN incidence)
-    Drawing d{{{s.index[pick], 0, 0, 0}, {1, 0, 0, 0}, 1}, {unit((x - below) / share), unit(u.y)}};
-    d.j = forward_row(Blend<1>(*this, d.one), d.u.y, guided);
+    if (pick < 0) return {0, u, 0, true};  // no positive weight (a NaN incidence)
+    Drawing d{s.index[pick], {unit((x - below) / share), unit(u.y)}};
+    d.j = forward_row(Blend<1>(*this, d.slice), d.u.y, guided);
     if (guided) {
-      const std::uint16_t* g = &col_guide[(d.one.index[0] * h + d.j) * w + bucket(d.u.x, w)];
+      const std::uint16_t* g = &col_guide[(d.slice * h + d.j) * w + bucket(d.u.x, w)];
       __builtin_prefetch(g);
       __builtin_prefetch(g + w);
     }
@@ -617,7 +620,7 @@ struct Warp {
   }
   void prefetch_nodes(const Drawing& d) const {
     if (d.blend || !guided) return;
-    const std::size_t first = (d.one.index[0] * h + d.j) * w, k = bucket(d.u.x, w);
+    const std::size_t first = (d.slice * h + d.j) * w, k = bucket(d.u.x, w);
     __builtin_prefetch(&node[first + col_guide[first + k]]);
     __builtin_prefetch(&node[first + w + col_guide[first + w + k]]);
   }
@@ -626,7 +629,7 @@ struct Warp {
       const RglWarpPoint p = forward(s, d.u);
       return {p, density(s, p)};
     }
-    const Cell c = forward_column(Blend<1>(*this, d.one), d.u, d.j, guided);
+    const Cell c = forward_column(Blend<1>(*this, d.slice), d.u, d.j, guided);
     return {{(double(c.i) + c.tx) / double(w - 1), (double(c.j) + c.ty) / double(h - 1)},
             with_blend(s, [&](const auto& b) { return density(b, c); })};
   }
@@ -681,11 +684,17 @@ struct RglBrdf::Impl {
   std::size_t wavelengths = 0;    // the spectral variant: its wavelengths, integrated to RGB
 
   Slices slices(double phi_i, double theta_i) const {
+    Slices s;
+    slices(phi_i, theta_i, s);
+    return s;
+  }
+  // The same in place (a block's array: no copy of the struct, whose piecewise stores a copy's
+  // wide loads would wait for).
+  void slices(double phi_i, double theta_i, Slices& s) const {
     std::size_t ip, it;
     double tp, tt;
     phi.locate(phi_i, ip, tp);
     theta.locate(theta_i, it, tt);
-    Slices s{};
     s.count = 0;
     for (int a = 0; a < 2; ++a) {
       const double wa = a ? tp : 1 - tp;
@@ -699,7 +708,6 @@ struct RglBrdf::Impl {
         ++s.count;
       }
     }
-    return s;
   }
 
   // fr·cos θo at incidence slices s, with um the half vector on the unit square of the VNDF and NDF
@@ -1129,7 +1137,7 @@ void RglBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> 
   for (std::size_t k = 0; k < n; ++k) {
     apart[k] = apart[k] || !valid[k] || near_seam(um_y[k]) || near_seam(uwi_y[k]);
     if (!apart[k]) {
-      slices[k] = m.slices(angle[1][k], angle[0][k]);
+      m.slices(angle[1][k], angle[0][k], slices[k]);
       m.vndf.prefetch(slices[k], {um_x[k], um_y[k]});
     }
   }
@@ -1213,7 +1221,7 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
   for (std::size_t k = 0; k < n; ++k) {
     apart[k] = apart[k] || !valid[k] || near_pi(signed_azimuth(angle[1][k]));
     if (apart[k]) continue;
-    slices[k] = m.slices(signed_azimuth(angle[1][k]), angle[0][k]);
+    m.slices(signed_azimuth(angle[1][k]), angle[0][k], slices[k]);
     drawing[k] = m.vndf.draw_row(slices[k], {u1[k], u2[k]});
   }
   for (std::size_t k = 0; k < n; ++k)
