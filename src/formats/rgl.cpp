@@ -1205,54 +1205,70 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
   alignas(64) std::uint8_t valid[kBlock];
   bool apart[kBlock];
   Flips flips[kBlock];
-  for (std::size_t k = 0; k < n; ++k) {
-    flips[k] = flips_for(m.reduction, wo[k]);
-    const Vec3<double> g = flips[k].apply(wo[k]);
-    apart[k] = !(g.z > 0) || (g.x == 0 && g.y == 0);
-    dirs[0][k] = dirs[3][k] = g.x;
-    dirs[1][k] = dirs[4][k] = g.y;
-    dirs[2][k] = dirs[5][k] = g.z;
+  // Two samples per row of the conversions, each way a pair of directions: sample k in half
+  // k % 2 of row k / 2 (columns 3 (k % 2) .. +2 of the directions, 2 (k % 2) .. +1 of the
+  // angles). A row's second half when n is odd, and the rows of samples that go apart, hold +z,
+  // which every conversion accepts.
+  const std::size_t rows = (n + 1) / 2;
+  for (std::size_t k = 0; k < 2 * rows; ++k) {
+    Vec3<double> g{0, 0, 1};
+    if (k < n) {
+      flips[k] = flips_for(m.reduction, wo[k]);
+      const Vec3<double> d = flips[k].apply(wo[k]);
+      apart[k] = !(d.z > 0) || (d.x == 0 && d.y == 0);
+      if (!apart[k]) g = d;
+    }
+    dirs[3 * (k % 2)][k / 2] = g.x;
+    dirs[3 * (k % 2) + 1][k / 2] = g.y;
+    dirs[3 * (k % 2) + 2][k / 2] = g.z;
   }
-  angles_of(dirs, n, angle, valid);
+  angles_of(dirs, rows, angle, valid);
+  double theta_g[kBlock], phi_g[kBlock];
+  for (std::size_t k = 0; k < n; ++k) {
+    theta_g[k] = angle[2 * (k % 2)][k / 2];
+    phi_g[k] = signed_azimuth(angle[2 * (k % 2) + 1][k / 2]);
+    apart[k] = apart[k] || !valid[k / 2] || near_pi(phi_g[k]);
+  }
   double pdf_u[kBlock] = {}, um_x[kBlock] = {};
   // The warp's draws in steps over the block (Warp::draw_row), each prefetching for the next.
   Slices slices[kBlock];
   Warp::Drawing drawing[kBlock];
   for (std::size_t k = 0; k < n; ++k) {
-    apart[k] = apart[k] || !valid[k] || near_pi(signed_azimuth(angle[1][k]));
     if (apart[k]) continue;
-    m.slices(signed_azimuth(angle[1][k]), angle[0][k], slices[k]);
+    m.slices(phi_g[k], theta_g[k], slices[k]);
     drawing[k] = m.vndf.draw_row(slices[k], {u1[k], u2[k]});
   }
   for (std::size_t k = 0; k < n; ++k)
     if (!apart[k]) m.vndf.prefetch_nodes(drawing[k]);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (apart[k]) continue;
-    const double phi_g = signed_azimuth(angle[1][k]);
-    const auto [um, density] = m.vndf.draw_column(slices[k], drawing[k]);
-    pdf_u[k] = density;
-    um_x[k] = um.x;
-    // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
-    const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g : 0.0);
-    angle[0][k] = angle[2][k] = um.x * um.x * (kPi / 2);
-    angle[1][k] = angle[3][k] = phi_m < 0 ? phi_m + 2 * kPi : phi_m >= 2 * kPi ? 0.0 : phi_m;
+  for (std::size_t k = 0; k < 2 * rows; ++k) {
+    double theta_m = 0, phi_m = 0;  // any valid angles for the rows apart
+    if (k < n && !apart[k]) {
+      const auto [um, density] = m.vndf.draw_column(slices[k], drawing[k]);
+      pdf_u[k] = density;
+      um_x[k] = um.x;
+      // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
+      const double phi = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g[k] : 0.0);
+      theta_m = um.x * um.x * (kPi / 2);
+      phi_m = phi < 0 ? phi + 2 * kPi : phi >= 2 * kPi ? 0.0 : phi;
+    }
+    angle[2 * (k % 2)][k / 2] = theta_m;
+    angle[2 * (k % 2) + 1][k / 2] = phi_m;
   }
-  for (std::size_t k = 0; k < n; ++k)
-    if (apart[k]) angle[0][k] = angle[1][k] = angle[2][k] = angle[3][k] = 0;  // any valid angles
   {
     const ConstColumn<double> in[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
     const Column<double> cols[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
                                     {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
-    convert<double>(Form{Space::spherical}, Form{Space::dirs}, in, n,
+    convert<double>(Form{Space::spherical}, Form{Space::dirs}, in, rows,
                     ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
   }
   for (std::size_t k = 0; k < n; ++k) {
-    if (apart[k] || !valid[k]) {
+    if (apart[k] || !valid[k / 2]) {
       out[k] = sample(wo[k], u1[k], u2[k]);
       continue;
     }
     const Vec3<double> g = flips[k].apply(wo[k]);
-    const Vec3<double> nm{dirs[0][k], dirs[1][k], dirs[2][k]};
+    const std::size_t c = 3 * (k % 2), r = k / 2;
+    const Vec3<double> nm{dirs[c][r], dirs[c + 1][r], dirs[c + 2][r]};
     const double dot = g.x * nm.x + g.y * nm.y + g.z * nm.z;
     const Vec3<double> wi =
         flips[k].apply({2 * dot * nm.x - g.x, 2 * dot * nm.y - g.y, 2 * dot * nm.z - g.z});
