@@ -180,16 +180,13 @@ struct Table {
   std::size_t w = 0, h = 0;
   std::vector<double> v;  // slices of h·w values
 
-  double eval(const Slices& s, double x, double y) const {
+  // The value at (x, y) (0 + the bilinear sum: the sign of a zero as a sum over slices gives it).
+  double eval(double x, double y) const {
     const Cell c = cell_of(x, y, w, h);
-    double r = 0;
-    for (int k = 0; k < s.count; ++k) {
-      const double* p = v.data() + s.index[k] * w * h + c.j * w + c.i;
-      const double top = (1 - c.tx) * p[0] + c.tx * p[1];
-      const double bottom = (1 - c.tx) * p[w] + c.tx * p[w + 1];
-      r += s.weight[k] * ((1 - c.ty) * top + c.ty * bottom);
-    }
-    return r;
+    const double* p = v.data() + c.j * w + c.i;
+    const double top = (1 - c.tx) * p[0] + c.tx * p[1];
+    const double bottom = (1 - c.tx) * p[w] + c.tx * p[w + 1];
+    return 0.0 + ((1 - c.ty) * top + c.ty * bottom);
   }
 };
 
@@ -587,7 +584,11 @@ struct Warp {
     RglWarpPoint point;
     double density;
   };
-  Drawn draw(const Slices& s, RglWarpPoint u) const { return draw_column(s, draw_row(s, u)); }
+  Drawn draw(const Slices& s, RglWarpPoint u) const {
+    Drawing d;
+    draw_row(s, u, d);
+    return draw_column(s, d);
+  }
 
   // draw() in steps, so that a block's column searches find the lines that the steps before ask
   // for: the slice and the row (the column guides of rows j and j + 1 prefetched), the nodes at
@@ -598,7 +599,8 @@ struct Warp {
     std::size_t j = 0;
     bool blend = false;  // no slice of positive weight: forward() of the blend
   };
-  Drawing draw_row(const Slices& s, RglWarpPoint u) const {
+  // Into d in place (a block's array: its copy would wait on the piecewise stores).
+  void draw_row(const Slices& s, RglWarpPoint u, Drawing& d) const {
     const double x = unit(u.x);
     int pick = -1;
     double below = 0, share = 1, sum = 0;
@@ -608,15 +610,19 @@ struct Warp {
       sum += s.weight[n];
       if (x < sum) break;  // the last slice of positive weight also takes x >= Σ w (rounding)
     }
-    if (pick < 0) return {0, u, 0, true};  // no positive weight (a NaN incidence)
-    Drawing d{s.index[pick], {unit((x - below) / share), unit(u.y)}};
+    d.blend = pick < 0;  // no positive weight (a NaN incidence)
+    if (d.blend) {
+      d.u = u;
+      return;
+    }
+    d.slice = s.index[pick];
+    d.u = {unit((x - below) / share), unit(u.y)};
     d.j = forward_row(Blend<1>(*this, d.slice), d.u.y, guided);
     if (guided) {
       const std::uint16_t* g = &col_guide[(d.slice * h + d.j) * w + bucket(d.u.x, w)];
       __builtin_prefetch(g);
       __builtin_prefetch(g + w);
     }
-    return d;
   }
   void prefetch_nodes(const Drawing& d) const {
     if (d.blend || !guided) return;
@@ -733,10 +739,7 @@ struct RglBrdf::Impl {
   Rgb shade(const Slices& s, RglWarpPoint sample, RglWarpPoint um, RglWarpPoint uwi,
             bool clamp_negative) const {
     double scale = 1;
-    if (jacobian) {
-      const Slices none{{0, 0, 0, 0}, {1, 0, 0, 0}, 1};
-      scale = ndf.eval(none, um.x, um.y) / (4 * sigma.eval(none, uwi.x, uwi.y));
-    }
+    if (jacobian) scale = ndf.eval(um.x, um.y) / (4 * sigma.eval(uwi.x, uwi.y));
     const std::array<double, 3> rgb_at = rgb.eval<N>(s, sample.x, sample.y);
     double c[3];
     for (std::size_t ch = 0; ch < 3; ++ch) {
@@ -1236,7 +1239,7 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
   for (std::size_t k = 0; k < n; ++k) {
     if (apart[k]) continue;
     m.slices(phi_g[k], theta_g[k], slices[k]);
-    drawing[k] = m.vndf.draw_row(slices[k], {u1[k], u2[k]});
+    m.vndf.draw_row(slices[k], {u1[k], u2[k]}, drawing[k]);
   }
   for (std::size_t k = 0; k < n; ++k)
     if (!apart[k]) m.vndf.prefetch_nodes(drawing[k]);
