@@ -20,6 +20,8 @@
 //    (the API it uses is unchanged), so the baseline is that build, run alternately with this one
 //    (docs/performance.md, "Renderer"). Options: --size N (512), --spp N (256), --threads N (1),
 //    --material ggx|rgl|all, --repeat N.
+// 5. The RGL file's sampling-interface calls as the renderer makes them (packets of 64 rows
+//    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
