@@ -20,6 +20,8 @@
 //    (the API it uses is unchanged), so the baseline is that build, run alternately with this one
 //    (docs/performance.md, "Renderer"). Options: --size N (512), --spp N (256), --threads N (1),
 //    --material ggx|rgl|all, --repeat N.
+// 5. The RGL file's sampling-interface calls as the renderer makes them (packets of 64 rows
+//    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
@@ -140,6 +142,56 @@ void throughput(const ThroughputOptions& o) {
     }
 }
 
+// Part 5: the RGL file's calls as the renderer makes them, in packets of 64 rows that share one
+// ωo (one pixel's samples): CPU ns per row of sample_batch, pdf_batch and eval_batch, over 2^16
+// rows at as many incidences, the numbers uniform (a fixed seed).
+void rgl_calls(const ThroughputOptions& o) {
+  const char* shared = std::getenv("HALFBACK_SHARED_DIR");
+  const std::string file =
+      (shared && *shared ? std::string(shared) : HALFBACK_SOURCE_DIR "/../shared") +
+      "/data/rgl/ilm_l3_37_metallic_rgb.bsdf";
+  const BrdfPtr brdf = load_brdf(file);
+  constexpr std::size_t kPacket = 64, kRows = std::size_t(1) << 16;
+  std::vector<Vec3<double>> wo(kRows);
+  std::vector<double> u1(kRows), u2(kRows);
+  std::uint64_t state = 12345;
+  auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 11) * 0x1p-53;
+  };
+  for (std::size_t p = 0; p < kRows; p += kPacket) {
+    const double z = 0.05 + 0.95 * next(), r = std::sqrt(1 - z * z), phi = 2 * 3.14159265 * next();
+    for (std::size_t k = p; k < p + kPacket; ++k) wo[k] = {r * std::cos(phi), r * std::sin(phi), z};
+  }
+  for (std::size_t k = 0; k < kRows; ++k) u1[k] = next(), u2[k] = next();
+  std::vector<BrdfSample> samples(kRows);
+  std::vector<DirPair<double>> pairs(kRows);
+  std::vector<double> pdfs(kRows);
+  std::vector<Rgb> values(kRows);
+  auto per_row = [&](auto body) {
+    const double c0 = cpu_seconds();
+    for (int rep = 0; rep < o.repeat; ++rep)
+      for (std::size_t p = 0; p < kRows; p += kPacket) body(p);
+    return (cpu_seconds() - c0) / (double(o.repeat) * kRows) * 1e9;
+  };
+  const double ns_sample = per_row([&](std::size_t p) {
+    brdf->sample_batch(std::span(wo).subspan(p, kPacket), std::span(u1).subspan(p, kPacket),
+                       std::span(u2).subspan(p, kPacket), std::span(samples).subspan(p, kPacket));
+  });
+  for (std::size_t k = 0; k < kRows; ++k)
+    pairs[k] = {samples[k].pdf > 0 ? samples[k].wi : Vec3<double>{0, 0, 1}, wo[k]};
+  const double ns_pdf = per_row([&](std::size_t p) {
+    brdf->pdf_batch(std::span(pairs).subspan(p, kPacket), std::span(pdfs).subspan(p, kPacket));
+  });
+  const double ns_eval = per_row([&](std::size_t p) {
+    brdf->eval_batch(std::span(pairs).subspan(p, kPacket), std::span(values).subspan(p, kPacket));
+  });
+  std::printf(
+      "| call | CPU ns per row |\n|---|---|\n| sample_batch | %.1f |\n| pdf_batch | %.1f |\n"
+      "| eval_batch | %.1f |\n",
+      ns_sample, ns_pdf, ns_eval);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -158,6 +210,10 @@ int main(int argc, char** argv) {
   }
   if (only == 4) {
     throughput(tp);
+    return 0;
+  }
+  if (only == 5) {
+    rgl_calls(tp);
     return 0;
   }
   const unsigned all = std::max(1u, std::thread::hardware_concurrency());

@@ -166,7 +166,7 @@ struct Cell {
   double tx, ty;
 };
 
-Cell cell_of(double x, double y, std::size_t w, std::size_t h) {
+[[gnu::always_inline]] inline Cell cell_of(double x, double y, std::size_t w, std::size_t h) {
   x = unit(x) * double(w - 1);
   y = unit(y) * double(h - 1);
   // Through a signed integer: x, y >= 0, and one instruction converts a double to it.
@@ -180,16 +180,13 @@ struct Table {
   std::size_t w = 0, h = 0;
   std::vector<double> v;  // slices of h·w values
 
-  double eval(const Slices& s, double x, double y) const {
+  // The value at (x, y) (0 + the bilinear sum: the sign of a zero as a sum over slices gives it).
+  double eval(double x, double y) const {
     const Cell c = cell_of(x, y, w, h);
-    double r = 0;
-    for (int k = 0; k < s.count; ++k) {
-      const double* p = v.data() + s.index[k] * w * h + c.j * w + c.i;
-      const double top = (1 - c.tx) * p[0] + c.tx * p[1];
-      const double bottom = (1 - c.tx) * p[w] + c.tx * p[w + 1];
-      r += s.weight[k] * ((1 - c.ty) * top + c.ty * bottom);
-    }
-    return r;
+    const double* p = v.data() + c.j * w + c.i;
+    const double top = (1 - c.tx) * p[0] + c.tx * p[1];
+    const double bottom = (1 - c.tx) * p[w] + c.tx * p[w + 1];
+    return 0.0 + ((1 - c.ty) * top + c.ty * bottom);
   }
 };
 
@@ -214,11 +211,25 @@ struct RgbTable {
     return v.data() + ((slice * h + j) * w + i) * kSlot;
   }
 
-  // The same arithmetic, channel by channel, as Table::eval on a channel's own table.
+  // Asks for the lines that eval(s, x, y) reads.
+  void prefetch(const Slices& s, double x, double y) const {
+    const Cell c = cell_of(x, y, w, h);
+    for (int k = 0; k < s.count; ++k) {
+      const double* p = slot(s.index[k], c.j, c.i);
+      __builtin_prefetch(p);
+      __builtin_prefetch(p + kSlot);
+      __builtin_prefetch(p + w * kSlot);
+      __builtin_prefetch(p + (w + 1) * kSlot);
+    }
+  }
+
+  // The same arithmetic, channel by channel, as Table::eval on a channel's own table; N is
+  // s.count.
+  template <int N>
   std::array<double, 3> eval(const Slices& s, double x, double y) const {
     const Cell c = cell_of(x, y, w, h);
     std::array<double, 3> r{0, 0, 0};
-    for (int k = 0; k < s.count; ++k) {
+    for (int k = 0; k < N; ++k) {
       const double* p = slot(s.index[k], c.j, c.i);
       const double* q = p + w * kSlot;  // the row above
       for (std::size_t ch = 0; ch < 3; ++ch) {
@@ -233,21 +244,24 @@ struct RgbTable {
 
 // A 2D distribution with the density bilinear in its grid values (a table per slice), sampled by
 // inverting its marginal CDF in y and its conditional CDF in x (docs/formats.md). The density and
-// the conditional CDF of a grid point are side by side (one 16-byte node), and so are the marginal
-// CDF and the total of a row: the inverse warp at a point reads two or three cache lines per
-// slice instead of seven.
+// the conditional CDF of a grid point are side by side (one 8-byte node of two floats: the file's
+// float32 value and its running sum, not normalized, so that the tables of a 128 × 128 file take
+// 1 MB rather than 2 and stay in a core's L2 cache), and so are the marginal CDF and the total of
+// a row: the inverse warp at a point reads one or two cache lines per slice. A slice's
+// normalization 1/total is applied to the blend's weights (Blend::scaled).
 struct Warp {
   struct Node {
-    double f;  // density grid value, each slice normalized (index units)
-    double c;  // C(j, i) = ∫_0^i f(s, j) ds (trapezoids)
+    float f;  // density grid value, as the file stores it
+    float c;  // C(j, i) = ∫_0^i f(s, j) ds (trapezoids, rounded to float)
   };
   struct Row {
-    double m;  // M(j) = ∫_0^j R(t) dt; M(h-1) = 1
-    double r;  // R(j) = C(j, w-1)
+    double m;  // M(j) = ∫_0^j R(t) dt / total: normalized, M(h-1) = 1
+    double r;  // R(j) = C(j, w-1), not normalized
   };
   std::size_t w = 0, h = 0;
-  std::vector<Node> node;  // h·w per slice
-  std::vector<Row> row;    // h per slice
+  std::vector<Node> node;         // h·w per slice
+  std::vector<Row> row;           // h per slice
+  std::vector<double> inv_total;  // 1 / ∫∫ f per slice
   // Guide tables (Chen and Asau 1974) of each slice's own CDFs: bucket k of the marginal's h
   // buckets holds the last row j with M(j) < k/h, bucket k of a row's w buckets the last column i
   // with C(j, i) < (k/w) R(j). They bound forward()'s searches of the blended CDFs (below).
@@ -259,6 +273,7 @@ struct Warp {
   bool build(const std::vector<double>& data, std::size_t slices) {
     node.resize(data.size());
     row.resize(slices * h);
+    inv_total.resize(slices);
     std::vector<double> c(w * h), m(h);
     for (std::size_t s = 0; s < slices; ++s) {
       const double* in = data.data() + s * w * h;
@@ -267,13 +282,17 @@ struct Warp {
         for (std::size_t i = 0; i + 1 < w; ++i)
           c[j * w + i + 1] = c[j * w + i] + 0.5 * (in[j * w + i] + in[j * w + i + 1]);
       }
+      // The sums as stored (float), and the marginal from the stored row totals: the inverse and
+      // forward warps then read one consistent set of values.
+      for (std::size_t k = 0; k < w * h; ++k) c[k] = double(float(c[k]));
       m[0] = 0;
       for (std::size_t j = 0; j + 1 < h; ++j)
         m[j + 1] = m[j] + 0.5 * (c[j * w + w - 1] + c[(j + 1) * w + w - 1]);
       const double total = m[h - 1];
-      if (!(total > 0)) return false;
-      for (std::size_t k = 0; k < w * h; ++k) node[s * w * h + k] = {in[k] / total, c[k] / total};
-      for (std::size_t j = 0; j < h; ++j) row[s * h + j] = {m[j] / total, c[j * w + w - 1] / total};
+      if (!(total > 0) || !std::isfinite(total)) return false;
+      for (std::size_t k = 0; k < w * h; ++k) node[s * w * h + k] = {float(in[k]), float(c[k])};
+      for (std::size_t j = 0; j < h; ++j) row[s * h + j] = {m[j] / total, c[j * w + w - 1]};
+      inv_total[s] = 1 / total;
     }
     build_guides(slices);
     return true;
@@ -346,52 +365,117 @@ struct Warp {
     return search(0, last);
   }
 
-  double F(const Slices& s, std::size_t j, std::size_t i) const {
-    double r = 0;
-    for (int n = 0; n < s.count; ++n) r += s.weight[n] * node[(s.index[n] * h + j) * w + i].f;
-    return r;
-  }
-  double C(const Slices& s, std::size_t j, std::size_t i) const {
-    double r = 0;
-    for (int n = 0; n < s.count; ++n) r += s.weight[n] * node[(s.index[n] * h + j) * w + i].c;
-    return r;
-  }
-  double M(const Slices& s, std::size_t j) const {
-    double r = 0;
-    for (int n = 0; n < s.count; ++n) r += s.weight[n] * row[s.index[n] * h + j].m;
-    return r;
-  }
-  double R(const Slices& s, std::size_t j) const {
-    double r = 0;
-    for (int n = 0; n < s.count; ++n) r += s.weight[n] * row[s.index[n] * h + j].r;
-    return r;
+  // The slices of a blend as pointers to their nodes and rows, with the count N (1, 2 or 4, as
+  // Impl::slices() gives) a constant: the loops unroll and the index arithmetic is done once.
+  // Each sum adds the slices in the order of s.index, as a loop over s.count would.
+  template <int N>
+  struct Blend {
+    const Node* node[N];  // the slice's h·w nodes
+    const Row* row[N];    // its h rows
+    const std::uint16_t* row_guide[N];
+    const std::uint16_t* col_guide[N];
+    double weight[N];  // of the normalized M
+    double scaled[N];  // weight / total: of F, C and R, stored without normalization
+    Blend(const Warp& wp, const Slices& s) {
+      for (int n = 0; n < N; ++n) {
+        const std::size_t first_row = s.index[n] * wp.h;
+        node[n] = wp.node.data() + first_row * wp.w;
+        row[n] = wp.row.data() + first_row;
+        row_guide[n] = wp.guided ? wp.row_guide.data() + first_row : nullptr;
+        col_guide[n] = wp.guided ? wp.col_guide.data() + first_row * wp.w : nullptr;
+        weight[n] = s.weight[n];
+        scaled[n] = s.weight[n] * wp.inv_total[s.index[n]];
+      }
+    }
+    // One slice of weight 1.
+    Blend(const Warp& wp, std::size_t slice) requires(N == 1)
+        : Blend(wp, Slices{{slice, 0, 0, 0}, {1, 0, 0, 0}, 1}) {}
+    // F and C at node k = j·w + i, M and R at row j, blended.
+    double F(std::size_t k) const {
+      double r = 0;
+      for (int n = 0; n < N; ++n) r += scaled[n] * double(node[n][k].f);
+      return r;
+    }
+    double C(std::size_t k) const {
+      double r = 0;
+      for (int n = 0; n < N; ++n) r += scaled[n] * double(node[n][k].c);
+      return r;
+    }
+    double M(std::size_t j) const {
+      double r = 0;
+      for (int n = 0; n < N; ++n) r += weight[n] * row[n][j].m;
+      return r;
+    }
+    double R(std::size_t j) const {
+      double r = 0;
+      for (int n = 0; n < N; ++n) r += scaled[n] * row[n][j].r;
+      return r;
+    }
+  };
+
+  // Calls f(Blend<N>) for the count of s.
+  template <class Fn>
+  decltype(auto) with_blend(const Slices& s, Fn f) const {
+    switch (s.count) {
+      case 1:
+        return f(Blend<1>(*this, s));
+      case 2:
+        return f(Blend<2>(*this, s));
+      default:
+        return f(Blend<4>(*this, s));
+    }
   }
 
   // Density on the unit square at p (the blended, normalized grid values, bilinear).
   double density(const Slices& s, RglWarpPoint p) const {
-    const Cell g = cell_of(p.x, p.y, w, h);
-    const double c0 = (1 - g.ty) * F(s, g.j, g.i) + g.ty * F(s, g.j + 1, g.i);
-    const double c1 = (1 - g.ty) * F(s, g.j, g.i + 1) + g.ty * F(s, g.j + 1, g.i + 1);
+    return with_blend(s, [&](const auto& b) { return density(b, p); });
+  }
+  template <int N>
+  double density(const Blend<N>& b, RglWarpPoint p) const {
+    return density(b, cell_of(p.x, p.y, w, h));
+  }
+  // The same in cell g.
+  template <int N>
+  double density(const Blend<N>& b, const Cell& g) const {
+    const std::size_t k = g.j * w + g.i;
+    const double c0 = (1 - g.ty) * b.F(k) + g.ty * b.F(k + w);
+    const double c1 = (1 - g.ty) * b.F(k + 1) + g.ty * b.F(k + w + 1);
     return ((1 - g.tx) * c0 + g.tx * c1) * double(w - 1) * double(h - 1);
+  }
+
+  // Asks for the lines that inverse(s, p) reads (a block's lookups then overlap).
+  void prefetch(const Slices& s, RglWarpPoint p) const {
+    const Cell g = cell_of(p.x, p.y, w, h);
+    for (int n = 0; n < s.count; ++n) {
+      const Node* a = &node[(s.index[n] * h + g.j) * w + g.i];
+      __builtin_prefetch(a);
+      __builtin_prefetch(a + w);
+      __builtin_prefetch(&row[s.index[n] * h + g.j]);
+    }
   }
 
   // Point p of the unit square -> sample (the CDFs at p): the inverse of the warp. The grid
   // values around p's cell (F at its corners, C at its left ones, R and M of its rows) are blended
   // over the slices in one pass, each sum in the order of F(), C(), R() and M().
   RglWarpPoint inverse(const Slices& s, RglWarpPoint p) const {
+    return with_blend(s, [&](const auto& b) { return inverse(b, p); });
+  }
+  template <int N>
+  RglWarpPoint inverse(const Blend<N>& b, RglWarpPoint p) const {
     const Cell g = cell_of(p.x, p.y, w, h);
+    const std::size_t k = g.j * w + g.i;
     double f00 = 0, f01 = 0, f10 = 0, f11 = 0, c00 = 0, c10 = 0, r0 = 0, r1 = 0, m0 = 0;
-    for (int n = 0; n < s.count; ++n) {
-      const double wn = s.weight[n];
-      const Node* a = &node[(s.index[n] * h + g.j) * w + g.i];
-      const Row* r = &row[s.index[n] * h + g.j];
-      f00 += wn * a[0].f;
-      f01 += wn * a[1].f;
-      f10 += wn * a[w].f;
-      f11 += wn * a[w + 1].f;
-      c00 += wn * a[0].c;
-      c10 += wn * a[w].c;
-      m0 += wn * r[0].m;
+    for (int n = 0; n < N; ++n) {
+      const double wn = b.scaled[n];
+      const Node* a = b.node[n] + k;
+      const Row* r = b.row[n] + g.j;
+      f00 += wn * double(a[0].f);
+      f01 += wn * double(a[1].f);
+      f10 += wn * double(a[w].f);
+      f11 += wn * double(a[w + 1].f);
+      c00 += wn * double(a[0].c);
+      c10 += wn * double(a[w].c);
+      m0 += b.weight[n] * r[0].m;
       r0 += wn * r[0].r;
       r1 += wn * r[1].r;
     }
@@ -409,14 +493,16 @@ struct Warp {
 
   // The bounds of the blended row search: each slice's own last row with M(j) < u.y (a blend of
   // non-decreasing CDFs with weights summing to 1 crosses u.y between its slices' crossings).
-  void row_bounds(const Slices& s, double uy, std::size_t& lo, std::size_t& hi) const {
+  template <int N>
+  void row_bounds(const Blend<N>& b, double uy, std::size_t& lo, std::size_t& hi) const {
     lo = h - 2;
     hi = 0;
-    for (int n = 0; n < s.count; ++n) {
-      if (!(s.weight[n] > 0)) continue;
-      const Row* r = &row[s.index[n] * h];
-      const std::size_t j = step_from(row_guide[s.index[n] * h + bucket(uy, h)], h - 2, uy,
-                                      [&](std::size_t q) { return r[q].m; });
+    const std::size_t k = bucket(uy, h);
+    for (int n = 0; n < N; ++n) {
+      if (!(b.weight[n] > 0)) continue;
+      const Row* r = b.row[n];
+      const std::size_t j =
+          step_from(b.row_guide[n][k], h - 2, uy, [&](std::size_t q) { return r[q].m; });
       lo = std::min(lo, j);
       hi = std::max(hi, j);
     }
@@ -424,18 +510,20 @@ struct Warp {
   }
 
   // The same for the columns of rows j and j + 1 blended with weights 1 - ty and ty: each row's
-  // and slice's own last column with C(j, i) < u.x R(j).
-  void column_bounds(const Slices& s, std::size_t j, double ty, double ux, std::size_t& lo,
+  // and slice's own last column with C(j, i) < u.x R(j). Both rows whatever ty (a row of weight
+  // 0 only widens the bounds), so that these loads need not wait for ty's square root.
+  template <int N>
+  void column_bounds(const Blend<N>& b, std::size_t j, double ux, std::size_t& lo,
                      std::size_t& hi) const {
     lo = w - 2;
     hi = 0;
-    for (int n = 0; n < s.count; ++n)
+    const std::size_t k = bucket(ux, w);
+    for (int n = 0; n < N; ++n)
       for (std::size_t d = 0; d < 2; ++d) {
-        if (!(s.weight[n] * (d ? ty : 1 - ty) > 0)) continue;
-        const std::size_t rj = s.index[n] * h + j + d;
-        const Node* a = &node[rj * w];
-        const double x = ux * row[rj].r;
-        const std::size_t i = step_from(col_guide[rj * w + bucket(ux, w)], w - 2, x,
+        if (!(b.weight[n] > 0)) continue;
+        const Node* a = b.node[n] + (j + d) * w;
+        const double x = ux * b.row[n][j + d].r;
+        const std::size_t i = step_from(b.col_guide[n][(j + d) * w + k], w - 2, x,
                                         [&](std::size_t q) { return a[q].c; });
         lo = std::min(lo, i);
         hi = std::max(hi, i);
@@ -447,26 +535,109 @@ struct Warp {
   // find what binary searches of [0, h-2] and [0, w-2] find, within the slices' guided bounds.
   // `use_guides` false: plain binary searches (the reference the tests compare with).
   RglWarpPoint forward(const Slices& s, RglWarpPoint u, bool use_guides = true) const {
+    return with_blend(s, [&](const auto& b) { return forward(b, u, use_guides); });
+  }
+  template <int N>
+  RglWarpPoint forward(const Blend<N>& b, RglWarpPoint u, bool use_guides = true) const {
+    const Cell c = forward_cell(b, u, use_guides);
+    return {(double(c.i) + c.tx) / double(w - 1), (double(c.j) + c.ty) / double(h - 1)};
+  }
+  // The same as a cell and the position in it.
+  template <int N>
+  Cell forward_cell(const Blend<N>& b, RglWarpPoint u, bool use_guides) const {
     const bool guides = guided && use_guides;
     u.x = unit(u.x);
     u.y = unit(u.y);
-    // Row: the last j in [0, h-2] with M(j) < u.y.
+    return forward_column(b, u, forward_row(b, u.y, guides), guides);
+  }
+  // Its row: the last j in [0, h-2] with M(j) < u.y.
+  template <int N>
+  std::size_t forward_row(const Blend<N>& b, double uy, bool guides) const {
     std::size_t lo = 0, hi = h - 2;
-    if (guides) row_bounds(s, u.y, lo, hi);
-    const std::size_t j = last_below([&](std::size_t q) { return M(s, q); }, u.y, lo, hi, h - 2);
-    const double r0 = R(s, j), r1 = R(s, j + 1);
-    const double ty = solve_linear_density(r0, r1, u.y - M(s, j));
+    if (guides) row_bounds(b, uy, lo, hi);
+    return last_below([&](std::size_t q) { return b.M(q); }, uy, lo, hi, h - 2);
+  }
+  // The rest, in row j (u in the unit square).
+  template <int N>
+  Cell forward_column(const Blend<N>& b, RglWarpPoint u, std::size_t j, bool guides) const {
+    std::size_t col_lo = 0, col_hi = w - 2;
+    if (guides) column_bounds(b, j, u.x, col_lo, col_hi);
+    const double r0 = b.R(j), r1 = b.R(j + 1);
+    const double ty = solve_linear_density(r0, r1, u.y - b.M(j));
     // Column: the last i in [0, w-2] with C_ty(i) < u.x · R(ty).
     const double target = u.x * ((1 - ty) * r0 + ty * r1);
-    auto ct = [&](std::size_t i) { return (1 - ty) * C(s, j, i) + ty * C(s, j + 1, i); };
-    lo = 0;
-    hi = w - 2;
-    if (guides) column_bounds(s, j, ty, u.x, lo, hi);
-    const std::size_t i = last_below(ct, target, lo, hi, w - 2);
-    const double c0 = (1 - ty) * F(s, j, i) + ty * F(s, j + 1, i);
-    const double c1 = (1 - ty) * F(s, j, i + 1) + ty * F(s, j + 1, i + 1);
-    const double sx = solve_linear_density(c0, c1, target - ct(i));
-    return {(double(i) + sx) / double(w - 1), (double(j) + ty) / double(h - 1)};
+    const std::size_t row0 = j * w, row1 = row0 + w;
+    auto ct = [&](std::size_t i) { return (1 - ty) * b.C(row0 + i) + ty * b.C(row1 + i); };
+    const std::size_t i = last_below(ct, target, col_lo, col_hi, w - 2);
+    const double c0 = (1 - ty) * b.F(row0 + i) + ty * b.F(row1 + i);
+    const double c1 = (1 - ty) * b.F(row0 + i + 1) + ty * b.F(row1 + i + 1);
+    return {i, j, solve_linear_density(c0, c1, target - ct(i)), ty};
+  }
+
+  // A point drawn from the blend's density, and its density (density(s, point) up to rounding):
+  // a slice n chosen with probability s.weight[n], then that slice's own CDFs inverted. The
+  // blend's density is the mixture Σ w_n p_n (the bilinear interpolant is linear in the grid
+  // values), so this samples what forward() samples, by another map of u: one slice's searches
+  // instead of the blend's (docs/formats.md, "Sampling"). u.x chooses the slice and is rescaled
+  // to its share.
+  struct Drawn {
+    RglWarpPoint point;
+    double density;
+  };
+  Drawn draw(const Slices& s, RglWarpPoint u) const {
+    Drawing d;
+    draw_row(s, u, d);
+    return draw_column(s, d);
+  }
+
+  // draw() in steps, so that a block's column searches find the lines that the steps before ask
+  // for: the slice and the row (the column guides of rows j and j + 1 prefetched), the nodes at
+  // the guides prefetched (prefetch_nodes), then the rest.
+  struct Drawing {
+    std::size_t slice = 0;  // the drawn one
+    RglWarpPoint u;
+    std::size_t j = 0;
+    bool blend = false;  // no slice of positive weight: forward() of the blend
+  };
+  // Into d in place (a block's array: its copy would wait on the piecewise stores).
+  void draw_row(const Slices& s, RglWarpPoint u, Drawing& d) const {
+    const double x = unit(u.x);
+    int pick = -1;
+    double below = 0, share = 1, sum = 0;
+    for (int n = 0; n < s.count; ++n) {
+      if (!(s.weight[n] > 0)) continue;
+      pick = n, below = sum, share = s.weight[n];
+      sum += s.weight[n];
+      if (x < sum) break;  // the last slice of positive weight also takes x >= Σ w (rounding)
+    }
+    d.blend = pick < 0;  // no positive weight (a NaN incidence)
+    if (d.blend) {
+      d.u = u;
+      return;
+    }
+    d.slice = s.index[pick];
+    d.u = {unit((x - below) / share), unit(u.y)};
+    d.j = forward_row(Blend<1>(*this, d.slice), d.u.y, guided);
+    if (guided) {
+      const std::uint16_t* g = &col_guide[(d.slice * h + d.j) * w + bucket(d.u.x, w)];
+      __builtin_prefetch(g);
+      __builtin_prefetch(g + w);
+    }
+  }
+  void prefetch_nodes(const Drawing& d) const {
+    if (d.blend || !guided) return;
+    const std::size_t first = (d.slice * h + d.j) * w, k = bucket(d.u.x, w);
+    __builtin_prefetch(&node[first + col_guide[first + k]]);
+    __builtin_prefetch(&node[first + w + col_guide[first + w + k]]);
+  }
+  Drawn draw_column(const Slices& s, const Drawing& d) const {
+    if (d.blend) {
+      const RglWarpPoint p = forward(s, d.u);
+      return {p, density(s, p)};
+    }
+    const Cell c = forward_column(Blend<1>(*this, d.slice), d.u, d.j, guided);
+    return {{(double(c.i) + c.tx) / double(w - 1), (double(c.j) + c.ty) / double(h - 1)},
+            with_blend(s, [&](const auto& b) { return density(b, c); })};
   }
 
   // t in [0, 1] with ∫_0^t ((1-τ) a + τ b) dτ = a t + (b - a) t²/2 = area, in the form that stays
@@ -519,11 +690,17 @@ struct RglBrdf::Impl {
   std::size_t wavelengths = 0;    // the spectral variant: its wavelengths, integrated to RGB
 
   Slices slices(double phi_i, double theta_i) const {
+    Slices s;
+    slices(phi_i, theta_i, s);
+    return s;
+  }
+  // The same in place (a block's array: no copy of the struct, whose piecewise stores a copy's
+  // wide loads would wait for).
+  void slices(double phi_i, double theta_i, Slices& s) const {
     std::size_t ip, it;
     double tp, tt;
     phi.locate(phi_i, ip, tp);
     theta.locate(theta_i, it, tt);
-    Slices s{};
     s.count = 0;
     for (int a = 0; a < 2; ++a) {
       const double wa = a ? tp : 1 - tp;
@@ -537,7 +714,6 @@ struct RglBrdf::Impl {
         ++s.count;
       }
     }
-    return s;
   }
 
   // fr·cos θo at incidence slices s, with um the half vector on the unit square of the VNDF and NDF
@@ -545,13 +721,26 @@ struct RglBrdf::Impl {
   // VNDF warp gives um, times the NDF over 4 sigma when the file asks for that Jacobian; negative
   // values clamped to 0 on request.
   Rgb value(const Slices& s, RglWarpPoint um, RglWarpPoint uwi, bool clamp_negative) const {
-    const RglWarpPoint sample = vndf.inverse(s, um);
-    double scale = 1;
-    if (jacobian) {
-      const Slices none{{0, 0, 0, 0}, {1, 0, 0, 0}, 1};
-      scale = ndf.eval(none, um.x, um.y) / (4 * sigma.eval(none, uwi.x, uwi.y));
+    return shade(s, vndf.inverse(s, um), um, uwi, clamp_negative);
+  }
+  // value() from the inverse warp's sample: the RGB tables there, the Jacobian.
+  Rgb shade(const Slices& s, RglWarpPoint sample, RglWarpPoint um, RglWarpPoint uwi,
+            bool clamp_negative) const {
+    switch (s.count) {
+      case 1:
+        return shade<1>(s, sample, um, uwi, clamp_negative);
+      case 2:
+        return shade<2>(s, sample, um, uwi, clamp_negative);
+      default:
+        return shade<4>(s, sample, um, uwi, clamp_negative);
     }
-    const std::array<double, 3> rgb_at = rgb.eval(s, sample.x, sample.y);
+  }
+  template <int N>
+  Rgb shade(const Slices& s, RglWarpPoint sample, RglWarpPoint um, RglWarpPoint uwi,
+            bool clamp_negative) const {
+    double scale = 1;
+    if (jacobian) scale = ndf.eval(um.x, um.y) / (4 * sigma.eval(uwi.x, uwi.y));
+    const std::array<double, 3> rgb_at = rgb.eval<N>(s, sample.x, sample.y);
     double c[3];
     for (std::size_t ch = 0; ch < 3; ++ch) {
       c[ch] = rgb_at[ch] * scale;
@@ -673,7 +862,8 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     m.vndf.w = static_cast<std::size_t>(f.shape[3]);
     std::vector<double> data = v.floats(f);
     m.noise_clamped += v.clamp_noise(f, data);
-    if (!m.vndf.build(data, m.n_slices)) v.fail("vndf", "a slice integrates to zero");
+    if (!m.vndf.build(data, m.n_slices))
+      v.fail("vndf", "a slice integrates to zero (or beyond the float range)");
   }
 
   const TensorField& lum = v.field("luminance", TensorDtype::float32, 4);
@@ -801,8 +991,7 @@ BrdfSample RglBrdf::sample(const Vec3<double>& wo, double u1, double u2) const {
   const double theta_g = std::atan2(std::hypot(g.x, g.y), g.z);
   const double phi_g = std::atan2(g.y, g.x);
   const Slices s = m.slices(phi_g, theta_g);
-  const RglWarpPoint um = m.vndf.forward(s, {u1, u2});
-  const double pdf_u = m.vndf.density(s, um);
+  const auto [um, pdf_u] = m.vndf.draw(s, {u1, u2});
   const double theta_m = um.x * um.x * (kPi / 2);
   const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g : 0.0);
   const Vec3<double> n{std::sin(theta_m) * std::cos(phi_m), std::sin(theta_m) * std::sin(phi_m),
@@ -950,12 +1139,22 @@ void RglBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> 
   Slices slices[kBlock];
   for (std::size_t k = 0; k < n; ++k) {
     apart[k] = apart[k] || !valid[k] || near_seam(um_y[k]) || near_seam(uwi_y[k]);
-    if (!apart[k]) slices[k] = m.slices(angle[1][k], angle[0][k]);
+    if (!apart[k]) {
+      m.slices(angle[1][k], angle[0][k], slices[k]);
+      m.vndf.prefetch(slices[k], {um_x[k], um_y[k]});
+    }
   }
+  // Impl::value() in two passes over the block, each prefetching what the next one reads.
+  RglWarpPoint sample[kBlock];
+  for (std::size_t k = 0; k < n; ++k)
+    if (!apart[k]) {
+      sample[k] = m.vndf.inverse(slices[k], {um_x[k], um_y[k]});
+      m.rgb.prefetch(slices[k], sample[k].x, sample[k].y);
+    }
   for (std::size_t k = 0; k < n; ++k)
     out[k] = apart[k] ? eval(pairs[k])
-                      : over_cosine(m.value(slices[k], {um_x[k], um_y[k]}, {uwi_x[k], uwi_y[k]},
-                                            options_.clamp_negative),
+                      : over_cosine(m.shade(slices[k], sample[k], {um_x[k], um_y[k]},
+                                            {uwi_x[k], uwi_y[k]}, options_.clamp_negative),
                                     pairs[k].wo);
 }
 
@@ -1009,45 +1208,70 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
   alignas(64) std::uint8_t valid[kBlock];
   bool apart[kBlock];
   Flips flips[kBlock];
-  for (std::size_t k = 0; k < n; ++k) {
-    flips[k] = flips_for(m.reduction, wo[k]);
-    const Vec3<double> g = flips[k].apply(wo[k]);
-    apart[k] = !(g.z > 0) || (g.x == 0 && g.y == 0);
-    dirs[0][k] = dirs[3][k] = g.x;
-    dirs[1][k] = dirs[4][k] = g.y;
-    dirs[2][k] = dirs[5][k] = g.z;
+  // Two samples per row of the conversions, each way a pair of directions: sample k in half
+  // k % 2 of row k / 2 (columns 3 (k % 2) .. +2 of the directions, 2 (k % 2) .. +1 of the
+  // angles). A row's second half when n is odd, and the rows of samples that go apart, hold +z,
+  // which every conversion accepts.
+  const std::size_t rows = (n + 1) / 2;
+  for (std::size_t k = 0; k < 2 * rows; ++k) {
+    Vec3<double> g{0, 0, 1};
+    if (k < n) {
+      flips[k] = flips_for(m.reduction, wo[k]);
+      const Vec3<double> d = flips[k].apply(wo[k]);
+      apart[k] = !(d.z > 0) || (d.x == 0 && d.y == 0);
+      if (!apart[k]) g = d;
+    }
+    dirs[3 * (k % 2)][k / 2] = g.x;
+    dirs[3 * (k % 2) + 1][k / 2] = g.y;
+    dirs[3 * (k % 2) + 2][k / 2] = g.z;
   }
-  angles_of(dirs, n, angle, valid);
-  double pdf_u[kBlock] = {}, um_x[kBlock] = {};
+  angles_of(dirs, rows, angle, valid);
+  double theta_g[kBlock], phi_g[kBlock];
   for (std::size_t k = 0; k < n; ++k) {
-    const double phi_g = signed_azimuth(angle[1][k]);
-    apart[k] = apart[k] || !valid[k] || near_pi(phi_g);
+    theta_g[k] = angle[2 * (k % 2)][k / 2];
+    phi_g[k] = signed_azimuth(angle[2 * (k % 2) + 1][k / 2]);
+    apart[k] = apart[k] || !valid[k / 2] || near_pi(phi_g[k]);
+  }
+  double pdf_u[kBlock] = {}, um_x[kBlock] = {};
+  // The warp's draws in steps over the block (Warp::draw_row), each prefetching for the next.
+  Slices slices[kBlock];
+  Warp::Drawing drawing[kBlock];
+  for (std::size_t k = 0; k < n; ++k) {
     if (apart[k]) continue;
-    const Slices s = m.slices(phi_g, angle[0][k]);
-    const RglWarpPoint um = m.vndf.forward(s, {u1[k], u2[k]});
-    pdf_u[k] = m.vndf.density(s, um);
-    um_x[k] = um.x;
-    // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
-    const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g : 0.0);
-    angle[0][k] = angle[2][k] = um.x * um.x * (kPi / 2);
-    angle[1][k] = angle[3][k] = phi_m < 0 ? phi_m + 2 * kPi : phi_m >= 2 * kPi ? 0.0 : phi_m;
+    m.slices(phi_g[k], theta_g[k], slices[k]);
+    m.vndf.draw_row(slices[k], {u1[k], u2[k]}, drawing[k]);
   }
   for (std::size_t k = 0; k < n; ++k)
-    if (apart[k]) angle[0][k] = angle[1][k] = angle[2][k] = angle[3][k] = 0;  // any valid angles
+    if (!apart[k]) m.vndf.prefetch_nodes(drawing[k]);
+  for (std::size_t k = 0; k < 2 * rows; ++k) {
+    double theta_m = 0, phi_m = 0;  // any valid angles for the rows apart
+    if (k < n && !apart[k]) {
+      const auto [um, density] = m.vndf.draw_column(slices[k], drawing[k]);
+      pdf_u[k] = density;
+      um_x[k] = um.x;
+      // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
+      const double phi = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g[k] : 0.0);
+      theta_m = um.x * um.x * (kPi / 2);
+      phi_m = phi < 0 ? phi + 2 * kPi : phi >= 2 * kPi ? 0.0 : phi;
+    }
+    angle[2 * (k % 2)][k / 2] = theta_m;
+    angle[2 * (k % 2) + 1][k / 2] = phi_m;
+  }
   {
     const ConstColumn<double> in[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
     const Column<double> cols[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
                                     {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
-    convert<double>(Form{Space::spherical}, Form{Space::dirs}, in, n,
+    convert<double>(Form{Space::spherical}, Form{Space::dirs}, in, rows,
                     ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
   }
   for (std::size_t k = 0; k < n; ++k) {
-    if (apart[k] || !valid[k]) {
+    if (apart[k] || !valid[k / 2]) {
       out[k] = sample(wo[k], u1[k], u2[k]);
       continue;
     }
     const Vec3<double> g = flips[k].apply(wo[k]);
-    const Vec3<double> nm{dirs[0][k], dirs[1][k], dirs[2][k]};
+    const std::size_t c = 3 * (k % 2), r = k / 2;
+    const Vec3<double> nm{dirs[c][r], dirs[c + 1][r], dirs[c + 2][r]};
     const double dot = g.x * nm.x + g.y * nm.y + g.z * nm.z;
     const Vec3<double> wi =
         flips[k].apply({2 * dot * nm.x - g.x, 2 * dot * nm.y - g.y, 2 * dot * nm.z - g.z});

@@ -136,10 +136,12 @@ class RglBrdf final : public Brdf {
 
   // Importance sampling as in Dupuy & Jakob 2018, through Brdf's interface: a uniform (u1, u2)
   // through the VNDF warp of the incidence ωo gives a microfacet normal m, and ωi is ωo reflected
-  // about m. The tables' incidence is the light direction, so this draws from the lobe of ρ(ωo, ·),
-  // which reciprocity makes a density resembling ρ(·, ωo) (an importance density only: pdf() is
-  // exact for it, so estimates stay unbiased). pdf is per unit solid angle (0 when ωo is at or
-  // below the horizon or ωi falls below it).
+  // about m. Between incidence slices, the blended density is sampled as the mixture it is: a
+  // slice drawn with probability its weight, then its own warp (docs/formats.md, "Sampling"). The
+  // tables' incidence is the light direction, so this draws from the lobe of ρ(ωo, ·), which
+  // reciprocity makes a density resembling ρ(·, ωo) (an importance density only: pdf() is exact for
+  // it, so estimates stay unbiased). pdf is per unit solid angle (0 when ωo is at or below the
+  // horizon or ωi falls below it).
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
   // sample() and pdf() of batches, the angles by the batch engine's SIMD conversions (as
