@@ -288,8 +288,9 @@ struct NearestBlock {
   alignas(64) std::uint32_t bin[kBlock];
 };
 
-// Rows per step of the trilinear pipeline: the prefetches of a step's rows, then the blends of the
-// previous block's rows of the step.
+// Rows per step of the trilinear pipeline: the prefetches of a step's rows of a block, then the
+// blends of the previous block's rows of the step. (A prefetch distance of 16 to 128 rows instead
+// of a block, 256 rows, measured 15-25 % slower.)
 constexpr std::size_t kStep = 16;
 
 }  // namespace
@@ -323,9 +324,9 @@ void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<
     for (std::size_t i = 0; i < previous->m; ++i) finish(*previous, i);
 }
 
-// Blocks in a pipeline: the corners of a block are prefetched, kStep rows at a time, between the
-// blends of the previous block, so that the blends' arithmetic runs while the table reads are in
-// flight.
+// Blocks in a pipeline: a block is converted and its cells found, then its corners are prefetched,
+// kStep rows at a time, between the blends of the previous block's rows, so that the blends'
+// arithmetic runs while the table reads are in flight.
 void MerlBrdf::trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                                 std::size_t begin, std::size_t end) const {
   const merl::BinValues* table = bins_.get();
