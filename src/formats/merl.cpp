@@ -258,45 +258,16 @@ void convert_block(std::span<const DirPair<double>> pairs, Coordinates& c) {
   merl_kernel::rows_apart(rows, valid, m, c.apart);
 }
 
-// Prefetches written in always-inlined functions: GCC takes a function whose only effects are
-// prefetches for a pure one, and drops its calls.
-[[gnu::always_inline]] inline void prefetch_cell(const merl::BinValues* table, std::uint32_t base,
-                                                 std::int32_t phi_step) {
-  using merl_kernel::kThetaDStep, merl_kernel::kThetaHStep;
-  const merl::BinValues* p = table + base;
-  const merl::BinValues* q = p + phi_step;
-  __builtin_prefetch(p);
-  __builtin_prefetch(q);
-  __builtin_prefetch(p + kThetaDStep);
-  __builtin_prefetch(q + kThetaDStep);
-  __builtin_prefetch(p + kThetaHStep);
-  __builtin_prefetch(q + kThetaHStep);
-  __builtin_prefetch(p + kThetaHStep + kThetaDStep);
-  __builtin_prefetch(q + kThetaHStep + kThetaDStep);
-}
-
-// A block of the trilinear pipeline: its rows, their cells, which rows go through eval().
-struct TrilinearBlock {
-  std::size_t first = 0, m = 0;
-  merl_kernel::Cells cells;
-  std::uint8_t apart[kBlock];
-};
-
 // A block of the nearest-bin pipeline: its rows and their bins (kScalarRow: through eval()).
 struct NearestBlock {
   std::size_t first = 0, m = 0;
   alignas(64) std::uint32_t bin[kBlock];
 };
 
-// Rows per step of the trilinear pipeline: the prefetches of a step's rows of a block, then the
-// blends of the previous block's rows of the step. (A prefetch distance of 16 to 128 rows instead
-// of a block, 256 rows, measured 15-25 % slower.)
-constexpr std::size_t kStep = 16;
-
 }  // namespace
 
-// Blocks in a pipeline, as trilinear_blocks below: a block's slots are prefetched row by row
-// between the reads of the previous block's values.
+// Blocks in a pipeline: a block's slots are prefetched row by row between the reads of the
+// previous block's values.
 void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                               std::size_t begin, std::size_t end) const {
   Coordinates c;
@@ -324,36 +295,20 @@ void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<
     for (std::size_t i = 0; i < previous->m; ++i) finish(*previous, i);
 }
 
-// Blocks in a pipeline: a block is converted and its cells found, then its corners are prefetched,
-// kStep rows at a time, between the blends of the previous block's rows, so that the blends'
-// arithmetic runs while the table reads are in flight.
+// Block by block: the conversion, the cells, then the blends (merl_kernel::blend_rows prefetches
+// its own corners a step ahead). Rows left to eval() get its values over the blend's.
 void MerlBrdf::trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                                 std::size_t begin, std::size_t end) const {
-  const merl::BinValues* table = bins_.get();
   Coordinates c;
-  TrilinearBlock stage[2];
-  const TrilinearBlock* previous = nullptr;
-  auto finish = [&](const TrilinearBlock& t, std::size_t from, std::size_t to) {
-    merl_kernel::blend_rows(table, t.cells, from, to, out.data() + t.first);
-    for (std::size_t i = from; i < to; ++i)
-      if (t.apart[i]) out[t.first + i] = eval(pairs[t.first + i]);
-  };
+  merl_kernel::Cells cells;
   for (std::size_t b = begin; b < end; ++b) {
-    TrilinearBlock& t = stage[(b - begin) % 2];
-    t.first = b * kBlock;
-    t.m = std::min(kBlock, pairs.size() - t.first);
-    convert_block(pairs.subspan(t.first, t.m), c);
-    merl_kernel::cells(c.q[0], c.q[1], c.q[2], t.m, t.cells);  // in range even for NaN
-    std::copy_n(c.apart, t.m, t.apart);
-    const std::size_t mp = previous ? previous->m : 0;
-    for (std::size_t i = 0; i < std::max(t.m, mp); i += kStep) {
-      for (std::size_t j = i; j < std::min(i + kStep, t.m); ++j)
-        prefetch_cell(table, t.cells.base[j], t.cells.phi_step[j]);
-      if (i < mp) finish(*previous, i, std::min(i + kStep, mp));
-    }
-    previous = &t;
+    const std::size_t first = b * kBlock, m = std::min(kBlock, pairs.size() - first);
+    convert_block(pairs.subspan(first, m), c);
+    merl_kernel::cells(c.q[0], c.q[1], c.q[2], m, cells);  // in range even for NaN
+    merl_kernel::blend_rows(bins_.get(), cells, 0, m, out.data() + first);
+    for (std::size_t i = 0; i < m; ++i)
+      if (c.apart[i]) out[first + i] = eval(pairs[first + i]);
   }
-  if (previous) finish(*previous, 0, previous->m);
 }
 
 void MerlBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {

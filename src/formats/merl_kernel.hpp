@@ -115,22 +115,38 @@ inline Cell cell_of(double theta_h, double theta_d, double phi_d) {
   return {cell_base(h.i, d.i, p.i), phi_step(p.i), {h.t, d.t, p.t}};
 }
 
+// A cell's 8 corner slots, copied in the order (θh, θd, φd).
+struct Corners {
+  merl::BinValues slot[8];
+};
+
+inline void load_corners(const merl::BinValues* table, const Cell& c, Corners& out) {
+  const merl::BinValues* p = table + c.base;
+  const merl::BinValues* q = p + c.phi_step;
+  out.slot[0] = p[0];
+  out.slot[1] = q[0];
+  out.slot[2] = p[kThetaDStep];
+  out.slot[3] = q[kThetaDStep];
+  out.slot[4] = p[kThetaHStep];
+  out.slot[5] = q[kThetaHStep];
+  out.slot[6] = p[kThetaHStep + kThetaDStep];
+  out.slot[7] = q[kThetaHStep + kThetaDStep];
+}
+
 // The blend of a cell's 8 corners: per channel, the weighted mean of the measured corners (an
 // unmeasured corner, negative, is skipped and the others' weights renormalized); NaN for a channel
-// with no measured corner. The corners in the order (θh, θd, φd), the weights as products in that
-// order. Written on scalars: the compiler packs the channels into vectors as the target allows
-// (explicit 4-wide vectors measured slower in the AVX-512 build, 2-wide ones no faster).
-inline Rgb blend(const merl::BinValues* table, const Cell& c) {
-  const merl::BinValues* first = table + c.base;
+// with no measured corner. The weights are products in the order (θh, θd, φd). Written on
+// scalars: the compiler packs the channels into vectors as the target allows (explicit 4-wide
+// vectors measured slower in the AVX-512 build, 2-wide ones no faster).
+inline Rgb blend_corners(const Corners& v, const double (&t)[3]) {
   double sum[4] = {}, wsum[4] = {};  // the pad too: the compiler then packs a slot in one vector
   for (int a = 0; a < 2; ++a) {
-    const double wa = a ? c.t[0] : 1 - c.t[0];
+    const double wa = a ? t[0] : 1 - t[0];
     for (int b = 0; b < 2; ++b) {
-      const double wb = wa * (b ? c.t[1] : 1 - c.t[1]);
-      const merl::BinValues* p = first + a * kThetaHStep + b * kThetaDStep;
+      const double wb = wa * (b ? t[1] : 1 - t[1]);
       for (int k = 0; k < 2; ++k) {
-        const double w = wb * (k ? c.t[2] : 1 - c.t[2]);
-        const double* x = p[k ? c.phi_step : 0].rgb;
+        const double w = wb * (k ? t[2] : 1 - t[2]);
+        const double* x = v.slot[4 * a + 2 * b + k].rgb;
         for (int ch = 0; ch < 4; ++ch) {
           sum[ch] += x[ch] >= 0 ? w * x[ch] : 0.0;  // an unmeasured corner is skipped
           wsum[ch] += x[ch] >= 0 ? w : 0.0;
@@ -142,6 +158,12 @@ inline Rgb blend(const merl::BinValues* table, const Cell& c) {
   for (int ch = 0; ch < 3; ++ch)
     rgb[ch] = wsum[ch] > 0 ? sum[ch] / wsum[ch] * merl::kScale[ch] : kNaN;
   return {rgb[0], rgb[1], rgb[2]};
+}
+
+inline Rgb blend(const merl::BinValues* table, const Cell& c) {
+  Corners v;
+  load_corners(table, c, v);
+  return blend_corners(v, c.t);
 }
 
 // The stored value of a bin times the scale, NaN for an unmeasured (negative) value.
