@@ -67,22 +67,36 @@ void cells(const double* theta_h, const double* theta_d, const double* phi_d, st
   __builtin_prefetch(q + kThetaHStep + kThetaDStep);
 }
 
-// Steps of kRows rows: the corners of the next step are prefetched, this step's corners copied in
-// a short loop of independent loads, then blended. Blending row by row, each row's arithmetic
-// filled the out-of-order window and few cache misses were in flight (3.1-3.3 against 2.2-2.4 ms
-// per 65536 rows, the conversion apart; the table reads alone take 1.0-1.1 ms). A prefetch a whole
-// block ahead instead of a step measured slower still (docs/performance.md).
+// Steps of kRows rows: the corners of the next step are prefetched, this step's corner values
+// copied into columns (a short loop of independent loads, so that many rows' cache misses are in
+// flight), then blended across rows in vectors. Blending row by row, each row's arithmetic filled
+// the out-of-order window (3.1-3.3 against 1.0-1.1 ms per 65536 rows for the table reads alone;
+// docs/performance.md).
 HALFBACK_MERL_CLONES
 void blend_rows(const merl::BinValues* table, const Cells& cells, std::size_t begin,
                 std::size_t end, Rgb* out) {
   constexpr std::size_t kRows = 16;
-  Corners v[kRows];
+  alignas(64) double x[8][3][kRows];
+  alignas(64) double rgb[3][kRows];
   for (std::size_t i = begin; i < end; i += kRows) {
     const std::size_t n = end - i < kRows ? end - i : kRows;
     for (std::size_t r = i + n; r < i + n + kRows && r < end; ++r)
       prefetch_corners(table, cells[r]);
-    for (std::size_t r = 0; r < n; ++r) load_corners(table, cells[i + r], v[r]);
-    for (std::size_t r = 0; r < n; ++r) out[i + r] = blend_corners(v[r], cells[i + r].t);
+    for (std::size_t r = 0; r < n; ++r) {
+      Corners v;
+      load_corners(table, cells[i + r], v);
+      for (int k = 0; k < 8; ++k)
+        for (int ch = 0; ch < 3; ++ch) x[k][ch][r] = v.slot[k].rgb[ch];
+    }
+    for (std::size_t r = 0; r < n; ++r) {
+      double one[3];
+      blend_channels<3>([&](int k, int ch) { return x[k][ch][r]; }, cells.t[0][i + r],
+                        cells.t[1][i + r], cells.t[2][i + r], one);
+      rgb[0][r] = one[0];
+      rgb[1][r] = one[1];
+      rgb[2][r] = one[2];
+    }
+    for (std::size_t r = 0; r < n; ++r) out[i + r] = {rgb[0][r], rgb[1][r], rgb[2][r]};
   }
 }
 

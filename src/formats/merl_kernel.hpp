@@ -135,35 +135,43 @@ inline void load_corners(const merl::BinValues* table, const Cell& c, Corners& o
 
 // The blend of a cell's 8 corners: per channel, the weighted mean of the measured corners (an
 // unmeasured corner, negative, is skipped and the others' weights renormalized); NaN for a channel
-// with no measured corner. The weights are products in the order (θh, θd, φd). Written on
-// scalars: the compiler packs the channels into vectors as the target allows (explicit 4-wide
-// vectors measured slower in the AVX-512 build, 2-wide ones no faster).
-inline Rgb blend_corners(const Corners& v, const double (&t)[3]) {
-  double sum[4] = {}, wsum[4] = {};  // the pad too: the compiler then packs a slot in one vector
+// with no measured corner. The weights are products in the order (θh, θd, φd). x(k, ch) is the
+// value of corner k (in the order θh, θd, φd) in channel ch; channels [0, C) are summed (C = 4
+// takes the pad along, so that the compiler packs a slot into one vector), the first 3 returned.
+// Written on scalars, for the one-row path and for the block loop that runs it across rows.
+template <int C, class X>
+inline void blend_channels(const X& x, double t0, double t1, double t2, double (&rgb)[3]) {
+  double sum[C] = {}, wsum[C] = {};
+  // Unrolled before vectorization: GCC 12 vectorizes the loop over rows around it only then.
+#pragma GCC unroll 2
   for (int a = 0; a < 2; ++a) {
-    const double wa = a ? t[0] : 1 - t[0];
+    const double wa = a ? t0 : 1 - t0;
+#pragma GCC unroll 2
     for (int b = 0; b < 2; ++b) {
-      const double wb = wa * (b ? t[1] : 1 - t[1]);
+      const double wb = wa * (b ? t1 : 1 - t1);
+#pragma GCC unroll 2
       for (int k = 0; k < 2; ++k) {
-        const double w = wb * (k ? t[2] : 1 - t[2]);
-        const double* x = v.slot[4 * a + 2 * b + k].rgb;
-        for (int ch = 0; ch < 4; ++ch) {
-          sum[ch] += x[ch] >= 0 ? w * x[ch] : 0.0;  // an unmeasured corner is skipped
-          wsum[ch] += x[ch] >= 0 ? w : 0.0;
+        const double w = wb * (k ? t2 : 1 - t2);
+#pragma GCC unroll 4
+        for (int ch = 0; ch < C; ++ch) {
+          const double v = x(4 * a + 2 * b + k, ch);
+          sum[ch] += v >= 0 ? w * v : 0.0;  // an unmeasured corner is skipped
+          wsum[ch] += v >= 0 ? w : 0.0;
         }
       }
     }
   }
-  double rgb[3];
+#pragma GCC unroll 3
   for (int ch = 0; ch < 3; ++ch)
     rgb[ch] = wsum[ch] > 0 ? sum[ch] / wsum[ch] * merl::kScale[ch] : kNaN;
-  return {rgb[0], rgb[1], rgb[2]};
 }
 
 inline Rgb blend(const merl::BinValues* table, const Cell& c) {
   Corners v;
   load_corners(table, c, v);
-  return blend_corners(v, c.t);
+  double rgb[3];
+  blend_channels<4>([&](int k, int ch) { return v.slot[k].rgb[ch]; }, c.t[0], c.t[1], c.t[2], rgb);
+  return {rgb[0], rgb[1], rgb[2]};
 }
 
 // The stored value of a bin times the scale, NaN for an unmeasured (negative) value.
