@@ -7,10 +7,15 @@
 //   The *_Threads/1 and /2 benchmarks run eval_batch in an arena of 1 or 2 threads and report wall
 //   time (and the process's CPU time, and their ratio: the threads kept busy), for the 2-thread
 //   speed-up: only meaningful on an otherwise idle machine (--benchmark_filter='_Threads/').
+//   The MerlFloor_* benchmarks time the parts of a MERL batch apart, on the same pairs: the SIMD
+//   conversion alone, and the table reads alone (and the trilinear blends) at precomputed bins
+//   and cells, on a table of the same layout and pages: what the batch cannot go below.
 // Every benchmark processes the same 65536 random direction pairs (fixed seed); items/s counts
 // pairs.
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
+
+#include <sys/mman.h>
 
 #include <chrono>
 #include <cmath>
@@ -23,7 +28,9 @@
 #include <vector>
 
 #include "bench_brdfs.hpp"
+#include "formats/merl_kernel.hpp"
 #include "formats/merl_reference.hpp"
+#include "halfback/core/batch.hpp"
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
@@ -167,6 +174,141 @@ BENCHMARK(BM_MerlTrilinear_Threads)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
+
+// --- The floors of the MERL batch: its parts timed apart ---
+
+// The batch's table layout (one 32-byte slot a bin, on 2 MB pages when the kernel gives them),
+// filled from the same data.
+const merl::BinValues* floor_table() {
+  static const merl::BinValues* t = [] {
+    constexpr std::size_t kPage = std::size_t(2) << 20;
+    const std::size_t bytes = (merl::kBins * sizeof(merl::BinValues) + kPage - 1) / kPage * kPage;
+    auto* p = static_cast<merl::BinValues*>(std::aligned_alloc(kPage, bytes));
+    madvise(p, bytes, MADV_HUGEPAGE);
+    const auto& v = merl_data().values;
+    for (std::size_t i = 0; i < merl::kBins; ++i)
+      p[i] = {{v[i], v[i + merl::kBins], v[i + 2 * merl::kBins], 0.0}};
+    return p;  // kept for the whole run
+  }();
+  return t;
+}
+
+// The bins and cells of the pairs, as eval() finds them.
+const std::vector<std::uint32_t>& floor_bins() {
+  static const std::vector<std::uint32_t> b = [] {
+    std::vector<std::uint32_t> b;
+    for (const auto& x : pairs()) {
+      const Tuple4<double> q = HalfDiff::forward(x);
+      b.push_back(merl_kernel::nearest_bin(q[0], q[2], q[3]));
+    }
+    return b;
+  }();
+  return b;
+}
+
+const std::vector<merl_kernel::Cells>& floor_cells() {
+  static const std::vector<merl_kernel::Cells> c = [] {
+    std::vector<merl_kernel::Cells> c(kPairs / merl_kernel::kBlock);
+    for (std::size_t i = 0; i < kPairs; ++i) {
+      const Tuple4<double> q = HalfDiff::forward(pairs()[i]);
+      const merl_kernel::Cell cell = merl_kernel::cell_of(q[0], q[2], q[3]);
+      auto& block = c[i / merl_kernel::kBlock];
+      const std::size_t k = i % merl_kernel::kBlock;
+      block.base[k] = cell.base;
+      block.phi_step[k] = cell.phi_step;
+      for (int a = 0; a < 3; ++a) block.t[a][k] = cell.t[a];
+    }
+    return c;
+  }();
+  return c;
+}
+
+// The conversion alone, as eval_batch calls it: blocks of 256 rows read in place, to (θh, θd, φd).
+void BM_MerlFloor_Conversion(benchmark::State& state) {
+  const auto& p = pairs();
+  constexpr std::size_t kBlock = merl_kernel::kBlock;
+  alignas(64) static double q[3][kBlock];
+  alignas(64) static std::uint8_t valid[kBlock];
+  const Column<double> cols[3] = {{q[0], 1}, {q[1], 1}, {q[2], 1}};
+  for (auto _ : state) {
+    for (std::size_t f = 0; f < p.size(); f += kBlock) {
+      const double* rows = &p[f].wi.x;
+      const ConstColumn<double> in[6] = {{rows, 6},     {rows + 1, 6}, {rows + 2, 6},
+                                         {rows + 3, 6}, {rows + 4, 6}, {rows + 5, 6}};
+      convert<double>(Form{Space::dirs}, Form{Space::halfdiff, true}, in, kBlock,
+                      ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
+      benchmark::DoNotOptimize(q[0][0]);
+    }
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
+}
+BENCHMARK(BM_MerlFloor_Conversion)->Unit(benchmark::kMillisecond);
+
+// The table reads alone: the slot of each row's bin, prefetched 16 rows ahead, summed.
+void BM_MerlFloor_NearestReads(benchmark::State& state) {
+  const merl::BinValues* t = floor_table();
+  const auto& b = floor_bins();
+  const std::size_t n = b.size();
+  for (auto _ : state) {
+    double sum = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i + 16 < n) __builtin_prefetch(t + b[i + 16]);
+      const double* v = t[b[i]].rgb;
+      sum += v[0] + v[1] + v[2];
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));
+}
+BENCHMARK(BM_MerlFloor_NearestReads)->Unit(benchmark::kMillisecond);
+
+// The table reads alone: one value of each of a row's 8 corners (4 to 8 cache lines), prefetched
+// 16 rows ahead, summed.
+void BM_MerlFloor_TrilinearReads(benchmark::State& state) {
+  using merl_kernel::kThetaDStep, merl_kernel::kThetaHStep, merl_kernel::kBlock;
+  const merl::BinValues* t = floor_table();
+  const auto& c = floor_cells();
+  auto corners = [&](std::size_t i) {
+    const auto& block = c[i / kBlock];
+    const merl::BinValues* p = t + block.base[i % kBlock];
+    return std::pair{p, p + block.phi_step[i % kBlock]};
+  };
+  for (auto _ : state) {
+    double sum = 0;
+    for (std::size_t i = 0; i < kPairs; ++i) {
+      if (i + 16 < kPairs) {
+        const auto [p, q] = corners(i + 16);
+        for (const merl::BinValues* x :
+             {p, q, p + kThetaDStep, q + kThetaDStep, p + kThetaHStep, q + kThetaHStep,
+              p + kThetaHStep + kThetaDStep, q + kThetaHStep + kThetaDStep})
+          __builtin_prefetch(x);
+      }
+      const auto [p, q] = corners(i);
+      sum += p->rgb[0] + q->rgb[0] + p[kThetaDStep].rgb[1] + q[kThetaDStep].rgb[1] +
+             p[kThetaHStep].rgb[2] + q[kThetaHStep].rgb[2] + p[kThetaHStep + kThetaDStep].rgb[0] +
+             q[kThetaHStep + kThetaDStep].rgb[0];
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kPairs));
+}
+BENCHMARK(BM_MerlFloor_TrilinearReads)->Unit(benchmark::kMillisecond);
+
+// The reads and the blends of the batch (the kernel it calls), at precomputed cells: the trilinear
+// batch without its conversion.
+void BM_MerlFloor_TrilinearBlends(benchmark::State& state) {
+  const merl::BinValues* t = floor_table();
+  const auto& c = floor_cells();
+  std::vector<Rgb> out(kPairs);
+  for (auto _ : state) {
+    for (std::size_t b = 0; b < c.size(); ++b)
+      merl_kernel::blend_rows(t, c[b], 0, merl_kernel::kBlock,
+                              out.data() + b * merl_kernel::kBlock);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kPairs));
+}
+BENCHMARK(BM_MerlFloor_TrilinearBlends)->Unit(benchmark::kMillisecond);
 
 std::filesystem::path shared_file(const char* sub) {
   const char* dir = std::getenv("HALFBACK_SHARED_DIR");

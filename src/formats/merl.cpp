@@ -23,6 +23,7 @@
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/format_error.hpp"
 #include "halfback/util/sha256.hpp"
+#include "merl_kernel.hpp"
 
 namespace halfback {
 
@@ -36,33 +37,6 @@ constexpr std::array<int, 3> kDims{merl::kThetaH, merl::kThetaD, merl::kPhiD};
 constexpr std::array<const char*, 3> kDimNames{"theta_h", "theta_d", "phi_d"};
 constexpr std::array<const char*, 3> kChannelNames{"red", "green", "blue"};
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// The reference reader's index computations, operation for operation (same rounding).
-int theta_h_index(double theta_h) {
-  if (!(theta_h > 0.0)) return 0;  // also NaN
-  const double deg = (theta_h / (kPi / 2.0)) * merl::kThetaH;
-  const double t = std::sqrt(deg * merl::kThetaH);
-  return t < merl::kThetaH - 1 ? static_cast<int>(t) : merl::kThetaH - 1;
-}
-
-int theta_d_index(double theta_d) {
-  const double t = theta_d / (kPi * 0.5) * merl::kThetaD;
-  if (!(t > 0.0)) return 0;
-  return t < merl::kThetaD - 1 ? static_cast<int>(t) : merl::kThetaD - 1;
-}
-
-// φd in (-π, π] (the reference's atan2 range) or [0, 2π) (the core's azimuths).
-int phi_d_index(double phi_d) {
-  if (phi_d < 0.0) {
-    phi_d += kPi;  // the reference's reciprocity fold
-  } else if (phi_d > kPi) {
-    phi_d -=
-        kPi;  // [0, 2π) convention: the same fold; φd = π itself is kept, as the reference does
-  }
-  const double t = phi_d / kPi * (2 * merl::kPhiD) / 2;
-  if (!(t > 0.0)) return 0;
-  return t < merl::kPhiD - 1 ? static_cast<int>(t) : merl::kPhiD - 1;
-}
 
 std::string bin_field(int c, std::size_t flat) {
   const std::size_t pd = flat % merl::kPhiD, td = (flat / merl::kPhiD) % merl::kThetaD,
@@ -98,7 +72,8 @@ void check_header(std::span<const std::byte> head, std::uintmax_t size, const st
 namespace merl {
 
 BinIndex bin_of(double theta_h, double theta_d, double phi_d) {
-  return {theta_h_index(theta_h), theta_d_index(theta_d), phi_d_index(phi_d)};
+  return {merl_kernel::theta_h_index(theta_h), merl_kernel::theta_d_index(theta_d),
+          merl_kernel::phi_d_index(phi_d)};
 }
 
 BinIndex bin_of(const DirPair<double>& pair) {
@@ -235,127 +210,13 @@ Rgb MerlBrdf::bin_value(int th, int td, int pd) const {
   return {v[0] * merl::kScale[0], v[1] * merl::kScale[1], v[2] * merl::kScale[2]};
 }
 
-Rgb MerlBrdf::nearest_at(std::size_t bin) const {
-  const double* v = bins_[bin].rgb;
-  // An unmeasured bin (a negative stored value) is missing: NaN, never a negative ρ.
-  return {v[0] < 0 ? kNaN : v[0] * merl::kScale[0], v[1] < 0 ? kNaN : v[1] * merl::kScale[1],
-          v[2] < 0 ? kNaN : v[2] * merl::kScale[2]};
-}
-
 Rgb MerlBrdf::nearest(double theta_h, double theta_d, double phi_d) const {
-  const merl::BinIndex b = merl::bin_of(theta_h, theta_d, phi_d);
-  return nearest_at(merl::bin(b.theta_h, b.theta_d, b.phi_d));
+  // An unmeasured bin (a negative stored value) is missing: NaN, never a negative ρ.
+  return merl_kernel::bin_rgb(bins_[merl_kernel::nearest_bin(theta_h, theta_d, phi_d)]);
 }
-
-namespace {
-
-// The cell of a trilinear lookup: its lowest bin, the step in φd to the next bin (1, or 1 − 180
-// across the wrap φd = π ≡ 0), and the position (θh, θd, φd) in the cell, each in [0, 1]. The other
-// bins are base + a·(90·180) + b·180 + c·phi_step for a, b, c in {0, 1}.
-struct Cell {
-  std::uint32_t base;
-  std::int32_t phi_step;
-  double t[3];
-};
-
-constexpr std::uint32_t kThetaHStep = std::uint32_t(merl::kThetaD) * merl::kPhiD;
-constexpr std::uint32_t kThetaDStep = merl::kPhiD;
-
-// A clamped axis (θh, θd) of n bins in continuous bin coordinates u (bin k covers [k, k+1), its
-// centre at k + ½): the lower centre i in [0, n−2] and the weight t of the upper one. Constant over
-// the half bins at both ends: below the first centre t = 0 at i = 0, above the last t = 1 at
-// i = n−2. NaN gives i = 0, t = 0.
-inline void clamped_axis(double u, int n, int& i, double& t) {
-  const double x = u - 0.5;
-  const double c = x > 0 ? (x < n - 1 ? x : double(n - 1)) : 0.0;
-  i = std::min(static_cast<int>(c), n - 2);
-  t = c - i;
-}
-
-inline Cell cell_of(double theta_h, double theta_d, double phi_d) {
-  const double uh =
-      theta_h > 0 ? std::sqrt(theta_h / (kPi / 2) * (merl::kThetaH * merl::kThetaH)) : 0.0;
-  const double ud = theta_d / (kPi / 2) * merl::kThetaD;
-  double pd = phi_d;
-  if (pd < 0) pd += kPi;
-  if (pd >= kPi) pd -= kPi;
-  // The periodic axis (φd, period π = 180 bins).
-  double x = pd / kPi * merl::kPhiD - 0.5;
-  if (!(x >= -1 && x < merl::kPhiD)) x = 0;  // only for non-finite input
-  int ip = static_cast<int>(x);
-  ip -= double(ip) > x ? 1 : 0;  // floor, without a libm call
-  Cell c;
-  c.t[2] = x - ip;
-  if (ip < 0) ip += merl::kPhiD;
-  c.phi_step = ip + 1 == merl::kPhiD ? 1 - merl::kPhiD : 1;
-  int ih, id;
-  clamped_axis(uh, merl::kThetaH, ih, c.t[0]);
-  clamped_axis(ud, merl::kThetaD, id, c.t[1]);
-  c.base = static_cast<std::uint32_t>(merl::bin(ih, id, ip));
-  return c;
-}
-
-// Two doubles in one vector (GCC/Clang vector extension, an SSE2 register): a bin's slot is two
-// of them, (r, g) and (b, pad).
-using V2 = double __attribute__((vector_size(16)));
-using M2 = std::int64_t __attribute__((vector_size(16)));
-
-// The weighted mean of the measured corners of a cell, per channel; NaN for a channel with no
-// measured corner. The corners in the order (θh, θd, φd), the weights as products in that order
-// and the sums channel by channel: eval() and eval_batch() give the same bits for the same cell.
-inline Rgb blend(const merl::BinValues* table, const Cell& c) {
-  V2 sum_rg{}, sum_b{}, wsum_rg{}, wsum_b{};
-  const merl::BinValues* first = table + c.base;
-  for (int a = 0; a < 2; ++a) {
-    const double wa = a ? c.t[0] : 1 - c.t[0];
-    for (int b = 0; b < 2; ++b) {
-      const double wb = wa * (b ? c.t[1] : 1 - c.t[1]);
-      const merl::BinValues* p = first + a * kThetaHStep + b * kThetaDStep;
-      for (int k = 0; k < 2; ++k) {
-        const double w = wb * (k ? c.t[2] : 1 - c.t[2]);
-        const V2 ww = {w, w};
-        V2 rg, bp;
-        std::memcpy(&rg, p[k ? c.phi_step : 0].rgb, sizeof rg);
-        std::memcpy(&bp, p[k ? c.phi_step : 0].rgb + 2, sizeof bp);
-        // An unmeasured corner (negative) is skipped.
-        const M2 m_rg = rg >= 0, m_b = bp >= 0;
-        sum_rg += (V2)((M2)(ww * rg) & m_rg);
-        sum_b += (V2)((M2)(ww * bp) & m_b);
-        wsum_rg += (V2)((M2)ww & m_rg);
-        wsum_b += (V2)((M2)ww & m_b);
-      }
-    }
-  }
-  return {wsum_rg[0] > 0 ? sum_rg[0] / wsum_rg[0] * merl::kScale[0] : kNaN,
-          wsum_rg[1] > 0 ? sum_rg[1] / wsum_rg[1] * merl::kScale[1] : kNaN,
-          wsum_b[0] > 0 ? sum_b[0] / wsum_b[0] * merl::kScale[2] : kNaN};
-}
-
-// Touches the 8 corners of the cells of rows [begin, end) but those left to eval(): 4 to 8 cache
-// lines a row. Always inlined: GCC takes a function whose only effects are prefetches for a pure
-// one, and drops its calls.
-[[gnu::always_inline]] inline void prefetch_cells(const merl::BinValues* table, const Cell* cell,
-                                                  const bool* apart, std::size_t begin,
-                                                  std::size_t end) {
-  for (std::size_t i = begin; i < end; ++i) {
-    if (apart[i]) continue;
-    const merl::BinValues* p = table + cell[i].base;
-    const merl::BinValues* q = p + cell[i].phi_step;
-    __builtin_prefetch(p);
-    __builtin_prefetch(q);
-    __builtin_prefetch(p + kThetaDStep);
-    __builtin_prefetch(q + kThetaDStep);
-    __builtin_prefetch(p + kThetaHStep);
-    __builtin_prefetch(q + kThetaHStep);
-    __builtin_prefetch(p + kThetaHStep + kThetaDStep);
-    __builtin_prefetch(q + kThetaHStep + kThetaDStep);
-  }
-}
-
-}  // namespace
 
 Rgb MerlBrdf::trilinear(double theta_h, double theta_d, double phi_d) const {
-  return blend(bins_.get(), cell_of(theta_h, theta_d, phi_d));
+  return merl_kernel::blend(bins_.get(), merl_kernel::cell_of(theta_h, theta_d, phi_d));
 }
 
 Rgb MerlBrdf::eval(const DirPair<double>& pair) const {
@@ -370,16 +231,14 @@ Rgb MerlBrdf::eval(const DirPair<double>& pair) const {
 
 namespace {
 
-// Rows per block of eval_batch: the coordinates, bins and cells of a block stay in L1/L2 while
-// its table reads are in flight.
-constexpr std::size_t kBlock = 256;
+using merl_kernel::kBlock;
 constexpr std::uint32_t kScalarRow = 0xffffffffu;  // a row left to eval()
 
 // The isotropic halfdiff coordinates (θh, θd, φd) of a block's rows, and which rows go through
 // eval().
 struct Coordinates {
   alignas(64) double q[3][kBlock];
-  bool apart[kBlock];
+  alignas(64) std::uint8_t apart[kBlock];
 };
 
 // The coordinates by the SIMD conversion (the φh that the lookups do not use is not computed).
@@ -396,52 +255,38 @@ void convert_block(std::span<const DirPair<double>> pairs, Coordinates& c) {
   const Column<double> cols[3] = {{c.q[0], 1}, {c.q[1], 1}, {c.q[2], 1}};
   convert<double>(Form{Space::dirs}, Form{Space::halfdiff, true}, in, m,
                   ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
-  for (std::size_t i = 0; i < m; ++i) {
-    const DirPair<double>& p = pairs[i];
-    c.apart[i] =
-        !valid[i] || p.wi.z < 0 || p.wo.z < 0 || (p.wi.x + p.wo.x == 0 && p.wi.y + p.wo.y == 0);
-  }
+  merl_kernel::rows_apart(rows, valid, m, c.apart);
 }
-
-// A block of the trilinear pipeline: its rows, their cells, which rows go through eval().
-struct TrilinearBlock {
-  std::size_t first = 0, m = 0;
-  Cell cell[kBlock];
-  bool apart[kBlock];
-};
 
 // A block of the nearest-bin pipeline: its rows and their bins (kScalarRow: through eval()).
 struct NearestBlock {
   std::size_t first = 0, m = 0;
-  std::uint32_t bin[kBlock];
+  alignas(64) std::uint32_t bin[kBlock];
 };
 
 }  // namespace
 
-// Blocks in a pipeline, as trilinear_blocks below: a block's slots are prefetched row by row
-// between the reads of the previous block's values.
+// Blocks in a pipeline: a block's slots are prefetched row by row between the reads of the
+// previous block's values.
 void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                               std::size_t begin, std::size_t end) const {
   Coordinates c;
   NearestBlock stage[2];
   const NearestBlock* previous = nullptr;
+  const merl::BinValues* table = bins_.get();
   auto finish = [&](const NearestBlock& t, std::size_t i) {
     const std::size_t row = t.first + i;
-    out[row] = t.bin[i] == kScalarRow ? eval(pairs[row]) : nearest_at(t.bin[i]);
+    out[row] = t.bin[i] == kScalarRow ? eval(pairs[row]) : merl_kernel::bin_rgb(table[t.bin[i]]);
   };
   for (std::size_t b = begin; b < end; ++b) {
     NearestBlock& t = stage[(b - begin) % 2];
     t.first = b * kBlock;
     t.m = std::min(kBlock, pairs.size() - t.first);
     convert_block(pairs.subspan(t.first, t.m), c);
-    for (std::size_t i = 0; i < t.m; ++i) {
-      const std::size_t k =
-          merl::bin(theta_h_index(c.q[0][i]), theta_d_index(c.q[1][i]), phi_d_index(c.q[2][i]));
-      t.bin[i] = c.apart[i] ? kScalarRow : static_cast<std::uint32_t>(k);
-    }
+    merl_kernel::nearest_bins(c.q[0], c.q[1], c.q[2], c.apart, t.m, kScalarRow, t.bin);
     const std::size_t mp = previous ? previous->m : 0;
     for (std::size_t i = 0; i < std::max(t.m, mp); ++i) {
-      if (i < t.m && t.bin[i] != kScalarRow) __builtin_prefetch(&bins_[t.bin[i]]);
+      if (i < t.m && t.bin[i] != kScalarRow) __builtin_prefetch(table + t.bin[i]);
       if (i < mp) finish(*previous, i);
     }
     previous = &t;
@@ -450,37 +295,20 @@ void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<
     for (std::size_t i = 0; i < previous->m; ++i) finish(*previous, i);
 }
 
-// Blocks in a pipeline: the corners of a block are prefetched row by row between the blends of
-// the previous block, so that the blends' arithmetic (and the next block's conversion) runs while
-// the table reads are in flight.
+// Block by block: the conversion, the cells, then the blends (merl_kernel::blend_rows prefetches
+// its own corners a step ahead). Rows left to eval() get its values over the blend's.
 void MerlBrdf::trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                                 std::size_t begin, std::size_t end) const {
-  const merl::BinValues* table = bins_.get();
   Coordinates c;
-  TrilinearBlock stage[2];
-  const TrilinearBlock* previous = nullptr;
-  auto finish = [&](const TrilinearBlock& t, std::size_t i) {
-    const std::size_t row = t.first + i;
-    out[row] = t.apart[i] ? eval(pairs[row]) : blend(table, t.cell[i]);
-  };
+  merl_kernel::Cells cells;
   for (std::size_t b = begin; b < end; ++b) {
-    TrilinearBlock& t = stage[(b - begin) % 2];
-    t.first = b * kBlock;
-    t.m = std::min(kBlock, pairs.size() - t.first);
-    convert_block(pairs.subspan(t.first, t.m), c);
-    for (std::size_t i = 0; i < t.m; ++i) {
-      t.apart[i] = c.apart[i];
-      t.cell[i] = cell_of(c.q[0][i], c.q[1][i], c.q[2][i]);  // in range even for NaN
-    }
-    const std::size_t mp = previous ? previous->m : 0;
-    for (std::size_t i = 0; i < std::max(t.m, mp); ++i) {
-      if (i < t.m) prefetch_cells(table, t.cell, t.apart, i, i + 1);
-      if (i < mp) finish(*previous, i);
-    }
-    previous = &t;
+    const std::size_t first = b * kBlock, m = std::min(kBlock, pairs.size() - first);
+    convert_block(pairs.subspan(first, m), c);
+    merl_kernel::cells(c.q[0], c.q[1], c.q[2], m, cells);  // in range even for NaN
+    merl_kernel::blend_rows(bins_.get(), cells, 0, m, out.data() + first);
+    for (std::size_t i = 0; i < m; ++i)
+      if (c.apart[i]) out[first + i] = eval(pairs[first + i]);
   }
-  if (previous)
-    for (std::size_t i = 0; i < previous->m; ++i) finish(*previous, i);
 }
 
 void MerlBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {

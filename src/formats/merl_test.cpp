@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "formats/binary_io.hpp"
+#include "formats/merl_kernel.hpp"
 #include "formats/merl_reference.hpp"
 #include "support/allocation_probe.hpp"
 #include "support/test_brdfs.hpp"
@@ -470,6 +471,11 @@ std::vector<DirPair<double>> batch_pairs() {
   return p;
 }
 
+// The same double, sign of zero included (any NaN equals any NaN).
+bool same_bits(double a, double b) {
+  return a == b ? std::signbit(a) == std::signbit(b) : std::isnan(a) && std::isnan(b);
+}
+
 bool same_value(double a, double b) {
   return a == b || (std::isnan(a) && std::isnan(b));
 }
@@ -638,6 +644,62 @@ TEST(MerlBatch, SameResultWhateverTheSplit) {
     EXPECT_TRUE(same_value(whole[i].r, parts[i].r) && same_value(whole[i].g, parts[i].g) &&
                 same_value(whole[i].b, parts[i].b))
         << i;
+  }
+}
+
+// The block loops (vectorized across rows, for the instruction set of this CPU) against the one-row
+// formulas eval() uses: the same bins, cells and blends, bit for bit, on coordinates of every kind
+// (inside, on bin edges, at both ends, the φd fold and wrap, negative, NaN, infinite), in every
+// lane position and block length.
+TEST(MerlKernel, BlockLoopsAreTheOneRowFormulas) {
+  using namespace merl_kernel;
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double nan = std::nan(""), inf = HUGE_VAL, top = kPi / 2;
+  const std::vector<double> special = {0.0,     -0.0, 1e-300,          -1e-12,        top,
+                                       top * 2, kPi,  2 * kPi - 1e-15, 7.0,           nan,
+                                       inf,     -inf, top / 90 * 37,   kPi / 180 * 91};
+  alignas(64) double q[3][kBlock];
+  alignas(64) std::uint8_t apart[kBlock];
+  std::uint32_t bins[kBlock];
+  Cells cells;
+  for (std::size_t m : {std::size_t(1), std::size_t(7), std::size_t(61), kBlock}) {
+    for (int round = 0; round < 20; ++round) {
+      for (std::size_t i = 0; i < m; ++i) {
+        for (int a = 0; a < 3; ++a)
+          q[a][i] =
+              u(rng) < 0.2 ? special[rng() % special.size()] : (a == 2 ? 2 * kPi : top) * u(rng);
+        apart[i] = u(rng) < 0.1;
+      }
+      nearest_bins(q[0], q[1], q[2], apart, m, 0xffffffffu, bins);
+      merl_kernel::cells(q[0], q[1], q[2], m, cells);
+      for (std::size_t i = 0; i < m; ++i) {
+        EXPECT_EQ(bins[i], apart[i] ? 0xffffffffu : nearest_bin(q[0][i], q[1][i], q[2][i])) << i;
+        const Cell one = cell_of(q[0][i], q[1][i], q[2][i]), block = cells[i];
+        EXPECT_EQ(block.base, one.base) << q[0][i] << " " << q[1][i] << " " << q[2][i];
+        EXPECT_EQ(block.phi_step, one.phi_step);
+        for (int a = 0; a < 3; ++a) EXPECT_TRUE(same_bits(block.t[a], one.t[a])) << a;
+        // All 8 corners in the table.
+        EXPECT_LT(one.base + kThetaHStep + kThetaDStep + std::max(one.phi_step, 0), merl::kBins);
+        EXPECT_GE(std::int64_t(one.base) + one.phi_step, 0);
+      }
+      // The blends, on a table with unmeasured bins: the block's rows against blend() of each cell.
+      static const std::vector<merl::BinValues> table = [] {
+        std::vector<merl::BinValues> t(merl::kBins);
+        for (std::size_t i = 0; i < merl::kBins; ++i)
+          for (int ch = 0; ch < 3; ++ch)
+            t[i].rgb[ch] = (i + ch) % 13 == 0 ? -1.0 : 1.0 + std::sin(0.01 * double(i) + ch);
+        return t;
+      }();
+      std::vector<Rgb> out(m);
+      blend_rows(table.data(), cells, 0, m, out.data());
+      for (std::size_t i = 0; i < m; ++i) {
+        const Rgb one = blend(table.data(), cells[i]);
+        EXPECT_TRUE(same_bits(out[i].r, one.r) && same_bits(out[i].g, one.g) &&
+                    same_bits(out[i].b, one.b))
+            << i;
+      }
+    }
   }
 }
 

@@ -137,7 +137,6 @@ class MerlBrdf final : public Brdf {
 
  private:
   Rgb nearest(double theta_h, double theta_d, double phi_d) const;
-  Rgb nearest_at(std::size_t bin) const;
   Rgb trilinear(double theta_h, double theta_d, double phi_d) const;
   // eval_batch over blocks [begin, end) of kBlock rows (merl.cpp).
   void nearest_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out, std::size_t begin,
