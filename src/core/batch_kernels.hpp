@@ -49,35 +49,45 @@ struct Lanes {
   }
 };
 
-// Runs f(x, y) on every vector of rows: x[c] holds rows [i, i + W) of in[c], and y[c] is stored
-// to out[c]. The last m % W rows go through a zero-padded buffer; lanes are independent, so the
-// padding never changes a real row's result.
+// f(x, y) on vectors [0, n) of rows: x[c] holds rows [i, i + W) of in[c], and y[c] is stored to
+// out[c]. The one flattened function of a stage: everything f calls, down to the xsimd
+// intrinsics, is inlined into this loop (GCC otherwise keeps the larger param.hpp functions and
+// xsimd's sincos out of line, passing 512-bit vectors through memory, which costs 2-3x). It is
+// not inlined itself, so that the full vectors and the padded last one share one copy of f's
+// body: inlined twice, the kernel files took twice as long to compile.
 template <class B, int NI, int NO, class F>
-inline void for_rows(const ScalarOf<B>* const* in, ScalarOf<B>* const* out, std::size_t m, F&& f) {
-  using S = ScalarOf<B>;
+[[gnu::noinline]] HALFBACK_FLATTEN void vector_loop(const ScalarOf<B>* const* in,
+                                                    ScalarOf<B>* const* out, std::size_t n, F f) {
   using L = Lanes<B>;
-  constexpr std::size_t W = L::size;
   B x[NI], y[NO];
-  std::size_t i = 0;
-  for (; i + W <= m; i += W) {
+  for (std::size_t i = 0; i < n; i += L::size) {
     for (int c = 0; c < NI; ++c) x[c] = L::load(in[c] + i);
     f(x, y);
     for (int c = 0; c < NO; ++c) L::store(out[c] + i, y[c]);
   }
-  if constexpr (W > 1) {
-    if (i == m) return;
-    const std::size_t r = m - i;
-    alignas(64) S buf[NI > NO ? NI : NO][W];
-    for (int c = 0; c < NI; ++c) {
-      for (std::size_t k = 0; k < W; ++k) buf[c][k] = k < r ? in[c][i + k] : S(0);
-      x[c] = L::load(buf[c]);
-    }
-    f(x, y);
-    for (int c = 0; c < NO; ++c) {
-      L::store(buf[c], y[c]);
-      for (std::size_t k = 0; k < r; ++k) out[c][i + k] = buf[c][k];
-    }
+}
+
+// Runs f on every row. The last m % W rows go through a zero-padded buffer; lanes are
+// independent, so the padding never changes a real row's result.
+template <class B, int NI, int NO, class F>
+inline void for_rows(const ScalarOf<B>* const* in, ScalarOf<B>* const* out, std::size_t m, F f) {
+  using S = ScalarOf<B>;
+  constexpr std::size_t W = Lanes<B>::size;
+  const std::size_t full = m - m % W;
+  vector_loop<B, NI, NO>(in, out, full, f);
+  if (full == m) return;
+  const std::size_t r = m - full;
+  alignas(64) S buf[NI > NO ? NI : NO][W];
+  const S* buf_in[NI];
+  S* buf_out[NO];
+  for (int c = 0; c < NI; ++c) {
+    for (std::size_t k = 0; k < W; ++k) buf[c][k] = k < r ? in[c][full + k] : S(0);
+    buf_in[c] = buf[c];
   }
+  for (int c = 0; c < NO; ++c) buf_out[c] = buf[c];
+  vector_loop<B, NI, NO>(buf_in, buf_out, W, f);
+  for (int c = 0; c < NO; ++c)
+    for (std::size_t k = 0; k < r; ++k) out[c][full + k] = buf[c][k];
 }
 
 template <class B>
@@ -93,12 +103,9 @@ inline B mask_to_lanes(const MaskOf<B>& m) {
 
 // dirs input: the pair_is_valid() mask and the accepted pair, onto the unit upper hemisphere
 // (accepted_pair(); NaN where invalid), which the encode stage reads.
-// The stages are flattened: everything they call, down to the xsimd intrinsics, is inlined into
-// one loop (GCC otherwise keeps the larger param.hpp functions and xsimd's sincos out of line,
-// passing 512-bit vectors through memory, which costs 2-3x).
 template <class B>
-HALFBACK_FLATTEN void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy,
-                                  ScalarOf<B>* mask, std::size_t m) {
+void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy, ScalarOf<B>* mask,
+                 std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   S* outs[7] = {copy[0], copy[1], copy[2], copy[3], copy[4], copy[5], mask};
@@ -114,8 +121,8 @@ HALFBACK_FLATTEN void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* con
 
 // P input: the pair (NaN where invalid) and the domain mask.
 template <class B, class P, bool Iso>
-HALFBACK_FLATTEN void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs,
-                                   ScalarOf<B>* mask, std::size_t m) {
+void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, ScalarOf<B>* mask,
+                  std::size_t m) {
   using S = ScalarOf<B>;
   constexpr int NI = Iso ? 3 : 4;
   constexpr int NO = 6 + 1;
@@ -142,8 +149,8 @@ HALFBACK_FLATTEN void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* co
 // stage and this one did before (convert_row's accepted pair, then its unit pair). The mask
 // is rewritten, 1 or 0.
 template <class B, class P, bool Iso>
-HALFBACK_FLATTEN void encode_stage(const ScalarOf<B>* const* dirs, ScalarOf<B>* mask,
-                                   ScalarOf<B>* const* out, std::size_t m) {
+void encode_stage(const ScalarOf<B>* const* dirs, ScalarOf<B>* mask, ScalarOf<B>* const* out,
+                  std::size_t m) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int kDim = Iso ? 3 : 4;
@@ -170,8 +177,7 @@ HALFBACK_FLATTEN void encode_stage(const ScalarOf<B>* const* dirs, ScalarOf<B>* 
 // row is invalid. (decode and encode computed it from the same q in the same lanes before, so the
 // bits are those of convert_one.)
 template <class B, class P, bool Iso>
-HALFBACK_FLATTEN void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<B>* jac,
-                                     std::size_t m) {
+void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<B>* jac, std::size_t m) {
   using S = ScalarOf<B>;
   constexpr int NI = Iso ? 3 : 4;
   S* outs[1] = {jac};

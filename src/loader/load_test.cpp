@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -18,6 +19,7 @@
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
 #include "halfback/models/analytic.hpp"
+#include "loader/embedded.hpp"
 #include "support/test_brdfs.hpp"
 #include "support/test_support.hpp"
 
@@ -356,6 +358,24 @@ TEST(BuiltinModels, SumOfSpecs) {
       EXPECT_NE(std::string(e.what()).find("a sum has an empty term"), std::string::npos)
           << spec << ": " << e.what();
     }
+  }
+}
+
+// The assembler's .incbin (cmake/embed_files.cmake) put every file's exact bytes, 16-aligned.
+TEST(Embedded, BytesAreTheFilesBytes) {
+  const auto files = detail::embedded_files();
+  ASSERT_EQ(files.size(), 6u);
+  for (const detail::EmbeddedFile& f : files) {
+    const bool rgl = f.name.find('-') == std::string_view::npos;
+    const std::string path =
+        std::string(HALFBACK_SOURCE_DIR) + (rgl ? "/data/rgl/" + std::string(f.name) + "_rgb.bsdf"
+                                                : "/data/nbrdf/" + std::string(f.name) + ".h5");
+    std::ifstream in(path, std::ios::binary);
+    ASSERT_TRUE(in) << path;
+    const std::vector<unsigned char> bytes{std::istreambuf_iterator<char>(in), {}};
+    ASSERT_EQ(f.bytes.size(), bytes.size()) << f.name;
+    EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), f.bytes.begin())) << f.name;
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(f.bytes.data()) % 16, 0u) << f.name;
   }
 }
 

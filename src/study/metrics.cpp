@@ -1,12 +1,15 @@
 #include "halfback/study/metrics.hpp"
 
-#include <Eigen/SVD>
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "halfback/brdf/resample.hpp"
+#include "svd.hpp"
 
 namespace halfback::study {
 
@@ -83,19 +86,14 @@ void solve_normal_rows(const Eigen::MatrixXd& normals, const Eigen::MatrixXd& rh
 }
 
 // The relative error of the best rank-r approximation of M in the weighted norm
-// Σ w_ij (M_ij − (U Vᵀ)_ij)², by alternating weighted least squares started from the SVD of
+// Σ w_ij (M_ij − (U Vᵀ)_ij)², by alternating weighted least squares started from `svd`, the SVD of
 // √w ∘ M (the exact answer when the weights are separable). Entries of weight 0 do not count, so a
 // table that is of rank r on the domain has error 0 whatever the shape of the domain.
-double weighted_rank_error(const Eigen::MatrixXd& m, const Eigen::MatrixXd& w, int r) {
-  const double norm = (w.array() * m.array().square()).sum();
-  if (norm <= 0) return 0.0;
-  const Eigen::Index rows = m.rows(), cols = m.cols();
-  r = int(std::min<Eigen::Index>(r, std::min(rows, cols)));
-  if (r == 0) return 1.0;
-  const Eigen::MatrixXd scaled = w.array().sqrt() * m.array();
-  const Eigen::BDCSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  Eigen::MatrixXd u = svd.matrixU().leftCols(r) * svd.singularValues().head(r).asDiagonal();
-  Eigen::MatrixXd v = svd.matrixV().leftCols(r);
+// `norm` = Σ w_ij M_ij² > 0 and 0 < r <= min(rows, cols).
+double weighted_rank_error(const Eigen::MatrixXd& m, const Eigen::MatrixXd& w, double norm,
+                           const detail::ThinSvd& svd, int r) {
+  Eigen::MatrixXd u = svd.u.leftCols(r) * svd.values.head(r).asDiagonal();
+  Eigen::MatrixXd v = svd.v.leftCols(r);
   auto error = [&] { return (w.array() * (m - u * v.transpose()).array().square()).sum(); };
   // One side given the other: an r × r weighted normal system per row (or column), all their
   // matrices from one product W · (v_a v_b)_{a <= b} (the systems are symmetric: r(r+1)/2
@@ -128,12 +126,25 @@ double weighted_rank_error(const Eigen::MatrixXd& m, const Eigen::MatrixXd& w, i
   return std::sqrt(std::max(last, 0.0) / norm);
 }
 
+// One SVD for all the ranks (it does not depend on r).
 std::vector<double> rank_errors(const Eigen::MatrixXd& m, const Eigen::MatrixXd& w,
                                 const std::vector<int>& ranks) {
+  for (int r : ranks)
+    if (r < 0) throw std::invalid_argument("separability: a rank must be >= 0");
+  const double norm = (w.array() * m.array().square()).sum();
+  const Eigen::Index most = std::min(m.rows(), m.cols());
+  std::optional<detail::ThinSvd> svd;
   std::vector<double> out;
   for (int r : ranks) {
-    if (r < 0) throw std::invalid_argument("separability: a rank must be >= 0");
-    out.push_back(weighted_rank_error(m, w, r));
+    r = int(std::min<Eigen::Index>(r, most));
+    if (norm <= 0) {
+      out.push_back(0.0);
+    } else if (r == 0) {
+      out.push_back(1.0);
+    } else {
+      if (!svd) svd = detail::thin_svd(w.array().sqrt() * m.array());
+      out.push_back(weighted_rank_error(m, w, norm, *svd, r));
+    }
   }
   return out;
 }

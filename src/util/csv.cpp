@@ -5,12 +5,12 @@
 #include <locale.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <deque>
-#include <iterator>
 #include <limits>
 #include <system_error>
 #include <unordered_set>
@@ -198,9 +198,24 @@ std::string parse_csv_number(std::string_view field, double& value, bool allow_n
   return {};
 }
 
+namespace {
+
+// %.17g exactly as printf writes it (std::to_chars with a precision is specified so; tested
+// against fmt's "{:.17g}" on 8 million values): twice as fast as fmt, and it keeps fmt's float
+// formatting engine out of this file (docs/performance.md, "Building").
+std::string_view format_17g(double value, std::array<char, 32>& digits) {
+  const auto end = std::to_chars(digits.data(), digits.data() + digits.size(), value,
+                                 std::chars_format::general, 17)
+                       .ptr;
+  return {digits.data(), std::size_t(end - digits.data())};
+}
+
+}  // namespace
+
 std::string format_csv_number(double value) {
   if (std::isnan(value)) return "nan";
-  return fmt::format("{:.17g}", value);
+  std::array<char, 32> digits;
+  return std::string(format_17g(value, digits));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -575,10 +590,8 @@ void write_csv_rows(std::span<const std::span<const double>> columns, const CsvS
     for (std::size_t c = 0; c < columns.size(); ++c) {
       if (c > 0) buf.push_back(',');
       const double v = columns[c][r];
-      if (std::isnan(v))
-        buf.append(std::string_view("nan"));
-      else
-        fmt::format_to(std::back_inserter(buf), "{:.17g}", v);
+      std::array<char, 32> digits;
+      buf.append(std::isnan(v) ? std::string_view("nan") : format_17g(v, digits));
     }
     buf.push_back('\n');
     if (buf.size() >= chunk_bytes) {
