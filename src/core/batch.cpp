@@ -376,10 +376,8 @@ class TileRunner {
     if (p.check && !p.encode) {
       p.check(in, out, mask, m);
     } else if (p.check) {
-      T* dirs[6];
-      for (int c = 0; c < 6; ++c) dirs[c] = column(kDirs + c);
-      p.check(in, dirs, mask, m);
-      p.encode(dirs, mask, out, m);
+      std::fill_n(mask, m, detail::kUnchecked<T>);  // encode checks the directions itself
+      p.encode(in, mask, out, m);
     } else if (!p.encode) {
       p.decode(in, out, mask, m);
     } else {

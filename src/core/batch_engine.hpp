@@ -7,7 +7,8 @@
 // measure is asked for:
 //   check    (dirs input)   6 direction columns -> mask, accepted pair (NaN if invalid)
 //   decode   (P input)      dim(P) columns -> 6 direction columns (NaN if invalid), mask
-//   encode   (P output)     6 direction columns + mask -> dim(P) columns (NaN if invalid)
+//   encode   (P output)     6 direction columns + mask -> dim(P) columns (NaN if invalid), mask;
+//                           with a mask of kUnchecked (dirs input) it does the check itself
 //   jacobian (P in or out)  dim(P) columns -> J(q), not masked (the engine masks it)
 // Masks are stored as T: 1 for a valid row, 0 otherwise. The Jacobian is a stage of its own rather
 // than a variant of decode and encode so that those, the largest kernels, are compiled once.
@@ -30,11 +31,15 @@ inline constexpr std::size_t kTileBytes = 2048;
 template <class T>
 inline constexpr std::size_t kTileRows = kTileBytes / sizeof(T);
 
+// The mask value of a row of user-given directions that no stage has checked yet.
+template <class T>
+inline constexpr T kUnchecked = T(2);
+
 template <class T>
 struct StageKernels {
   using CheckFn = void (*)(const T* const* in, T* const* copy, T* mask, std::size_t m);
   using DecodeFn = void (*)(const T* const* in, T* const* dirs, T* mask, std::size_t m);
-  using EncodeFn = void (*)(const T* const* dirs, const T* mask, T* const* out, std::size_t m);
+  using EncodeFn = void (*)(const T* const* dirs, T* mask, T* const* out, std::size_t m);
   using JacobianFn = void (*)(const T* const* coords, T* jac, std::size_t m);
   std::size_t width;  // lanes per vector
   CheckFn check;

@@ -721,6 +721,58 @@ std::vector<std::vector<T>> invalid_rows(Form from) {
   return rows;
 }
 
+// dirs -> P: the encode stage checks unchecked rows itself (one pass over the input); its bits
+// must be those of the check stage followed by the encode stage, as before, on every instruction
+// set: valid pairs, pairs off unit length that are rescaled, and invalid ones. (Rescaling twice is
+// what convert_row does; on these inputs a second rescale never changed a bit, so a kernel that
+// rescaled once would pass too: the test guards the check, the mask and the data path.)
+TYPED_TEST(BatchTest, EncodeOfUncheckedRowsIsCheckThenEncode) {
+  using T = TypeParam;
+  auto pairs = test_pairs(3000, 31);
+  const std::size_t valid_rows = pairs.size();
+  for (std::size_t r = 0; r < 200; ++r) {  // off unit length: accepted and rescaled, or refused
+    DirPair<double> p = pairs[r];
+    const double s = 1 + (r % 2 ? 3e-7 : -2e-3) * double(r % 7);
+    p.wi = {p.wi.x * s, p.wi.y * s, p.wi.z * s};
+    if (r % 3 == 0) p.wo.z = -p.wo.z - 1e-3;  // below the horizon
+    pairs.push_back(p);
+  }
+  pairs.push_back({{std::nan(""), 0, 1}, {0, 0, 1}});
+  const Table<T> in = inputs_for<T>({Space::dirs, false}, pairs);
+  const std::size_t n = pairs.size();
+  const T* in_cols[6];
+  for (int c = 0; c < 6; ++c) in_cols[c] = in[c].data();
+  for (SimdIsa isa : available_isas()) {
+    const auto& k = detail::kernels_for(isa)->template stages<T>();
+    Table<T> copy = make_table<T>(6, n);
+    std::vector<T> mask_old(n), mask_new(n, detail::kUnchecked<T>);
+    T* copy_cols[6];
+    for (int c = 0; c < 6; ++c) copy_cols[c] = copy[c].data();
+    k.check(in_cols, copy_cols, mask_old.data(), n);
+    for (Form to : test::parameterization_forms()) {
+      SCOPED_TRACE(std::string(detail::isa_name(isa)) + " dirs->" + form_name(to));
+      const auto encode = k.encode[static_cast<int>(to.space) - 1][to.isotropic ? 1 : 0];
+      Table<T> out_old = make_table<T>(dimension(to), n), out_new = out_old;
+      T *o_old[4], *o_new[4];
+      for (std::size_t c = 0; c < dimension(to); ++c) {
+        o_old[c] = out_old[c].data();
+        o_new[c] = out_new[c].data();
+      }
+      std::vector<T> m_old = mask_old, m_new = mask_new;
+      encode(copy_cols, m_old.data(), o_old, n);
+      encode(in_cols, m_new.data(), o_new, n);
+      EXPECT_EQ(m_new, m_old);
+      for (std::size_t c = 0; c < dimension(to); ++c)
+        EXPECT_EQ(std::memcmp(out_new[c].data(), out_old[c].data(), n * sizeof(T)), 0)
+            << "column " << c;
+      // The test would prove nothing if every row were valid or every row refused.
+      const auto accepted = std::count(m_new.begin(), m_new.end(), T(1));
+      EXPECT_GE(accepted, static_cast<std::ptrdiff_t>(valid_rows));
+      EXPECT_LT(accepted, static_cast<std::ptrdiff_t>(n));
+    }
+  }
+}
+
 TYPED_TEST(BatchTest, InvalidRowsAreNanWithValidZero) {
   using T = TypeParam;
   const auto pairs = test_pairs(300, 21);
