@@ -1101,6 +1101,25 @@ void angles_of(double (&dirs)[6][kBlock], std::size_t n, double (&angle)[4][kBlo
                   ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
 }
 
+// A block of pairs as eval_block and pdf_block read it: per row, the direction that indexes the
+// tables (ωi for eval, ωo for pdf) and the unit half vector (put_direction_and_half_vector), their
+// spherical angles (angles_of), and whether the row goes through the one-pair path.
+struct PairBlock {
+  alignas(64) double dirs[6][kBlock];
+  alignas(64) double angle[4][kBlock];
+  alignas(64) std::uint8_t valid[kBlock];
+  bool apart[kBlock];
+
+  PairBlock(int reduction, std::span<const DirPair<double>> pairs, bool given_is_wi) {
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const DirPair<double>& p = pairs[k];
+      apart[k] = given_is_wi ? put_direction_and_half_vector(reduction, p.wi, p.wo, dirs, k)
+                             : put_direction_and_half_vector(reduction, p.wo, p.wi, dirs, k);
+    }
+    angles_of(dirs, pairs.size(), angle, valid);
+  }
+};
+
 }  // namespace
 
 Rgb RglBrdf::eval(const DirPair<double>& pair) const {
@@ -1118,13 +1137,8 @@ Rgb RglBrdf::eval(const DirPair<double>& pair) const {
 void RglBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
   const Impl& m = *impl_;
   const std::size_t n = pairs.size();
-  alignas(64) double dirs[6][kBlock];
-  alignas(64) double angle[4][kBlock];
-  alignas(64) std::uint8_t valid[kBlock];
-  bool apart[kBlock];
-  for (std::size_t k = 0; k < n; ++k)
-    apart[k] = put_direction_and_half_vector(m.reduction, pairs[k].wi, pairs[k].wo, dirs, k);
-  angles_of(dirs, n, angle, valid);
+  PairBlock block(m.reduction, pairs, true);
+  auto& [dirs, angle, valid, apart] = block;
 
   // The table coordinates of every row, in a loop without calls that the compiler vectorizes.
   alignas(64) double um_x[kBlock], um_y[kBlock], uwi_x[kBlock], uwi_y[kBlock];
@@ -1300,13 +1314,8 @@ void RglBrdf::pdf_batch(std::span<const DirPair<double>> pairs, std::span<double
 void RglBrdf::pdf_block(std::span<const DirPair<double>> pairs, std::span<double> out) const {
   const Impl& m = *impl_;
   const std::size_t n = pairs.size();
-  alignas(64) double dirs[6][kBlock];
-  alignas(64) double angle[4][kBlock];
-  alignas(64) std::uint8_t valid[kBlock];
-  bool apart[kBlock];
-  for (std::size_t k = 0; k < n; ++k)
-    apart[k] = put_direction_and_half_vector(m.reduction, pairs[k].wo, pairs[k].wi, dirs, k);
-  angles_of(dirs, n, angle, valid);
+  const PairBlock block(m.reduction, pairs, false);
+  const auto& [dirs, angle, valid, apart] = block;
   for (std::size_t k = 0; k < n; ++k) {
     const double phi_g = signed_azimuth(angle[1][k]);
     const double phi_m = signed_azimuth(angle[3][k]);
