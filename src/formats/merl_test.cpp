@@ -703,6 +703,92 @@ TEST(MerlKernel, BlockLoopsAreTheOneRowFormulas) {
   }
 }
 
+// The blend kernels, each of them (the AVX-512 one where the CPU has it, the portable loop
+// always), against blend() of each row, bit for bit: every block length from 1 to kBlock (all
+// tails of the 8-row lane groups), a start inside the block, cells of every kind (the φd wrap, the
+// clamped ends, unmeasured corners, corners missing in one channel or all three, a cell with none
+// measured: NaN).
+TEST(MerlKernel, BlendKernelsAreBlendBitForBit) {
+  using namespace merl_kernel;
+  static const std::vector<merl::BinValues> table = [] {
+    std::vector<merl::BinValues> t(merl::kBins);
+    for (std::size_t i = 0; i < merl::kBins; ++i)
+      for (int ch = 0; ch < 3; ++ch)
+        t[i].rgb[ch] = (i + ch) % 13 == 0 || i % 97 < 9 ? -1.0
+                       : i % 89 == 5                    ? 0.0  // measured zeros count
+                       : i % 89 == 6                    ? -0.0
+                                                        : 1.0 + std::sin(0.01 * double(i) + ch);
+    return t;
+  }();
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double nan = std::nan(""), top = kPi / 2;
+  const std::vector<double> special = {0.0, -0.0, 1e-300, -1e-12, top, 2 * top, kPi, 7.0, nan};
+  alignas(64) double q[3][kBlock];
+  Cells cells;
+  using Kernel = void (*)(const merl::BinValues*, const Cells&, std::size_t, std::size_t, Rgb*);
+  std::vector<std::pair<const char*, Kernel>> kernels = {{"portable", blend_rows_portable},
+                                                         {"dispatched", blend_rows}};
+  if (avx512_kernels()) kernels.push_back({"avx512", blend_rows_avx512});
+  std::size_t rows = 0;
+  for (std::size_t m = 1; m <= kBlock; m += m < 40 ? 1 : 23) {
+    for (std::size_t i = 0; i < m; ++i)
+      for (int a = 0; a < 3; ++a)
+        q[a][i] = u(rng) < 0.15  ? special[rng() % special.size()]
+                  : u(rng) < 0.1 ? (a == 2 ? kPi * (1 - 1e-4 * u(rng)) : top * 1e-5 * u(rng))
+                                 : (a == 2 ? 2 * kPi : top) * u(rng);
+    merl_kernel::cells(q[0], q[1], q[2], m, cells);
+    const std::size_t begin = m > 9 ? m % 5 : 0;
+    for (const auto& [name, kernel] : kernels) {
+      std::vector<Rgb> out(m, Rgb{-7, -7, -7});
+      kernel(table.data(), cells, begin, m, out.data());
+      for (std::size_t i = 0; i < m; ++i) {
+        const Rgb one = i < begin ? Rgb{-7, -7, -7} : blend(table.data(), cells[i]);
+        ASSERT_TRUE(same_bits(out[i].r, one.r) && same_bits(out[i].g, one.g) &&
+                    same_bits(out[i].b, one.b))
+            << name << " m " << m << " row " << i << ": " << out[i].r << " " << one.r;
+      }
+    }
+    rows += m;
+  }
+  EXPECT_GT(rows, 2000u);
+}
+
+// rows_apart, each kernel, against its definition, on rows of every kind at every lane position.
+TEST(MerlKernel, RowsApartKernelsAgree) {
+  using namespace merl_kernel;
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double nan = std::nan("");
+  using Kernel = void (*)(const double*, const std::uint8_t*, std::size_t, std::uint8_t*);
+  std::vector<std::pair<const char*, Kernel>> kernels = {{"portable", rows_apart_portable},
+                                                         {"dispatched", rows_apart}};
+  if (avx512_kernels()) kernels.push_back({"avx512", rows_apart_avx512});
+  for (std::size_t m = 1; m <= kBlock; m += m < 20 ? 1 : 29) {
+    std::vector<double> rows(6 * m);
+    std::vector<std::uint8_t> valid(m), expected(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      double* p = rows.data() + 6 * i;
+      for (int c = 0; c < 6; ++c) p[c] = u(rng);
+      const int kind = int(rng() % 8);
+      if (kind == 0) p[2 + 3 * (rng() % 2)] = rng() % 2 ? -0.0 : 0.0;  // at the horizon: kept
+      if (kind == 1) p[3] = -p[0], p[4] = -p[1];                       // ωi + ωo along the normal
+      if (kind == 2) p[rng() % 6] = nan;                               // NaN compares false
+      if (kind == 3) p[3] = -p[0];                                     // one component only
+      if (kind >= 4) p[2] = std::abs(p[2]), p[5] = std::abs(p[5]);     // above
+      valid[i] = rng() % 9 ? std::uint8_t(1 + rng() % 255) : 0;        // any non-zero is valid
+      expected[i] = valid[i] == 0 || p[2] < 0 || p[5] < 0 || (p[0] + p[3] == 0 && p[1] + p[4] == 0);
+    }
+    for (const auto& [name, kernel] : kernels) {
+      std::vector<std::uint8_t> apart(m + 8, 0xee);
+      kernel(rows.data(), valid.data(), m, apart.data());
+      for (std::size_t i = 0; i < m; ++i)
+        ASSERT_EQ(apart[i], expected[i]) << name << " " << m << " " << i;
+      EXPECT_EQ(apart[m], 0xee) << name << ": wrote past the end";
+    }
+  }
+}
+
 TEST(MerlWriter, RoundTripAtBinCentres) {
   TempDir tmp;
   const auto path = tmp / "lobe.binary";
