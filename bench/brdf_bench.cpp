@@ -223,26 +223,28 @@ const std::vector<merl_kernel::Cells>& floor_cells() {
   return c;
 }
 
-// The conversion alone, as eval_batch calls it: blocks of 256 rows read in place, to (θh, θd, φd).
+// The conversion alone, as eval_batch calls it: blocks of state.range(0) rows (256: the batch's
+// blocks; 32: the cost of smaller calls, for a pipeline that would interleave them with the table
+// reads) read in place, to (θh, θd, φd).
 void BM_MerlFloor_Conversion(benchmark::State& state) {
   const auto& p = pairs();
-  constexpr std::size_t kBlock = merl_kernel::kBlock;
-  alignas(64) static double q[3][kBlock];
-  alignas(64) static std::uint8_t valid[kBlock];
+  const std::size_t block = static_cast<std::size_t>(state.range(0));
+  alignas(64) static double q[3][merl_kernel::kBlock];
+  alignas(64) static std::uint8_t valid[merl_kernel::kBlock];
   const Column<double> cols[3] = {{q[0], 1}, {q[1], 1}, {q[2], 1}};
   for (auto _ : state) {
-    for (std::size_t f = 0; f < p.size(); f += kBlock) {
+    for (std::size_t f = 0; f < p.size(); f += block) {
       const double* rows = &p[f].wi.x;
       const ConstColumn<double> in[6] = {{rows, 6},     {rows + 1, 6}, {rows + 2, 6},
                                          {rows + 3, 6}, {rows + 4, 6}, {rows + 5, 6}};
-      convert<double>(Form{Space::dirs}, Form{Space::halfdiff, true}, in, kBlock,
+      convert<double>(Form{Space::dirs}, Form{Space::halfdiff, true}, in, block,
                       ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
       benchmark::DoNotOptimize(q[0][0]);
     }
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
 }
-BENCHMARK(BM_MerlFloor_Conversion)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MerlFloor_Conversion)->Arg(256)->Arg(32)->Unit(benchmark::kMillisecond);
 
 // The table reads alone: the slot of each row's bin, prefetched 16 rows ahead, summed.
 void BM_MerlFloor_NearestReads(benchmark::State& state) {
@@ -263,14 +265,16 @@ void BM_MerlFloor_NearestReads(benchmark::State& state) {
 BENCHMARK(BM_MerlFloor_NearestReads)->Unit(benchmark::kMillisecond);
 
 // The table reads alone: one value of each of a row's 8 corners (4 to 8 cache lines), prefetched
-// 16 rows ahead, summed.
-void BM_MerlFloor_TrilinearReads(benchmark::State& state) {
+// 16 rows ahead, summed; on the batch's table (32-byte slots of doubles), or on a float32 copy
+// (16-byte slots: 2 to 8 lines a row, fewer on average), for the record: the lookups keep the
+// doubles (a float table would change their tested 1e-12 agreement with the stored values).
+template <class Slot>
+void trilinear_reads(benchmark::State& state, const Slot* t) {
   using merl_kernel::kThetaDStep, merl_kernel::kThetaHStep, merl_kernel::kBlock;
-  const merl::BinValues* t = floor_table();
   const auto& c = floor_cells();
   auto corners = [&](std::size_t i) {
     const auto& block = c[i / kBlock];
-    const merl::BinValues* p = t + block.base[i % kBlock];
+    const Slot* p = t + block.base[i % kBlock];
     return std::pair{p, p + block.phi_step[i % kBlock]};
   };
   for (auto _ : state) {
@@ -278,7 +282,7 @@ void BM_MerlFloor_TrilinearReads(benchmark::State& state) {
     for (std::size_t i = 0; i < kPairs; ++i) {
       if (i + 16 < kPairs) {
         const auto [p, q] = corners(i + 16);
-        for (const merl::BinValues* x :
+        for (const Slot* x :
              {p, q, p + kThetaDStep, q + kThetaDStep, p + kThetaHStep, q + kThetaHStep,
               p + kThetaHStep + kThetaDStep, q + kThetaHStep + kThetaDStep})
           __builtin_prefetch(x);
@@ -292,7 +296,30 @@ void BM_MerlFloor_TrilinearReads(benchmark::State& state) {
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kPairs));
 }
+
+void BM_MerlFloor_TrilinearReads(benchmark::State& state) {
+  trilinear_reads(state, floor_table());
+}
 BENCHMARK(BM_MerlFloor_TrilinearReads)->Unit(benchmark::kMillisecond);
+
+struct alignas(16) FloatSlot {
+  float rgb[4];
+};
+
+void BM_MerlFloor_TrilinearReadsFloat32(benchmark::State& state) {
+  static const FloatSlot* t = [] {
+    constexpr std::size_t kPage = std::size_t(2) << 20;
+    const std::size_t bytes = (merl::kBins * sizeof(FloatSlot) + kPage - 1) / kPage * kPage;
+    auto* p = static_cast<FloatSlot*>(std::aligned_alloc(kPage, bytes));
+    madvise(p, bytes, MADV_HUGEPAGE);
+    const merl::BinValues* d = floor_table();
+    for (std::size_t i = 0; i < merl::kBins; ++i)
+      p[i] = {{float(d[i].rgb[0]), float(d[i].rgb[1]), float(d[i].rgb[2]), 0.0f}};
+    return p;  // kept for the whole run
+  }();
+  trilinear_reads(state, t);
+}
+BENCHMARK(BM_MerlFloor_TrilinearReadsFloat32)->Unit(benchmark::kMillisecond);
 
 // The reads and the blends of the batch (the kernel it calls), at precomputed cells: the trilinear
 // batch without its conversion.
