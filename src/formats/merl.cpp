@@ -300,7 +300,8 @@ void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<
 // Software-pipelined: the next block's conversion and cells are computed before this block's
 // blends, with the corners of this block's first rows prefetched just before that conversion, so
 // that their cache misses are served while it computes (merl_kernel::blend_rows prefetches the
-// rest a few rows ahead of itself). Rows left to eval() get its values over the blend's.
+// rest a few rows ahead of itself; under load no faster nor slower: docs/performance.md, fourth
+// round). Rows left to eval() get its values over the blend's.
 void MerlBrdf::trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                                 std::size_t begin, std::size_t end) const {
   struct Block {

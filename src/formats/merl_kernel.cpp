@@ -2,7 +2,8 @@
 // chosen at load time by the CPU (GCC's target_clones). The loops are the formulas of
 // merl_kernel.hpp applied row by row; the compiler vectorizes them across rows. Compiled without
 // errno for sqrt, without trapping math and without contraction (src/formats/CMakeLists.txt): the
-// roundings are those of the one-row path.
+// roundings are those of the one-row path. The blend and rows_apart also have hand-written
+// AVX-512 kernels (target attributes, chosen at run time by avx512_kernels()), the same bits.
 #include "merl_kernel.hpp"
 #include <algorithm>
 #include <cstdlib>
