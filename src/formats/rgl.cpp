@@ -34,9 +34,22 @@ struct Row {
 struct EvalRows;
 }  // namespace rgl_kernel
 
+// The block loops compiled for AVX-512, AVX2 and the baseline, chosen at load time by the CPU
+// (GCC's target_clones, as merl_kernel.cpp).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define HALFBACK_RGL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define HALFBACK_RGL_CLONES
+#endif
+
 namespace {
 
 using io_detail::load_le;
+
+// Rows per block of eval_batch, sample_batch and pdf_batch: the columns, angles and lookups of a
+// block stay in L1 while its table reads are in flight.
+constexpr std::size_t kBlock = 64;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -659,6 +672,150 @@ struct Warp {
   }
 };
 
+// Warp::draw_column() of a block's rows (sample_block), in passes across the rows: the column
+// bounds and row values (loads), the row's position ty (a square root and a division, in vector
+// lanes), the column search and its values (loads), the column's position, then the blend's
+// density at the cell (loads, then vector lanes). Each row's chain of dependent loads, square roots
+// and divisions is cut at the passes, so the rows' steps overlap. The arithmetic is draw_column()'s
+// operation for operation (the solves as selects), the same points and densities bit for bit.
+// Rows `apart` are skipped; rows of no positive weight, and warps without guides, go through
+// draw_column().
+class ColumnDraws {
+ public:
+  ColumnDraws(const Warp& wp, const Slices* s, const Warp::Drawing* d) : wp_(wp), s_(s), d_(d) {}
+
+  void run(const bool* apart, std::size_t n, Warp::Drawn* out) {
+    m_ = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (apart[k]) continue;
+      if (d_[k].blend || !wp_.guided)
+        out[k] = wp_.draw_column(s_[k], d_[k]);
+      else
+        at_[m_++] = k;
+    }
+    if (m_ == 0) return;
+    bounds();
+    rows();
+    columns();
+    cells();
+    switch (s_[at_[0]].count) {  // the same for every row (Impl::slices())
+      case 1:
+        densities<1>();
+        break;
+      case 2:
+        densities<2>();
+        break;
+      default:
+        densities<4>();
+    }
+    for (std::size_t q = 0; q < m_; ++q) out[at_[q]] = {{x_[q], y_[q]}, density_[q]};
+  }
+
+ private:
+  // Warp::solve_linear_density() as selects, so that its loops vectorize.
+  static double solve(double a, double b, double area) {
+    const double x = a * a + 2 * (b - a) * area;
+    const double den = a + std::sqrt(x < 0.0 ? 0.0 : x);  // std::max(x, 0.0)
+    const double t = unit(2 * area / den);
+    return (area > 0) & (den > 0) ? t : 0.0;
+  }
+
+  // The guided column bounds (Warp::column_bounds) and R, M of the drawn slice's rows j, j + 1.
+  void bounds() {
+    for (std::size_t q = 0; q < m_; ++q) {
+      const Warp::Drawing& d = d_[at_[q]];
+      const Warp::Blend<1> b(wp_, d.slice);
+      wp_.column_bounds(b, d.j, d.u.x, lo_[q], hi_[q]);
+      r0_[q] = b.R(d.j), r1_[q] = b.R(d.j + 1);
+      area_[q] = d.u.y - b.M(d.j);
+      ux_[q] = d.u.x;
+    }
+  }
+  // The row's position ty, and the target of the column search.
+  void rows() {
+    for (std::size_t q = 0; q < m_; ++q) {
+      const double r0 = r0_[q], r1 = r1_[q];
+      const double ty = solve(r0, r1, area_[q]);
+      ty_[q] = ty;
+      target_[q] = ux_[q] * ((1 - ty) * r0 + ty * r1);
+    }
+  }
+  // The column (Warp::forward_column's search), C there, F at its ends.
+  void columns() {
+    const std::size_t w = wp_.w;
+    for (std::size_t q = 0; q < m_; ++q) {
+      const Warp::Drawing& d = d_[at_[q]];
+      const Warp::Blend<1> b(wp_, d.slice);
+      const double ty = ty_[q];
+      const std::size_t row0 = d.j * w, row1 = row0 + w;
+      auto ct = [&](std::size_t i) { return (1 - ty) * b.C(row0 + i) + ty * b.C(row1 + i); };
+      const std::size_t i = Warp::last_below(ct, target_[q], lo_[q], hi_[q], w - 2);
+      i_[q] = i;
+      cell_x_[q] = double(i), cell_y_[q] = double(d.j);
+      below_[q] = ct(i);
+      f_[0][q] = b.F(row0 + i), f_[1][q] = b.F(row1 + i);
+      f_[2][q] = b.F(row0 + i + 1), f_[3][q] = b.F(row1 + i + 1);
+    }
+  }
+  // The column's position tx, and the point.
+  void cells() {
+    const double sx = double(wp_.w - 1), sy = double(wp_.h - 1);
+    for (std::size_t q = 0; q < m_; ++q) {
+      const double ty = ty_[q];
+      const double c0 = (1 - ty) * f_[0][q] + ty * f_[1][q];
+      const double c1 = (1 - ty) * f_[2][q] + ty * f_[3][q];
+      const double tx = solve(c0, c1, target_[q] - below_[q]);
+      tx_[q] = tx;
+      x_[q] = (cell_x_[q] + tx) / sx;
+      y_[q] = (cell_y_[q] + ty) / sy;
+    }
+  }
+  // Warp::density(Blend<N>, cell) of the rows' slices.
+  template <int N>
+  void densities() {
+    const std::size_t w = wp_.w, h = wp_.h;
+    alignas(64) double f[N][4][kBlock], scaled[N][kBlock];
+    for (std::size_t q = 0; q < m_; ++q) {
+      const Slices& s = s_[at_[q]];
+      const std::size_t k = d_[at_[q]].j * w + i_[q];
+      for (int n = 0; n < N; ++n) {
+        const Warp::Node* a = wp_.node.data() + s.index[n] * h * w + k;
+        f[n][0][q] = a[0].f, f[n][1][q] = a[w].f, f[n][2][q] = a[1].f, f[n][3][q] = a[w + 1].f;
+        scaled[n][q] = s.weight[n] * wp_.inv_total[s.index[n]];
+      }
+    }
+    const double area = double(w - 1) * double(h - 1);
+    for (std::size_t q = 0; q < m_; ++q) {
+      double f00 = 0, f10 = 0, f01 = 0, f11 = 0;
+      for (int n = 0; n < N; ++n) {
+        f00 += scaled[n][q] * f[n][0][q];
+        f10 += scaled[n][q] * f[n][1][q];
+        f01 += scaled[n][q] * f[n][2][q];
+        f11 += scaled[n][q] * f[n][3][q];
+      }
+      const double tx = tx_[q], ty = ty_[q];
+      const double c0 = (1 - ty) * f00 + ty * f10;
+      const double c1 = (1 - ty) * f01 + ty * f11;
+      density_[q] = ((1 - tx) * c0 + tx * c1) * area;
+    }
+  }
+
+  const Warp& wp_;
+  const Slices* s_;
+  const Warp::Drawing* d_;
+  std::size_t m_ = 0;  // rows in the passes
+  std::size_t at_[kBlock], lo_[kBlock], hi_[kBlock], i_[kBlock];
+  alignas(64) double ux_[kBlock], r0_[kBlock], r1_[kBlock], area_[kBlock], ty_[kBlock];
+  alignas(64) double target_[kBlock], below_[kBlock], f_[4][kBlock], tx_[kBlock];
+  alignas(64) double cell_x_[kBlock], cell_y_[kBlock];  // i, j as doubles
+  alignas(64) double x_[kBlock], y_[kBlock], density_[kBlock];
+};
+
+HALFBACK_RGL_CLONES void draw_columns(const Warp& wp, const Slices* s, const Warp::Drawing* d,
+                                      const bool* apart, std::size_t n, Warp::Drawn* out) {
+  ColumnDraws(wp, s, d).run(apart, n, out);
+}
+
 bool negative_sign(double v) {
   return !std::signbit(v);
 }  // mulsign_neg: flip when v >= +0
@@ -1071,10 +1228,6 @@ Rgb over_cosine(Rgb r, const Vec3<double>& wo) {
   return r;
 }
 
-// Rows per block of eval_batch, sample_batch and pdf_batch: the columns, angles and lookups of a
-// block stay in L1 while its table reads are in flight.
-constexpr std::size_t kBlock = 64;
-
 // Row k of a block's directions: `given`, the direction whose azimuth indexes the tables, and the
 // unit half vector of the pair, both after the flips that bring `given` into the range the data
 // covers. True when the row must go through the one-pair path: a direction at or below the
@@ -1147,13 +1300,6 @@ struct PairBlock {
 // contraction (src/formats/CMakeLists.txt), so every lane rounds as the one-row path does: the
 // values are those of Impl::value() bit for bit.
 namespace rgl_kernel {
-
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define HALFBACK_RGL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define HALFBACK_RGL_CLONES
-#endif
 
 inline constexpr std::size_t kRows = kBlock;
 
@@ -1499,10 +1645,12 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
   }
   for (std::size_t k = 0; k < n; ++k)
     if (!apart[k]) m.vndf.prefetch_nodes(drawing[k]);
+  Warp::Drawn drawn[kBlock];
+  draw_columns(m.vndf, slices, drawing, apart, n, drawn);
   for (std::size_t k = 0; k < 2 * rows; ++k) {
     double theta_m = 0, phi_m = 0;  // any valid angles for the rows apart
     if (k < n && !apart[k]) {
-      const auto [um, density] = m.vndf.draw_column(slices[k], drawing[k]);
+      const auto [um, density] = drawn[k];
       pdf_u[k] = density;
       um_x[k] = um.x;
       // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
