@@ -19,7 +19,8 @@
 //    ../shared/data (or $HALFBACK_SHARED_DIR/data). The same source builds against an older tree
 //    (the API it uses is unchanged), so the baseline is that build, run alternately with this one
 //    (docs/performance.md, "Renderer"). Options: --size N (512), --spp N (256), --threads N (1),
-//    --material ggx|rgl|all, --repeat N.
+//    --material ggx|rgl|all, --repeat N, --hash (a hash of each image, to check that two builds
+//    render bit-identical images).
 // 5. The RGL file's sampling-interface calls as the renderer makes them (packets of 64 rows
 //    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
@@ -27,6 +28,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -102,8 +104,18 @@ double cpu_seconds() {
 
 struct ThroughputOptions {
   int size = 512, spp = 256, threads = 1, repeat = 1;
+  bool hash = false;  // --hash: print each image's hash (builds whose renders must be equal)
   std::string material = "all";
 };
+
+// FNV-1a of the image's bytes: equal for bit-identical renders.
+std::uint64_t image_hash(const render::Image& image) {
+  std::uint64_t h = 14695981039346656037ull;
+  const auto* p = reinterpret_cast<const unsigned char*>(image.rgb.data());
+  for (std::size_t i = 0; i < image.rgb.size() * sizeof(float); ++i)
+    h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
 
 // Part 4: one line per material and repetition: CPU seconds of the set-up and of the render,
 // and pixel samples per CPU second.
@@ -138,6 +150,9 @@ void throughput(const ThroughputOptions& o) {
       const double samples = double(o.size) * o.size * o.spp;
       std::printf("| %s | %.3f | %.2f | %.2f | %.2f |\n", m.key.c_str(), c1 - c0, c2 - c1, wall,
                   samples / (c2 - c0) * 1e-6);
+      if (o.hash)
+        std::printf("image hash %s: %016llx\n", m.key.c_str(),
+                    static_cast<unsigned long long>(image_hash(r.image)));
       std::fflush(stdout);
     }
 }
@@ -206,6 +221,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--spp") == 0 && more) tp.spp = std::atoi(argv[++i]);
     if (std::strcmp(argv[i], "--threads") == 0 && more) tp.threads = std::atoi(argv[++i]);
     if (std::strcmp(argv[i], "--repeat") == 0 && more) tp.repeat = std::atoi(argv[++i]);
+    if (std::strcmp(argv[i], "--hash") == 0) tp.hash = true;
     if (std::strcmp(argv[i], "--material") == 0 && more) tp.material = argv[++i];
   }
   if (only == 4) {
