@@ -22,7 +22,8 @@
 //    --material ggx|rgl|all, --repeat N, --hash (a hash of each image, to check that two builds
 //    render bit-identical images).
 // 5. The RGL file's sampling-interface calls as the renderer makes them (packets of 64 rows
-//    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N).
+//    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N;
+//    --hash prints a hash of each call's outputs, to check that two builds compute the same bits).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
@@ -108,13 +109,16 @@ struct ThroughputOptions {
   std::string material = "all";
 };
 
-// FNV-1a of the image's bytes: equal for bit-identical renders.
-std::uint64_t image_hash(const render::Image& image) {
+// FNV-1a of an array's bytes: equal for bit-identical results.
+template <class T>
+std::uint64_t bytes_hash(const std::vector<T>& v) {
   std::uint64_t h = 14695981039346656037ull;
-  const auto* p = reinterpret_cast<const unsigned char*>(image.rgb.data());
-  for (std::size_t i = 0; i < image.rgb.size() * sizeof(float); ++i)
-    h = (h ^ p[i]) * 1099511628211ull;
+  const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+  for (std::size_t i = 0; i < v.size() * sizeof(T); ++i) h = (h ^ p[i]) * 1099511628211ull;
   return h;
+}
+std::uint64_t image_hash(const render::Image& image) {
+  return bytes_hash(image.rgb);
 }
 
 // Part 4: one line per material and repetition: CPU seconds of the set-up and of the render,
@@ -205,6 +209,11 @@ void rgl_calls(const ThroughputOptions& o) {
       "| call | CPU ns per row |\n|---|---|\n| sample_batch | %.1f |\n| pdf_batch | %.1f |\n"
       "| eval_batch | %.1f |\n",
       ns_sample, ns_pdf, ns_eval);
+  if (o.hash)  // the calls' outputs (the image's float sums would hide differences of an ulp)
+    std::printf("hashes: samples %016llx, pdfs %016llx, values %016llx\n",
+                static_cast<unsigned long long>(bytes_hash(samples)),
+                static_cast<unsigned long long>(bytes_hash(pdfs)),
+                static_cast<unsigned long long>(bytes_hash(values)));
 }
 
 }  // namespace

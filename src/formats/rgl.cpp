@@ -784,7 +784,7 @@ class ColumnDraws {
         scaled[n][q] = s.weight[n] * wp_.inv_total[s.index[n]];
       }
     }
-    const double area = double(w - 1) * double(h - 1);
+    const double sx = double(w - 1), sy = double(h - 1);
     for (std::size_t q = 0; q < m_; ++q) {
       double f00 = 0, f10 = 0, f01 = 0, f11 = 0;
       for (int n = 0; n < N; ++n) {
@@ -796,7 +796,7 @@ class ColumnDraws {
       const double tx = tx_[q], ty = ty_[q];
       const double c0 = (1 - ty) * f00 + ty * f10;
       const double c1 = (1 - ty) * f01 + ty * f11;
-      density_[q] = ((1 - tx) * c0 + tx * c1) * area;
+      density_[q] = ((1 - tx) * c0 + tx * c1) * sx * sy;
     }
   }
 
