@@ -672,6 +672,74 @@ struct Warp {
   }
 };
 
+// Warp::density(Blend<N>, cell) of m rows in cells (i, j) at (tx, ty) of the unit square, the
+// slices of row q slices(q): the grid values copied into columns (many rows' loads in flight),
+// then blended in vector lanes, operation for operation as density() (the same values bit for
+// bit).
+template <int N, class SlicesOf>
+[[gnu::always_inline]] inline void densities_in_cells(const Warp& wp, std::size_t m,
+                                                      SlicesOf slices, const std::size_t* i,
+                                                      const std::size_t* j, const double* tx,
+                                                      const double* ty, double* out) {
+  const std::size_t w = wp.w, h = wp.h;
+  alignas(64) double f[N][4][kBlock], scaled[N][kBlock];
+  for (std::size_t q = 0; q < m; ++q) {
+    const Slices& s = slices(q);
+    const std::size_t k = j[q] * w + i[q];
+    for (int n = 0; n < N; ++n) {
+      const Warp::Node* a = wp.node.data() + s.index[n] * h * w + k;
+      f[n][0][q] = a[0].f, f[n][1][q] = a[w].f, f[n][2][q] = a[1].f, f[n][3][q] = a[w + 1].f;
+      scaled[n][q] = s.weight[n] * wp.inv_total[s.index[n]];
+    }
+  }
+  const double sx = double(w - 1), sy = double(h - 1);
+  for (std::size_t q = 0; q < m; ++q) {
+    double f00 = 0, f10 = 0, f01 = 0, f11 = 0;
+    for (int n = 0; n < N; ++n) {
+      f00 += scaled[n][q] * f[n][0][q];
+      f10 += scaled[n][q] * f[n][1][q];
+      f01 += scaled[n][q] * f[n][2][q];
+      f11 += scaled[n][q] * f[n][3][q];
+    }
+    const double c0 = (1 - ty[q]) * f00 + ty[q] * f10;
+    const double c1 = (1 - ty[q]) * f01 + ty[q] * f11;
+    out[q] = ((1 - tx[q]) * c0 + tx[q] * c1) * sx * sy;
+  }
+}
+
+// Warp::density() of m rows at points (x, y) (pdf_block): the cells as cell_of() finds them, in
+// vector lanes, then densities_in_cells(). Every row has as many slices (Impl::slices()).
+template <int N>
+[[gnu::always_inline]] inline void densities_at(const Warp& wp, const Slices* s, const double* x,
+                                                const double* y, std::size_t m, double* out) {
+  const double sx = double(wp.w - 1), sy = double(wp.h - 1);
+  const auto last_i = std::int32_t(wp.w - 2), last_j = std::int32_t(wp.h - 2);
+  alignas(64) std::int32_t ci[kBlock], cj[kBlock];
+  alignas(64) double tx[kBlock], ty[kBlock];
+  for (std::size_t q = 0; q < m; ++q) {  // cell_of(), with 32-bit indices: the same cells
+    const double u = unit(x[q]) * sx, v = unit(y[q]) * sy;
+    ci[q] = std::min(static_cast<std::int32_t>(u), last_i);
+    cj[q] = std::min(static_cast<std::int32_t>(v), last_j);
+    tx[q] = u - double(ci[q]), ty[q] = v - double(cj[q]);
+  }
+  std::size_t i[kBlock], j[kBlock];
+  for (std::size_t q = 0; q < m; ++q) i[q] = std::size_t(ci[q]), j[q] = std::size_t(cj[q]);
+  densities_in_cells<N>(
+      wp, m, [&](std::size_t q) -> const Slices& { return s[q]; }, i, j, tx, ty, out);
+}
+HALFBACK_RGL_CLONES void densities_at(const Warp& wp, const Slices* s, const double* x,
+                                      const double* y, std::size_t m, double* out) {
+  if (m == 0) return;
+  switch (s[0].count) {  // the same for every row (Impl::slices())
+    case 1:
+      return densities_at<1>(wp, s, x, y, m, out);
+    case 2:
+      return densities_at<2>(wp, s, x, y, m, out);
+    default:
+      return densities_at<4>(wp, s, x, y, m, out);
+  }
+}
+
 // Warp::draw_column() of a block's rows (sample_block), in passes across the rows: the column
 // bounds and row values (loads), the row's position ty (a square root and a division, in vector
 // lanes), the column search and its values (loads), the column's position, then the blend's
@@ -773,38 +841,17 @@ class ColumnDraws {
   // Warp::density(Blend<N>, cell) of the rows' slices.
   template <int N>
   void densities() {
-    const std::size_t w = wp_.w, h = wp_.h;
-    alignas(64) double f[N][4][kBlock], scaled[N][kBlock];
-    for (std::size_t q = 0; q < m_; ++q) {
-      const Slices& s = s_[at_[q]];
-      const std::size_t k = d_[at_[q]].j * w + i_[q];
-      for (int n = 0; n < N; ++n) {
-        const Warp::Node* a = wp_.node.data() + s.index[n] * h * w + k;
-        f[n][0][q] = a[0].f, f[n][1][q] = a[w].f, f[n][2][q] = a[1].f, f[n][3][q] = a[w + 1].f;
-        scaled[n][q] = s.weight[n] * wp_.inv_total[s.index[n]];
-      }
-    }
-    const double sx = double(w - 1), sy = double(h - 1);
-    for (std::size_t q = 0; q < m_; ++q) {
-      double f00 = 0, f10 = 0, f01 = 0, f11 = 0;
-      for (int n = 0; n < N; ++n) {
-        f00 += scaled[n][q] * f[n][0][q];
-        f10 += scaled[n][q] * f[n][1][q];
-        f01 += scaled[n][q] * f[n][2][q];
-        f11 += scaled[n][q] * f[n][3][q];
-      }
-      const double tx = tx_[q], ty = ty_[q];
-      const double c0 = (1 - ty) * f00 + ty * f10;
-      const double c1 = (1 - ty) * f01 + ty * f11;
-      density_[q] = ((1 - tx) * c0 + tx * c1) * sx * sy;
-    }
+    for (std::size_t q = 0; q < m_; ++q) j_[q] = d_[at_[q]].j;
+    densities_in_cells<N>(
+        wp_, m_, [&](std::size_t q) -> const Slices& { return s_[at_[q]]; }, i_, j_, tx_, ty_,
+        density_);
   }
 
   const Warp& wp_;
   const Slices* s_;
   const Warp::Drawing* d_;
   std::size_t m_ = 0;  // rows in the passes
-  std::size_t at_[kBlock], lo_[kBlock], hi_[kBlock], i_[kBlock];
+  std::size_t at_[kBlock], lo_[kBlock], hi_[kBlock], i_[kBlock], j_[kBlock];
   alignas(64) double ux_[kBlock], r0_[kBlock], r1_[kBlock], area_[kBlock], ty_[kBlock];
   alignas(64) double target_[kBlock], below_[kBlock], f_[4][kBlock], tx_[kBlock];
   alignas(64) double cell_x_[kBlock], cell_y_[kBlock];  // i, j as doubles
@@ -1706,6 +1753,10 @@ void RglBrdf::pdf_block(std::span<const DirPair<double>> pairs, std::span<double
   const std::size_t n = pairs.size();
   const PairBlock block(m.reduction, pairs, false);
   const auto& [dirs, angle, valid, apart] = block;
+  // The rows' points and Jacobians, then their densities in passes (densities_at).
+  Slices slices[kBlock];
+  std::size_t at[kBlock], rows = 0;
+  alignas(64) double um_x[kBlock], um_y[kBlock], jacobian[kBlock], pdf_u[kBlock];
   for (std::size_t k = 0; k < n; ++k) {
     const double phi_g = signed_azimuth(angle[1][k]);
     const double phi_m = signed_azimuth(angle[3][k]);
@@ -1714,15 +1765,19 @@ void RglBrdf::pdf_block(std::span<const DirPair<double>> pairs, std::span<double
       out[k] = pdf(pairs[k].wo, pairs[k].wi);
       continue;
     }
+    const std::size_t q = rows++;
+    at[q] = k;
     const double theta_m = angle[2][k];
-    const RglWarpPoint um{std::sqrt(theta_m / (kPi / 2)), v};
-    const double pdf_u = m.vndf.density(m.slices(phi_g, angle[0][k]), um);
+    um_x[q] = std::sqrt(theta_m / (kPi / 2)), um_y[q] = v;
+    m.slices(phi_g, angle[0][k], slices[q]);
     const double sin_m = std::sqrt(dirs[3][k] * dirs[3][k] + dirs[4][k] * dirs[4][k]);
     const double cos_gm =
         dirs[0][k] * dirs[3][k] + dirs[1][k] * dirs[4][k] + dirs[2][k] * dirs[5][k];
-    const double jacobian = 2 * kPi * kPi * um.x * sin_m * 4 * std::abs(cos_gm);
-    out[k] = jacobian > 0 && std::isfinite(pdf_u) ? pdf_u / jacobian : 0;
+    jacobian[q] = 2 * kPi * kPi * um_x[q] * sin_m * 4 * std::abs(cos_gm);
   }
+  densities_at(m.vndf, slices, um_x, um_y, rows, pdf_u);
+  for (std::size_t q = 0; q < rows; ++q)
+    out[at[q]] = jacobian[q] > 0 && std::isfinite(pdf_u[q]) ? pdf_u[q] / jacobian[q] : 0;
 }
 
 std::shared_ptr<const RglBrdf> load_rgl(const std::filesystem::path& path, RglOptions options) {
