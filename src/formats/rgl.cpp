@@ -238,18 +238,6 @@ struct RgbTable {
     return v.data() + ((slice * h + j) * w + i) * kSlot;
   }
 
-  // Asks for the lines that eval(s, x, y) reads.
-  void prefetch(const Slices& s, double x, double y) const {
-    const Cell c = cell_of(x, y, w, h);
-    for (int k = 0; k < s.count; ++k) {
-      const double* p = slot(s.index[k], c.j, c.i);
-      __builtin_prefetch(p);
-      __builtin_prefetch(p + kSlot);
-      __builtin_prefetch(p + w * kSlot);
-      __builtin_prefetch(p + (w + 1) * kSlot);
-    }
-  }
-
   // The same arithmetic, channel by channel, as Table::eval on a channel's own table; N is
   // s.count.
   template <int N>
@@ -462,17 +450,6 @@ struct Warp {
     const double c0 = (1 - g.ty) * b.F(k) + g.ty * b.F(k + w);
     const double c1 = (1 - g.ty) * b.F(k + 1) + g.ty * b.F(k + w + 1);
     return ((1 - g.tx) * c0 + g.tx * c1) * double(w - 1) * double(h - 1);
-  }
-
-  // Asks for the lines that inverse(s, p) reads (a block's lookups then overlap).
-  void prefetch(const Slices& s, RglWarpPoint p) const {
-    const Cell g = cell_of(p.x, p.y, w, h);
-    for (int n = 0; n < s.count; ++n) {
-      const Node* a = &node[(s.index[n] * h + g.j) * w + g.i];
-      __builtin_prefetch(a);
-      __builtin_prefetch(a + w);
-      __builtin_prefetch(&row[s.index[n] * h + g.j]);
-    }
   }
 
   // Point p of the unit square -> sample (the CDFs at p): the inverse of the warp. The grid
