@@ -19,14 +19,17 @@
 //    ../shared/data (or $HALFBACK_SHARED_DIR/data). The same source builds against an older tree
 //    (the API it uses is unchanged), so the baseline is that build, run alternately with this one
 //    (docs/performance.md, "Renderer"). Options: --size N (512), --spp N (256), --threads N (1),
-//    --material ggx|rgl|all, --repeat N.
+//    --material ggx|rgl|all, --repeat N, --hash (a hash of each image, to check that two builds
+//    render bit-identical images).
 // 5. The RGL file's sampling-interface calls as the renderer makes them (packets of 64 rows
-//    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N).
+//    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N;
+//    --hash prints a hash of each call's outputs, to check that two builds compute the same bits).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -102,8 +105,21 @@ double cpu_seconds() {
 
 struct ThroughputOptions {
   int size = 512, spp = 256, threads = 1, repeat = 1;
+  bool hash = false;  // --hash: print each image's hash (builds whose renders must be equal)
   std::string material = "all";
 };
+
+// FNV-1a of an array's bytes: equal for bit-identical results.
+template <class T>
+std::uint64_t bytes_hash(const std::vector<T>& v) {
+  std::uint64_t h = 14695981039346656037ull;
+  const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+  for (std::size_t i = 0; i < v.size() * sizeof(T); ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+std::uint64_t image_hash(const render::Image& image) {
+  return bytes_hash(image.rgb);
+}
 
 // Part 4: one line per material and repetition: CPU seconds of the set-up and of the render,
 // and pixel samples per CPU second.
@@ -138,6 +154,9 @@ void throughput(const ThroughputOptions& o) {
       const double samples = double(o.size) * o.size * o.spp;
       std::printf("| %s | %.3f | %.2f | %.2f | %.2f |\n", m.key.c_str(), c1 - c0, c2 - c1, wall,
                   samples / (c2 - c0) * 1e-6);
+      if (o.hash)
+        std::printf("image hash %s: %016llx\n", m.key.c_str(),
+                    static_cast<unsigned long long>(image_hash(r.image)));
       std::fflush(stdout);
     }
 }
@@ -190,6 +209,11 @@ void rgl_calls(const ThroughputOptions& o) {
       "| call | CPU ns per row |\n|---|---|\n| sample_batch | %.1f |\n| pdf_batch | %.1f |\n"
       "| eval_batch | %.1f |\n",
       ns_sample, ns_pdf, ns_eval);
+  if (o.hash)  // the calls' outputs (the image's float sums would hide differences of an ulp)
+    std::printf("hashes: samples %016llx, pdfs %016llx, values %016llx\n",
+                static_cast<unsigned long long>(bytes_hash(samples)),
+                static_cast<unsigned long long>(bytes_hash(pdfs)),
+                static_cast<unsigned long long>(bytes_hash(values)));
 }
 
 }  // namespace
@@ -206,6 +230,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--spp") == 0 && more) tp.spp = std::atoi(argv[++i]);
     if (std::strcmp(argv[i], "--threads") == 0 && more) tp.threads = std::atoi(argv[++i]);
     if (std::strcmp(argv[i], "--repeat") == 0 && more) tp.repeat = std::atoi(argv[++i]);
+    if (std::strcmp(argv[i], "--hash") == 0) tp.hash = true;
     if (std::strcmp(argv[i], "--material") == 0 && more) tp.material = argv[++i];
   }
   if (only == 4) {

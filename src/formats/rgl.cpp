@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -20,9 +21,35 @@
 
 namespace halfback {
 
+// The VNDF warp's storage (Warp, below), shared with the evaluation's block kernel (eval_rows).
+namespace rgl_kernel {
+struct Node {
+  float f;  // density grid value, as the file stores it
+  float c;  // C(j, i) = ∫_0^i f(s, j) ds (trapezoids, rounded to float)
+};
+struct Row {
+  double m;  // M(j) = ∫_0^j R(t) dt / total: normalized, M(h-1) = 1
+  double r;  // R(j) = C(j, w-1), not normalized
+};
+struct EvalRows;
+}  // namespace rgl_kernel
+
+// The block loops compiled for AVX-512, AVX2 and the baseline, chosen at load time by the CPU
+// (GCC's target_clones, as merl_kernel.cpp).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define HALFBACK_RGL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define HALFBACK_RGL_CLONES
+#endif
+
 namespace {
 
 using io_detail::load_le;
+
+// Rows per block of eval_batch, sample_batch and pdf_batch: the columns, angles and lookups of a
+// block stay in L1 while its table reads are in flight.
+constexpr std::size_t kBlock = 64;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -211,18 +238,6 @@ struct RgbTable {
     return v.data() + ((slice * h + j) * w + i) * kSlot;
   }
 
-  // Asks for the lines that eval(s, x, y) reads.
-  void prefetch(const Slices& s, double x, double y) const {
-    const Cell c = cell_of(x, y, w, h);
-    for (int k = 0; k < s.count; ++k) {
-      const double* p = slot(s.index[k], c.j, c.i);
-      __builtin_prefetch(p);
-      __builtin_prefetch(p + kSlot);
-      __builtin_prefetch(p + w * kSlot);
-      __builtin_prefetch(p + (w + 1) * kSlot);
-    }
-  }
-
   // The same arithmetic, channel by channel, as Table::eval on a channel's own table; N is
   // s.count.
   template <int N>
@@ -250,14 +265,8 @@ struct RgbTable {
 // a row: the inverse warp at a point reads one or two cache lines per slice. A slice's
 // normalization 1/total is applied to the blend's weights (Blend::scaled).
 struct Warp {
-  struct Node {
-    float f;  // density grid value, as the file stores it
-    float c;  // C(j, i) = ∫_0^i f(s, j) ds (trapezoids, rounded to float)
-  };
-  struct Row {
-    double m;  // M(j) = ∫_0^j R(t) dt / total: normalized, M(h-1) = 1
-    double r;  // R(j) = C(j, w-1), not normalized
-  };
+  using Node = rgl_kernel::Node;
+  using Row = rgl_kernel::Row;
   std::size_t w = 0, h = 0;
   std::vector<Node> node;         // h·w per slice
   std::vector<Row> row;           // h per slice
@@ -441,17 +450,6 @@ struct Warp {
     const double c0 = (1 - g.ty) * b.F(k) + g.ty * b.F(k + w);
     const double c1 = (1 - g.ty) * b.F(k + 1) + g.ty * b.F(k + w + 1);
     return ((1 - g.tx) * c0 + g.tx * c1) * double(w - 1) * double(h - 1);
-  }
-
-  // Asks for the lines that inverse(s, p) reads (a block's lookups then overlap).
-  void prefetch(const Slices& s, RglWarpPoint p) const {
-    const Cell g = cell_of(p.x, p.y, w, h);
-    for (int n = 0; n < s.count; ++n) {
-      const Node* a = &node[(s.index[n] * h + g.j) * w + g.i];
-      __builtin_prefetch(a);
-      __builtin_prefetch(a + w);
-      __builtin_prefetch(&row[s.index[n] * h + g.j]);
-    }
   }
 
   // Point p of the unit square -> sample (the CDFs at p): the inverse of the warp. The grid
@@ -651,6 +649,197 @@ struct Warp {
   }
 };
 
+// Warp::density(Blend<N>, cell) of m rows in cells (i, j) at (tx, ty) of the unit square, the
+// slices of row q slices(q): the grid values copied into columns (many rows' loads in flight),
+// then blended in vector lanes, operation for operation as density() (the same values bit for
+// bit).
+template <int N, class SlicesOf>
+[[gnu::always_inline]] inline void densities_in_cells(const Warp& wp, std::size_t m,
+                                                      SlicesOf slices, const std::size_t* i,
+                                                      const std::size_t* j, const double* tx,
+                                                      const double* ty, double* out) {
+  const std::size_t w = wp.w, h = wp.h;
+  alignas(64) double f[N][4][kBlock], scaled[N][kBlock];
+  for (std::size_t q = 0; q < m; ++q) {
+    const Slices& s = slices(q);
+    const std::size_t k = j[q] * w + i[q];
+    for (int n = 0; n < N; ++n) {
+      const Warp::Node* a = wp.node.data() + s.index[n] * h * w + k;
+      f[n][0][q] = a[0].f, f[n][1][q] = a[w].f, f[n][2][q] = a[1].f, f[n][3][q] = a[w + 1].f;
+      scaled[n][q] = s.weight[n] * wp.inv_total[s.index[n]];
+    }
+  }
+  const double sx = double(w - 1), sy = double(h - 1);
+  for (std::size_t q = 0; q < m; ++q) {
+    double f00 = 0, f10 = 0, f01 = 0, f11 = 0;
+    for (int n = 0; n < N; ++n) {
+      f00 += scaled[n][q] * f[n][0][q];
+      f10 += scaled[n][q] * f[n][1][q];
+      f01 += scaled[n][q] * f[n][2][q];
+      f11 += scaled[n][q] * f[n][3][q];
+    }
+    const double c0 = (1 - ty[q]) * f00 + ty[q] * f10;
+    const double c1 = (1 - ty[q]) * f01 + ty[q] * f11;
+    out[q] = ((1 - tx[q]) * c0 + tx[q] * c1) * sx * sy;
+  }
+}
+
+// Warp::density() of m rows at points (x, y) (pdf_block): the cells as cell_of() finds them, in
+// vector lanes, then densities_in_cells(). Every row has as many slices (Impl::slices()).
+template <int N>
+[[gnu::always_inline]] inline void densities_at(const Warp& wp, const Slices* s, const double* x,
+                                                const double* y, std::size_t m, double* out) {
+  const double sx = double(wp.w - 1), sy = double(wp.h - 1);
+  const auto last_i = std::int32_t(wp.w - 2), last_j = std::int32_t(wp.h - 2);
+  alignas(64) std::int32_t ci[kBlock], cj[kBlock];
+  alignas(64) double tx[kBlock], ty[kBlock];
+  for (std::size_t q = 0; q < m; ++q) {  // cell_of(), with 32-bit indices: the same cells
+    const double u = unit(x[q]) * sx, v = unit(y[q]) * sy;
+    ci[q] = std::min(static_cast<std::int32_t>(u), last_i);
+    cj[q] = std::min(static_cast<std::int32_t>(v), last_j);
+    tx[q] = u - double(ci[q]), ty[q] = v - double(cj[q]);
+  }
+  std::size_t i[kBlock], j[kBlock];
+  for (std::size_t q = 0; q < m; ++q) i[q] = std::size_t(ci[q]), j[q] = std::size_t(cj[q]);
+  densities_in_cells<N>(
+      wp, m, [&](std::size_t q) -> const Slices& { return s[q]; }, i, j, tx, ty, out);
+}
+HALFBACK_RGL_CLONES void densities_at(const Warp& wp, const Slices* s, const double* x,
+                                      const double* y, std::size_t m, double* out) {
+  if (m == 0) return;
+  switch (s[0].count) {  // the same for every row (Impl::slices())
+    case 1:
+      return densities_at<1>(wp, s, x, y, m, out);
+    case 2:
+      return densities_at<2>(wp, s, x, y, m, out);
+    default:
+      return densities_at<4>(wp, s, x, y, m, out);
+  }
+}
+
+// Warp::draw_column() of a block's rows (sample_block), in passes across the rows: the column
+// bounds and row values (loads), the row's position ty (a square root and a division, in vector
+// lanes), the column search and its values (loads), the column's position, then the blend's
+// density at the cell (loads, then vector lanes). Each row's chain of dependent loads, square roots
+// and divisions is cut at the passes, so the rows' steps overlap. The arithmetic is draw_column()'s
+// operation for operation (the solves as selects), the same points and densities bit for bit.
+// Rows `apart` are skipped; rows of no positive weight, and warps without guides, go through
+// draw_column().
+class ColumnDraws {
+ public:
+  ColumnDraws(const Warp& wp, const Slices* s, const Warp::Drawing* d) : wp_(wp), s_(s), d_(d) {}
+
+  void run(const bool* apart, std::size_t n, Warp::Drawn* out) {
+    m_ = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (apart[k]) continue;
+      if (d_[k].blend || !wp_.guided)
+        out[k] = wp_.draw_column(s_[k], d_[k]);
+      else
+        at_[m_++] = k;
+    }
+    if (m_ == 0) return;
+    bounds();
+    rows();
+    columns();
+    cells();
+    switch (s_[at_[0]].count) {  // the same for every row (Impl::slices())
+      case 1:
+        densities<1>();
+        break;
+      case 2:
+        densities<2>();
+        break;
+      default:
+        densities<4>();
+    }
+    for (std::size_t q = 0; q < m_; ++q) out[at_[q]] = {{x_[q], y_[q]}, density_[q]};
+  }
+
+ private:
+  // Warp::solve_linear_density() as selects, so that its loops vectorize.
+  static double solve(double a, double b, double area) {
+    const double x = a * a + 2 * (b - a) * area;
+    const double den = a + std::sqrt(x < 0.0 ? 0.0 : x);  // std::max(x, 0.0)
+    const double t = unit(2 * area / den);
+    return (area > 0) & (den > 0) ? t : 0.0;
+  }
+
+  // The guided column bounds (Warp::column_bounds) and R, M of the drawn slice's rows j, j + 1.
+  void bounds() {
+    for (std::size_t q = 0; q < m_; ++q) {
+      const Warp::Drawing& d = d_[at_[q]];
+      const Warp::Blend<1> b(wp_, d.slice);
+      wp_.column_bounds(b, d.j, d.u.x, lo_[q], hi_[q]);
+      r0_[q] = b.R(d.j), r1_[q] = b.R(d.j + 1);
+      area_[q] = d.u.y - b.M(d.j);
+      ux_[q] = d.u.x;
+    }
+  }
+  // The row's position ty, and the target of the column search.
+  void rows() {
+    for (std::size_t q = 0; q < m_; ++q) {
+      const double r0 = r0_[q], r1 = r1_[q];
+      const double ty = solve(r0, r1, area_[q]);
+      ty_[q] = ty;
+      target_[q] = ux_[q] * ((1 - ty) * r0 + ty * r1);
+    }
+  }
+  // The column (Warp::forward_column's search), C there, F at its ends.
+  void columns() {
+    const std::size_t w = wp_.w;
+    for (std::size_t q = 0; q < m_; ++q) {
+      const Warp::Drawing& d = d_[at_[q]];
+      const Warp::Blend<1> b(wp_, d.slice);
+      const double ty = ty_[q];
+      const std::size_t row0 = d.j * w, row1 = row0 + w;
+      auto ct = [&](std::size_t i) { return (1 - ty) * b.C(row0 + i) + ty * b.C(row1 + i); };
+      const std::size_t i = Warp::last_below(ct, target_[q], lo_[q], hi_[q], w - 2);
+      i_[q] = i;
+      cell_x_[q] = double(i), cell_y_[q] = double(d.j);
+      below_[q] = ct(i);
+      f_[0][q] = b.F(row0 + i), f_[1][q] = b.F(row1 + i);
+      f_[2][q] = b.F(row0 + i + 1), f_[3][q] = b.F(row1 + i + 1);
+    }
+  }
+  // The column's position tx, and the point.
+  void cells() {
+    const double sx = double(wp_.w - 1), sy = double(wp_.h - 1);
+    for (std::size_t q = 0; q < m_; ++q) {
+      const double ty = ty_[q];
+      const double c0 = (1 - ty) * f_[0][q] + ty * f_[1][q];
+      const double c1 = (1 - ty) * f_[2][q] + ty * f_[3][q];
+      const double tx = solve(c0, c1, target_[q] - below_[q]);
+      tx_[q] = tx;
+      x_[q] = (cell_x_[q] + tx) / sx;
+      y_[q] = (cell_y_[q] + ty) / sy;
+    }
+  }
+  // Warp::density(Blend<N>, cell) of the rows' slices.
+  template <int N>
+  void densities() {
+    for (std::size_t q = 0; q < m_; ++q) j_[q] = d_[at_[q]].j;
+    densities_in_cells<N>(
+        wp_, m_, [&](std::size_t q) -> const Slices& { return s_[at_[q]]; }, i_, j_, tx_, ty_,
+        density_);
+  }
+
+  const Warp& wp_;
+  const Slices* s_;
+  const Warp::Drawing* d_;
+  std::size_t m_ = 0;  // rows in the passes
+  std::size_t at_[kBlock], lo_[kBlock], hi_[kBlock], i_[kBlock], j_[kBlock];
+  alignas(64) double ux_[kBlock], r0_[kBlock], r1_[kBlock], area_[kBlock], ty_[kBlock];
+  alignas(64) double target_[kBlock], below_[kBlock], f_[4][kBlock], tx_[kBlock];
+  alignas(64) double cell_x_[kBlock], cell_y_[kBlock];  // i, j as doubles
+  alignas(64) double x_[kBlock], y_[kBlock], density_[kBlock];
+};
+
+HALFBACK_RGL_CLONES void draw_columns(const Warp& wp, const Slices* s, const Warp::Drawing* d,
+                                      const bool* apart, std::size_t n, Warp::Drawn* out) {
+  ColumnDraws(wp, s, d).run(apart, n, out);
+}
+
 bool negative_sign(double v) {
   return !std::signbit(v);
 }  // mulsign_neg: flip when v >= +0
@@ -688,6 +877,11 @@ struct RglBrdf::Impl {
   std::size_t noise_clamped = 0;  // tiny negative ndf, vndf and luminance values set to 0
   std::size_t rgb_negative = 0;   // negative (out-of-gamut) RGB values
   std::size_t wavelengths = 0;    // the spectral variant: its wavelengths, integrated to RGB
+
+  bool lanes = false;  // the tables' sides fit the block kernel's 32-bit cell indices
+
+  // Impl::value() of the packed rows of a block, over cos θo (eval_block): the block kernel.
+  void eval_rows(rgl_kernel::EvalRows& rows, bool clamp_negative) const;
 
   Slices slices(double phi_i, double theta_i) const {
     Slices s;
@@ -904,6 +1098,9 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
     if (flag > 1) v.fail("jacobian", "is " + std::to_string(flag) + ", expected 0 or 1");
     m.jacobian = flag == 1;
   }
+  constexpr std::size_t kSide = INT32_MAX;
+  m.lanes = std::max({m.vndf.w, m.vndf.h, m.rgb.w, m.rgb.h, m.ndf.w, m.ndf.h, m.sigma.w,
+                      m.sigma.h}) < kSide;
 }
 
 RglBrdf::~RglBrdf() = default;
@@ -1055,10 +1252,6 @@ Rgb over_cosine(Rgb r, const Vec3<double>& wo) {
   return r;
 }
 
-// Rows per block of eval_batch, sample_batch and pdf_batch: the columns, angles and lookups of a
-// block stay in L1 while its table reads are in flight.
-constexpr std::size_t kBlock = 64;
-
 // Row k of a block's directions: `given`, the direction whose azimuth indexes the tables, and the
 // unit half vector of the pair, both after the flips that bring `given` into the range the data
 // covers. True when the row must go through the one-pair path: a direction at or below the
@@ -1122,6 +1315,224 @@ struct PairBlock {
 
 }  // namespace
 
+// The evaluation's block kernel: Impl::value() and over_cosine() of a block's rows, step by step
+// across the rows, each step a loop that the compiler vectorizes (the cells, the blends, the
+// inverse warp's solve, the shading) or a loop of independent loads into columns (the tables'
+// values at the cells, many rows' misses in flight), instead of each row's chain of dependent
+// loads, divisions and square roots in turn. Compiled for AVX-512, AVX2 and the baseline, chosen
+// at load time by the CPU (GCC's target_clones, as merl_kernel.cpp); rgl.cpp is compiled without
+// contraction (src/formats/CMakeLists.txt), so every lane rounds as the one-row path does: the
+// values are those of Impl::value() bit for bit.
+namespace rgl_kernel {
+
+inline constexpr std::size_t kRows = kBlock;
+
+// The tables eval() reads (RglBrdf::Impl), as plain arrays.
+struct EvalTables {
+  const Node* node;  // the VNDF warp: slices of vh·vw nodes
+  const Row* row;    // slices of vh rows
+  const double* inv_total;
+  std::size_t vw, vh;
+  const double* rgb;  // slices of rh·rw slots of RgbTable::kSlot
+  std::size_t rw, rh;
+  const double* ndf;
+  std::size_t nw, nh;
+  const double* sigma;
+  std::size_t sw, sh;
+  bool jacobian, clamp_negative;
+};
+
+// The rows of a block that take the common path, packed: their table coordinates, slices and ωo
+// in, fr out.
+struct EvalRows {
+  std::size_t n = 0;
+  alignas(64) double um_x[kRows], um_y[kRows], uwi_x[kRows], uwi_y[kRows];
+  alignas(64) double wo[3][kRows];
+  alignas(64) std::size_t slice[4][kRows];
+  alignas(64) double weight[4][kRows];
+  alignas(64) double fr[3][kRows];
+};
+
+// cell_of() of n points (x, y) in columns, with 32-bit indices (a conversion the vector units
+// have; the tables' sides fit, eval_block checks): the same cells.
+struct Cells {
+  alignas(64) std::int32_t i[kRows], j[kRows];
+  alignas(64) double tx[kRows], ty[kRows];
+};
+[[gnu::always_inline]] inline void cells_of(const double* x, const double* y, std::size_t n,
+                                            std::size_t w, std::size_t h, Cells& c) {
+  const double sw = double(w - 1), sh = double(h - 1);
+  const auto last_i = std::int32_t(w - 2), last_j = std::int32_t(h - 2);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double u = unit(x[k]) * sw, v = unit(y[k]) * sh;
+    const std::int32_t i = std::min(static_cast<std::int32_t>(u), last_i);
+    const std::int32_t j = std::min(static_cast<std::int32_t>(v), last_j);
+    c.i[k] = i, c.j[k] = j;
+    c.tx[k] = u - double(i), c.ty[k] = v - double(j);
+  }
+}
+
+// Table::eval() of n points: the corners copied into columns, then blended.
+[[gnu::always_inline]] inline void table_eval(const double* v, std::size_t w, std::size_t h,
+                                              const double* x, const double* y, std::size_t n,
+                                              double* out) {
+  Cells c;
+  cells_of(x, y, n, w, h, c);
+  alignas(64) double p[4][kRows];
+  for (std::size_t k = 0; k < n; ++k) {
+    const double* a = v + std::size_t(c.j[k]) * w + std::size_t(c.i[k]);
+    p[0][k] = a[0], p[1][k] = a[1], p[2][k] = a[w], p[3][k] = a[w + 1];
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const double tx = c.tx[k], ty = c.ty[k];
+    const double top = (1 - tx) * p[0][k] + tx * p[1][k];
+    const double bottom = (1 - tx) * p[2][k] + tx * p[3][k];
+    out[k] = 0.0 + ((1 - ty) * top + ty * bottom);
+  }
+}
+
+// Warp::inverse() of the rows' um: the point on the unit square of the RGB tables.
+template <int N>
+[[gnu::always_inline]] inline void inverse_warp(const EvalTables& t, const EvalRows& r, double* sx,
+                                                double* sy) {
+  const std::size_t n = r.n, w = t.vw, h = t.vh;
+  Cells c;
+  cells_of(r.um_x, r.um_y, n, w, h, c);
+  // Per slice: F at the cell's corners, C at its left ones (as double), M, R of its rows, 1/total.
+  alignas(64) double v[N][10][kRows];
+  for (std::size_t k = 0; k < n; ++k)
+    for (int s = 0; s < N; ++s) {
+      const std::size_t first = r.slice[s][k] * h + std::size_t(c.j[k]);
+      const Node* a = t.node + first * w + std::size_t(c.i[k]);
+      const Row* q = t.row + first;
+      v[s][0][k] = a[0].f, v[s][1][k] = a[1].f, v[s][2][k] = a[w].f, v[s][3][k] = a[w + 1].f;
+      v[s][4][k] = a[0].c, v[s][5][k] = a[w].c;
+      v[s][6][k] = q[0].m, v[s][7][k] = q[0].r, v[s][8][k] = q[1].r;
+      v[s][9][k] = t.inv_total[r.slice[s][k]];
+    }
+  for (std::size_t k = 0; k < n; ++k) {
+    double f00 = 0, f01 = 0, f10 = 0, f11 = 0, c00 = 0, c10 = 0, r0 = 0, r1 = 0, m0 = 0;
+    for (int s = 0; s < N; ++s) {
+      const double wn = r.weight[s][k] * v[s][9][k];
+      f00 += wn * v[s][0][k];
+      f01 += wn * v[s][1][k];
+      f10 += wn * v[s][2][k];
+      f11 += wn * v[s][3][k];
+      c00 += wn * v[s][4][k];
+      c10 += wn * v[s][5][k];
+      m0 += r.weight[s][k] * v[s][6][k];
+      r0 += wn * v[s][7][k];
+      r1 += wn * v[s][8][k];
+    }
+    const double tx = c.tx[k], ty = c.ty[k];
+    const double c0 = (1 - ty) * f00 + ty * f10;
+    const double c1 = (1 - ty) * f01 + ty * f11;
+    const double below = (1 - ty) * c00 + ty * c10;
+    const double num = below + tx * c0 + 0.5 * tx * tx * (c1 - c0);
+    const double row_total = (1 - ty) * r0 + ty * r1;
+    // Both sides, then a select (a branch stops the loop's vectorization).
+    const double x = unit(num / row_total), x_empty = unit(r.um_x[k]);
+    sx[k] = row_total > 0 ? x : x_empty;
+    sy[k] = unit(m0 + ty * r0 + 0.5 * ty * ty * (r1 - r0));
+  }
+}
+
+// Impl::shade() and over_cosine() of the rows, sample (sx, sy) on the RGB tables.
+template <int N>
+[[gnu::always_inline]] inline void shade(const EvalTables& t, EvalRows& r, const double* sx,
+                                         const double* sy) {
+  const std::size_t n = r.n, w = t.rw, h = t.rh;
+  constexpr std::size_t kSlot = RgbTable::kSlot;
+  Cells c;
+  cells_of(sx, sy, n, w, h, c);
+  alignas(64) double v[N][4][3][kRows];  // the corners (i, j), (i+1, j), (i, j+1), (i+1, j+1)
+  for (std::size_t k = 0; k < n; ++k)
+    for (int s = 0; s < N; ++s) {
+      const double* p =
+          t.rgb + ((r.slice[s][k] * h + std::size_t(c.j[k])) * w + std::size_t(c.i[k])) * kSlot;
+      const double* q = p + w * kSlot;
+      for (std::size_t ch = 0; ch < 3; ++ch) {
+        v[s][0][ch][k] = p[ch], v[s][1][ch][k] = p[kSlot + ch];
+        v[s][2][ch][k] = q[ch], v[s][3][ch][k] = q[kSlot + ch];
+      }
+    }
+  alignas(64) double scale[kRows], fr[3][kRows];
+  if (t.jacobian) {
+    alignas(64) double ndf[kRows], sigma[kRows];
+    table_eval(t.ndf, t.nw, t.nh, r.um_x, r.um_y, n, ndf);
+    table_eval(t.sigma, t.sw, t.sh, r.uwi_x, r.uwi_y, n, sigma);
+    for (std::size_t k = 0; k < n; ++k) scale[k] = ndf[k] / (4 * sigma[k]);
+  } else {
+    for (std::size_t k = 0; k < n; ++k) scale[k] = 1;
+  }
+  const bool clamp = t.clamp_negative;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double tx = c.tx[k], ty = c.ty[k];
+    const double x = r.wo[0][k], y = r.wo[1][k], z = r.wo[2][k];
+    const double inverse_cos_o = std::sqrt(x * x + y * y + z * z) / z;
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+      double sum = 0;
+      for (int s = 0; s < N; ++s) {
+        const double top = (1 - tx) * v[s][0][ch][k] + tx * v[s][1][ch][k];
+        const double bottom = (1 - tx) * v[s][2][ch][k] + tx * v[s][3][ch][k];
+        sum += r.weight[s][k] * ((1 - ty) * top + ty * bottom);
+      }
+      const double value = sum * scale[k];
+      // std::max(value, 0.0) on request, as a select.
+      fr[ch][k] = (clamp & (value < 0.0) ? 0.0 : value) * inverse_cos_o;
+    }
+  }
+  for (std::size_t ch = 0; ch < 3; ++ch)
+    for (std::size_t k = 0; k < n; ++k) r.fr[ch][k] = fr[ch][k];
+}
+
+template <int N>
+[[gnu::always_inline]] inline void eval_rows(const EvalTables& t, EvalRows& r) {
+  alignas(64) double sx[kRows], sy[kRows];
+  inverse_warp<N>(t, r, sx, sy);
+  shade<N>(t, r, sx, sy);
+}
+
+// One function per slice count (1, 2 or 4: Impl::slices()).
+HALFBACK_RGL_CLONES void eval_rows_1(const EvalTables& t, EvalRows& r) {
+  eval_rows<1>(t, r);
+}
+HALFBACK_RGL_CLONES void eval_rows_2(const EvalTables& t, EvalRows& r) {
+  eval_rows<2>(t, r);
+}
+HALFBACK_RGL_CLONES void eval_rows_4(const EvalTables& t, EvalRows& r) {
+  eval_rows<4>(t, r);
+}
+
+}  // namespace rgl_kernel
+
+void RglBrdf::Impl::eval_rows(rgl_kernel::EvalRows& rows, bool clamp_negative) const {
+  const rgl_kernel::EvalTables t{vndf.node.data(),
+                                 vndf.row.data(),
+                                 vndf.inv_total.data(),
+                                 vndf.w,
+                                 vndf.h,
+                                 rgb.v.data(),
+                                 rgb.w,
+                                 rgb.h,
+                                 ndf.v.data(),
+                                 ndf.w,
+                                 ndf.h,
+                                 sigma.v.data(),
+                                 sigma.w,
+                                 sigma.h,
+                                 jacobian,
+                                 clamp_negative};
+  switch ((phi.stride ? 2 : 1) * (theta.stride ? 2 : 1)) {  // Slices::count of every incidence
+    case 1:
+      return rgl_kernel::eval_rows_1(t, rows);
+    case 2:
+      return rgl_kernel::eval_rows_2(t, rows);
+    default:
+      return rgl_kernel::eval_rows_4(t, rows);
+  }
+}
+
 Rgb RglBrdf::eval(const DirPair<double>& pair) const {
   const Rgb r = eval_cosine(pair);
   if (!(pair.wi.z > 0) || !(pair.wo.z > 0)) return r;  // 0, or NaN for NaN input
@@ -1150,26 +1561,27 @@ void RglBrdf::eval_block(std::span<const DirPair<double>> pairs, std::span<Rgb> 
     uwi_x[k] = theta_to_u(angle[0][k]);
     uwi_y[k] = phi_to_u(phi_i);
   }
-  Slices slices[kBlock];
+  // The common rows packed for the block kernel (rgl_kernel), the others through eval().
+  rgl_kernel::EvalRows rows;
+  std::size_t at[kBlock];  // the rows' places in the block
   for (std::size_t k = 0; k < n; ++k) {
-    apart[k] = apart[k] || !valid[k] || near_seam(um_y[k]) || near_seam(uwi_y[k]);
-    if (!apart[k]) {
-      m.slices(angle[1][k], angle[0][k], slices[k]);
-      m.vndf.prefetch(slices[k], {um_x[k], um_y[k]});
-    }
+    apart[k] = apart[k] || !valid[k] || near_seam(um_y[k]) || near_seam(uwi_y[k]) || !m.lanes;
+    if (apart[k]) continue;
+    const std::size_t r = rows.n++;
+    at[r] = k;
+    Slices s;
+    m.slices(angle[1][k], angle[0][k], s);
+    for (int c = 0; c < s.count; ++c)
+      rows.slice[c][r] = s.index[c], rows.weight[c][r] = s.weight[c];
+    rows.um_x[r] = um_x[k], rows.um_y[r] = um_y[k];
+    rows.uwi_x[r] = uwi_x[k], rows.uwi_y[r] = uwi_y[k];
+    rows.wo[0][r] = pairs[k].wo.x, rows.wo[1][r] = pairs[k].wo.y, rows.wo[2][r] = pairs[k].wo.z;
   }
-  // Impl::value() in two passes over the block, each prefetching what the next one reads.
-  RglWarpPoint sample[kBlock];
+  m.eval_rows(rows, options_.clamp_negative);
+  for (std::size_t r = 0; r < rows.n; ++r)
+    out[at[r]] = {rows.fr[0][r], rows.fr[1][r], rows.fr[2][r]};
   for (std::size_t k = 0; k < n; ++k)
-    if (!apart[k]) {
-      sample[k] = m.vndf.inverse(slices[k], {um_x[k], um_y[k]});
-      m.rgb.prefetch(slices[k], sample[k].x, sample[k].y);
-    }
-  for (std::size_t k = 0; k < n; ++k)
-    out[k] = apart[k] ? eval(pairs[k])
-                      : over_cosine(m.shade(slices[k], sample[k], {um_x[k], um_y[k]},
-                                            {uwi_x[k], uwi_y[k]}, options_.clamp_negative),
-                                    pairs[k].wo);
+    if (apart[k]) out[k] = eval(pairs[k]);
 }
 
 void RglBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
@@ -1257,10 +1669,12 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
   }
   for (std::size_t k = 0; k < n; ++k)
     if (!apart[k]) m.vndf.prefetch_nodes(drawing[k]);
+  Warp::Drawn drawn[kBlock];
+  draw_columns(m.vndf, slices, drawing, apart, n, drawn);
   for (std::size_t k = 0; k < 2 * rows; ++k) {
     double theta_m = 0, phi_m = 0;  // any valid angles for the rows apart
     if (k < n && !apart[k]) {
-      const auto [um, density] = m.vndf.draw_column(slices[k], drawing[k]);
+      const auto [um, density] = drawn[k];
       pdf_u[k] = density;
       um_x[k] = um.x;
       // The normal's angles, φm in [0, 2π) as the inverse conversion takes it.
@@ -1316,6 +1730,10 @@ void RglBrdf::pdf_block(std::span<const DirPair<double>> pairs, std::span<double
   const std::size_t n = pairs.size();
   const PairBlock block(m.reduction, pairs, false);
   const auto& [dirs, angle, valid, apart] = block;
+  // The rows' points and Jacobians, then their densities in passes (densities_at).
+  Slices slices[kBlock];
+  std::size_t at[kBlock], rows = 0;
+  alignas(64) double um_x[kBlock], um_y[kBlock], jacobian[kBlock], pdf_u[kBlock];
   for (std::size_t k = 0; k < n; ++k) {
     const double phi_g = signed_azimuth(angle[1][k]);
     const double phi_m = signed_azimuth(angle[3][k]);
@@ -1324,15 +1742,19 @@ void RglBrdf::pdf_block(std::span<const DirPair<double>> pairs, std::span<double
       out[k] = pdf(pairs[k].wo, pairs[k].wi);
       continue;
     }
+    const std::size_t q = rows++;
+    at[q] = k;
     const double theta_m = angle[2][k];
-    const RglWarpPoint um{std::sqrt(theta_m / (kPi / 2)), v};
-    const double pdf_u = m.vndf.density(m.slices(phi_g, angle[0][k]), um);
+    um_x[q] = std::sqrt(theta_m / (kPi / 2)), um_y[q] = v;
+    m.slices(phi_g, angle[0][k], slices[q]);
     const double sin_m = std::sqrt(dirs[3][k] * dirs[3][k] + dirs[4][k] * dirs[4][k]);
     const double cos_gm =
         dirs[0][k] * dirs[3][k] + dirs[1][k] * dirs[4][k] + dirs[2][k] * dirs[5][k];
-    const double jacobian = 2 * kPi * kPi * um.x * sin_m * 4 * std::abs(cos_gm);
-    out[k] = jacobian > 0 && std::isfinite(pdf_u) ? pdf_u / jacobian : 0;
+    jacobian[q] = 2 * kPi * kPi * um_x[q] * sin_m * 4 * std::abs(cos_gm);
   }
+  densities_at(m.vndf, slices, um_x, um_y, rows, pdf_u);
+  for (std::size_t q = 0; q < rows; ++q)
+    out[at[q]] = jacobian[q] > 0 && std::isfinite(pdf_u[q]) ? pdf_u[q] / jacobian[q] : 0;
 }
 
 std::shared_ptr<const RglBrdf> load_rgl(const std::filesystem::path& path, RglOptions options) {
