@@ -129,9 +129,25 @@ struct LaneOps<xsimd::batch<S, A>> {
   static T atan2(const T& y, const T& x) {
     using C = Atan2Constants<S>;
     const T a = xsimd::abs(y), b = xsimd::abs(x);
-    // Beyond 2^1000 a + b could overflow: scale both (exactly) by 1/4.
-    const T scale = xsimd::select(a > T(C::huge) || b > T(C::huge), T(S(0.25)), T(S(1)));
-    const T as = a * scale, bs = b * scale;
+    // Beyond 2^1000 a + b could overflow: scale both (exactly) by 1/4. Rare, so tested for the
+    // whole vector (a branch, ~3 instructions, instead of a compare and two multiplications
+    // in every call: a forward halfdiff has five atan2); the scale of 1 is exact, so the other
+    // path gives the same bits.
+    const auto huge = a > T(C::huge) || b > T(C::huge);
+    if (xsimd::any(huge)) [[unlikely]] {
+      const T scale = xsimd::select(huge, T(S(0.25)), T(S(1)));
+      return finish_atan2(y, x, folded_atan(a, b, a * scale, b * scale));
+    }
+    return finish_atan2(y, x, folded_atan(a, b, a, b));
+  }
+
+  // The angle in [0, π/2] from a = |y|, b = |x| (as, bs: the same, maybe scaled), unsigned,
+  // before the quadrant of x: atan(r) and its offset (hi, lo), see atan2.
+  struct Folded {
+    T at, off_hi, off_lo;
+  };
+  static Folded folded_atan(const T& a, const T& b, const T& as, const T& bs) {
+    using C = Atan2Constants<S>;
     const auto low = a <= b * T(C::tan_pi_8);  // |y/x| <= tan(π/8)
     const auto high = a * T(C::tan_pi_8) > b;  // |x/y| < tan(π/8)
     const T num = xsimd::select(low, as, xsimd::select(high, -bs, as - bs));
@@ -147,17 +163,28 @@ struct LaneOps<xsimd::batch<S, A>> {
         xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_hi), T(C::quarter_pi_hi)));
     const T off_lo =
         xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_lo), T(C::quarter_pi_lo)));
+    return {at, off_hi, off_lo};
+  }
+
+  // The quadrant of x, the special cases and the sign of y. Zero over zero and infinity over
+  // infinity are rare too: r = 0/0 or ∞/∞ makes their angle NaN, so they are looked for only when
+  // a lane of the vector is NaN (one compare instead of six operations and four selects).
+  static T finish_atan2(const T& y, const T& x, const Folded& f) {
+    using C = Atan2Constants<S>;
     // x < 0 (or -0): π - (off + at) = (π_hi - off_hi) + ((π_lo - off_lo) - at).
     const auto left = xsimd::copysign(T(S(1)), x) < T(S(0));
-    const T base = xsimd::select(left, T(C::pi_hi) - off_hi, off_hi);
-    const T rest = xsimd::select(left, (T(C::pi_lo) - off_lo) - at, at + off_lo);
-    const T angle = base + rest;
-    const auto zero = (y == T(S(0))) && (x == T(S(0)));
-    const auto both_inf = xsimd::isinf(y) && xsimd::isinf(x);
-    constexpr S pi = std::numbers::pi_v<S>;
-    const T special = xsimd::select(zero, xsimd::select(left, T(pi), T(S(0))),
-                                    xsimd::select(left, T(S(0.75) * pi), T(S(0.25) * pi)));
-    return xsimd::copysign(xsimd::select(zero || both_inf, special, angle), y);
+    const T base = xsimd::select(left, T(C::pi_hi) - f.off_hi, f.off_hi);
+    const T rest = xsimd::select(left, (T(C::pi_lo) - f.off_lo) - f.at, f.at + f.off_lo);
+    T angle = base + rest;
+    if (xsimd::any(xsimd::isnan(angle))) [[unlikely]] {
+      const auto zero = (y == T(S(0))) && (x == T(S(0)));
+      const auto both_inf = xsimd::isinf(y) && xsimd::isinf(x);
+      constexpr S pi = std::numbers::pi_v<S>;
+      const T special = xsimd::select(zero, xsimd::select(left, T(pi), T(S(0))),
+                                      xsimd::select(left, T(S(0.75) * pi), T(S(0.25) * pi)));
+      angle = xsimd::select(zero || both_inf, special, angle);
+    }
+    return xsimd::copysign(angle, y);
   }
 
   static T min(const T& a, const T& b) {
@@ -196,6 +223,115 @@ struct LaneOps<xsimd::batch<S, A>> {
   static Mask mask_not(const Mask& a) {
     return !a;
   }
+  static Mask select_mask(const Mask& c, const Mask& a, const Mask& b) {
+    return (c && a) || (!c && b);
+  }
+};
+
+// Two vectors as one lane type: every operation is issued on both halves, next to each other in
+// the instruction stream. The forward kernels are chains of dependent divisions, square roots and
+// polynomials (~700 instructions a vector for halfdiff double), longer than the out-of-order
+// window, so one vector's latency stalls were not hidden by the next vector's work; with the two
+// halves interleaved, each stall has an independent instruction beside it. Lanes are
+// independent, so a row's result is bit for bit that of the single vector.
+template <class B>
+struct Twin {
+  B lo, hi;
+  Twin() = default;
+  Twin(const B& l, const B& h) : lo(l), hi(h) {}
+  template <class U>
+  requires std::is_arithmetic_v<U>
+  explicit(false) Twin(U s) : lo(B(static_cast<typename B::value_type>(s))), hi(lo) {}
+  static constexpr std::size_t size = 2 * B::size;
+  // What batch_kernels.hpp's Lanes calls on a vector type.
+  template <class S>
+  static Twin load_unaligned(const S* p) {
+    return {B::load_unaligned(p), B::load_unaligned(p + B::size)};
+  }
+  template <class S>
+  void store_unaligned(S* p) const {
+    lo.store_unaligned(p);
+    hi.store_unaligned(p + B::size);
+  }
+};
+
+template <class M>
+struct TwinMask {
+  M lo, hi;
+};
+
+template <class M>
+inline TwinMask<M> operator&&(const TwinMask<M>& a, const TwinMask<M>& b) {
+  return {a.lo && b.lo, a.hi && b.hi};
+}
+template <class M>
+inline TwinMask<M> operator||(const TwinMask<M>& a, const TwinMask<M>& b) {
+  return {a.lo || b.lo, a.hi || b.hi};
+}
+template <class M>
+inline TwinMask<M> operator!(const TwinMask<M>& a) {
+  return {!a.lo, !a.hi};
+}
+template <class M>
+inline bool all(const TwinMask<M>& m) {
+  return xsimd::all(m.lo) && xsimd::all(m.hi);
+}
+template <class M>
+inline bool any(const TwinMask<M>& m) {
+  return xsimd::any(m.lo) || xsimd::any(m.hi);
+}
+
+#define HALFBACK_TWIN_BINARY(op)                                   \
+  template <class B>                                               \
+  inline Twin<B> operator op(const Twin<B>& a, const Twin<B>& b) { \
+    return {a.lo op b.lo, a.hi op b.hi};                           \
+  }
+HALFBACK_TWIN_BINARY(+)
+HALFBACK_TWIN_BINARY(-)
+HALFBACK_TWIN_BINARY(*)
+HALFBACK_TWIN_BINARY(/)
+#undef HALFBACK_TWIN_BINARY
+#define HALFBACK_TWIN_COMPARE(op)                                                                \
+  template <class B>                                                                             \
+  inline TwinMask<typename B::batch_bool_type> operator op(const Twin<B>& a, const Twin<B>& b) { \
+    return {a.lo op b.lo, a.hi op b.hi};                                                         \
+  }
+HALFBACK_TWIN_COMPARE(<)
+HALFBACK_TWIN_COMPARE(<=)
+HALFBACK_TWIN_COMPARE(>)
+HALFBACK_TWIN_COMPARE(>=)
+HALFBACK_TWIN_COMPARE(==)
+#undef HALFBACK_TWIN_COMPARE
+template <class B>
+inline Twin<B> operator-(const Twin<B>& a) {
+  return {-a.lo, -a.hi};
+}
+
+template <class B>
+struct LaneOps<Twin<B>> {
+  using T = Twin<B>;
+  using O = LaneOps<B>;
+  using Scalar = typename O::Scalar;
+  using Mask = TwinMask<typename O::Mask>;
+
+  static T select(const Mask& c, const T& a, const T& b) {
+    return {O::select(c.lo, a.lo, b.lo), O::select(c.hi, a.hi, b.hi)};
+  }
+  static T fma(const T& a, const T& b, const T& c) {
+    return {O::fma(a.lo, b.lo, c.lo), O::fma(a.hi, b.hi, c.hi)};
+  }
+  static T sqrt(const T& x) { return {O::sqrt(x.lo), O::sqrt(x.hi)}; }
+  static T abs(const T& x) { return {O::abs(x.lo), O::abs(x.hi)}; }
+  static T atan2(const T& y, const T& x) { return {O::atan2(y.lo, x.lo), O::atan2(y.hi, x.hi)}; }
+  static T min(const T& a, const T& b) { return {O::min(a.lo, b.lo), O::min(a.hi, b.hi)}; }
+  static T max(const T& a, const T& b) { return {O::max(a.lo, b.lo), O::max(a.hi, b.hi)}; }
+  static void sincos(const T& x, T& s, T& c) {
+    O::sincos(x.lo, s.lo, c.lo);
+    O::sincos(x.hi, s.hi, c.hi);
+  }
+  static Mask mask_and(const Mask& a, const Mask& b) { return a && b; }
+  static Mask mask_or(const Mask& a, const Mask& b) { return a || b; }
+  static Mask mask_not(const Mask& a) { return !a; }
   static Mask select_mask(const Mask& c, const Mask& a, const Mask& b) {
     return (c && a) || (!c && b);
   }
