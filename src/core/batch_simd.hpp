@@ -129,25 +129,9 @@ struct LaneOps<xsimd::batch<S, A>> {
   static T atan2(const T& y, const T& x) {
     using C = Atan2Constants<S>;
     const T a = xsimd::abs(y), b = xsimd::abs(x);
-    // Beyond 2^1000 a + b could overflow: scale both (exactly) by 1/4. Rare, so tested for the
-    // whole vector (a branch, ~3 instructions, instead of a compare and two multiplications
-    // in every call: a forward halfdiff has five atan2); the scale of 1 is exact, so the other
-    // path gives the same bits.
-    const auto huge = a > T(C::huge) || b > T(C::huge);
-    if (xsimd::any(huge)) [[unlikely]] {
-      const T scale = xsimd::select(huge, T(S(0.25)), T(S(1)));
-      return finish_atan2(y, x, folded_atan(a, b, a * scale, b * scale));
-    }
-    return finish_atan2(y, x, folded_atan(a, b, a, b));
-  }
-
-  // The angle in [0, π/2] from a = |y|, b = |x| (as, bs: the same, maybe scaled), unsigned,
-  // before the quadrant of x: atan(r) and its offset (hi, lo), see atan2.
-  struct Folded {
-    T at, off_hi, off_lo;
-  };
-  static Folded folded_atan(const T& a, const T& b, const T& as, const T& bs) {
-    using C = Atan2Constants<S>;
+    // Beyond 2^1000 a + b could overflow: scale both (exactly) by 1/4.
+    const T scale = xsimd::select(a > T(C::huge) || b > T(C::huge), T(S(0.25)), T(S(1)));
+    const T as = a * scale, bs = b * scale;
     const auto low = a <= b * T(C::tan_pi_8);  // |y/x| <= tan(π/8)
     const auto high = a * T(C::tan_pi_8) > b;  // |x/y| < tan(π/8)
     const T num = xsimd::select(low, as, xsimd::select(high, -bs, as - bs));
@@ -163,28 +147,17 @@ struct LaneOps<xsimd::batch<S, A>> {
         xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_hi), T(C::quarter_pi_hi)));
     const T off_lo =
         xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_lo), T(C::quarter_pi_lo)));
-    return {at, off_hi, off_lo};
-  }
-
-  // The quadrant of x, the special cases and the sign of y. Zero over zero and infinity over
-  // infinity are rare too: r = 0/0 or ∞/∞ makes their angle NaN, so they are looked for only when
-  // a lane of the vector is NaN (one compare instead of six operations and four selects).
-  static T finish_atan2(const T& y, const T& x, const Folded& f) {
-    using C = Atan2Constants<S>;
     // x < 0 (or -0): π - (off + at) = (π_hi - off_hi) + ((π_lo - off_lo) - at).
     const auto left = xsimd::copysign(T(S(1)), x) < T(S(0));
-    const T base = xsimd::select(left, T(C::pi_hi) - f.off_hi, f.off_hi);
-    const T rest = xsimd::select(left, (T(C::pi_lo) - f.off_lo) - f.at, f.at + f.off_lo);
-    T angle = base + rest;
-    if (xsimd::any(xsimd::isnan(angle))) [[unlikely]] {
-      const auto zero = (y == T(S(0))) && (x == T(S(0)));
-      const auto both_inf = xsimd::isinf(y) && xsimd::isinf(x);
-      constexpr S pi = std::numbers::pi_v<S>;
-      const T special = xsimd::select(zero, xsimd::select(left, T(pi), T(S(0))),
-                                      xsimd::select(left, T(S(0.75) * pi), T(S(0.25) * pi)));
-      angle = xsimd::select(zero || both_inf, special, angle);
-    }
-    return xsimd::copysign(angle, y);
+    const T base = xsimd::select(left, T(C::pi_hi) - off_hi, off_hi);
+    const T rest = xsimd::select(left, (T(C::pi_lo) - off_lo) - at, at + off_lo);
+    const T angle = base + rest;
+    const auto zero = (y == T(S(0))) && (x == T(S(0)));
+    const auto both_inf = xsimd::isinf(y) && xsimd::isinf(x);
+    constexpr S pi = std::numbers::pi_v<S>;
+    const T special = xsimd::select(zero, xsimd::select(left, T(pi), T(S(0))),
+                                    xsimd::select(left, T(S(0.75) * pi), T(S(0.25) * pi)));
+    return xsimd::copysign(xsimd::select(zero || both_inf, special, angle), y);
   }
 
   static T min(const T& a, const T& b) {
