@@ -6,7 +6,7 @@
 //   scalar_forward/P/T      a straightforward per-pair loop through a virtual, parameterization-
 //   scalar_inverse/P/T      generic interface with std math (the baseline of the speed-up)
 //   plainstores/DIR/P/T     forward/inverse on one thread with the outputs' non-temporal stores
-//   ntstores/DIR/P/T        forced off / on (by default: on for outputs of >= 16 MiB)
+//   ntstores/DIR/P/T        forced off / on (by default: off)
 //   packets/forward/spherical/T/k  the first 65536 rows in calls of k rows (16: the renderer's
 //                           packets; 65536: one call)
 //   stream/6to4/T/threads:k a plain triad moving the same bytes per pair as forward (6 columns
@@ -15,18 +15,25 @@
 // output against SoA columns in the same run (layout/.../rows vs layout/.../soa).
 // Timing: CPU time of the calling thread for one-thread runs (the machine is shared: wall time
 // would count the other processes), wall time and the process's CPU time for threads:k > 1.
-// Counters: s_per_pair (displayed with an SI prefix, e.g. 2.1n = 2.1 ns per pair) and
-// bytes_per_second (input + output bytes per pair). HALFBACK_BENCH_PAIRS overrides the size.
+// Counters: s_per_pair (displayed with an SI prefix, e.g. 2.1n = 2.1 ns per pair),
+// bytes_per_second (input + output bytes per pair); for the conversions also faults (page faults
+// per iteration: none once the outputs are touched), sys_ms (system CPU time per iteration) and,
+// on one thread, x_stream: the CPU time per pair over that of the triad of the same direction,
+// timed right after the benchmark (the best of two passes), so that the ratio to the streaming
+// bound holds under the same load. HALFBACK_BENCH_PAIRS overrides the size.
 #include <benchmark/benchmark.h>
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <ctime>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -108,6 +115,28 @@ void set_counters(benchmark::State& state, std::size_t n, std::size_t columns) {
   state.SetBytesProcessed(static_cast<std::int64_t>(pairs * columns * sizeof(T)));
 }
 
+// CPU time of the calling thread, in seconds.
+double thread_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Page faults and system time of the process, sampled around a benchmark's loop.
+struct Usage {
+  double faults, sys_s;
+  static Usage now() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return {
+        static_cast<double>(u.ru_minflt + u.ru_majflt),
+        static_cast<double>(u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_stime.tv_usec)};
+  }
+};
+
+template <class T>
+double stream_seconds_per_pair(bool forward);
+
 // --- the engine ---------------------------------------------------------------------------
 
 template <class T>
@@ -120,11 +149,21 @@ void bm_convert(benchmark::State& state, Space space, bool forward, unsigned thr
   std::vector<Column<T>> oc;
   for (std::size_t c = 0; c < (forward ? 4u : 6u); ++c) oc.push_back({d.out[c].data(), 1});
   const ConvertOutput<T> out{oc, {}, d.valid.data()};
+  const Usage u0 = Usage::now();
+  const double t0 = thread_seconds();
   for (auto _ : state) {
     convert<T>(forward ? dirs : param, forward ? param : dirs, ic, d.n, out, {int(threads)});
     benchmark::ClobberMemory();
   }
+  const double cpu = thread_seconds() - t0;
+  const Usage u1 = Usage::now();
   set_counters<T>(state, d.n, 10);
+  const auto iterations = static_cast<double>(state.iterations());
+  state.counters["faults"] = (u1.faults - u0.faults) / iterations;
+  state.counters["sys_ms"] = 1e3 * (u1.sys_s - u0.sys_s) / iterations;
+  if (threads == 1)
+    state.counters["x_stream"] =
+        cpu / (iterations * static_cast<double>(d.n)) / stream_seconds_per_pair<T>(forward);
 }
 
 // The same conversion with the input and the output as row-major arrays ((N, 6) and (N, 4),
@@ -160,8 +199,8 @@ void bm_layout(benchmark::State& state, Space space, bool forward, bool rows) {
   set_counters<T>(state, d.n, 10);
 }
 
-// The same with the outputs' non-temporal stores forced off (on) whatever the size: what they
-// change, measured in the same run (by default they are on from kStreamingBytes of output).
+// The same with the outputs' non-temporal stores forced off (on): what they change, measured in
+// the same run (by default they are off).
 template <class T>
 void bm_stores(benchmark::State& state, Space space, bool forward, bool streaming) {
   detail::set_streaming_stores(streaming);
@@ -302,6 +341,22 @@ void stream_rows(const Columns<T>& a, Columns<T>& o, std::size_t nin, std::size_
     }
   }
   (void)nout;
+}
+
+// One thread's CPU time per pair of the triad, the best of two passes.
+template <class T>
+double stream_seconds_per_pair(bool forward) {
+  Data<T>& d = Data<T>::get();
+  const Columns<T>& src = forward ? d.dirs : d.coords[0];
+  double best = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double t0 = thread_seconds();
+    stream_rows(src, d.out, forward ? 6 : 4, forward ? 4 : 6, 0, d.n);
+    benchmark::ClobberMemory();
+    const double t = thread_seconds() - t0;
+    best = pass == 0 ? t : std::min(best, t);
+  }
+  return best / static_cast<double>(d.n);
 }
 
 template <class T>

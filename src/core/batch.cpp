@@ -132,18 +132,17 @@ const KernelSet& active_kernels() {
 }
 
 namespace {
-std::atomic<int> g_streaming{-1};  // -1: by size, 0: off, 1: on
+std::atomic<bool> g_streaming{false};
 }  // namespace
 
 void set_streaming_stores(std::optional<bool> on) {
-  g_streaming.store(on ? int(*on) : -1, std::memory_order_release);
+  g_streaming.store(on.value_or(false), std::memory_order_release);
 }
 
-// Whether convert() writes an output of this size with non-temporal stores.
-bool streaming_stores(std::size_t output_bytes);
-bool streaming_stores(std::size_t output_bytes) {
-  const int forced = g_streaming.load(std::memory_order_acquire);
-  return forced < 0 ? output_bytes >= kStreamingBytes : forced == 1;
+// Whether convert() writes its outputs with non-temporal stores (off unless forced).
+bool streaming_stores();
+bool streaming_stores() {
+  return g_streaming.load(std::memory_order_acquire);
 }
 
 bool set_batch_isa(std::optional<SimdIsa> isa) {
@@ -437,7 +436,7 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
   check_shapes(from, to, in.size(), out.columns.size());
   if (n == 0) return;
   const Plan<T> plan(detail::active_kernels().stages<T>(), from, to, in, out,
-                     detail::streaming_stores(n * dimension(to) * sizeof(T)));
+                     detail::streaming_stores());
 
   constexpr std::size_t tile = kTileRows<T>;
   const std::size_t tiles = (n + tile - 1) / tile;

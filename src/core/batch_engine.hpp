@@ -90,13 +90,13 @@ const KernelSet& active_kernels();
 // false, changing nothing, when `isa` is not available here. Not meant to race with convert().
 bool set_batch_isa(std::optional<SimdIsa> isa);
 
-// Outputs of at least this many bytes (all output columns of one call) are written with
-// non-temporal stores: they would not stay in cache, and a plain store first reads the line it
-// writes (for a forward conversion, 4 of the 14 values moved per pair).
-inline constexpr std::size_t kStreamingBytes = std::size_t{16} << 20;
-
-// For tests and benchmarks: forces non-temporal output stores on (true) or off (false) whatever
-// the size; nullopt: by size (kStreamingBytes). Not meant to race with convert().
+// Outputs are written with plain stores by default. Non-temporal stores (outputs assembled in
+// the tile's scratch, then copied past the caches) avoid the write-allocate reads of the output
+// lines, but measured slower on every conversion at 10^7 pairs on AMD Zen 5 (11-44 %) and within
+// noise on Intel (docs/performance.md, "Conversions"): the burst of copies at the end of each tile
+// waits on the write-combining buffers, while plain stores overlap the kernels' arithmetic.
+// For tests and benchmarks: forces non-temporal output stores on (true) or off (false);
+// nullopt: the default (off). Not meant to race with convert().
 void set_streaming_stores(std::optional<bool> on);
 
 }  // namespace halfback::detail

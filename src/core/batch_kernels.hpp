@@ -240,16 +240,26 @@ void scatter_rows(const S* __restrict columns, S* __restrict rows, std::size_t m
 }
 
 template <class B, class P, int Space>
-constexpr void fill_param(StageKernels<ScalarOf<B>>& k) {
+constexpr void fill_decode(StageKernels<ScalarOf<B>>& k) {
   k.decode[Space][0] = &decode_stage<B, P, false>;
   k.decode[Space][1] = &decode_stage<B, P, true>;
+}
+
+template <class B, class P, int Space>
+constexpr void fill_encode(StageKernels<ScalarOf<B>>& k) {
   k.encode[Space][0] = &encode_stage<B, P, false>;
   k.encode[Space][1] = &encode_stage<B, P, true>;
+}
+
+template <class B, class P, int Space>
+constexpr void fill_jacobian(StageKernels<ScalarOf<B>>& k) {
   k.jacobian[Space][0] = &jacobian_stage<B, P, false>;
   k.jacobian[Space][1] = &jacobian_stage<B, P, true>;
 }
 
-template <class B>
+// B: the vector type of the stages; W: that of the decodes and of halfdiff's encode (the
+// longest kernels), which may be two vectors per step (Twin, batch_kernels_avx512.cpp).
+template <class B, class W = B>
 constexpr StageKernels<ScalarOf<B>> make_stages() {
   StageKernels<ScalarOf<B>> k{};
   k.width = Lanes<B>::size;
@@ -262,16 +272,24 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   k.scatter[4] = &scatter_rows<S, 4>;
   k.scatter[6] = &scatter_rows<S, 6>;
   // Indices follow Space: spherical = 1, halfdiff = 2, ortho = 3, hybrid = 4.
-  fill_param<B, Spherical, 0>(k);
-  fill_param<B, HalfDiff, 1>(k);
-  fill_param<B, Ortho, 2>(k);
-  fill_param<B, Hybrid, 3>(k);
+  fill_decode<W, Spherical, 0>(k);
+  fill_decode<W, HalfDiff, 1>(k);
+  fill_decode<W, Ortho, 2>(k);
+  fill_decode<W, Hybrid, 3>(k);
+  fill_encode<B, Spherical, 0>(k);
+  fill_encode<W, HalfDiff, 1>(k);
+  fill_encode<B, Ortho, 2>(k);
+  fill_encode<B, Hybrid, 3>(k);
+  fill_jacobian<B, Spherical, 0>(k);
+  fill_jacobian<B, HalfDiff, 1>(k);
+  fill_jacobian<B, Ortho, 2>(k);
+  fill_jacobian<B, Hybrid, 3>(k);
   return k;
 }
 
-template <class BF, class BD>
+template <class BF, class BD, class WF = BF, class WD = BD>
 constexpr KernelSet make_kernel_set(SimdIsa isa, std::string_view name) {
-  return KernelSet{isa, name, make_stages<BF>(), make_stages<BD>()};
+  return KernelSet{isa, name, make_stages<BF, WF>(), make_stages<BD, WD>()};
 }
 
 }  // namespace

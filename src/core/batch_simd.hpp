@@ -201,4 +201,113 @@ struct LaneOps<xsimd::batch<S, A>> {
   }
 };
 
+// Two vectors as one lane type: every operation is issued on both halves, next to each other in
+// the instruction stream. The forward kernels are chains of dependent divisions, square roots and
+// polynomials (~700 instructions a vector for halfdiff double), longer than the out-of-order
+// window, so one vector's latency stalls were not hidden by the next vector's work; with the two
+// halves interleaved, each stall has an independent instruction beside it. Lanes are
+// independent, so a row's result is bit for bit that of the single vector.
+template <class B>
+struct Twin {
+  B lo, hi;
+  Twin() = default;
+  Twin(const B& l, const B& h) : lo(l), hi(h) {}
+  template <class U>
+  requires std::is_arithmetic_v<U>
+  explicit(false) Twin(U s) : lo(B(static_cast<typename B::value_type>(s))), hi(lo) {}
+  static constexpr std::size_t size = 2 * B::size;
+  // What batch_kernels.hpp's Lanes calls on a vector type.
+  template <class S>
+  static Twin load_unaligned(const S* p) {
+    return {B::load_unaligned(p), B::load_unaligned(p + B::size)};
+  }
+  template <class S>
+  void store_unaligned(S* p) const {
+    lo.store_unaligned(p);
+    hi.store_unaligned(p + B::size);
+  }
+};
+
+template <class M>
+struct TwinMask {
+  M lo, hi;
+};
+
+template <class M>
+inline TwinMask<M> operator&&(const TwinMask<M>& a, const TwinMask<M>& b) {
+  return {a.lo && b.lo, a.hi && b.hi};
+}
+template <class M>
+inline TwinMask<M> operator||(const TwinMask<M>& a, const TwinMask<M>& b) {
+  return {a.lo || b.lo, a.hi || b.hi};
+}
+template <class M>
+inline TwinMask<M> operator!(const TwinMask<M>& a) {
+  return {!a.lo, !a.hi};
+}
+template <class M>
+inline bool all(const TwinMask<M>& m) {
+  return xsimd::all(m.lo) && xsimd::all(m.hi);
+}
+template <class M>
+inline bool any(const TwinMask<M>& m) {
+  return xsimd::any(m.lo) || xsimd::any(m.hi);
+}
+
+#define HALFBACK_TWIN_BINARY(op)                                   \
+  template <class B>                                               \
+  inline Twin<B> operator op(const Twin<B>& a, const Twin<B>& b) { \
+    return {a.lo op b.lo, a.hi op b.hi};                           \
+  }
+HALFBACK_TWIN_BINARY(+)
+HALFBACK_TWIN_BINARY(-)
+HALFBACK_TWIN_BINARY(*)
+HALFBACK_TWIN_BINARY(/)
+#undef HALFBACK_TWIN_BINARY
+#define HALFBACK_TWIN_COMPARE(op)                                                                \
+  template <class B>                                                                             \
+  inline TwinMask<typename B::batch_bool_type> operator op(const Twin<B>& a, const Twin<B>& b) { \
+    return {a.lo op b.lo, a.hi op b.hi};                                                         \
+  }
+HALFBACK_TWIN_COMPARE(<)
+HALFBACK_TWIN_COMPARE(<=)
+HALFBACK_TWIN_COMPARE(>)
+HALFBACK_TWIN_COMPARE(>=)
+HALFBACK_TWIN_COMPARE(==)
+#undef HALFBACK_TWIN_COMPARE
+template <class B>
+inline Twin<B> operator-(const Twin<B>& a) {
+  return {-a.lo, -a.hi};
+}
+
+template <class B>
+struct LaneOps<Twin<B>> {
+  using T = Twin<B>;
+  using O = LaneOps<B>;
+  using Scalar = typename O::Scalar;
+  using Mask = TwinMask<typename O::Mask>;
+
+  static T select(const Mask& c, const T& a, const T& b) {
+    return {O::select(c.lo, a.lo, b.lo), O::select(c.hi, a.hi, b.hi)};
+  }
+  static T fma(const T& a, const T& b, const T& c) {
+    return {O::fma(a.lo, b.lo, c.lo), O::fma(a.hi, b.hi, c.hi)};
+  }
+  static T sqrt(const T& x) { return {O::sqrt(x.lo), O::sqrt(x.hi)}; }
+  static T abs(const T& x) { return {O::abs(x.lo), O::abs(x.hi)}; }
+  static T atan2(const T& y, const T& x) { return {O::atan2(y.lo, x.lo), O::atan2(y.hi, x.hi)}; }
+  static T min(const T& a, const T& b) { return {O::min(a.lo, b.lo), O::min(a.hi, b.hi)}; }
+  static T max(const T& a, const T& b) { return {O::max(a.lo, b.lo), O::max(a.hi, b.hi)}; }
+  static void sincos(const T& x, T& s, T& c) {
+    O::sincos(x.lo, s.lo, c.lo);
+    O::sincos(x.hi, s.hi, c.hi);
+  }
+  static Mask mask_and(const Mask& a, const Mask& b) { return a && b; }
+  static Mask mask_or(const Mask& a, const Mask& b) { return a || b; }
+  static Mask mask_not(const Mask& a) { return !a; }
+  static Mask select_mask(const Mask& c, const Mask& a, const Mask& b) {
+    return (c && a) || (!c && b);
+  }
+};
+
 }  // namespace halfback

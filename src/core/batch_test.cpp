@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -983,6 +985,66 @@ TYPED_TEST(BatchLaneOps, Atan2SpecialValuesMatchStd) {
         EXPECT_EQ(std::signbit(got), std::signbit(want)) << "atan2(" << y << ", " << x << ")";
       }
     }
+}
+
+// atan2 takes the rare cases (huge magnitudes, 0/0, ∞/∞) on a branch for the whole vector: a
+// lane's result must not depend on its neighbours. Each lane of a mixed vector is compared bit
+// for bit with the same value in every lane.
+TYPED_TEST(BatchLaneOps, Atan2LanesAreIndependent) {
+  using S = TypeParam;
+  using L = LaneOps<Sse2<S>>;
+  constexpr std::size_t W = Sse2<S>::size;
+  const S inf = std::numeric_limits<S>::infinity(), nan = std::numeric_limits<S>::quiet_NaN();
+  const S big = std::numeric_limits<S>::max() / 3;
+  const S vals[] = {0, -S(0), 1, -S(0.3), S(2.5), inf, -inf, big, -big, S(1e-30), nan};
+  auto bits = [](S v) {
+    return std::bit_cast<std::conditional_t<sizeof(S) == 4, std::uint32_t, std::uint64_t>>(v);
+  };
+  for (S y0 : vals)
+    for (S x0 : vals)
+      for (S y1 : vals)
+        for (S x1 : vals) {
+          std::vector<S> y(W, y1), x(W, x1);
+          y[0] = y0;
+          x[0] = x0;
+          const std::vector<S> mixed =
+              lanes(L::atan2(Sse2<S>::load_unaligned(y.data()), Sse2<S>::load_unaligned(x.data())));
+          const S alone0 = lanes(L::atan2(make<S>({y0}), make<S>({x0})))[0];
+          const S alone1 = lanes(L::atan2(make<S>({y1}), make<S>({x1})))[0];
+          ASSERT_EQ(bits(mixed[0]), bits(alone0))
+              << y0 << " " << x0 << " beside " << y1 << " " << x1;
+          ASSERT_EQ(bits(mixed[1]), bits(alone1))
+              << y1 << " " << x1 << " beside " << y0 << " " << x0;
+        }
+}
+
+// Twin (two vectors as one lane type) gives each half the bits of the single vector.
+TYPED_TEST(BatchLaneOps, TwinHalvesAreTheSingleVectors) {
+  using S = TypeParam;
+  using B = Sse2<S>;
+  using L = LaneOps<B>;
+  using LT = LaneOps<Twin<B>>;
+  const B a = make<S>({S(0.25), -S(3), S(1e-20), 0}), b = make<S>({S(-2), S(0.5), 0, S(40)});
+  const B c = make<S>({S(7), S(1e5), S(-0.5), S(2)});
+  const Twin<B> ta{a, b}, tb{b, c};
+  auto same = [](const B& x, const B& y) {
+    const std::vector<S> u = lanes(x), v = lanes(y);
+    for (std::size_t k = 0; k < u.size(); ++k)
+      if (std::memcmp(&u[k], &v[k], sizeof(S)) != 0) return false;
+    return true;
+  };
+  const Twin<B> t2 = LT::atan2(ta, tb), tq = ta / tb, tf = LT::fma(ta, tb, ta);
+  EXPECT_TRUE(same(t2.lo, L::atan2(a, b)) && same(t2.hi, L::atan2(b, c)));
+  EXPECT_TRUE(same(tq.lo, a / b) && same(tq.hi, b / c));
+  EXPECT_TRUE(same(tf.lo, L::fma(a, b, a)) && same(tf.hi, L::fma(b, c, b)));
+  Twin<B> s, co;
+  LT::sincos(ta, s, co);
+  B s0, c0, s1, c1;
+  L::sincos(a, s0, c0);
+  L::sincos(b, s1, c1);
+  EXPECT_TRUE(same(s.lo, s0) && same(co.lo, c0) && same(s.hi, s1) && same(co.hi, c1));
+  const Twin<B> sel = LT::select(ta < tb, ta, tb);
+  EXPECT_TRUE(same(sel.lo, L::select(a < b, a, b)) && same(sel.hi, L::select(b < c, b, c)));
 }
 
 TYPED_TEST(BatchLaneOps, MinMaxIgnoreNanLikeFminFmax) {
