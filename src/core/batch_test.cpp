@@ -748,7 +748,7 @@ TYPED_TEST(BatchTest, EncodeOfUncheckedRowsIsCheckThenEncode) {
     std::vector<T> mask_old(n), mask_new(n, detail::kUnchecked<T>);
     T* copy_cols[6];
     for (int c = 0; c < 6; ++c) copy_cols[c] = copy[c].data();
-    k.check(in_cols, copy_cols, mask_old.data(), n);
+    k.check(in_cols, copy_cols, mask_old.data(), n, {});
     for (Form to : test::parameterization_forms()) {
       SCOPED_TRACE(std::string(detail::isa_name(isa)) + " dirs->" + form_name(to));
       const auto encode = k.encode[static_cast<int>(to.space) - 1][to.isotropic ? 1 : 0];
@@ -759,8 +759,8 @@ TYPED_TEST(BatchTest, EncodeOfUncheckedRowsIsCheckThenEncode) {
         o_new[c] = out_new[c].data();
       }
       std::vector<T> m_old = mask_old, m_new = mask_new;
-      encode(copy_cols, m_old.data(), o_old, n);
-      encode(in_cols, m_new.data(), o_new, n);
+      encode(copy_cols, m_old.data(), o_old, n, {});
+      encode(in_cols, m_new.data(), o_new, n, {});
       EXPECT_EQ(m_new, m_old);
       for (std::size_t c = 0; c < dimension(to); ++c)
         EXPECT_EQ(std::memcmp(out_new[c].data(), out_old[c].data(), n * sizeof(T)), 0)
