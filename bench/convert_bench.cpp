@@ -434,7 +434,7 @@ void register_all() {
         ("packets/forward/spherical/" + t + "/" + std::to_string(packet)).c_str(),
         [=](benchmark::State& st) { bm_packets<T>(st, Space::spherical, packet); })
         ->Apply(timing(1));
-  for (Space s : {Space::halfdiff, Space::hybrid})
+  for (Space s : {Space::spherical, Space::halfdiff, Space::ortho, Space::hybrid})
     for (bool forward : {true, false})
       for (bool rows : {false, true})
         benchmark::RegisterBenchmark(

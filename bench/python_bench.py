@@ -3,13 +3,16 @@
 batch path, measured in the same run (docs/performance.md, "Through Python").
 
     PYTHONPATH=build/release/python /usr/bin/python3 bench/python_bench.py [--pairs N]
-        [--conversions-only]
+        [--conversions-only | --layouts-only]
 
 Conversions dirs -> hybrid and hybrid -> dirs on N pairs (default 10^7), float64 and float32,
 C-order (NumPy's default) and Fortran-order arrays, a new result and out=, alternated;
 BRDF evaluation of a MERL table (nearest bin; NumPy: the reference lookup written with arrays)
 and of an RGL material. The C++ figures come from build/release/bench/halfback_bench and
 halfback_brdf_bench run by this script.
+
+--layouts-only: C order against Fortran order alone (no NumPy, no C++), dirs <-> hybrid and
+halfdiff, both precisions, a new result and out=, alternated ("Array layouts").
 """
 
 import argparse
@@ -107,13 +110,51 @@ def cxx_ns_per_pair(binary, filt, pairs, counter="s_per_pair"):
     return result
 
 
+def time_layouts(xc, src, dst, dim, dtype, n, repeat=3):
+    """Seconds per pair of halfback.convert on C-order and Fortran-order arrays, a new result
+    (for Fortran order: out= a fresh Fortran array, so that both pay the allocation) and out=."""
+    xf = np.asfortranarray(xc)
+    outc, outf = np.empty((n, dim), dtype), np.empty((n, dim), dtype, order="F")
+    # The two layouts alternate, so that they share the machine's varying load.
+    t = {"c": [], "c_out": [], "f": [], "f_out": []}
+    for _ in range(repeat):
+        t["c"].append(best_of(lambda: halfback.convert(xc, src, dst), 1))
+        t["f"].append(best_of(
+            lambda: halfback.convert(xf, src, dst, out=np.empty((n, dim), dtype, order="F")), 1))
+        t["c_out"].append(best_of(lambda: halfback.convert(xc, src, dst, out=outc), 1))
+        t["f_out"].append(best_of(lambda: halfback.convert(xf, src, dst, out=outf), 1))
+    return {k: min(v) / n for k, v in t.items()}
+
+
+def layouts(n):
+    print(f"# halfback.convert, C order against Fortran order, {n} pairs, {os.cpu_count()} cores\n")
+    print("| conversion | C order | F order | C / F | C order, out= | F order, out= | C / F, out= |")
+    print("|---|---|---|---|---|---|---|")
+    for dtype, tname in [(np.float64, "double"), (np.float32, "float")]:
+        x = random_pairs(n, dtype)
+        for space in ["hybrid", "halfdiff"]:
+            q = halfback.convert(x, "dirs", space)
+            for src, dst, xc, dim in [("dirs", space, x, 4), (space, "dirs", q, 6)]:
+                t = time_layouts(xc, src, dst, dim, dtype, n)
+                print(f"| {src} -> {dst}, {tname} | {t['c'] * 1e9:.1f} ns | {t['f'] * 1e9:.1f} ns | "
+                      f"{t['c'] / t['f']:.2f}× | {t['c_out'] * 1e9:.1f} ns | "
+                      f"{t['f_out'] * 1e9:.1f} ns | {t['c_out'] / t['f_out']:.2f}× |", flush=True)
+            del q
+        del x
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--pairs", type=int, default=10_000_000)
     ap.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
     ap.add_argument("--conversions-only", action="store_true", help="skip the BRDF evaluations")
+    ap.add_argument("--layouts-only", action="store_true",
+                    help="only C order against Fortran order, hybrid and halfdiff")
     a = ap.parse_args()
     n = a.pairs
+    if a.layouts_only:
+        return layouts(n)
     print(f"# halfback through Python, {n} pairs, {os.cpu_count()} cores\n")
     print("| operation | NumPy | C order | C order, out= | F order | F order, out= | "
           "C++ batch (SoA) | vs NumPy | C / F order | C / F order, out= |")
@@ -127,31 +168,21 @@ def main():
     for dtype, tname in [(np.float64, "double"), (np.float32, "float")]:
         x = random_pairs(n, dtype)
         q = halfback.convert(x, "dirs", "hybrid")
-        # C order (NumPy's default): rows of 6 and 4 values, the engine's transposing path.
-        # Column-major (Fortran-order) arrays hand the engine contiguous columns: its SoA path.
-        xf, qf = np.asfortranarray(x), np.asfortranarray(q)
-        cases = [("dirs -> hybrid", x, xf, "dirs", "hybrid", 4, lambda: numpy_hybrid(x),
+        # C order (NumPy's default): rows of 6 and 4 values; Fortran order hands the engine
+        # contiguous columns (its SoA path).
+        cases = [("dirs -> hybrid", x, "dirs", "hybrid", 4, lambda: numpy_hybrid(x),
                   f"forward/hybrid/{tname}/threads:{threads}{timing}"),
-                 ("hybrid -> dirs", q, qf, "hybrid", "dirs", 6, lambda: numpy_hybrid_inverse(q),
+                 ("hybrid -> dirs", q, "hybrid", "dirs", 6, lambda: numpy_hybrid_inverse(q),
                   f"inverse/hybrid/{tname}/threads:{threads}{timing}")]
-        for label, xc, xfo, src, dst, dim, fnp, key in cases:
-            outc, outf = np.empty((n, dim), dtype), np.empty((n, dim), dtype, order="F")
+        for label, xc, src, dst, dim, fnp, key in cases:
             t_np = best_of(fnp) / n
-            # The two layouts alternate, so that they share the machine's varying load.
-            t = {"c": [], "c_out": [], "f": [], "f_out": []}
-            for _ in range(3):
-                t["c"].append(best_of(lambda: halfback.convert(xc, src, dst), 1))
-                t["f"].append(best_of(
-                    lambda: halfback.convert(xfo, src, dst, out=np.empty((n, dim), dtype, order="F")), 1))
-                t["c_out"].append(best_of(lambda: halfback.convert(xc, src, dst, out=outc), 1))
-                t["f_out"].append(best_of(lambda: halfback.convert(xfo, src, dst, out=outf), 1))
-            t = {k: min(v) / n for k, v in t.items()}
+            t = time_layouts(xc, src, dst, dim, dtype, n)
             t_cxx = cxx.get(key, float("nan"))
             print(f"| {label}, {tname} | {t_np * 1e9:.1f} ns | {t['c'] * 1e9:.1f} ns | "
                   f"{t['c_out'] * 1e9:.1f} ns | {t['f'] * 1e9:.1f} ns | {t['f_out'] * 1e9:.1f} ns | "
                   f"{t_cxx * 1e9:.1f} ns | {t_np / t['c']:.1f}× faster | {t['c'] / t['f']:.2f}× | "
                   f"{t['c_out'] / t['f_out']:.2f}× |")
-        del x, q, xf, qf
+        del x, q
     if a.conversions_only:
         return 0
     # BRDF evaluation.

@@ -3,10 +3,12 @@
 // Rows are processed in tiles of kTileBytes per column (512 float or 256 double rows). For each
 // tile: input columns with stride 1 are read in place, others are gathered into SoA scratch; the
 // stage kernels of batch_engine.hpp (check or decode, then encode) run on the tile; outputs with
-// stride 1 are written in place, others scattered from scratch. Tiles are grouped into chunks run
-// by oneTBB on up to BatchOptions::threads threads. Every row is computed by the same vector
-// code, in the same lane, whatever the chunking (tiles are whole multiples of every vector
-// width), so the result does not depend on the thread count.
+// stride 1 are written in place, others scattered from scratch. A row-major (m, D) input or
+// output (NumPy's C order) is read or written by the first or last stage itself, transposed in
+// its vector loop, where the kernel table can (fused_rows), and else transposed in one pass. Tiles
+// are grouped into chunks run by oneTBB on up to BatchOptions::threads threads. Every row is
+// computed by the same vector code, in the same lane, whatever the chunking (tiles are whole
+// multiples of every vector width), so the result does not depend on the thread count.
 #include "halfback/core/batch.hpp"
 
 #include <tbb/blocked_range.h>
@@ -199,6 +201,9 @@ struct Plan {
   // (dimension(to)) values a row: moved by one vectorized transpose instead of per column.
   typename Stages::GatherFn gather = nullptr;
   typename Stages::ScatterFn scatter = nullptr;
+  // Set instead when the stages read (write) those rows themselves: the Jacobian's stages read
+  // columns, so a call that asks for it takes the transpose passes.
+  bool rows_in = false, rows_out = false;
 
   // Outputs written with non-temporal stores (through scratch).
   bool stream;
@@ -225,8 +230,12 @@ struct Plan {
       encode = k.encode[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0];
       if (want_jac) jacobian_out = k.jacobian[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0];
     }
-    if (interleaved(in)) gather = k.gather[dim_in];
-    if (interleaved(std::span<const Column<T>>(o.columns))) scatter = k.scatter[dim_out];
+    const bool in_rows = interleaved(in);
+    const bool out_rows = interleaved(std::span<const Column<T>>(o.columns));
+    rows_in = in_rows && !want_jac && k.fused_rows[dim_in];
+    rows_out = out_rows && !want_jac && k.fused_rows[dim_out];
+    if (in_rows && !rows_in) gather = k.gather[dim_in];
+    if (out_rows && !rows_out) scatter = k.scatter[dim_out];
   }
 
   // Whether column c is field c of one row-major array of columns.size() values a row.
@@ -328,12 +337,16 @@ class TileRunner {
   void run(std::size_t r0, std::size_t m) {
     const Plan<T>& p = plan_;
     const auto base = static_cast<std::ptrdiff_t>(r0);
-    const T* in[detail::kMaxDim];
+    const T* in[detail::kMaxDim] = {};
+    detail::StageRows<T> rows;
+    if (p.rows_in) rows.in = p.in[0].data + base * static_cast<std::ptrdiff_t>(p.dim_in);
     if (p.gather)
       p.gather(p.in[0].data + base * static_cast<std::ptrdiff_t>(p.dim_in), column(kInput), m);
     for (std::size_t c = 0; c < p.dim_in; ++c) {
       const ConstColumn<T>& col = p.in[c];
-      if (p.gather) {
+      if (p.rows_in) {
+        break;  // the first stage reads the rows
+      } else if (p.gather) {
         in[c] = column(kInput + c);
       } else if (col.stride == 1) {
         in[c] = col.data + base;
@@ -346,8 +359,9 @@ class TileRunner {
     }
     // With non-temporal stores, every output is assembled in scratch first.
     const bool direct = !p.stream;
-    T* out[detail::kMaxDim];
-    for (std::size_t c = 0; c < p.dim_out; ++c) {
+    T* out[detail::kMaxDim] = {};
+    if (p.rows_out) rows.out = direct ? out_rows(r0) : column(kOutput);
+    for (std::size_t c = 0; c < p.dim_out && !p.rows_out; ++c) {
       const Column<T>& col = p.out->columns[c];
       out[c] = col.stride == 1 && direct ? col.data + base : column(kOutput + c);
     }
@@ -356,34 +370,41 @@ class TileRunner {
     if (p.want_jac) jac = jcol.stride == 1 && direct ? jcol.data + base : column(kJacobian);
     T* mask = column(kMask);
 
-    run_stages(in, out, jac, mask, m);
+    run_stages(in, out, jac, mask, m, rows);
     write_outputs(out, jac, mask, r0, m);
   }
 
  private:
   // Columns: 6 gathered inputs (also the staging of non-temporal row stores, once the stages have
-  // read them), 6 outputs to scatter, 6 directions, mask, jacobian.
+  // read them), 6 outputs to scatter (or the staged rows the last stage writes, with non-temporal
+  // stores), 6 directions, mask, jacobian.
   static constexpr std::size_t kInput = 0, kOutput = 6, kDirs = 12, kMask = 18, kJacobian = 19,
                                kColumns = 20;
   static_assert(kColumns * detail::kTileBytes <= ScratchLease::kBytes);
   T* column(std::size_t c) { return scratch_ + c * kTileRows<T>; }
+  // The output rows of the tile at row r0 (a row-major output).
+  T* out_rows(std::size_t r0) const {
+    return plan_.out->columns[0].data + static_cast<std::ptrdiff_t>(r0 * plan_.dim_out);
+  }
 
-  void run_stages(const T* const* in, T* const* out, T* jac, T* mask, std::size_t m) {
+  // `rows`: the row-major input the first stage reads, the output rows the last one writes.
+  void run_stages(const T* const* in, T* const* out, T* jac, T* mask, std::size_t m,
+                  detail::StageRows<T> rows) {
     const Plan<T>& p = plan_;
     // The input's measure before decoding: `out` may share memory with `in`.
     if (jac && p.jacobian_in) p.jacobian_in(in, jac, m);
     if (p.check && !p.encode) {
-      p.check(in, out, mask, m);
+      p.check(in, out, mask, m, rows);
     } else if (p.check) {
       std::fill_n(mask, m, detail::kUnchecked<T>);  // encode checks the directions itself
-      p.encode(in, mask, out, m);
+      p.encode(in, mask, out, m, rows);
     } else if (!p.encode) {
-      p.decode(in, out, mask, m);
+      p.decode(in, out, mask, m, rows);
     } else {
       T* dirs[6];
       for (int c = 0; c < 6; ++c) dirs[c] = column(kDirs + c);
-      p.decode(in, dirs, mask, m);
-      p.encode(dirs, mask, out, m);
+      p.decode(in, dirs, mask, m, {rows.in, nullptr});
+      p.encode(dirs, mask, out, m, {nullptr, rows.out});
     }
     if (jac && p.jacobian_out) p.jacobian_out(out, jac, m);
     if (jac) mask_jacobian(mask, jac, m, !p.jacobian_in && !p.jacobian_out);
@@ -392,8 +413,10 @@ class TileRunner {
   void write_outputs(T* const* out, const T* jac, const T* mask, std::size_t r0, std::size_t m) {
     const Plan<T>& p = plan_;
     const auto base = static_cast<std::ptrdiff_t>(r0);
-    if (p.scatter) {
-      T* rows = p.out->columns[0].data + base * static_cast<std::ptrdiff_t>(p.dim_out);
+    if (p.rows_out) {
+      if (p.stream) stream_copy(column(kOutput), out_rows(r0), m * p.dim_out);  // staged rows
+    } else if (p.scatter) {
+      T* rows = out_rows(r0);
       if (p.stream) {
         p.scatter(column(kOutput), column(kInput), m);
         stream_copy(column(kInput), rows, m * p.dim_out);

@@ -12,6 +12,11 @@
 //   jacobian (P in or out)  dim(P) columns -> J(q), not masked (the engine masks it)
 // Masks are stored as T: 1 for a valid row, 0 otherwise. The Jacobian is a stage of its own rather
 // than a variant of decode and encode so that those, the largest kernels, are compiled once.
+//
+// Row-major (NumPy C-order) inputs and outputs are transposed inside the stages' vector loops
+// where the table says so (fused_rows): the first stage reads its D input values straight from
+// the rows, the last one writes its D outputs as rows (StageRows). A transpose pass of its own
+// over scratch (gather/scatter) cost as much as a third of a conversion at 10^7 pairs.
 
 #pragma once
 
@@ -35,11 +40,23 @@ inline constexpr std::size_t kTileRows = kTileBytes / sizeof(T);
 template <class T>
 inline constexpr T kUnchecked = T(2);
 
+// Where a stage reads its coordinates (or directions) and writes them, when not its column
+// pointers: `in`, if set, holds the m rows of the stage's D input values (a row-major (m, D)
+// array; the mask, if read, stays a column); `out`, if set, receives its D output values as rows.
+template <class T>
+struct StageRows {
+  const T* in = nullptr;
+  T* out = nullptr;
+};
+
 template <class T>
 struct StageKernels {
-  using CheckFn = void (*)(const T* const* in, T* const* copy, T* mask, std::size_t m);
-  using DecodeFn = void (*)(const T* const* in, T* const* dirs, T* mask, std::size_t m);
-  using EncodeFn = void (*)(const T* const* dirs, T* mask, T* const* out, std::size_t m);
+  using CheckFn = void (*)(const T* const* in, T* const* copy, T* mask, std::size_t m,
+                           StageRows<T> rows);
+  using DecodeFn = void (*)(const T* const* in, T* const* dirs, T* mask, std::size_t m,
+                            StageRows<T> rows);
+  using EncodeFn = void (*)(const T* const* dirs, T* mask, T* const* out, std::size_t m,
+                            StageRows<T> rows);
   using JacobianFn = void (*)(const T* const* coords, T* jac, std::size_t m);
   std::size_t width;  // lanes per vector
   CheckFn check;
@@ -52,6 +69,9 @@ struct StageKernels {
   using ScatterFn = void (*)(const T* columns, T* rows, std::size_t m);
   GatherFn gather[7];
   ScatterFn scatter[7];
+  // Whether the check, decode and encode stages take rows of D values (StageRows) in their
+  // vector loops, for D = 3, 4, 6; where not, the engine transposes with gather and scatter.
+  bool fused_rows[7];
 };
 
 struct KernelSet {

@@ -49,45 +49,83 @@ struct Lanes {
   }
 };
 
+// Moves W (lanes) rows of D values between memory and D lane vectors, for the stages' row-major
+// inputs and outputs (StageRows). This generic one is for the scalar kernels (W = 1: a plain
+// copy); a SIMD table that transposes in registers specializes it (batch_kernels_avx512.cpp), and
+// the others leave it off (fused = false: the engine transposes with gather and scatter).
+template <class B, int D>
+struct RowTranspose {
+  static constexpr bool fused = std::is_floating_point_v<B>;
+  static void load(const ScalarOf<B>* rows, B* x) {
+    for (int c = 0; c < D; ++c) x[c] = rows[c];
+  }
+  static void store(const B* y, ScalarOf<B>* rows) {
+    for (int c = 0; c < D; ++c) rows[c] = y[c];
+  }
+};
+
 // f(x, y) on vectors [0, n) of rows: x[c] holds rows [i, i + W) of in[c], and y[c] is stored to
-// out[c]. The one flattened function of a stage: everything f calls, down to the xsimd
-// intrinsics, is inlined into this loop (GCC otherwise keeps the larger param.hpp functions and
-// xsimd's sincos out of line, passing 512-bit vectors through memory, which costs 2-3x). It is
-// not inlined itself, so that the full vectors and the padded last one share one copy of f's
-// body: inlined twice, the kernel files took twice as long to compile.
-template <class B, int NI, int NO, class F>
+// out[c]; with rows.in (rows.out) set, x[0, DI) (y[0, DO)) come from (go to) rows of DI (DO)
+// values instead (DI, DO = 0: never). The one flattened function of a stage: everything f calls,
+// down to the xsimd intrinsics, is inlined into this loop (GCC otherwise keeps the larger
+// param.hpp functions and xsimd's sincos out of line, passing 512-bit vectors through memory,
+// which costs 2-3x). It is not inlined itself, so that the full vectors and the padded last one
+// share one copy of f's body: inlined twice, the kernel files took twice as long to compile. The
+// layout is a branch per vector rather than a template parameter for the same reason; it is
+// always predicted.
+template <class B, int NI, int NO, int DI, int DO, class F>
 [[gnu::noinline]] HALFBACK_FLATTEN void vector_loop(const ScalarOf<B>* const* in,
-                                                    ScalarOf<B>* const* out, std::size_t n, F f) {
+                                                    ScalarOf<B>* const* out, std::size_t n,
+                                                    StageRows<ScalarOf<B>> rows, F f) {
   using L = Lanes<B>;
+  constexpr bool rows_in = DI > 0 && RowTranspose<B, DI>::fused;
+  constexpr bool rows_out = DO > 0 && RowTranspose<B, DO>::fused;
   B x[NI], y[NO];
   for (std::size_t i = 0; i < n; i += L::size) {
-    for (int c = 0; c < NI; ++c) x[c] = L::load(in[c] + i);
+    if (rows_in && rows.in) {
+      if constexpr (rows_in) RowTranspose<B, DI>::load(rows.in + DI * i, x);
+      for (int c = DI; c < NI; ++c) x[c] = L::load(in[c] + i);
+    } else {
+      for (int c = 0; c < NI; ++c) x[c] = L::load(in[c] + i);
+    }
     f(x, y);
-    for (int c = 0; c < NO; ++c) L::store(out[c] + i, y[c]);
+    if (rows_out && rows.out) {
+      if constexpr (rows_out) RowTranspose<B, DO>::store(y, rows.out + DO * i);
+      for (int c = DO; c < NO; ++c) L::store(out[c] + i, y[c]);
+    } else {
+      for (int c = 0; c < NO; ++c) L::store(out[c] + i, y[c]);
+    }
   }
 }
 
-// Runs f on every row. The last m % W rows go through a zero-padded buffer; lanes are
-// independent, so the padding never changes a real row's result.
-template <class B, int NI, int NO, class F>
-inline void for_rows(const ScalarOf<B>* const* in, ScalarOf<B>* const* out, std::size_t m, F f) {
+// Runs f on every row. The last m % W rows go through a zero-padded buffer (as columns, also
+// those of row-major inputs and outputs); lanes are independent, so the padding never changes a
+// real row's result.
+template <class B, int NI, int NO, int DI = 0, int DO = 0, class F>
+inline void for_rows(const ScalarOf<B>* const* in, ScalarOf<B>* const* out, std::size_t m,
+                     StageRows<ScalarOf<B>> rows, F f) {
   using S = ScalarOf<B>;
   constexpr std::size_t W = Lanes<B>::size;
   const std::size_t full = m - m % W;
-  vector_loop<B, NI, NO>(in, out, full, f);
+  vector_loop<B, NI, NO, DI, DO>(in, out, full, rows, f);
   if (full == m) return;
   const std::size_t r = m - full;
   alignas(64) S buf[NI > NO ? NI : NO][W];
   const S* buf_in[NI];
   S* buf_out[NO];
   for (int c = 0; c < NI; ++c) {
-    for (std::size_t k = 0; k < W; ++k) buf[c][k] = k < r ? in[c][full + k] : S(0);
+    const bool from_rows = rows.in && c < DI;
+    for (std::size_t k = 0; k < W; ++k)
+      buf[c][k] = k >= r ? S(0) : from_rows ? rows.in[DI * (full + k) + c] : in[c][full + k];
     buf_in[c] = buf[c];
   }
   for (int c = 0; c < NO; ++c) buf_out[c] = buf[c];
-  vector_loop<B, NI, NO>(buf_in, buf_out, W, f);
-  for (int c = 0; c < NO; ++c)
-    for (std::size_t k = 0; k < r; ++k) out[c][full + k] = buf[c][k];
+  vector_loop<B, NI, NO, DI, DO>(buf_in, buf_out, W, {}, f);
+  for (int c = 0; c < NO; ++c) {
+    const bool to_rows = rows.out && c < DO;
+    for (std::size_t k = 0; k < r; ++k)
+      (to_rows ? rows.out[DO * (full + k) + c] : out[c][full + k]) = buf[c][k];
+  }
 }
 
 template <class B>
@@ -105,11 +143,11 @@ inline B mask_to_lanes(const MaskOf<B>& m) {
 // (accepted_pair(); NaN where invalid), which the encode stage reads.
 template <class B>
 void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy, ScalarOf<B>* mask,
-                 std::size_t m) {
+                 std::size_t m, StageRows<ScalarOf<B>> rows) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   S* outs[7] = {copy[0], copy[1], copy[2], copy[3], copy[4], copy[5], mask};
-  for_rows<B, 6, 7>(in, outs, m, [](const B* x, B* y) {
+  for_rows<B, 6, 7, 6, 6>(in, outs, m, rows, [](const B* x, B* y) {
     const DirPair<B> raw{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
     const auto ok = pair_is_valid(raw);
     const DirPair<B> p = accepted_pair(raw);
@@ -122,14 +160,14 @@ void check_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* copy, ScalarO
 // P input: the pair (NaN where invalid) and the domain mask.
 template <class B, class P, bool Iso>
 void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, ScalarOf<B>* mask,
-                  std::size_t m) {
+                  std::size_t m, StageRows<ScalarOf<B>> rows) {
   using S = ScalarOf<B>;
   constexpr int NI = Iso ? 3 : 4;
   constexpr int NO = 6 + 1;
   S* outs[NO];
   for (int c = 0; c < 6; ++c) outs[c] = dirs[c];
   outs[6] = mask;
-  for_rows<B, NI, NO>(in, outs, m, [](const B* q, B* y) {
+  for_rows<B, NI, NO, NI, 6>(in, outs, m, rows, [](const B* q, B* y) {
     const Solved<B> s = decode_param<P, B>(Iso, q);
     y[0] = s.pair.wi.x;
     y[1] = s.pair.wi.y;
@@ -150,7 +188,7 @@ void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, Scalar
 // is rewritten, 1 or 0.
 template <class B, class P, bool Iso>
 void encode_stage(const ScalarOf<B>* const* dirs, ScalarOf<B>* mask, ScalarOf<B>* const* out,
-                  std::size_t m) {
+                  std::size_t m, StageRows<ScalarOf<B>> rows) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int kDim = Iso ? 3 : 4;
@@ -158,7 +196,7 @@ void encode_stage(const ScalarOf<B>* const* dirs, ScalarOf<B>* mask, ScalarOf<B>
   S* outs[kDim + 1];
   for (int c = 0; c < kDim; ++c) outs[c] = out[c];
   outs[kDim] = mask;
-  for_rows<B, 7, kDim + 1>(ins, outs, m, [](const B* x, B* y) {
+  for_rows<B, 7, kDim + 1, 6, kDim>(ins, outs, m, rows, [](const B* x, B* y) {
     const DirPair<B> raw{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
     const auto unchecked = x[6] == B(kUnchecked<S>);
     const auto ok = L::mask_or(x[6] == B(S(1)), L::mask_and(unchecked, pair_is_valid(raw)));
@@ -181,7 +219,8 @@ void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<B>* jac, std::siz
   using S = ScalarOf<B>;
   constexpr int NI = Iso ? 3 : 4;
   S* outs[1] = {jac};
-  for_rows<B, NI, 1>(coords, outs, m, [](const B* q, B* y) { y[0] = jacobian_of<P, B>(Iso, q); });
+  for_rows<B, NI, 1>(coords, outs, m, {},
+                     [](const B* q, B* y) { y[0] = jacobian_of<P, B>(Iso, q); });
 }
 
 template <class S, int D, std::size_t Pitch>
@@ -271,6 +310,9 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   k.scatter[3] = &scatter_rows<S, 3>;
   k.scatter[4] = &scatter_rows<S, 4>;
   k.scatter[6] = &scatter_rows<S, 6>;
+  k.fused_rows[3] = RowTranspose<B, 3>::fused;
+  k.fused_rows[4] = RowTranspose<B, 4>::fused;
+  k.fused_rows[6] = RowTranspose<B, 6>::fused;
   // Indices follow Space: spherical = 1, halfdiff = 2, ortho = 3, hybrid = 4.
   fill_decode<W, Spherical, 0>(k);
   fill_decode<W, HalfDiff, 1>(k);

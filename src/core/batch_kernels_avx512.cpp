@@ -81,33 +81,78 @@ struct TransposeIndices {
   }
 };
 
+// W rows of D values (D registers) <-> D column registers.
 template <class S, int D>
-void gather_zmm(const S* __restrict rows, S* __restrict columns, std::size_t m) {
+struct ZmmRows {
   using Z = Zmm<S>;
-  constexpr int W = Z::W, P = D / 2;
-  constexpr std::size_t pitch = kTileRows<S>;
-  static constexpr TransposeIndices<typename Z::Index, W, D> idx;
-  __m512i ia[P], ib[P];
-  for (int p = 0; p < P; ++p) {
-    ia[p] = _mm512_loadu_si512(idx.gather_a[p].data());
-    ib[p] = _mm512_loadu_si512(idx.gather_b[p].data());
+  using V = typename Z::V;
+  static constexpr int W = Z::W, P = D / 2;
+  static constexpr TransposeIndices<typename Z::Index, W, D> idx{};
+
+  static __m512i index(const std::array<typename Z::Index, W>& i) {
+    return _mm512_loadu_si512(i.data());
   }
-  std::size_t i = 0;
-  for (; i + W <= m; i += W) {
-    typename Z::V half[2][P];
+  static void load(const S* rows, V* columns) {
+    V half[2][P];
     for (int g = 0; g < 2; ++g) {
-      const S* src = rows + D * i + g * P * W;
-      typename Z::V r[P];
+      const S* src = rows + g * P * W;
+      V r[P];
       for (int k = 0; k < P; ++k) r[k] = Z::load(src + k * W);
       for (int p = 0; p < P; ++p) {
-        half[g][p] = Z::permute2(r[0], ia[p], r[1]);
-        if constexpr (D == 6) half[g][p] = Z::permute2(half[g][p], ib[p], r[2]);
+        half[g][p] = Z::permute2(r[0], index(idx.gather_a[p]), r[1]);
+        if constexpr (D == 6) half[g][p] = Z::permute2(half[g][p], index(idx.gather_b[p]), r[2]);
       }
     }
     for (int p = 0; p < P; ++p) {
-      Z::store(columns + 2 * p * pitch + i, Z::low_halves(half[0][p], half[1][p]));
-      Z::store(columns + (2 * p + 1) * pitch + i, Z::high_halves(half[0][p], half[1][p]));
+      columns[2 * p] = Z::low_halves(half[0][p], half[1][p]);
+      columns[2 * p + 1] = Z::high_halves(half[0][p], half[1][p]);
     }
+  }
+  static void store(const V* columns, S* rows) {
+    V half[2][P];
+    for (int p = 0; p < P; ++p) {
+      half[0][p] = Z::low_halves(columns[2 * p], columns[2 * p + 1]);
+      half[1][p] = Z::high_halves(columns[2 * p], columns[2 * p + 1]);
+    }
+    for (int g = 0; g < 2; ++g) {
+      S* dst = rows + g * P * W;
+      for (int r = 0; r < P; ++r) {
+        V v = Z::permute2(half[g][0], index(idx.scatter_a[r]), half[g][1]);
+        if constexpr (D == 6) v = Z::permute2(v, index(idx.scatter_b[r]), half[g][2]);
+        Z::store(dst + r * W, v);
+      }
+    }
+  }
+};
+
+// The rows of the stages' vector loops (batch_kernels.hpp), transposed in registers; rows of 3
+// (isotropic coordinates) keep the engine's transpose passes.
+template <class S, int D>
+struct RowTranspose<xsimd::batch<S, xsimd::avx512f>, D> {
+  using B = xsimd::batch<S, xsimd::avx512f>;
+  static constexpr bool fused = D == 4 || D == 6;
+  static void load(const S* rows, B* x) {
+    typename Zmm<S>::V c[D];
+    ZmmRows<S, D>::load(rows, c);
+    for (int k = 0; k < D; ++k) x[k] = B(c[k]);
+  }
+  static void store(const B* y, S* rows) {
+    typename Zmm<S>::V c[D];
+    for (int k = 0; k < D; ++k) c[k] = y[k];
+    ZmmRows<S, D>::store(c, rows);
+  }
+};
+
+// The transpose passes over scratch, for the cases the stages do not fuse (the Jacobian's).
+template <class S, int D>
+void gather_zmm(const S* __restrict rows, S* __restrict columns, std::size_t m) {
+  constexpr int W = Zmm<S>::W;
+  constexpr std::size_t pitch = kTileRows<S>;
+  std::size_t i = 0;
+  for (; i + W <= m; i += W) {
+    typename Zmm<S>::V c[D];
+    ZmmRows<S, D>::load(rows + D * i, c);
+    for (int k = 0; k < D; ++k) Zmm<S>::store(columns + k * pitch + i, c[k]);
   }
   for (; i < m; ++i)
     for (int c = 0; c < D; ++c) columns[c * pitch + i] = rows[D * i + c];
@@ -115,32 +160,13 @@ void gather_zmm(const S* __restrict rows, S* __restrict columns, std::size_t m) 
 
 template <class S, int D>
 void scatter_zmm(const S* __restrict columns, S* __restrict rows, std::size_t m) {
-  using Z = Zmm<S>;
-  constexpr int W = Z::W, P = D / 2;
+  constexpr int W = Zmm<S>::W;
   constexpr std::size_t pitch = kTileRows<S>;
-  static constexpr TransposeIndices<typename Z::Index, W, D> idx;
-  __m512i ia[P], ib[P];
-  for (int r = 0; r < P; ++r) {
-    ia[r] = _mm512_loadu_si512(idx.scatter_a[r].data());
-    ib[r] = _mm512_loadu_si512(idx.scatter_b[r].data());
-  }
   std::size_t i = 0;
   for (; i + W <= m; i += W) {
-    typename Z::V half[2][P];
-    for (int p = 0; p < P; ++p) {
-      const typename Z::V a = Z::load(columns + 2 * p * pitch + i);
-      const typename Z::V b = Z::load(columns + (2 * p + 1) * pitch + i);
-      half[0][p] = Z::low_halves(a, b);
-      half[1][p] = Z::high_halves(a, b);
-    }
-    for (int g = 0; g < 2; ++g) {
-      S* dst = rows + D * i + g * P * W;
-      for (int r = 0; r < P; ++r) {
-        typename Z::V v = Z::permute2(half[g][0], ia[r], half[g][1]);
-        if constexpr (D == 6) v = Z::permute2(v, ib[r], half[g][2]);
-        Z::store(dst + r * W, v);
-      }
-    }
+    typename Zmm<S>::V c[D];
+    for (int k = 0; k < D; ++k) c[k] = Zmm<S>::load(columns + k * pitch + i);
+    ZmmRows<S, D>::store(c, rows + D * i);
   }
   for (; i < m; ++i)
     for (int c = 0; c < D; ++c) rows[D * i + c] = columns[c * pitch + i];
