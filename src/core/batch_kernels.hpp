@@ -313,6 +313,9 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   k.fused_rows[3] = RowTranspose<B, 3>::fused;
   k.fused_rows[4] = RowTranspose<B, 4>::fused;
   k.fused_rows[6] = RowTranspose<B, 6>::fused;
+  // The plan reads fused_rows for the whole table: the Twin stages must fuse the same widths.
+  static_assert(RowTranspose<W, 4>::fused == RowTranspose<B, 4>::fused &&
+                RowTranspose<W, 6>::fused == RowTranspose<B, 6>::fused);
   // Indices follow Space: spherical = 1, halfdiff = 2, ortho = 3, hybrid = 4.
   fill_decode<W, Spherical, 0>(k);
   fill_decode<W, HalfDiff, 1>(k);

@@ -143,6 +143,30 @@ struct RowTranspose<xsimd::batch<S, xsimd::avx512f>, D> {
   }
 };
 
+// Two vectors per step (the decodes, halfdiff's encode): the rows of each half in turn. Without
+// it the Twin stages would not read the rows the plan hands them (fused_rows is per table).
+template <class S, int D>
+struct RowTranspose<Twin<xsimd::batch<S, xsimd::avx512f>>, D> {
+  using B = xsimd::batch<S, xsimd::avx512f>;
+  using Half = RowTranspose<B, D>;
+  static constexpr bool fused = Half::fused;
+  static void load(const S* rows, Twin<B>* x) {
+    B lo[D], hi[D];
+    Half::load(rows, lo);
+    Half::load(rows + D * B::size, hi);
+    for (int k = 0; k < D; ++k) x[k] = Twin<B>(lo[k], hi[k]);
+  }
+  static void store(const Twin<B>* y, S* rows) {
+    B lo[D], hi[D];
+    for (int k = 0; k < D; ++k) {
+      lo[k] = y[k].lo;
+      hi[k] = y[k].hi;
+    }
+    Half::store(lo, rows);
+    Half::store(hi, rows + D * B::size);
+  }
+};
+
 // The transpose passes over scratch, for the cases the stages do not fuse (the Jacobian's).
 template <class S, int D>
 void gather_zmm(const S* __restrict rows, S* __restrict columns, std::size_t m) {
