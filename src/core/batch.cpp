@@ -342,11 +342,9 @@ class TileRunner {
     if (p.rows_in) rows.in = p.in[0].data + base * static_cast<std::ptrdiff_t>(p.dim_in);
     if (p.gather)
       p.gather(p.in[0].data + base * static_cast<std::ptrdiff_t>(p.dim_in), column(kInput), m);
-    for (std::size_t c = 0; c < p.dim_in; ++c) {
+    for (std::size_t c = 0; c < p.dim_in && !p.rows_in; ++c) {  // else the first stage reads rows
       const ConstColumn<T>& col = p.in[c];
-      if (p.rows_in) {
-        break;  // the first stage reads the rows
-      } else if (p.gather) {
+      if (p.gather) {
         in[c] = column(kInput + c);
       } else if (col.stride == 1) {
         in[c] = col.data + base;

@@ -112,9 +112,10 @@ bool set_batch_isa(std::optional<SimdIsa> isa);
 
 // Outputs are written with plain stores by default. Non-temporal stores (outputs assembled in
 // the tile's scratch, then copied past the caches) avoid the write-allocate reads of the output
-// lines, but measured slower on every conversion at 10^7 pairs on AMD Zen 5 (11-44 %) and within
-// noise on Intel (docs/performance.md, "Conversions"): the burst of copies at the end of each tile
-// waits on the write-combining buffers, while plain stores overlap the kernels' arithmetic.
+// lines, but measured slower in 14 of 16 conversions at 10^7 pairs on AMD Zen 5 (5-77 %, the
+// other two within noise) and within noise on Intel (docs/performance.md, "Conversions"): the
+// burst of copies at the end of each tile waits on the write-combining buffers, while plain
+// stores overlap the kernels' arithmetic.
 // For tests and benchmarks: forces non-temporal output stores on (true) or off (false);
 // nullopt: the default (off). Not meant to race with convert().
 void set_streaming_stores(std::optional<bool> on);

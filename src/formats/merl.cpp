@@ -233,8 +233,6 @@ namespace {
 
 using merl_kernel::kBlock;
 constexpr std::uint32_t kScalarRow = 0xffffffffu;  // a row left to eval()
-// Rows of a trilinear block whose corners are prefetched before the next block's conversion.
-constexpr std::size_t kPrefetchLead = 16;
 
 // The isotropic halfdiff coordinates (θh, θd, φd) of a block's rows, and which rows go through
 // eval().
@@ -297,34 +295,21 @@ void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<
     for (std::size_t i = 0; i < previous->m; ++i) finish(*previous, i);
 }
 
-// Software-pipelined: the next block's conversion and cells are computed before this block's
-// blends, with the corners of this block's first rows prefetched just before that conversion, so
-// that their cache misses are served while it computes (merl_kernel::blend_rows prefetches the
-// rest a few rows ahead of itself; under load no faster nor slower: docs/performance.md, fourth
-// round). Rows left to eval() get its values over the blend's.
+// Block by block: the conversion, the cells, then the blends (merl_kernel::blend_rows prefetches
+// its own corners a step ahead). Rows left to eval() get its values over the blend's. Converting
+// the next block before this block's blends (software pipelining) measured no faster, loaded or
+// idle (docs/performance.md, "MERL, fourth round").
 void MerlBrdf::trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                                 std::size_t begin, std::size_t end) const {
-  struct Block {
-    std::size_t first = 0, m = 0;
-    Coordinates c;
-    merl_kernel::Cells cells;
-  };
-  Block stage[2];
-  auto prepare = [&](Block& t, std::size_t b) {
-    t.first = b * kBlock;
-    t.m = std::min(kBlock, pairs.size() - t.first);
-    convert_block(pairs.subspan(t.first, t.m), t.c);
-    merl_kernel::cells(t.c.q[0], t.c.q[1], t.c.q[2], t.m, t.cells);  // in range even for NaN
-  };
-  const merl::BinValues* table = bins_.get();
-  if (begin < end) prepare(stage[0], begin);
+  Coordinates c;
+  merl_kernel::Cells cells;
   for (std::size_t b = begin; b < end; ++b) {
-    Block& t = stage[(b - begin) % 2];
-    merl_kernel::prefetch_rows(table, t.cells, 0, std::min(t.m, kPrefetchLead));
-    if (b + 1 < end) prepare(stage[(b + 1 - begin) % 2], b + 1);
-    merl_kernel::blend_rows(table, t.cells, 0, t.m, out.data() + t.first);
-    for (std::size_t i = 0; i < t.m; ++i)
-      if (t.c.apart[i]) out[t.first + i] = eval(pairs[t.first + i]);
+    const std::size_t first = b * kBlock, m = std::min(kBlock, pairs.size() - first);
+    convert_block(pairs.subspan(first, m), c);
+    merl_kernel::cells(c.q[0], c.q[1], c.q[2], m, cells);  // in range even for NaN
+    merl_kernel::blend_rows(bins_.get(), cells, 0, m, out.data() + first);
+    for (std::size_t i = 0; i < m; ++i)
+      if (c.apart[i]) out[first + i] = eval(pairs[first + i]);
   }
 }
 

@@ -73,11 +73,6 @@ void cells(const double* theta_h, const double* theta_d, const double* phi_d, st
   __builtin_prefetch(q + kThetaHStep + kThetaDStep);
 }
 
-void prefetch_rows(const merl::BinValues* table, const Cells& cells, std::size_t begin,
-                   std::size_t end) {
-  for (std::size_t r = begin; r < end; ++r) prefetch_corners(table, cells[r]);
-}
-
 // Steps of kRows rows: the corners of the next step are prefetched, this step's corner values
 // copied into columns (a short loop of independent loads, so that many rows' cache misses are in
 // flight), then blended across rows in vectors. Blending row by row, each row's arithmetic filled

@@ -202,10 +202,6 @@ void cells(const double* theta_h, const double* theta_d, const double* phi_d, st
 void blend_rows(const merl::BinValues* table, const Cells& cells, std::size_t begin,
                 std::size_t end, Rgb* out);
 
-// Prefetches the 8 corners of rows [begin, end) of a block's cells.
-void prefetch_rows(const merl::BinValues* table, const Cells& cells, std::size_t begin,
-                   std::size_t end);
-
 // Whether each of m row-major pairs (6 doubles a row) is left to eval(): rejected by the
 // conversion (valid = 0), below the horizon, or with ωi + ωo along the normal.
 void rows_apart(const double* rows, const std::uint8_t* valid, std::size_t m, std::uint8_t* apart);
