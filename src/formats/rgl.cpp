@@ -59,6 +59,25 @@ double unit(double x) {
   return x > 0 ? (x < 1 ? x : 1) : 0;
 }
 
+// cell_of() of n points (x, y) in columns, with 32-bit indices (a conversion the vector units
+// have; the tables' sides fit, eval_block checks): the same cells.
+struct Cells {
+  alignas(64) std::int32_t i[kBlock], j[kBlock];
+  alignas(64) double tx[kBlock], ty[kBlock];
+};
+[[gnu::always_inline]] inline void cells_of(const double* x, const double* y, std::size_t n,
+                                            std::size_t w, std::size_t h, Cells& c) {
+  const double sw = double(w - 1), sh = double(h - 1);
+  const auto last_i = std::int32_t(w - 2), last_j = std::int32_t(h - 2);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double u = unit(x[k]) * sw, v = unit(y[k]) * sh;
+    const std::int32_t i = std::min(static_cast<std::int32_t>(u), last_i);
+    const std::int32_t j = std::min(static_cast<std::int32_t>(v), last_j);
+    c.i[k] = i, c.j[k] = j;
+    c.tx[k] = u - double(i), c.ty[k] = v - double(j);
+  }
+}
+
 double theta_to_u(double theta) {
   return std::sqrt(theta * (2 / kPi));
 }
@@ -689,20 +708,12 @@ template <int N, class SlicesOf>
 template <int N>
 [[gnu::always_inline]] inline void densities_at(const Warp& wp, const Slices* s, const double* x,
                                                 const double* y, std::size_t m, double* out) {
-  const double sx = double(wp.w - 1), sy = double(wp.h - 1);
-  const auto last_i = std::int32_t(wp.w - 2), last_j = std::int32_t(wp.h - 2);
-  alignas(64) std::int32_t ci[kBlock], cj[kBlock];
-  alignas(64) double tx[kBlock], ty[kBlock];
-  for (std::size_t q = 0; q < m; ++q) {  // cell_of(), with 32-bit indices: the same cells
-    const double u = unit(x[q]) * sx, v = unit(y[q]) * sy;
-    ci[q] = std::min(static_cast<std::int32_t>(u), last_i);
-    cj[q] = std::min(static_cast<std::int32_t>(v), last_j);
-    tx[q] = u - double(ci[q]), ty[q] = v - double(cj[q]);
-  }
+  Cells c;
+  cells_of(x, y, m, wp.w, wp.h, c);
   std::size_t i[kBlock], j[kBlock];
-  for (std::size_t q = 0; q < m; ++q) i[q] = std::size_t(ci[q]), j[q] = std::size_t(cj[q]);
+  for (std::size_t q = 0; q < m; ++q) i[q] = std::size_t(c.i[q]), j[q] = std::size_t(c.j[q]);
   densities_in_cells<N>(
-      wp, m, [&](std::size_t q) -> const Slices& { return s[q]; }, i, j, tx, ty, out);
+      wp, m, [&](std::size_t q) -> const Slices& { return s[q]; }, i, j, c.tx, c.ty, out);
 }
 HALFBACK_RGL_CLONES void densities_at(const Warp& wp, const Slices* s, const double* x,
                                       const double* y, std::size_t m, double* out) {
@@ -1352,25 +1363,6 @@ struct EvalRows {
   alignas(64) double weight[4][kRows];
   alignas(64) double fr[3][kRows];
 };
-
-// cell_of() of n points (x, y) in columns, with 32-bit indices (a conversion the vector units
-// have; the tables' sides fit, eval_block checks): the same cells.
-struct Cells {
-  alignas(64) std::int32_t i[kRows], j[kRows];
-  alignas(64) double tx[kRows], ty[kRows];
-};
-[[gnu::always_inline]] inline void cells_of(const double* x, const double* y, std::size_t n,
-                                            std::size_t w, std::size_t h, Cells& c) {
-  const double sw = double(w - 1), sh = double(h - 1);
-  const auto last_i = std::int32_t(w - 2), last_j = std::int32_t(h - 2);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double u = unit(x[k]) * sw, v = unit(y[k]) * sh;
-    const std::int32_t i = std::min(static_cast<std::int32_t>(u), last_i);
-    const std::int32_t j = std::min(static_cast<std::int32_t>(v), last_j);
-    c.i[k] = i, c.j[k] = j;
-    c.tx[k] = u - double(i), c.ty[k] = v - double(j);
-  }
-}
 
 // Table::eval() of n points: the corners copied into columns, then blended.
 [[gnu::always_inline]] inline void table_eval(const double* v, std::size_t w, std::size_t h,
