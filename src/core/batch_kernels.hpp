@@ -200,12 +200,18 @@ void encode_stage(const ScalarOf<B>* const* dirs, ScalarOf<B>* mask, ScalarOf<B>
     const DirPair<B> raw{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
     const auto unchecked = x[6] == B(kUnchecked<S>);
     const auto ok = L::mask_or(x[6] == B(S(1)), L::mask_and(unchecked, pair_is_valid(raw)));
-    const DirPair<B> once = accepted_pair(raw), twice = accepted_pair(once);
-    auto pick = [&](const Vec3<B>& a, const Vec3<B>& b) {
-      return Vec3<B>{L::select(unchecked, a.x, b.x), L::select(unchecked, a.y, b.y),
-                     L::select(unchecked, a.z, b.z)};
-    };
-    encode_param<P, B>(Iso, DirPair<B>{pick(twice.wi, once.wi), pick(twice.wo, once.wo)}, y);
+    // Almost always every direction is unit to rounding and kept as it is, twice: one test.
+    DirPair<B> pair = raw;
+    if (!all_lanes(L::mask_and(on_unit_hemisphere(raw.wi), on_unit_hemisphere(raw.wo))))
+        [[unlikely]] {
+      const DirPair<B> once = accepted_pair(raw), twice = accepted_pair(once);
+      auto pick = [&](const Vec3<B>& a, const Vec3<B>& b) {
+        return Vec3<B>{L::select(unchecked, a.x, b.x), L::select(unchecked, a.y, b.y),
+                       L::select(unchecked, a.z, b.z)};
+      };
+      pair = {pick(twice.wi, once.wi), pick(twice.wo, once.wo)};
+    }
+    encode_param<P, B>(Iso, pair, y);
     for (int c = 0; c < kDim; ++c) y[c] = L::select(ok, y[c], nan_lanes<B>());
     y[kDim] = mask_to_lanes<B>(ok);
   });

@@ -131,33 +131,61 @@ struct LaneOps<xsimd::batch<S, A>> {
     const T a = xsimd::abs(y), b = xsimd::abs(x);
     // Beyond 2^1000 a + b could overflow: scale both (exactly) by 1/4.
     const T scale = xsimd::select(a > T(C::huge) || b > T(C::huge), T(S(0.25)), T(S(1)));
-    const T as = a * scale, bs = b * scale;
+    const T angle = half_plane_angle(first_quadrant(a * scale, b * scale), x);
+    const auto zero = (y == T(S(0))) && (x == T(S(0)));
+    const auto both_inf = xsimd::isinf(y) && xsimd::isinf(x);
+    const auto left = xsimd::copysign(T(S(1)), x) < T(S(0));
+    constexpr S pi = std::numbers::pi_v<S>;
+    const T special = xsimd::select(zero, xsimd::select(left, T(pi), T(S(0))),
+                                    xsimd::select(left, T(S(0.75) * pi), T(S(0.25) * pi)));
+    return xsimd::copysign(xsimd::select(zero || both_inf, special, angle), y);
+  }
+
+  // atan2 for finite x, y below 2^1000 in magnitude and not both zero (other lanes get an
+  // unspecified value): the same bits as atan2 there, without its scaling and rare cases. The
+  // azimuths of the forward conversions, whose invalid rows are masked afterwards.
+  static T atan2_finite(const T& y, const T& x) {
+    return xsimd::copysign(half_plane_angle(first_quadrant(xsimd::abs(y), xsimd::abs(x)), x), y);
+  }
+
+  // atan2 for y >= 0 and x >= 0 (either may be -0) under the same conditions: the same bits as
+  // atan2 there. Elevations, whose two arguments are a length and a z >= 0.
+  static T atan2_nonneg(const T& y, const T& x) {
+    const Octant o = first_quadrant(y, x);
+    return o.off_hi + (o.at + o.off_lo);
+  }
+
+  // The angle of (b, a) for a, b >= 0 as off_hi + (at + off_lo): the octant's offset, split in
+  // two for accuracy, and atan of the reduced ratio.
+  struct Octant {
+    T at, off_hi, off_lo;
+  };
+  static Octant first_quadrant(const T& a, const T& b) {
+    using C = Atan2Constants<S>;
     const auto low = a <= b * T(C::tan_pi_8);  // |y/x| <= tan(π/8)
     const auto high = a * T(C::tan_pi_8) > b;  // |x/y| < tan(π/8)
-    const T num = xsimd::select(low, as, xsimd::select(high, -bs, as - bs));
-    const T den = xsimd::select(low, bs, xsimd::select(high, as, as + bs));
+    const T num = xsimd::select(low, a, xsimd::select(high, -b, a - b));
+    const T den = xsimd::select(low, b, xsimd::select(high, a, a + b));
     const T r = num / den;
     const T z = r * r;
     // A local copy: the loop then reads no symbol that every instruction set's kernel file would
     // share (halfback_isa_symbols forbids weak symbols common to two of them).
     constexpr auto coefficients = C::g;
     const T g = polynomial(coefficients, z);
-    const T at = fma(r * z, g, r);
-    const T off_hi =
-        xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_hi), T(C::quarter_pi_hi)));
-    const T off_lo =
-        xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_lo), T(C::quarter_pi_lo)));
-    // x < 0 (or -0): π - (off + at) = (π_hi - off_hi) + ((π_lo - off_lo) - at).
+    return {
+        fma(r * z, g, r),
+        xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_hi), T(C::quarter_pi_hi))),
+        xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_lo), T(C::quarter_pi_lo)))};
+  }
+
+  // The first-quadrant angle o reflected to π minus it where x < 0 (or -0):
+  // π - (off + at) = (π_hi - off_hi) + ((π_lo - off_lo) - at).
+  static T half_plane_angle(const Octant& o, const T& x) {
+    using C = Atan2Constants<S>;
     const auto left = xsimd::copysign(T(S(1)), x) < T(S(0));
-    const T base = xsimd::select(left, T(C::pi_hi) - off_hi, off_hi);
-    const T rest = xsimd::select(left, (T(C::pi_lo) - off_lo) - at, at + off_lo);
-    const T angle = base + rest;
-    const auto zero = (y == T(S(0))) && (x == T(S(0)));
-    const auto both_inf = xsimd::isinf(y) && xsimd::isinf(x);
-    constexpr S pi = std::numbers::pi_v<S>;
-    const T special = xsimd::select(zero, xsimd::select(left, T(pi), T(S(0))),
-                                    xsimd::select(left, T(S(0.75) * pi), T(S(0.25) * pi)));
-    return xsimd::copysign(xsimd::select(zero || both_inf, special, angle), y);
+    const T base = xsimd::select(left, T(C::pi_hi) - o.off_hi, o.off_hi);
+    const T rest = xsimd::select(left, (T(C::pi_lo) - o.off_lo) - o.at, o.at + o.off_lo);
+    return base + rest;
   }
 
   static T min(const T& a, const T& b) {
@@ -296,6 +324,12 @@ struct LaneOps<Twin<B>> {
   static T sqrt(const T& x) { return {O::sqrt(x.lo), O::sqrt(x.hi)}; }
   static T abs(const T& x) { return {O::abs(x.lo), O::abs(x.hi)}; }
   static T atan2(const T& y, const T& x) { return {O::atan2(y.lo, x.lo), O::atan2(y.hi, x.hi)}; }
+  static T atan2_finite(const T& y, const T& x) {
+    return {O::atan2_finite(y.lo, x.lo), O::atan2_finite(y.hi, x.hi)};
+  }
+  static T atan2_nonneg(const T& y, const T& x) {
+    return {O::atan2_nonneg(y.lo, x.lo), O::atan2_nonneg(y.hi, x.hi)};
+  }
   static T min(const T& a, const T& b) { return {O::min(a.lo, b.lo), O::min(a.hi, b.hi)}; }
   static T max(const T& a, const T& b) { return {O::max(a.lo, b.lo), O::max(a.hi, b.hi)}; }
   static void sincos(const T& x, T& s, T& c) {

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -1101,6 +1102,104 @@ TYPED_TEST(BatchLaneOps, TwinHalvesAreTheSingleVectors) {
   EXPECT_TRUE(same(s.lo, s0) && same(co.lo, c0) && same(s.hi, s1) && same(co.hi, c1));
   const Twin<B> sel = LT::select(ta < tb, ta, tb);
   EXPECT_TRUE(same(sel.lo, L::select(a < b, a, b)) && same(sel.hi, L::select(b < c, b, c)));
+}
+
+// atan2_finite and atan2_nonneg drop atan2's scaling and rare cases: on their domains they must
+// give atan2's bits, including at the octant boundaries and for x = -0.
+TYPED_TEST(BatchLaneOps, NarrowAtan2sGiveTheBitsOfAtan2) {
+  using S = TypeParam;
+  using L = LaneOps<Sse2<S>>;
+  constexpr std::size_t W = Sse2<S>::size;
+  const S t8 = Atan2Constants<S>::tan_pi_8;
+  std::vector<S> edge = {0,
+                         -S(0),
+                         1,
+                         S(1e-30),
+                         std::numeric_limits<S>::min(),
+                         std::numeric_limits<S>::denorm_min(),
+                         t8,
+                         1 / t8,
+                         std::nextafter(t8, S(0)),
+                         std::nextafter(t8, S(1)),
+                         S(0.5),
+                         S(2)};
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto bits = [](S v) {
+    return std::bit_cast<std::conditional_t<sizeof(S) == 4, std::uint32_t, std::uint64_t>>(v);
+  };
+  auto check = [&](const std::vector<S>& y, const std::vector<S>& x) {
+    const auto Y = Sse2<S>::load_unaligned(y.data()), X = Sse2<S>::load_unaligned(x.data());
+    const auto full = lanes(L::atan2(Y, X)), finite = lanes(L::atan2_finite(Y, X));
+    const auto nonneg = lanes(L::atan2_nonneg(L::abs(Y), L::abs(X)));
+    const auto full_abs = lanes(L::atan2(L::abs(Y), L::abs(X)));
+    for (std::size_t k = 0; k < W; ++k) {
+      if (y[k] == 0 && x[k] == 0) continue;  // outside both domains
+      ASSERT_EQ(bits(finite[k]), bits(full[k])) << "atan2_finite(" << y[k] << ", " << x[k] << ")";
+      ASSERT_EQ(bits(nonneg[k]), bits(full_abs[k]))
+          << "atan2_nonneg(|" << y[k] << "|, |" << x[k] << "|)";
+    }
+  };
+  for (S a : edge)
+    for (S b : edge)
+      for (S sy : {S(1), S(-1)})
+        for (S sx : {S(1), S(-1)}) check(std::vector<S>(W, sy * a), std::vector<S>(W, sx * b));
+  for (int it = 0; it < 100000; ++it) {
+    std::vector<S> y(W), x(W);
+    for (std::size_t k = 0; k < W; ++k) {
+      y[k] = static_cast<S>(u(rng) * std::pow(10.0, 3 * u(rng)));
+      x[k] = static_cast<S>(u(rng) * std::pow(10.0, 3 * u(rng)));
+    }
+    check(y, x);
+  }
+}
+
+// HalfDiff::forward skips the clamp of θh (and its atan2) when no lane can need it. A lane's
+// result must be the same whether its vector takes that shortcut or not: each pair alone in a
+// vector is compared with the pair beside an invalid (NaN) one, which always evaluates the clamp.
+// The pairs are near h = 0 and at grazing, where the clamp acts.
+TYPED_TEST(BatchLaneOps, HalfDiffClampShortcutKeepsTheBits) {
+  using S = TypeParam;
+  using B = Sse2<S>;
+  constexpr std::size_t W = B::size;
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto bits = [](S v) {
+    return std::bit_cast<std::conditional_t<sizeof(S) == 4, std::uint32_t, std::uint64_t>>(v);
+  };
+  auto unit = [](double x, double y, double z) {
+    const double n = std::sqrt(x * x + y * y + z * z);
+    return std::array<S, 3>{S(x / n), S(y / n), S(z / n)};
+  };
+  const S nan = std::numeric_limits<S>::quiet_NaN();
+  int clamped = 0;
+  for (int it = 0; it < 50000; ++it) {
+    const double phi = 2 * std::numbers::pi * u(rng), tilt = std::pow(10.0, -12 * u(rng));
+    const double dphi = (u(rng) - 0.5) * std::pow(10.0, -10 * u(rng));
+    const auto wi = unit(std::cos(phi), std::sin(phi), tilt * u(rng));
+    const auto wo =
+        unit(-std::cos(phi + dphi), -std::sin(phi + dphi), it % 3 ? tilt * u(rng) : u(rng));
+    auto vec = [&](std::size_t c, bool poisoned) {
+      std::vector<S> v(W, c < 3 ? wi[c] : wo[c - 3]);
+      if (poisoned) v[W - 1] = nan;
+      return B::load_unaligned(v.data());
+    };
+    auto forward = [&](bool poisoned) {
+      const DirPair<B> p{{vec(0, poisoned), vec(1, poisoned), vec(2, poisoned)},
+                         {vec(3, poisoned), vec(4, poisoned), vec(5, poisoned)}};
+      return HalfDiff::forward(p);
+    };
+    const Tuple4<B> alone = forward(false), beside = forward(true);
+    for (int c = 0; c < 4; ++c)
+      ASSERT_EQ(bits(lanes(alone[c])[0]), bits(lanes(beside[c])[0]))
+          << "column " << c << " of (" << wi[0] << ", " << wi[1] << ", " << wi[2] << ") (" << wo[0]
+          << ", " << wo[1] << ", " << wo[2] << ")";
+    const DirPair<double> pd{{wi[0], wi[1], wi[2]}, {wo[0], wo[1], wo[2]}};
+    const double sx = pd.wi.x + pd.wo.x, sy = pd.wi.y + pd.wo.y;
+    clamped +=
+        HalfDiff::forward(pd)[0] < std::atan2(std::sqrt(sx * sx + sy * sy), pd.wi.z + pd.wo.z);
+  }
+  EXPECT_GT(clamped, 100) << "the pairs should reach the clamp";
 }
 
 TYPED_TEST(BatchLaneOps, MinMaxIgnoreNanLikeFminFmax) {

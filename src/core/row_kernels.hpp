@@ -24,13 +24,16 @@ inline MaskOf<T> pair_is_valid(const DirPair<T>& p) {
                      L::mask_and(p.wi.z >= -horizon_tol, p.wo.z >= -horizon_tol));
 }
 
-// Whether a mask is true in every lane (xsimd's all() for packs, found by argument lookup).
-template <class M>
-inline bool all_lanes(const M& m) {
-  if constexpr (std::is_same_v<M, bool>)
-    return m;
-  else
-    return all(m);
+// Whether w is kept as it is by onto_unit_hemisphere below: ‖ω‖² within 4ε of 1 (z below the
+// horizon counted as 0) and z >= 0; false for NaN.
+template <class T>
+inline MaskOf<T> on_unit_hemisphere(const Vec3<T>& w) {
+  using L = LaneOps<T>;
+  using S = ScalarOf<T>;
+  const T z = L::max(w.z, T(0));
+  const T e = w.x * w.x + w.y * w.y + z * z - T(1);
+  const T unit_tol(S(4) * std::numeric_limits<S>::epsilon());
+  return L::mask_and(L::mask_and(e <= unit_tol, e >= -unit_tol), w.z >= T(0));
 }
 
 // An accepted direction onto the unit upper hemisphere: a z below the horizon (within the
@@ -43,14 +46,11 @@ inline bool all_lanes(const M& m) {
 template <class T>
 inline Vec3<T> onto_unit_hemisphere(const Vec3<T>& w) {
   using L = LaneOps<T>;
-  using S = ScalarOf<T>;
-  const T z = L::max(w.z, T(0));
-  const T n2 = w.x * w.x + w.y * w.y + z * z;
-  const T e = n2 - T(1), unit_tol(S(4) * std::numeric_limits<S>::epsilon());
-  const auto keep = L::mask_and(L::mask_and(e <= unit_tol, e >= -unit_tol), w.z >= T(0));
+  const auto keep = on_unit_hemisphere(w);
   if (all_lanes(keep)) [[likely]]
     return w;
-  const T inv = T(1) / L::sqrt(n2);
+  const T z = L::max(w.z, T(0));
+  const T inv = T(1) / L::sqrt(w.x * w.x + w.y * w.y + z * z);
   return {L::select(keep, w.x, w.x * inv), L::select(keep, w.y, w.y * inv),
           L::select(keep, w.z, z * inv)};
 }

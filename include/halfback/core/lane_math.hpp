@@ -25,6 +25,10 @@ struct LaneOps<T> {
   static T select(bool c, T a, T b) { return c ? a : b; }
   static T sqrt(T x) { return std::sqrt(x); }
   static T atan2(T y, T x) { return std::atan2(y, x); }
+  // Narrower contracts that SIMD lanes exploit (batch_simd.hpp): finite |x|, |y| < 2^1000, not
+  // both zero; and in addition x, y >= 0. Other lanes get an unspecified value.
+  static T atan2_finite(T y, T x) { return std::atan2(y, x); }
+  static T atan2_nonneg(T y, T x) { return std::atan2(y, x); }
   static T abs(T x) { return std::abs(x); }
   static T min(T a, T b) { return std::fmin(a, b); }
   static T max(T a, T b) { return std::fmax(a, b); }
@@ -37,6 +41,16 @@ struct LaneOps<T> {
   static bool mask_not(bool a) { return !a; }
   static bool select_mask(bool c, bool a, bool b) { return c ? a : b; }
 };
+
+// Whether a mask is true in every lane (all() for packs, found by argument lookup): for a branch
+// around work that every lane can skip.
+template <class M>
+inline bool all_lanes(const M& m) {
+  if constexpr (std::is_same_v<M, bool>)
+    return m;
+  else
+    return all(m);
+}
 
 template <class T>
 using ScalarOf = typename LaneOps<T>::Scalar;

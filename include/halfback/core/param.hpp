@@ -52,12 +52,14 @@ struct Solved {
 
 namespace detail {
 
-// Azimuth of the planar vector (x, y) in [0, 2π); 0 for the zero vector; never -0.
+// Azimuth of the planar vector (x, y) in [0, 2π); 0 for the zero vector; never -0. For finite
+// x, y below 2^1000 in magnitude (larger or non-finite ones give an unspecified value), which
+// every valid pair's planar vectors are.
 template <class T>
 inline T azimuth(T y, T x) {
   using L = LaneOps<T>;
   using S = ScalarOf<T>;
-  T phi = L::atan2(y, x);
+  T phi = L::atan2_finite(y, x);
   phi = L::select(phi < T(0), phi + T(kTwoPi<S>), phi);
   phi = L::select(phi >= T(kTwoPi<S>), T(0), phi);  // -tiny + 2π may round up to 2π
   phi = L::select(L::mask_and(x == T(0), y == T(0)), T(0), phi);
@@ -85,11 +87,17 @@ inline MaskOf<T> is_azimuth(T phi) {
   return LaneOps<T>::mask_and(phi >= T(0), phi < T(kTwoPi<S>));
 }
 
-// Elevation angle of (x, y, z) from n: atan2 is accurate near 0 and π/2, where acos is not.
+// Elevation angle of (x, y, z) from n, for z >= 0 and finite coordinates below 2^500 not all zero
+// (others give an unspecified value): atan2 is accurate near 0 and π/2, where acos is not.
 template <class T>
 inline T elevation(T x, T y, T z) {
-  return LaneOps<T>::atan2(LaneOps<T>::sqrt(x * x + y * y), z);
+  return LaneOps<T>::atan2_nonneg(LaneOps<T>::sqrt(x * x + y * y), z);
 }
+
+// Margin, relative to the lengths involved, below which HalfDiff::forward's clamp of θh is
+// evaluated: 64ε against the ~5ε that the rounding of its test and of two atan2 can account for.
+template <class S>
+inline constexpr S kClampMargin = S(64) * std::numeric_limits<S>::epsilon();
 
 // Tolerance on a reconstructed elevation whose rounding error grows like ε / cond: the domain
 // predicates accept z >= -tol / max(cond, √tol) (docs/math.md, "Valid domain").
@@ -228,13 +236,14 @@ struct HalfDiff {
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
     using L = LaneOps<T>;
+    using S = ScalarOf<T>;
     const T sx = p.wi.x + p.wo.x, sy = p.wi.y + p.wo.y, sz = p.wi.z + p.wo.z;
     const T rxy = L::sqrt(sx * sx + sy * sy);
     const T len = L::sqrt(rxy * rxy + sz * sz);
     const auto flat = rxy == T(0), null = len == T(0);
     const T cp = L::select(flat, T(1), sx / rxy), sp = L::select(flat, T(0), sy / rxy);
     const T ct = L::select(null, T(1), sz / len), st = L::select(null, T(0), rxy / len);
-    const T theta_h_raw = L::select(null, T(0), L::atan2(rxy, sz));
+    const T theta_h_raw = L::select(null, T(0), L::atan2_nonneg(rxy, sz));
     // d = R_y(-θh) R_z(-φh) ωi, computed symmetrically in ωi and ωo: R⁻¹h = (0, 0, ‖h‖) exactly,
     // so d = (R⁻¹k)_xy + ‖h‖ n. Rotating ωi alone would make the inverse reflect ωi about ĥ, and
     // amplify the inputs' unit-norm rounding (‖ωi‖ ≠ ‖ωo‖ by an ulp) by 1/‖h‖ near h = 0; with
@@ -251,8 +260,16 @@ struct HalfDiff {
     // opposite each other at the horizon) θh is then noise that breaks this by up to ε/‖h‖. A tilt
     // of ĥ down to the bound rotates the pair by no more than that error, and keeps the round trip
     // of every accepted pair valid (docs/math.md §6). Valid pairs are unchanged but for rounding.
-    const T theta_h_max = L::atan2(dz, L::abs(dx));
-    const T theta_h = L::select(theta_h_raw > theta_h_max, theta_h_max, theta_h_raw);
+    // θh_raw > θh_max iff sin(θh_max - θh_raw) ∝ dz sz - |dx| rxy < 0. Where that is clearly
+    // positive in every lane (beyond the rounding of both sides and of both atan2, docs/math.md
+    // §6), the clamp cannot act and its atan2 is skipped: the same bits either way.
+    const T adx = L::abs(dx);
+    const auto clear = dz * sz - adx * rxy > T(detail::kClampMargin<S>) * len * (dz + adx);
+    T theta_h = theta_h_raw;
+    if (!all_lanes(clear)) [[unlikely]] {
+      const T theta_h_max = L::atan2_nonneg(dz, adx);
+      theta_h = L::select(theta_h_raw > theta_h_max, theta_h_max, theta_h_raw);
+    }
     return {theta_h, detail::azimuth(sy, sx), detail::elevation(dx, dy, dz),
             detail::azimuth(dy, dx)};
   }
