@@ -73,6 +73,8 @@ struct RowTranspose {
 // share one copy of f's body: inlined twice, the kernel files took twice as long to compile. The
 // layout is a branch per vector rather than a template parameter for the same reason; it is
 // always predicted.
+inline constexpr std::size_t kPrefetchBytes = 1024;
+
 template <class B, int NI, int NO, int DI, int DO, class F>
 [[gnu::noinline]] HALFBACK_FLATTEN void vector_loop(const ScalarOf<B>* const* in,
                                                     ScalarOf<B>* const* out, std::size_t n,
@@ -81,7 +83,12 @@ template <class B, int NI, int NO, int DI, int DO, class F>
   constexpr bool rows_in = DI > 0 && RowTranspose<B, DI>::fused;
   constexpr bool rows_out = DO > 0 && RowTranspose<B, DO>::fused;
   B x[NI], y[NO];
+  using S = ScalarOf<B>;
+  constexpr std::size_t ahead = kPrefetchBytes / sizeof(S), line = 64 / sizeof(S);
   for (std::size_t i = 0; i < n; i += L::size) {
+    if constexpr (L::size % line == 0)
+      for (int c = 0; c < NI; ++c)
+        for (std::size_t k = 0; k < L::size; k += line) __builtin_prefetch(in[c] + i + ahead + k);
     if (rows_in && rows.in) {
       if constexpr (rows_in) RowTranspose<B, DI>::load(rows.in + DI * i, x);
       for (int c = DI; c < NI; ++c) x[c] = L::load(in[c] + i);
