@@ -73,9 +73,25 @@ struct RowTranspose {
 // share one copy of f's body: inlined twice, the kernel files took twice as long to compile. The
 // layout is a branch per vector rather than a template parameter for the same reason; it is
 // always predicted.
+// Software prefetch of the columns kPrefetchBytes ahead of each vector step, every line of it:
+// the hardware prefetcher alone kept the 6 to 11 streams of a conversion too few lines ahead of
+// the arithmetic (docs/performance.md, "Conversions"). Only where a vector step is whole lines
+// (AVX-512). Outputs too for the decodes (the inverse conversions' last stage), where it measured
+// faster; the encodes were no faster with it.
 inline constexpr std::size_t kPrefetchBytes = 1024;
+enum class Prefetch { inputs, inputs_and_outputs };
 
-template <class B, int NI, int NO, int DI, int DO, class F>
+template <class B, int N, int RW>
+inline void prefetch_step(const ScalarOf<B>* const* columns, std::size_t i) {
+  using S = ScalarOf<B>;
+  constexpr std::size_t ahead = kPrefetchBytes / sizeof(S), line = 64 / sizeof(S);
+  if constexpr (Lanes<B>::size % line == 0)
+    for (int c = 0; c < N; ++c)
+      for (std::size_t k = 0; k < Lanes<B>::size; k += line)
+        __builtin_prefetch(columns[c] + i + ahead + k, RW);
+}
+
+template <class B, int NI, int NO, int DI, int DO, Prefetch PF, class F>
 [[gnu::noinline]] HALFBACK_FLATTEN void vector_loop(const ScalarOf<B>* const* in,
                                                     ScalarOf<B>* const* out, std::size_t n,
                                                     StageRows<ScalarOf<B>> rows, F f) {
@@ -83,12 +99,9 @@ template <class B, int NI, int NO, int DI, int DO, class F>
   constexpr bool rows_in = DI > 0 && RowTranspose<B, DI>::fused;
   constexpr bool rows_out = DO > 0 && RowTranspose<B, DO>::fused;
   B x[NI], y[NO];
-  using S = ScalarOf<B>;
-  constexpr std::size_t ahead = kPrefetchBytes / sizeof(S), line = 64 / sizeof(S);
   for (std::size_t i = 0; i < n; i += L::size) {
-    if constexpr (L::size % line == 0)
-      for (int c = 0; c < NI; ++c)
-        for (std::size_t k = 0; k < L::size; k += line) __builtin_prefetch(in[c] + i + ahead + k);
+    prefetch_step<B, NI, 0>(in, i);
+    if constexpr (PF == Prefetch::inputs_and_outputs) prefetch_step<B, NO, 1>(out, i);
     if (rows_in && rows.in) {
       if constexpr (rows_in) RowTranspose<B, DI>::load(rows.in + DI * i, x);
       for (int c = DI; c < NI; ++c) x[c] = L::load(in[c] + i);
@@ -108,13 +121,13 @@ template <class B, int NI, int NO, int DI, int DO, class F>
 // Runs f on every row. The last m % W rows go through a zero-padded buffer (as columns, also
 // those of row-major inputs and outputs); lanes are independent, so the padding never changes a
 // real row's result.
-template <class B, int NI, int NO, int DI = 0, int DO = 0, class F>
+template <class B, int NI, int NO, int DI = 0, int DO = 0, Prefetch PF = Prefetch::inputs, class F>
 inline void for_rows(const ScalarOf<B>* const* in, ScalarOf<B>* const* out, std::size_t m,
                      StageRows<ScalarOf<B>> rows, F f) {
   using S = ScalarOf<B>;
   constexpr std::size_t W = Lanes<B>::size;
   const std::size_t full = m - m % W;
-  vector_loop<B, NI, NO, DI, DO>(in, out, full, rows, f);
+  vector_loop<B, NI, NO, DI, DO, PF>(in, out, full, rows, f);
   if (full == m) return;
   const std::size_t r = m - full;
   alignas(64) S buf[NI > NO ? NI : NO][W];
@@ -127,7 +140,7 @@ inline void for_rows(const ScalarOf<B>* const* in, ScalarOf<B>* const* out, std:
     buf_in[c] = buf[c];
   }
   for (int c = 0; c < NO; ++c) buf_out[c] = buf[c];
-  vector_loop<B, NI, NO, DI, DO>(buf_in, buf_out, W, {}, f);
+  vector_loop<B, NI, NO, DI, DO, PF>(buf_in, buf_out, W, {}, f);
   for (int c = 0; c < NO; ++c) {
     const bool to_rows = rows.out && c < DO;
     for (std::size_t k = 0; k < r; ++k)
@@ -174,7 +187,7 @@ void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, Scalar
   S* outs[NO];
   for (int c = 0; c < 6; ++c) outs[c] = dirs[c];
   outs[6] = mask;
-  for_rows<B, NI, NO, NI, 6>(in, outs, m, rows, [](const B* q, B* y) {
+  for_rows<B, NI, NO, NI, 6, Prefetch::inputs_and_outputs>(in, outs, m, rows, [](const B* q, B* y) {
     const Solved<B> s = decode_param<P, B>(Iso, q);
     y[0] = s.pair.wi.x;
     y[1] = s.pair.wi.y;
@@ -309,8 +322,8 @@ constexpr void fill_jacobian(StageKernels<ScalarOf<B>>& k) {
   k.jacobian[Space][1] = &jacobian_stage<B, P, true>;
 }
 
-// B: the vector type of the stages; W: that of the decodes and of halfdiff's encode (the
-// longest kernels), which may be two vectors per step (Twin, batch_kernels_avx512.cpp).
+// B: the vector type of the stages; W: that of the decodes, which may be two vectors per step
+// (Twin, batch_kernels_avx512.cpp).
 template <class B, class W = B>
 constexpr StageKernels<ScalarOf<B>> make_stages() {
   StageKernels<ScalarOf<B>> k{};
@@ -335,7 +348,7 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   fill_decode<W, Ortho, 2>(k);
   fill_decode<W, Hybrid, 3>(k);
   fill_encode<B, Spherical, 0>(k);
-  fill_encode<W, HalfDiff, 1>(k);
+  fill_encode<B, HalfDiff, 1>(k);
   fill_encode<B, Ortho, 2>(k);
   fill_encode<B, Hybrid, 3>(k);
   fill_jacobian<B, Spherical, 0>(k);

@@ -200,10 +200,11 @@ constexpr KernelSet make_avx512_set() {
   using A = xsimd::avx512f;
   using F = xsimd::batch<float, A>;
   using D = xsimd::batch<double, A>;
-  // Two vectors per step (Twin, batch_simd.hpp) for every decode (the inverses) and halfdiff's
-  // encode, the longest kernel. Measured in cache (32768 pairs, CPU time, the machine loaded):
-  // the inverses 5-10 % faster, forward halfdiff 3-6 %; the other encodes were 4-13 % slower
-  // (more of their registers spill), so they keep one vector.
+  // Two vectors per step (Twin, batch_simd.hpp) for every decode (the inverses): measured in
+  // cache (32768 pairs, CPU time, the machine loaded) 5-10 % faster, and at 10^7 pairs 5-15 %.
+  // The encodes keep one vector: with two, spherical, ortho and hybrid were 4-13 % slower (more
+  // of their registers spill), and halfdiff, once its clamp's atan2 became rare, 3-8 % slower at
+  // 10^7 pairs.
   KernelSet k = make_kernel_set<F, D, Twin<F>, Twin<D>>(SimdIsa::avx512, "avx512");
   k.f32.gather[4] = &gather_zmm<float, 4>;
   k.f32.gather[6] = &gather_zmm<float, 6>;
