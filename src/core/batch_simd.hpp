@@ -9,18 +9,18 @@
 //     get the IEEE values of std::atan2 (±0 or ±π, ±π/4 or ±3π/4).
 //   - min/max: SSE/AVX min/max return the second operand when either is NaN; std::fmin/fmax
 //     return the other, non-NaN, operand. Ties (including ±0) return the second operand in both.
-//   - sincos: xsimd chooses its range reduction by testing all lanes at once, so one huge or NaN
-//     lane would switch the other lanes to a different (slightly differently rounded) reduction.
-//     Lanes beyond 20π are evaluated separately, so a row's result never depends on its
-//     neighbours in the vector.
+//   - sincos: our own, for |x| <= 20π (every angle of a valid row); lanes beyond get an
+//     unspecified value, which the kernels mask. Branch-free, so a row's result never depends on
+//     its neighbours in the vector (xsimd's chooses its reduction by testing all lanes at once).
 //   - Never use operator!= of xsimd 8.1 for NaN tests: it is unordered on SSE2 (NaN != x is true,
 //     as in IEEE) but ordered (_CMP_NEQ_OQ, false) on AVX and AVX-512. param.hpp does not use it.
 // Accuracy (measured, tests/batch_test.cpp and docs/performance.md): atan2 (ours) within 2.4 ulp
-// of the exact value, xsimd's sin/cos within 1.5 ulp, sqrt is exact.
+// of the exact value, sin/cos (ours) within 1.6 ulp, sqrt is exact.
 #pragma once
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <iterator>
 #include <numbers>
 #include <type_traits>
@@ -67,6 +67,48 @@ struct Atan2Constants<float> {
   static constexpr float quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
   static constexpr std::array<float, 5> g = {-0x1.08197cp-4f, 0x1.b802fp-4f, -0x1.241f98p-3f,
                                              0x1.99972cp-3f, -0x1.555554p-2f};
+};
+
+// The constants of LaneOps::sincos below: 2/π, the shifter that rounds x 2/π to an integer k in
+// the low bits of its mantissa, π/2 in three parts (the first two short enough, 45 bits in
+// double and 18 and 16 in float, that k times them, |k| <= 41, is exact also where fma is two
+// operations: SSE2), the bit positions that move k's two low bits to the sign and to the
+// exponent, and the polynomials
+// S(z) ≈ (sin(r) - r)/(r z) and Y(z) ≈ (1 - cos(r))/z on z = r² <= (π/4)², highest degree first:
+// Chebyshev least-squares fits (mpmath, 50 digits; 6 and 7 terms for double, 4 and 4 for float),
+// relative errors below 2e-16 and 3e-8 on S, 3e-18 and 3e-9 on Y, under the types' rounding.
+template <class S>
+struct SincosConstants;
+template <>
+struct SincosConstants<double> {
+  using Int = std::int64_t;
+  static constexpr double two_over_pi = 0x1.45f306dc9c883p-1, shifter = 0x1.8p52;
+  static constexpr double pio2_1 = 0x1.921fb54442d00p0, pio2_2 = 0x1.8469898cc5180p-48,
+                          pio2_3 = -0x1.fc8f8cbb5bf6cp-97;
+  static constexpr int sign_shift = 62, exponent_shift = 52;
+  static constexpr Int one_bits = 0x3ff0000000000000;
+  static constexpr std::array<double, 6> s = {0x1.5e0a1f55525f5p-33, -0x1.ae6007fd13afdp-26,
+                                              0x1.71de379346184p-19, -0x1.a01a019e80c94p-13,
+                                              0x1.1111111110ba4p-7,  -0x1.5555555555555p-3};
+  static constexpr std::array<double, 7> y = {0x1.8ff8292cf1c76p-37,
+                                              -0x1.1eea7c0e8ca3dp-29,
+                                              0x1.27e4f8e057a91p-22,
+                                              -0x1.a01a019ddbb17p-16,
+                                              0x1.6c16c16c15d46p-10,
+                                              -0x1.5555555555551p-5,
+                                              0x1.0p-1};
+};
+template <>
+struct SincosConstants<float> {
+  using Int = std::int32_t;
+  static constexpr float two_over_pi = 0x1.45f306p-1f, shifter = 0x1.8p23f;
+  static constexpr float pio2_1 = 0x1.921f80p0f, pio2_2 = 0x1.aa2200p-19f, pio2_3 = 0x1.68c234p-39f;
+  static constexpr int sign_shift = 30, exponent_shift = 23;
+  static constexpr Int one_bits = 0x3f800000;
+  static constexpr std::array<float, 4> s = {0x1.6dbc22p-19f, -0x1.a013a0p-13f, 0x1.11110ep-7f,
+                                             -0x1.555556p-3f};
+  static constexpr std::array<float, 4> y = {-0x1.9a6ab8p-16f, 0x1.6c0df8p-10f, -0x1.55554cp-5f,
+                                             0x1.0p-1f};
 };
 
 template <class S, class A>
@@ -195,24 +237,36 @@ struct LaneOps<xsimd::batch<S, A>> {
     return xsimd::select(xsimd::isnan(b), a, xsimd::max(a, b));
   }
 
+  // sin and cos of x for |x| <= 20π, which every angle of a valid row is (elevations, azimuths
+  // and their differences); other lanes (out-of-domain rows, NaN) get an unspecified value, and
+  // the kernels mask those rows. Our own rather than xsimd's: one reduction for both, the
+  // quadrant from the bits of the rounded k rather than floor and four selects, and no branch on
+  // the range of the whole vector (xsimd tests all lanes to choose its reduction, so a lane's
+  // result could depend on its neighbours).
+  // x = k π/2 + r with |r| <= π/4 (k = round(x 2/π)); sin and cos of r by polynomials, then
+  // swapped where k is odd and negated in quadrants 2-3 (sin) and 1-2 (cos).
   static void sincos(const T& x, T& s, T& c) {
-    const T limit(S(20) * std::numbers::pi_v<S>);
-    const auto large = !(xsimd::abs(x) <= limit);  // NaN included
-    if (xsimd::any(large)) [[unlikely]] {
-      sincos_with_large_lanes(x, large, s, c);
-      return;
-    }
-    const auto r = xsimd::sincos(x);
-    s = r.first;
-    c = r.second;
-  }
-
-  // Out of line, so that the kernels inline only the common path.
-  [[gnu::noinline]] static void sincos_with_large_lanes(const T& x, const Mask& large, T& s, T& c) {
-    const auto small = xsimd::sincos(xsimd::select(large, T(S(0)), x));
-    const auto big = xsimd::sincos(xsimd::select(large, x, T(S(0))));
-    s = xsimd::select(large, big.first, small.first);
-    c = xsimd::select(large, big.second, small.second);
+    using C = SincosConstants<S>;
+    using I = xsimd::batch<typename C::Int, A>;
+    const T t = fma(x, T(C::two_over_pi), T(C::shifter));  // k in the low bits of t's mantissa
+    const T minus_k = T(C::shifter) - t;
+    T r = fma(minus_k, T(C::pio2_1), x);  // exact: k pio2_1 and x lie on one grid
+    r = fma(minus_k, T(C::pio2_2), r);
+    r = fma(minus_k, T(C::pio2_3), r);
+    const T z = r * r;
+    constexpr auto sc = C::s;  // local copies, as in atan2
+    constexpr auto yc = C::y;
+    const T sin_r = fma(r * z, polynomial(sc, z), r);
+    const T cos_r = fma(-z, polynomial(yc, z), T(S(1)));
+    const I q = xsimd::bitwise_cast<I>(t);
+    // k odd: 1.0 or 2.0 by k's low bit moved into the exponent, compared in the float domain
+    // (xsimd 8 has no cast from an integer mask to a floating-point one).
+    const auto odd = xsimd::bitwise_cast<T>(I(C::one_bits) + ((q & I(1)) << C::exponent_shift)) >
+                     T(S(1.5));
+    const T sin_sign = xsimd::bitwise_cast<T>((q & I(2)) << C::sign_shift);
+    const T cos_sign = xsimd::bitwise_cast<T>(((q + I(1)) & I(2)) << C::sign_shift);
+    s = xsimd::select(odd, cos_r, sin_r) ^ sin_sign;
+    c = xsimd::select(odd, sin_r, cos_r) ^ cos_sign;
   }
 
   static Mask mask_and(const Mask& a, const Mask& b) {
