@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <type_traits>
 
@@ -64,15 +65,6 @@ struct RowTranspose {
   }
 };
 
-// f(x, y) on vectors [0, n) of rows: x[c] holds rows [i, i + W) of in[c], and y[c] is stored to
-// out[c]; with rows.in (rows.out) set, x[0, DI) (y[0, DO)) come from (go to) rows of DI (DO)
-// values instead (DI, DO = 0: never). The one flattened function of a stage: everything f calls,
-// down to the xsimd intrinsics, is inlined into this loop (GCC otherwise keeps the larger
-// param.hpp functions and xsimd's sincos out of line, passing 512-bit vectors through memory,
-// which costs 2-3x). It is not inlined itself, so that the full vectors and the padded last one
-// share one copy of f's body: inlined twice, the kernel files took twice as long to compile. The
-// layout is a branch per vector rather than a template parameter for the same reason; it is
-// always predicted.
 // Software prefetch of the columns kPrefetchBytes ahead of each vector step, every line of it:
 // the hardware prefetcher alone kept the 6 to 11 streams of a conversion too few lines ahead of
 // the arithmetic (docs/performance.md, "Conversions"). Only where a vector step is whole lines
@@ -81,16 +73,31 @@ struct RowTranspose {
 inline constexpr std::size_t kPrefetchBytes = 1024;
 enum class Prefetch { inputs, inputs_and_outputs };
 
+// The address is formed as an integer: it may lie past the end of a column (a prefetch never
+// faults), and a column the stage reads or writes as rows is null.
 template <class B, int N, int RW>
 inline void prefetch_step(const ScalarOf<B>* const* columns, std::size_t i) {
   using S = ScalarOf<B>;
   constexpr std::size_t ahead = kPrefetchBytes / sizeof(S), line = 64 / sizeof(S);
   if constexpr (Lanes<B>::size % line == 0)
     for (int c = 0; c < N; ++c)
-      for (std::size_t k = 0; k < Lanes<B>::size; k += line)
-        __builtin_prefetch(columns[c] + i + ahead + k, RW);
+      if (columns[c])
+        for (std::size_t k = 0; k < Lanes<B>::size; k += line)
+          __builtin_prefetch(
+              reinterpret_cast<const void*>(reinterpret_cast<std::uintptr_t>(columns[c]) +
+                                            (i + ahead + k) * sizeof(S)),
+              RW);
 }
 
+// f(x, y) on vectors [0, n) of rows: x[c] holds rows [i, i + W) of in[c], and y[c] is stored to
+// out[c]; with rows.in (rows.out) set, x[0, DI) (y[0, DO)) come from (go to) rows of DI (DO)
+// values instead (DI, DO = 0: never). The one flattened function of a stage: everything f calls,
+// down to the xsimd intrinsics, is inlined into this loop (GCC otherwise keeps the larger
+// param.hpp functions and sincos out of line, passing 512-bit vectors through memory,
+// which costs 2-3x). It is not inlined itself, so that the full vectors and the padded last one
+// share one copy of f's body: inlined twice, the kernel files took twice as long to compile. The
+// layout is a branch per vector rather than a template parameter for the same reason; it is
+// always predicted.
 template <class B, int NI, int NO, int DI, int DO, Prefetch PF, class F>
 [[gnu::noinline]] HALFBACK_FLATTEN void vector_loop(const ScalarOf<B>* const* in,
                                                     ScalarOf<B>* const* out, std::size_t n,
