@@ -22,6 +22,7 @@
 #endif
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -194,6 +195,7 @@ struct Plan {
   typename Stages::CheckFn check = nullptr;
   typename Stages::DecodeFn decode = nullptr;
   typename Stages::EncodeFn encode = nullptr;
+  typename Stages::ValidFn valid_bytes;
   // The measure: of the output coordinates, or of the input ones when `to` is dirs; none (1 for a
   // valid row) when both are dirs.
   typename Stages::JacobianFn jacobian_in = nullptr, jacobian_out = nullptr;
@@ -216,6 +218,7 @@ struct Plan {
         dim_out(dimension(t)),
         in(i),
         out(&o),
+        valid_bytes(k.valid_bytes),
         stream(streaming_stores) {
     want_jac = o.jacobian.data != nullptr;
     const bool to_dirs = t.space == Space::dirs;
@@ -247,6 +250,14 @@ struct Plan {
     return true;
   }
 };
+
+// The input mask of the encode stage for user-given directions: not yet checked (it checks them).
+template <class T>
+constexpr auto kUncheckedTile = [] {
+  std::array<T, kTileRows<T>> column{};
+  column.fill(detail::kUnchecked<T>);
+  return column;
+}();
 
 // The measure where the mask is 1, NaN elsewhere; without a stage (dirs to dirs), 1.
 template <class T>
@@ -394,15 +405,14 @@ class TileRunner {
     if (p.check && !p.encode) {
       p.check(in, out, mask, m, rows);
     } else if (p.check) {
-      std::fill_n(mask, m, detail::kUnchecked<T>);  // encode checks the directions itself
-      p.encode(in, mask, out, m, rows);
+      p.encode(in, kUncheckedTile<T>.data(), mask, out, m, rows);  // it checks them itself
     } else if (!p.encode) {
       p.decode(in, out, mask, m, rows);
     } else {
       T* dirs[6];
       for (int c = 0; c < 6; ++c) dirs[c] = column(kDirs + c);
       p.decode(in, dirs, mask, m, {rows.in, nullptr});
-      p.encode(dirs, mask, out, m, {nullptr, rows.out});
+      p.encode(dirs, mask, mask, out, m, {nullptr, rows.out});
     }
     if (jac && p.jacobian_out) p.jacobian_out(out, jac, m);
     if (jac) mask_jacobian(mask, jac, m, !p.jacobian_in && !p.jacobian_out);
@@ -425,9 +435,7 @@ class TileRunner {
       for (std::size_t c = 0; c < p.dim_out; ++c) write_column(p.out->columns[c], out[c], base, m);
     }
     if (jac) write_column(p.out->jacobian, jac, base, m);
-    if (std::uint8_t* valid = p.out->valid) {
-      for (std::size_t i = 0; i < m; ++i) valid[r0 + i] = mask[i] > T(0) ? 1 : 0;
-    }
+    if (std::uint8_t* valid = p.out->valid) p.valid_bytes(mask, valid + r0, m);
   }
 
   // A column computed in scratch to its place (nothing to do when it was computed in place).

@@ -8,7 +8,8 @@
 //   check    (dirs input)   6 direction columns -> mask, accepted pair (NaN if invalid)
 //   decode   (P input)      dim(P) columns -> 6 direction columns (NaN if invalid), mask
 //   encode   (P output)     6 direction columns + mask -> dim(P) columns (NaN if invalid), mask;
-//                           with a mask of kUnchecked (dirs input) it does the check itself
+//                           with a mask of kUnchecked (dirs input: a constant column) it does
+//                           the check itself
 //   jacobian (P in or out)  dim(P) columns -> J(q), not masked (the engine masks it)
 // Masks are stored as T: 1 for a valid row, 0 otherwise. The Jacobian is a stage of its own rather
 // than a variant of decode and encode so that those, the largest kernels, are compiled once.
@@ -21,6 +22,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string_view>
 
@@ -55,8 +57,8 @@ struct StageKernels {
                            StageRows<T> rows);
   using DecodeFn = void (*)(const T* const* in, T* const* dirs, T* mask, std::size_t m,
                             StageRows<T> rows);
-  using EncodeFn = void (*)(const T* const* dirs, T* mask, T* const* out, std::size_t m,
-                            StageRows<T> rows);
+  using EncodeFn = void (*)(const T* const* dirs, const T* mask_in, T* mask_out, T* const* out,
+                            std::size_t m, StageRows<T> rows);
   using JacobianFn = void (*)(const T* const* coords, T* jac, std::size_t m);
   std::size_t width;  // lanes per vector
   CheckFn check;
@@ -72,6 +74,10 @@ struct StageKernels {
   // Whether the check, decode and encode stages take rows of D values (StageRows) in their
   // vector loops, for D = 3, 4, 6; where not, the engine transposes with gather and scatter.
   bool fused_rows[7];
+  // The mask column (1 or 0) as ConvertOutput::valid's bytes; here so that each table's compiler
+  // flags vectorize it (the baseline build compared one double at a time: 5 % of a conversion).
+  using ValidFn = void (*)(const T* mask, std::uint8_t* valid, std::size_t m);
+  ValidFn valid_bytes;
 };
 
 struct KernelSet {

@@ -214,15 +214,15 @@ void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, Scalar
 // stage and this one did before (convert_row's accepted pair, then its unit pair). The mask
 // is rewritten, 1 or 0.
 template <class B, class P, bool Iso>
-void encode_stage(const ScalarOf<B>* const* dirs, ScalarOf<B>* mask, ScalarOf<B>* const* out,
-                  std::size_t m, StageRows<ScalarOf<B>> rows) {
+void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask_in, ScalarOf<B>* mask_out,
+                  ScalarOf<B>* const* out, std::size_t m, StageRows<ScalarOf<B>> rows) {
   using S = ScalarOf<B>;
   using L = LaneOps<B>;
   constexpr int kDim = Iso ? 3 : 4;
-  const S* ins[7] = {dirs[0], dirs[1], dirs[2], dirs[3], dirs[4], dirs[5], mask};
+  const S* ins[7] = {dirs[0], dirs[1], dirs[2], dirs[3], dirs[4], dirs[5], mask_in};
   S* outs[kDim + 1];
   for (int c = 0; c < kDim; ++c) outs[c] = out[c];
-  outs[kDim] = mask;
+  outs[kDim] = mask_out;
   for_rows<B, 7, kDim + 1, 6, kDim>(ins, outs, m, rows, [](const B* x, B* y) {
     const DirPair<B> raw{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
     const auto unchecked = x[6] == B(kUnchecked<S>);
@@ -254,6 +254,11 @@ void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<B>* jac, std::siz
   S* outs[1] = {jac};
   for_rows<B, NI, 1>(coords, outs, m, {},
                      [](const B* q, B* y) { y[0] = jacobian_of<P, B>(Iso, q); });
+}
+
+template <class S>
+void valid_bytes(const S* __restrict mask, std::uint8_t* __restrict valid, std::size_t m) {
+  for (std::size_t i = 0; i < m; ++i) valid[i] = mask[i] > S(0);
 }
 
 template <class S, int D, std::size_t Pitch>
@@ -336,6 +341,7 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   StageKernels<ScalarOf<B>> k{};
   k.width = Lanes<B>::size;
   k.check = &check_stage<B>;
+  k.valid_bytes = &valid_bytes<ScalarOf<B>>;
   using S = ScalarOf<B>;
   k.gather[3] = &gather_rows<S, 3>;
   k.gather[4] = &gather_rows<S, 4>;

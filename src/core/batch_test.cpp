@@ -817,9 +817,9 @@ TYPED_TEST(BatchTest, EncodeOfUncheckedRowsIsCheckThenEncode) {
         o_old[c] = out_old[c].data();
         o_new[c] = out_new[c].data();
       }
-      std::vector<T> m_old = mask_old, m_new = mask_new;
-      encode(copy_cols, m_old.data(), o_old, n, {});
-      encode(in_cols, m_new.data(), o_new, n, {});
+      std::vector<T> m_old = mask_old, m_new(n);
+      encode(copy_cols, m_old.data(), m_old.data(), o_old, n, {});
+      encode(in_cols, mask_new.data(), m_new.data(), o_new, n, {});
       EXPECT_EQ(m_new, m_old);
       for (std::size_t c = 0; c < dimension(to); ++c)
         EXPECT_EQ(std::memcmp(out_new[c].data(), out_old[c].data(), n * sizeof(T)), 0)
