@@ -404,7 +404,7 @@ TEST_F(CliTest, StdinStdoutAndDash) {
   ASSERT_EQ(a.status, 0);
   EXPECT_EQ(a.out,
             "theta_h,phi_h,theta_d,phi_d\n"
-            "0.32175055439664219,0,0.32175055439664224,3.1415926535897931\n");
+            "0.32175055439664219,0,0.32175055439664219,3.1415926535897931\n");
   EXPECT_EQ(b.out, a.out);
   EXPECT_EQ(c.out, a.out);
   EXPECT_EQ(entries(), (std::vector<std::string>{"in.csv"}));

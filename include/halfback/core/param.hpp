@@ -238,40 +238,42 @@ struct HalfDiff {
     using L = LaneOps<T>;
     using S = ScalarOf<T>;
     const T sx = p.wi.x + p.wo.x, sy = p.wi.y + p.wo.y, sz = p.wi.z + p.wo.z;
-    const T rxy = L::sqrt(sx * sx + sy * sy);
-    const T len = L::sqrt(rxy * rxy + sz * sz);
-    const auto flat = rxy == T(0), null = len == T(0);
+    const T rxy2 = sx * sx + sy * sy, len2 = rxy2 + sz * sz;
+    const T rxy = L::sqrt(rxy2), len = L::sqrt(len2);
+    const auto flat = rxy == T(0), null = len2 == T(0);
     const T cp = L::select(flat, T(1), sx / rxy), sp = L::select(flat, T(0), sy / rxy);
-    const T ct = L::select(null, T(1), sz / len), st = L::select(null, T(0), rxy / len);
     const T theta_h_raw = L::select(null, T(0), L::atan2_nonneg(rxy, sz));
     // d = R_y(-θh) R_z(-φh) ωi, computed symmetrically in ωi and ωo: R⁻¹h = (0, 0, ‖h‖) exactly,
     // so d = (R⁻¹k)_xy + ‖h‖ n. Rotating ωi alone would make the inverse reflect ωi about ĥ, and
     // amplify the inputs' unit-norm rounding (‖ωi‖ ≠ ‖ωo‖ by an ulp) by 1/‖h‖ near h = 0; with
     // the symmetric form the inverse reproduces the pair up to one common scale (docs/math.md).
+    // Only d's direction matters: D = 2‖h‖ d = len d is computed, which needs no division by len
+    // (R_y(-θh) is (sz, rxy)/len) and no wait for len in the chain to θd (docs/math.md §2.2).
     const T half(0.5);
     const T kx = half * (p.wi.x - p.wo.x), ky = half * (p.wi.y - p.wo.y),
             kz = half * (p.wi.z - p.wo.z);
     const T a = cp * kx + sp * ky;
     const T dy = cp * ky - sp * kx;
-    const T dx = ct * a - st * kz;
-    const T dz = half * len;
-    // The inverse's elevations are dz cos θh ∓ dx sin θh, both >= 0 iff θh <= atan2(dz, |dx|).
+    // h = 0: ĥ := n, so d = (k_x, k_y, 0) rotated by -φh, unscaled.
+    const T Dx = L::select(null, a, sz * a - rxy * kz), Dy = L::select(null, dy, len * dy);
+    const T Dz = half * len2;
+    // The inverse's elevations are Dz cos θh ∓ Dx sin θh, both >= 0 iff θh <= atan2(Dz, |Dx|).
     // For inputs unit only to rounding, h·k = (‖ωi‖² − ‖ωo‖²)/4 is not 0, and near h = 0 (a pair
     // opposite each other at the horizon) θh is then noise that breaks this by up to ε/‖h‖. A tilt
     // of ĥ down to the bound rotates the pair by no more than that error, and keeps the round trip
     // of every accepted pair valid (docs/math.md §6). Valid pairs are unchanged but for rounding.
-    // θh_raw > θh_max iff sin(θh_max - θh_raw) ∝ dz sz - |dx| rxy < 0. Where that is clearly
+    // θh_raw > θh_max iff sin(θh_max - θh_raw) ∝ Dz sz - |Dx| rxy < 0. Where that is clearly
     // positive in every lane (beyond the rounding of both sides and of both atan2, docs/math.md
-    // §6), the clamp cannot act and its atan2 is skipped: the same bits either way.
-    const T adx = L::abs(dx);
-    const auto clear = dz * sz - adx * rxy > T(detail::kClampMargin<S>) * len * (dz + adx);
+    // §6), the clamp cannot act and its atan2 is skipped: the same result either way.
+    const T adx = L::abs(Dx);
+    const auto clear = Dz * sz - adx * rxy > T(detail::kClampMargin<S>) * (rxy + sz) * (Dz + adx);
     T theta_h = theta_h_raw;
     if (!all_lanes(clear)) [[unlikely]] {
-      const T theta_h_max = L::atan2_nonneg(dz, adx);
+      const T theta_h_max = L::atan2_nonneg(Dz, adx);
       theta_h = L::select(theta_h_raw > theta_h_max, theta_h_max, theta_h_raw);
     }
-    return {theta_h, detail::azimuth(sy, sx), detail::elevation(dx, dy, dz),
-            detail::azimuth(dy, dx)};
+    return {theta_h, detail::azimuth(sy, sx), detail::elevation(Dx, Dy, Dz),
+            detail::azimuth(Dy, Dx)};
   }
 
   template <class T>
