@@ -240,7 +240,11 @@ struct HalfDiff {
     const T sx = p.wi.x + p.wo.x, sy = p.wi.y + p.wo.y, sz = p.wi.z + p.wo.z;
     const T rxy2 = sx * sx + sy * sy, len2 = rxy2 + sz * sz;
     const T rxy = L::sqrt(rxy2), len = L::sqrt(len2);
-    const auto flat = rxy == T(0), null = len2 == T(0);
+    const T half(0.5);
+    const T Dz = half * len2;  // D = len d below
+    // h = 0, or so small that Dz underflows to 0 (‖ωi + ωo‖ ≈ 1e-162 in double): then ĥ := n,
+    // as the squares of D's other components could underflow too and leave atan2(0, 0).
+    const auto flat = rxy == T(0), null = Dz == T(0);
     const T cp = L::select(flat, T(1), sx / rxy), sp = L::select(flat, T(0), sy / rxy);
     const T theta_h_raw = L::select(null, T(0), L::atan2_nonneg(rxy, sz));
     // d = R_y(-θh) R_z(-φh) ωi, computed symmetrically in ωi and ωo: R⁻¹h = (0, 0, ‖h‖) exactly,
@@ -249,14 +253,12 @@ struct HalfDiff {
     // the symmetric form the inverse reproduces the pair up to one common scale (docs/math.md).
     // Only d's direction matters: D = 2‖h‖ d = len d is computed, which needs no division by len
     // (R_y(-θh) is (sz, rxy)/len) and no wait for len in the chain to θd (docs/math.md §2.2).
-    const T half(0.5);
     const T kx = half * (p.wi.x - p.wo.x), ky = half * (p.wi.y - p.wo.y),
             kz = half * (p.wi.z - p.wo.z);
     const T a = cp * kx + sp * ky;
     const T dy = cp * ky - sp * kx;
     // h = 0: ĥ := n, so d = (k_x, k_y, 0) rotated by -φh, unscaled.
     const T Dx = L::select(null, a, sz * a - rxy * kz), Dy = L::select(null, dy, len * dy);
-    const T Dz = half * len2;
     // The inverse's elevations are Dz cos θh ∓ Dx sin θh, both >= 0 iff θh <= atan2(Dz, |Dx|).
     // For inputs unit only to rounding, h·k = (‖ωi‖² − ‖ωo‖²)/4 is not 0, and near h = 0 (a pair
     // opposite each other at the horizon) θh is then noise that breaks this by up to ε/‖h‖. A tilt
