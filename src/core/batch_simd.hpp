@@ -50,7 +50,8 @@ template <class S>
 struct Atan2Constants;
 template <>
 struct Atan2Constants<double> {
-  static constexpr double tan_pi_8 = 0.41421356237309503, huge = 0x1p1000;
+  static constexpr double tan_pi_8 = 0.41421356237309503, huge = 0x1p1000, tiny = 0x1p-1000;
+  static constexpr double grow = 0x1p600;
   static constexpr double pi_hi = 0x1.921fb54442d18p1, pi_lo = 0x1.1a62633145c07p-53;
   static constexpr double half_pi_hi = pi_hi / 2, half_pi_lo = pi_lo / 2;
   static constexpr double quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
@@ -61,7 +62,8 @@ struct Atan2Constants<double> {
 };
 template <>
 struct Atan2Constants<float> {
-  static constexpr float tan_pi_8 = 0.41421356f, huge = 0x1p100f;
+  static constexpr float tan_pi_8 = 0.41421356f, huge = 0x1p100f, tiny = 0x1p-120f;
+  static constexpr float grow = 0x1p60f;
   static constexpr float pi_hi = 0x1.921fb6p1f, pi_lo = -0x1.777a5cp-24f;
   static constexpr float half_pi_hi = pi_hi / 2, half_pi_lo = pi_lo / 2;
   static constexpr float quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
@@ -171,8 +173,12 @@ struct LaneOps<xsimd::batch<S, A>> {
   static T atan2(const T& y, const T& x) {
     using C = Atan2Constants<S>;
     const T a = xsimd::abs(y), b = xsimd::abs(x);
-    // Beyond 2^1000 a + b could overflow: scale both (exactly) by 1/4.
-    const T scale = xsimd::select(a > T(C::huge) || b > T(C::huge), T(S(0.25)), T(S(1)));
+    // Beyond 2^1000 a + b could overflow: scale both (exactly) by 1/4. Where both are tiny
+    // (subnormal or nearly), scale them up: the octant tests' products by tan(π/8) would round on
+    // the subnormal grid (atan2(2^-1074, 0) took the middle octant with r = 1, 0.018 rad off).
+    const auto big = a > T(C::huge) || b > T(C::huge);
+    const auto small = a < T(C::tiny) && b < T(C::tiny);
+    const T scale = xsimd::select(big, T(S(0.25)), xsimd::select(small, T(C::grow), T(S(1))));
     const T angle = half_plane_angle(first_quadrant(a * scale, b * scale), x);
     const auto zero = (y == T(S(0))) && (x == T(S(0)));
     const auto both_inf = xsimd::isinf(y) && xsimd::isinf(x);
@@ -183,9 +189,10 @@ struct LaneOps<xsimd::batch<S, A>> {
     return xsimd::copysign(xsimd::select(zero || both_inf, special, angle), y);
   }
 
-  // atan2 for finite x, y below 2^1000 in magnitude and not both zero (other lanes get an
-  // unspecified value): the same bits as atan2 there, without its scaling and rare cases. The
-  // azimuths of the forward conversions, whose invalid rows are masked afterwards.
+  // atan2 for finite x, y below 2^1000 in magnitude and not both below `tiny` (2^-1000, float
+  // 2^-120; other lanes get an unspecified value): the same bits as atan2 there, without its
+  // scaling and rare cases. The azimuths of the forward conversions, whose invalid rows are
+  // masked afterwards, and whose planar vectors that tiny only move a direction by as little.
   static T atan2_finite(const T& y, const T& x) {
     return xsimd::copysign(half_plane_angle(first_quadrant(xsimd::abs(y), xsimd::abs(x)), x), y);
   }
@@ -261,8 +268,8 @@ struct LaneOps<xsimd::batch<S, A>> {
     const I q = xsimd::bitwise_cast<I>(t);
     // k odd: 1.0 or 2.0 by k's low bit moved into the exponent, compared in the float domain
     // (xsimd 8 has no cast from an integer mask to a floating-point one).
-    const auto odd = xsimd::bitwise_cast<T>(I(C::one_bits) + ((q & I(1)) << C::exponent_shift)) >
-                     T(S(1.5));
+    const auto odd =
+        xsimd::bitwise_cast<T>(I(C::one_bits) + ((q & I(1)) << C::exponent_shift)) > T(S(1.5));
     const T sin_sign = xsimd::bitwise_cast<T>((q & I(2)) << C::sign_shift);
     const T cos_sign = xsimd::bitwise_cast<T>(((q + I(1)) & I(2)) << C::sign_shift);
     s = xsimd::select(odd, cos_r, sin_r) ^ sin_sign;

@@ -26,7 +26,8 @@ struct LaneOps<T> {
   static T sqrt(T x) { return std::sqrt(x); }
   static T atan2(T y, T x) { return std::atan2(y, x); }
   // Narrower contracts that SIMD lanes exploit (batch_simd.hpp): finite |x|, |y| < 2^1000, not
-  // both zero; and in addition x, y >= 0. Other lanes get an unspecified value.
+  // both below 2^-1000 (float 2^-120); and in addition x, y >= 0. Other lanes get an unspecified
+  // value (for both tiny, an angle up to 0.02 off).
   static T atan2_finite(T y, T x) { return std::atan2(y, x); }
   static T atan2_nonneg(T y, T x) { return std::atan2(y, x); }
   static T abs(T x) { return std::abs(x); }
@@ -50,6 +51,15 @@ inline bool all_lanes(const M& m) {
     return m;
   else
     return all(m);
+}
+
+// Whether a mask is true in some lane: for a branch into work that only a few rows need.
+template <class M>
+inline bool any_lanes(const M& m) {
+  if constexpr (std::is_same_v<M, bool>)
+    return m;
+  else
+    return any(m);
 }
 
 template <class T>

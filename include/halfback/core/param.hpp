@@ -54,7 +54,9 @@ namespace detail {
 
 // Azimuth of the planar vector (x, y) in [0, 2π); 0 for the zero vector; never -0. For finite
 // x, y below 2^1000 in magnitude (larger or non-finite ones give an unspecified value), which
-// every valid pair's planar vectors are.
+// every valid pair's planar vectors are. Where both are below 2^-1000 (float 2^-120) the SIMD
+// lanes' angle may be up to 0.02 off: such a vector moves its direction by less than 1e-300
+// (1e-36) whatever its azimuth; HalfDiff's φh, which sets the frame of d, is scaled first.
 template <class T>
 inline T azimuth(T y, T x) {
   using L = LaneOps<T>;
@@ -98,6 +100,21 @@ inline T elevation(T x, T y, T z) {
 // evaluated: 64ε against the ~5ε that the rounding of its test and of two atan2 can account for.
 template <class S>
 inline constexpr S kClampMargin = S(64) * std::numeric_limits<S>::epsilon();
+
+// Powers of two for HalfDiff's scaled frame. frame_min: the least (rxy len)² for which the unscaled
+// D's squares are normal with a margin (its rounding near underflow then stays below ε/8 of |D|).
+// A sum of squares below tiny_sq has its components multiplied by up, exactly: the smallest
+// subnormal then squares to a normal number, and the largest scaled component is far from overflow.
+template <class S>
+struct TinyScale;
+template <>
+struct TinyScale<double> {
+  static constexpr double frame_min = 0x1p-963, tiny_sq = 0x1p-900, up = 0x1p600;
+};
+template <>
+struct TinyScale<float> {
+  static constexpr float frame_min = 0x1p-96f, tiny_sq = 0x1p-100f, up = 0x1p99f;
+};
 
 // Tolerance on a reconstructed elevation whose rounding error grows like ε / cond: the domain
 // predicates accept z >= -tol / max(cond, √tol) (docs/math.md, "Valid domain").
@@ -233,49 +250,21 @@ struct HalfDiff {
   static constexpr std::array<std::string_view, 4> columns{"theta_h", "phi_h", "theta_d", "phi_d"};
   static constexpr std::array<std::string_view, 3> iso_columns{"theta_h", "theta_d", "phi_d"};
 
+  // θd and φd depend only on the direction of d = R_y(-θh) R_z(-φh) ωi, which is computed
+  // symmetrically in ωi and ωo: R h = (0, 0, ‖h‖) exactly, so d = (R k)_xy + ‖h‖ n. Rotating ωi
+  // alone would make the inverse reflect ωi about ĥ, and amplify the inputs' unit-norm rounding
+  // (‖ωi‖ ≠ ‖ωo‖ by an ulp) by 1/‖h‖ near h = 0; with the symmetric form the inverse reproduces
+  // the pair up to one common scale (docs/math.md §2.2). A positive multiple D of d is computed:
+  // D = 4‖h̄‖ ‖h‖ d needs no division (frame()). Where that multiple would underflow, near a
+  // vertical ĥ or near h = 0, the rows take scaled_frame() instead, which rescales by powers of 2.
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
-    using L = LaneOps<T>;
-    using S = ScalarOf<T>;
-    const T sx = p.wi.x + p.wo.x, sy = p.wi.y + p.wo.y, sz = p.wi.z + p.wo.z;
-    const T rxy2 = sx * sx + sy * sy, len2 = rxy2 + sz * sz;
-    const T rxy = L::sqrt(rxy2), len = L::sqrt(len2);
-    const T half(0.5);
-    const T Dz = half * len2;  // D = len d below
-    // h = 0, or so small that Dz underflows to 0 (‖ωi + ωo‖ ≈ 1e-162 in double): then ĥ := n,
-    // as the squares of D's other components could underflow too and leave atan2(0, 0).
-    const auto flat = rxy == T(0), null = Dz == T(0);
-    const T cp = L::select(flat, T(1), sx / rxy), sp = L::select(flat, T(0), sy / rxy);
-    const T theta_h_raw = L::select(null, T(0), L::atan2_nonneg(rxy, sz));
-    // d = R_y(-θh) R_z(-φh) ωi, computed symmetrically in ωi and ωo: R⁻¹h = (0, 0, ‖h‖) exactly,
-    // so d = (R⁻¹k)_xy + ‖h‖ n. Rotating ωi alone would make the inverse reflect ωi about ĥ, and
-    // amplify the inputs' unit-norm rounding (‖ωi‖ ≠ ‖ωo‖ by an ulp) by 1/‖h‖ near h = 0; with
-    // the symmetric form the inverse reproduces the pair up to one common scale (docs/math.md).
-    // Only d's direction matters: D = 2‖h‖ d = len d is computed, which needs no division by len
-    // (R_y(-θh) is (sz, rxy)/len) and no wait for len in the chain to θd (docs/math.md §2.2).
-    const T kx = half * (p.wi.x - p.wo.x), ky = half * (p.wi.y - p.wo.y),
-            kz = half * (p.wi.z - p.wo.z);
-    const T a = cp * kx + sp * ky;
-    const T dy = cp * ky - sp * kx;
-    // h = 0: ĥ := n, so d = (k_x, k_y, 0) rotated by -φh, unscaled.
-    const T Dx = L::select(null, a, sz * a - rxy * kz), Dy = L::select(null, dy, len * dy);
-    // The inverse's elevations are Dz cos θh ∓ Dx sin θh, both >= 0 iff θh <= atan2(Dz, |Dx|).
-    // For inputs unit only to rounding, h·k = (‖ωi‖² − ‖ωo‖²)/4 is not 0, and near h = 0 (a pair
-    // opposite each other at the horizon) θh is then noise that breaks this by up to ε/‖h‖. A tilt
-    // of ĥ down to the bound rotates the pair by no more than that error, and keeps the round trip
-    // of every accepted pair valid (docs/math.md §6). Valid pairs are unchanged but for rounding.
-    // θh_raw > θh_max iff sin(θh_max - θh_raw) ∝ Dz sz - |Dx| rxy < 0. Where that is clearly
-    // positive in every lane (beyond the rounding of both sides and of both atan2, docs/math.md
-    // §6), the clamp cannot act and its atan2 is skipped: the same result either way.
-    const T adx = L::abs(Dx);
-    const auto clear = Dz * sz - adx * rxy > T(detail::kClampMargin<S>) * (rxy + sz) * (Dz + adx);
-    T theta_h = theta_h_raw;
-    if (!all_lanes(clear)) [[unlikely]] {
-      const T theta_h_max = L::atan2_nonneg(Dz, adx);
-      theta_h = L::select(theta_h_raw > theta_h_max, theta_h_max, theta_h_raw);
+    const Sums<T> s = sums(p);
+    if (any_lanes(needs_scaled_frame(s))) [[unlikely]] {
+      const auto scaled = needs_scaled_frame(s);
+      return finish(select_frame(scaled, scaled_frame(s), frame(s)));
     }
-    return {theta_h, detail::azimuth(sy, sx), detail::elevation(Dx, Dy, Dz),
-            detail::azimuth(Dy, Dx)};
+    return finish(frame(s));
   }
 
   template <class T>
@@ -350,6 +339,128 @@ struct HalfDiff {
 
  private:
   static constexpr double kPi = std::numbers::pi;
+
+  template <class T>
+  struct Sums {
+    T sx, sy, sz;  // s = ωi + ωo = 2h
+    T kx, ky, kz;  // k = (ωi - ωo)/2
+    T rxy2, len2;  // ‖(sx, sy)‖², ‖s‖²
+  };
+  template <class T>
+  static Sums<T> sums(const DirPair<T>& p) {
+    const T half(0.5);
+    const T sx = p.wi.x + p.wo.x, sy = p.wi.y + p.wo.y, sz = p.wi.z + p.wo.z;
+    const T rxy2 = sx * sx + sy * sy;
+    return {sx,
+            sy,
+            sz,
+            half * (p.wi.x - p.wo.x),
+            half * (p.wi.y - p.wo.y),
+            half * (p.wi.z - p.wo.z),
+            rxy2,
+            rxy2 + sz * sz};
+  }
+
+  // θh before its clamp, φh, (st, ct) = a positive multiple of (sin θh, cos θh), and D a positive
+  // multiple of d.
+  template <class T>
+  struct Frame {
+    T theta_h, phi_h, st, ct;
+    Vec3<T> D;
+  };
+  template <class T>
+  static Frame<T> select_frame(const MaskOf<T>& m, const Frame<T>& a, const Frame<T>& b) {
+    using L = LaneOps<T>;
+    return {L::select(m, a.theta_h, b.theta_h),
+            L::select(m, a.phi_h, b.phi_h),
+            L::select(m, a.st, b.st),
+            L::select(m, a.ct, b.ct),
+            {L::select(m, a.D.x, b.D.x), L::select(m, a.D.y, b.D.y), L::select(m, a.D.z, b.D.z)}};
+  }
+
+  // D = rxy len d with rxy = ‖(sx, sy)‖ = 2‖h̄‖ and len = ‖s‖ = 2‖h‖ (docs/math.md §2.2):
+  // (A, B) = rxy R_z(-φh) k_xy = (s_xy · k_xy, s_xy × k_xy), and R_y(-θh) is (sz, rxy)/len, so
+  //   D = (sz A - rxy² kz, len B, rxy len²/2).
+  // No division, and len's square root is off the chain to D_xy. When h̄ = 0 (ĥ = n, c := (1, 0)),
+  // D = len d = (sz kx, len ky, len²/2). Accurate (its squares normal) unless needs_scaled_frame.
+  template <class T>
+  static Frame<T> frame(const Sums<T>& s) {
+    using L = LaneOps<T>;
+    const T rxy = L::sqrt(s.rxy2), len = L::sqrt(s.len2), half(0.5);
+    const auto flat = s.rxy2 == T(0);
+    const T A = s.sx * s.kx + s.sy * s.ky, B = s.sx * s.ky - s.sy * s.kx;
+    const T Dz = half * s.len2;
+    return {L::atan2_nonneg(rxy, s.sz),
+            detail::azimuth(s.sy, s.sx),
+            rxy,
+            s.sz,
+            {L::select(flat, s.sz * s.kx, s.sz * A - s.rxy2 * s.kz),
+             L::select(flat, len * s.ky, len * B), L::select(flat, Dz, Dz * rxy)}};
+  }
+
+  // Rows where frame()'s D, of size rxy len (len on a vertical ĥ), would have a subnormal square:
+  // ĥ within ~1e-145 rad of n or ‖ωi + ωo‖ below ~1e-145 in double (3e-15 in float).
+  template <class T>
+  static MaskOf<T> needs_scaled_frame(const Sums<T>& s) {
+    using L = LaneOps<T>;
+    using S = ScalarOf<T>;
+    // h̄ = 0 exactly: frame() takes c := (1, 0) and D = len d. Not where only rxy² underflows to 0
+    // (|s_xy| < 1e-162): that h̄ has an azimuth, which the scaled frame keeps.
+    const auto flat = L::mask_and(s.sx == T(0), s.sy == T(0));
+    const T w2 = L::select(flat, s.len2, s.rxy2 * s.len2);
+    return w2 < T(detail::TinyScale<S>::frame_min);
+  }
+
+  // The same angles with s_xy and s rescaled by powers of two (exact) so that their squares are
+  // normal, and D = d itself, whose z component ‖h‖ is formed without squaring. Rare rows only.
+  // h = 0 exactly: ĥ := n, θh = 0 and D = (kx, ky, 0).
+  template <class T>
+  static Frame<T> scaled_frame(const Sums<T>& s) {
+    using L = LaneOps<T>;
+    using Scale = detail::TinyScale<ScalarOf<T>>;
+    const T tiny(Scale::tiny_sq), one(1), up(Scale::up);
+    const T pxy = L::select(s.rxy2 < tiny, up, one), p = L::select(s.len2 < tiny, up, one);
+    const T xs = pxy * s.sx, ys = pxy * s.sy;
+    const T rs = L::sqrt(xs * xs + ys * ys);                               // pxy rxy
+    const auto flat = rs == T(0), null = L::mask_and(flat, s.sz == T(0));  // s = 0
+    const T cx = L::select(flat, one, xs / rs), cy = L::select(flat, T(0), ys / rs);
+    const T a = cx * s.kx + cy * s.ky, b = cx * s.ky - cy * s.kx;
+    const T rxy = (p / pxy) * rs, sz = p * s.sz;  // p rxy, p sz: exact unless underflowing
+    const T len = L::sqrt(rxy * rxy + sz * sz);   // p len
+    const T norm = L::select(null, one, len);
+    const T dz = T(0.5) * (len / p);  // ‖h‖
+    return {L::select(null, T(0), L::atan2_nonneg(rxy, sz)),
+            detail::azimuth(ys, xs),  // exact multiples of sy, sx, and not subnormal
+            rxy,
+            sz,
+            {L::select(null, s.kx, (sz / norm) * a - (rxy / norm) * s.kz), L::select(null, s.ky, b),
+             L::select(null, T(0), dz)}};
+  }
+
+  // φh, θd, φd from the frame, and θh clamped (below): the inverse's elevations are
+  // Dz cos θh ∓ Dx sin θh, both >= 0 iff θh <= atan2(Dz, |Dx|). For inputs unit only to rounding,
+  // h·k = (‖ωi‖² − ‖ωo‖²)/4 is not 0, and near h = 0 (a pair opposite each other at the horizon)
+  // θh is then noise that breaks this by up to ε/‖h‖. A tilt of ĥ down to the bound rotates the
+  // pair by no more than that error, and keeps the round trip of every accepted pair valid
+  // (docs/math.md §6). Valid pairs are unchanged but for rounding. θh_raw > θh_max iff
+  // sin(θh_max - θh_raw) ∝ Dz ct - |Dx| st < 0. Where that is clearly positive in every lane
+  // (beyond the rounding of both sides and of both atan2, docs/math.md §6), the clamp cannot act
+  // and its atan2 is skipped: the same result either way.
+  template <class T>
+  static Tuple4<T> finish(const Frame<T>& f) {
+    using L = LaneOps<T>;
+    using S = ScalarOf<T>;
+    const Vec3<T>& D = f.D;
+    const T adx = L::abs(D.x);
+    const auto clear =
+        D.z * f.ct - adx * f.st > T(detail::kClampMargin<S>) * (f.st + f.ct) * (D.z + adx);
+    T theta_h = f.theta_h;
+    if (!all_lanes(clear)) [[unlikely]] {
+      const T theta_h_max = L::atan2_nonneg(D.z, adx);
+      theta_h = L::select(theta_h > theta_h_max, theta_h_max, theta_h);
+    }
+    return {theta_h, f.phi_h, detail::elevation(D.x, D.y, D.z), detail::azimuth(D.y, D.x)};
+  }
 };
 
 // --------------------------------------------------------------------------------------------
