@@ -189,12 +189,13 @@ struct LaneOps<xsimd::batch<S, A>> {
     return xsimd::copysign(xsimd::select(zero || both_inf, special, angle), y);
   }
 
-  // atan2 for finite x, y below 2^1000 in magnitude and not both below `tiny` (2^-1000, float
-  // 2^-120; other lanes get an unspecified value): the same bits as atan2 there, without its
-  // scaling and rare cases. The azimuths of the forward conversions, whose invalid rows are
-  // masked afterwards, and whose planar vectors that tiny only move a direction by as little.
-  static T atan2_finite(const T& y, const T& x) {
-    return xsimd::copysign(half_plane_angle(first_quadrant(xsimd::abs(y), xsimd::abs(x)), x), y);
+  // |atan2(y, x)| for finite x, y below 2^1000 in magnitude and not both below `tiny` (2^-1000,
+  // float 2^-120; other lanes get an unspecified value): the same bits as atan2's magnitude there,
+  // without its scaling, rare cases and sign. The azimuths of the forward conversions, whose
+  // invalid rows are masked afterwards, and whose planar vectors that tiny only move a direction
+  // by as little.
+  static T atan2_abs(const T& y, const T& x) {
+    return half_plane_angle(first_quadrant(xsimd::abs(y), xsimd::abs(x)), x);
   }
 
   // atan2 for y >= 0 and x >= 0 (either may be -0) under the same conditions: the same bits as
@@ -385,11 +386,11 @@ struct LaneOps<Twin<B>> {
   static T sqrt(const T& x) { return {O::sqrt(x.lo), O::sqrt(x.hi)}; }
   static T abs(const T& x) { return {O::abs(x.lo), O::abs(x.hi)}; }
   static T atan2(const T& y, const T& x) { return {O::atan2(y.lo, x.lo), O::atan2(y.hi, x.hi)}; }
-  static T atan2_finite(const T& y, const T& x) {
-    return {O::atan2_finite(y.lo, x.lo), O::atan2_finite(y.hi, x.hi)};
-  }
   static T atan2_nonneg(const T& y, const T& x) {
     return {O::atan2_nonneg(y.lo, x.lo), O::atan2_nonneg(y.hi, x.hi)};
+  }
+  static T atan2_abs(const T& y, const T& x) {
+    return {O::atan2_abs(y.lo, x.lo), O::atan2_abs(y.hi, x.hi)};
   }
   static T min(const T& a, const T& b) { return {O::min(a.lo, b.lo), O::min(a.hi, b.hi)}; }
   static T max(const T& a, const T& b) { return {O::max(a.lo, b.lo), O::max(a.hi, b.hi)}; }

@@ -24,14 +24,13 @@ inline MaskOf<T> pair_is_valid(const DirPair<T>& p) {
                      L::mask_and(p.wi.z >= -horizon_tol, p.wo.z >= -horizon_tol));
 }
 
-// Whether w is kept as it is by onto_unit_hemisphere below: ‖ω‖² within 4ε of 1 (z below the
-// horizon counted as 0) and z >= 0; false for NaN.
+// Whether w is kept as it is by onto_unit_hemisphere below: ‖ω‖² within 4ε of 1 and z >= 0;
+// false for NaN. (‖ω‖² is pair_is_valid's expression, so the kernels compute it once.)
 template <class T>
 inline MaskOf<T> on_unit_hemisphere(const Vec3<T>& w) {
   using L = LaneOps<T>;
   using S = ScalarOf<T>;
-  const T z = L::max(w.z, T(0));
-  const T e = w.x * w.x + w.y * w.y + z * z - T(1);
+  const T e = dot(w, w) - T(1);
   const T unit_tol(S(4) * std::numeric_limits<S>::epsilon());
   return L::mask_and(L::mask_and(e <= unit_tol, e >= -unit_tol), w.z >= T(0));
 }

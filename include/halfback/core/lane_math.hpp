@@ -26,9 +26,9 @@ struct LaneOps<T> {
   static T sqrt(T x) { return std::sqrt(x); }
   static T atan2(T y, T x) { return std::atan2(y, x); }
   // Narrower contracts that SIMD lanes exploit (batch_simd.hpp): finite |x|, |y| < 2^1000, not
-  // both below 2^-1000 (float 2^-120); and in addition x, y >= 0. Other lanes get an unspecified
-  // value (for both tiny, an angle up to 0.02 off).
-  static T atan2_finite(T y, T x) { return std::atan2(y, x); }
+  // both below 2^-1000 (float 2^-120; atan2_abs = |atan2|); and in addition x, y >= 0
+  // (atan2_nonneg). Other lanes get an unspecified value (for both tiny, an angle up to 0.02 off).
+  static T atan2_abs(T y, T x) { return std::abs(std::atan2(y, x)); }
   static T atan2_nonneg(T y, T x) { return std::atan2(y, x); }
   static T abs(T x) { return std::abs(x); }
   static T min(T a, T b) { return std::fmin(a, b); }

@@ -61,8 +61,10 @@ template <class T>
 inline T azimuth(T y, T x) {
   using L = LaneOps<T>;
   using S = ScalarOf<T>;
-  T phi = L::atan2_finite(y, x);
-  phi = L::select(phi < T(0), phi + T(kTwoPi<S>), phi);
+  // atan2 negated where y < 0 and then wrapped, 2π + (-|atan2|), is 2π - |atan2| (the same
+  // rounding): the sign of y selects it, and a SIMD atan2 need not apply that sign first.
+  const T a = L::atan2_abs(y, x);
+  T phi = L::select(y < T(0), T(kTwoPi<S>) - a, a);
   phi = L::select(phi >= T(kTwoPi<S>), T(0), phi);  // -tiny + 2π may round up to 2π
   phi = L::select(L::mask_and(x == T(0), y == T(0)), T(0), phi);
   return phi + T(0);  // -0 + 0 = +0
