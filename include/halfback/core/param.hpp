@@ -66,8 +66,9 @@ inline T azimuth(T y, T x) {
   const T a = L::atan2_abs(y, x);
   T phi = L::select(y < T(0), T(kTwoPi<S>) - a, a);
   phi = L::select(phi >= T(kTwoPi<S>), T(0), phi);  // -tiny + 2π may round up to 2π
-  phi = L::select(L::mask_and(x == T(0), y == T(0)), T(0), phi);
-  return phi + T(0);  // -0 + 0 = +0
+  // Never -0: |atan2| is +0 or more (the SIMD one too: +0/b and fma(-0, g, -0) + π/2 for the
+  // reduced ratios), and 2π - |atan2| is positive.
+  return L::select(L::mask_and(x == T(0), y == T(0)), T(0), phi);
 }
 
 // Reduces an angle in (-2π, 4π) to [0, 2π). Both steps are exact (Sterbenz) or round into range.
@@ -262,9 +263,11 @@ struct HalfDiff {
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
     const Sums<T> s = sums(p);
-    if (any_lanes(needs_scaled_frame(s))) [[unlikely]] {
+    // (rxy len)² small somewhere: a lane needs the scaled frame, or has h̄ = 0 exactly (which
+    // frame() serves unless len is small too).
+    if (any_lanes(s.rxy2 * s.len2 < T(detail::TinyScale<ScalarOf<T>>::frame_min))) [[unlikely]] {
       const auto scaled = needs_scaled_frame(s);
-      return finish(select_frame(scaled, scaled_frame(s), frame(s)));
+      if (any_lanes(scaled)) return finish(select_frame(scaled, scaled_frame(s), frame(s)));
     }
     return finish(frame(s));
   }
@@ -345,22 +348,14 @@ struct HalfDiff {
   template <class T>
   struct Sums {
     T sx, sy, sz;  // s = ωi + ωo = 2h
-    T kx, ky, kz;  // k = (ωi - ωo)/2
+    T tx, ty, tz;  // ωi - ωo = 2k
     T rxy2, len2;  // ‖(sx, sy)‖², ‖s‖²
   };
   template <class T>
   static Sums<T> sums(const DirPair<T>& p) {
-    const T half(0.5);
     const T sx = p.wi.x + p.wo.x, sy = p.wi.y + p.wo.y, sz = p.wi.z + p.wo.z;
     const T rxy2 = sx * sx + sy * sy;
-    return {sx,
-            sy,
-            sz,
-            half * (p.wi.x - p.wo.x),
-            half * (p.wi.y - p.wo.y),
-            half * (p.wi.z - p.wo.z),
-            rxy2,
-            rxy2 + sz * sz};
+    return {sx, sy, sz, p.wi.x - p.wo.x, p.wi.y - p.wo.y, p.wi.z - p.wo.z, rxy2, rxy2 + sz * sz};
   }
 
   // θh before its clamp, φh, (st, ct) = a positive multiple of (sin θh, cos θh), and D a positive
@@ -380,24 +375,25 @@ struct HalfDiff {
             {L::select(m, a.D.x, b.D.x), L::select(m, a.D.y, b.D.y), L::select(m, a.D.z, b.D.z)}};
   }
 
-  // D = rxy len d with rxy = ‖(sx, sy)‖ = 2‖h̄‖ and len = ‖s‖ = 2‖h‖ (docs/math.md §2.2):
-  // (A, B) = rxy R_z(-φh) k_xy = (s_xy · k_xy, s_xy × k_xy), and R_y(-θh) is (sz, rxy)/len, so
-  //   D = (sz A - rxy² kz, len B, rxy len²/2).
-  // No division, and len's square root is off the chain to D_xy. When h̄ = 0 (ĥ = n, c := (1, 0)),
-  // D = len d = (sz kx, len ky, len²/2). Accurate (its squares normal) unless needs_scaled_frame.
+  // D = 2 rxy len d with rxy = ‖(sx, sy)‖ = 2‖h̄‖, len = ‖s‖ = 2‖h‖ and t = ωi - ωo = 2k
+  // (docs/math.md §2.2): (A, B) = rxy R_z(-φh) t_xy = (s_xy · t_xy, s_xy × t_xy), and R_y(-θh)
+  // is (sz, rxy)/len, so
+  //   D = (sz A - rxy² tz, len B, rxy len²).
+  // No division, and len's square root is off the chain to Dx. When h̄ = 0 (ĥ = n, c := (1, 0)),
+  // D = 2 len d = (sz tx, len ty, len²). Accurate (its squares normal) unless needs_scaled_frame,
+  // which also takes the rows where rxy² alone underflows to 0.
   template <class T>
   static Frame<T> frame(const Sums<T>& s) {
     using L = LaneOps<T>;
-    const T rxy = L::sqrt(s.rxy2), len = L::sqrt(s.len2), half(0.5);
+    const T rxy = L::sqrt(s.rxy2), len = L::sqrt(s.len2);
     const auto flat = s.rxy2 == T(0);
-    const T A = s.sx * s.kx + s.sy * s.ky, B = s.sx * s.ky - s.sy * s.kx;
-    const T Dz = half * s.len2;
+    const T A = s.sx * s.tx + s.sy * s.ty, B = s.sx * s.ty - s.sy * s.tx;
     return {L::atan2_nonneg(rxy, s.sz),
             detail::azimuth(s.sy, s.sx),
             rxy,
             s.sz,
-            {L::select(flat, s.sz * s.kx, s.sz * A - s.rxy2 * s.kz),
-             L::select(flat, len * s.ky, len * B), L::select(flat, Dz, Dz * rxy)}};
+            {L::select(flat, s.sz * s.tx, s.sz * A - s.rxy2 * s.tz),
+             L::select(flat, len * s.ty, len * B), L::select(flat, s.len2, s.len2 * rxy)}};
   }
 
   // Rows where frame()'s D, of size rxy len (len on a vertical ĥ), would have a subnormal square:
@@ -414,8 +410,8 @@ struct HalfDiff {
   }
 
   // The same angles with s_xy and s rescaled by powers of two (exact) so that their squares are
-  // normal, and D = d itself, whose z component ‖h‖ is formed without squaring. Rare rows only.
-  // h = 0 exactly: ĥ := n, θh = 0 and D = (kx, ky, 0).
+  // normal, and D = 2d, whose z component 2‖h‖ is formed without squaring. Rare rows only.
+  // h = 0 exactly: ĥ := n, θh = 0 and D = (tx, ty, 0).
   template <class T>
   static Frame<T> scaled_frame(const Sums<T>& s) {
     using L = LaneOps<T>;
@@ -426,17 +422,16 @@ struct HalfDiff {
     const T rs = L::sqrt(xs * xs + ys * ys);                               // pxy rxy
     const auto flat = rs == T(0), null = L::mask_and(flat, s.sz == T(0));  // s = 0
     const T cx = L::select(flat, one, xs / rs), cy = L::select(flat, T(0), ys / rs);
-    const T a = cx * s.kx + cy * s.ky, b = cx * s.ky - cy * s.kx;
+    const T a = cx * s.tx + cy * s.ty, b = cx * s.ty - cy * s.tx;
     const T rxy = (p / pxy) * rs, sz = p * s.sz;  // p rxy, p sz: exact unless underflowing
     const T len = L::sqrt(rxy * rxy + sz * sz);   // p len
     const T norm = L::select(null, one, len);
-    const T dz = T(0.5) * (len / p);  // ‖h‖
     return {L::select(null, T(0), L::atan2_nonneg(rxy, sz)),
             detail::azimuth(ys, xs),  // exact multiples of sy, sx, and not subnormal
             rxy,
             sz,
-            {L::select(null, s.kx, (sz / norm) * a - (rxy / norm) * s.kz), L::select(null, s.ky, b),
-             L::select(null, T(0), dz)}};
+            {L::select(null, s.tx, (sz / norm) * a - (rxy / norm) * s.tz), L::select(null, s.ty, b),
+             L::select(null, T(0), len / p)}};
   }
 
   // φh, θd, φd from the frame, and θh clamped (below): the inverse's elevations are
