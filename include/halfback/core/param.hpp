@@ -388,12 +388,13 @@ struct HalfDiff {
     const T rxy = L::sqrt(s.rxy2), len = L::sqrt(s.len2);
     const auto flat = s.rxy2 == T(0);
     const T A = s.sx * s.tx + s.sy * s.ty, B = s.sx * s.ty - s.sy * s.tx;
-    return {L::atan2_nonneg(rxy, s.sz),
-            detail::azimuth(s.sy, s.sx),
-            rxy,
-            s.sz,
-            {L::select(flat, s.sz * s.tx, s.sz * A - s.rxy2 * s.tz),
-             L::select(flat, len * s.ty, len * B), L::select(flat, s.len2, s.len2 * rxy)}};
+    const Vec3<T> D{L::select(flat, s.sz * s.tx, s.sz * A - s.rxy2 * s.tz),
+                    L::select(flat, len * s.ty, len * B), L::select(flat, s.len2, s.len2 * rxy)};
+    // D before the angles of ĥ: GCC keeps this order, and the sums are then dead during the
+    // four atan2 (3-4 % fewer cycles than the angles first, by register pressure; same bits).
+    const T theta_h = L::atan2_nonneg(rxy, s.sz);
+    const T phi_h = detail::azimuth(s.sy, s.sx);
+    return {theta_h, phi_h, rxy, s.sz, D};
   }
 
   // Rows where frame()'s D, of size rxy len (len on a vertical ĥ), would have a subnormal square:
