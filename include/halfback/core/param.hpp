@@ -258,8 +258,9 @@ struct HalfDiff {
   // alone would make the inverse reflect ωi about ĥ, and amplify the inputs' unit-norm rounding
   // (‖ωi‖ ≠ ‖ωo‖ by an ulp) by 1/‖h‖ near h = 0; with the symmetric form the inverse reproduces
   // the pair up to one common scale (docs/math.md §2.2). A positive multiple D of d is computed:
-  // D = 2 rxy len d = 8‖h̄‖ ‖h‖ d needs no division (frame()). Where that multiple would underflow, near a
-  // vertical ĥ or near h = 0, the rows take scaled_frame() instead, which rescales by powers of 2.
+  // D = 2 rxy len d = 8‖h̄‖ ‖h‖ d needs no division (frame()). Where that multiple would underflow,
+  // near a vertical ĥ or near h = 0, the rows take scaled_frame() instead, which rescales by powers
+  // of 2.
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
     const Sums<T> s = sums(p);
