@@ -1,6 +1,6 @@
 // HalfDiff's forward map against an independent long double reference at every scale of
-// ωi + ωo: the kernel computes a multiple of d whose size is ‖h̄‖ ‖h‖ (docs/math.md §2.2) and
-// rescales by powers of two where that would underflow (ĥ within ~1e-145 rad of n, or h ≈ 0).
+// ωi + ωo: the kernel computes D = 2 rxy len d = 8‖h̄‖ ‖h‖ d (docs/math.md §2.2) and rescales by
+// powers of two where that would underflow (ĥ within ~1e-145 rad of n, or h ≈ 0).
 // The pairs below are built so that the sums are exactly tiny: ωi + ωo = (t1 + t2, 0, z1 + z2).
 #include <gtest/gtest.h>
 
@@ -8,7 +8,6 @@
 #include <cmath>
 #include <limits>
 #include <random>
-#include <span>
 #include <string>
 #include <vector>
 
