@@ -42,10 +42,11 @@
 
 namespace halfback {
 
-// The constants of LaneOps::atan2 below: π/4, π/2, π as a rounded value and its remainder, and the
-// polynomial g(z) ≈ (atan(√z)/√z - 1)/z on [0, tan²(π/8)], highest degree first: Chebyshev
-// least-squares fits (mpmath, 50 digits; 11 terms for double, 5 for float), whose error on
-// atan(r) is below 6e-18 and 3e-9 relative, under the types' rounding.
+// The constants of LaneOps::atan2 below: π and π/4 as a rounded value and its remainder; π/4 split
+// again for azimuth, its high part short enough (50 bits in double, 21 in float) that k times it
+// is exact for k <= 8; and the polynomial g(z) ≈ (atan(√z)/√z - 1)/z on [0, tan²(π/8)], highest
+// degree first: Chebyshev least-squares fits (mpmath, 50 digits; 11 terms for double, 5 for float),
+// whose error on atan(r) is below 6e-18 and 3e-9 relative, under the types' rounding.
 template <class S>
 struct Atan2Constants;
 template <>
@@ -53,8 +54,8 @@ struct Atan2Constants<double> {
   static constexpr double tan_pi_8 = 0.41421356237309503, huge = 0x1p1000, tiny = 0x1p-1000;
   static constexpr double grow = 0x1p600;
   static constexpr double pi_hi = 0x1.921fb54442d18p1, pi_lo = 0x1.1a62633145c07p-53;
-  static constexpr double half_pi_hi = pi_hi / 2, half_pi_lo = pi_lo / 2;
   static constexpr double quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
+  static constexpr double eighth_turn_hi = quarter_pi_hi, eighth_turn_lo = quarter_pi_lo;
   static constexpr std::array<double, 11> g = {
       -0x1.39b571eaf17abp-6, 0x1.412ff8ed2a9c8p-5, -0x1.a0880440d55f1p-5, 0x1.dfe2ebe99b2b4p-5,
       -0x1.10fa460dd6e79p-4, 0x1.3b125f7f3f520p-4, -0x1.745d0b01be884p-4, 0x1.c71c71844817bp-4,
@@ -65,8 +66,8 @@ struct Atan2Constants<float> {
   static constexpr float tan_pi_8 = 0.41421356f, huge = 0x1p100f, tiny = 0x1p-120f;
   static constexpr float grow = 0x1p60f;
   static constexpr float pi_hi = 0x1.921fb6p1f, pi_lo = -0x1.777a5cp-24f;
-  static constexpr float half_pi_hi = pi_hi / 2, half_pi_lo = pi_lo / 2;
   static constexpr float quarter_pi_hi = pi_hi / 4, quarter_pi_lo = pi_lo / 4;
+  static constexpr float eighth_turn_hi = 0x1.921fbp-1f, eighth_turn_lo = 0x1.5110b4p-23f;
   static constexpr std::array<float, 5> g = {-0x1.08197cp-4f, 0x1.b802fp-4f, -0x1.241f98p-3f,
                                              0x1.99972cp-3f, -0x1.555554p-2f};
 };
@@ -142,26 +143,37 @@ struct LaneOps<xsimd::batch<S, A>> {
     return xsimd::abs(x);
   }
 
-  // The polynomial with coefficients c (highest degree first) at z. Beyond 6 terms by Estrin's
-  // scheme: terms paired at each level (a + b z, then with z², z⁴, ...), so the chain of dependent
-  // fmas is log2(N) long instead of N - 1 (Horner), which the forward kernels' latency feels (the
-  // 11 terms of double: 14.6 against 15.7 ns a forward halfdiff); Horner for the 5 of float.
+  // The polynomial with coefficients c (highest degree first) at z. Up to 6 terms by Horner's
+  // rule. For 7 and 8 (sincos) by Estrin's scheme: terms paired at each level (a + b z, then with
+  // z², z⁴), so the chain of dependent fmas is log2(N) long instead of N - 1, which the inverse
+  // kernels' latency feels. Beyond (atan2's 11 terms in double) by a second-order Horner rule,
+  // even and odd terms as two chains in w = z²: N - 1 fmas and one product, two fewer than
+  // Estrin's squares of z, which the forward kernels' throughput feels more than its longer chain
+  // (docs/performance.md, seventh round).
   template <std::size_t N>
   static T polynomial(const std::array<S, N>& c, const T& z) {
     if constexpr (N <= 6) {
       T g(c[0]);
       for (std::size_t i = 1; i < N; ++i) g = fma(g, z, T(c[i]));
       return g;
+    } else if constexpr (N <= 8) {
+      std::array<T, N> t;  // lowest degree first
+      for (std::size_t k = 0; k < N; ++k) t[k] = T(c[N - 1 - k]);
+      T x = z;
+      for (std::size_t n = N; n > 1; n = (n + 1) / 2) {
+        for (std::size_t j = 0; j < n / 2; ++j) t[j] = fma(t[2 * j + 1], x, t[2 * j]);
+        if (n % 2 == 1) t[n / 2] = t[n - 1];
+        if (n > 2) x = x * x;
+      }
+      return t[0];
+    } else {
+      constexpr std::size_t top_odd = N % 2;  // c[top_odd] is the odd term of highest degree
+      const T w = z * z;
+      T even(c[1 - top_odd]), odd(c[top_odd]);
+      for (std::size_t i = 3 - top_odd; i < N; i += 2) even = fma(even, w, T(c[i]));
+      for (std::size_t i = 2 + top_odd; i < N; i += 2) odd = fma(odd, w, T(c[i]));
+      return fma(odd, z, even);
     }
-    std::array<T, N> t;  // lowest degree first
-    for (std::size_t k = 0; k < N; ++k) t[k] = T(c[N - 1 - k]);
-    T x = z;
-    for (std::size_t n = N; n > 1; n = (n + 1) / 2) {
-      for (std::size_t j = 0; j < n / 2; ++j) t[j] = fma(t[2 * j + 1], x, t[2 * j]);
-      if (n % 2 == 1) t[n / 2] = t[n - 1];
-      if (n > 2) x = x * x;
-    }
-    return t[0];
   }
 
   // atan2 with one division (xsimd's takes four in double and three in float, the most costly
@@ -189,52 +201,69 @@ struct LaneOps<xsimd::batch<S, A>> {
     return xsimd::copysign(xsimd::select(zero || both_inf, special, angle), y);
   }
 
-  // |atan2(y, x)| for finite x, y below 2^1000 in magnitude and not both below `tiny` (2^-1000,
-  // float 2^-120; other lanes get an unspecified value): the same bits as atan2's magnitude there,
-  // without its scaling, rare cases and sign. The azimuths of the forward conversions, whose
-  // invalid rows are masked afterwards, and whose planar vectors that tiny only move a direction
-  // by as little.
-  static T atan2_abs(const T& y, const T& x) {
-    return half_plane_angle(first_quadrant(xsimd::abs(y), xsimd::abs(x)), x);
+  // The azimuth of (x, y) in [0, 2π), 0 for the zero vector and never -0, for finite x, y below
+  // 2^1000 in magnitude and, but for the zero vector, not both below `tiny` (2^-1000, float
+  // 2^-120; other lanes get an unspecified value). The forward conversions' azimuths: their
+  // invalid rows are masked afterwards, and a planar vector that tiny moves its direction by as
+  // little. One octant reduction for the whole circle: the angle is c ± (k π/4 + at) with k the
+  // octant of (|x|, |y|), which is k' π/4 ± at for an integer k' <= 8 (docs/math.md §6.1), so the
+  // reflections cost no rounding of their own and no select per half plane.
+  static T azimuth(const T& y, const T& x) {
+    using C = Atan2Constants<S>;
+    const Octant o = first_quadrant<true>(xsimd::abs(y), xsimd::abs(x));
+    // x = -0 counts as right: the same angle where y != 0 (π/2 or 3π/2), and 0 for (±0, -0).
+    const auto below = y < T(S(0)), left = x < T(S(0));
+    // π - θ or 2π - θ, of θ = k π/4 + at: below xor left. (xsimd 8.1's ^ of masks is an or on
+    // AVX-512, and its != of masks compares them as NaNs on SSE2.)
+    const auto mirrored = (below & ~left) | (left & ~below);
+    const T k =
+        xsimd::select(below, T(S(4)), T(S(0))) + xsimd::select(mirrored, T(S(4)) - o.k, o.k);
+    const T at = xsimd::select(mirrored, -o.at, o.at);
+    const T phi = fma(k, T(C::eighth_turn_lo), at) + k * T(C::eighth_turn_hi);
+    return xsimd::select(phi >= T(kTwoPi<S>), T(S(0)), phi);  // 2π - tiny may round up to 2π
   }
 
-  // atan2 for y >= 0 and x >= 0 (either may be -0) under the same conditions: the same bits as
-  // atan2 there. Elevations, whose two arguments are a length and a z >= 0.
+  // atan2 for y >= 0 and x >= 0 (either may be -0) under the same conditions as azimuth: the same
+  // bits as atan2 there. Elevations, whose two arguments are a length and a z >= 0.
   static T atan2_nonneg(const T& y, const T& x) {
+    using C = Atan2Constants<S>;
     const Octant o = first_quadrant(y, x);
-    return o.off_hi + (o.at + o.off_lo);
+    return o.k * T(C::quarter_pi_hi) + fma(o.k, T(C::quarter_pi_lo), o.at);
   }
 
-  // The angle of (b, a) for a, b >= 0 as off_hi + (at + off_lo): the octant's offset, split in
-  // two for accuracy, and atan of the reduced ratio.
+  // The angle of (b, a) for a, b >= 0 as k π/4 + at: the octant k in {0, 1, 2} (as a lane value)
+  // and atan of the reduced ratio, |at| <= π/8. k times the halves of a split π/4 is exact, so the
+  // offset k π/4 costs no select per half. ZeroSafe: (0, 0) gives k = 0 and at = 0 instead of
+  // NaN (the denominator is raised to the least normal number, which changes no other lane of
+  // the narrow domain: there it is at least max(a, b) >= `tiny`).
   struct Octant {
-    T at, off_hi, off_lo;
+    T at, k;
   };
+  template <bool ZeroSafe = false>
   static Octant first_quadrant(const T& a, const T& b) {
     using C = Atan2Constants<S>;
     const auto low = a <= b * T(C::tan_pi_8);  // |y/x| <= tan(π/8)
     const auto high = a * T(C::tan_pi_8) > b;  // |x/y| < tan(π/8)
     const T num = xsimd::select(low, a, xsimd::select(high, -b, a - b));
-    const T den = xsimd::select(low, b, xsimd::select(high, a, a + b));
+    T den = xsimd::select(low, b, xsimd::select(high, a, a + b));
+    if constexpr (ZeroSafe) den = xsimd::max(den, T(std::numeric_limits<S>::min()));
     const T r = num / den;
     const T z = r * r;
     // A local copy: the loop then reads no symbol that every instruction set's kernel file would
     // share (halfback_isa_symbols forbids weak symbols common to two of them).
     constexpr auto coefficients = C::g;
     const T g = polynomial(coefficients, z);
-    return {
-        fma(r * z, g, r),
-        xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_hi), T(C::quarter_pi_hi))),
-        xsimd::select(low, T(S(0)), xsimd::select(high, T(C::half_pi_lo), T(C::quarter_pi_lo)))};
+    return {fma(r * z, g, r), xsimd::select(low, T(S(0)), xsimd::select(high, T(S(2)), T(S(1))))};
   }
 
   // The first-quadrant angle o reflected to π minus it where x < 0 (or -0):
-  // π - (off + at) = (π_hi - off_hi) + ((π_lo - off_lo) - at).
+  // π - (off + at) = (π_hi - off_hi) + ((π_lo - off_lo) - at), off = k π/4 (both halves exact).
   static T half_plane_angle(const Octant& o, const T& x) {
     using C = Atan2Constants<S>;
+    const T off_hi = o.k * T(C::quarter_pi_hi), off_lo = o.k * T(C::quarter_pi_lo);
     const auto left = xsimd::copysign(T(S(1)), x) < T(S(0));
-    const T base = xsimd::select(left, T(C::pi_hi) - o.off_hi, o.off_hi);
-    const T rest = xsimd::select(left, (T(C::pi_lo) - o.off_lo) - o.at, o.at + o.off_lo);
+    const T base = xsimd::select(left, T(C::pi_hi) - off_hi, off_hi);
+    const T rest = xsimd::select(left, (T(C::pi_lo) - off_lo) - o.at, o.at + off_lo);
     return base + rest;
   }
 
@@ -389,8 +418,8 @@ struct LaneOps<Twin<B>> {
   static T atan2_nonneg(const T& y, const T& x) {
     return {O::atan2_nonneg(y.lo, x.lo), O::atan2_nonneg(y.hi, x.hi)};
   }
-  static T atan2_abs(const T& y, const T& x) {
-    return {O::atan2_abs(y.lo, x.lo), O::atan2_abs(y.hi, x.hi)};
+  static T azimuth(const T& y, const T& x) {
+    return {O::azimuth(y.lo, x.lo), O::azimuth(y.hi, x.hi)};
   }
   static T min(const T& a, const T& b) { return {O::min(a.lo, b.lo), O::min(a.hi, b.hi)}; }
   static T max(const T& a, const T& b) { return {O::max(a.lo, b.lo), O::max(a.hi, b.hi)}; }

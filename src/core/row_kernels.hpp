@@ -17,8 +17,7 @@ inline MaskOf<T> pair_is_valid(const DirPair<T>& p) {
   using S = ScalarOf<T>;
   const T unit_tol(static_cast<S>(kUnitTolerance)), horizon_tol(kDomainTolerance<S>);
   auto unit = [&](const Vec3<T>& w) {
-    const T e = dot(w, w) - T(1);
-    return L::mask_and(e <= unit_tol, e >= -unit_tol);  // false for NaN and ±inf
+    return L::abs(dot(w, w) - T(1)) <= unit_tol;  // false for NaN and ±inf
   };
   return L::mask_and(L::mask_and(unit(p.wi), unit(p.wo)),
                      L::mask_and(p.wi.z >= -horizon_tol, p.wo.z >= -horizon_tol));
@@ -30,9 +29,8 @@ template <class T>
 inline MaskOf<T> on_unit_hemisphere(const Vec3<T>& w) {
   using L = LaneOps<T>;
   using S = ScalarOf<T>;
-  const T e = dot(w, w) - T(1);
   const T unit_tol(S(4) * std::numeric_limits<S>::epsilon());
-  return L::mask_and(L::mask_and(e <= unit_tol, e >= -unit_tol), w.z >= T(0));
+  return L::mask_and(L::abs(dot(w, w) - T(1)) <= unit_tol, w.z >= T(0));
 }
 
 // An accepted direction onto the unit upper hemisphere: a z below the horizon (within the

@@ -14,6 +14,11 @@
 
 namespace halfback {
 
+template <class S>
+inline constexpr S kTwoPi = S(2) * std::numbers::pi_v<S>;
+template <class S>
+inline constexpr S kHalfPi = std::numbers::pi_v<S> / S(2);
+
 template <class T>
 struct LaneOps;
 
@@ -26,10 +31,21 @@ struct LaneOps<T> {
   static T sqrt(T x) { return std::sqrt(x); }
   static T atan2(T y, T x) { return std::atan2(y, x); }
   // Narrower contracts that SIMD lanes exploit (batch_simd.hpp): finite |x|, |y| < 2^1000, not
-  // both below 2^-1000 (float 2^-120; atan2_abs = |atan2|); and in addition x, y >= 0
+  // both below 2^-1000 (float 2^-120) but for azimuth's zero vector; and in addition x, y >= 0
   // (atan2_nonneg). Other lanes get an unspecified value (for both tiny, an angle up to 0.02 off).
-  static T atan2_abs(T y, T x) { return std::abs(std::atan2(y, x)); }
   static T atan2_nonneg(T y, T x) { return std::atan2(y, x); }
+  // The azimuth of the planar vector (x, y) in [0, 2π); 0 for the zero vector; never -0. Where
+  // both are below 2^-1000 (float 2^-120) the SIMD lanes' angle may be up to 0.02 off: such a
+  // vector moves its direction by less than 1e-300 (1e-36) whatever its azimuth; HalfDiff's φh,
+  // which sets the frame of d, is taken of scaled sums.
+  static T azimuth(T y, T x) {
+    // atan2 negated where y < 0 and then wrapped, 2π + (-|atan2|), is 2π - |atan2| (the same
+    // rounding).
+    const T a = std::abs(std::atan2(y, x));
+    T phi = y < T(0) ? kTwoPi<T> - a : a;
+    if (phi >= kTwoPi<T>) phi = T(0);  // -tiny + 2π may round up to 2π
+    return x == T(0) && y == T(0) ? T(0) : phi;
+  }
   static T abs(T x) { return std::abs(x); }
   static T min(T a, T b) { return std::fmin(a, b); }
   static T max(T a, T b) { return std::fmax(a, b); }
@@ -83,10 +99,5 @@ constexpr S constexpr_sqrt(S x) {
 
 template <class S>
 inline constexpr S kSqrtDomainTolerance = constexpr_sqrt(kDomainTolerance<S>);
-
-template <class S>
-inline constexpr S kTwoPi = S(2) * std::numbers::pi_v<S>;
-template <class S>
-inline constexpr S kHalfPi = std::numbers::pi_v<S> / S(2);
 
 }  // namespace halfback

@@ -52,25 +52,6 @@ struct Solved {
 
 namespace detail {
 
-// Azimuth of the planar vector (x, y) in [0, 2π); 0 for the zero vector; never -0. For finite
-// x, y below 2^1000 in magnitude (larger or non-finite ones give an unspecified value), which
-// every valid pair's planar vectors are. Where both are below 2^-1000 (float 2^-120) the SIMD
-// lanes' angle may be up to 0.02 off: such a vector moves its direction by less than 1e-300
-// (1e-36) whatever its azimuth; HalfDiff's φh, which sets the frame of d, is scaled first.
-template <class T>
-inline T azimuth(T y, T x) {
-  using L = LaneOps<T>;
-  using S = ScalarOf<T>;
-  // atan2 negated where y < 0 and then wrapped, 2π + (-|atan2|), is 2π - |atan2| (the same
-  // rounding): the sign of y selects it, and a SIMD atan2 need not apply that sign first.
-  const T a = L::atan2_abs(y, x);
-  T phi = L::select(y < T(0), T(kTwoPi<S>) - a, a);
-  phi = L::select(phi >= T(kTwoPi<S>), T(0), phi);  // -tiny + 2π may round up to 2π
-  // Never -0: |atan2| is +0 or more (the SIMD one too: +0/b and fma(-0, g, -0) + π/2 for the
-  // reduced ratios), and 2π - |atan2| is positive.
-  return L::select(L::mask_and(x == T(0), y == T(0)), T(0), phi);
-}
-
 // Reduces an angle in (-2π, 4π) to [0, 2π). Both steps are exact (Sterbenz) or round into range.
 template <class T>
 inline T wrap_two_pi(T a) {
@@ -150,9 +131,10 @@ struct Spherical {
 
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
-    using detail::azimuth, detail::elevation;
-    return {elevation(p.wi.x, p.wi.y, p.wi.z), azimuth(p.wi.y, p.wi.x),
-            elevation(p.wo.x, p.wo.y, p.wo.z), azimuth(p.wo.y, p.wo.x)};
+    using detail::elevation;
+    using L = LaneOps<T>;
+    return {elevation(p.wi.x, p.wi.y, p.wi.z), L::azimuth(p.wi.y, p.wi.x),
+            elevation(p.wo.x, p.wo.y, p.wo.z), L::azimuth(p.wo.y, p.wo.x)};
   }
 
   template <class T>
@@ -233,7 +215,7 @@ struct Spherical {
     L::sincos(q[1], spi, cpi);
     L::sincos(q[2], sto, cto);
     L::sincos(q[3], spo, cpo);
-    const T phi_h = detail::azimuth(sti * spi + sto * spo, sti * cpi + sto * cpo);
+    const T phi_h = LaneOps<T>::azimuth(sti * spi + sto * spo, sti * cpi + sto * cpo);
     const T phi_i = L::select(q[0] == T(0), T(0), detail::wrap_two_pi(T(2) * phi_h - q[1]));
     const T phi_o = L::select(q[2] == T(0), T(0), detail::wrap_two_pi(T(2) * phi_h - q[3]));
     return {q[0], phi_i, q[2], phi_o};
@@ -266,10 +248,9 @@ struct HalfDiff {
     const Sums<T> s = sums(p);
     // (rxy len)² small somewhere: a lane needs the scaled frame, or has h̄ = 0 exactly (which
     // frame() serves unless len is small too).
-    if (any_lanes(s.rxy2 * s.len2 < T(detail::TinyScale<ScalarOf<T>>::frame_min))) [[unlikely]] {
-      const auto scaled = needs_scaled_frame(s);
-      if (any_lanes(scaled)) return finish(select_frame(scaled, scaled_frame(s), frame(s)));
-    }
+    const auto scaled = needs_scaled_frame(s);
+    if (any_lanes(scaled)) [[unlikely]]
+      return finish(select_frame(scaled, scaled_frame(s), frame(s)));
     return finish(frame(s));
   }
 
@@ -365,6 +346,7 @@ struct HalfDiff {
   struct Frame {
     T theta_h, phi_h, st, ct;
     Vec3<T> D;
+    T dxy;  // ‖(D.x, D.y)‖
   };
   template <class T>
   static Frame<T> select_frame(const MaskOf<T>& m, const Frame<T>& a, const Frame<T>& b) {
@@ -373,7 +355,8 @@ struct HalfDiff {
             L::select(m, a.phi_h, b.phi_h),
             L::select(m, a.st, b.st),
             L::select(m, a.ct, b.ct),
-            {L::select(m, a.D.x, b.D.x), L::select(m, a.D.y, b.D.y), L::select(m, a.D.z, b.D.z)}};
+            {L::select(m, a.D.x, b.D.x), L::select(m, a.D.y, b.D.y), L::select(m, a.D.z, b.D.z)},
+            L::select(m, a.dxy, b.dxy)};
   }
 
   // D = 2 rxy len d with rxy = ‖(sx, sy)‖ = 2‖h̄‖, len = ‖s‖ = 2‖h‖ and t = ωi - ωo = 2k
@@ -387,28 +370,21 @@ struct HalfDiff {
   static Frame<T> frame(const Sums<T>& s) {
     using L = LaneOps<T>;
     const T rxy = L::sqrt(s.rxy2), len = L::sqrt(s.len2);
-    const auto flat = s.rxy2 == T(0);
     const T A = s.sx * s.tx + s.sy * s.ty, B = s.sx * s.ty - s.sy * s.tx;
-    const Vec3<T> D{L::select(flat, s.sz * s.tx, s.sz * A - s.rxy2 * s.tz),
-                    L::select(flat, len * s.ty, len * B), L::select(flat, s.len2, s.len2 * rxy)};
+    const Vec3<T> D{s.sz * A - s.rxy2 * s.tz, len * B, s.len2 * rxy};
+    const T dxy = L::sqrt(D.x * D.x + D.y * D.y);
     // D before the angles of ĥ: GCC keeps this order, and the sums are then dead during the
     // four atan2 (3-4 % fewer cycles than the angles first, by register pressure; same bits).
     const T theta_h = L::atan2_nonneg(rxy, s.sz);
-    const T phi_h = detail::azimuth(s.sy, s.sx);
-    return {theta_h, phi_h, rxy, s.sz, D};
+    const T phi_h = LaneOps<T>::azimuth(s.sy, s.sx);
+    return {theta_h, phi_h, rxy, s.sz, D, dxy};
   }
 
-  // Rows where frame()'s D, of size rxy len (len on a vertical ĥ), would have a subnormal square:
-  // ĥ within ~1e-145 rad of n or ‖ωi + ωo‖ below ~1e-145 in double (3e-15 in float).
+  // Rows where frame()'s D, of size rxy len, would have a subnormal square: ĥ within ~1e-145 rad
+  // of n (h̄ = 0 included) or ‖ωi + ωo‖ below ~1e-145 in double (3e-15 in float).
   template <class T>
   static MaskOf<T> needs_scaled_frame(const Sums<T>& s) {
-    using L = LaneOps<T>;
-    using S = ScalarOf<T>;
-    // h̄ = 0 exactly: frame() takes c := (1, 0) and D = len d. Not where only rxy² underflows to 0
-    // (|s_xy| < 1e-162): that h̄ has an azimuth, which the scaled frame keeps.
-    const auto flat = L::mask_and(s.sx == T(0), s.sy == T(0));
-    const T w2 = L::select(flat, s.len2, s.rxy2 * s.len2);
-    return w2 < T(detail::TinyScale<S>::frame_min);
+    return s.rxy2 * s.len2 < T(detail::TinyScale<ScalarOf<T>>::frame_min);
   }
 
   // The same angles with s_xy and s rescaled by powers of two (exact) so that their squares are
@@ -428,12 +404,14 @@ struct HalfDiff {
     const T rxy = (p / pxy) * rs, sz = p * s.sz;  // p rxy, p sz: exact unless underflowing
     const T len = L::sqrt(rxy * rxy + sz * sz);   // p len
     const T norm = L::select(null, one, len);
+    const Vec3<T> D{L::select(null, s.tx, (sz / norm) * a - (rxy / norm) * s.tz),
+                    L::select(null, s.ty, b), L::select(null, T(0), len / p)};
     return {L::select(null, T(0), L::atan2_nonneg(rxy, sz)),
-            detail::azimuth(ys, xs),  // exact multiples of sy, sx, and not subnormal
+            LaneOps<T>::azimuth(ys, xs),  // exact multiples of sy, sx, and not subnormal
             rxy,
             sz,
-            {L::select(null, s.tx, (sz / norm) * a - (rxy / norm) * s.tz), L::select(null, s.ty, b),
-             L::select(null, T(0), len / p)}};
+            D,
+            L::sqrt(D.x * D.x + D.y * D.y)};
   }
 
   // φh, θd, φd from the frame, and θh clamped (below): the inverse's elevations are
@@ -458,7 +436,7 @@ struct HalfDiff {
       const T theta_h_max = L::atan2_nonneg(D.z, adx);
       theta_h = L::select(theta_h > theta_h_max, theta_h_max, theta_h);
     }
-    return {theta_h, f.phi_h, detail::elevation(D.x, D.y, D.z), detail::azimuth(D.y, D.x)};
+    return {theta_h, f.phi_h, L::atan2_nonneg(f.dxy, D.z), L::azimuth(D.y, D.x)};
   }
 };
 
@@ -527,8 +505,8 @@ struct Ortho {
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
     const auto v = detail::planar_hk(p);
-    return {detail::magnitude(v.hx * v.hx + v.hy * v.hy), detail::azimuth(v.hy, v.hx),
-            detail::magnitude(v.kx * v.kx + v.ky * v.ky), detail::azimuth(v.ky, v.kx)};
+    return {detail::magnitude(v.hx * v.hx + v.hy * v.hy), LaneOps<T>::azimuth(v.hy, v.hx),
+            detail::magnitude(v.kx * v.kx + v.ky * v.ky), LaneOps<T>::azimuth(v.ky, v.kx)};
   }
 
   template <class T>
@@ -602,9 +580,9 @@ struct Hybrid {
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
     const auto v = detail::planar_hk(p);
-    return {detail::magnitude(v.hx * v.hx + v.hy * v.hy), detail::azimuth(v.hy, v.hx),
+    return {detail::magnitude(v.hx * v.hx + v.hy * v.hy), LaneOps<T>::azimuth(v.hy, v.hx),
             detail::magnitude(v.kx * v.kx + v.ky * v.ky + v.kz * v.kz),
-            detail::azimuth(v.ky, v.kx)};
+            LaneOps<T>::azimuth(v.ky, v.kx)};
   }
 
   // The pieces of the inverse that the Jacobian shares: hz² = 1 - ‖h̄‖² - ‖k‖², and
