@@ -205,13 +205,13 @@ struct LaneOps<xsimd::batch<S, A>> {
   // 2^1000 in magnitude and, but for the zero vector, not both below `tiny` (2^-1000, float
   // 2^-120; other lanes get an unspecified value). The forward conversions' azimuths: their
   // invalid rows are masked afterwards, and a planar vector that tiny moves its direction by as
-  // little. One octant reduction for the whole circle: the angle is c ± (k π/4 + at) with k the
-  // octant of (|x|, |y|), which is k' π/4 ± at for an integer k' <= 8 (docs/math.md §6.1), so the
-  // reflections cost no rounding of their own and no select per half plane.
+  // little. One octant reduction for the whole circle: θ, π - θ, π + θ or 2π - θ of the
+  // first-quadrant angle θ = k π/4 + at is k' π/4 ± at for an integer k' <= 8 (docs/math.md §6,
+  // "The SIMD azimuth"), so the reflections cost no rounding of their own and no select per half.
   static T azimuth(const T& y, const T& x) {
     using C = Atan2Constants<S>;
     const Octant o = first_quadrant<true>(xsimd::abs(y), xsimd::abs(x));
-    // x = -0 counts as right: the same angle where y != 0 (π/2 or 3π/2), and 0 for (±0, -0).
+    // x = -0 counts as right: the same angle where y != 0 (π/2 or 3π/2), and 0 for (±0, ±0).
     const auto below = y < T(S(0)), left = x < T(S(0));
     // π - θ or 2π - θ, of θ = k π/4 + at: below xor left. (xsimd 8.1's ^ of masks is an or on
     // AVX-512, and its != of masks compares them as NaNs on SSE2.)
