@@ -239,7 +239,8 @@ void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask_in, Sc
       pair = {pick(twice.wi, once.wi), pick(twice.wo, once.wo)};
     }
     encode_param<P, B>(Iso, pair, y);
-    for (int c = 0; c < kDim; ++c) y[c] = L::select(ok, y[c], nan_lanes<B>());
+    if (!all_lanes(ok)) [[unlikely]]
+      for (int c = 0; c < kDim; ++c) y[c] = L::select(ok, y[c], nan_lanes<B>());
     y[kDim] = mask_to_lanes<B>(ok);
   });
 }
