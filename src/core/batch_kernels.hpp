@@ -225,12 +225,15 @@ void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask_in, Sc
   outs[kDim] = mask_out;
   for_rows<B, 7, kDim + 1, 6, kDim>(ins, outs, m, rows, [](const B* x, B* y) {
     const DirPair<B> raw{{x[0], x[1], x[2]}, {x[3], x[4], x[5]}};
-    const auto unchecked = x[6] == B(kUnchecked<S>);
-    const auto ok = L::mask_or(x[6] == B(S(1)), L::mask_and(unchecked, pair_is_valid(raw)));
-    // Almost always every direction is unit to rounding and kept as it is, twice: one test.
+    const auto unchecked = x[6] == B(kUnchecked<S>), checked_valid = x[6] == B(S(1));
+    // Almost always every direction is unit to rounding and kept as it is, twice: one test. Such
+    // a pair is valid too (on_unit_hemisphere's tolerances are within pair_is_valid's).
+    static_assert(S(4) * std::numeric_limits<S>::epsilon() < static_cast<S>(kUnitTolerance));
+    const auto kept = L::mask_and(on_unit_hemisphere(raw.wi), on_unit_hemisphere(raw.wo));
+    auto ok = L::mask_or(checked_valid, L::mask_and(unchecked, kept));
     DirPair<B> pair = raw;
-    if (!all_lanes(L::mask_and(on_unit_hemisphere(raw.wi), on_unit_hemisphere(raw.wo))))
-        [[unlikely]] {
+    if (!all_lanes(kept)) [[unlikely]] {
+      ok = L::mask_or(checked_valid, L::mask_and(unchecked, pair_is_valid(raw)));
       const DirPair<B> once = accepted_pair(raw), twice = accepted_pair(once);
       auto pick = [&](const Vec3<B>& a, const Vec3<B>& b) {
         return Vec3<B>{L::select(unchecked, a.x, b.x), L::select(unchecked, a.y, b.y),
