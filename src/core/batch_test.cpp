@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -905,6 +906,47 @@ const std::pair<Form, Form> kSampleConversions[] = {
     {{Space::ortho, false}, {Space::dirs, false}},
     {{Space::halfdiff, true}, {Space::spherical, false}},
 };
+
+// The engine starts its tiles on a 64-byte line of unit-stride columns that share their offset in
+// a line (an aligning head of up to 7 rows, 15 in float; batches of 16 tiles and more): rows are
+// independent, so every placement of the same data gives the same bits, the head or not, the
+// columns agreeing or not, on one thread or several.
+TYPED_TEST(BatchTest, ColumnOffsetsGiveIdenticalBits) {
+  using T = TypeParam;
+  const std::size_t n = 16 * detail::kTileRows<T> + 37, lanes_per_line = 64 / sizeof(T);
+  for (const auto& [from, to] : kSampleConversions) {
+    const Table<T> in = big_input<T>(from, n);
+    const Result<T> want = run_batch<T>(from, to, in, true);
+    // Every column at `offset` elements past a 64-byte line, inputs at `in_offset`.
+    for (std::size_t in_offset : {std::size_t{0}, std::size_t{1}, lanes_per_line - 1})
+      for (std::size_t offset :
+           {std::size_t{0}, std::size_t{1}, std::size_t{3}, lanes_per_line - 1})
+        for (int threads : {1, 2}) {
+          const std::size_t din = in.size(), dout = dimension(to), pitch = n + 2 * lanes_per_line;
+          std::vector<T> buffer((din + dout + 1) * pitch + lanes_per_line);
+          void* start = buffer.data();
+          std::size_t room = buffer.size() * sizeof(T);
+          T* const lines = static_cast<T*>(std::align(64, sizeof(T), start, room));  // pitch: lines
+          std::vector<ConstColumn<T>> ic;
+          for (std::size_t c = 0; c < din; ++c) {
+            T* col = lines + c * pitch + in_offset;
+            std::copy(in[c].begin(), in[c].end(), col);
+            ic.push_back({col, 1});
+          }
+          std::vector<Column<T>> oc;
+          for (std::size_t c = 0; c < dout; ++c)
+            oc.push_back({lines + (din + c) * pitch + offset, 1});
+          T* jac = lines + (din + dout) * pitch + offset;
+          std::vector<std::uint8_t> valid(n);
+          convert<T>(from, to, ic, n, {oc, {jac, 1}, valid.data()}, {threads});
+          Result<T> got{make_table<T>(dout, n), std::vector<T>(jac, jac + n), valid};
+          for (std::size_t c = 0; c < dout; ++c)
+            std::copy(oc[c].data, oc[c].data + n, got.cols[c].begin());
+          EXPECT_TRUE(same_bits(got, want)) << pair_name(from, to) << ", offsets " << in_offset
+                                            << "/" << offset << ", " << threads << " threads";
+        }
+  }
+}
 
 TYPED_TEST(BatchTest, ThreadCountsGiveIdenticalBits) {
   using T = TypeParam;
