@@ -907,10 +907,10 @@ const std::pair<Form, Form> kSampleConversions[] = {
     {{Space::halfdiff, true}, {Space::spherical, false}},
 };
 
-// The engine starts its tiles on a 64-byte line of unit-stride columns that share their offset in
-// a line (an aligning head of up to 7 rows, 15 in float; batches of 16 tiles and more): rows are
-// independent, so every placement of the same data gives the same bits, the head or not, the
-// columns agreeing or not, on one thread or several.
+// The engine starts its tiles on a 64-byte line of the arrays it reads and writes where it can
+// (an aligning head of up to 63 rows, in batches of 16 tiles and more): rows are independent, so
+// every placement of the same data gives the same bits, the head or not, the columns agreeing or
+// not, columns or rows, on one thread or several.
 TYPED_TEST(BatchTest, ColumnOffsetsGiveIdenticalBits) {
   using T = TypeParam;
   const std::size_t n = 16 * detail::kTileRows<T> + 37, lanes_per_line = 64 / sizeof(T);
@@ -945,6 +945,33 @@ TYPED_TEST(BatchTest, ColumnOffsetsGiveIdenticalBits) {
           EXPECT_TRUE(same_bits(got, want)) << pair_name(from, to) << ", offsets " << in_offset
                                             << "/" << offset << ", " << threads << " threads";
         }
+    // Row-major input and output (the head then aligns rows), without the Jacobian.
+    const Result<T> want_rows = run_batch<T>(from, to, in, false);
+    for (std::size_t in_offset : {std::size_t{0}, std::size_t{2}, lanes_per_line - 1})
+      for (std::size_t offset : {std::size_t{0}, std::size_t{2}, lanes_per_line - 1}) {
+        const std::size_t din = in.size(), dout = dimension(to);
+        std::vector<T> buffer((din + dout) * n + 4 * lanes_per_line);
+        void* start = buffer.data();
+        std::size_t room = buffer.size() * sizeof(T);
+        T* const lines = static_cast<T*>(std::align(64, sizeof(T), start, room));
+        T* const rows_in = lines + in_offset;
+        T* const rows_out = lines + (din * n / lanes_per_line + 2) * lanes_per_line + offset;
+        const std::vector<T> packed = row_major(in);
+        std::copy(packed.begin(), packed.end(), rows_in);
+        std::vector<ConstColumn<T>> ic;
+        for (std::size_t c = 0; c < din; ++c)
+          ic.push_back({rows_in + c, static_cast<std::ptrdiff_t>(din)});
+        std::vector<Column<T>> oc;
+        for (std::size_t c = 0; c < dout; ++c)
+          oc.push_back({rows_out + c, static_cast<std::ptrdiff_t>(dout)});
+        std::vector<std::uint8_t> valid(n);
+        convert<T>(from, to, ic, n, {oc, {}, valid.data()}, {1});
+        Result<T> got{make_table<T>(dout, n), {}, valid};
+        for (std::size_t r = 0; r < n; ++r)
+          for (std::size_t c = 0; c < dout; ++c) got.cols[c][r] = rows_out[r * dout + c];
+        EXPECT_TRUE(same_bits(got, want_rows))
+            << pair_name(from, to) << ", rows at offsets " << in_offset << "/" << offset;
+      }
   }
 }
 
