@@ -455,38 +455,30 @@ class TileRunner {
   T* scratch_;
 };
 
-// Rows before the first tile, so that the other tiles start on a 64-byte line in every array they
-// read or write: unit-stride columns and row-major arrays (a column of stride = the form's
-// dimension is taken as field c of one, as the plan does). Arrays allocated alike share their
-// offset in a line (malloc's large blocks start 16 bytes into a page), and whole-line vectors then
-// load and store one line instead of two: 3-4 % of a forward conversion at 10^7 pairs
-// (docs/performance.md, seventh round). The least such head below 64 rows, or 0 if there is none
-// or the batch is small (one more partial tile would cost more).
+// Rows before the first tile, so that the other tiles start on a 64-byte line in every unit-stride
+// column, when they all have the same offset in a line (arrays allocated alike: malloc's large
+// blocks start 16 bytes into a page). Every whole-line vector then loads and stores one line
+// instead of two: 3-4 % of a forward conversion at 10^7 pairs (docs/performance.md, seventh
+// round). 0 for a small batch (one more partial tile would cost more), for columns that disagree,
+// and for row-major data (its rows are not lines).
 template <class T>
 std::size_t aligning_head(std::span<const ConstColumn<T>> in, const ConvertOutput<T>& out,
                           std::size_t n) {
   if (n < 16 * kTileRows<T>) return 0;
-  constexpr std::uintptr_t kLine = 64;
-  struct Start {
-    std::uintptr_t offset, step;  // of row 0 in its line; bytes from a row to the next
+  constexpr std::uintptr_t kLine = 64, kNone = kLine;
+  std::uintptr_t offset = kNone;
+  bool agree = true;
+  auto see = [&](const void* data, std::ptrdiff_t stride) {
+    if (data == nullptr || stride != 1) return;
+    const std::uintptr_t o = reinterpret_cast<std::uintptr_t>(data) % kLine;
+    agree = agree && (offset == kNone || offset == o);
+    offset = o;
   };
-  std::array<Start, 2 * detail::kMaxDim + 1> starts;
-  std::size_t count = 0;
-  auto see = [&](const void* data, std::ptrdiff_t stride, std::size_t field, std::size_t dim) {
-    if (data == nullptr || (stride != 1 && stride != static_cast<std::ptrdiff_t>(dim))) return;
-    const std::uintptr_t row0 =
-        reinterpret_cast<std::uintptr_t>(data) - (stride == 1 ? 0 : field * sizeof(T));
-    starts[count++] = {row0 % kLine, static_cast<std::uintptr_t>(stride) * sizeof(T) % kLine};
-  };
-  for (std::size_t c = 0; c < in.size(); ++c) see(in[c].data, in[c].stride, c, in.size());
-  for (std::size_t c = 0; c < out.columns.size(); ++c)
-    see(out.columns[c].data, out.columns[c].stride, c, out.columns.size());
-  see(out.jacobian.data, out.jacobian.stride == 1 ? 1 : 0, 0, 1);
-  for (std::uintptr_t h = 0; count > 0 && h < kLine; ++h)
-    if (std::all_of(starts.begin(), starts.begin() + count,
-                    [h](const Start& s) { return (s.offset + h * s.step) % kLine == 0; }))
-      return h;
-  return 0;
+  for (const ConstColumn<T>& c : in) see(c.data, c.stride);
+  for (const Column<T>& c : out.columns) see(c.data, c.stride);
+  see(out.jacobian.data, out.jacobian.stride);
+  if (!agree || offset == kNone || offset % sizeof(T) != 0) return 0;
+  return (kLine - offset) % kLine / sizeof(T);
 }
 
 // Threads available to this process (TBB reads the affinity mask); more would only oversubscribe.

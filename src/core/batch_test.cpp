@@ -907,10 +907,10 @@ const std::pair<Form, Form> kSampleConversions[] = {
     {{Space::halfdiff, true}, {Space::spherical, false}},
 };
 
-// The engine starts its tiles on a 64-byte line of the arrays it reads and writes where it can
-// (an aligning head of up to 63 rows, in batches of 16 tiles and more): rows are independent, so
-// every placement of the same data gives the same bits, the head or not, the columns agreeing or
-// not, columns or rows, on one thread or several.
+// The engine starts its tiles on a 64-byte line of unit-stride columns that share their offset in
+// a line (an aligning head of up to 7 rows, 15 in float, in batches of 16 tiles and more): rows
+// are independent, so every placement of the same data gives the same bits, the head or not, the
+// columns agreeing or not, columns or rows, on one thread or several.
 TYPED_TEST(BatchTest, ColumnOffsetsGiveIdenticalBits) {
   using T = TypeParam;
   const std::size_t n = 16 * detail::kTileRows<T> + 37, lanes_per_line = 64 / sizeof(T);
@@ -945,7 +945,7 @@ TYPED_TEST(BatchTest, ColumnOffsetsGiveIdenticalBits) {
           EXPECT_TRUE(same_bits(got, want)) << pair_name(from, to) << ", offsets " << in_offset
                                             << "/" << offset << ", " << threads << " threads";
         }
-    // Row-major input and output (the head then aligns rows), without the Jacobian.
+    // Row-major input and output at every offset (no head: rows are not lines), no Jacobian.
     const Result<T> want_rows = run_batch<T>(from, to, in, false);
     for (std::size_t in_offset : {std::size_t{0}, std::size_t{2}, lanes_per_line - 1})
       for (std::size_t offset : {std::size_t{0}, std::size_t{2}, lanes_per_line - 1}) {
