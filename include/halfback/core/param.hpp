@@ -215,7 +215,7 @@ struct Spherical {
     L::sincos(q[1], spi, cpi);
     L::sincos(q[2], sto, cto);
     L::sincos(q[3], spo, cpo);
-    const T phi_h = LaneOps<T>::azimuth(sti * spi + sto * spo, sti * cpi + sto * cpo);
+    const T phi_h = L::azimuth(sti * spi + sto * spo, sti * cpi + sto * cpo);
     const T phi_i = L::select(q[0] == T(0), T(0), detail::wrap_two_pi(T(2) * phi_h - q[1]));
     const T phi_o = L::select(q[2] == T(0), T(0), detail::wrap_two_pi(T(2) * phi_h - q[3]));
     return {q[0], phi_i, q[2], phi_o};
@@ -246,8 +246,7 @@ struct HalfDiff {
   template <class T>
   static Tuple4<T> forward(const DirPair<T>& p) {
     const Sums<T> s = sums(p);
-    // (rxy len)² small somewhere: a lane needs the scaled frame, or has h̄ = 0 exactly (which
-    // frame() serves unless len is small too).
+    // (rxy len)² small somewhere (h̄ = 0 included): those lanes take the scaled frame.
     const auto scaled = needs_scaled_frame(s);
     if (any_lanes(scaled)) [[unlikely]]
       return finish(select_frame(scaled, scaled_frame(s), frame(s)));
@@ -363,9 +362,8 @@ struct HalfDiff {
   // (docs/math.md §2.2): (A, B) = rxy R_z(-φh) t_xy = (s_xy · t_xy, s_xy × t_xy), and R_y(-θh)
   // is (sz, rxy)/len, so
   //   D = (sz A - rxy² tz, len B, rxy len²).
-  // No division, and len's square root is off the chain to Dx. When h̄ = 0 (ĥ = n, c := (1, 0)),
-  // D = 2 len d = (sz tx, len ty, len²). Accurate (its squares normal) unless needs_scaled_frame,
-  // which also takes the rows where rxy² alone underflows to 0.
+  // No division, and len's square root is off the chain to Dx. Accurate (its squares normal)
+  // unless needs_scaled_frame: that takes the rows where rxy len is tiny, and h̄ = 0 (here D = 0).
   template <class T>
   static Frame<T> frame(const Sums<T>& s) {
     using L = LaneOps<T>;
@@ -373,10 +371,10 @@ struct HalfDiff {
     const T A = s.sx * s.tx + s.sy * s.ty, B = s.sx * s.ty - s.sy * s.tx;
     const Vec3<T> D{s.sz * A - s.rxy2 * s.tz, len * B, s.len2 * rxy};
     const T dxy = L::sqrt(D.x * D.x + D.y * D.y);
-    // D before the angles of ĥ: GCC keeps this order, and the sums are then dead during the
-    // four atan2 (3-4 % fewer cycles than the angles first, by register pressure; same bits).
+    // D and ‖D_xy‖ before the angles of ĥ: GCC keeps this order, so the sums are dead during the
+    // atan2 (fewer cycles by register pressure) and the square root overlaps them; same bits.
     const T theta_h = L::atan2_nonneg(rxy, s.sz);
-    const T phi_h = LaneOps<T>::azimuth(s.sy, s.sx);
+    const T phi_h = L::azimuth(s.sy, s.sx);
     return {theta_h, phi_h, rxy, s.sz, D, dxy};
   }
 
@@ -407,7 +405,7 @@ struct HalfDiff {
     const Vec3<T> D{L::select(null, s.tx, (sz / norm) * a - (rxy / norm) * s.tz),
                     L::select(null, s.ty, b), L::select(null, T(0), len / p)};
     return {L::select(null, T(0), L::atan2_nonneg(rxy, sz)),
-            LaneOps<T>::azimuth(ys, xs),  // exact multiples of sy, sx, and not subnormal
+            L::azimuth(ys, xs),  // exact multiples of sy, sx, and not subnormal
             rxy,
             sz,
             D,
