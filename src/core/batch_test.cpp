@@ -907,6 +907,14 @@ const std::pair<Form, Form> kSampleConversions[] = {
     {{Space::halfdiff, true}, {Space::spherical, false}},
 };
 
+// The first element of `buffer` on a 64-byte line (a buffer a line longer than it needs).
+template <class T>
+T* first_line(std::vector<T>& buffer) {
+  void* start = buffer.data();
+  std::size_t room = buffer.size() * sizeof(T);
+  return static_cast<T*>(std::align(64, sizeof(T), start, room));
+}
+
 // The engine starts its tiles on a 64-byte line of unit-stride columns that share their offset in
 // a line (an aligning head of up to 7 rows, 15 in float, in batches of 16 tiles and more): rows
 // are independent, so every placement of the same data gives the same bits, the head or not, the
@@ -924,9 +932,7 @@ TYPED_TEST(BatchTest, ColumnOffsetsGiveIdenticalBits) {
         for (int threads : {1, 2}) {
           const std::size_t din = in.size(), dout = dimension(to), pitch = n + 2 * lanes_per_line;
           std::vector<T> buffer((din + dout + 1) * pitch + lanes_per_line);
-          void* start = buffer.data();
-          std::size_t room = buffer.size() * sizeof(T);
-          T* const lines = static_cast<T*>(std::align(64, sizeof(T), start, room));  // pitch: lines
+          T* const lines = first_line(buffer);  // columns `pitch` apart: whole lines
           std::vector<ConstColumn<T>> ic;
           for (std::size_t c = 0; c < din; ++c) {
             T* col = lines + c * pitch + in_offset;
@@ -951,9 +957,7 @@ TYPED_TEST(BatchTest, ColumnOffsetsGiveIdenticalBits) {
       for (std::size_t offset : {std::size_t{0}, std::size_t{2}, lanes_per_line - 1}) {
         const std::size_t din = in.size(), dout = dimension(to);
         std::vector<T> buffer((din + dout) * n + 4 * lanes_per_line);
-        void* start = buffer.data();
-        std::size_t room = buffer.size() * sizeof(T);
-        T* const lines = static_cast<T*>(std::align(64, sizeof(T), start, room));
+        T* const lines = first_line(buffer);
         T* const rows_in = lines + in_offset;
         T* const rows_out = lines + (din * n / lanes_per_line + 2) * lanes_per_line + offset;
         const std::vector<T> packed = row_major(in);

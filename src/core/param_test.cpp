@@ -368,8 +368,8 @@ TEST(Azimuth, RangeAndZeroVector) {
   EXPECT_EQ(LaneOps<double>::azimuth(0.0, -0.0), 0.0);  // std::atan2 would say π
   EXPECT_FALSE(std::signbit(LaneOps<double>::azimuth(-0.0, 1.0)));
   EXPECT_LT(LaneOps<double>::azimuth(-1e-30, 1.0), kTwoPiD);
-  EXPECT_LT(LaneOps<float>::azimuth(-1e-30f, 1.0f),
-            kTwoPi<float>);  // -tiny + 2π rounds up in float
+  // -tiny + 2π rounds up to 2π in float.
+  EXPECT_LT(LaneOps<float>::azimuth(-1e-30f, 1.0f), kTwoPi<float>);
   EXPECT_NEAR(LaneOps<double>::azimuth(-1.0, 0.0), 1.5 * kPi, 1e-15);
 }
 

@@ -345,7 +345,7 @@ struct HalfDiff {
   struct Frame {
     T theta_h, phi_h, st, ct;
     Vec3<T> D;
-    T dxy;  // ‖(D.x, D.y)‖
+    T dxy;  // ‖(D.x, D.y)‖, formed by the frames so that its square root overlaps ĥ's atan2
   };
   template <class T>
   static Frame<T> select_frame(const MaskOf<T>& m, const Frame<T>& a, const Frame<T>& b) {
