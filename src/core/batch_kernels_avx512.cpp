@@ -81,9 +81,9 @@ struct TransposeIndices {
   }
 };
 
-// W rows of D values (D registers) <-> D column registers.
+// W rows of D values (D registers) <-> D column registers, by two-source permutes.
 template <class S, int D>
-struct ZmmRows {
+struct PermuteRows {
   using Z = Zmm<S>;
   using V = typename Z::V;
   static constexpr int W = Z::W, P = D / 2;
@@ -121,6 +121,41 @@ struct ZmmRows {
         if constexpr (D == 6) v = Z::permute2(v, index(idx.scatter_b[r]), half[g][2]);
         Z::store(dst + r * W, v);
       }
+    }
+  }
+};
+
+template <class S, int D>
+struct ZmmRows : PermuteRows<S, D> {};
+
+// 8 rows of 6 doubles to columns without two-source permutes, which on Zen 5 issue to the FMA
+// pipes the conversions need (docs/performance.md, "C-order rows"). A 128-bit piece is two
+// values of a row (piece p: columns 2p, 2p + 1). r[k] = [chunk k of rows 0-3 | of rows 4-7]
+// (chunk: four values, pieces 2k and 2k + 1) comes from a 256-bit load and a broadcast one,
+// blended; swapping the two pieces of each 256-bit half (an in-half permute) and blending
+// gathers piece p of the even rows (even[p]) and of the odd rows (odd[p]) in row order, and
+// unpacklo and unpackhi of those are columns 2p and 2p + 1: 12 loads, 6 permutes, 12 blends and
+// 6 unpacks for 6 loads, 18 permutes and 12 index loads. The stores keep the permutes (this
+// order measured no faster there), and so do floats (measured no faster either).
+template <>
+struct ZmmRows<double, 6> : PermuteRows<double, 6> {
+  using V = __m512d;
+  static V swap(V v) { return _mm512_permutex_pd(v, 0x4E); }
+  // Pieces 0 and 2 of a, 1 and 3 of b.
+  static V interleave(V a, V b) { return _mm512_mask_blend_pd(0xCC, a, b); }
+  static void load(const double* rows, V* columns) {
+    V r[6];
+    for (int k = 0; k < 6; ++k)
+      r[k] = _mm512_mask_blend_pd(0xF0, _mm512_castpd256_pd512(_mm256_loadu_pd(rows + 4 * k)),
+                                  _mm512_broadcast_f64x4(_mm256_loadu_pd(rows + 24 + 4 * k)));
+    // Row j's piece p is piece 3j + p of its half: in r[(3j + p) / 2], at (3j + p) % 2.
+    const V even[3] = {interleave(r[0], swap(r[3])), interleave(swap(r[0]), r[3]),
+                       interleave(r[1], swap(r[4]))};
+    const V odd[3] = {interleave(swap(r[1]), r[4]), interleave(r[2], swap(r[5])),
+                      interleave(swap(r[2]), r[5])};
+    for (int p = 0; p < 3; ++p) {
+      columns[2 * p] = _mm512_unpacklo_pd(even[p], odd[p]);
+      columns[2 * p + 1] = _mm512_unpackhi_pd(even[p], odd[p]);
     }
   }
 };
