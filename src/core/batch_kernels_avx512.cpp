@@ -129,10 +129,10 @@ template <class S, int D>
 struct ZmmRows : PermuteRows<S, D> {};
 
 // 8 rows of 6 doubles to columns without two-source permutes, which on Zen 5 issue to the FMA
-// pipes the conversions need (docs/performance.md, "C-order rows"). A 128-bit piece is two
-// values of a row (piece p: columns 2p, 2p + 1). r[k] = [chunk k of rows 0-3 | of rows 4-7]
-// (chunk: four values, pieces 2k and 2k + 1) comes from a 256-bit load and a broadcast one,
-// blended; swapping the two pieces of each 256-bit half (an in-half permute) and blending
+// pipes the conversions need (docs/performance.md, "Array layouts", eighth round). A 128-bit
+// piece is two values of a row (piece p: columns 2p, 2p + 1). r[k] = [chunk k of rows 0-3 | of
+// rows 4-7] (chunk: four values, pieces 2k and 2k + 1) comes from a 256-bit load and a broadcast
+// one, blended; swapping the two pieces of each 256-bit half (an in-half permute) and blending
 // gathers piece p of the even rows (even[p]) and of the odd rows (odd[p]) in row order, and
 // unpacklo and unpackhi of those are columns 2p and 2p + 1: 12 loads, 6 permutes, 12 blends and
 // 6 unpacks for 6 loads, 18 permutes and 12 index loads. The stores keep the permutes (this
