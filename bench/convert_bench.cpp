@@ -184,8 +184,8 @@ void bm_convert(benchmark::State& state, Space space, bool forward, unsigned thr
 // The same conversion with the input and the output as row-major arrays ((N, 6) and (N, 4),
 // NumPy's default C order) and as structure-of-arrays columns, interleaved: each iteration
 // converts once in each layout (in alternating order), timed apart by the thread's CPU time, so
-// that both see the same state of a shared host (its memory bandwidth moved by 1.5x within a
-// minute on the AMD VM, and a median of separate runs then compared different machines).
+// that both see the same state of a shared host (on the AMD VM its memory bandwidth moved by up
+// to 1.5x between runs, and medians of separate benchmarks compared different states of it).
 // Counters: soa and rows (the least time a pair of either), rows_over_soa (their ratio) and
 // rows_over_soa_med (the median of the iterations' own ratios).
 template <class T>

@@ -140,7 +140,7 @@ struct ZmmRows : PermuteRows<S, D> {};
 template <>
 struct ZmmRows<double, 6> : PermuteRows<double, 6> {
   using V = __m512d;
-  static V swap(V v) { return _mm512_permutex_pd(v, 0x4E); }
+  static V swap_pieces(V v) { return _mm512_permutex_pd(v, 0x4E); }
   // Pieces 0 and 2 of a, 1 and 3 of b.
   static V interleave(V a, V b) { return _mm512_mask_blend_pd(0xCC, a, b); }
   static void load(const double* rows, V* columns) {
@@ -149,10 +149,10 @@ struct ZmmRows<double, 6> : PermuteRows<double, 6> {
       r[k] = _mm512_mask_blend_pd(0xF0, _mm512_castpd256_pd512(_mm256_loadu_pd(rows + 4 * k)),
                                   _mm512_broadcast_f64x4(_mm256_loadu_pd(rows + 24 + 4 * k)));
     // Row j's piece p is piece 3j + p of its half: in r[(3j + p) / 2], at (3j + p) % 2.
-    const V even[3] = {interleave(r[0], swap(r[3])), interleave(swap(r[0]), r[3]),
-                       interleave(r[1], swap(r[4]))};
-    const V odd[3] = {interleave(swap(r[1]), r[4]), interleave(r[2], swap(r[5])),
-                      interleave(swap(r[2]), r[5])};
+    const V even[3] = {interleave(r[0], swap_pieces(r[3])), interleave(swap_pieces(r[0]), r[3]),
+                       interleave(r[1], swap_pieces(r[4]))};
+    const V odd[3] = {interleave(swap_pieces(r[1]), r[4]), interleave(r[2], swap_pieces(r[5])),
+                      interleave(swap_pieces(r[2]), r[5])};
     for (int p = 0; p < 3; ++p) {
       columns[2 * p] = _mm512_unpacklo_pd(even[p], odd[p]);
       columns[2 * p + 1] = _mm512_unpackhi_pd(even[p], odd[p]);
