@@ -19,6 +19,7 @@ from ._core import (
     jacobian,
     load,
     models,
+    simd_isa,
     ssim,
     valid,
 )
@@ -53,6 +54,7 @@ __all__ = [
     "load",
     "merge_study",
     "models",
+    "simd_isa",
     "ssim",
     "study_brdf",
     "study_profile",

@@ -25,6 +25,9 @@ def jacobian(x: npt.ArrayLike, param: Param, isotropic: bool = False) -> FloatAr
 def columns(name: Param, isotropic: bool = False) -> list[str]:
     """Column names of a form, in order."""
 
+def simd_isa() -> Literal["scalar", "sse2", "avx2", "avx512"]:
+    """The instruction set of the SIMD kernels in use (HALFBACK_ISA, else the CPU's best)."""
+
 Kind = Literal["full", "isotropic", "slice"]
 
 class Brdf:

@@ -5,12 +5,14 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <new>
 #include <string>
 #include <vector>
 
 #include "command.hpp"
+#include "halfback/core/simd.hpp"
 #include "halfback/util/signal_cleanup.hpp"
 
 #ifndef HALFBACK_VERSION
@@ -79,9 +81,22 @@ int run_command(const std::string& who, const Command& command) {
   return kExitDataError;
 }
 
+// The version, and the instruction set of the SIMD kernels: HALFBACK_ISA's if this CPU runs it,
+// else the best (said, so that a misspelt or unsupported HALFBACK_ISA is not silently ignored).
+std::string version_text() {
+  const std::string_view isa = simd_isa_name(simd_isa());
+  std::string text = fmt::format("halfback {}\nSIMD kernels: {}", HALFBACK_VERSION, isa);
+  if (const char* asked = std::getenv("HALFBACK_ISA"); asked && asked != isa)
+    text += fmt::format(
+        " (HALFBACK_ISA={} not used: not one of scalar, sse2, avx2, avx512 that this CPU runs)",
+        asked);
+  return text;
+}
+
 int run(int argc, char** argv) {
   CLI::App app(kDescription, "halfback");
-  app.set_version_flag("--version", "halfback " HALFBACK_VERSION, "Print the version and exit");
+  app.set_version_flag("--version", version_text,
+                       "Print the version and the SIMD instruction set in use, and exit");
   app.set_help_flag("-h,--help", "Print this help and exit");
   app.require_subcommand(0, 1);
   app.footer(kFooter);

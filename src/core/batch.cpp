@@ -161,6 +161,14 @@ bool set_batch_isa(std::optional<SimdIsa> isa) {
 
 }  // namespace detail
 
+SimdIsa simd_isa() {
+  return detail::active_kernels().isa;
+}
+
+std::string_view simd_isa_name(SimdIsa isa) {
+  return detail::isa_name(isa);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The tiled engine
 // ---------------------------------------------------------------------------------------------

@@ -26,9 +26,11 @@
 #include <optional>
 #include <string_view>
 
+#include "halfback/core/simd.hpp"
+
 namespace halfback::detail {
 
-enum class SimdIsa { scalar, sse2, avx2, avx512 };
+using halfback::SimdIsa;
 
 inline constexpr SimdIsa kAllIsas[] = {SimdIsa::scalar, SimdIsa::sse2, SimdIsa::avx2,
                                        SimdIsa::avx512};

@@ -1059,9 +1059,12 @@ TEST(Batch, DispatchPicksTheBestAvailableInstructionSet) {
     EXPECT_EQ(detail::set_batch_isa(isa), available);
     if (available) {
       EXPECT_EQ(detail::active_kernels().isa, isa);
+      EXPECT_EQ(simd_isa(), isa);  // the public query is the engine's choice
+      EXPECT_EQ(simd_isa_name(isa), detail::isa_name(isa));
     }
   }
   detail::set_batch_isa(std::nullopt);
+  EXPECT_EQ(simd_isa(), detail::active_kernels().isa);
   std::printf("  active: %s\n", std::string(detail::active_kernels().name).c_str());
 }
 

@@ -5,8 +5,11 @@
 // roundings are those of the one-row path. The blend and rows_apart also have hand-written
 // AVX-512 kernels (target attributes, chosen at run time by avx512_kernels()), the same bits.
 #include "merl_kernel.hpp"
+
 #include <algorithm>
 #include <cstdlib>
+
+#include "halfback/core/simd.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #define HALFBACK_MERL_AVX512 1
@@ -267,12 +270,9 @@ HALFBACK_AVX512 void rows_apart_avx512(const double* rows, const std::uint8_t* v
 #pragma GCC diagnostic pop
 
 bool avx512_kernels() {
-  // __builtin_cpu_supports also checks that the OS saves the ZMM state (XGETBV).
-  static const bool yes = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx512f") != 0;
-  }();
-  return yes;
+  // The library's one choice (core/simd.hpp): the CPU and OS support AVX-512F, and HALFBACK_ISA
+  // does not ask for less.
+  return simd_isa() == SimdIsa::avx512;
 }
 
 #else

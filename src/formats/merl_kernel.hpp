@@ -206,10 +206,10 @@ void blend_rows(const merl::BinValues* table, const Cells& cells, std::size_t be
 // conversion (valid = 0), below the horizon, or with ωi + ωo along the normal.
 void rows_apart(const double* rows, const std::uint8_t* valid, std::size_t m, std::uint8_t* apart);
 
-// blend_rows and rows_apart run the AVX-512 kernels when avx512_kernels() (the CPU has AVX-512F;
-// asked once), else the portable loops (target_clones, vectorized by the compiler): the same bits
-// either way. Both are public for the tests; the *_avx512 ones only where avx512_kernels() (they
-// fall back to the portable loops where the build has no x86 kernels).
+// blend_rows and rows_apart run the AVX-512 kernels when avx512_kernels() (simd_isa() is avx512:
+// core/simd.hpp), else the portable loops (target_clones, vectorized by the compiler): the same
+// bits either way. Both are public for the tests; the *_avx512 ones only where avx512_kernels()
+// (they fall back to the portable loops where the build has no x86 kernels).
 bool avx512_kernels();
 void blend_rows_portable(const merl::BinValues* table, const Cells& cells, std::size_t begin,
                          std::size_t end, Rgb* out);

@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/batch_engine.hpp"
 #include "formats/binary_io.hpp"
 #include "formats/merl_kernel.hpp"
 #include "formats/merl_reference.hpp"
@@ -760,6 +761,17 @@ TEST(MerlKernel, BlendKernelsAreBlendBitForBit) {
 }
 
 // rows_apart, each kernel, against its definition, on rows of every kind at every lane position.
+// The AVX-512 kernels run when the library's one instruction-set choice is AVX-512 (core/simd.hpp:
+// the CPU's best, or HALFBACK_ISA's), and not when a lower set is forced.
+TEST(MerlKernel, AvxKernelsFollowTheLibrarysInstructionSet) {
+  for (SimdIsa isa : detail::kAllIsas) {
+    if (!detail::set_batch_isa(isa)) continue;
+    EXPECT_EQ(merl_kernel::avx512_kernels(), isa == SimdIsa::avx512) << simd_isa_name(isa);
+  }
+  detail::set_batch_isa(std::nullopt);
+  EXPECT_EQ(merl_kernel::avx512_kernels(), simd_isa() == SimdIsa::avx512);
+}
+
 TEST(MerlKernel, RowsApartKernelsAgree) {
   using namespace merl_kernel;
   std::mt19937_64 rng(41);

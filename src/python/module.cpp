@@ -21,6 +21,7 @@
 #include "halfback/brdf/registry.hpp"
 #include "halfback/brdf/resample.hpp"
 #include "halfback/core/batch.hpp"
+#include "halfback/core/simd.hpp"
 #include "halfback/figure/hemisphere.hpp"
 #include "halfback/formats/table_file.hpp"
 #include "halfback/loader/load.hpp"
@@ -383,6 +384,13 @@ py::array_t<float> render_brdf(const PyBrdf& b, const std::string& env, int widt
 }
 
 void bind_conversions(py::module_& m) {
+  m.def(
+      "simd_isa", [] { return std::string(simd_isa_name(simd_isa())); },
+      R"doc(The instruction set of the SIMD kernels in use: "scalar", "sse2", "avx2" or "avx512".
+
+The best this CPU runs, or the one the environment variable HALFBACK_ISA names (read once, when
+first needed) if this CPU runs it. The instruction sets agree within the conversions' accuracy,
+not bit for bit.)doc");
   m.def(
       "convert",
       [](const py::object& x, const std::string& src, const std::string& dst, bool isotropic,

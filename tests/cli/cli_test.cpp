@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "halfback/core/batch.hpp"
+#include "halfback/core/simd.hpp"
 #include "halfback/core/space.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
@@ -226,7 +227,21 @@ TEST_F(CliTest, HelpAndVersion) {
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
   r = run({"--version"});
   EXPECT_EQ(r.status, 0);
-  EXPECT_EQ(r.out, "halfback 0.1.0\n");
+  EXPECT_EQ(r.out,
+            "halfback 0.1.0\nSIMD kernels: " + std::string(simd_isa_name(simd_isa())) + "\n");
+  // A HALFBACK_ISA that names no instruction set is said, not silently ignored.
+  const char* had = std::getenv("HALFBACK_ISA");
+  const std::string before = had ? had : "";
+  ::setenv("HALFBACK_ISA", "avx3", 1);
+  r = run({"--version"});
+  if (had)
+    ::setenv("HALFBACK_ISA", before.c_str(), 1);
+  else
+    ::unsetenv("HALFBACK_ISA");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("(HALFBACK_ISA=avx3 not used: not one of scalar, sse2, avx2, avx512"),
+            std::string::npos)
+      << r.out;
 }
 
 TEST_F(CliTest, UsageErrorsExitWithTwo) {

@@ -2,6 +2,8 @@
 
 import os
 import subprocess
+import sys
+import tempfile
 
 import numpy as np
 import pytest
@@ -114,6 +116,26 @@ def test_jacobian_integrates_to_the_measure_of_pairs():
 def test_columns():
     assert halfback.columns("hybrid") == ["hbar", "phi_h", "k", "phi_k"]
     assert halfback.columns("ortho", isotropic=True) == ["hbar", "kbar", "dphi"]
+
+
+def test_simd_isa_is_the_one_halfback_isa_asks_for():
+    assert halfback.simd_isa() in ("scalar", "sse2", "avx2", "avx512")
+    # A fresh interpreter with HALFBACK_ISA=scalar (every CPU runs it) uses the scalar kernels;
+    # its conversions agree with these (a few ulp: not the same atan2).
+    x = random_dirs(1000, seed=7)
+    code = ("import sys, numpy as np, halfback; x = np.load(sys.argv[1]); "
+            "np.save(sys.argv[2], halfback.convert(x, 'dirs', 'hybrid')); print(halfback.simd_isa())")
+    with tempfile.TemporaryDirectory() as d:
+        np.save(os.path.join(d, "x.npy"), x)
+        out = subprocess.run([sys.executable, "-c", code, os.path.join(d, "x.npy"),
+                              os.path.join(d, "q.npy")], env={**os.environ, "HALFBACK_ISA": "scalar"},
+                             capture_output=True, text=True, check=True)
+        assert out.stdout.strip() == "scalar"
+        q = np.load(os.path.join(d, "q.npy"))
+    here = halfback.convert(x, "dirs", "hybrid")
+    eps = np.finfo(np.float64).eps
+    assert np.abs(q[:, [0, 2]] - here[:, [0, 2]]).max() <= 4 * eps  # norms in [0, 1]
+    assert angle_diff(q[:, [1, 3]], here[:, [1, 3]]).max() <= 8 * 2 * np.pi * eps
 
 
 @pytest.mark.parametrize("call,exc,text", [
