@@ -760,7 +760,6 @@ TEST(MerlKernel, BlendKernelsAreBlendBitForBit) {
   EXPECT_GT(rows, 2000u);
 }
 
-// rows_apart, each kernel, against its definition, on rows of every kind at every lane position.
 // The AVX-512 kernels run when the library's one instruction-set choice is AVX-512 (core/simd.hpp:
 // the CPU's best, or HALFBACK_ISA's), and not when a lower set is forced.
 TEST(MerlKernel, AvxKernelsFollowTheLibrarysInstructionSet) {
@@ -772,6 +771,7 @@ TEST(MerlKernel, AvxKernelsFollowTheLibrarysInstructionSet) {
   EXPECT_EQ(merl_kernel::avx512_kernels(), simd_isa() == SimdIsa::avx512);
 }
 
+// rows_apart, each kernel, against its definition, on rows of every kind at every lane position.
 TEST(MerlKernel, RowsApartKernelsAgree) {
   using namespace merl_kernel;
   std::mt19937_64 rng(41);
