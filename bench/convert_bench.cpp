@@ -214,16 +214,17 @@ void bm_layout(benchmark::State& state, Space space, bool forward) {
     benchmark::ClobberMemory();
     return thread_seconds() - t0;
   };
-  std::vector<double> soa, rows, ratio;
+  std::vector<double> soa, rows;
   for (auto _ : state) {
     const bool rows_first = soa.size() % 2 == 1;
     const double first = seconds(rows_first), second = seconds(!rows_first);
     soa.push_back(rows_first ? second : first);
     rows.push_back(rows_first ? first : second);
-    ratio.push_back(rows.back() / soa.back());
     state.SetIterationTime(first + second);
   }
   if (soa.empty()) return;
+  std::vector<double> ratio(soa.size());
+  for (std::size_t i = 0; i < soa.size(); ++i) ratio[i] = rows[i] / soa[i];
   const auto n = static_cast<double>(d.n);
   const double soa_min = *std::min_element(soa.begin(), soa.end());
   const double rows_min = *std::min_element(rows.begin(), rows.end());

@@ -5,7 +5,6 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <new>
 #include <string>
@@ -81,12 +80,12 @@ int run_command(const std::string& who, const Command& command) {
   return kExitDataError;
 }
 
-// The version, and the instruction set of the SIMD kernels: HALFBACK_ISA's if this CPU runs it,
-// else the best (said, so that a misspelt or unsupported HALFBACK_ISA is not silently ignored).
+// The version, and the instruction set of the SIMD kernels (said with a HALFBACK_ISA that is not
+// used, so that a misspelt or unsupported one is not silently ignored).
 std::string version_text() {
-  const std::string_view isa = simd_isa_name(simd_isa());
-  std::string text = fmt::format("halfback {}\nSIMD kernels: {}", HALFBACK_VERSION, isa);
-  if (const char* asked = std::getenv("HALFBACK_ISA"); asked && asked != isa)
+  std::string text =
+      fmt::format("halfback {}\nSIMD kernels: {}", HALFBACK_VERSION, simd_isa_name(simd_isa()));
+  if (const std::string_view asked = simd_isa_request_ignored(); !asked.empty())
     text += fmt::format(
         " (HALFBACK_ISA={} not used: not one of scalar, sse2, avx2, avx512 that this CPU runs)",
         asked);

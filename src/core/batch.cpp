@@ -95,15 +95,25 @@ const KernelSet* best_kernels() {
   return &kernels_scalar();
 }
 
-const KernelSet& default_kernels() {
-  static const KernelSet* const chosen = [] {
-    if (const char* env = std::getenv("HALFBACK_ISA")) {
-      if (const auto isa = isa_from_name(env))
-        if (const KernelSet* k = kernels_for(*isa)) return k;
-    }
-    return best_kernels();
+// The default table, and HALFBACK_ISA when it is set but not used (read once).
+struct DefaultChoice {
+  const KernelSet* kernels;
+  std::string ignored_request;
+};
+
+const DefaultChoice& default_choice() {
+  static const DefaultChoice chosen = []() -> DefaultChoice {
+    const char* env = std::getenv("HALFBACK_ISA");
+    if (!env) return {best_kernels(), {}};
+    if (const auto isa = isa_from_name(env))
+      if (const KernelSet* k = kernels_for(*isa)) return {k, {}};
+    return {best_kernels(), env};
   }();
-  return *chosen;
+  return chosen;
+}
+
+const KernelSet& default_kernels() {
+  return *default_choice().kernels;
 }
 
 std::atomic<const KernelSet*> g_override{nullptr};
@@ -167,6 +177,10 @@ SimdIsa simd_isa() {
 
 std::string_view simd_isa_name(SimdIsa isa) {
   return detail::isa_name(isa);
+}
+
+std::string_view simd_isa_request_ignored() {
+  return detail::default_choice().ignored_request;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1052,6 +1052,7 @@ TEST(Batch, DispatchPicksTheBestAvailableInstructionSet) {
 #endif
   if (std::getenv("HALFBACK_ISA") == nullptr) {
     EXPECT_EQ(detail::active_kernels().isa, isas.back());
+    EXPECT_TRUE(simd_isa_request_ignored().empty());
   }
   for (SimdIsa isa : detail::kAllIsas) {
     EXPECT_EQ(detail::isa_from_name(detail::isa_name(isa)), isa);

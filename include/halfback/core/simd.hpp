@@ -19,4 +19,8 @@ SimdIsa simd_isa();
 // "scalar", "sse2", "avx2" or "avx512".
 std::string_view simd_isa_name(SimdIsa isa);
 
+// HALFBACK_ISA's value when it is set but not used (it names no instruction set, or one this CPU
+// does not run: the best is used instead); empty when it is unset or used.
+std::string_view simd_isa_request_ignored();
+
 }  // namespace halfback
