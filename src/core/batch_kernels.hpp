@@ -320,6 +320,50 @@ void scatter_rows(const S* __restrict columns, S* __restrict rows, std::size_t m
   }
 }
 
+// The same passes through a SIMD table's in-register transposes (RowTranspose), where it has them.
+template <class B, int D>
+void gather_transposed(const ScalarOf<B>* __restrict rows, ScalarOf<B>* __restrict columns,
+                       std::size_t m) {
+  using L = Lanes<B>;
+  constexpr std::size_t pitch = kTileRows<ScalarOf<B>>;
+  std::size_t i = 0;
+  for (; i + L::size <= m; i += L::size) {
+    B x[D];
+    RowTranspose<B, D>::load(rows + D * i, x);
+    for (int c = 0; c < D; ++c) L::store(columns + c * pitch + i, x[c]);
+  }
+  for (; i < m; ++i)
+    for (int c = 0; c < D; ++c) columns[c * pitch + i] = rows[D * i + c];
+}
+
+template <class B, int D>
+void scatter_transposed(const ScalarOf<B>* __restrict columns, ScalarOf<B>* __restrict rows,
+                        std::size_t m) {
+  using L = Lanes<B>;
+  constexpr std::size_t pitch = kTileRows<ScalarOf<B>>;
+  std::size_t i = 0;
+  for (; i + L::size <= m; i += L::size) {
+    B y[D];
+    for (int c = 0; c < D; ++c) y[c] = L::load(columns + c * pitch + i);
+    RowTranspose<B, D>::store(y, rows + D * i);
+  }
+  for (; i < m; ++i)
+    for (int c = 0; c < D; ++c) rows[D * i + c] = columns[c * pitch + i];
+}
+
+// The transpose passes of rows of D (the calls whose stages do not read or write the rows).
+template <class B, int D>
+constexpr void fill_transposes(StageKernels<ScalarOf<B>>& k) {
+  using S = ScalarOf<B>;
+  if constexpr (RowTranspose<B, D>::fused && !std::is_floating_point_v<B>) {
+    k.gather[D] = &gather_transposed<B, D>;
+    k.scatter[D] = &scatter_transposed<B, D>;
+  } else {
+    k.gather[D] = &gather_rows<S, D>;
+    k.scatter[D] = &scatter_rows<S, D>;
+  }
+}
+
 template <class B, class P, int Space>
 constexpr void fill_decode(StageKernels<ScalarOf<B>>& k) {
   k.decode[Space][0] = &decode_stage<B, P, false>;
@@ -346,13 +390,9 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   k.width = Lanes<B>::size;
   k.check = &check_stage<B>;
   k.valid_bytes = &valid_bytes<ScalarOf<B>>;
-  using S = ScalarOf<B>;
-  k.gather[3] = &gather_rows<S, 3>;
-  k.gather[4] = &gather_rows<S, 4>;
-  k.gather[6] = &gather_rows<S, 6>;
-  k.scatter[3] = &scatter_rows<S, 3>;
-  k.scatter[4] = &scatter_rows<S, 4>;
-  k.scatter[6] = &scatter_rows<S, 6>;
+  fill_transposes<B, 3>(k);
+  fill_transposes<B, 4>(k);
+  fill_transposes<B, 6>(k);
   k.fused_rows[3] = RowTranspose<B, 3>::fused;
   k.fused_rows[4] = RowTranspose<B, 4>::fused;
   k.fused_rows[6] = RowTranspose<B, 6>::fused;

@@ -202,35 +202,6 @@ struct RowTranspose<Twin<xsimd::batch<S, xsimd::avx512f>>, D> {
   }
 };
 
-// The transpose passes over scratch, for the cases the stages do not fuse (the Jacobian's).
-template <class S, int D>
-void gather_zmm(const S* __restrict rows, S* __restrict columns, std::size_t m) {
-  constexpr int W = Zmm<S>::W;
-  constexpr std::size_t pitch = kTileRows<S>;
-  std::size_t i = 0;
-  for (; i + W <= m; i += W) {
-    typename Zmm<S>::V c[D];
-    ZmmRows<S, D>::load(rows + D * i, c);
-    for (int k = 0; k < D; ++k) Zmm<S>::store(columns + k * pitch + i, c[k]);
-  }
-  for (; i < m; ++i)
-    for (int c = 0; c < D; ++c) columns[c * pitch + i] = rows[D * i + c];
-}
-
-template <class S, int D>
-void scatter_zmm(const S* __restrict columns, S* __restrict rows, std::size_t m) {
-  constexpr int W = Zmm<S>::W;
-  constexpr std::size_t pitch = kTileRows<S>;
-  std::size_t i = 0;
-  for (; i + W <= m; i += W) {
-    typename Zmm<S>::V c[D];
-    for (int k = 0; k < D; ++k) c[k] = Zmm<S>::load(columns + k * pitch + i);
-    ZmmRows<S, D>::store(c, rows + D * i);
-  }
-  for (; i < m; ++i)
-    for (int c = 0; c < D; ++c) rows[D * i + c] = columns[c * pitch + i];
-}
-
 constexpr KernelSet make_avx512_set() {
   using A = xsimd::avx512f;
   using F = xsimd::batch<float, A>;
@@ -240,16 +211,7 @@ constexpr KernelSet make_avx512_set() {
   // The encodes keep one vector: with two, spherical, ortho and hybrid were 4-13 % slower (more
   // of their registers spill), and halfdiff, once its clamp's atan2 became rare, 3-8 % slower at
   // 10^7 pairs.
-  KernelSet k = make_kernel_set<F, D, Twin<F>, Twin<D>>(SimdIsa::avx512, "avx512");
-  k.f32.gather[4] = &gather_zmm<float, 4>;
-  k.f32.gather[6] = &gather_zmm<float, 6>;
-  k.f32.scatter[4] = &scatter_zmm<float, 4>;
-  k.f32.scatter[6] = &scatter_zmm<float, 6>;
-  k.f64.gather[4] = &gather_zmm<double, 4>;
-  k.f64.gather[6] = &gather_zmm<double, 6>;
-  k.f64.scatter[4] = &scatter_zmm<double, 4>;
-  k.f64.scatter[6] = &scatter_zmm<double, 6>;
-  return k;
+  return make_kernel_set<F, D, Twin<F>, Twin<D>>(SimdIsa::avx512, "avx512");
 }
 
 }  // namespace
