@@ -561,6 +561,16 @@ TYPED_TEST(BatchTest, StridedLayoutsGiveTheSameBitsAsSoa) {
         for (std::size_t r = 0; r < n; ++r)
           for (std::size_t c = 0; c < dout; ++c) rows.cols[c][r] = rows_out[r * dout + c];
         EXPECT_TRUE(same_bits(rows, soa)) << label << ": rows of " << din << " -> " << dout;
+        // The same rows with the Jacobian asked for: the transpose passes instead of the stages.
+        std::vector<T> jac_rows_out(n * dout, T(-7));
+        for (std::size_t c = 0; c < dout; ++c)
+          oc[c] = {jac_rows_out.data() + c, static_cast<std::ptrdiff_t>(dout)};
+        Result<T> jac_rows{make_table<T>(dout, n), std::vector<T>(n), std::vector<std::uint8_t>(n)};
+        convert<T>(from, to, ic, n, {oc, {jac_rows.jac.data(), 1}, jac_rows.valid.data()});
+        for (std::size_t r = 0; r < n; ++r)
+          for (std::size_t c = 0; c < dout; ++c) jac_rows.cols[c][r] = jac_rows_out[r * dout + c];
+        EXPECT_TRUE(same_bits(jac_rows, soa))
+            << label << ": rows of " << din << " -> " << dout << " with the Jacobian";
         if (din == dout) {  // in place: the output overwrites the input array
           std::vector<T> inout(aos_in);
           std::vector<ConstColumn<T>> ip(din);
