@@ -52,8 +52,9 @@ struct Lanes {
 
 // Moves W (lanes) rows of D values between memory and D lane vectors, for the stages' row-major
 // inputs and outputs (StageRows). This generic one is for the scalar kernels (W = 1: a plain
-// copy); a SIMD table that transposes in registers specializes it (batch_kernels_avx512.cpp), and
-// the others leave it off (fused = false: the engine transposes with gather and scatter).
+// copy); the SIMD tables specialize it with their in-register transposes for rows of 4 and 6
+// (batch_kernels_avx512.cpp; lane_transposes.hpp for SSE2 and AVX2) and leave rows of 3 off
+// (fused = false: the engine transposes them with gather and scatter).
 template <class B, int D>
 struct RowTranspose {
   static constexpr bool fused = std::is_floating_point_v<B>;
@@ -277,7 +278,8 @@ inline void scatter_rows_spaced(const S* __restrict columns, S* __restrict rows,
     for (int c = 0; c < D; ++c) rows[D * i + c] = columns[c * Pitch + i];
 }
 
-// Row-major (m, D) <-> D columns kTileRows apart. Plain loops with compile-time D and spacing,
+// Row-major (m, D) <-> D columns kTileRows apart, for the rows a table does not transpose in
+// registers (rows of 3; every D of the scalar table). Plain loops with compile-time D and spacing,
 // which GCC vectorizes with this translation unit's permutes (a runtime spacing defeats it, and so
 // does a group of 6: rows of 6 go as 2m rows of 3 and an even/odd split, both vectorized).
 template <class S, int D>
