@@ -66,6 +66,25 @@ struct RowTranspose {
   }
 };
 
+// The specialization of a SIMD table, from its in-register transposes `Rows` (load and store
+// between rows and D registers of type Rows::V, the native vectors that B wraps) for rows of 4
+// and 6; rows of 3 (isotropic coordinates) keep the engine's transpose passes.
+template <class Rows, class B, int D>
+struct RegisterRowTranspose {
+  using S = ScalarOf<B>;
+  static constexpr bool fused = D == 4 || D == 6;
+  static void load(const S* rows, B* x) {
+    typename Rows::V c[D];
+    Rows::load(rows, c);
+    for (int k = 0; k < D; ++k) x[k] = B(c[k]);
+  }
+  static void store(const B* y, S* rows) {
+    typename Rows::V c[D];
+    for (int k = 0; k < D; ++k) c[k] = y[k];
+    Rows::store(c, rows);
+  }
+};
+
 // Software prefetch of the columns kPrefetchBytes ahead of each vector step, every line of it:
 // the hardware prefetcher alone kept the 6 to 11 streams of a conversion too few lines ahead of
 // the arithmetic (docs/performance.md, "Conversions"). Only where a vector step is whole lines

@@ -63,7 +63,8 @@ struct AvxLanes {
 
 template <class S, int D>
 struct RowTranspose<xsimd::batch<S, xsimd::fma3<xsimd::avx2>>, D>
-    : LaneRowTranspose<AvxLanes, xsimd::batch<S, xsimd::fma3<xsimd::avx2>>, D> {};
+    : RegisterRowTranspose<LaneRows<AvxLanes, S, D>, xsimd::batch<S, xsimd::fma3<xsimd::avx2>>, D> {
+};
 
 }  // namespace
 

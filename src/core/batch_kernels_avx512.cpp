@@ -160,23 +160,9 @@ struct ZmmRows<double, 6> : PermuteRows<double, 6> {
   }
 };
 
-// The rows of the stages' vector loops (batch_kernels.hpp), transposed in registers; rows of 3
-// (isotropic coordinates) keep the engine's transpose passes.
 template <class S, int D>
-struct RowTranspose<xsimd::batch<S, xsimd::avx512f>, D> {
-  using B = xsimd::batch<S, xsimd::avx512f>;
-  static constexpr bool fused = D == 4 || D == 6;
-  static void load(const S* rows, B* x) {
-    typename Zmm<S>::V c[D];
-    ZmmRows<S, D>::load(rows, c);
-    for (int k = 0; k < D; ++k) x[k] = B(c[k]);
-  }
-  static void store(const B* y, S* rows) {
-    typename Zmm<S>::V c[D];
-    for (int k = 0; k < D; ++k) c[k] = y[k];
-    ZmmRows<S, D>::store(c, rows);
-  }
-};
+struct RowTranspose<xsimd::batch<S, xsimd::avx512f>, D>
+    : RegisterRowTranspose<ZmmRows<S, D>, xsimd::batch<S, xsimd::avx512f>, D> {};
 
 // Two vectors per step (the decodes, halfdiff's encode): the rows of each half in turn. Without
 // it the Twin stages would not read the rows the plan hands them (fused_rows is per table).

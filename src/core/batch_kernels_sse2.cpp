@@ -42,7 +42,7 @@ struct SseLanes {
 
 template <class S, int D>
 struct RowTranspose<xsimd::batch<S, xsimd::sse2>, D>
-    : LaneRowTranspose<SseLanes, xsimd::batch<S, xsimd::sse2>, D> {};
+    : RegisterRowTranspose<LaneRows<SseLanes, S, D>, xsimd::batch<S, xsimd::sse2>, D> {};
 
 }  // namespace
 

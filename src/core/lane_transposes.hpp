@@ -127,24 +127,5 @@ struct LaneRows<Ops, float, 6> {
   }
 };
 
-// The RowTranspose (batch_kernels.hpp) of a table whose lane type B wraps Ops's vectors; rows of
-// 3 (isotropic coordinates) keep the engine's transpose passes.
-template <class Ops, class B, int D>
-struct LaneRowTranspose {
-  using S = ScalarOf<B>;
-  using Rows = LaneRows<Ops, S, D>;
-  static constexpr bool fused = D == 4 || D == 6;
-  static void load(const S* rows, B* x) {
-    typename Rows::V c[D];
-    Rows::load(rows, c);
-    for (int k = 0; k < D; ++k) x[k] = B(c[k]);
-  }
-  static void store(const B* y, S* rows) {
-    typename Rows::V c[D];
-    for (int k = 0; k < D; ++k) c[k] = y[k];
-    Rows::store(c, rows);
-  }
-};
-
 }  // namespace
 }  // namespace halfback::detail
