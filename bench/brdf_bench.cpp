@@ -237,7 +237,7 @@ void BM_MerlFloor_Conversion(benchmark::State& state) {
       const double* rows = &p[f].wi.x;
       const ConstColumn<double> in[6] = {{rows, 6},     {rows + 1, 6}, {rows + 2, 6},
                                          {rows + 3, 6}, {rows + 4, 6}, {rows + 5, 6}};
-      convert<double>(Form{Space::dirs}, Form{Space::halfdiff, true}, in, block,
+      convert<double>(Form{Space::dirs}, Form{space_of<HalfDiff>, true}, in, block,
                       ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
       benchmark::DoNotOptimize(q[0][0]);
     }

@@ -79,7 +79,7 @@ struct Data {
       }
       for (int c = 0; c < 6; ++c) dirs[c][r] = static_cast<T>(w[c]);
     }
-    for (Space s : kParameterizations) {
+    for (Space s : kBuiltinSpaces) {
       Columns<T> q(4, std::vector<T>(rows));
       std::vector<ConstColumn<T>> ic;
       for (const auto& c : dirs) ic.push_back({c.data(), 1});
@@ -107,7 +107,7 @@ struct Data {
     for (const auto& c : dirs) ic.push_back({c.data(), 1});
     std::vector<Column<T>> oc;
     for (std::size_t c = 0; c < 4; ++c) oc.push_back({out[c].data(), 1});
-    convert<T>({Space::dirs, false}, {Space::ortho, false}, ic, n, {oc, {}, valid.data()});
+    convert<T>({Space::dirs, false}, {space_of<Ortho>, false}, ic, n, {oc, {}, valid.data()});
   }
 };
 
@@ -278,9 +278,9 @@ void bm_isa(benchmark::State& state, detail::SimdIsa isa, Space space, bool forw
 // --- the scalar baseline: per pair, virtual, std math ------------------------------------------
 
 template <class T>
-class Parameterization {
+class VirtualParam {
  public:
-  virtual ~Parameterization() = default;
+  virtual ~VirtualParam() = default;
   // Coordinates of a pair (NaN and false when the pair is not a valid one).
   virtual bool forward(const DirPair<T>& p, T* q) const = 0;
   // The pair with coordinates q (NaN and false outside the domain).
@@ -288,7 +288,7 @@ class Parameterization {
 };
 
 template <class P, class T>
-class ParameterizationOf final : public Parameterization<T> {
+class VirtualParamOf final : public VirtualParam<T> {
  public:
   bool forward(const DirPair<T>& p, T* q) const override {
     if (!detail::pair_is_valid(p)) {
@@ -307,17 +307,17 @@ class ParameterizationOf final : public Parameterization<T> {
 };
 
 template <class T>
-std::unique_ptr<Parameterization<T>> make_parameterization(Space space) {
-  return visit_parameterization(space, [](auto p) -> std::unique_ptr<Parameterization<T>> {
-    return std::make_unique<ParameterizationOf<decltype(p), T>>();
+std::unique_ptr<VirtualParam<T>> make_parameterization(Space space) {
+  return visit_builtin(space.builtin_index(), [](auto p) -> std::unique_ptr<VirtualParam<T>> {
+    return std::make_unique<VirtualParamOf<decltype(p), T>>();
   });
 }
 
 template <class T>
 void bm_scalar(benchmark::State& state, Space space, bool forward) {
   Data<T>& d = Data<T>::get();
-  std::unique_ptr<Parameterization<T>> param = make_parameterization<T>(space);
-  const Parameterization<T>* pp = param.get();
+  std::unique_ptr<VirtualParam<T>> param = make_parameterization<T>(space);
+  const VirtualParam<T>* pp = param.get();
   benchmark::DoNotOptimize(pp);  // keep the call virtual
   const Columns<T>& q = d.coords[static_cast<int>(space) - 1];
   for (auto _ : state) {
@@ -434,7 +434,7 @@ void register_all() {
   if (all > 1) thread_counts.push_back(all);
   for (bool forward : {true, false}) {
     const std::string dir = forward ? "forward" : "inverse";
-    for (Space s : kParameterizations) {
+    for (Space s : kBuiltinSpaces) {
       const std::string p(name_of(s));
       for (unsigned k : thread_counts)
         benchmark::RegisterBenchmark(
@@ -463,14 +463,14 @@ void register_all() {
           (std::string("isa/") + (forward ? "forward" : "inverse") + "/halfdiff/" + t + "/" +
            std::string(detail::isa_name(isa)))
               .c_str(),
-          [=](benchmark::State& st) { bm_isa<T>(st, isa, Space::halfdiff, forward); })
+          [=](benchmark::State& st) { bm_isa<T>(st, isa, space_of<HalfDiff>, forward); })
           ->Unit(benchmark::kMillisecond);
   for (std::size_t packet : {std::size_t{16}, std::size_t{65536}})
     benchmark::RegisterBenchmark(
         ("packets/forward/spherical/" + t + "/" + std::to_string(packet)).c_str(),
-        [=](benchmark::State& st) { bm_packets<T>(st, Space::spherical, packet); })
+        [=](benchmark::State& st) { bm_packets<T>(st, space_of<Spherical>, packet); })
         ->Apply(timing(1));
-  for (Space s : {Space::spherical, Space::halfdiff, Space::ortho, Space::hybrid})
+  for (Space s : {space_of<Spherical>, space_of<HalfDiff>, space_of<Ortho>, space_of<Hybrid>})
     for (bool forward : {true, false})
       benchmark::RegisterBenchmark((std::string("layout/") + (forward ? "forward/" : "inverse/") +
                                     std::string(name_of(s)) + "/" + t)

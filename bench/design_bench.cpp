@@ -36,7 +36,7 @@ GonioSetup setup_of(Space space, Spacing spacing) {
     static const std::vector<LearnedWarps> learned = [] {
       std::vector<DesignProfile> profiles;
       for (const char* spec : {"ggx:alpha=0.1", "ggx:alpha=0.3"})
-        profiles.push_back(design_profile(*model_registry().create(spec), kParameterizations,
+        profiles.push_back(design_profile(*model_registry().create(spec), kBuiltinSpaces,
                                           {32, 32, 32}, ErrorSpace::log));
       profiles.push_back({});  // the held-out slot: never read
       return learn_warps(profiles, 2);
@@ -61,7 +61,7 @@ void BM_Design(benchmark::State& state) {
 }
 
 void designs(benchmark::internal::Benchmark* b) {
-  for (Space s : {Space::halfdiff, Space::hybrid})
+  for (Space s : {space_of<HalfDiff>, space_of<Hybrid>})
     for (Spacing d : kSpacings) b->Args({static_cast<long>(s), static_cast<long>(d)});
 }
 BENCHMARK(BM_Design)->Apply(designs)->Unit(benchmark::kMillisecond);

@@ -54,7 +54,8 @@ void BM_Baseline_Eval1M(benchmark::State& state) {
 void BM_Stage_Metrics12(benchmark::State& state) {
   const study::StudyConfig c;
   on_one_core(state, [&] {
-    const study::IsoSamples x = study::sample_isotropic(network(), Space::hybrid, c.grid, c.space);
+    const study::IsoSamples x =
+        study::sample_isotropic(network(), space_of<Hybrid>, c.grid, c.space);
     benchmark::DoNotOptimize(study::azimuthal_error(x));
     benchmark::DoNotOptimize(study::separability_2d(x, c.ranks));
     benchmark::DoNotOptimize(study::separability_unfolded(x, c.ranks));
@@ -70,7 +71,7 @@ void BM_Stage_Gonio(benchmark::State& state) {
   on_one_core(state, [&] {
     for (study::Design d : study::kDesigns)
       for (std::size_t budget : c.budgets) {
-        study::GonioSetup setup{Space::hybrid, true, d, budget, c.seed};
+        study::GonioSetup setup{space_of<Hybrid>, true, d, budget, c.seed};
         setup.max_theta_deg = c.max_theta_deg;
         const study::GonioReconstruction rec(network(), setup);
         benchmark::DoNotOptimize(study::reconstruction_error(rec, test));

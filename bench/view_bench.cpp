@@ -54,7 +54,7 @@ void BM_Slice(benchmark::State& state) {
   const BrdfPtr brdf = brdf_of(int(state.range(0)));
   state.SetLabel(kNames[state.range(0)]);
   for (auto _ : state) {
-    auto v = view::slice_field(*brdf, Space::hybrid, kAzimuth, kSide, 1);
+    auto v = view::slice_field(*brdf, space_of<Hybrid>, kAzimuth, kSide, 1);
     benchmark::DoNotOptimize(v.data());
   }
 }
@@ -66,7 +66,7 @@ void BM_PairsBatch(benchmark::State& state) {
   const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
   const BrdfPtr lambert = load_brdf("lambert");
   for (auto _ : state) {
-    auto v = view::slice_field(*lambert, Space::hybrid, kAzimuth, kSide, 1);
+    auto v = view::slice_field(*lambert, space_of<Hybrid>, kAzimuth, kSide, 1);
     benchmark::DoNotOptimize(v.data());
   }
 }
@@ -74,10 +74,10 @@ BENCHMARK(BM_PairsBatch)->Unit(benchmark::kMillisecond);
 
 void BM_PairsPerTuple(benchmark::State& state) {
   const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-  const auto c = figure::iso_coordinates(Space::hybrid);
+  const auto c = figure::iso_coordinates(space_of<Hybrid>);
   const auto grid = figure::Grid::pixel_centres(kSide, kSide, 0, c[0].max, 0, c[1].max);
   for (auto _ : state) {
-    auto s = figure::sample_slice(Space::hybrid, kAzimuth, grid, 1);
+    auto s = figure::sample_slice(space_of<Hybrid>, kAzimuth, grid, 1);
     benchmark::DoNotOptimize(s.pairs.data());
   }
 }
@@ -87,9 +87,9 @@ void BM_EvalOnly(benchmark::State& state) {
   const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
   const BrdfPtr brdf = brdf_of(int(state.range(0)));
   state.SetLabel(kNames[state.range(0)]);
-  const auto c = figure::iso_coordinates(Space::hybrid);
+  const auto c = figure::iso_coordinates(space_of<Hybrid>);
   const figure::SliceSample s =
-      figure::sample_slice(Space::hybrid, kAzimuth,
+      figure::sample_slice(space_of<Hybrid>, kAzimuth,
                            figure::Grid::pixel_centres(kSide, kSide, 0, c[0].max, 0, c[1].max), 1);
   std::vector<DirPair<double>> pairs;
   for (std::size_t k = 0; k < s.pairs.size(); ++k)

@@ -35,7 +35,7 @@ std::vector<double> coords_of(const GridSpec& g, std::size_t flat) {
 
 TEST(Resample, EveryPointIsTheBrdfAtTheCheckedInverse) {
   const Smooth brdf;
-  for (Space s : kParameterizations) {
+  for (Space s : kBuiltinSpaces) {
     for (GridKind kind : {GridKind::full, GridKind::isotropic, GridKind::slice}) {
       const std::size_t n = kind == GridKind::full ? 7 : kind == GridKind::isotropic ? 11 : 23;
       GridSpec g = default_grid(s, kind, {n}, 1.1);
@@ -65,7 +65,7 @@ TEST(Resample, EveryPointIsTheBrdfAtTheCheckedInverse) {
         EXPECT_EQ(valid, t.valid_count());
         // Every grid has points on both sides of the domain boundary.
         EXPECT_GT(valid, 0u) << name_of(s) << " " << name_of(kind);
-        if (s != Space::spherical) {
+        if (s != space_of<Spherical>) {
           EXPECT_LT(valid, g.points()) << name_of(s);
         }
       }
@@ -78,7 +78,7 @@ TEST(Resample, EveryPointIsTheBrdfAtTheCheckedInverse) {
 TEST(Resample, SlicesOfTheTestFunctionsMatchTheirClosedForms) {
   const TestFunctionBrdf specular(TestFunction::specular), fresnel(TestFunction::fresnel);
   for (double az_deg : {0.0, 45.0, 90.0}) {
-    for (Space s : {Space::ortho, Space::hybrid}) {
+    for (Space s : {space_of<Ortho>, space_of<Hybrid>}) {
       const GridSpec g = default_grid(s, GridKind::slice, {64}, az_deg * kPi / 180);
       const ResampledTable t = resample(specular, g);
       for (std::size_t p = 0; p < g.points(); ++p) {
@@ -87,7 +87,7 @@ TEST(Resample, SlicesOfTheTestFunctionsMatchTheirClosedForms) {
         EXPECT_NEAR(t.rgb[3 * p], 1 - hbar, 1e-12);
       }
     }
-    const GridSpec g = default_grid(Space::halfdiff, GridKind::slice, {64}, az_deg * kPi / 180);
+    const GridSpec g = default_grid(space_of<HalfDiff>, GridKind::slice, {64}, az_deg * kPi / 180);
     const ResampledTable t = resample(fresnel, g);
     for (std::size_t p = 0; p < g.points(); ++p) {
       if (!t.valid[p]) continue;
@@ -102,9 +102,9 @@ TEST(Resample, SlicesOfTheTestFunctionsMatchTheirClosedForms) {
 // directions and the whole square is valid; at φd = 0, z = cos(θh ± θd), valid iff θh + θd ≤ π/2.
 TEST(Resample, HalfdiffSliceDomainsHaveTheirClosedForm) {
   const TestFunctionBrdf g_fn(TestFunction::grazing);
-  const GridSpec g90 = default_grid(Space::halfdiff, GridKind::slice, {40}, kPi / 2);
+  const GridSpec g90 = default_grid(space_of<HalfDiff>, GridKind::slice, {40}, kPi / 2);
   EXPECT_EQ(resample(g_fn, g90).valid_count(), g90.points());
-  const GridSpec g0 = default_grid(Space::halfdiff, GridKind::slice, {40}, 0);
+  const GridSpec g0 = default_grid(space_of<HalfDiff>, GridKind::slice, {40}, 0);
   const ResampledTable t0 = resample(g_fn, g0);
   for (std::size_t p = 0; p < g0.points(); ++p) {
     const double th = g0.axes[0].position(p / 40, g0.sampling);
@@ -127,19 +127,19 @@ TEST(Resample, SamplePositions) {
 }
 
 TEST(Resample, DefaultGridsAndValidation) {
-  const GridSpec g = default_grid(Space::hybrid, GridKind::isotropic, {4, 5, 6});
+  const GridSpec g = default_grid(space_of<Hybrid>, GridKind::isotropic, {4, 5, 6});
   ASSERT_EQ(g.axes.size(), 3u);
   EXPECT_EQ(g.axes[0].name, "hbar");
   EXPECT_EQ(g.axes[1].name, "k");
   EXPECT_EQ(g.axes[2].name, "dphi");
   EXPECT_EQ(g.axes[2].hi, 2 * kPi);
   EXPECT_EQ(g.points(), 120u);
-  const GridSpec f = default_grid(Space::halfdiff, GridKind::full, {3});
+  const GridSpec f = default_grid(space_of<HalfDiff>, GridKind::full, {3});
   EXPECT_EQ(f.axes[0].name, "theta_h");
   EXPECT_EQ(f.axes[0].hi, kPi / 2);
   EXPECT_EQ(f.axes[1].name, "phi_h");
   EXPECT_EQ(f.points(), 81u);
-  const GridSpec s = default_grid(Space::ortho, GridKind::slice, {8});
+  const GridSpec s = default_grid(space_of<Ortho>, GridKind::slice, {8});
   ASSERT_EQ(s.axes.size(), 2u);
   EXPECT_EQ(s.axes[1].name, "kbar");
 
@@ -154,11 +154,12 @@ TEST(Resample, DefaultGridsAndValidation) {
   EXPECT_NE(message([] { default_grid(Space::dirs, GridKind::full, {4}); }).find("dirs"),
             std::string::npos);
   EXPECT_NE(message([] {
-              default_grid(Space::hybrid, GridKind::full, {4, 4});
+              default_grid(space_of<Hybrid>, GridKind::full, {4, 4});
             }).find("4 axes"),
             std::string::npos);
-  EXPECT_NE(message([] { default_grid(Space::hybrid, GridKind::slice, {0}); }).find("no samples"),
-            std::string::npos);
+  EXPECT_NE(
+      message([] { default_grid(space_of<Hybrid>, GridKind::slice, {0}); }).find("no samples"),
+      std::string::npos);
   GridSpec bad = g;
   bad.axes[1].lo = 2, bad.axes[1].hi = 1;
   EXPECT_NE(message([&] { validate(bad); }).find("lo <= hi"), std::string::npos);
@@ -168,12 +169,12 @@ TEST(Resample, DefaultGridsAndValidation) {
   bad = g;
   bad.axes[0].name = "theta_h";
   EXPECT_NE(message([&] { validate(bad); }).find("'theta_h'"), std::string::npos);
-  EXPECT_NE(message([] { default_grid(Space::hybrid, GridKind::full, {400}); }).find("2^26"),
+  EXPECT_NE(message([] { default_grid(space_of<Hybrid>, GridKind::full, {400}); }).find("2^26"),
             std::string::npos);
   // 91^4 = 68574961 points is just above the limit, 90^4 = 65610000 just below it.
-  EXPECT_NE(message([] { default_grid(Space::hybrid, GridKind::full, {91}); }).find("1.7 GB"),
+  EXPECT_NE(message([] { default_grid(space_of<Hybrid>, GridKind::full, {91}); }).find("1.7 GB"),
             std::string::npos);
-  EXPECT_NO_THROW(validate(default_grid(Space::hybrid, GridKind::full, {90})));
+  EXPECT_NO_THROW(validate(default_grid(space_of<Hybrid>, GridKind::full, {90})));
 }
 
 TEST(Resample, CoordinatesToPairs) {
@@ -183,7 +184,7 @@ TEST(Resample, CoordinatesToPairs) {
   const std::vector<std::span<const double>> columns{hbar, k, phi};
   std::vector<DirPair<double>> pairs(2);
   std::vector<std::uint8_t> valid(2);
-  coordinates_to_pairs({Space::hybrid, true}, columns, pairs, valid);
+  coordinates_to_pairs({space_of<Hybrid>, true}, columns, pairs, valid);
   ASSERT_EQ(valid[0], 1);
   EXPECT_EQ(valid[1], 0);
   EXPECT_NEAR(pairs[0].wi.z, 0.8, 1e-12);
@@ -191,19 +192,19 @@ TEST(Resample, CoordinatesToPairs) {
   EXPECT_NEAR(std::abs(pairs[0].wi.x - pairs[0].wo.x), 1.2, 1e-12);
   EXPECT_TRUE(std::isnan(pairs[1].wi.z));
   // Two columns for a 3D form, or columns of the wrong length, are refused.
-  EXPECT_THROW(coordinates_to_pairs({Space::hybrid, true},
+  EXPECT_THROW(coordinates_to_pairs({space_of<Hybrid>, true},
                                     std::vector<std::span<const double>>{hbar, k}, pairs, valid),
                std::invalid_argument);
   const std::vector<double> one{0};
   EXPECT_THROW(
-      coordinates_to_pairs({Space::hybrid, true},
+      coordinates_to_pairs({space_of<Hybrid>, true},
                            std::vector<std::span<const double>>{hbar, k, one}, pairs, valid),
       std::invalid_argument);
 }
 
 TEST(Resample, ThreadCountDoesNotChangeTheBits) {
   const Smooth brdf;
-  const GridSpec g = default_grid(Space::ortho, GridKind::isotropic, {33, 17, 29});
+  const GridSpec g = default_grid(space_of<Ortho>, GridKind::isotropic, {33, 17, 29});
   const ResampledTable a = resample(brdf, g, {1}), b = resample(brdf, g, {0});
   EXPECT_EQ(a.valid, b.valid);
   ASSERT_EQ(a.rgb.size(), b.rgb.size());
@@ -239,7 +240,7 @@ TEST(Resample, AzimuthsWrapIntoZeroTo360Degrees) {
 // inverse wants [0, 2π)). A hand-made GridSpec with an unwrapped azimuth is wrapped too.
 TEST(Resample, SlicesAtEquivalentAzimuthsAreTheSame) {
   const Smooth brdf;
-  for (Space s : kParameterizations) {
+  for (Space s : kBuiltinSpaces) {
     const ResampledTable ref = resample(brdf, default_grid(s, GridKind::slice, {16}, 1.5 * kPi));
     ASSERT_GT(ref.valid_count(), 16u) << name_of(s);
     for (const double az : {-0.5 * kPi, 3.5 * kPi, -2.5 * kPi}) {

@@ -129,4 +129,15 @@ CLI::Validator space_name_validator() {
       "");
 }
 
+CLI::Validator parameterization_validator() {
+  return CLI::Validator(
+      [](std::string& name) -> std::string {
+        const auto s = space_from_name(name);
+        if (s && !s->is_dirs()) return {};
+        return fmt::format("unknown parameterization '{}' (expected one of: {})", name,
+                           parameterization_names(", "));
+      },
+      "");
+}
+
 }  // namespace halfback::cli

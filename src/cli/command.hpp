@@ -114,5 +114,7 @@ double parse_number(std::string_view text, const std::string& what);
 // A CLI11 validator for parameterization names ("dirs", "hybrid", ...), with a message listing
 // the names.
 CLI::Validator space_name_validator();
+// The same for a parameterization (not "dirs").
+CLI::Validator parameterization_validator();
 
 }  // namespace halfback::cli

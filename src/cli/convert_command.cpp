@@ -59,7 +59,9 @@ std::string header_hint(const std::vector<std::string>& found, Form expected) {
       if (names[i] != found[i]) return false;
     return true;
   };
-  for (Space s : {Space::dirs, Space::spherical, Space::halfdiff, Space::ortho, Space::hybrid}) {
+  std::vector<Space> spaces{Space::dirs};
+  for (Space s : parameterizations()) spaces.push_back(s);
+  for (Space s : spaces) {
     for (bool iso : {false, true}) {
       if (iso && s == Space::dirs) continue;
       const Form f{s, iso};
@@ -235,8 +237,9 @@ int run_convert(const ConvertOptions& o) {
 std::string columns_help() {
   std::string s =
       "Columns of each form (the input header must list exactly these, in this order):\n";
-  for (Space space :
-       {Space::dirs, Space::spherical, Space::halfdiff, Space::ortho, Space::hybrid}) {
+  std::vector<Space> spaces{Space::dirs};
+  for (Space p : parameterizations()) spaces.push_back(p);
+  for (Space space : spaces) {
     s += fmt::format("  {:<10} {}", name_of(space), join(column_names({space, false})));
     if (space != Space::dirs)
       s += fmt::format("{:<{}}isotropic: {}", "", 31 - join(column_names({space, false})).size(),

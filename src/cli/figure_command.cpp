@@ -85,14 +85,13 @@ struct MaterialArgs {
   std::string out = "material.png";
 };
 
-std::vector<Space> parameterizations(const std::string& list) {
+std::vector<Space> parameterization_list(const std::string& list) {
   std::vector<Space> spaces;
   for (const std::string& n : split_list(list, "--param", "parameterization")) {
     const auto s = space_from_name(n);
     if (!s || *s == Space::dirs)
-      throw UsageError(fmt::format(
-          "--param: unknown parameterization '{}' (expected spherical, halfdiff, ortho or hybrid)",
-          n));
+      throw UsageError(fmt::format("--param: unknown parameterization '{}' (expected {})", n,
+                                   parameterization_names()));
     spaces.push_back(*s);
   }
   return spaces;
@@ -124,7 +123,7 @@ int run_hemisphere(const HemisphereArgs& a) {
   check_output(a.out);
   check_scale(a.scale);
   figure::HemisphereOptions o;
-  o.params = parameterizations(a.params);
+  o.params = parameterization_list(a.params);
   o.elevations_deg = number_list(a.elevations, "--elevations", "elevation");
   for (double e : o.elevations_deg)
     if (!(e >= 0 && e <= 90))
@@ -163,7 +162,7 @@ int run_slices(const SliceArgs& a) {
   check_output(a.out);
   check_scale(a.scale);
   figure::SliceOptions o;
-  o.params = parameterizations(a.params);
+  o.params = parameterization_list(a.params);
   o.azimuths_deg = number_list(a.azimuths, "--azimuths", "azimuth");
   if (a.colour == "luminance")
     o.colouring = figure::SliceColouring::luminance;
@@ -220,7 +219,7 @@ int run_material(const MaterialArgs& a) {
   check_scale(a.scale);
   figure::MaterialFigureOptions o;
   o.environments = load_environments(a.envs);
-  o.slices.params = parameterizations(a.params);
+  o.slices.params = parameterization_list(a.params);
   o.slices.azimuths_deg = number_list(a.azimuths, "--azimuths", "azimuth");
   if (a.colour == "luminance")
     o.slices.colouring = figure::SliceColouring::luminance;

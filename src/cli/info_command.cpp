@@ -36,7 +36,7 @@ int run_info(const InfoOptions& o) {
   // The largest ρ over the nodes of an isotropic halfdiff grid (θh = 0 and θd = 0 included, so
   // the specular and retro-reflective peaks are sampled). Azimuth of the half vector: 0.
   const GridSpec grid = [] {
-    GridSpec g = default_grid(Space::halfdiff, GridKind::isotropic, {91, 91, 73});
+    GridSpec g = default_grid(space_of<HalfDiff>, GridKind::isotropic, {91, 91, 73});
     g.sampling = GridSampling::nodes;
     g.axes[2].hi = 2 * std::numbers::pi * 72 / 73;
     return g;

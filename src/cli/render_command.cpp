@@ -52,8 +52,8 @@ int run_render(const RenderOptions& o) {
   s.projection = o.perspective ? render::Projection::perspective : render::Projection::orthographic;
   s.strategy = render::strategy_from_name(o.strategy).value();  // checked by the parser
   s.heuristic = o.heuristic == "balance" ? render::Heuristic::balance : render::Heuristic::power;
-  s.tabulation.param = render::table_param_from_name(o.sampling);
-  s.progress = !o.quiet;  // drawn only when stderr is a terminal
+  s.tabulation.param = *space_from_name(o.sampling);  // checked by the parser
+  s.progress = !o.quiet;                              // drawn only when stderr is a terminal
 
   const BrdfPtr brdf = load_brdf(o.brdf);
   const render::EnvMap env = [&] {
@@ -136,9 +136,9 @@ Command register_render(CLI::App& parent) {
       ->check(CLI::IsMember({"power", "balance"}))
       ->capture_default_str();
   app->add_option("--sampling-param", o->sampling,
-                  "parameterization of the tabulated sampler of measured BRDFs: hybrid, "
-                  "halfdiff or spherical")
-      ->check(CLI::IsMember({"hybrid", "halfdiff", "spherical"}))
+                  "parameterization whose chart the tabulated sampler of measured BRDFs uses: " +
+                      parameterization_names())
+      ->check(parameterization_validator())
       ->capture_default_str();
   app->add_option("--threads", o->threads, "worker threads (0: all cores)")
       ->check(CLI::Range(0, 1024))

@@ -35,6 +35,7 @@
 #include <string>
 
 #include "batch_engine.hpp"
+#include "batch_registered.hpp"
 #include "halfback/core/parallel.hpp"
 #include "row_kernels.hpp"
 
@@ -44,10 +45,6 @@ namespace halfback {
 // Instruction-set dispatch
 // ---------------------------------------------------------------------------------------------
 namespace detail {
-
-static_assert(static_cast<int>(Space::spherical) == 1 && static_cast<int>(Space::halfdiff) == 2 &&
-                  static_cast<int>(Space::ortho) == 3 && static_cast<int>(Space::hybrid) == 4,
-              "the kernel tables are indexed by Space - 1");
 
 std::string_view isa_name(SimdIsa isa) {
   switch (isa) {
@@ -184,11 +181,13 @@ std::string_view simd_isa_request_ignored() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The tiled engine
+// The tiled engine (the parameterizations of BuiltinParams; the others: batch_registered.cpp)
 // ---------------------------------------------------------------------------------------------
 namespace {
 
 void check_shapes(Form from, Form to, std::size_t n_in, std::size_t n_out) {
+  for (Form f : {from, to})
+    if (!f.space.is_dirs()) (void)f.space.param();  // throws for an unknown space
   if (n_in != dimension(from))
     throw std::invalid_argument("convert: " + std::string(name_of(from.space)) + " needs " +
                                 std::to_string(dimension(from)) + " input columns, got " +
@@ -197,7 +196,7 @@ void check_shapes(Form from, Form to, std::size_t n_in, std::size_t n_out) {
     throw std::invalid_argument("convert: " + std::string(name_of(to.space)) + " needs " +
                                 std::to_string(dimension(to)) + " output columns, got " +
                                 std::to_string(n_out));
-  if ((from.space == Space::dirs && from.isotropic) || (to.space == Space::dirs && to.isotropic))
+  if ((from.space.is_dirs() && from.isotropic) || (to.space.is_dirs() && to.isotropic))
     throw std::invalid_argument("convert: dirs has no isotropic form");
 }
 
@@ -243,17 +242,17 @@ struct Plan {
         valid_bytes(k.valid_bytes),
         stream(streaming_stores) {
     want_jac = o.jacobian.data != nullptr;
-    const bool to_dirs = t.space == Space::dirs;
-    if (f.space == Space::dirs) {
+    const bool to_dirs = t.space.is_dirs();
+    if (f.space.is_dirs()) {
       check = k.check;
     } else {
-      decode = k.decode[static_cast<int>(f.space) - 1][f.isotropic ? 1 : 0];
+      decode = k.decode[f.space.builtin_index()][f.isotropic ? 1 : 0];
       if (want_jac && to_dirs)
-        jacobian_in = k.jacobian[static_cast<int>(f.space) - 1][f.isotropic ? 1 : 0];
+        jacobian_in = k.jacobian[f.space.builtin_index()][f.isotropic ? 1 : 0];
     }
     if (!to_dirs) {
-      encode = k.encode[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0];
-      if (want_jac) jacobian_out = k.jacobian[static_cast<int>(t.space) - 1][t.isotropic ? 1 : 0];
+      encode = k.encode[t.space.builtin_index()][t.isotropic ? 1 : 0];
+      if (want_jac) jacobian_out = k.jacobian[t.space.builtin_index()][t.isotropic ? 1 : 0];
     }
     const bool in_rows = interleaved(in);
     const bool out_rows = interleaved(std::span<const Column<T>>(o.columns));
@@ -512,6 +511,9 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
              const ConvertOutput<T>& out, const BatchOptions& options) {
   check_shapes(from, to, in.size(), out.columns.size());
   if (n == 0) return;
+  const auto tabled = [](Form f) { return f.space.is_dirs() || f.space.is_builtin(); };
+  if (!tabled(from) || !tabled(to))
+    return detail::convert_registered(from, to, in, n, out, options);
   const Plan<T> plan(detail::active_kernels().stages<T>(), from, to, in, out,
                      detail::streaming_stores());
 

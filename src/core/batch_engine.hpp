@@ -26,6 +26,7 @@
 #include <optional>
 #include <string_view>
 
+#include "halfback/core/parameterization.hpp"
 #include "halfback/core/simd.hpp"
 
 namespace halfback::detail {
@@ -64,9 +65,10 @@ struct StageKernels {
   using JacobianFn = void (*)(const T* const* coords, T* jac, std::size_t m);
   std::size_t width;  // lanes per vector
   CheckFn check;
-  DecodeFn decode[4][2];      // [space - 1][isotropic]
-  EncodeFn encode[4][2];      // [space - 1][isotropic]
-  JacobianFn jacobian[4][2];  // [space - 1][isotropic]
+  // [index in BuiltinParams][isotropic]
+  DecodeFn decode[kBuiltinParamCount][2];
+  EncodeFn encode[kBuiltinParamCount][2];
+  JacobianFn jacobian[kBuiltinParamCount][2];
   // Transposes between m rows of D values (a row-major (m, D) array, such as a NumPy C-order
   // array) and D scratch columns spaced kTileRows<T> apart; [D] for D = 3, 4, 6, else null.
   using GatherFn = void (*)(const T* rows, T* columns, std::size_t m);

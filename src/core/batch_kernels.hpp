@@ -385,22 +385,15 @@ constexpr void fill_transposes(StageKernels<ScalarOf<B>>& k) {
   }
 }
 
-template <class B, class P, int Space>
-constexpr void fill_decode(StageKernels<ScalarOf<B>>& k) {
-  k.decode[Space][0] = &decode_stage<B, P, false>;
-  k.decode[Space][1] = &decode_stage<B, P, true>;
-}
-
-template <class B, class P, int Space>
-constexpr void fill_encode(StageKernels<ScalarOf<B>>& k) {
-  k.encode[Space][0] = &encode_stage<B, P, false>;
-  k.encode[Space][1] = &encode_stage<B, P, true>;
-}
-
-template <class B, class P, int Space>
-constexpr void fill_jacobian(StageKernels<ScalarOf<B>>& k) {
-  k.jacobian[Space][0] = &jacobian_stage<B, P, false>;
-  k.jacobian[Space][1] = &jacobian_stage<B, P, true>;
+// The stages of parameterization P, at its index I in BuiltinParams; the decodes on vectors W.
+template <class B, class W, class P, std::size_t I>
+constexpr void fill_param_stages(StageKernels<ScalarOf<B>>& k) {
+  k.decode[I][0] = &decode_stage<W, P, false>;
+  k.decode[I][1] = &decode_stage<W, P, true>;
+  k.encode[I][0] = &encode_stage<B, P, false>;
+  k.encode[I][1] = &encode_stage<B, P, true>;
+  k.jacobian[I][0] = &jacobian_stage<B, P, false>;
+  k.jacobian[I][1] = &jacobian_stage<B, P, true>;
 }
 
 // B: the vector type of the stages; W: that of the decodes, which may be two vectors per step
@@ -420,19 +413,8 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   // The plan reads fused_rows for the whole table: the Twin stages must fuse the same widths.
   static_assert(RowTranspose<W, 4>::fused == RowTranspose<B, 4>::fused &&
                 RowTranspose<W, 6>::fused == RowTranspose<B, 6>::fused);
-  // Indices follow Space: spherical = 1, halfdiff = 2, ortho = 3, hybrid = 4.
-  fill_decode<W, Spherical, 0>(k);
-  fill_decode<W, HalfDiff, 1>(k);
-  fill_decode<W, Ortho, 2>(k);
-  fill_decode<W, Hybrid, 3>(k);
-  fill_encode<B, Spherical, 0>(k);
-  fill_encode<B, HalfDiff, 1>(k);
-  fill_encode<B, Ortho, 2>(k);
-  fill_encode<B, Hybrid, 3>(k);
-  fill_jacobian<B, Spherical, 0>(k);
-  fill_jacobian<B, HalfDiff, 1>(k);
-  fill_jacobian<B, Ortho, 2>(k);
-  fill_jacobian<B, Hybrid, 3>(k);
+  for_each_param(BuiltinParams{},
+                 [&]<class P, std::size_t I>() { fill_param_stages<B, W, P, I>(k); });
   return k;
 }
 

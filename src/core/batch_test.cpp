@@ -204,17 +204,17 @@ double distance(Form f, std::size_t c, double a, double b) {
 // forms adds a rotation about n known to ε / ‖h̄‖.
 double shape_bound(Form form, const DirPair<double>& p, double eps) {
   double cond = 1;
-  switch (form.space) {
-    case Space::dirs:
-    case Space::spherical:
+  switch (form.space.id()) {
+    case Space::dirs.id():
+    case space_of<Spherical>.id():
       break;
-    case Space::halfdiff:
+    case space_of<HalfDiff>.id():
       cond = std::sqrt(std::max(0.0, 0.5 * (1 + detail::dot(p.wi, p.wo))));
       break;
-    case Space::ortho:
+    case space_of<Ortho>.id():
       cond = std::min(p.wi.z, p.wo.z);
       break;
-    case Space::hybrid:
+    case space_of<Hybrid>.id():
       cond = 0.5 * (p.wi.z + p.wo.z);
       break;
   }
@@ -249,20 +249,20 @@ template <class T>
 double jacobian_condition(Form form, const T* q) {
   const T q4[4] = {q[0], form.isotropic ? T(0) : q[1], form.isotropic ? q[1] : q[2],
                    form.isotropic ? q[2] : q[3]};
-  switch (form.space) {
-    case Space::dirs:
-    case Space::spherical:
+  switch (form.space.id()) {
+    case Space::dirs.id():
+    case space_of<Spherical>.id():
       return 1;
-    case Space::halfdiff:
+    case space_of<HalfDiff>.id():
       return 1 + 1 / std::abs(std::cos(double(q4[2])));
-    case Space::ortho: {
+    case space_of<Ortho>.id(): {
       const T hx = q4[0] * std::cos(q4[1]), hy = q4[0] * std::sin(q4[1]);
       const T kx = q4[2] * std::cos(q4[3]), ky = q4[2] * std::sin(q4[3]);
       const T xi = hx + kx, yi = hy + ky, xo = hx - kx, yo = hy - ky;
       const T zi2 = T(1) - (xi * xi + yi * yi), zo2 = T(1) - (xo * xo + yo * yo);
       return 1 + 2 / std::abs(double(zi2)) + 2 / std::abs(double(zo2));
     }
-    case Space::hybrid: {
+    case space_of<Hybrid>.id(): {
       const T hz2 = T(1) - q4[0] * q4[0] - q4[2] * q4[2];
       const double hz = std::sqrt(std::max(double(hz2), 0.0));
       const double c = double(q4[0]) * std::cos(double(q4[3]) - double(q4[1]));
@@ -276,8 +276,9 @@ double jacobian_condition(Form form, const T* q) {
 template <class T>
 T reference_jacobian(Form form, const T* q) {
   if (form.space == Space::dirs) return T(1);
-  return visit_parameterization(
-      form.space, [&](auto p) { return detail::jacobian_of<decltype(p), T>(form.isotropic, q); });
+  return visit_builtin(form.space.builtin_index(), [&](auto p) {
+    return detail::jacobian_of<decltype(p), T>(form.isotropic, q);
+  });
 }
 
 template <class T>
@@ -751,7 +752,7 @@ std::vector<std::vector<T>> invalid_rows(Form from) {
     return rows;
   }
   const std::size_t dim = dimension(from);
-  const bool angular = from.space == Space::spherical || from.space == Space::halfdiff;
+  const bool angular = from.space == space_of<Spherical> || from.space == space_of<HalfDiff>;
   // A valid tuple, and per column its upper limit (π/2 or 1 for magnitudes, 2π excluded).
   std::vector<T> ok =
       from.isotropic ? std::vector<T>{0.3f, 0.4f, 1.0f} : std::vector<T>{0.3f, 1.0f, 0.4f, 2.0f};
@@ -769,23 +770,23 @@ std::vector<std::vector<T>> invalid_rows(Form from) {
     if (from.isotropic) q4 = {q4[0], q4[2], q4[3]};  // φh = 0
     rows.push_back(q4);
   };
-  switch (from.space) {
-    case Space::spherical:
+  switch (from.space.id()) {
+    case space_of<Spherical>.id():
       break;  // its domain is the box
-    case Space::halfdiff:
+    case space_of<HalfDiff>.id():
       push({1.2f, 0, 1.2f, 0});        // ωi.z = cos 2.4 < 0
       push({1.2f, 0, 1.2f, 3.1416f});  // ωo.z < 0
       break;
-    case Space::ortho:
+    case space_of<Ortho>.id():
       push({0.8f, 0, 0.8f, 0});      // |h̄ + k̄| = 1.6
       push({0.8f, 0, 0.8f, 3.14f});  // |h̄ − k̄| > 1
       push({0.9f, 0, 0.2f, 0.1f});
       break;
-    case Space::hybrid:
+    case space_of<Hybrid>.id():
       push({0.8f, 0, 0.8f, 1.0f});  // ‖h̄‖² + ‖k‖² > 1
       push({0.1f, 0, 0.99f, 0});    // k along h̄ with |kz| > hz
       break;
-    case Space::dirs:
+    case Space::dirs.id():
       break;
   }
   return rows;
@@ -821,7 +822,7 @@ TYPED_TEST(BatchTest, EncodeOfUncheckedRowsIsCheckThenEncode) {
     k.check(in_cols, copy_cols, mask_old.data(), n, {});
     for (Form to : test::parameterization_forms()) {
       SCOPED_TRACE(std::string(detail::isa_name(isa)) + " dirs->" + form_name(to));
-      const auto encode = k.encode[static_cast<int>(to.space) - 1][to.isotropic ? 1 : 0];
+      const auto encode = k.encode[to.space.builtin_index()][to.isotropic ? 1 : 0];
       Table<T> out_old = make_table<T>(dimension(to), n), out_new = out_old;
       T *o_old[4], *o_new[4];
       for (std::size_t c = 0; c < dimension(to); ++c) {
@@ -911,10 +912,10 @@ Table<T> big_input(Form from, std::size_t n) {
 }
 
 const std::pair<Form, Form> kSampleConversions[] = {
-    {{Space::dirs, false}, {Space::halfdiff, false}},
-    {{Space::spherical, false}, {Space::hybrid, true}},
-    {{Space::ortho, false}, {Space::dirs, false}},
-    {{Space::halfdiff, true}, {Space::spherical, false}},
+    {{Space::dirs, false}, {space_of<HalfDiff>, false}},
+    {{space_of<Spherical>, false}, {space_of<Hybrid>, true}},
+    {{space_of<Ortho>, false}, {Space::dirs, false}},
+    {{space_of<HalfDiff>, true}, {space_of<Spherical>, false}},
 };
 
 // The first element of `buffer` on a 64-byte line (a buffer a line longer than it needs).
@@ -1008,12 +1009,13 @@ TYPED_TEST(BatchTest, SizesIncludingEmptyAndTails) {
   {
     std::vector<ConstColumn<T>> ic(6);
     std::vector<Column<T>> oc(4);
-    EXPECT_NO_THROW(convert<T>({Space::dirs, false}, {Space::ortho, false}, ic, 0, {oc}));
+    EXPECT_NO_THROW(convert<T>({Space::dirs, false}, {space_of<Ortho>, false}, ic, 0, {oc}));
     T sentinel = T(42);
     std::uint8_t valid = 9;
     std::vector<ConstColumn<T>> ic4(4, ConstColumn<T>{&sentinel, 1});
     std::vector<Column<T>> oc6(6, Column<T>{&sentinel, 1});
-    convert<T>({Space::hybrid, false}, {Space::dirs, false}, ic4, 0, {oc6, {&sentinel, 1}, &valid});
+    convert<T>({space_of<Hybrid>, false}, {Space::dirs, false}, ic4, 0,
+               {oc6, {&sentinel, 1}, &valid});
     EXPECT_EQ(sentinel, T(42));
     EXPECT_EQ(valid, 9);
   }
@@ -1046,7 +1048,7 @@ TYPED_TEST(BatchTest, SizesIncludingEmptyAndTails) {
 TEST(Batch, RejectsWrongShapes) {
   std::vector<ConstColumn<double>> in6(6), in4(4);
   std::vector<Column<double>> out4(4), out3(3), out6(6);
-  const Form dirs{Space::dirs, false}, sph{Space::spherical, false};
+  const Form dirs{Space::dirs, false}, sph{space_of<Spherical>, false};
   EXPECT_THROW(convert<double>(dirs, sph, in4, 1, {out4}), std::invalid_argument);
   EXPECT_THROW(convert<double>(dirs, sph, in6, 1, {out3}), std::invalid_argument);
   EXPECT_THROW(convert<double>(sph, {Space::dirs, true}, in4, 1, {out6}), std::invalid_argument);

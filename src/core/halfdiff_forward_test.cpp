@@ -156,7 +156,7 @@ TYPED_TEST(HalfDiffForward, MatchesLongDoubleReferenceAtEveryScale) {
 // the reference is taken of that normalized pair (convert_one's, bit for bit the engine's).
 TYPED_TEST(HalfDiffForward, BatchMatchesLongDoubleReferenceOnEveryInstructionSet) {
   using T = TypeParam;
-  const Form dirs{Space::dirs, false}, halfdiff{Space::halfdiff, false};
+  const Form dirs{Space::dirs, false}, halfdiff{space_of<HalfDiff>, false};
   const auto raw = test_pairs<T>();
   const std::size_t n = raw.size();
   std::vector<DirPair<T>> pairs;

@@ -158,7 +158,7 @@ void expect_batch_round_trips(const std::vector<T>& pairs) {
 // The reproductions of the issue: ‖h̄‖ = 1.0000004 from a direction 4e-7 long, and ωi = ωo exactly
 // on the horizon, where ‖h̄‖ rounds to 1 + 2e-16.
 TEST(NearUnitDirections, IssueReproductions) {
-  const Form dirs{Space::dirs, false}, ortho{Space::ortho, false};
+  const Form dirs{Space::dirs, false}, ortho{space_of<Ortho>, false};
   const double s = std::sqrt(1 + 8e-7);
   const double x = 0.6 * s, y = 0.8 * s;
   const std::array<double, 6> long_pair{x, y, 0.0, x, y, 0.0};
@@ -175,7 +175,7 @@ TEST(NearUnitDirections, IssueReproductions) {
   const double phi = 0.3;
   const std::array<double, 6> horizon{std::cos(phi), std::sin(phi), 0.0,
                                       std::cos(phi), std::sin(phi), 0.0};
-  for (Space space : {Space::ortho, Space::hybrid}) {
+  for (Space space : {space_of<Ortho>, space_of<Hybrid>}) {
     std::array<double, 4> h;
     ASSERT_TRUE(convert_one<double>(dirs, {space, false}, horizon, h));
     EXPECT_LE(h[0], 1.0) << name_of(space);

@@ -379,13 +379,16 @@ TEST(Azimuth, RangeAndZeroVector) {
 namespace halfback {
 namespace {
 
-TEST(Space, VisitParameterizationNamesEachAndRefusesDirs) {
+TEST(Space, BuiltinSpacesFollowTheListAndDirsIsNoParameterization) {
   auto name_of_p = [](auto p) { return decltype(p)::name; };
-  EXPECT_EQ(visit_parameterization(Space::spherical, name_of_p), "spherical");
-  EXPECT_EQ(visit_parameterization(Space::halfdiff, name_of_p), "halfdiff");
-  EXPECT_EQ(visit_parameterization(Space::ortho, name_of_p), "ortho");
-  EXPECT_EQ(visit_parameterization(Space::hybrid, name_of_p), "hybrid");
-  EXPECT_THROW(visit_parameterization(Space::dirs, name_of_p), std::invalid_argument);
+  EXPECT_EQ(visit_builtin(space_of<Spherical>.builtin_index(), name_of_p), "spherical");
+  EXPECT_EQ(visit_builtin(space_of<HalfDiff>.builtin_index(), name_of_p), "halfdiff");
+  EXPECT_EQ(visit_builtin(space_of<Ortho>.builtin_index(), name_of_p), "ortho");
+  EXPECT_EQ(visit_builtin(space_of<Hybrid>.builtin_index(), name_of_p), "hybrid");
+  for (Space s : kBuiltinSpaces) EXPECT_EQ(s.param().name(), name_of(s));
+  EXPECT_EQ(space_names(), "dirs, spherical, halfdiff, ortho, hybrid");
+  EXPECT_THROW((void)Space::dirs.param(), std::invalid_argument);
+  EXPECT_THROW((void)Space::from_id(60000).param(), std::invalid_argument);
 }
 
 }  // namespace

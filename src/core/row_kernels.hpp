@@ -85,18 +85,52 @@ inline T jacobian_of(bool isotropic, const T* q) {
 
 inline constexpr int kMaxDim = 6;
 
+// A parameterization outside BuiltinParams, through its descriptor (in double).
+template <class T>
+inline Solved<T> decode_registered(Form from, const T* in) {
+  const ParamDescriptor& d = from.space.param();
+  const Solved<double> s =
+      from.isotropic ? d.inverse_iso({double(in[0]), double(in[1]), double(in[2])})
+                     : d.inverse({double(in[0]), double(in[1]), double(in[2]), double(in[3])});
+  const auto& p = s.pair;
+  return {{{T(p.wi.x), T(p.wi.y), T(p.wi.z)}, {T(p.wo.x), T(p.wo.y), T(p.wo.z)}}, s.in_domain};
+}
+
+template <class T>
+inline void encode_registered(Form to, const DirPair<T>& p, T* out) {
+  const ParamDescriptor& d = to.space.param();
+  const DirPair<double> pd{{p.wi.x, p.wi.y, p.wi.z}, {p.wo.x, p.wo.y, p.wo.z}};
+  if (to.isotropic) {
+    const Tuple3<double> q = d.forward_iso(pd);
+    for (int i = 0; i < 3; ++i) out[i] = T(q[i]);
+  } else {
+    const Tuple4<double> q = d.forward(pd);
+    for (int i = 0; i < 4; ++i) out[i] = T(q[i]);
+  }
+}
+
+template <class T>
+inline T jacobian_registered(Form side, const T* q) {
+  const ParamDescriptor& d = side.space.param();
+  if (side.isotropic) return T(d.jacobian_iso({double(q[0]), double(q[1]), double(q[2])}));
+  return T(d.jacobian({double(q[0]), double(q[1]), double(q[2]), double(q[3])}));
+}
+
 // One row, scalar T: the reference semantics of convert().
 template <class T>
 inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
   DirPair<T> pair;
   bool ok;
-  if (from.space == Space::dirs) {
+  if (from.space.is_dirs()) {
     pair = {{in[0], in[1], in[2]}, {in[3], in[4], in[5]}};
     ok = pair_is_valid(pair);
     pair = accepted_pair(pair);
   } else {
-    const Solved<T> s = visit_parameterization(
-        from.space, [&](auto p) { return decode_param<decltype(p)>(from.isotropic, in); });
+    const Solved<T> s =
+        from.space.is_builtin()
+            ? visit_builtin(from.space.builtin_index(),
+                            [&](auto p) { return decode_param<decltype(p)>(from.isotropic, in); })
+            : decode_registered(from, in);
     pair = s.pair;
     ok = s.in_domain;
   }
@@ -106,21 +140,29 @@ inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
     if (jacobian) *jacobian = std::numeric_limits<T>::quiet_NaN();
     return false;
   }
-  if (to.space == Space::dirs) {
+  if (to.space.is_dirs()) {
     const T v[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
     for (int i = 0; i < 6; ++i) out[i] = v[i];
   } else {
     // A decoded pair too is unit only to rounding (accepted_pair keeps it when within 4ε).
     const DirPair<T> unit = accepted_pair(pair);
-    visit_parameterization(to.space,
-                           [&](auto p) { encode_param<decltype(p)>(to.isotropic, unit, out); });
+    if (to.space.is_builtin())
+      visit_builtin(to.space.builtin_index(),
+                    [&](auto p) { encode_param<decltype(p)>(to.isotropic, unit, out); });
+    else
+      encode_registered(to, unit, out);
   }
   if (jacobian) {
-    const Form side = to.space != Space::dirs ? to : from;
-    const T* q = to.space != Space::dirs ? out : in;
-    *jacobian = side.space == Space::dirs ? T(1) : visit_parameterization(side.space, [&](auto p) {
-      return jacobian_of<decltype(p)>(side.isotropic, q);
-    });
+    const Form side = !to.space.is_dirs() ? to : from;
+    const T* q = !to.space.is_dirs() ? out : in;
+    if (side.space.is_dirs())
+      *jacobian = T(1);
+    else if (side.space.is_builtin())
+      *jacobian = visit_builtin(side.space.builtin_index(), [&](auto p) {
+        return jacobian_of<decltype(p)>(side.isotropic, q);
+      });
+    else
+      *jacobian = jacobian_registered(side, q);
   }
   return true;
 }

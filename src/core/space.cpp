@@ -1,47 +1,187 @@
 #include "halfback/core/space.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <mutex>
 
 namespace halfback {
 
+// ---------------------------------------------------------------------------------------------
+// ParamDescriptor
+// ---------------------------------------------------------------------------------------------
+ParamDescriptor::ParamDescriptor(const Names& n)
+    : name_(keep(n.name)),
+      summary_(keep(n.summary)),
+      axes_(n.axes),
+      iso_axes_(n.iso_axes),
+      chart_(n.chart) {
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    axes_[i].column = columns_[i] = keep(axes_[i].column);
+    axes_[i].label = keep(axes_[i].label);
+  }
+  for (std::size_t i = 0; i < iso_axes_.size(); ++i) {
+    iso_axes_[i].column = iso_columns_[i] = keep(iso_axes_[i].column);
+    iso_axes_[i].label = keep(iso_axes_[i].label);
+  }
+}
+
+std::string_view ParamDescriptor::keep(std::string_view s) {
+  return strings_.emplace_back(s);
+}
+
+void ParamDescriptor::forward_rows(bool isotropic, const DirPair<double>* pairs, std::size_t m,
+                                   double* coords) const {
+  for (std::size_t i = 0; i < m; ++i) {
+    if (isotropic) {
+      const Tuple3<double> q = forward_iso(pairs[i]);
+      std::copy(q.begin(), q.end(), coords + 3 * i);
+    } else {
+      const Tuple4<double> q = forward(pairs[i]);
+      std::copy(q.begin(), q.end(), coords + 4 * i);
+    }
+  }
+}
+
+void ParamDescriptor::inverse_rows(bool isotropic, const double* coords, std::size_t m,
+                                   DirPair<double>* pairs, std::uint8_t* in_domain) const {
+  for (std::size_t i = 0; i < m; ++i) {
+    const double* q = coords + (isotropic ? 3 : 4) * i;
+    const Solved<double> s =
+        isotropic ? inverse_iso({q[0], q[1], q[2]}) : inverse({q[0], q[1], q[2], q[3]});
+    pairs[i] = s.pair;
+    in_domain[i] = s.in_domain ? 1 : 0;
+  }
+}
+
+void ParamDescriptor::jacobian_rows(bool isotropic, const double* coords, std::size_t m,
+                                    double* jacobian) const {
+  for (std::size_t i = 0; i < m; ++i) {
+    const double* q = coords + (isotropic ? 3 : 4) * i;
+    jacobian[i] =
+        isotropic ? jacobian_iso({q[0], q[1], q[2]}) : this->jacobian({q[0], q[1], q[2], q[3]});
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The registry: the built-in list, then the registered parameterizations. Entries are never
+// removed, so a reader holding a Space may use its descriptor without a lock once it is published.
+// ---------------------------------------------------------------------------------------------
 namespace {
-constexpr std::array<std::string_view, 5> kNames{"dirs", "spherical", "halfdiff", "ortho",
-                                                 "hybrid"};
+
+constexpr std::size_t kMaxSpaces = 1024;
+
+struct Registry {
+  std::mutex mutex;  // serializes registrations
+  std::array<std::shared_ptr<const ParamDescriptor>, kMaxSpaces> slots;
+  std::atomic<std::size_t> count{0};  // published slots (ids 1 .. count)
+
+  Registry() {
+    std::size_t i = 0;
+    for_each_param(BuiltinParams{}, [&]<class P, std::size_t I>() {
+      slots[i++] = std::make_shared<CompiledParam<P>>();
+    });
+    count.store(i, std::memory_order_release);
+  }
+  const ParamDescriptor* find(Space s) const {
+    if (s.is_dirs() || s.id() > count.load(std::memory_order_acquire)) return nullptr;
+    return slots[s.id() - 1].get();
+  }
+};
+
+Registry& registry() {
+  static Registry r;
+  return r;
+}
+
 constexpr std::array<std::string_view, 6> kDirColumns{"wi_x", "wi_y", "wi_z",
                                                       "wo_x", "wo_y", "wo_z"};
+
 }  // namespace
 
+const ParamDescriptor& Space::param() const {
+  if (const ParamDescriptor* d = registry().find(*this)) return *d;
+  if (is_dirs())
+    throw std::invalid_argument("dirs is not a parameterization (expected " +
+                                parameterization_names() + ")");
+  throw std::invalid_argument("no parameterization has the id " + std::to_string(id_));
+}
+
+std::vector<Space> parameterizations() {
+  const std::size_t n = registry().count.load(std::memory_order_acquire);
+  std::vector<Space> all;
+  for (std::size_t i = 1; i <= n; ++i) all.push_back(Space::from_id(std::uint16_t(i)));
+  return all;
+}
+
+Space register_parameterization(std::shared_ptr<const ParamDescriptor> descriptor) {
+  if (!descriptor) throw std::invalid_argument("register_parameterization: no descriptor");
+  const std::string_view name = descriptor->name();
+  if (name.empty() || name == "dirs")
+    throw std::invalid_argument("a parameterization cannot be named '" + std::string(name) + "'");
+  for (Space s : kBuiltinSpaces)
+    if (s.param().name() == name)
+      throw std::invalid_argument("'" + std::string(name) +
+                                  "' is a built-in parameterization: choose another name");
+  Registry& r = registry();
+  std::lock_guard lock(r.mutex);
+  const std::size_t n = r.count.load(std::memory_order_relaxed);
+  if (n >= kMaxSpaces)
+    throw std::length_error("register_parameterization: more than " +
+                            std::to_string(kMaxSpaces - 1) + " parameterizations");
+  r.slots[n] = std::move(descriptor);
+  r.count.store(n + 1, std::memory_order_release);
+  return Space::from_id(std::uint16_t(n + 1));
+}
+
 std::string_view name_of(Space space) {
-  return kNames[static_cast<std::size_t>(space)];
+  if (space.is_dirs()) return "dirs";
+  if (const ParamDescriptor* d = registry().find(space)) return d->name();
+  return "unknown";
 }
 
 std::optional<Space> space_from_name(std::string_view name) {
-  for (std::size_t i = 0; i < kNames.size(); ++i)
-    if (kNames[i] == name) return static_cast<Space>(i);
+  if (name == "dirs") return Space::dirs;
+  const std::vector<Space> all = parameterizations();
+  for (auto it = all.rbegin(); it != all.rend(); ++it)  // the newest of a registered name
+    if (it->param().name() == name) return *it;
   return std::nullopt;
 }
 
+namespace {
+// The current spaces' names: those registered again later are left out.
+std::vector<std::string_view> current_names() {
+  std::vector<std::string_view> names;
+  for (Space s : parameterizations())
+    if (space_from_name(s.param().name()) == s) names.push_back(s.param().name());
+  return names;
+}
+}  // namespace
+
 std::string space_names() {
+  std::string s = "dirs";
+  for (std::string_view n : current_names()) (s += ", ") += n;
+  return s;
+}
+
+std::string parameterization_names(std::string_view last_separator) {
+  const std::vector<std::string_view> names = current_names();
   std::string s;
-  for (auto n : kNames) {
-    if (!s.empty()) s += ", ";
-    s += n;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) s += i + 1 == names.size() ? last_separator : std::string_view(", ");
+    s += names[i];
   }
   return s;
 }
 
 std::size_t dimension(Form form) {
-  if (form.space == Space::dirs) return 6;
+  if (form.space.is_dirs()) return 6;
   return form.isotropic ? 3 : 4;
 }
 
 std::span<const std::string_view> column_names(Form form) {
-  if (form.space == Space::dirs) return kDirColumns;
-  return visit_parameterization(form.space, [&](auto p) -> std::span<const std::string_view> {
-    using P = decltype(p);
-    if (form.isotropic) return P::iso_columns;
-    return P::columns;
-  });
+  if (form.space.is_dirs()) return kDirColumns;
+  return form.space.param().columns(form.isotropic);
 }
 
 PairStatus check_pair(const DirPair<double>& p) {

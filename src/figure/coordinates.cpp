@@ -9,41 +9,20 @@
 namespace halfback::figure {
 
 namespace {
-constexpr double kHalfPi = std::numbers::pi / 2;
-constexpr double kTenDegrees = std::numbers::pi / 18;
-const std::string kHbar = "‖h\u0304‖";
-const std::string kKbar = "‖k\u0304‖";
+CoordinateInfo info_of(const Axis& a) {
+  return {std::string(a.label), a.hi, a.is_angle(), a.spacing};
+}
 }  // namespace
 
 std::array<CoordinateInfo, 2> iso_coordinates(Space space) {
-  switch (space) {
-    case Space::spherical:
-      return {{{"θ_i", kHalfPi, true, kTenDegrees}, {"θ_o", kHalfPi, true, kTenDegrees}}};
-    case Space::halfdiff:
-      return {{{"θ_h", kHalfPi, true, kTenDegrees}, {"θ_d", kHalfPi, true, kTenDegrees}}};
-    case Space::ortho:
-      return {{{kHbar, 1.0, false, 0.1}, {kKbar, 1.0, false, 0.1}}};
-    case Space::hybrid:
-      return {{{kHbar, 1.0, false, 0.1}, {"‖k‖", 1.0, false, 0.1}}};
-    case Space::dirs:
-      break;
-  }
-  throw std::invalid_argument("the dirs space has no isotropic coordinates");
+  if (space.is_dirs()) throw std::invalid_argument("the dirs space has no isotropic coordinates");
+  const auto axes = space.param().axes(true);
+  return {info_of(axes[0]), info_of(axes[1])};
 }
 
 std::string relative_azimuth_label(Space space) {
-  switch (space) {
-    case Space::spherical:
-      return "φ_o − φ_i";
-    case Space::halfdiff:
-      return "φ_d";
-    case Space::ortho:
-    case Space::hybrid:
-      return "φ_k − φ_h";
-    case Space::dirs:
-      break;
-  }
-  throw std::invalid_argument("the dirs space has no isotropic coordinates");
+  if (space.is_dirs()) throw std::invalid_argument("the dirs space has no isotropic coordinates");
+  return std::string(space.param().axes(true)[2].label);
 }
 
 std::string format_coordinate(const CoordinateInfo& c, double value) {

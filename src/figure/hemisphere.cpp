@@ -179,31 +179,29 @@ HemisphereSample sample_hemisphere(Space space, const HemisphereView& view, cons
   s.first.valid.assign(s.grid.size(), 0);
   s.second.valid.assign(s.grid.size(), 0);
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-  visit_parameterization(space, [&](auto p) {
-    using P = decltype(p);
-    parallel_for(
-        s.grid.ny, 1,
-        [&](std::size_t begin, std::size_t end) {
-          for (std::size_t j = begin; j < end; ++j) {
-            for (std::size_t i = 0; i < s.grid.nx; ++i) {
-              const std::size_t k = s.grid.index(i, j);
-              s.first.values[k] = s.second.values[k] = nan;
-              const auto w = view.direction(s.grid.x(i), s.grid.y(j));
-              if (!w) continue;
-              if (w->z < 0) {
-                s.region[k] = 1;
-                continue;
-              }
-              const Tuple3<double> q = P::forward_iso(DirPair<double>{*w, wo});
-              s.region[k] = 2;
-              s.first.values[k] = q[0];
-              s.second.values[k] = q[1];
-              s.first.valid[k] = s.second.valid[k] = 1;
+  const ParamDescriptor& param = space.param();
+  parallel_for(
+      s.grid.ny, 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j) {
+          for (std::size_t i = 0; i < s.grid.nx; ++i) {
+            const std::size_t k = s.grid.index(i, j);
+            s.first.values[k] = s.second.values[k] = nan;
+            const auto w = view.direction(s.grid.x(i), s.grid.y(j));
+            if (!w) continue;
+            if (w->z < 0) {
+              s.region[k] = 1;
+              continue;
             }
+            const Tuple3<double> q = param.forward_iso(DirPair<double>{*w, wo});
+            s.region[k] = 2;
+            s.first.values[k] = q[0];
+            s.second.values[k] = q[1];
+            s.first.valid[k] = s.second.valid[k] = 1;
           }
-        },
-        threads);
-  });
+        }
+      },
+      threads);
   return s;
 }
 
@@ -251,17 +249,17 @@ void draw_key(Scene& scene, Space space, const Rect& rect, double ppp) {
   ScalarField a(g), b(g);
   a.valid.assign(g.size(), 0);
   b.valid.assign(g.size(), 0);
-  visit_parameterization(space, [&](auto p) {
-    using P = decltype(p);
-    for (std::size_t j = 0; j < g.ny; ++j)
-      for (std::size_t i = 0; i < g.nx; ++i) {
-        const std::size_t k = g.index(i, j);
-        a.values[k] = g.x(i);
-        b.values[k] = g.y(j);
-        const bool ok = valid_iso<P>(Tuple3<double>{g.x(i), g.y(j), 0.5 * kPi});
-        a.valid[k] = b.valid[k] = ok ? 1 : 0;
-      }
-  });
+  const ParamDescriptor& param = space.param();
+  auto inside = [&](double x, double y) {
+    return bool(param.inverse_iso(Tuple3<double>{x, y, 0.5 * kPi}).in_domain);
+  };
+  for (std::size_t j = 0; j < g.ny; ++j)
+    for (std::size_t i = 0; i < g.nx; ++i) {
+      const std::size_t k = g.index(i, j);
+      a.values[k] = g.x(i);
+      b.values[k] = g.y(j);
+      a.valid[k] = b.valid[k] = inside(g.x(i), g.y(j)) ? 1 : 0;
+    }
   scene.add(raster(map, g, [&](std::size_t i, std::size_t j) {
     const std::size_t k = g.index(i, j);
     if (!a.valid[k]) return hatch(i, j, kInvalidLight, kInvalidDark);
@@ -269,14 +267,9 @@ void draw_key(Scene& scene, Space space, const Rect& rect, double ppp) {
   }));
   draw_coordinate_isolines(scene, map, a, coords[0], kFirstStroke);
   draw_coordinate_isolines(scene, map, b, coords[1], kSecondStroke);
-  if (space == Space::ortho || space == Space::hybrid) {
-    // The domain boundary ‖h̄‖² + ‖k‖² = 1 (at 90°), drawn exactly.
+  if (std::find(a.valid.begin(), a.valid.end(), 0) != a.valid.end()) {
+    // The domain boundary (at 90°; ‖h̄‖² + ‖k‖² = 1 for hybrid), drawn exactly.
     std::vector<std::uint8_t> flags(a.valid);
-    auto inside = [&](double x, double y) {
-      return visit_parameterization(space, [&](auto p) {
-        return bool(valid_iso<decltype(p)>(Tuple3<double>{x, y, 0.5 * kPi}));
-      });
-    };
     draw_polylines(scene, map, region_boundary(g, flags, inside), Stroke{kBlack, 0.8});
   }
   AxisSpec ax{coords[0].label + " (red)", {0, 0.5 * coords[0].max, coords[0].max}, {}};
@@ -294,9 +287,8 @@ HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
     throw std::invalid_argument("hemisphere figure: no elevation given");
   for (Space s : o.params)
     if (s == Space::dirs)
-      throw std::invalid_argument(
-          "hemisphere figure: 'dirs' is not a parameterization (use spherical, halfdiff, ortho "
-          "or hybrid)");
+      throw std::invalid_argument("hemisphere figure: 'dirs' is not a parameterization (use " +
+                                  parameterization_names() + ")");
   for (double e : o.elevations_deg)
     if (!(e >= 0 && e <= 90))
       throw std::invalid_argument(

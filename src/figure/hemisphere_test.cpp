@@ -64,7 +64,7 @@ TEST(HemisphereView, ProjectionsRoundTripAndAreEqualArea) {
 
 TEST(HemisphereFigure, MirrorPixelHasZeroThetaH) {
   HemisphereOptions o;
-  o.params = {Space::halfdiff};
+  o.params = {space_of<HalfDiff>};
   o.elevations_deg = {35};  // θd = 35° at the mirror pair: not an isoline level
   o.markers = false;
   o.threads = 2;
@@ -105,7 +105,7 @@ TEST(HemisphereFigure, MirrorPixelHasZeroThetaH) {
 TEST(HemisphereFigure, CentredViews) {
   for (ViewCentre which : {ViewCentre::mirror, ViewCentre::back}) {
     HemisphereOptions o;
-    o.params = {Space::halfdiff, Space::hybrid};
+    o.params = {space_of<HalfDiff>, space_of<Hybrid>};
     o.elevations_deg = {80};
     o.centre = which;
     o.markers = false;
@@ -140,7 +140,7 @@ TEST(HemisphereFigure, CentredViews) {
 
 TEST(HemisphereFigure, NormalViewHasNoBelowHorizonAndColoursAreTheCoordinates) {
   HemisphereOptions o;
-  o.params = {Space::ortho};
+  o.params = {space_of<Ortho>};
   o.elevations_deg = {0, 60};
   o.pixels_per_point = 1;
   const auto fig = hemisphere_figure(o);
@@ -163,7 +163,7 @@ TEST(HemisphereFigure, BadInput) {
   EXPECT_THROW(hemisphere_figure(o), std::invalid_argument);
   o.params = {Space::dirs};
   EXPECT_THROW(hemisphere_figure(o), std::invalid_argument);
-  o.params = {Space::hybrid};
+  o.params = {space_of<Hybrid>};
   o.elevations_deg = {};
   EXPECT_THROW(hemisphere_figure(o), std::invalid_argument);
   o.elevations_deg = {95};

@@ -81,23 +81,20 @@ SliceSample sample_slice(Space space, double azimuth, const Grid& grid, int thre
   s.grid = grid;
   s.valid.assign(grid.size(), 0);
   s.pairs.resize(grid.size());
-  visit_parameterization(space, [&](auto p) {
-    using P = decltype(p);
-    parallel_for(
-        grid.ny, 1,
-        [&](std::size_t begin, std::size_t end) {
-          for (std::size_t j = begin; j < end; ++j) {
-            for (std::size_t i = 0; i < grid.nx; ++i) {
-              const Tuple3<double> q{grid.x(i), grid.y(j), azimuth};
-              const Solved<double> r = inverse_iso<P>(q);
-              const std::size_t k = grid.index(i, j);
-              s.valid[k] = valid_iso<P>(q) ? 1 : 0;
-              s.pairs[k] = r.pair;
-            }
+  const ParamDescriptor& param = space.param();
+  parallel_for(
+      grid.ny, 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j) {
+          for (std::size_t i = 0; i < grid.nx; ++i) {
+            const Solved<double> r = param.inverse_iso({grid.x(i), grid.y(j), azimuth});
+            const std::size_t k = grid.index(i, j);
+            s.valid[k] = r.in_domain ? 1 : 0;
+            s.pairs[k] = r.pair;
           }
-        },
-        threads);
-  });
+        }
+      },
+      threads);
   return s;
 }
 
@@ -140,9 +137,8 @@ void check_slice_options(const SliceOptions& o) {
     throw std::invalid_argument("slice figure: no test function and no BRDF given");
   for (Space s : o.params)
     if (s == Space::dirs)
-      throw std::invalid_argument(
-          "slice figure: 'dirs' is not a parameterization (use spherical, halfdiff, ortho or "
-          "hybrid)");
+      throw std::invalid_argument("slice figure: 'dirs' is not a parameterization (use " +
+                                  parameterization_names() + ")");
   for (double a : o.azimuths_deg)
     if (!std::isfinite(a))
       throw std::invalid_argument("slice figure: the azimuths must be finite numbers");
@@ -330,9 +326,7 @@ void draw_panel_isolines(Scene& sc, const SliceOptions& o, const SliceFigure& fi
 void draw_domain_boundary(Scene& sc, const SliceFigure::Panel& p) {
   const double az = std::fmod(std::fmod(p.azimuth_deg, 360.0) + 360.0, 360.0) * kDeg;
   auto inside = [&](double x, double y) {
-    return visit_parameterization(p.param, [&](auto q) {
-      return bool(valid_iso<decltype(q)>(Tuple3<double>{x, y, az < 2 * kPi ? az : 0.0}));
-    });
+    return bool(p.param.param().inverse_iso({x, y, az < 2 * kPi ? az : 0.0}).in_domain);
   };
   draw_polylines(sc, p.map, region_boundary(p.sample.grid, p.sample.valid, inside),
                  Stroke{kBlack, 0.8});

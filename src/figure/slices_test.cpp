@@ -26,7 +26,7 @@ bool is_invalid_style(const std::array<std::uint8_t, 4>& c) {
 
 TEST(Slices, OutsideTheDomainIsDrawnInvalid) {
   SliceOptions o;
-  o.params = {Space::ortho, Space::hybrid, Space::halfdiff};
+  o.params = {space_of<Ortho>, space_of<Hybrid>, space_of<HalfDiff>};
   o.azimuths_deg = {0};
   o.threads = 2;
   const auto fig = slice_figure(o);
@@ -59,7 +59,7 @@ TEST(Slices, SpecularIsolineIsAVerticalLineInOrthoAndHybrid) {
   // S = 1 − ‖h̄‖, and x = ‖h̄‖: the isoline S = 1 − c is the line x = c, on every slice.
   for (double c : {0.2, 0.35, 0.5, 0.77}) {
     SliceOptions o;
-    o.params = {Space::ortho, Space::hybrid};
+    o.params = {space_of<Ortho>, space_of<Hybrid>};
     o.azimuths_deg = {0, 45, 90, 150};
     o.test_functions = {TestFunction::specular};
     o.levels = {1 - c};
@@ -93,7 +93,7 @@ TEST(Slices, SpecularIsolineIsAVerticalLineInOrthoAndHybrid) {
 
 TEST(Slices, OrthoAndHybridCoincideAt90Degrees) {
   SliceOptions o;
-  o.params = {Space::ortho, Space::hybrid};
+  o.params = {space_of<Ortho>, space_of<Hybrid>};
   o.azimuths_deg = {90};
   const auto fig = slice_figure(o);
   const auto& a = fig.panels[0].sample;
@@ -137,7 +137,7 @@ TEST(Slices, OrthoAndHybridCoincideAt90Degrees) {
 TEST(Slices, GrazingIsCircularInHybridOnlyAt90Degrees) {
   // G = 1 − zi zo = ‖h̄‖² + ‖k‖² where kz = 0 (docs/math.md §8): circles at 90° only.
   SliceOptions o;
-  o.params = {Space::hybrid};
+  o.params = {space_of<Hybrid>};
   o.azimuths_deg = {90, 0};
   o.pixels_per_point = 1;
   const auto fig = slice_figure(o);
@@ -157,7 +157,7 @@ TEST(Slices, GrazingIsCircularInHybridOnlyAt90Degrees) {
 
 TEST(Slices, GenericBrdfMode) {
   SliceOptions o;
-  o.params = {Space::halfdiff, Space::hybrid};
+  o.params = {space_of<HalfDiff>, space_of<Hybrid>};
   o.azimuths_deg = {0, 90};
   o.brdf = std::make_shared<TestFunctionBrdf>(TestFunction::grazing);
   o.pixels_per_point = 1;
@@ -215,7 +215,7 @@ TEST(Slices, BadInput) {
   EXPECT_THROW(slice_figure(o), std::invalid_argument);
   o.params = {};
   EXPECT_THROW(slice_figure(o), std::invalid_argument);
-  o.params = {Space::hybrid};
+  o.params = {space_of<Hybrid>};
   o.test_functions = {};
   EXPECT_THROW(slice_figure(o), std::invalid_argument);
   o.test_functions = {TestFunction::fresnel};

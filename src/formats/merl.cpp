@@ -253,7 +253,7 @@ void convert_block(std::span<const DirPair<double>> pairs, Coordinates& c) {
                                      {rows + 3, 6}, {rows + 4, 6}, {rows + 5, 6}};
   alignas(64) std::uint8_t valid[kBlock];
   const Column<double> cols[3] = {{c.q[0], 1}, {c.q[1], 1}, {c.q[2], 1}};
-  convert<double>(Form{Space::dirs}, Form{Space::halfdiff, true}, in, m,
+  convert<double>(Form{Space::dirs}, Form{space_of<HalfDiff>, true}, in, m,
                   ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
   merl_kernel::rows_apart(rows, valid, m, c.apart);
 }

@@ -176,7 +176,7 @@ class Validator {
 };
 
 // A grid over an incidence parameter (θi or φi): where a value falls, and its weights.
-struct Axis {
+struct IncidenceAxis {
   std::vector<double> values;
   std::size_t stride = 0;  // in slices; 0 when the axis has a single value
 
@@ -877,7 +877,7 @@ Flips flips_for(int reduction, const Vec3<double>& given) {
 struct RglBrdf::Impl {
   std::string description;
   std::vector<float> theta_i_raw, phi_i_raw;
-  Axis phi, theta;  // incidence grids; slices are ordered [φi][θi]
+  IncidenceAxis phi, theta;  // incidence grids; slices are ordered [φi][θi]
   bool isotropic = true;
   bool jacobian = true;
   int reduction = 1;  // anisotropic data covering 2π / reduction of φi, by symmetry
@@ -1013,7 +1013,7 @@ RglBrdf::RglBrdf(const TensorFile& tf, std::string label, RglOptions options)
   }
 
   auto incidence = [&](std::string_view name, double lo, double hi, std::vector<float>& raw,
-                       Axis& axis) {
+                       IncidenceAxis& axis) {
     const TensorField& f = v.field(name, TensorDtype::float32, 1);
     v.require_at_least(f, 0, 1);
     axis.values = v.floats(f);
@@ -1301,7 +1301,7 @@ void angles_of(double (&dirs)[6][kBlock], std::size_t n, double (&angle)[4][kBlo
   const ConstColumn<double> in[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
                                      {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
   const Column<double> cols[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
-  convert<double>(Form{Space::dirs}, Form{Space::spherical}, in, n,
+  convert<double>(Form{Space::dirs}, Form{space_of<Spherical>}, in, n,
                   ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
 }
 
@@ -1681,7 +1681,7 @@ void RglBrdf::sample_block(std::span<const Vec3<double>> wo, std::span<const dou
     const ConstColumn<double> in[4] = {{angle[0], 1}, {angle[1], 1}, {angle[2], 1}, {angle[3], 1}};
     const Column<double> cols[6] = {{dirs[0], 1}, {dirs[1], 1}, {dirs[2], 1},
                                     {dirs[3], 1}, {dirs[4], 1}, {dirs[5], 1}};
-    convert<double>(Form{Space::spherical}, Form{Space::dirs}, in, rows,
+    convert<double>(Form{space_of<Spherical>}, Form{Space::dirs}, in, rows,
                     ConvertOutput<double>{cols, {}, valid}, BatchOptions{1});
   }
   for (std::size_t k = 0; k < n; ++k) {

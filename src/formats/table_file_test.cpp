@@ -32,7 +32,7 @@ std::string slurp(const std::filesystem::path& p) {
 
 TEST(TableFile, NpyHeaderAndData) {
   test::TempDir dir;
-  const GridSpec g = default_grid(Space::hybrid, GridKind::slice, {3, 5}, 0.5);
+  const GridSpec g = default_grid(space_of<Hybrid>, GridKind::slice, {3, 5}, 0.5);
   const ResampledTable t = resample(Smooth(), g);
   write_table(dir.path() / "t.npy", t);
   const std::string b = slurp(dir.path() / "t.npy");
@@ -58,7 +58,7 @@ TEST(TableFile, NpyHeaderAndData) {
 
 TEST(TableFile, ExrChannelsAndAttributes) {
   test::TempDir dir;
-  GridSpec g = default_grid(Space::halfdiff, GridKind::isotropic, {4, 6, 8});
+  GridSpec g = default_grid(space_of<HalfDiff>, GridKind::isotropic, {4, 6, 8});
   g.axes[0].hi = 1.0;  // a custom range shows in the attributes
   const ResampledTable t = resample(Smooth(), g);
   const auto path = dir.path() / "t.exr";
@@ -107,7 +107,7 @@ TEST(TableFile, ExrChannelsAndAttributes) {
 
 TEST(TableFile, BadNamesAndDestinations) {
   test::TempDir dir;
-  const ResampledTable t = resample(Smooth(), default_grid(Space::hybrid, GridKind::slice, {2}));
+  const ResampledTable t = resample(Smooth(), default_grid(space_of<Hybrid>, GridKind::slice, {2}));
   EXPECT_THROW(write_table(dir.path() / "t.csv", t), std::invalid_argument);
   EXPECT_ANY_THROW(write_table(dir.path() / "missing" / "t.npz", t));
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "missing"));

@@ -79,7 +79,7 @@ TEST(BrdfBatch, PropagatesExceptions) {
 TEST(EvalAt, EveryFormAgreesWithDirections) {
   const Smooth b;
   const auto pairs = random_pairs(500, 3);
-  for (Space space : kParameterizations) {
+  for (Space space : kBuiltinSpaces) {
     for (bool iso : {false, true}) {
       const Form form{space, iso};
       for (const auto& p : pairs) {
@@ -111,15 +111,15 @@ TEST(EvalAt, EveryFormAgreesWithDirections) {
 TEST(EvalAt, InvalidCoordinatesGiveNaN) {
   const Smooth b;
   const double out_of_domain[4] = {0.9, 0.0, 0.9, 0.0};  // ortho: ‖h̄‖ + ‖k̄‖ > 1
-  EXPECT_TRUE(std::isnan(eval_at(b, Form{Space::ortho, false}, out_of_domain).r));
+  EXPECT_TRUE(std::isnan(eval_at(b, Form{space_of<Ortho>, false}, out_of_domain).r));
   const double bad_angle[4] = {2.0, 0.0, 0.1, 0.0};  // halfdiff: θh > π/2
-  EXPECT_TRUE(std::isnan(eval_at(b, Form{Space::halfdiff, false}, bad_angle).g));
+  EXPECT_TRUE(std::isnan(eval_at(b, Form{space_of<HalfDiff>, false}, bad_angle).g));
   const double not_unit[6] = {0, 0, 2, 0, 0, 1};
   EXPECT_TRUE(std::isnan(eval_at(b, Form{Space::dirs, false}, not_unit).b));
   const double below[6] = {0, 0, 1, 0.6, 0, -0.8};
   EXPECT_TRUE(std::isnan(eval_at(b, Form{Space::dirs, false}, below).r));
   const double three[3] = {0.1, 0.2, 0.3};
-  EXPECT_THROW(eval_at(b, Form{Space::halfdiff, false}, three), std::invalid_argument);
+  EXPECT_THROW(eval_at(b, Form{space_of<HalfDiff>, false}, three), std::invalid_argument);
   EXPECT_THROW(eval_at(b, Form{Space::dirs, false}, three), std::invalid_argument);
 }
 

@@ -416,7 +416,7 @@ many batches without allocating.)doc");
       "valid",
       [](const py::object& x, const std::string& param, bool isotropic) {
         const Form form = parse_form(param, isotropic, "param");
-        const Form other = form.space == Space::dirs ? Form{Space::hybrid} : Form{Space::dirs};
+        const Form other = form.space == Space::dirs ? Form{space_of<Hybrid>} : Form{Space::dirs};
         return dispatch(x, form, other, {.valid = true}).valid;
       },
       py::arg("x"), py::arg("param"), py::arg("isotropic") = false,

@@ -24,12 +24,13 @@ double azimuth(double y, double x) {
   return p < 0 ? p + 2 * kPi : p;
 }
 
-// The cell coordinates (s, t) ∈ [0, 1]² of ωi for a fixed ωo, and back (see TableParam).
+// The cell coordinates (s, t) ∈ [0, 1]² of ωi for a fixed ωo, and back: the polar chart of the
+// parameterization (params/charts.hpp), r = r_max s² when warped, φ = 2π t.
 struct ParamMap {
-  TableParam param;
+  const SamplerChart& chart;
   bool warp;
 
-  double r_max() const { return param == TableParam::hybrid ? 1.0 : kPi / 2; }
+  double r_max() const { return chart.r_max; }
   double radius(double s) const { return r_max() * (warp ? s * s : s); }
   double radius_derivative(double s) const { return r_max() * (warp ? 2 * s : 1.0); }
   double s_of(double r) const {
@@ -41,65 +42,14 @@ struct ParamMap {
   bool forward(const Vec3<double>& wo, double s, double t, Vec3<double>& wi, double& jac) const {
     const double r = radius(s), dr = radius_derivative(s);
     const double phi = 2 * kPi * t;
-    const double cp = std::cos(phi), sp = std::sin(phi);
-    switch (param) {
-      case TableParam::spherical: {
-        const double po = (wo.x == 0 && wo.y == 0) ? 0 : std::atan2(wo.y, wo.x);
-        const double st = std::sin(r);
-        wi = {st * std::cos(phi + po), st * std::sin(phi + po), std::cos(r)};
-        jac = st * dr * 2 * kPi;
-        break;
-      }
-      case TableParam::halfdiff: {
-        const double st = std::sin(r);
-        const Vec3<double> h{st * cp, st * sp, std::cos(r)};
-        const double c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
-        if (!(c > 0)) return false;
-        wi = {2 * c * h.x - wo.x, 2 * c * h.y - wo.y, 2 * c * h.z - wo.z};
-        jac = 4 * c * st * dr * 2 * kPi;
-        break;
-      }
-      case TableParam::hybrid: {
-        const double x = 2 * r * cp - wo.x, y = 2 * r * sp - wo.y;
-        const double z2 = 1 - x * x - y * y;
-        if (!(z2 > 0)) return false;
-        wi = {x, y, std::sqrt(z2)};
-        jac = 4 * r * dr * 2 * kPi / wi.z;
-        break;
-      }
-    }
+    if (!chart.to_direction(wo, r, dr, phi, wi, jac)) return false;
     return wi.z > 0 && jac > 0 && std::isfinite(jac);
   }
 
   bool inverse(const Vec3<double>& wo, const Vec3<double>& wi, double& s, double& t,
                double& jac) const {
     double r = 0, phi = 0;
-    switch (param) {
-      case TableParam::spherical: {
-        r = std::atan2(std::sqrt(wi.x * wi.x + wi.y * wi.y), wi.z);
-        const double po = (wo.x == 0 && wo.y == 0) ? 0 : std::atan2(wo.y, wo.x);
-        phi = azimuth(wi.y, wi.x) - po;
-        jac = std::sin(r);
-        break;
-      }
-      case TableParam::halfdiff: {
-        Vec3<double> h{wi.x + wo.x, wi.y + wo.y, wi.z + wo.z};
-        const double l = std::sqrt(h.x * h.x + h.y * h.y + h.z * h.z);
-        if (!(l > 0)) return false;
-        h = {h.x / l, h.y / l, h.z / l};
-        r = std::atan2(std::sqrt(h.x * h.x + h.y * h.y), h.z);
-        phi = azimuth(h.y, h.x);
-        jac = 4 * (wo.x * h.x + wo.y * h.y + wo.z * h.z) * std::sin(r);
-        break;
-      }
-      case TableParam::hybrid: {
-        const double hx = 0.5 * (wi.x + wo.x), hy = 0.5 * (wi.y + wo.y);
-        r = std::sqrt(hx * hx + hy * hy);
-        phi = azimuth(hy, hx);
-        jac = 4 * r / wi.z;
-        break;
-      }
-    }
+    if (!chart.from_direction(wo, wi, r, phi, jac)) return false;
     phi = std::fmod(phi, 2 * kPi);
     if (phi < 0) phi += 2 * kPi;
     s = s_of(r);
@@ -127,25 +77,6 @@ std::string format_seconds(double seconds) {
   return text;
 }
 
-const char* name_of(TableParam p) {
-  switch (p) {
-    case TableParam::spherical:
-      return "spherical";
-    case TableParam::halfdiff:
-      return "halfdiff";
-    case TableParam::hybrid:
-      return "hybrid";
-  }
-  return "?";
-}
-
-TableParam table_param_from_name(const std::string& name) {
-  for (TableParam p : {TableParam::spherical, TableParam::halfdiff, TableParam::hybrid})
-    if (name == name_of(p)) return p;
-  throw std::invalid_argument("unknown sampling parameterization '" + name +
-                              "' (expected spherical, halfdiff or hybrid)");
-}
-
 std::shared_ptr<const Brdf> with_importance_sampling(const Brdf& brdf,
                                                      const TabulationOptions& options,
                                                      bool force_tabulated) {
@@ -170,7 +101,7 @@ TabulatedSampler::TabulatedSampler(const Brdf& brdf, const TabulationOptions& o)
   n_phi_ = isotropic_ ? 1 : o.aniso_phi_slices;
   n_radial_ = isotropic_ ? o.radial : std::max(2, o.radial / 2);
   n_azimuthal_ = isotropic_ ? o.azimuthal : std::max(2, o.azimuthal / 2);
-  const ParamMap map{o.param, o.warp};
+  const ParamMap map{o.param.param().sampler_chart(), o.warp};
   const int n_slices = n_theta_ * n_phi_, ss = o.supersample;
   slices_.resize(std::size_t(n_slices));
 
@@ -237,10 +168,11 @@ std::size_t TabulatedSampler::cells() const {
 }
 
 std::string TabulatedSampler::describe_sampling() const {
-  return std::string("tabulated (") + name_of(options_.param) + (options_.warp ? ", warped" : "") +
-         ", " + std::to_string(n_theta_) + (isotropic_ ? "" : " x " + std::to_string(n_phi_)) +
-         " slices of " + std::to_string(n_radial_) + " x " + std::to_string(n_azimuthal_) +
-         " cells) of " + brdf_.name();
+  return std::string("tabulated (") + std::string(name_of(options_.param)) +
+         (options_.warp ? ", warped" : "") + ", " + std::to_string(n_theta_) +
+         (isotropic_ ? "" : " x " + std::to_string(n_phi_)) + " slices of " +
+         std::to_string(n_radial_) + " x " + std::to_string(n_azimuthal_) + " cells) of " +
+         brdf_.name();
 }
 
 TabulatedSampler::Blend TabulatedSampler::blend(const Vec3<double>& wo) const {
@@ -319,7 +251,8 @@ BrdfSample TabulatedSampler::sample(const Vec3<double>& wo_in, double u1, double
   const double tt = (double(cell.col) + cell.remapped_col) / n_azimuthal_;
   Vec3<double> wi{0, 0, 0};
   double jac = 0;
-  if (!ParamMap{options_.param, options_.warp}.forward(wo, ss, tt, wi, jac)) return {};
+  if (!ParamMap{options_.param.param().sampler_chart(), options_.warp}.forward(wo, ss, tt, wi, jac))
+    return {};
   wi = rotate_z(wi, c, s);
   return {wi, pdf(wo_in, wi)};
 }
@@ -327,7 +260,8 @@ BrdfSample TabulatedSampler::sample(const Vec3<double>& wo_in, double u1, double
 double TabulatedSampler::table_pdf(const Vec3<double>& wo, const Vec3<double>& wi,
                                    const Blend& b) const {
   double s = 0, t = 0, jac = 0;
-  if (!ParamMap{options_.param, options_.warp}.inverse(wo, wi, s, t, jac)) return 0;
+  if (!ParamMap{options_.param.param().sampler_chart(), options_.warp}.inverse(wo, wi, s, t, jac))
+    return 0;
   const std::size_t row = std::min(std::size_t(s * n_radial_), std::size_t(n_radial_ - 1));
   const std::size_t col = std::min(std::size_t(t * n_azimuthal_), std::size_t(n_azimuthal_ - 1));
   double p = 0;

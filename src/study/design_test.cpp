@@ -34,7 +34,7 @@ std::vector<DesignProfile> family_profiles() {
   std::vector<DesignProfile> profiles;
   for (double sigma : {0.08, 0.1, 0.12, 0.15})
     profiles.push_back(
-        design_profile(lobe(sigma), kParameterizations, {32, 32, 32}, ErrorSpace::linear));
+        design_profile(lobe(sigma), kBuiltinSpaces, {32, 32, 32}, ErrorSpace::linear));
   return profiles;
 }
 
@@ -56,7 +56,7 @@ void expect_bijection(const AxisWarp& w, const std::string& what) {
 TEST(Design, EveryWarpIsAMonotoneBijectionOfItsAxis) {
   const std::vector<DesignProfile> profiles = family_profiles();
   const std::vector<LearnedWarps> learned = learn_warps(profiles, 0);
-  ASSERT_EQ(learned.size(), kParameterizations.size());
+  ASSERT_EQ(learned.size(), kBuiltinSpaces.size());
   for (const LearnedWarps& l : learned)
     for (bool iso : {true, false}) {
       const GridSpec g = default_grid(l.space, iso ? GridKind::isotropic : GridKind::full, {4});
@@ -80,7 +80,7 @@ TEST(Design, AnalyticWarpsMatchTheirDefinitions) {
   EXPECT_NEAR(AxisWarp(K::merl_angle, 0, kPi / 2).forward(kPi / 8), kPi / 4, 1e-15);
   EXPECT_NEAR(AxisWarp(K::merl_arcsine, 0, 1).forward(std::sin(kPi / 8)), 0.5, 1e-15);
   // Which axes each design warps: hybrid (‖h̄‖, ‖k‖, φk) and halfdiff (θh, θd, φd).
-  const GridSpec hybrid = default_grid(Space::hybrid, GridKind::isotropic, {4});
+  const GridSpec hybrid = default_grid(space_of<Hybrid>, GridKind::isotropic, {4});
   const std::vector<AxisWarp> angle = design_warps(hybrid, Spacing::angle, nullptr);
   EXPECT_EQ(angle[0].kind(), K::arcsine);
   EXPECT_EQ(angle[1].kind(), K::arcsine);
@@ -88,15 +88,15 @@ TEST(Design, AnalyticWarpsMatchTheirDefinitions) {
   const std::vector<AxisWarp> merl = design_warps(hybrid, Spacing::merl, nullptr);
   EXPECT_EQ(merl[0].kind(), K::merl_arcsine);
   EXPECT_EQ(merl[1].kind(), K::arcsine);
-  const GridSpec halfdiff = default_grid(Space::halfdiff, GridKind::full, {4});
+  const GridSpec halfdiff = default_grid(space_of<HalfDiff>, GridKind::full, {4});
   const std::vector<AxisWarp> hd = design_warps(halfdiff, Spacing::merl, nullptr);
   EXPECT_EQ(hd[0].kind(), K::merl_angle);  // θh
   for (std::size_t a = 1; a < 4; ++a) EXPECT_EQ(hd[a].kind(), K::identity);
-  EXPECT_TRUE(same_as_own(Space::halfdiff, true, Spacing::angle));
-  EXPECT_TRUE(same_as_own(Space::spherical, false, Spacing::merl));
-  EXPECT_FALSE(same_as_own(Space::halfdiff, true, Spacing::merl));
-  EXPECT_FALSE(same_as_own(Space::ortho, true, Spacing::angle));
-  EXPECT_FALSE(same_as_own(Space::spherical, true, Spacing::learned));
+  EXPECT_TRUE(same_as_own(space_of<HalfDiff>, true, Spacing::angle));
+  EXPECT_TRUE(same_as_own(space_of<Spherical>, false, Spacing::merl));
+  EXPECT_FALSE(same_as_own(space_of<HalfDiff>, true, Spacing::merl));
+  EXPECT_FALSE(same_as_own(space_of<Ortho>, true, Spacing::angle));
+  EXPECT_FALSE(same_as_own(space_of<Spherical>, true, Spacing::learned));
 }
 
 TEST(Design, BadWarpsAndMissingLearnedWarpsAreRefused) {
@@ -104,10 +104,10 @@ TEST(Design, BadWarpsAndMissingLearnedWarpsAreRefused) {
   EXPECT_THROW(AxisWarp::from_cdf(0, 1, {0, 0.5, 0.9}), std::invalid_argument);
   EXPECT_THROW(AxisWarp(AxisWarp::Kind::arcsine, 0, kPi / 2), std::invalid_argument);
   EXPECT_THROW(AxisWarp(AxisWarp::Kind::identity, 1, 1), std::invalid_argument);
-  const GridSpec g = default_grid(Space::hybrid, GridKind::isotropic, {4});
+  const GridSpec g = default_grid(space_of<Hybrid>, GridKind::isotropic, {4});
   EXPECT_THROW(design_warps(g, Spacing::learned, nullptr), std::invalid_argument);
   LearnedWarps other;
-  other.space = Space::ortho;
+  other.space = space_of<Ortho>;
   EXPECT_THROW(design_warps(g, Spacing::learned, &other), std::invalid_argument);
   EXPECT_EQ(parse_spacing("merl"), Spacing::merl);
   EXPECT_EQ(parse_spacing("uniform"), std::nullopt);
@@ -118,7 +118,7 @@ TEST(Design, LearnedWarpsPutTheSamplesWhereTheFamilyVariesAndBeatUniform) {
   const std::vector<DesignProfile> profiles = family_profiles();
   const std::vector<LearnedWarps> learned = learn_warps(profiles, 0);
   const auto halfdiff = std::find_if(learned.begin(), learned.end(), [](const LearnedWarps& w) {
-    return w.space == Space::halfdiff;
+    return w.space == space_of<HalfDiff>;
   });
   ASSERT_NE(halfdiff, learned.end());
   // The lobes live at θh < 0.3 rad, 19 % of θh's range: the learned θh axis gives them at least
@@ -129,7 +129,7 @@ TEST(Design, LearnedWarpsPutTheSamplesWhereTheFamilyVariesAndBeatUniform) {
   const test::FunctionBrdf held_out = lobe(0.08);
   const TestPairs test = draw_test_pairs(held_out, 40000, 5, ErrorSpace::linear, 85);
   GonioSetup setup;
-  setup.space = Space::halfdiff;
+  setup.space = space_of<HalfDiff>;
   setup.budget = 4000;
   setup.max_theta_deg = 85;
   const double uniform = reconstruction_error(GonioReconstruction(held_out, setup), test);
@@ -147,7 +147,7 @@ TEST(Design, LeaveOneOutNeverReadsTheHeldOutBrdf) {
   const std::vector<LearnedWarps> before = learn_warps(profiles, 1);
   const std::vector<LearnedWarps> others_before = learn_warps(profiles, 0);
   // Replace the held-out BRDF by a very different one (a lobe 5x wider).
-  profiles[1] = design_profile(lobe(0.6), kParameterizations, {32, 32, 32}, ErrorSpace::linear);
+  profiles[1] = design_profile(lobe(0.6), kBuiltinSpaces, {32, 32, 32}, ErrorSpace::linear);
   EXPECT_EQ(learn_warps(profiles, 1), before);
   // It does count when it is not held out (the check above could not pass by accident).
   EXPECT_NE(learn_warps(profiles, 0), others_before);

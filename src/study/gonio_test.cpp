@@ -37,7 +37,7 @@ double smooth_spherical(const DirPair<double>& p) {
 }
 
 TEST(Gonio, BudgetsAreMetWithinTheStepOfTheGrid) {
-  for (Space s : kParameterizations)
+  for (Space s : kBuiltinSpaces)
     for (bool iso : {true, false})
       for (std::size_t budget : {std::size_t(1000), std::size_t(20000)}) {
         const GonioSetup setup{s, iso, Design::regular, budget, 1};
@@ -65,7 +65,7 @@ TEST(Gonio, AffineFunctionsAreReconstructedExactly) {
   std::uniform_real_distribution<double> theta(0.25, 1.3), phi(0, 2 * kPi);
   for (bool iso : {true, false})
     for (Design d : {Design::regular, Design::stratified}) {
-      const GonioReconstruction r(affine, {Space::spherical, iso, d, 4000, 3});
+      const GonioReconstruction r(affine, {space_of<Spherical>, iso, d, 4000, 3});
       int exact = 0;
       for (int i = 0; i < 200; ++i) {
         const DirPair<double> p{dir(theta(rng), phi(rng)), dir(theta(rng), phi(rng))};
@@ -87,7 +87,7 @@ TEST(Gonio, AffineFunctionsStayExactAtTheDomainsEdgeAndTheReach) {
     return 1 - std::hypot(p.wi.x + p.wo.x, p.wi.y + p.wo.y) / 2;
   });
   const TestPairs test = draw_test_pairs(s, 20000, 9, ErrorSpace::linear, 85);
-  for (Space space : {Space::ortho, Space::hybrid}) {
+  for (Space space : {space_of<Ortho>, space_of<Hybrid>}) {
     GonioSetup setup{space, true, Design::regular, 2000, 1};
     setup.max_theta_deg = 85;
     const GonioReconstruction r(s, setup);
@@ -107,10 +107,10 @@ double order(const Brdf& f, Space s, Design d, std::size_t n0, std::size_t n1,
 TEST(Gonio, InterpolationErrorFallsAtSecondOrderForSmoothFunctions) {
   const Fn f(smooth_spherical);
   const TestPairs test = draw_test_pairs(f, 40000, 11, ErrorSpace::linear);
-  const double regular = order(f, Space::spherical, Design::regular, 1000, 64000, test);
+  const double regular = order(f, space_of<Spherical>, Design::regular, 1000, 64000, test);
   EXPECT_GT(regular, 1.7);
   EXPECT_LT(regular, 2.4);
-  const double stratified = order(f, Space::spherical, Design::stratified, 1000, 64000, test);
+  const double stratified = order(f, space_of<Spherical>, Design::stratified, 1000, 64000, test);
   EXPECT_GT(stratified, 1.5);
   EXPECT_LT(stratified, 2.6);
   // In hybrid, where the domain's edge cuts cells (filled by dilation), the error still falls.
@@ -119,7 +119,7 @@ TEST(Gonio, InterpolationErrorFallsAtSecondOrderForSmoothFunctions) {
     return std::exp(-(hx * hx + hy * hy) / 0.1);
   });
   const TestPairs lobe_test = draw_test_pairs(lobe, 40000, 12, ErrorSpace::linear);
-  EXPECT_GT(order(lobe, Space::hybrid, Design::regular, 1000, 27000, lobe_test), 1.2);
+  EXPECT_GT(order(lobe, space_of<Hybrid>, Design::regular, 1000, 27000, lobe_test), 1.2);
 }
 
 TEST(Gonio, TestPairsFollowTheProjectedSolidAngleMeasure) {
@@ -164,19 +164,19 @@ TEST(Gonio, ReconstructionErrorOfTheTruthIsZeroAndGrowsWithADifference) {
 TEST(Gonio, StratifiedDesignsAreReproducibleAndDependOnTheSeed) {
   const Fn f(smooth_spherical);
   const TestPairs t = draw_test_pairs(f, 5000, 4, ErrorSpace::linear);
-  const GonioReconstruction a(f, {Space::hybrid, true, Design::stratified, 3000, 1});
-  const GonioReconstruction b(f, {Space::hybrid, true, Design::stratified, 3000, 1});
-  const GonioReconstruction c(f, {Space::hybrid, true, Design::stratified, 3000, 2});
+  const GonioReconstruction a(f, {space_of<Hybrid>, true, Design::stratified, 3000, 1});
+  const GonioReconstruction b(f, {space_of<Hybrid>, true, Design::stratified, 3000, 1});
+  const GonioReconstruction c(f, {space_of<Hybrid>, true, Design::stratified, 3000, 2});
   EXPECT_EQ(reconstruction_error(a, t), reconstruction_error(b, t));
   EXPECT_NE(reconstruction_error(a, t), reconstruction_error(c, t));
   // Redrawn points make the stratified design measure about as many cells as the regular one.
-  const GonioReconstruction r(f, {Space::hybrid, true, Design::regular, 3000, 1});
+  const GonioReconstruction r(f, {space_of<Hybrid>, true, Design::regular, 3000, 1});
   EXPECT_GT(double(a.samples()), 0.95 * double(r.samples()));
 }
 
 TEST(Gonio, PairsOutsideTheHemisphereAndBadInput) {
   const Fn f(smooth_spherical);
-  const GonioReconstruction r(f, {Space::ortho, true, Design::regular, 1000, 1});
+  const GonioReconstruction r(f, {space_of<Ortho>, true, Design::regular, 1000, 1});
   const Rgb below = r.eval({dir(0.3, 0), {0.6, 0, -0.8}});
   EXPECT_EQ(below.r, 0.0);
   const Rgb nan = r.eval({{std::nan(""), 0, 1}, dir(0.3, 1)});
@@ -184,10 +184,10 @@ TEST(Gonio, PairsOutsideTheHemisphereAndBadInput) {
   EXPECT_NE(r.name().find("gonio:ortho/own/regular/"), std::string::npos);
   EXPECT_THROW(GonioReconstruction(f, {Space::dirs, true, Design::regular, 1000, 1}),
                std::invalid_argument);
-  EXPECT_THROW(GonioReconstruction(f, {Space::hybrid, true, Design::regular, 0, 1}),
+  EXPECT_THROW(GonioReconstruction(f, {space_of<Hybrid>, true, Design::regular, 0, 1}),
                std::invalid_argument);
   const Fn none([](const DirPair<double>&) { return std::numeric_limits<double>::quiet_NaN(); });
-  EXPECT_THROW(GonioReconstruction(none, {Space::hybrid, true, Design::regular, 500, 1}),
+  EXPECT_THROW(GonioReconstruction(none, {space_of<Hybrid>, true, Design::regular, 500, 1}),
                std::runtime_error);
 }
 

@@ -32,15 +32,16 @@ const IsoGrid kGrid{24, 24, 32};
 TEST(Azimuthal, ZeroWhereTheBrdfDependsOnTheTwoMagnitudesOnly) {
   // A function of (‖h̄‖, ‖k‖): no azimuthal dependence in hybrid, some in the others.
   const Fn f([](const DirPair<double>& p) { return 1 + 3 * hbar_of(p) * hbar_of(p) + k_of(p); });
-  EXPECT_LT(azimuthal_error(sample_isotropic(f, Space::hybrid, kGrid, ErrorSpace::linear)), 1e-12);
-  EXPECT_GT(azimuthal_error(sample_isotropic(f, Space::ortho, kGrid, ErrorSpace::linear)), 1e-3);
+  EXPECT_LT(azimuthal_error(sample_isotropic(f, space_of<Hybrid>, kGrid, ErrorSpace::linear)),
+            1e-12);
+  EXPECT_GT(azimuthal_error(sample_isotropic(f, space_of<Ortho>, kGrid, ErrorSpace::linear)), 1e-3);
   // A function of θh alone: none in halfdiff, and none in hybrid either (θh is a function of
   // ‖h̄‖ and ‖k‖: h_z = √(1 − ‖k‖² − ‖h̄‖²)); some in ortho, whose ‖k̄‖ leaves h_z to φ.
   const Fn g([](const DirPair<double>& p) { return std::exp(-8 * theta_h_of(p)); });
   for (ErrorSpace es : {ErrorSpace::linear, ErrorSpace::log, ErrorSpace::cbrt}) {
-    EXPECT_LT(azimuthal_error(sample_isotropic(g, Space::halfdiff, kGrid, es)), 1e-12);
-    EXPECT_LT(azimuthal_error(sample_isotropic(g, Space::hybrid, kGrid, es)), 1e-12);
-    EXPECT_GT(azimuthal_error(sample_isotropic(g, Space::ortho, kGrid, es)), 1e-3);
+    EXPECT_LT(azimuthal_error(sample_isotropic(g, space_of<HalfDiff>, kGrid, es)), 1e-12);
+    EXPECT_LT(azimuthal_error(sample_isotropic(g, space_of<Hybrid>, kGrid, es)), 1e-12);
+    EXPECT_GT(azimuthal_error(sample_isotropic(g, space_of<Ortho>, kGrid, es)), 1e-3);
   }
 }
 
@@ -50,13 +51,14 @@ TEST(Azimuthal, DependsOnTheAzimuthWhenTheBrdfDoes) {
     const double c = p.wi.x * p.wo.x + p.wi.y * p.wo.y + p.wi.z * p.wo.z;
     return (1 + c) * (1 + c);
   });
-  EXPECT_LT(azimuthal_error(sample_isotropic(f, Space::halfdiff, kGrid, ErrorSpace::linear)),
+  EXPECT_LT(azimuthal_error(sample_isotropic(f, space_of<HalfDiff>, kGrid, ErrorSpace::linear)),
             1e-12);
   // ‖k‖² = (1 − ωi·ωo)/2: a function of ‖k‖ alone, so none in hybrid either.
-  EXPECT_LT(azimuthal_error(sample_isotropic(f, Space::hybrid, kGrid, ErrorSpace::linear)), 1e-12);
+  EXPECT_LT(azimuthal_error(sample_isotropic(f, space_of<Hybrid>, kGrid, ErrorSpace::linear)),
+            1e-12);
   // The product cos θi cos θo does depend on φ in every parameterization.
   const Fn g([](const DirPair<double>& p) { return p.wi.z * p.wo.z; });
-  for (Space s : {Space::halfdiff, Space::ortho, Space::hybrid})
+  for (Space s : {space_of<HalfDiff>, space_of<Ortho>, space_of<Hybrid>})
     EXPECT_GT(azimuthal_error(sample_isotropic(g, s, kGrid, ErrorSpace::linear)), 1e-2)
         << name_of(s);
 }
@@ -68,7 +70,7 @@ TEST(Separability, RankOneFunctionsHaveZeroRankOneError) {
     const double theta_d = std::acos(std::clamp(std::sqrt((1 + c) / 2), -1.0, 1.0));
     return std::exp(-4 * theta_h_of(p)) * (1 + std::cos(3 * theta_d));
   });
-  const IsoSamples s = sample_isotropic(f, Space::halfdiff, kGrid, ErrorSpace::linear);
+  const IsoSamples s = sample_isotropic(f, space_of<HalfDiff>, kGrid, ErrorSpace::linear);
   const auto e = separability_2d(s, {0, 1, 2});
   EXPECT_DOUBLE_EQ(e[0], 1.0);
   EXPECT_LT(e[1], 1e-6);
@@ -82,7 +84,7 @@ TEST(Separability, RankOneFunctionsHaveZeroRankOneError) {
     return std::exp(-4 * theta_h_of(p)) + theta_d * theta_d;
   });
   const auto e2 =
-      separability_2d(sample_isotropic(g, Space::halfdiff, kGrid, ErrorSpace::linear), {1, 2});
+      separability_2d(sample_isotropic(g, space_of<HalfDiff>, kGrid, ErrorSpace::linear), {1, 2});
   EXPECT_GT(e2[0], 1e-3);
   EXPECT_LT(e2[1], 1e-6);
 }
@@ -93,7 +95,7 @@ TEST(Measure, WeightsIntegrateTheProjectedSolidAngleMeasure) {
   // singularities of the Jacobians).
   const Fn one([](const DirPair<double>&) { return 1.0; });
   const double pi2 = std::numbers::pi * std::numbers::pi;
-  for (Space s : kParameterizations) {
+  for (Space s : kBuiltinSpaces) {
     const IsoSamples x = sample_isotropic(one, s, {64, 64, 64}, ErrorSpace::linear);
     EXPECT_NEAR(x.total_weight() / pi2, 1.0, 0.03) << name_of(s);
   }
@@ -103,9 +105,9 @@ TEST(Metrics, BadInput) {
   const Fn one([](const DirPair<double>&) { return 1.0; });
   EXPECT_THROW(sample_isotropic(one, Space::dirs, kGrid, ErrorSpace::linear),
                std::invalid_argument);
-  EXPECT_THROW(sample_isotropic(one, Space::hybrid, {0, 4, 4}, ErrorSpace::linear),
+  EXPECT_THROW(sample_isotropic(one, space_of<Hybrid>, {0, 4, 4}, ErrorSpace::linear),
                std::invalid_argument);
-  const IsoSamples x = sample_isotropic(one, Space::hybrid, kGrid, ErrorSpace::linear);
+  const IsoSamples x = sample_isotropic(one, space_of<Hybrid>, kGrid, ErrorSpace::linear);
   EXPECT_THROW(separability_2d(x, {-1}), std::invalid_argument);
 }
 
@@ -133,7 +135,7 @@ TEST(Metrics, CosineErrorSpacesSeeEachPairsCosines) {
   // A constant BRDF: in the Löw space its table is ln(1 + cos θi), not a constant, so dropping
   // the azimuth of spherical (θi, θo, φ) is still exact but the 2D table is not rank 0.
   const Fn one([](const DirPair<double>&) { return 1.0; });
-  const IsoSamples s = sample_isotropic(one, Space::spherical, kGrid, ErrorSpace::low);
+  const IsoSamples s = sample_isotropic(one, space_of<Spherical>, kGrid, ErrorSpace::low);
   EXPECT_LT(azimuthal_error(s), 1e-12);
   // θi is the first axis: each row of the table is ln(1 + cos θi) at its cell centre.
   const double theta = (0.5 + 3) * (std::numbers::pi / 2) / double(kGrid.a);

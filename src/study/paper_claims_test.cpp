@@ -24,8 +24,9 @@ double azimuthal(const Brdf& b, Space s, std::size_t cells) {
 // most" does not hold in this sense).
 TEST(PaperClaims, AzimuthalDependenceOfHalfDiffAndHybridConverges) {
   const TestFunctionBrdf g(TestFunction::grazing);
-  const double g_hd = azimuthal(g, Space::halfdiff, 64), g_hy = azimuthal(g, Space::hybrid, 64);
-  const double g_ortho = azimuthal(g, Space::ortho, 64);
+  const double g_hd = azimuthal(g, space_of<HalfDiff>, 64),
+               g_hy = azimuthal(g, space_of<Hybrid>, 64);
+  const double g_ortho = azimuthal(g, space_of<Ortho>, 64);
   RecordProperty("G_halfdiff_64", std::to_string(g_hd));
   RecordProperty("G_hybrid_64", std::to_string(g_hy));
   RecordProperty("G_ortho_64", std::to_string(g_ortho));
@@ -35,8 +36,9 @@ TEST(PaperClaims, AzimuthalDependenceOfHalfDiffAndHybridConverges) {
   // A sharp lobe needs finer grids; the gap is quadrature error, so it shrinks with the cells.
   const BrdfPtr ggx = load_brdf("ggx:alpha=0.3,f0=0.9");
   const double coarse =
-      std::abs(azimuthal(*ggx, Space::halfdiff, 16) - azimuthal(*ggx, Space::hybrid, 16));
-  const double hd = azimuthal(*ggx, Space::halfdiff, 64), hy = azimuthal(*ggx, Space::hybrid, 64);
+      std::abs(azimuthal(*ggx, space_of<HalfDiff>, 16) - azimuthal(*ggx, space_of<Hybrid>, 16));
+  const double hd = azimuthal(*ggx, space_of<HalfDiff>, 64),
+               hy = azimuthal(*ggx, space_of<Hybrid>, 64);
   RecordProperty("ggx_halfdiff_64", std::to_string(hd));
   RecordProperty("ggx_hybrid_64", std::to_string(hy));
   RecordProperty("ggx_gap_16", std::to_string(coarse));

@@ -126,7 +126,7 @@ TEST(Report, DesignsSectionComparesBestAgainstBest) {
       const std::vector<GonioPoint> own = p.gonio;
       for (const GonioPoint& g : own) {
         if (g.design != Design::regular) continue;
-        const double learned = p.space == Space::hybrid ? 0.1 : 1.0;
+        const double learned = p.space == space_of<Hybrid> ? 0.1 : 1.0;
         p.gonio.push_back({g.design, g.budget, g.samples, g.error * 2, Spacing::angle});
         p.gonio.push_back({g.design, g.budget, g.samples, g.error * learned, Spacing::learned});
       }

@@ -265,7 +265,7 @@ TEST(ViewApi, SlicesOfTwoBrdfsAndFourFormsInOneAnswer) {
   ASSERT_EQ(v.size(), 2 * 4 * block);
   const double lambert = load_brdf("lambert")->eval({{0, 0, 1}, {0, 0, 1}}).g;
   for (std::size_t f = 0; f < 4; ++f) {
-    const std::string form(name_of(kParameterizations[f]));
+    const std::string form(name_of(kBuiltinSpaces[f]));
     for (const auto& [b, spec] :
          {std::pair<std::size_t, std::string>{0, "arg:0"}, {1, "lambert"}}) {
       const Response one = slices({{"brdf", spec}, {"forms", form}});
@@ -414,8 +414,8 @@ TEST(ViewApi, PointListsEveryParameterizationAndRho) {
   EXPECT_NE(r.body.find(fmt::format("{:.17g}", rho.r)), std::string::npos) << r.body;
   const double d[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
   double q[4], jacobian = 0;
-  ASSERT_TRUE(
-      convert_one<double>(Form{Space::dirs, false}, Form{Space::hybrid, false}, d, q, &jacobian));
+  ASSERT_TRUE(convert_one<double>(Form{Space::dirs, false}, Form{space_of<Hybrid>, false}, d, q,
+                                  &jacobian));
   EXPECT_NE(r.body.find(fmt::format("{:.17g},{:.17g},{:.17g},{:.17g}", q[0], q[1], q[2], q[3])),
             std::string::npos);
   EXPECT_NE(r.body.find(fmt::format("\"jacobian\":{:.17g}", jacobian)), std::string::npos);

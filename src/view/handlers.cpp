@@ -140,10 +140,10 @@ RhoValues values_param(const Request& r) {
       400, fmt::format("parameter 'values': '{}' is not rgb or luminance", v->substr(0, 64)));
 }
 
-// The isotropic forms of `forms=` (comma-separated, each at most once); all four by default.
+// The isotropic forms of `forms=` (comma-separated, each at most once); all by default.
 std::vector<Space> forms_param(const Request& r) {
   const std::string* text = r.param("forms");
-  if (!text) return {kParameterizations.begin(), kParameterizations.end()};
+  if (!text) return parameterizations();
   std::vector<Space> forms;
   std::string_view rest = *text;
   while (true) {
@@ -151,9 +151,9 @@ std::vector<Space> forms_param(const Request& r) {
     const std::string_view name = rest.substr(0, comma);
     const auto s = space_from_name(name);
     if (!s || *s == Space::dirs)
-      throw RequestError(400, fmt::format("parameter 'forms': '{}' is not one of spherical, "
-                                          "halfdiff, ortho, hybrid (comma-separated)",
-                                          name.substr(0, 64)));
+      throw RequestError(400, fmt::format("parameter 'forms': '{}' is not one of {} "
+                                          "(comma-separated)",
+                                          name.substr(0, 64), parameterization_names(", ")));
     if (std::find(forms.begin(), forms.end(), *s) != forms.end())
       throw RequestError(400, fmt::format("parameter 'forms': '{}' is named twice", name));
     forms.push_back(*s);
@@ -183,9 +183,9 @@ void write_models(JsonWriter& w) {
 
 void write_forms(JsonWriter& w) {
   w.key("forms").begin_array();
-  for (const Space s : kParameterizations) {
+  for (const Space s : parameterizations()) {
     const auto coords = figure::iso_coordinates(s);
-    w.begin_object().field("space", name_of(s));
+    w.begin_object().field("space", name_of(s)).field("summary", s.param().summary());
     w.field("azimuth_label", figure::relative_azimuth_label(s)).key("axes").begin_array();
     for (const auto& c : coords)
       w.begin_object()
@@ -336,7 +336,7 @@ bool point_pair(const Request& request, DirPair<double>& pair) {
 void write_coordinates(JsonWriter& w, const DirPair<double>& pair, bool valid) {
   const double d[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
   w.key("forms").begin_array();
-  for (const Space s : kParameterizations) {
+  for (const Space s : parameterizations()) {
     w.begin_object().field("space", name_of(s));
     for (const bool iso : {false, true}) {
       const Form to{s, iso};

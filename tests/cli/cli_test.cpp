@@ -297,7 +297,7 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
 TEST_F(CliTest, RoundTripThroughEveryParameterization) {
   const auto pairs = well_conditioned_pairs(500, 1);
   put(path("pairs.csv"), dirs_csv(pairs));
-  for (Space space : kParameterizations) {
+  for (Space space : kBuiltinSpaces) {
     const std::string name(name_of(space));
     SCOPED_TRACE(name);
     Result r = run({"convert", "--from", "dirs", "--to", name, "-i", "pairs.csv", "-o", "p.csv"});
@@ -327,7 +327,7 @@ TEST_F(CliTest, RoundTripThroughEveryParameterization) {
 TEST_F(CliTest, IsotropicRoundTrip) {
   const auto pairs = well_conditioned_pairs(500, 2);
   put(path("pairs.csv"), dirs_csv(pairs));
-  for (Space space : kParameterizations) {
+  for (Space space : kBuiltinSpaces) {
     const std::string name(name_of(space));
     SCOPED_TRACE(name);
     Result r = run({"convert", "--from", "dirs", "--to", name, "--isotropic", "-i", "pairs.csv",
@@ -399,7 +399,7 @@ TEST_F(CliTest, ParameterizationToParameterization) {
     ASSERT_EQ(direct.status, 0);
     ASSERT_EQ(via.status, 0) << via.err;
     const CsvTable a = parse(direct.out), b = parse(via.out);
-    EXPECT_EQ(b.header, header_of(column_names({Space::halfdiff, iso}), {"valid"}));
+    EXPECT_EQ(b.header, header_of(column_names({space_of<HalfDiff>, iso}), {"valid"}));
     ASSERT_EQ(b.rows(), a.rows());
     for (std::size_t c = 0; c < a.header.size(); ++c)
       for (std::size_t i = 0; i < a.rows(); ++i) {
@@ -477,7 +477,7 @@ TEST_F(CliTest, ManyRows) {
 TEST_F(CliTest, JacobianColumnMatchesTheLibraryAndTheSphericalFormula) {
   const auto pairs = well_conditioned_pairs(100, 5);
   put(path("pairs.csv"), dirs_csv(pairs));
-  for (Space space : kParameterizations) {
+  for (Space space : kBuiltinSpaces) {
     for (bool iso : {false, true}) {
       const std::string name(name_of(space));
       SCOPED_TRACE(name + (iso ? " isotropic" : ""));
@@ -510,7 +510,7 @@ TEST_F(CliTest, JacobianColumnMatchesTheLibraryAndTheSphericalFormula) {
         EXPECT_NEAR(j, jac, 1e-12 * std::abs(jac)) << i;
         EXPECT_NEAR(back.columns[7][i], jac, 1e-10 * std::abs(jac)) << i;
         EXPECT_EQ(back.columns[6][i], 1.0);
-        if (space == Space::spherical) {  // dwi dwo = sin(theta_i) sin(theta_o) dq
+        if (space == space_of<Spherical>) {  // dwi dwo = sin(theta_i) sin(theta_o) dq
           const double expected = std::sqrt(1 - p.wi.z * p.wi.z) * std::sqrt(1 - p.wo.z * p.wo.z) *
                                   (iso ? 2 * kPi : 1.0);
           EXPECT_NEAR(j, expected, 1e-12 * expected) << i;
@@ -641,7 +641,7 @@ TEST_F(CliTest, SkipInvalidWritesValidZeroRows) {
             "halfback convert: warning: 5 invalid input rows written with valid = 0; the first: "
             "<stdin>:3: wo is not a unit vector (|wo|^2 - 1 = 3.2e-04)\n");
   const CsvTable t = parse(r.out);
-  ASSERT_EQ(t.header, header_of(column_names({Space::halfdiff, false}), {"valid", "jacobian"}));
+  ASSERT_EQ(t.header, header_of(column_names({space_of<HalfDiff>, false}), {"valid", "jacobian"}));
   ASSERT_EQ(t.rows(), 7u);
   EXPECT_EQ(t.columns[4], (std::vector<double>{1, 0, 0, 0, 0, 0, 1}));
   for (std::size_t row = 1; row <= 5; ++row)
@@ -818,7 +818,7 @@ TEST_F(CliTest, InfoOfAModelAndOfAMerlFileItWrote) {
   const double th = std::pow(40.5 / 90, 2) * kPi / 2, td = 30.5 / 90 * kPi / 2,
                pd = 60.5 / 180 * kPi;
   std::array<double, 6> d{};
-  ASSERT_TRUE(convert_one<double>({Space::halfdiff, true}, {Space::dirs, false},
+  ASSERT_TRUE(convert_one<double>({space_of<HalfDiff>, true}, {Space::dirs, false},
                                   std::array<double, 3>{th, td, pd}, d));
   const std::string input = std::string(kDirsHeader) + fmt_row(d) + "\n";
   const Result a = run({"eval", "--brdf", "ggx.binary"}, input);
@@ -1682,9 +1682,10 @@ TEST_F(CliTest, ConvertStreamsBlocksByteIdentically) {
   ConvertOutput<double> conv;
   conv.columns = out_cols;
   conv.jacobian = {out[4].data(), 1};
-  convert<double>({Space::dirs, false}, {Space::hybrid, false}, in_cols, n, conv);
+  convert<double>({Space::dirs, false}, {space_of<Hybrid>, false}, in_cols, n, conv);
   const std::vector<std::span<const double>> cols(out.begin(), out.end());
-  EXPECT_TRUE(r.out == to_csv(header_of(column_names({Space::hybrid, false}), {"jacobian"}), cols))
+  EXPECT_TRUE(r.out ==
+              to_csv(header_of(column_names({space_of<Hybrid>, false}), {"jacobian"}), cols))
       << "the streamed output differs from the whole-input conversion";
 }
 

@@ -42,7 +42,7 @@ struct GridAxis {
 };
 
 struct GridSpec {
-  Space space = Space::hybrid;  // a parameterization, not dirs
+  Space space = space_of<Hybrid>;  // a parameterization, not dirs
   GridKind kind = GridKind::isotropic;
   GridSampling sampling = GridSampling::centres;
   double slice_azimuth = 0;    // kind == slice: the relative azimuth, radians (wrapped by point)

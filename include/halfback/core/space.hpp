@@ -1,23 +1,73 @@
 // Run-time names for the coordinate spaces, for code that picks a parameterization from user
-// input (CLI, Python, file metadata). Compile-time code uses the structs of param.hpp directly.
+// input (CLI, Python, file metadata, the explorer). A Space is `dirs` (the 6 Cartesian components
+// of the pair) or a parameterization: one of BuiltinParams (parameterization.hpp), or one
+// registered at run time (a test's, or a Python user's). Compile-time code uses the structs of
+// params/ directly; space_of<P> names a built-in one.
 #pragma once
 
 #include <array>
+#include <compare>
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
-#include "halfback/core/param.hpp"
+#include "halfback/core/parameterization.hpp"
 
 namespace halfback {
 
-enum class Space { dirs, spherical, halfdiff, ortho, hybrid };
+class Space {
+ public:
+  static const Space dirs;
+  constexpr Space() = default;  // dirs
 
-inline constexpr std::array<Space, 4> kParameterizations{Space::spherical, Space::halfdiff,
-                                                         Space::ortho, Space::hybrid};
+  // Ids: 0 is dirs, 1 .. kBuiltinParamCount the built-in list, then the registered ones.
+  static constexpr Space from_id(std::uint16_t id) { return Space(id); }
+  constexpr std::uint16_t id() const { return id_; }
+  constexpr bool is_dirs() const { return id_ == 0; }
+  constexpr bool is_builtin() const { return id_ >= 1 && id_ <= kBuiltinParamCount; }
+  // The position in BuiltinParams; only for is_builtin().
+  constexpr std::size_t builtin_index() const { return std::size_t(id_) - 1; }
+
+  // The parameterization; throws std::invalid_argument for dirs.
+  const ParamDescriptor& param() const;
+
+  friend constexpr bool operator==(Space, Space) = default;
+  friend constexpr auto operator<=>(Space, Space) = default;
+
+ private:
+  explicit constexpr Space(std::uint16_t id) : id_(id) {}
+  std::uint16_t id_ = 0;
+};
+inline constexpr Space Space::dirs{};
+
+// The space of the built-in parameterization P.
+template <class P>
+inline constexpr Space space_of = Space::from_id(std::uint16_t(1 + builtin_index<P>));
+
+// The built-in parameterizations, in the order of BuiltinParams.
+inline constexpr std::array<Space, kBuiltinParamCount> kBuiltinSpaces = [] {
+  std::array<Space, kBuiltinParamCount> a{};
+  for (std::size_t i = 0; i < a.size(); ++i) a[i] = Space::from_id(std::uint16_t(i + 1));
+  return a;
+}();
+
+// Every parameterization: the built-in ones, then those registered, in the order registered.
+std::vector<Space> parameterizations();
+
+// Adds a parameterization at run time and returns its space. Its name must not be "dirs" nor a
+// built-in one's (std::invalid_argument); registering a name again gives a new space, which the
+// name then denotes (spaces of the older one stay valid). Thread-safe; never unregistered.
+Space register_parameterization(std::shared_ptr<const ParamDescriptor> descriptor);
+template <Parameterization P>
+Space register_parameterization() {
+  return register_parameterization(std::make_shared<CompiledParam<P>>());
+}
 
 // A space and whether its isotropic (3D, canonical-pose) form is meant. `dirs` has no isotropic
 // form: it is always the 6 Cartesian components (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z).
@@ -27,30 +77,11 @@ struct Form {
   friend bool operator==(const Form&, const Form&) = default;
 };
 
-// Calls f(P{}) with the parameterization struct named by `space`; throws std::invalid_argument
-// for dirs, which is not a parameterization.
-template <class F>
-decltype(auto) visit_parameterization(Space space, F&& f) {
-  switch (space) {
-    case Space::spherical:
-      return f(Spherical{});
-    case Space::halfdiff:
-      return f(HalfDiff{});
-    case Space::ortho:
-      return f(Ortho{});
-    case Space::hybrid:
-      return f(Hybrid{});
-    case Space::dirs:
-      break;
-  }
-  throw std::invalid_argument(
-      "dirs is not a parameterization (expected spherical, halfdiff, "
-      "ortho or hybrid)");
-}
-
 std::string_view name_of(Space space);
 std::optional<Space> space_from_name(std::string_view name);
-std::string space_names();  // "dirs, spherical, halfdiff, ortho, hybrid"
+std::string space_names();  // "dirs, spherical, halfdiff, ortho, hybrid" (and registered)
+std::string parameterization_names(std::string_view last_separator = " or ");
+// "spherical, halfdiff, ortho or hybrid"
 
 // Number of coordinates of a form: 6 for dirs, 4 or 3 for a parameterization.
 std::size_t dimension(Form form);

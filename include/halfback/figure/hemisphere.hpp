@@ -67,7 +67,7 @@ HemisphereSample sample_hemisphere(Space space, const HemisphereView& view, cons
                                    std::size_t pixels, int threads = 0);
 
 struct HemisphereOptions {
-  std::vector<Space> params{Space::halfdiff, Space::ortho, Space::hybrid};
+  std::vector<Space> params{space_of<HalfDiff>, space_of<Ortho>, space_of<Hybrid>};
   std::vector<double> elevations_deg{0, 40, 80};  // θo, the polar angle of ωo from n
   Projection projection = Projection::equal_area;
   ViewCentre centre = ViewCentre::normal;

@@ -39,7 +39,7 @@ ScalarField test_function_field(const SliceSample& slice, TestFunction f);
 enum class SliceColouring { luminance, rgb };
 
 struct SliceOptions {
-  std::vector<Space> params{Space::halfdiff, Space::ortho, Space::hybrid};
+  std::vector<Space> params{space_of<HalfDiff>, space_of<Ortho>, space_of<Hybrid>};
   std::vector<double> azimuths_deg{0, 45, 90};
   // Test-function mode: which functions, at which levels.
   std::vector<TestFunction> test_functions{TestFunction::specular, TestFunction::grazing,

@@ -14,22 +14,15 @@
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
+#include "halfback/core/space.hpp"
 #include "halfback/render/distribution.hpp"
 
 namespace halfback::render {
 
-// The 2D parameterization of ωi, for a fixed ωo, that a tabulated sampler's cells live in:
-//  spherical: (θi, φi − φo), dωi = sin θi dθi dφ;
-//  halfdiff:  (θh, φh) of the half vector ĥ, ωi = 2(ωo·ĥ)ĥ − ωo, dωi = 4 (ωo·ĥ) sin θh dθh dφh;
-//  hybrid:    (‖h̄‖, φh) of the projected half vector, ωi_xy = 2h̄ − ωo_xy: the first two
-//             coordinates of the hybrid (and ortho) parameterizations; dωi = 4‖h̄‖ d‖h̄‖ dφh / cos
-//             θi, so ρ cos θi dωi = 4 ρ ‖h̄‖ d‖h̄‖ dφh: the cosine cancels.
-enum class TableParam { spherical, halfdiff, hybrid };
-const char* name_of(TableParam p);
-TableParam table_param_from_name(const std::string& name);  // throws std::invalid_argument
-
 struct TabulationOptions {
-  TableParam param = TableParam::hybrid;
+  // The parameterization whose sampler chart (params/charts.hpp: the 2D chart of ωi, for a fixed
+  // ωo, of its first two coordinates) the tabulated sampler's cells live in.
+  Space param = space_of<Hybrid>;
   // The radial coordinate (θi, θh or ‖h̄‖) as r = r_max s², s uniform over the cells: cells are
   // finer near the lobe's peak (the normal for spherical, the mirror direction for the others).
   bool warp = true;

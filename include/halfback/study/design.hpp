@@ -63,7 +63,7 @@ class AxisWarp {
 
 // Warps learned for one parameterization: one per axis of its isotropic form (a, b, φ).
 struct LearnedWarps {
-  Space space = Space::hybrid;
+  Space space = space_of<Hybrid>;
   std::array<AxisWarp, 3> axes;
   bool operator==(const LearnedWarps&) const = default;
 };
@@ -83,7 +83,7 @@ bool same_as_own(Space space, bool isotropic, Spacing spacing);
 // measure of metrics.hpp), by second differences on the grid of sample_isotropic, normalized by
 // ∫ w T² so that every BRDF weighs the same in relative error.
 struct AxisDemand {
-  Space space = Space::hybrid;
+  Space space = space_of<Hybrid>;
   std::array<std::vector<double>, 3> demand;  // per axis, one value per grid cell
 };
 struct DesignProfile {

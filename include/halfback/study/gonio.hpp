@@ -59,8 +59,8 @@ inline constexpr std::array<Design, 2> kDesigns{Design::regular, Design::stratif
 std::string_view name_of(Design d);
 
 struct GonioSetup {
-  Space space = Space::hybrid;  // a parameterization, not dirs
-  bool isotropic = true;        // measure in the isotropic (3D) form, else in the full (4D) one
+  Space space = space_of<Hybrid>;  // a parameterization, not dirs
+  bool isotropic = true;           // measure in the isotropic (3D) form, else in the full (4D) one
   Design design = Design::regular;
   std::size_t budget = 10000;  // measurements wanted (>= 1)
   std::uint64_t seed = 1;      // the stratified design's random points

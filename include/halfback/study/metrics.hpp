@@ -43,7 +43,7 @@ struct IsoGrid {
 
 // An isotropic BRDF sampled on the isotropic grid of one parameterization.
 struct IsoSamples {
-  Space space = Space::hybrid;
+  Space space = space_of<Hybrid>;
   IsoGrid grid;
   std::vector<double> value;  // a.b.phi values (φ fastest) in the error space; 0 where invalid
   std::vector<double> weight;  // dμ of each cell: J₃ cos θi cos θo Δa Δb Δφ; 0 where invalid
@@ -72,7 +72,7 @@ std::vector<double> separability_unfolded(const IsoSamples& s, const std::vector
 // (a, φa, b, φb) of a parameterization — (θh, φh, θd, φd), (‖h̄‖, φh, ‖k̄‖, φk), (‖h̄‖, φh, ‖k‖, φk)
 // or (θi, φi, θo, φo) — with dμ = J₄ cos θi cos θo da dφa db dφb (the core's 4D Jacobian).
 struct FullSamples {
-  Space space = Space::hybrid;
+  Space space = space_of<Hybrid>;
   std::array<std::size_t, 4> counts{16, 32, 16, 32};  // cells of a, φa, b, φb
   std::vector<double> value;   // row-major (φb fastest), in the error space; 0 where invalid
   std::vector<double> weight;  // dμ of each cell; 0 where invalid

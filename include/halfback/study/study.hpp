@@ -22,8 +22,8 @@
 namespace halfback::study {
 
 // The parameterizations compared, in the order of every table.
-inline constexpr std::array<Space, 4> kStudied{Space::halfdiff, Space::ortho, Space::hybrid,
-                                               Space::spherical};
+inline constexpr std::array<Space, 4> kStudied{space_of<HalfDiff>, space_of<Ortho>,
+                                               space_of<Hybrid>, space_of<Spherical>};
 
 // Stated maxima of a study's work (StudyConfig::validate refuses more): a budget's tables and the
 // test pairs take tens of bytes per sample, so these keep one study within a few GB and hours.
@@ -90,7 +90,7 @@ struct ImagePoint {
 };
 
 struct ParamResult {
-  Space space = Space::hybrid;
+  Space space = space_of<Hybrid>;
   double azimuthal = 0;
   std::vector<double> separability_2d, separability_3d;  // one per rank
   std::vector<GonioPoint> gonio;                         // designs × budgets (isotropic)

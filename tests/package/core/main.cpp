@@ -16,7 +16,7 @@ int main() {
   }
   const double in[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
   double out[4];
-  if (!convert_one<double>({Space::dirs, false}, {Space::hybrid, false}, in, out)) return 1;
+  if (!convert_one<double>({Space::dirs, false}, {space_of<Hybrid>, false}, in, out)) return 1;
   std::printf("core consumer: round trip ok, hbar %.17g\n", out[0]);
   return 0;
 }
