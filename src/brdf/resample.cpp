@@ -18,19 +18,13 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Whether a column name is an azimuth ([0, 2π)), a polar angle ([0, π/2]) or a length ([0, 1]).
-std::pair<double, double> natural_range(std::string_view column) {
-  if (column.starts_with("phi") || column == "dphi") return {0, 2 * kPi};
-  if (column.starts_with("theta")) return {0, kPi / 2};
-  return {0, 1};
-}
-
-// The axes of a kind: the columns of the form, without the relative azimuth for a slice.
-std::vector<std::string_view> axis_names(Space space, GridKind kind) {
-  const auto cols = column_names({space, kind != GridKind::full});
-  std::vector<std::string_view> names(cols.begin(), cols.end());
-  if (kind == GridKind::slice) names.pop_back();  // the isotropic forms end with their azimuth
-  return names;
+// The axes of a kind (the parameterization's descriptor): those of the form, without the relative
+// azimuth for a slice.
+std::vector<Axis> grid_axes(Space space, GridKind kind) {
+  const auto axes = space.param().axes(kind != GridKind::full);
+  std::vector<Axis> v(axes.begin(), axes.end());
+  if (kind == GridKind::slice) v.pop_back();  // the isotropic forms end with their azimuth
+  return v;
 }
 
 }  // namespace
@@ -103,30 +97,29 @@ std::size_t GridSpec::points() const {
 GridSpec default_grid(Space space, GridKind kind, std::vector<std::size_t> counts,
                       double slice_azimuth) {
   if (space == Space::dirs)
-    throw std::invalid_argument(
-        "a grid needs a parameterization (spherical, halfdiff, ortho or "
-        "hybrid), not dirs");
-  const auto names = axis_names(space, kind);
-  if (counts.size() == 1) counts.assign(names.size(), counts.front());
-  if (counts.size() != names.size())
+    throw std::invalid_argument("a grid needs a parameterization (" + parameterization_names() +
+                                "), not dirs");
+  const std::vector<Axis> axes = grid_axes(space, kind);
+  if (counts.size() == 1) counts.assign(axes.size(), counts.front());
+  if (counts.size() != axes.size())
     throw std::invalid_argument(fmt::format("a {} grid of {} has {} axes, got {} sample counts",
-                                            name_of(kind), name_of(space), names.size(),
+                                            name_of(kind), name_of(space), axes.size(),
                                             counts.size()));
   GridSpec g;
   g.space = space;
   g.kind = kind;
   g.slice_azimuth = wrap_azimuth_radians(slice_azimuth);
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    const auto [lo, hi] = natural_range(names[i]);
-    g.axes.push_back({std::string(names[i]), lo, hi, counts[i]});
-  }
+  for (std::size_t i = 0; i < axes.size(); ++i)
+    g.axes.push_back({std::string(axes[i].column), axes[i].lo, axes[i].hi, counts[i]});
   validate(g);
   return g;
 }
 
 void validate(const GridSpec& g) {
   if (g.space == Space::dirs) throw std::invalid_argument("a grid needs a parameterization");
-  const auto names = axis_names(g.space, g.kind);
+  const std::vector<Axis> axes = grid_axes(g.space, g.kind);
+  std::vector<std::string_view> names;
+  for (const Axis& a : axes) names.push_back(a.column);
   if (g.axes.size() != names.size())
     throw std::invalid_argument(fmt::format("a {} grid of {} has {} axes, not {}", name_of(g.kind),
                                             name_of(g.space), names.size(), g.axes.size()));

@@ -34,14 +34,11 @@ namespace {
 constexpr double kHalfPi = std::numbers::pi / 2;
 constexpr double kUniformShare = 0.2;  // of the learned density: the floor of learn_warps()
 
-bool sine_like(std::string_view axis) {
-  return axis == "hbar" || axis == "k" || axis == "kbar";
-}
-bool half_vector(std::string_view axis) {
-  return axis == "hbar" || axis == "theta_h";
-}
-bool azimuth(std::string_view axis) {
-  return axis.find("phi") != std::string_view::npos;
+// The descriptor's axis that a grid axis samples.
+const Axis& descriptor_axis(const GridSpec& g, const GridAxis& a) {
+  for (const Axis& axis : g.space.param().axes(g.kind != GridKind::full))
+    if (axis.column == a.name) return axis;
+  throw std::invalid_argument(fmt::format("{} has no coordinate '{}'", name_of(g.space), a.name));
 }
 
 }  // namespace
@@ -134,15 +131,18 @@ std::vector<AxisWarp> design_warps(const GridSpec& cells, Spacing spacing,
   for (const GridAxis& a : cells.axes) {
     using K = AxisWarp::Kind;
     if (spacing == Spacing::learned) {
-      const std::size_t k = azimuth(a.name) ? 2 : magnitude++;
-      const bool full_azimuth = azimuth(a.name) && cells.kind == GridKind::full;
+      const bool azimuth = descriptor_axis(cells, a).kind == AxisKind::azimuth;
+      const std::size_t k = azimuth ? 2 : magnitude++;
+      const bool full_azimuth = azimuth && cells.kind == GridKind::full;
       warps.push_back(full_azimuth ? AxisWarp(K::identity, a.lo, a.hi) : learned->axes[k]);
       continue;
     }
+    const Axis& axis = descriptor_axis(cells, a);
+    const bool sine = axis.encoding == AngleEncoding::sine;
     K kind = K::identity;
-    if (spacing != Spacing::own && sine_like(a.name)) kind = K::arcsine;
-    if (spacing == Spacing::merl && half_vector(a.name))
-      kind = sine_like(a.name) ? K::merl_arcsine : K::merl_angle;
+    if (spacing != Spacing::own && sine) kind = K::arcsine;
+    if (spacing == Spacing::merl && axis.half_vector_tilt)
+      kind = sine ? K::merl_arcsine : K::merl_angle;
     warps.emplace_back(kind, a.lo, a.hi);
   }
   return warps;

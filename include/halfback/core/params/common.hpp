@@ -132,26 +132,44 @@ enum class AxisKind {
   azimuth,  // radians in [lo, hi), periodic
   length,   // a dimensionless length in [lo, hi]
 };
+// What a non-azimuthal coordinate is a function of, for the designs that re-space it as an angle
+// (study/design.hpp): the angle itself, or its sine (‖h̄‖ ≈ sin θh, ‖k‖ = sin θd).
+enum class AngleEncoding { none, angle, sine };
 struct Axis {
   std::string_view column;  // CSV and NumPy name, e.g. "theta_h"
   std::string_view label;  // figure label, with the markup of figure/scene.hpp: "θ_h", "‖h\u0304‖"
   AxisKind kind = AxisKind::length;
   double lo = 0, hi = 1;
   double spacing = 0.1;  // the figures' isoline spacing, in the axis's units
+  AngleEncoding encoding = AngleEncoding::none;
+  bool half_vector_tilt = false;  // measures ĥ's tilt from n (θh, ‖h̄‖): the specular peak's axis
   constexpr std::string_view unit() const { return kind == AxisKind::length ? "" : "rad"; }
   constexpr bool is_angle() const { return kind != AxisKind::length; }
+  constexpr Axis tilting_half_vector() const {
+    Axis a = *this;
+    a.half_vector_tilt = true;
+    return a;
+  }
 };
 
-// The common kinds of axis: an elevation in [0, π/2], an azimuth in [0, 2π), a length in [0, 1].
+// The common kinds of axis: an elevation in [0, π/2], an azimuth in [0, 2π), a length in [0, 1]
+// that is the sine of an angle.
 constexpr Axis elevation_axis(std::string_view column, std::string_view label) {
-  return {column, label, AxisKind::angle, 0, std::numbers::pi / 2, std::numbers::pi / 18};
+  return {column,
+          label,
+          AxisKind::angle,
+          0,
+          std::numbers::pi / 2,
+          std::numbers::pi / 18,
+          AngleEncoding::angle};
 }
 constexpr Axis azimuth_axis(std::string_view column, std::string_view label) {
   return {column, label, AxisKind::azimuth, 0, 2 * std::numbers::pi, std::numbers::pi / 18};
 }
-constexpr Axis length_axis(std::string_view column, std::string_view label) {
-  return {column, label, AxisKind::length, 0, 1, 0.1};
+constexpr Axis sine_axis(std::string_view column, std::string_view label) {
+  return {column, label, AxisKind::length, 0, 1, 0.1, AngleEncoding::sine};
 }
+
 // --------------------------------------------------------------------------------------------
 // Checked operations, common to all parameterizations.
 // --------------------------------------------------------------------------------------------

@@ -19,11 +19,11 @@ struct HalfDiff {
   static constexpr std::string_view name = "halfdiff";
   static constexpr std::string_view summary = "(θh, φh, θd, φd), Rusinkiewicz 1998";
   static constexpr std::array<Axis, 4> axes{
-      elevation_axis("theta_h", "θ_h"), azimuth_axis("phi_h", "φ_h"),
+      elevation_axis("theta_h", "θ_h").tilting_half_vector(), azimuth_axis("phi_h", "φ_h"),
       elevation_axis("theta_d", "θ_d"), azimuth_axis("phi_d", "φ_d")};
-  static constexpr std::array<Axis, 3> iso_axes{elevation_axis("theta_h", "θ_h"),
-                                                elevation_axis("theta_d", "θ_d"),
-                                                azimuth_axis("phi_d", "φ_d")};
+  static constexpr std::array<Axis, 3> iso_axes{
+      elevation_axis("theta_h", "θ_h").tilting_half_vector(), elevation_axis("theta_d", "θ_d"),
+      azimuth_axis("phi_d", "φ_d")};
   using SamplerChart = HalfVectorChart;
 
   // θd and φd depend only on the direction of d = R_y(-θh) R_z(-φh) ωi, which is computed

@@ -17,11 +17,12 @@ struct Hybrid {
   template <class S>
   static constexpr S kNoisyHz2 = S(16) * std::numeric_limits<S>::epsilon();
   static constexpr std::string_view summary = "(‖h̄‖, φh, ‖k‖, φk), Stark 2005, Barla et al. 2015";
-  static constexpr std::array<Axis, 4> axes{length_axis("hbar", "‖h\u0304‖"),
-                                            azimuth_axis("phi_h", "φ_h"), length_axis("k", "‖k‖"),
+  static constexpr std::array<Axis, 4> axes{sine_axis("hbar", "‖h\u0304‖").tilting_half_vector(),
+                                            azimuth_axis("phi_h", "φ_h"), sine_axis("k", "‖k‖"),
                                             azimuth_axis("phi_k", "φ_k")};
   static constexpr std::array<Axis, 3> iso_axes{
-      length_axis("hbar", "‖h\u0304‖"), length_axis("k", "‖k‖"), azimuth_axis("dphi", "φ_k − φ_h")};
+      sine_axis("hbar", "‖h\u0304‖").tilting_half_vector(), sine_axis("k", "‖k‖"),
+      azimuth_axis("dphi", "φ_k − φ_h")};
   using SamplerChart = ProjectedHalfChart;
 
   template <class T>

@@ -14,11 +14,11 @@ struct Ortho {
   static constexpr std::string_view name = "ortho";
   static constexpr std::string_view summary = "(‖h̄‖, φh, ‖k̄‖, φk), Neumann 1999, Löw 2012";
   static constexpr std::array<Axis, 4> axes{
-      length_axis("hbar", "‖h\u0304‖"), azimuth_axis("phi_h", "φ_h"),
-      length_axis("kbar", "‖k\u0304‖"), azimuth_axis("phi_k", "φ_k")};
-  static constexpr std::array<Axis, 3> iso_axes{length_axis("hbar", "‖h\u0304‖"),
-                                                length_axis("kbar", "‖k\u0304‖"),
-                                                azimuth_axis("dphi", "φ_k − φ_h")};
+      sine_axis("hbar", "‖h\u0304‖").tilting_half_vector(), azimuth_axis("phi_h", "φ_h"),
+      sine_axis("kbar", "‖k\u0304‖"), azimuth_axis("phi_k", "φ_k")};
+  static constexpr std::array<Axis, 3> iso_axes{
+      sine_axis("hbar", "‖h\u0304‖").tilting_half_vector(), sine_axis("kbar", "‖k\u0304‖"),
+      azimuth_axis("dphi", "φ_k − φ_h")};
   using SamplerChart = ProjectedHalfChart;
 
   template <class T>
