@@ -10,6 +10,7 @@
 #include <random>
 
 #include "halfback/core/param.hpp"
+#include "support/param_types.hpp"
 #include "support/test_util.hpp"
 
 namespace halfback {
@@ -20,7 +21,7 @@ using test::kTwoPiD;
 
 template <class P>
 class JacobianTest : public ::testing::Test {};
-using AllParams = ::testing::Types<Spherical, HalfDiff, Ortho, Hybrid>;
+using AllParams = test::BuiltinParamTypes;
 class ParamNames {
  public:
   template <class P>

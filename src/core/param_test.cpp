@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "support/param_types.hpp"
 #include "support/test_util.hpp"
 
 namespace halfback {
@@ -43,7 +44,7 @@ double round_trip_bound(double cond) {
 
 template <class P>
 class ParamTest : public ::testing::Test {};
-using AllParams = ::testing::Types<Spherical, HalfDiff, Ortho, Hybrid>;
+using AllParams = test::BuiltinParamTypes;
 class ParamNames {
  public:
   template <class P>
