@@ -1,6 +1,6 @@
 """halfback: exact, fast BRDF parameterizations (Barla, Belcour, Pacanowski 2015).
 
-Parameterization names: "dirs" (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z), "spherical"
+Parameterization names (every one: parameterizations()): "dirs" (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z), "spherical"
 (theta_i, phi_i, theta_o, phi_o), "halfdiff" (theta_h, phi_h, theta_d, phi_d), "ortho"
 (hbar, phi_h, kbar, phi_k) and "hybrid" (hbar, phi_h, k, phi_k). With isotropic=True, phi_h is
 dropped and the second azimuth is relative. Conventions and derivations: docs/math.md.
@@ -19,6 +19,7 @@ from ._core import (
     jacobian,
     load,
     models,
+    parameterizations,
     simd_isa,
     ssim,
     valid,

@@ -49,6 +49,35 @@ Form parse_form(const std::string& name, bool isotropic, const char* argument) {
   return {s, isotropic && s != Space::dirs};
 }
 
+py::dict axis_dict(const Axis& a) {
+  static constexpr const char* kKinds[] = {"angle", "azimuth", "length"};
+  py::dict d;
+  d["column"] = std::string(a.column);
+  d["label"] = std::string(a.label);
+  d["kind"] = kKinds[static_cast<int>(a.kind)];
+  d["unit"] = std::string(a.unit());
+  d["lo"] = a.lo;
+  d["hi"] = a.hi;
+  return d;
+}
+
+py::list parameterization_table() {
+  py::list all;
+  for (Space s : parameterizations()) {
+    const ParamDescriptor& p = s.param();
+    py::dict d;
+    d["name"] = std::string(p.name());
+    d["summary"] = std::string(p.summary());
+    for (const bool iso : {false, true}) {
+      py::list axes;
+      for (const Axis& a : p.axes(iso)) axes.append(axis_dict(a));
+      d[iso ? "iso_axes" : "axes"] = axes;
+    }
+    all.append(d);
+  }
+  return all;
+}
+
 std::string shape_text(const py::array& a) {
   std::string s = "(";
   for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
@@ -444,6 +473,10 @@ forms, the measure of the 3 coordinates: 2*pi times the 4D J of the canonical po
         return cols;
       },
       py::arg("name"), py::arg("isotropic") = false, "Column names of a form, in order.");
+
+  m.def("parameterizations", &parameterization_table,
+        R"doc(Every parameterization (built in, then registered), each a dict: name, summary, axes
+and iso_axes (per coordinate: column, label, kind ("angle", "azimuth" or "length"), unit, lo, hi).)doc");
 }
 
 void bind_brdf_class(py::module_& m) {

@@ -1,6 +1,8 @@
 """Tests of the Python module against independent NumPy formulas, the CLI, and bad input."""
 
 import os
+import pathlib
+import re
 import subprocess
 import sys
 import tempfile
@@ -198,3 +200,24 @@ def test_convert_into_out():
     ro.flags.writeable = False
     with pytest.raises(ValueError, match="read-only"):
         halfback.convert(x, "dirs", "hybrid", out=ro)
+
+
+def test_parameterizations_describe_every_space_and_the_stubs_name_them():
+    table = halfback.parameterizations()
+    names = [p["name"] for p in table]
+    assert names[:4] == ["spherical", "halfdiff", "ortho", "hybrid"]
+    for p in table:
+        assert len(p["axes"]) == 4 and len(p["iso_axes"]) == 3
+        assert [a["column"] for a in p["axes"]] == halfback.columns(p["name"])
+        assert [a["column"] for a in p["iso_axes"]] == halfback.columns(p["name"], isotropic=True)
+        for a in p["axes"] + p["iso_axes"]:
+            assert a["kind"] in ("angle", "azimuth", "length")
+            assert a["unit"] == ("" if a["kind"] == "length" else "rad")
+            assert a["lo"] < a["hi"]
+    # The stubs are generated from the same list (src/python/stubgen.cpp).
+    stubs = (pathlib.Path(halfback.__file__).parent / "__init__.pyi").read_text()
+    literal = re.search(r"^Param = Literal\[(.*)\]$", stubs, re.M).group(1)
+    assert [n.strip().strip('"') for n in literal.split(",")] == ["dirs"] + names
+    public = [n for n in dir(halfback._core) if not n.startswith("_")]
+    missing = [n for n in public if not re.search(rf"^(def|class) {n}\b", stubs, re.M)]
+    assert missing == []

@@ -672,6 +672,9 @@ async function main() {
   $('azimuth-value').textContent = `${state.az}°`;
   $('scale').value = state.scale;
   $('levels').value = state.levels === 'auto' ? '' : state.levels;
+  for (const f of info.forms)  // the parameterizations come from the server (/api/info)
+    $('hemi-colour').append(Object.assign(document.createElement('option'),
+      { value: f.space, textContent: f.space, title: f.summary }));
   $('hemi-colour').value = state.hemi;
   $('polar-scale').value = state.polar;
   ensureOption($('env'), state.env);
