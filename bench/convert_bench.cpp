@@ -79,7 +79,7 @@ struct Data {
       }
       for (int c = 0; c < 6; ++c) dirs[c][r] = static_cast<T>(w[c]);
     }
-    for (Space s : kBuiltinSpaces) {
+    for (Space s : kKernelSpaces) {
       Columns<T> q(4, std::vector<T>(rows));
       std::vector<ConstColumn<T>> ic;
       for (const auto& c : dirs) ic.push_back({c.data(), 1});
@@ -308,7 +308,7 @@ class VirtualParamOf final : public VirtualParam<T> {
 
 template <class T>
 std::unique_ptr<VirtualParam<T>> make_parameterization(Space space) {
-  return visit_builtin(space.builtin_index(), [](auto p) -> std::unique_ptr<VirtualParam<T>> {
+  return visit_kernel_param(space.kernel_index(), [](auto p) -> std::unique_ptr<VirtualParam<T>> {
     return std::make_unique<VirtualParamOf<decltype(p), T>>();
   });
 }
@@ -434,7 +434,7 @@ void register_all() {
   if (all > 1) thread_counts.push_back(all);
   for (bool forward : {true, false}) {
     const std::string dir = forward ? "forward" : "inverse";
-    for (Space s : kBuiltinSpaces) {
+    for (Space s : kKernelSpaces) {
       const std::string p(name_of(s));
       for (unsigned k : thread_counts)
         benchmark::RegisterBenchmark(

@@ -36,7 +36,7 @@ GonioSetup setup_of(Space space, Spacing spacing) {
     static const std::vector<LearnedWarps> learned = [] {
       std::vector<DesignProfile> profiles;
       for (const char* spec : {"ggx:alpha=0.1", "ggx:alpha=0.3"})
-        profiles.push_back(design_profile(*model_registry().create(spec), kBuiltinSpaces,
+        profiles.push_back(design_profile(*model_registry().create(spec), kKernelSpaces,
                                           {32, 32, 32}, ErrorSpace::log));
       profiles.push_back({});  // the held-out slot: never read
       return learn_warps(profiles, 2);

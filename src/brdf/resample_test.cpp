@@ -35,7 +35,7 @@ std::vector<double> coords_of(const GridSpec& g, std::size_t flat) {
 
 TEST(Resample, EveryPointIsTheBrdfAtTheCheckedInverse) {
   const Smooth brdf;
-  for (Space s : kBuiltinSpaces) {
+  for (Space s : kKernelSpaces) {
     for (GridKind kind : {GridKind::full, GridKind::isotropic, GridKind::slice}) {
       const std::size_t n = kind == GridKind::full ? 7 : kind == GridKind::isotropic ? 11 : 23;
       GridSpec g = default_grid(s, kind, {n}, 1.1);
@@ -240,7 +240,7 @@ TEST(Resample, AzimuthsWrapIntoZeroTo360Degrees) {
 // inverse wants [0, 2π)). A hand-made GridSpec with an unwrapped azimuth is wrapped too.
 TEST(Resample, SlicesAtEquivalentAzimuthsAreTheSame) {
   const Smooth brdf;
-  for (Space s : kBuiltinSpaces) {
+  for (Space s : kKernelSpaces) {
     const ResampledTable ref = resample(brdf, default_grid(s, GridKind::slice, {16}, 1.5 * kPi));
     ASSERT_GT(ref.valid_count(), 16u) << name_of(s);
     for (const double az : {-0.5 * kPi, 3.5 * kPi, -2.5 * kPi}) {

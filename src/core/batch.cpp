@@ -181,7 +181,7 @@ std::string_view simd_isa_request_ignored() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The tiled engine (the parameterizations of BuiltinParams; the others: batch_registered.cpp)
+// The tiled engine (the parameterizations of KernelParams; the others: batch_registered.cpp)
 // ---------------------------------------------------------------------------------------------
 namespace {
 
@@ -246,13 +246,13 @@ struct Plan {
     if (f.space.is_dirs()) {
       check = k.check;
     } else {
-      decode = k.decode[f.space.builtin_index()][f.isotropic ? 1 : 0];
+      decode = k.decode[f.space.kernel_index()][f.isotropic ? 1 : 0];
       if (want_jac && to_dirs)
-        jacobian_in = k.jacobian[f.space.builtin_index()][f.isotropic ? 1 : 0];
+        jacobian_in = k.jacobian[f.space.kernel_index()][f.isotropic ? 1 : 0];
     }
     if (!to_dirs) {
-      encode = k.encode[t.space.builtin_index()][t.isotropic ? 1 : 0];
-      if (want_jac) jacobian_out = k.jacobian[t.space.builtin_index()][t.isotropic ? 1 : 0];
+      encode = k.encode[t.space.kernel_index()][t.isotropic ? 1 : 0];
+      if (want_jac) jacobian_out = k.jacobian[t.space.kernel_index()][t.isotropic ? 1 : 0];
     }
     const bool in_rows = interleaved(in);
     const bool out_rows = interleaved(std::span<const Column<T>>(o.columns));
@@ -511,7 +511,7 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
              const ConvertOutput<T>& out, const BatchOptions& options) {
   check_shapes(from, to, in.size(), out.columns.size());
   if (n == 0) return;
-  const auto tabled = [](Form f) { return f.space.is_dirs() || f.space.is_builtin(); };
+  const auto tabled = [](Form f) { return f.space.is_dirs() || f.space.has_kernels(); };
   if (!tabled(from) || !tabled(to))
     return detail::convert_registered(from, to, in, n, out, options);
   const Plan<T> plan(detail::active_kernels().stages<T>(), from, to, in, out,

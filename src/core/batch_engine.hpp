@@ -65,10 +65,10 @@ struct StageKernels {
   using JacobianFn = void (*)(const T* const* coords, T* jac, std::size_t m);
   std::size_t width;  // lanes per vector
   CheckFn check;
-  // [index in BuiltinParams][isotropic]
-  DecodeFn decode[kBuiltinParamCount][2];
-  EncodeFn encode[kBuiltinParamCount][2];
-  JacobianFn jacobian[kBuiltinParamCount][2];
+  // [index in KernelParams][isotropic]
+  DecodeFn decode[kKernelParamCount][2];
+  EncodeFn encode[kKernelParamCount][2];
+  JacobianFn jacobian[kKernelParamCount][2];
   // Transposes between m rows of D values (a row-major (m, D) array, such as a NumPy C-order
   // array) and D scratch columns spaced kTileRows<T> apart; [D] for D = 3, 4, 6, else null.
   using GatherFn = void (*)(const T* rows, T* columns, std::size_t m);

@@ -385,7 +385,7 @@ constexpr void fill_transposes(StageKernels<ScalarOf<B>>& k) {
   }
 }
 
-// The stages of parameterization P, at its index I in BuiltinParams; the decodes on vectors W.
+// The stages of parameterization P, at its index I in KernelParams; the decodes on vectors W.
 template <class B, class W, class P, std::size_t I>
 constexpr void fill_param_stages(StageKernels<ScalarOf<B>>& k) {
   k.decode[I][0] = &decode_stage<W, P, false>;
@@ -413,7 +413,7 @@ constexpr StageKernels<ScalarOf<B>> make_stages() {
   // The plan reads fused_rows for the whole table: the Twin stages must fuse the same widths.
   static_assert(RowTranspose<W, 4>::fused == RowTranspose<B, 4>::fused &&
                 RowTranspose<W, 6>::fused == RowTranspose<B, 6>::fused);
-  for_each_param(BuiltinParams{},
+  for_each_param(KernelParams{},
                  [&]<class P, std::size_t I>() { fill_param_stages<B, W, P, I>(k); });
   return k;
 }

@@ -15,7 +15,7 @@ namespace {
 constexpr std::size_t kBlockRows = 4096;
 
 bool concurrent(Form f) {
-  return f.space.is_dirs() || f.space.is_builtin() || f.space.param().concurrent();
+  return f.space.is_dirs() || f.space.has_kernels() || f.space.param().concurrent();
 }
 
 // One block of rows: decoded into pairs, encoded, measured, written.
@@ -41,6 +41,13 @@ class Block {
  private:
   static constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
+  // The pair the conversions use (accepted_pair), in T's precision as convert_row takes it.
+  static DirPair<double> accepted_in_precision(const DirPair<double>& p) {
+    const DirPair<T> a = accepted_pair(
+        DirPair<T>{{T(p.wi.x), T(p.wi.y), T(p.wi.z)}, {T(p.wo.x), T(p.wo.y), T(p.wo.z)}});
+    return {{a.wi.x, a.wi.y, a.wi.z}, {a.wo.x, a.wo.y, a.wo.z}};
+  }
+
   void read(std::span<const ConstColumn<T>> in, std::size_t r0) {
     const std::size_t d = in.size();
     for (std::size_t i = 0; i < m_; ++i)
@@ -51,7 +58,7 @@ class Block {
   // Rows of `from` to direction pairs and their validity (NaN pairs where invalid).
   void decode() {
     const std::size_t d = dimension(from_);
-    if (!from_.space.is_dirs() && !from_.space.is_builtin()) {
+    if (!from_.space.is_dirs() && !from_.space.has_kernels()) {
       from_.space.param().inverse_rows(from_.isotropic, qin_.data(), m_, pairs_.data(),
                                        valid_.data());
       return;
@@ -72,7 +79,7 @@ class Block {
         const double v[6] = {p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z};
         std::copy(v, v + 6, qout_.begin() + std::ptrdiff_t(6 * i));
       }
-    } else if (to_.space.is_builtin()) {
+    } else if (to_.space.has_kernels()) {
       for (std::size_t i = 0; i < m_; ++i) {
         const auto& p = pairs_[i];
         const T w[6] = {T(p.wi.x), T(p.wi.y), T(p.wi.z), T(p.wo.x), T(p.wo.y), T(p.wo.z)};
@@ -81,8 +88,9 @@ class Block {
         for (std::size_t c = 0; c < d; ++c) qout_[i * d + c] = valid_[i] ? double(q[c]) : kNan;
       }
     } else {
-      for (auto& p : pairs_) p = accepted_pair(p);
+      for (auto& p : pairs_) p = accepted_in_precision(p);
       to_.space.param().forward_rows(to_.isotropic, pairs_.data(), m_, qout_.data());
+      for (double& v : qout_) v = double(T(v));  // what the caller gets, and the measure sees
     }
     for (std::size_t i = 0; i < m_; ++i)
       if (!valid_[i]) std::fill_n(qout_.begin() + std::ptrdiff_t(i * d), d, kNan);
@@ -95,13 +103,13 @@ class Block {
     const Form side = out_side ? to_ : from_;
     const std::vector<double>& q = out_side ? qout_ : qin_;
     const std::size_t d = dimension(side);
-    if (!side.space.is_dirs() && !side.space.is_builtin()) {
+    if (!side.space.is_dirs() && !side.space.has_kernels()) {
       side.space.param().jacobian_rows(side.isotropic, q.data(), m_, jac.data());
     } else if (!side.space.is_dirs()) {
       for (std::size_t i = 0; i < m_; ++i) {
         T qt[kMaxDim];
         for (std::size_t c = 0; c < d; ++c) qt[c] = T(q[i * d + c]);
-        jac[i] = double(visit_builtin(side.space.builtin_index(), [&](auto p) {
+        jac[i] = double(visit_kernel_param(side.space.kernel_index(), [&](auto p) {
           return jacobian_of<decltype(p)>(side.isotropic, qt);
         }));
       }

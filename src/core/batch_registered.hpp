@@ -1,4 +1,4 @@
-// convert() for forms whose parameterization is outside BuiltinParams (registered at run time):
+// convert() for forms whose parameterization is outside KernelParams (registered at run time):
 // blocks of rows through the descriptors' row maps (ParamDescriptor::forward_rows, ...), with the
 // built-in side, if any, through the scalar reference (convert_row). Slower than the SIMD tables,
 // the same semantics (masks, NaN rows, the measure).

@@ -276,7 +276,7 @@ double jacobian_condition(Form form, const T* q) {
 template <class T>
 T reference_jacobian(Form form, const T* q) {
   if (form.space == Space::dirs) return T(1);
-  return visit_builtin(form.space.builtin_index(), [&](auto p) {
+  return visit_kernel_param(form.space.kernel_index(), [&](auto p) {
     return detail::jacobian_of<decltype(p), T>(form.isotropic, q);
   });
 }
@@ -822,7 +822,7 @@ TYPED_TEST(BatchTest, EncodeOfUncheckedRowsIsCheckThenEncode) {
     k.check(in_cols, copy_cols, mask_old.data(), n, {});
     for (Form to : test::parameterization_forms()) {
       SCOPED_TRACE(std::string(detail::isa_name(isa)) + " dirs->" + form_name(to));
-      const auto encode = k.encode[to.space.builtin_index()][to.isotropic ? 1 : 0];
+      const auto encode = k.encode[to.space.kernel_index()][to.isotropic ? 1 : 0];
       Table<T> out_old = make_table<T>(dimension(to), n), out_new = out_old;
       T *o_old[4], *o_new[4];
       for (std::size_t c = 0; c < dimension(to); ++c) {
@@ -1425,6 +1425,39 @@ TYPED_TEST(BatchLaneOps, MathFunctionsAreAccurate) {
   EXPECT_LE(worst_atan2, 3.0);
   EXPECT_LE(worst_sin, 2.0);
   EXPECT_LE(worst_cos, 2.0);
+}
+
+}  // namespace
+}  // namespace halfback
+
+namespace halfback {
+namespace {
+
+// The parameterizations without SIMD kernels (PortableParams) go through the descriptors' row
+// maps in blocks: the same bits as convert_one, in both directions, with the measure and the mask,
+// on one thread or two.
+TYPED_TEST(BatchTest, PortableParameterizationsMatchTheScalarPath) {
+  using T = TypeParam;
+  auto pairs = test_pairs(20000, 41);
+  pairs.push_back({{0, 0, -1}, {0, 0, 1}});  // invalid
+  for (Space s : kBuiltinSpaces) {
+    if (s.has_kernels()) continue;
+    for (const bool iso : {false, true}) {
+      const Form form{s, iso};
+      SCOPED_TRACE(form_name(form));
+      const Table<T> dirs = inputs_for<T>({Space::dirs, false}, pairs);
+      const Table<T> coords = inputs_for<T>(form, pairs);
+      for (const int threads : {1, 2}) {
+        for (const auto& [from, to, in] : {std::tuple{Form{Space::dirs}, form, &dirs},
+                                           std::tuple{form, Form{Space::dirs}, &coords}}) {
+          const Result<T> b = run_batch<T>(from, to, *in, true, threads);
+          const Result<T> r = run_scalar<T>(from, to, *in);
+          EXPECT_TRUE(same_bits(b, r)) << name_of(from.space) << " -> " << name_of(to.space);
+          EXPECT_EQ(b.valid.back(), 0);
+        }
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -85,7 +85,7 @@ inline T jacobian_of(bool isotropic, const T* q) {
 
 inline constexpr int kMaxDim = 6;
 
-// A parameterization outside BuiltinParams, through its descriptor (in double).
+// A parameterization outside KernelParams, through its descriptor (in double).
 template <class T>
 inline Solved<T> decode_registered(Form from, const T* in) {
   const ParamDescriptor& d = from.space.param();
@@ -127,9 +127,10 @@ inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
     pair = accepted_pair(pair);
   } else {
     const Solved<T> s =
-        from.space.is_builtin()
-            ? visit_builtin(from.space.builtin_index(),
-                            [&](auto p) { return decode_param<decltype(p)>(from.isotropic, in); })
+        from.space.has_kernels()
+            ? visit_kernel_param(
+                  from.space.kernel_index(),
+                  [&](auto p) { return decode_param<decltype(p)>(from.isotropic, in); })
             : decode_registered(from, in);
     pair = s.pair;
     ok = s.in_domain;
@@ -146,9 +147,9 @@ inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
   } else {
     // A decoded pair too is unit only to rounding (accepted_pair keeps it when within 4ε).
     const DirPair<T> unit = accepted_pair(pair);
-    if (to.space.is_builtin())
-      visit_builtin(to.space.builtin_index(),
-                    [&](auto p) { encode_param<decltype(p)>(to.isotropic, unit, out); });
+    if (to.space.has_kernels())
+      visit_kernel_param(to.space.kernel_index(),
+                         [&](auto p) { encode_param<decltype(p)>(to.isotropic, unit, out); });
     else
       encode_registered(to, unit, out);
   }
@@ -157,8 +158,8 @@ inline bool convert_row(Form from, Form to, const T* in, T* out, T* jacobian) {
     const T* q = !to.space.is_dirs() ? out : in;
     if (side.space.is_dirs())
       *jacobian = T(1);
-    else if (side.space.is_builtin())
-      *jacobian = visit_builtin(side.space.builtin_index(), [&](auto p) {
+    else if (side.space.has_kernels())
+      *jacobian = visit_kernel_param(side.space.kernel_index(), [&](auto p) {
         return jacobian_of<decltype(p)>(side.isotropic, q);
       });
     else

@@ -78,9 +78,9 @@ struct Registry {
 
   Registry() {
     std::size_t i = 0;
-    for_each_param(BuiltinParams{}, [&]<class P, std::size_t I>() {
-      slots[i++] = std::make_shared<CompiledParam<P>>();
-    });
+    auto add = [&]<class P, std::size_t I>() { slots[i++] = std::make_shared<CompiledParam<P>>(); };
+    for_each_param(KernelParams{}, add);
+    for_each_param(PortableParams{}, add);
     count.store(i, std::memory_order_release);
   }
   const ParamDescriptor* find(Space s) const {

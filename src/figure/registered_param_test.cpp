@@ -108,7 +108,7 @@ Space toy_space() {
 
 TEST(RegisteredParam, IsNamedListedAndDescribed) {
   const Space s = toy_space();
-  EXPECT_FALSE(s.is_builtin());
+  EXPECT_FALSE(s.has_kernels());
   EXPECT_EQ(name_of(s), "test-cosine-spherical");
   EXPECT_EQ(space_from_name("test-cosine-spherical"), s);
   const std::vector<Space> all = parameterizations();

@@ -79,7 +79,7 @@ TEST(BrdfBatch, PropagatesExceptions) {
 TEST(EvalAt, EveryFormAgreesWithDirections) {
   const Smooth b;
   const auto pairs = random_pairs(500, 3);
-  for (Space space : kBuiltinSpaces) {
+  for (Space space : kKernelSpaces) {
     for (bool iso : {false, true}) {
       const Form form{space, iso};
       for (const auto& p : pairs) {

@@ -34,7 +34,7 @@ std::vector<DesignProfile> family_profiles() {
   std::vector<DesignProfile> profiles;
   for (double sigma : {0.08, 0.1, 0.12, 0.15})
     profiles.push_back(
-        design_profile(lobe(sigma), kBuiltinSpaces, {32, 32, 32}, ErrorSpace::linear));
+        design_profile(lobe(sigma), kKernelSpaces, {32, 32, 32}, ErrorSpace::linear));
   return profiles;
 }
 
@@ -56,7 +56,7 @@ void expect_bijection(const AxisWarp& w, const std::string& what) {
 TEST(Design, EveryWarpIsAMonotoneBijectionOfItsAxis) {
   const std::vector<DesignProfile> profiles = family_profiles();
   const std::vector<LearnedWarps> learned = learn_warps(profiles, 0);
-  ASSERT_EQ(learned.size(), kBuiltinSpaces.size());
+  ASSERT_EQ(learned.size(), kKernelSpaces.size());
   for (const LearnedWarps& l : learned)
     for (bool iso : {true, false}) {
       const GridSpec g = default_grid(l.space, iso ? GridKind::isotropic : GridKind::full, {4});
@@ -147,7 +147,7 @@ TEST(Design, LeaveOneOutNeverReadsTheHeldOutBrdf) {
   const std::vector<LearnedWarps> before = learn_warps(profiles, 1);
   const std::vector<LearnedWarps> others_before = learn_warps(profiles, 0);
   // Replace the held-out BRDF by a very different one (a lobe 5x wider).
-  profiles[1] = design_profile(lobe(0.6), kBuiltinSpaces, {32, 32, 32}, ErrorSpace::linear);
+  profiles[1] = design_profile(lobe(0.6), kKernelSpaces, {32, 32, 32}, ErrorSpace::linear);
   EXPECT_EQ(learn_warps(profiles, 1), before);
   // It does count when it is not held out (the check above could not pass by accident).
   EXPECT_NE(learn_warps(profiles, 0), others_before);

@@ -37,7 +37,7 @@ double smooth_spherical(const DirPair<double>& p) {
 }
 
 TEST(Gonio, BudgetsAreMetWithinTheStepOfTheGrid) {
-  for (Space s : kBuiltinSpaces)
+  for (Space s : kKernelSpaces)
     for (bool iso : {true, false})
       for (std::size_t budget : {std::size_t(1000), std::size_t(20000)}) {
         const GonioSetup setup{s, iso, Design::regular, budget, 1};

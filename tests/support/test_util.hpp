@@ -116,7 +116,7 @@ inline DirPair<double> rotate_pair(const DirPair<double>& p, double alpha) {
 // Every parameterization's full and isotropic forms, and a form's name for test messages.
 inline std::vector<Form> parameterization_forms() {
   std::vector<Form> forms;
-  for (Space s : kBuiltinSpaces) {
+  for (Space s : kKernelSpaces) {
     forms.push_back({s, false});
     forms.push_back({s, true});
   }

@@ -1,8 +1,9 @@
-// What a parameterization is (the concept `Parameterization`), the list of the built-in ones, and
+// What a parameterization is (the concept `Parameterization`), the lists of the built-in ones, and
 // their run-time form (ParamDescriptor) through which every tool reaches them: the batch engine's
 // tables, the run-time names (space.hpp), figure axes, the samplers' charts, the study's rows, the
 // explorer and the Python module are all derived from these. Adding a parameterization is its
-// header (params/) and one line in BuiltinParams below, plus its tests (docs/architecture.md).
+// header (params/) and one line in KernelParams or PortableParams below, plus its tests
+// (docs/architecture.md).
 #pragma once
 
 #include <array>
@@ -20,9 +21,12 @@
 #include "halfback/core/params/charts.hpp"
 #include "halfback/core/params/common.hpp"
 #include "halfback/core/params/halfdiff.hpp"
+#include "halfback/core/params/halfway_disk.hpp"
 #include "halfback/core/params/hybrid.hpp"
 #include "halfback/core/params/ortho.hpp"
+#include "halfback/core/params/rectified_hybrid.hpp"
 #include "halfback/core/params/spherical.hpp"
+#include "halfback/core/params/stereographic.hpp"
 
 namespace halfback {
 
@@ -67,9 +71,15 @@ struct ParamList {
 };
 
 // The built-in parameterizations, in the order of every run-time list (space ids 1, 2, ...).
-using BuiltinParams = ParamList<Spherical, HalfDiff, Ortho, Hybrid>;
+// KernelParams have SIMD kernels in the batch engine's tables, one instantiation per instruction
+// set; PortableParams are converted through their descriptors, in double, a block of rows at a
+// time (batch_registered.cpp): each in the SIMD tables would add to every clean build's heaviest
+// translation units (docs/performance.md, "Building") for maps that are not on a hot path.
+using KernelParams = ParamList<Spherical, HalfDiff, Ortho, Hybrid>;
+using PortableParams = ParamList<RectifiedHybrid, StereoHalfDiff, Stereographic, HalfwayDisk>;
 
-inline constexpr std::size_t kBuiltinParamCount = BuiltinParams::size;
+inline constexpr std::size_t kKernelParamCount = KernelParams::size;
+inline constexpr std::size_t kBuiltinParamCount = KernelParams::size + PortableParams::size;
 
 namespace detail {
 template <class P, class List>
@@ -82,13 +92,22 @@ struct IndexIn<P, ParamList<Ps...>> {
       if (same[i]) return i;
     return sizeof...(Ps);
   }();
-  static_assert(value < sizeof...(Ps), "not a built-in parameterization (BuiltinParams)");
+  static constexpr bool found = value < sizeof...(Ps);
 };
 }  // namespace detail
 
-// The position of P in BuiltinParams.
+// The position of P in KernelParams.
 template <class P>
-inline constexpr std::size_t builtin_index = detail::IndexIn<P, BuiltinParams>::value;
+inline constexpr std::size_t kernel_index = detail::IndexIn<P, KernelParams>::value;
+
+// The position of P among the built-in parameterizations: KernelParams, then PortableParams.
+template <class P>
+inline constexpr std::size_t builtin_index = [] {
+  using InKernels = detail::IndexIn<P, KernelParams>;
+  using InPortable = detail::IndexIn<P, PortableParams>;
+  static_assert(InKernels::found || InPortable::found, "not a built-in parameterization");
+  return InKernels::found ? InKernels::value : KernelParams::size + InPortable::value;
+}();
 
 // Calls f.template operator()<P, I>() for each P of the list, with I its index.
 template <class... Ps, class F>
@@ -99,9 +118,9 @@ constexpr void for_each_param(ParamList<Ps...>, F&& f) {
   (std::index_sequence_for<Ps...>{});
 }
 
-// Calls f(P{}) with the built-in parameterization at `index` (< kBuiltinParamCount).
+// Calls f(P{}) with the built-in parameterization at `index` (< kKernelParamCount).
 template <class F>
-decltype(auto) visit_builtin(std::size_t index, F&& f) {
+decltype(auto) visit_kernel_param(std::size_t index, F&& f) {
   return [&]<class... Ps>(ParamList<Ps...>) -> decltype(auto) {
     using R = decltype(f(Spherical{}));
     if constexpr (std::is_void_v<R>) {
@@ -113,7 +132,7 @@ decltype(auto) visit_builtin(std::size_t index, F&& f) {
       ((i++ == index ? (result = f(Ps{}), true) : false) || ...);
       return result;
     }
-  }(BuiltinParams{});
+  }(KernelParams{});
 }
 
 // A parameterization at run time: its names and axes, and its maps in double precision, for code
@@ -159,7 +178,7 @@ class ParamDescriptor {
   virtual Tuple3<double> reciprocal_iso(const Tuple3<double>& q) const = 0;
   virtual Tuple3<double> mirror_iso(const Tuple3<double>& q) const = 0;
 
-  // Blocks of m rows, for the batch engine's path of a parameterization outside BuiltinParams
+  // Blocks of m rows, for the batch engine's path of a parameterization outside KernelParams
   // (row-major: `coords` holds m tuples of 4, or 3 when isotropic). The defaults loop over the
   // maps above; a run-time parameterization overrides them to call its vectorized code once.
   virtual void forward_rows(bool isotropic, const DirPair<double>* pairs, std::size_t m,

@@ -1,6 +1,6 @@
 // Run-time names for the coordinate spaces, for code that picks a parameterization from user
 // input (CLI, Python, file metadata, the explorer). A Space is `dirs` (the 6 Cartesian components
-// of the pair) or a parameterization: one of BuiltinParams (parameterization.hpp), or one
+// of the pair) or a parameterization: one of KernelParams (parameterization.hpp), or one
 // registered at run time (a test's, or a Python user's). Compile-time code uses the structs of
 // params/ directly; space_of<P> names a built-in one.
 #pragma once
@@ -26,13 +26,15 @@ class Space {
   static const Space dirs;
   constexpr Space() = default;  // dirs
 
-  // Ids: 0 is dirs, 1 .. kBuiltinParamCount the built-in list, then the registered ones.
+  // Ids: 0 is dirs, 1 .. kKernelParamCount KernelParams, then PortableParams, then the registered
+  // ones.
   static constexpr Space from_id(std::uint16_t id) { return Space(id); }
   constexpr std::uint16_t id() const { return id_; }
   constexpr bool is_dirs() const { return id_ == 0; }
-  constexpr bool is_builtin() const { return id_ >= 1 && id_ <= kBuiltinParamCount; }
-  // The position in BuiltinParams; only for is_builtin().
-  constexpr std::size_t builtin_index() const { return std::size_t(id_) - 1; }
+  // Whether the batch engine has SIMD kernels for it (KernelParams).
+  constexpr bool has_kernels() const { return id_ >= 1 && id_ <= kKernelParamCount; }
+  // The position in KernelParams; only for has_kernels().
+  constexpr std::size_t kernel_index() const { return std::size_t(id_) - 1; }
 
   // The parameterization; throws std::invalid_argument for dirs.
   const ParamDescriptor& param() const;
@@ -50,7 +52,13 @@ inline constexpr Space Space::dirs{};
 template <class P>
 inline constexpr Space space_of = Space::from_id(std::uint16_t(1 + builtin_index<P>));
 
-// The built-in parameterizations, in the order of BuiltinParams.
+// The parameterizations with SIMD kernels, in the order of KernelParams.
+inline constexpr std::array<Space, kKernelParamCount> kKernelSpaces = [] {
+  std::array<Space, kKernelParamCount> a{};
+  for (std::size_t i = 0; i < a.size(); ++i) a[i] = Space::from_id(std::uint16_t(i + 1));
+  return a;
+}();
+// Every built-in parameterization: KernelParams, then PortableParams.
 inline constexpr std::array<Space, kBuiltinParamCount> kBuiltinSpaces = [] {
   std::array<Space, kBuiltinParamCount> a{};
   for (std::size_t i = 0; i < a.size(); ++i) a[i] = Space::from_id(std::uint16_t(i + 1));

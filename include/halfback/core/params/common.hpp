@@ -170,6 +170,26 @@ constexpr Axis sine_axis(std::string_view column, std::string_view label) {
   return {column, label, AxisKind::length, 0, 1, 0.1, AngleEncoding::sine};
 }
 
+namespace detail {
+
+// Rotates a solved pair about n so that h̄ lies on +x: the canonical pose, for isotropic inverses
+// that first place ωi at azimuth 0 (nothing to do when h̄ = 0: ωi is then already at azimuth 0).
+// The pose is discontinuous at h̄ = 0, so an h̄ at the rounding level of its terms (an exact mirror
+// configuration) counts as zero rather than picking a random rotation.
+template <class T>
+inline void rotate_to_canonical_pose(Solved<T>& r) {
+  using L = LaneOps<T>;
+  const T hx = r.pair.wi.x + r.pair.wo.x, hy = r.pair.wi.y + r.pair.wo.y;
+  const T len = L::sqrt(hx * hx + hy * hy);
+  const T scale = L::abs(r.pair.wi.x) + L::abs(r.pair.wo.x) + L::abs(r.pair.wo.y);
+  const auto zero = len <= T(8 * std::numeric_limits<ScalarOf<T>>::epsilon()) * scale;
+  const T c = L::select(zero, T(1), hx / len), s = L::select(zero, T(0), -hy / len);
+  r.pair.wi = rotate_z(r.pair.wi, c, s);
+  r.pair.wo = rotate_z(r.pair.wo, c, s);
+}
+
+}  // namespace detail
+
 // --------------------------------------------------------------------------------------------
 // Checked operations, common to all parameterizations.
 // --------------------------------------------------------------------------------------------
@@ -216,9 +236,15 @@ inline MaskOf<T> valid_iso(const Tuple3<T>& q) {
 }
 
 // The measure of the isotropic coordinates: ∫ over the rotation about n of dωi dωo = J3 dq3.
+// The measure of the isotropic coordinates: ∫ over the rotation about n of dωi dωo = J3 dq3. A
+// parameterization whose isotropic coordinates are not three of its 4D ones with the rotation
+// dropped (a radius of Cartesian coordinates, say) gives its own P::jacobian_iso.
 template <class P, class T>
 inline T jacobian_iso(const Tuple3<T>& q) {
-  return T(kTwoPi<ScalarOf<T>>) * P::jacobian(P::lift_iso(q));
+  if constexpr (requires { P::template jacobian_iso<T>(q); })
+    return P::template jacobian_iso<T>(q);
+  else
+    return T(kTwoPi<ScalarOf<T>>) * P::jacobian(P::lift_iso(q));
 }
 
 }  // namespace halfback

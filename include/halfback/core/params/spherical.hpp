@@ -77,18 +77,8 @@ struct Spherical {
 
   template <class T>
   static Solved<T> inverse_iso_raw(const Tuple3<T>& q) {
-    using L = LaneOps<T>;
     Solved<T> r = inverse_raw(lift_iso(q));
-    // Rotate by -φh so that h̄ lies on +x (nothing to do when h̄ = 0: ωi is already at azimuth 0).
-    // The pose is discontinuous at h̄ = 0, so an h̄ at the rounding level of its two terms (an
-    // exact mirror configuration, Δφ = π) counts as zero rather than picking a random rotation.
-    const T hx = r.pair.wi.x + r.pair.wo.x, hy = r.pair.wi.y + r.pair.wo.y;
-    const T len = L::sqrt(hx * hx + hy * hy);
-    const T scale = L::abs(r.pair.wi.x) + L::abs(r.pair.wo.x) + L::abs(r.pair.wo.y);
-    const auto zero = len <= T(8 * std::numeric_limits<ScalarOf<T>>::epsilon()) * scale;
-    const T c = L::select(zero, T(1), hx / len), s = L::select(zero, T(0), -hy / len);
-    r.pair.wi = detail::rotate_z(r.pair.wi, c, s);
-    r.pair.wo = detail::rotate_z(r.pair.wo, c, s);
+    detail::rotate_to_canonical_pose(r);
     return r;
   }
 
