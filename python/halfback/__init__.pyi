@@ -1,5 +1,5 @@
 from collections.abc import Mapping, Sequence
-from typing import Any, Literal
+from typing import Any, Literal, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -85,7 +85,26 @@ def load(spec: str) -> Brdf:
 def models() -> list[str]:
     """The analytic models' names."""
 
-StudySettings = Mapping[str, Any]
+class StudySettings(TypedDict, total=False):
+    """The options of `halfback study`, '-' spelled '_' (missing: the defaults)."""
+
+    params: Sequence[str]  # parameterization names (default: all of them, spherical last)
+    space: str  # the error space (also "error_space")
+    error_space: str
+    designs: Sequence[str]
+    profiles: Sequence[str]  # study_profile() of every BRDF, for the learned design
+    quick: bool
+    no_gonio: bool
+    no_images: bool
+    budgets: Sequence[int]
+    budgets_4d: Sequence[int]
+    test_pairs: int
+    env: Sequence[str]
+    image_budget: int
+    image_size: int
+    image_spp: int
+    max_theta: float
+    seed: int
 
 def study_brdf(spec: str, settings: StudySettings | None = None) -> dict[str, Any]:
     """The study of one BRDF: tables as CSV text, "settings" and "renderings" (GIL released)."""
