@@ -595,10 +595,11 @@ PySettings study_settings(const py::object& settings) {
     else if (key == "env")
       s.environments = setting<std::vector<std::string>>(v, key);
     else
-      throw py::value_error("settings: unknown key '" + key +
-                            "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
-                            "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
-                            "seed, no_gonio, no_images)");
+      throw py::value_error(
+          "settings: unknown key '" + key +
+          "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
+          "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
+          "seed, no_gonio, no_images)");
   }
   return out;
 }

@@ -51,7 +51,8 @@ inline BrdfResult to_result(const FakeBrdf& f) {
     if (!f.isotropic) add_azimuthal(table("azimuthal"), p.space, p.azimuthal_4d, 4);
     add_separability(table("separability"), p.space, p.ranks, p.separability_2d, 2);
     add_separability(table("separability"), p.space, p.ranks, p.separability_3d, 3);
-    if (!f.isotropic) add_separability(table("separability"), p.space, p.ranks, p.separability_4d, 4);
+    if (!f.isotropic)
+      add_separability(table("separability"), p.space, p.ranks, p.separability_4d, 4);
     for (const GonioPoint& g : p.gonio) add_gonio(table("gonio"), p.space, g, 3);
     for (const GonioPoint& g : p.gonio_4d) add_gonio(table("gonio"), p.space, g, 4);
     for (const ImagePoint& i : p.images) add_image(table("image"), p.space, i);

@@ -85,7 +85,8 @@ bool is_image_line(const std::string& line) {
 // "![alt](file.png)": the file's bytes as a data: URI, or a link when it cannot be read.
 std::string image_html(const std::string& line, const std::filesystem::path& image_dir) {
   const std::size_t mid = line.find("](");
-  const std::string alt = line.substr(2, mid - 2), src = line.substr(mid + 2, line.size() - mid - 3);
+  const std::string alt = line.substr(2, mid - 2),
+                    src = line.substr(mid + 2, line.size() - mid - 3);
   std::ifstream f(image_dir / src, std::ios::binary);
   const std::string data((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   if (!f.good() && data.empty())
@@ -149,8 +150,8 @@ std::string markdown_to_html(std::string_view markdown, const std::filesystem::p
   };
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const std::string& l = lines[i];
-    const bool block = l.empty() || l[0] == '#' || is_image_line(l) || is_table_line(l) ||
-                       is_list_line(l);
+    const bool block =
+        l.empty() || l[0] == '#' || is_image_line(l) || is_table_line(l) || is_list_line(l);
     if (!block) {
       paragraph += (paragraph.empty() ? "" : " ") + l;
       continue;

@@ -124,7 +124,8 @@ std::string describe_config(const StudyConfig& c) {
     envs += csv_text_field(e.label);
   }
   return fmt::format(
-      "parameterizations = {}\nspace = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = {}\nbudgets_4d = {}\n"
+      "parameterizations = {}\nspace = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = "
+      "{}\nbudgets_4d = {}\n"
       "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
       "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
       "learned_from = {}\n",
@@ -326,8 +327,8 @@ constexpr std::string_view kBrdfHeader = "brdf,isotropic,seconds";
 
 StudyTables to_tables(const BrdfResult& b) {
   StudyTables t;
-  t["brdf"] = fmt::format("{}\n{},{},{}\n", kBrdfHeader, csv_text_field(b.label),
-                          int(b.isotropic), format_csv_number(b.seconds));
+  t["brdf"] = fmt::format("{}\n{},{},{}\n", kBrdfHeader, csv_text_field(b.label), int(b.isotropic),
+                          format_csv_number(b.seconds));
   for (const MetricTable& table : b.tables)
     t[table.name] = csv_header(table) + csv_rows(table, b.label, NumberText::exact);
   return t;
@@ -359,15 +360,14 @@ void read_brdf_table(const StudyTables& t, const std::string& source, BrdfResult
 void check_rows(const MetricTable& table, std::string_view brdf, const BrdfResult& b,
                 const std::string& source) {
   if (!table.rows.empty() && brdf != b.label)
-    throw std::runtime_error(fmt::format("{}: table {}: rows of '{}' in the tables of '{}'",
-                                         source, table.name, brdf, b.label));
+    throw std::runtime_error(fmt::format("{}: table {}: rows of '{}' in the tables of '{}'", source,
+                                         table.name, brdf, b.label));
   for (const Row& row : table.rows) {
     const std::string& name = table.text(row, "parameterization");
-    if (std::none_of(b.params.begin(), b.params.end(),
-                     [&](Space s) { return name_of(s) == name; }))
-      throw std::runtime_error(fmt::format(
-          "{}: table {}: the parameterization '{}' is not one of the run's ({})", source,
-          table.name, name, joined(names_of(b.params))));
+    if (std::none_of(b.params.begin(), b.params.end(), [&](Space s) { return name_of(s) == name; }))
+      throw std::runtime_error(
+          fmt::format("{}: table {}: the parameterization '{}' is not one of the run's ({})",
+                      source, table.name, name, joined(names_of(b.params))));
   }
 }
 

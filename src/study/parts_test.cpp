@@ -8,8 +8,8 @@
 #include <fstream>
 #include <numbers>
 
-#include "halfback/loader/load.hpp"
 #include "fake_results.hpp"
+#include "halfback/loader/load.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::study {

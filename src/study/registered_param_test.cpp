@@ -114,7 +114,8 @@ TEST(StudyRegistered, ParameterizationsAreChosenByName) {
   c.params = {space_of<Hybrid>, space_of<HalfDiff>};
   const std::string text = describe_config(c);
   EXPECT_EQ(config_from_description(text, "t").params, c.params);
-  EXPECT_THROW(config_from_description("parameterizations = toy-hybrid\n" + text.substr(text.find('\n') + 1), "t"),
+  EXPECT_THROW(config_from_description(
+                   "parameterizations = toy-hybrid\n" + text.substr(text.find('\n') + 1), "t"),
                std::runtime_error);
 }
 

@@ -235,8 +235,8 @@ std::string kind_of(const std::string& label) {
 
 // The gonio-reflectometer at `ref`, each parameterization in its best design, for the BRDFs
 // that c compares (INFINITY for the others).
-SummaryMetric best_design_metric(const std::vector<BrdfResult>& results,
-                                 const DesignComparison& c, std::size_t ref) {
+SummaryMetric best_design_metric(const std::vector<BrdfResult>& results, const DesignComparison& c,
+                                 std::size_t ref) {
   SummaryMetric best{
       fmt::format("gonio-reflectometer, N = {}, each in its best design", ref), "best", {}};
   for (const BrdfResult& b : results) {

@@ -24,8 +24,7 @@ std::vector<std::string> param_names(const std::vector<Space>& params) {
 // A bar chart with a row per BRDF and a bar per parameterization: value(b, s) for each BRDF of
 // results that `shown` accepts.
 template <class Value, class Shown>
-figure::BarChart per_brdf_chart(const std::vector<BrdfResult>& results, Value value,
-                                Shown shown) {
+figure::BarChart per_brdf_chart(const std::vector<BrdfResult>& results, Value value, Shown shown) {
   figure::BarChart c;
   c.series = param_names(params_of(results));
   for (const BrdfResult& b : results) {
@@ -37,7 +36,8 @@ figure::BarChart per_brdf_chart(const std::vector<BrdfResult>& results, Value va
   return c;
 }
 
-figure::BarChart azimuthal_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+figure::BarChart azimuthal_chart(const std::vector<BrdfResult>& results,
+                                 const StudyConfig& config) {
   figure::BarChart c = per_brdf_chart(
       results, [](const BrdfResult& b, Space s) { return azimuthal_error(b, s, 3); },
       [](const BrdfResult&) { return true; });
@@ -157,8 +157,8 @@ figure::Scene designs_chart(const std::vector<BrdfResult>& results, const StudyC
   const DesignComparison c = compare_designs(results, ref);
   if (c.brdfs.empty() || c.keys.size() < 2) return {};
   figure::BarChart chart;
-  chart.title =
-      fmt::format("Designs: median relative error ({} space) at N = {}", name_of(config.space), ref);
+  chart.title = fmt::format("Designs: median relative error ({} space) at N = {}",
+                            name_of(config.space), ref);
   chart.x_label =
       fmt::format("median over {} BRDFs of the reconstruction's relative error", c.brdfs.size());
   for (const DesignKey& k : c.keys) chart.series.push_back(design_name(k));

@@ -146,8 +146,8 @@ std::string azimuthal_table_md(const std::vector<BrdfResult>& results);
 std::string azimuthal_4d_table_md(const std::vector<BrdfResult>& results);
 // One table of separability errors of the tables of `dims` ("r1 / r2 / ..." per cell), and which
 // parameterization has the lowest rank-1 error.
-std::string separability_table_md(const std::vector<BrdfResult>& results,
-                                  const StudyConfig& config, const char* heading, int dims);
+std::string separability_table_md(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                                  const char* heading, int dims);
 std::string gonio_budget_table(const std::vector<BrdfResult>& results, std::size_t budget);
 std::string samples_to_target_table(const std::vector<BrdfResult>& results, double target);
 std::string matching_budget_table(const std::vector<BrdfResult>& results, std::size_t ref);
@@ -171,8 +171,8 @@ std::string report_header(const std::vector<BrdfResult>& results, const StudyCon
 std::string summary_section(const std::vector<BrdfResult>& results,
                             const std::vector<SummaryMetric>& metrics, const ReportPlots& plots);
 std::string azimuthal_section(const std::vector<BrdfResult>& results, bool any_aniso);
-std::string separability_section(const std::vector<BrdfResult>& results,
-                                 const StudyConfig& config, bool any_aniso);
+std::string separability_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                                 bool any_aniso);
 std::string gonio_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
                           bool any_aniso, const ReportPlots& plots);
 std::string designs_section(const std::vector<BrdfResult>& results, const StudyConfig& config,

@@ -64,8 +64,8 @@ std::string azimuthal_section(const std::vector<BrdfResult>& results, bool any_a
 }
 
 // 2. Separability.
-std::string separability_section(const std::vector<BrdfResult>& results,
-                                 const StudyConfig& config, bool any_aniso) {
+std::string separability_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                                 bool any_aniso) {
   std::string ranks;
   for (std::size_t i = 0; i < config.ranks.size(); ++i)
     ranks += fmt::format("{}{}", i ? ", " : "", config.ranks[i]);
@@ -75,8 +75,8 @@ std::string separability_section(const std::vector<BrdfResult>& results,
       ranks);
   md += separability_table_md(results, config, "2D projection ρ̄(a, b):", 2);
   md += "![Separability, rank 1](separability.png)\n\n";
-  md += separability_table_md(results, config, "3D table unfolded along its azimuth, (a, b) × φ:",
-                              3);
+  md +=
+      separability_table_md(results, config, "3D table unfolded along its azimuth, (a, b) × φ:", 3);
   if (any_aniso)
     md += separability_table_md(results, config,
                                 "Anisotropic BRDFs, 4D table unfolded as (a, φa) × (b, φb):", 4);
@@ -222,8 +222,8 @@ std::string files_and_networks_section(const std::vector<BrdfResult>& results,
   md += file_network_winner_table(results, ref);
   if (ref == 0) return md;
   return md +
-         fmt::format(
-             "Gonio-reflectometer error at N = {} (regular design), file then network:\n\n", ref) +
+         fmt::format("Gonio-reflectometer error at N = {} (regular design), file then network:\n\n",
+                     ref) +
          file_network_gonio_table(results, ref) + "\n";
 }
 

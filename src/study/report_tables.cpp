@@ -132,8 +132,8 @@ std::string azimuthal_4d_table_md(const std::vector<BrdfResult>& results) {
   return md;
 }
 
-std::string separability_table_md(const std::vector<BrdfResult>& results,
-                                  const StudyConfig& config, const char* heading, int dims) {
+std::string separability_table_md(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                                  const char* heading, int dims) {
   const std::vector<Space>& params = params_of(results);
   std::string t = std::string(heading) + "\n\n" + table_header("BRDF", params);
   Wins w(params);
@@ -162,8 +162,8 @@ std::string separability_table_md(const std::vector<BrdfResult>& results,
 
 std::string gonio_budget_table(const std::vector<BrdfResult>& results, std::size_t budget) {
   const std::vector<Space>& params = params_of(results);
-  std::string md = fmt::format("Budget {} (regular / stratified):\n\n", budget) +
-                   table_header("BRDF", params);
+  std::string md =
+      fmt::format("Budget {} (regular / stratified):\n\n", budget) + table_header("BRDF", params);
   Wins w(params);
   for (const BrdfResult& b : results) {
     md += row_start(b.label);
@@ -195,10 +195,9 @@ std::string samples_to_target_table(const std::vector<BrdfResult>& results, doub
       for (Design d : kDesigns) {
         const GonioCurve c = gonio_curve(points, d);
         cell += (cell.empty() ? "" : " / ") +
-                (c.samples.empty()
-                     ? std::string("–")
-                     : samples_text(samples_to_reach(c.samples, c.errors, target),
-                                    c.samples.front()));
+                (c.samples.empty() ? std::string("–")
+                                   : samples_text(samples_to_reach(c.samples, c.errors, target),
+                                                  c.samples.front()));
       }
       md += " " + cell + " |";
     }
@@ -313,8 +312,7 @@ std::string image_tables(const std::vector<BrdfResult>& results) {
         const MeanImageError m = mean_image_error(image_points(b, s), kDesigns[d]);
         rmse.push_back(m.relative_rmse);
         delta_e.push_back(m.delta_e);
-        rows[d] +=
-            m.count ? fmt::format(" {:.4f} / {:.2f} |", m.relative_rmse, m.delta_e) : " – |";
+        rows[d] += m.count ? fmt::format(" {:.4f} / {:.2f} |", m.relative_rmse, m.delta_e) : " – |";
       }
       rows[d] += "\n";
       rmse_wins[d].add(rmse);

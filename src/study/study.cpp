@@ -48,7 +48,8 @@ std::vector<Space> default_studied() {
 const MetricTable& BrdfResult::table(std::string_view name) const {
   for (const MetricTable& t : tables)
     if (t.name == name) return t;
-  throw std::invalid_argument(fmt::format("study: the result of '{}' has no table '{}'", label, name));
+  throw std::invalid_argument(
+      fmt::format("study: the result of '{}' has no table '{}'", label, name));
 }
 
 void StudyConfig::validate() const {

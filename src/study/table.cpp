@@ -61,7 +61,8 @@ std::size_t MetricTable::column(std::string_view column_name) const {
 void MetricTable::add(Row row) {
   bool fits = row.size() == columns.size();
   for (std::size_t c = 0; fits && c < row.size(); ++c) fits = holds_kind(row[c], columns[c].kind);
-  if (!fits) throw std::logic_error(fmt::format("table {}: a row that does not fit its columns", name));
+  if (!fits)
+    throw std::logic_error(fmt::format("table {}: a row that does not fit its columns", name));
   rows.push_back(std::move(row));
 }
 

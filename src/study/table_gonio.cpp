@@ -18,9 +18,8 @@ MetricTable gonio_table() {
 }
 
 void add_gonio(MetricTable& table, Space space, const GonioPoint& p, int dims) {
-  table.add({std::string(name_of(space)), std::string(name_of(p.design)),
-             std::int64_t(p.samples), p.error, std::int64_t(dims), std::int64_t(p.budget),
-             std::string(name_of(p.spacing))});
+  table.add({std::string(name_of(space)), std::string(name_of(p.design)), std::int64_t(p.samples),
+             p.error, std::int64_t(dims), std::int64_t(p.budget), std::string(name_of(p.spacing))});
 }
 
 std::vector<GonioPoint> gonio_points(const BrdfResult& result, Space space, int dims) {
@@ -64,9 +63,11 @@ void add_budget_rows(MetricTable& into, Space space, const std::vector<GonioPoin
       for (double target : kTargetErrors) {
         const double s = samples_to_reach(c.samples, c.errors, target);
         const bool reached = s != 0 && !std::isinf(s);
-        into.add({std::string(name_of(space)), std::string(name_of(d)), std::int64_t(dims),
-                  target, reached ? fmt::format("{:.0f}", s) : std::string(),
-                  std::string(s == 0 ? "below_range" : reached ? "reached" : "not_reached"),
+        into.add({std::string(name_of(space)), std::string(name_of(d)), std::int64_t(dims), target,
+                  reached ? fmt::format("{:.0f}", s) : std::string(),
+                  std::string(s == 0    ? "below_range"
+                              : reached ? "reached"
+                                        : "not_reached"),
                   std::string(name_of(spacing))});
       }
     }

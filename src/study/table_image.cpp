@@ -14,9 +14,8 @@ MetricTable image_table() {
 }
 
 void add_image(MetricTable& table, Space space, const ImagePoint& p) {
-  table.add({std::string(name_of(space)), std::string(name_of(p.design)),
-             std::int64_t(p.samples), p.environment, p.relative_rmse, p.mean_delta_e,
-             p.p95_delta_e, p.mae, p.rmse, p.ssim});
+  table.add({std::string(name_of(space)), std::string(name_of(p.design)), std::int64_t(p.samples),
+             p.environment, p.relative_rmse, p.mean_delta_e, p.p95_delta_e, p.mae, p.rmse, p.ssim});
 }
 
 std::vector<ImagePoint> image_points(const BrdfResult& result, Space space) {
