@@ -30,7 +30,7 @@ namespace {
 struct StudyOptions {
   std::vector<std::string> specs, merge;
   std::string out = "study";
-  std::string budgets, budgets_4d, environments;
+  std::string budgets, budgets_4d, environments, params;
   std::string designs = "own,angle,merl,learned";
   study::StudySettings settings;
   bool resume = false;
@@ -44,6 +44,7 @@ study::StudyConfig make_config(const StudyOptions& o) {
     s.budgets_4d = count_list(o.budgets_4d, "--budgets-4d", "sample budget");
   if (!o.environments.empty()) s.environments = split_list(o.environments, "--env", "environment");
   s.designs = split_list(o.designs, "--designs", "design");
+  if (!o.params.empty()) s.params = split_list(o.params, "--params", "parameterization");
   try {
     return study::make_config(s);
   } catch (const std::invalid_argument& e) {
@@ -180,7 +181,7 @@ study::BrdfResult study_one(const std::string& spec, std::size_t k,
   const std::string key = study::part_key(spec);
   std::error_code ec;
   if (resume && std::filesystem::exists(parts / (key + ".part"), ec)) {
-    study::BrdfResult kept = study::read_part(parts, key);
+    study::BrdfResult kept = study::read_part(parts, key, config.params);
     progress.resumed(k, kept.label);
     return kept;
   }
@@ -196,7 +197,7 @@ study::BrdfResult study_one(const std::string& spec, std::size_t k,
   study::write_part(parts, key, result, k);
   progress.finished(result.seconds, cpu_seconds() - cpu0);
   // Read back, so that a run and its resumption write the report from the same numbers.
-  return study::read_part(parts, key);
+  return study::read_part(parts, key, config.params);
 }
 
 // The first pass of the learned design: every BRDF's profile (each file loaded once, one at a
@@ -303,6 +304,9 @@ Command register_study(CLI::App& parent) {
                   "specs");
   app->add_option("-o,--out", o->out, "Output directory (created if missing)")
       ->capture_default_str();
+  app->add_option("--params", o->params,
+                  "Parameterizations compared, comma-separated, in the order of the tables: " +
+                      parameterization_names(", ") + " (default: all of them, spherical last)");
   app->add_option("--space,--error-space", o->settings.space,
                   "Error space: linear, log (ln(1 + Y)), cbrt (Y^(1/3)), nielsen (Nielsen et al. "
                   "2015's log-relative mapping) or low (Low et al. 2012's cosine-weighted log)")

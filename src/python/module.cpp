@@ -594,7 +594,9 @@ PySettings study_settings(const py::object& settings) {
   if (settings.is_none()) return out;
   for (const auto& [k, v] : settings.cast<py::dict>()) {
     const std::string key = py::str(k);
-    if (key == "space" || key == "error_space")
+    if (key == "params")
+      s.params = setting<std::vector<std::string>>(v, key);
+    else if (key == "space" || key == "error_space")
       s.space = setting<std::string>(v, key);
     else if (key == "designs")
       s.designs = setting<std::vector<std::string>>(v, key);
@@ -626,10 +628,11 @@ PySettings study_settings(const py::object& settings) {
     else if (key == "env")
       s.environments = setting<std::vector<std::string>>(v, key);
     else
-      throw py::value_error("settings: unknown key '" + key +
-                            "' (accepted: space, designs, profiles, quick, budgets, budgets_4d, "
-                            "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
-                            "seed, no_gonio, no_images)");
+      throw py::value_error(
+          "settings: unknown key '" + key +
+          "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
+          "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
+          "seed, no_gonio, no_images)");
   }
   return out;
 }
@@ -676,14 +679,17 @@ py::dict study_one_brdf(const std::string& spec, const py::object& settings) {
   return d;
 }
 
-// A result dict of study_one_brdf as a BrdfResult.
-study::BrdfResult result_of(const py::dict& d, const std::string& source) {
+// A result dict of study_one_brdf as a BrdfResult, of a study of `params` (its settings').
+study::BrdfResult result_of(const py::dict& d, const std::vector<Space>& params,
+                            const std::string& source) {
   study::StudyTables tables;
-  for (const char* name : {"brdf", "azimuthal", "separability", "gonio", "image"}) {
+  std::vector<std::string> names{"brdf"};
+  for (const study::MetricTable& t : study::stored_tables()) names.push_back(t.name);
+  for (const std::string& name : names) {
     if (!d.contains(name)) throw py::value_error(source + ": no table '" + name + "'");
-    tables[name] = d[name].cast<std::string>();
+    tables[name] = d[name.c_str()].cast<std::string>();
   }
-  study::BrdfResult b = study::from_tables(tables, source);
+  study::BrdfResult b = study::from_tables(tables, params, source);
   if (d.contains("renderings"))
     for (const auto& item : d["renderings"].cast<py::list>()) {
       const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(item);
@@ -712,7 +718,9 @@ py::dict merge_study(const std::string& out, const py::list& parts) {
       const py::dict d = item.cast<py::dict>();
       const std::string source = "parts[" + std::to_string(i) + "]";
       if (!d.contains("settings")) throw py::value_error(source + ": no 'settings'");
-      study::merge_into(merged, d["settings"].cast<std::string>(), source, {result_of(d, source)});
+      const std::string settings = d["settings"].cast<std::string>();
+      const auto params = study::config_from_description(settings, source).params;
+      study::merge_into(merged, settings, source, {result_of(d, params, source)});
     } else {
       const std::string dir = py::str(py::module_::import("os").attr("fspath")(item));
       study::MergedParts one = study::read_parts({dir});
@@ -739,13 +747,14 @@ void bind_study(py::module_& m) {
         R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
 
 spec: a file or model spec, as for load(). settings: a dict of the options of `halfback study`
-with '-' spelled '_': space (the error space), designs (a list), quick, budgets, budgets_4d,
+with '-' spelled '_': params (a list of parameterization names; missing: all of them, spherical
+last), space (the error space), designs (a list), quick, budgets, budgets_4d,
 test_pairs, env (a list), image_budget, image_size, image_spp, max_theta, seed, no_gonio,
 no_images (missing: the defaults), and, for the learned design (a default design), profiles: the
 study_profile() texts of every BRDF of the study, this one's included, in the study's order (the
 warps are learned from all but this one's; without them, a ValueError).
-Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image"; the
-rows of the CSV files of the study, numbers in exact round-trip form, e.g. for
+Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image": one
+row per parameterization and measurement, as in the CSV files of the study, numbers in exact round-trip form, e.g. for
 pandas.read_csv(io.StringIO(t))), "settings" (the resolved settings, which merge_study checks)
 and "renderings" (the example images, (H, W, 3) float32). Independent of any other BRDF: map it
 over BRDFs with any engine (docs/study.md, "Scaling out").)doc");

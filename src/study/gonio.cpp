@@ -19,6 +19,12 @@ std::string_view name_of(Design d) {
   return d == Design::regular ? "regular" : "stratified";
 }
 
+std::optional<Design> parse_design(std::string_view name) {
+  for (Design d : kDesigns)
+    if (name_of(d) == name) return d;
+  return std::nullopt;
+}
+
 namespace {
 
 constexpr std::size_t kBlock = 1 << 16;

@@ -12,18 +12,13 @@
 #include <type_traits>
 
 #include "halfback/render/image.hpp"
+#include "halfback/study/metric_tables.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/csv.hpp"
 
 namespace halfback::study {
 
 namespace {
-
-std::optional<Design> design_named(std::string_view name) {
-  for (Design d : kDesigns)
-    if (name_of(d) == name) return d;
-  return std::nullopt;
-}
 
 void apply_quick(StudyConfig& c) {
   c.grid = {24, 24, 32};
@@ -41,10 +36,29 @@ void check_ascending(const std::vector<std::size_t>& v, const char* option) {
       throw std::invalid_argument(fmt::format("{}: budgets must be ascending", option));
 }
 
-std::vector<std::string_view> spacing_names(const std::vector<Spacing>& spacings) {
+template <class T>
+std::vector<std::string_view> names_of(const std::vector<T>& items) {
   std::vector<std::string_view> names;
-  for (Spacing s : spacings) names.push_back(name_of(s));
+  for (const T& item : items) names.push_back(name_of(item));
   return names;
+}
+
+// The parameterizations of --params (std::invalid_argument) or of a description
+// (std::runtime_error), by name.
+template <class Error>
+std::vector<Space> params_named(const std::vector<std::string>& names, const std::string& where) {
+  std::vector<Space> params;
+  for (const std::string& name : names) {
+    const auto space = space_from_name(name);
+    if (!space || space->is_dirs())
+      throw Error(fmt::format("{}: '{}' is not a parameterization ({})", where, name,
+                              parameterization_names()));
+    if (std::find(params.begin(), params.end(), *space) != params.end())
+      throw Error(fmt::format("{}: '{}' is given twice", where, name));
+    params.push_back(*space);
+  }
+  if (params.empty()) throw Error(where + ": no parameterization given");
+  return params;
 }
 
 template <class T>
@@ -58,6 +72,7 @@ std::string joined(const std::vector<T>& v) {
 
 StudyConfig make_config(const StudySettings& o) {
   StudyConfig c;
+  if (!o.params.empty()) c.params = params_named<std::invalid_argument>(o.params, "--params");
   const auto space = parse_error_space(o.space);
   if (!space)
     throw std::invalid_argument(fmt::format(
@@ -109,14 +124,15 @@ std::string describe_config(const StudyConfig& c) {
     envs += csv_text_field(e.label);
   }
   return fmt::format(
-      "space = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = {}\nbudgets_4d = {}\n"
+      "parameterizations = {}\nspace = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = "
+      "{}\nbudgets_4d = {}\n"
       "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
       "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
       "learned_from = {}\n",
-      name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
+      joined(names_of(c.params)), name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
       joined(std::vector<std::size_t>(c.full_grid.begin(), c.full_grid.end())), joined(c.ranks),
       joined(c.budgets), joined(c.budgets_4d), c.test_pairs, format_csv_number(c.max_theta_deg),
-      c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(spacing_names(c.spacings)),
+      c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(names_of(c.spacings)),
       c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from);
 }
 
@@ -163,6 +179,8 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
   };
   const std::string where = source;
   StudyConfig c;
+  c.params = params_named<std::runtime_error>(split_csv_line(get("parameterizations")),
+                                              source + ": parameterizations");
   const auto space = parse_error_space(get("space"));
   if (!space) throw std::runtime_error(fmt::format("{}: unknown error space", source));
   c.space = *space;
@@ -224,7 +242,7 @@ bool wants_learned(const StudyConfig& c) {
 }
 
 LabeledProfile study_profile(const Brdf& brdf, const std::string& label, const StudyConfig& c) {
-  return {label, design_profile(brdf, kStudied, c.profile_grid, c.space)};
+  return {label, design_profile(brdf, c.params, c.profile_grid, c.space)};
 }
 
 // The label, then per space its name and one line of numbers per axis.
@@ -259,9 +277,8 @@ LabeledProfile profile_from_text(std::string_view text, const std::string& sourc
     if (line.rfind("space = ", 0) != 0)
       throw std::runtime_error(fmt::format("{}: expected 'space = NAME', got '{}'", source, line));
     AxisDemand d;
-    const auto space = std::find_if(kStudied.begin(), kStudied.end(),
-                                    [&](Space s) { return name_of(s) == line.substr(8); });
-    if (space == kStudied.end())
+    const auto space = space_from_name(line.substr(8));
+    if (!space || space->is_dirs())
       throw std::runtime_error(fmt::format("{}: unknown space '{}'", source, line.substr(8)));
     d.space = *space;
     for (std::vector<double>& axis : d.demand) {
@@ -303,178 +320,72 @@ void set_learned(StudyConfig& c, std::span<const LabeledProfile> profiles,
 
 namespace {
 
-// The columns of gonio.csv and image.csv (report.cpp writes the same).
-constexpr std::string_view kGonioHeader =
-    "brdf,parameterization,design,samples,error,dims,budget,spacing";
-constexpr std::string_view kImageHeader =
-    "brdf,parameterization,design,samples,environment,relative_rmse,mean_delta_e2000,"
-    "p95_delta_e2000,mae,rmse,ssim";
-
-std::string num(double v) {
-  return format_csv_number(v);
-}
-
-void add_rank_rows(std::string& csv, const std::string& brdf, std::string_view pn,
-                   const std::vector<double>& errors, int dims) {
-  // The rank itself is the position: the ranks of the run's configuration.
-  for (std::size_t i = 0; i < errors.size(); ++i)
-    csv += fmt::format("{},{},{},{},{}\n", brdf, pn, i, num(errors[i]), dims);
-}
-
-void add_gonio_rows(std::string& csv, const std::string& brdf, std::string_view pn,
-                    const std::vector<GonioPoint>& pts, int dims) {
-  for (const GonioPoint& g : pts)
-    csv += fmt::format("{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(g.design), g.samples,
-                       num(g.error), dims, g.budget, name_of(g.spacing));
-}
+// The "brdf" table: what a result holds besides its metric tables.
+constexpr std::string_view kBrdfHeader = "brdf,isotropic,seconds";
 
 }  // namespace
 
 StudyTables to_tables(const BrdfResult& b) {
-  const std::string brdf = csv_text_field(b.label);
   StudyTables t;
-  t["brdf"] =
-      fmt::format("brdf,isotropic,seconds\n{},{},{}\n", brdf, int(b.isotropic), num(b.seconds));
-  std::string az = "brdf,parameterization,error,dims\n";
-  std::string sep = "brdf,parameterization,rank_index,error,dims\n";
-  std::string gonio = std::string(kGonioHeader) + "\n";
-  std::string image = std::string(kImageHeader) + "\n";
-  for (const ParamResult& p : b.params) {
-    const std::string_view pn = name_of(p.space);
-    az += fmt::format("{},{},{},3\n", brdf, pn, num(p.azimuthal));
-    if (!b.isotropic) az += fmt::format("{},{},{},4\n", brdf, pn, num(p.azimuthal_4d));
-    add_rank_rows(sep, brdf, pn, p.separability_2d, 2);
-    add_rank_rows(sep, brdf, pn, p.separability_3d, 3);
-    if (!b.isotropic) add_rank_rows(sep, brdf, pn, p.separability_4d, 4);
-    add_gonio_rows(gonio, brdf, pn, p.gonio, 3);
-    add_gonio_rows(gonio, brdf, pn, p.gonio_4d, 4);
-    for (const ImagePoint& i : p.images)
-      image +=
-          fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", brdf, pn, name_of(i.design), i.samples,
-                      csv_text_field(i.environment), num(i.relative_rmse), num(i.mean_delta_e),
-                      num(i.p95_delta_e), num(i.mae), num(i.rmse), num(i.ssim));
-  }
-  t["azimuthal"] = az;
-  t["separability"] = sep;
-  t["gonio"] = gonio;
-  t["image"] = image;
+  t["brdf"] = fmt::format("{}\n{},{},{}\n", kBrdfHeader, csv_text_field(b.label), int(b.isotropic),
+                          format_csv_number(b.seconds));
+  for (const MetricTable& table : b.tables)
+    t[table.name] = csv_header(table) + csv_rows(table, b.label, NumberText::exact);
   return t;
 }
 
 namespace {
 
-// The rows of one table after its header, which must be `header`; each row of `columns` fields.
-struct TableReader {
-  const std::string& source;
-  std::string name;
-  std::vector<std::vector<std::string>> rows;
-  std::vector<std::size_t> lines;
-
-  std::string where(std::size_t row) const {
-    return fmt::format("{}: table {}, line {}", source, name, lines[row]);
-  }
-};
-
-TableReader read_table(const StudyTables& t, const char* name, std::string_view header,
-                       const std::string& source) {
-  TableReader r{source, name, {}, {}};
-  const auto it = t.find(name);
-  if (it == t.end()) throw std::runtime_error(fmt::format("{}: no table '{}'", source, name));
+// The label, isotropy and seconds of the "brdf" table.
+void read_brdf_table(const StudyTables& t, const std::string& source, BrdfResult& b) {
+  const auto it = t.find("brdf");
+  if (it == t.end()) throw std::runtime_error(fmt::format("{}: no table 'brdf'", source));
   std::istringstream in(it->second);
-  std::string line;
-  if (!std::getline(in, line) || line != header)
+  std::string header, line;
+  std::getline(in, header);
+  if (header != kBrdfHeader)
     throw std::runtime_error(
-        fmt::format("{}: table {}: the header is not '{}'", source, name, header));
-  const std::size_t columns = split_csv_line(header).size();
-  for (std::size_t n = 2; std::getline(in, line); ++n) {
-    if (line.empty()) continue;
-    std::vector<std::string> f;
-    try {
-      f = split_csv_line(line);
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(fmt::format("{}: table {}, line {}: {}", source, name, n, e.what()));
-    }
-    if (f.size() != columns)
-      throw std::runtime_error(fmt::format("{}: table {}, line {}: {} fields, expected {}", source,
-                                           name, n, f.size(), columns));
-    r.rows.push_back(std::move(f));
-    r.lines.push_back(n);
-  }
-  return r;
+        fmt::format("{}: table brdf: the header is not '{}'", source, kBrdfHeader));
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(in, line))
+    if (!line.empty()) rows.push_back(split_csv_line(line));
+  if (rows.size() != 1 || rows[0].size() != 3)
+    throw std::runtime_error(fmt::format("{}: table brdf: expected one row of 3 fields", source));
+  b.label = rows[0][0];
+  b.isotropic = rows[0][1] == "1";
+  b.seconds = number_of<double>(rows[0][2], source + ": table brdf, line 2");
 }
 
-ParamResult& param_named(BrdfResult& b, const std::string& name, const std::string& where) {
-  for (ParamResult& p : b.params)
-    if (name_of(p.space) == name) return p;
-  throw std::runtime_error(fmt::format("{}: unknown parameterization '{}'", where, name));
-}
-
-Design design_of(const std::string& name, const std::string& where) {
-  const auto d = design_named(name);
-  if (!d) throw std::runtime_error(fmt::format("{}: unknown design '{}'", where, name));
-  return *d;
-}
-
-void read_metric_tables(const StudyTables& t, const std::string& source, BrdfResult& b) {
-  const TableReader az = read_table(t, "azimuthal", "brdf,parameterization,error,dims", source);
-  for (std::size_t i = 0; i < az.rows.size(); ++i) {
-    const auto& f = az.rows[i];
-    ParamResult& p = param_named(b, f[1], az.where(i));
-    (f[3] == "4" ? p.azimuthal_4d : p.azimuthal) = number_of<double>(f[2], az.where(i));
-  }
-  const TableReader sep =
-      read_table(t, "separability", "brdf,parameterization,rank_index,error,dims", source);
-  for (std::size_t i = 0; i < sep.rows.size(); ++i) {
-    const auto& f = sep.rows[i];
-    ParamResult& p = param_named(b, f[1], sep.where(i));
-    const int dims = number_of<int>(f[4], sep.where(i));
-    auto& v = dims == 2 ? p.separability_2d : dims == 3 ? p.separability_3d : p.separability_4d;
-    if (number_of<std::size_t>(f[2], sep.where(i)) != v.size())
-      throw std::runtime_error(sep.where(i) + ": the ranks are not in order");
-    v.push_back(number_of<double>(f[3], sep.where(i)));
-  }
-}
-
-void read_gonio_tables(const StudyTables& t, const std::string& source, BrdfResult& b) {
-  const TableReader g = read_table(t, "gonio", kGonioHeader, source);
-  for (std::size_t i = 0; i < g.rows.size(); ++i) {
-    const auto& f = g.rows[i];
-    const std::string w = g.where(i);
-    ParamResult& p = param_named(b, f[1], w);
-    const auto spacing = parse_spacing(f[7]);
-    if (!spacing) throw std::runtime_error(fmt::format("{}: unknown spacing '{}'", w, f[7]));
-    (f[5] == "4" ? p.gonio_4d : p.gonio)
-        .push_back({design_of(f[2], w), number_of<std::size_t>(f[6], w),
-                    number_of<std::size_t>(f[3], w), number_of<double>(f[4], w), *spacing});
-  }
-  const TableReader im = read_table(t, "image", kImageHeader, source);
-  for (std::size_t i = 0; i < im.rows.size(); ++i) {
-    const auto& f = im.rows[i];
-    const std::string w = im.where(i);
-    param_named(b, f[1], w)
-        .images.push_back({design_of(f[2], w), number_of<std::size_t>(f[3], w), f[4],
-                           number_of<double>(f[5], w), number_of<double>(f[6], w),
-                           number_of<double>(f[7], w), number_of<double>(f[8], w),
-                           number_of<double>(f[9], w), number_of<double>(f[10], w)});
+// Every row of `table` is of one of `params` and of the BRDF `label` (read_csv_rows' `brdf`).
+void check_rows(const MetricTable& table, std::string_view brdf, const BrdfResult& b,
+                const std::string& source) {
+  if (!table.rows.empty() && brdf != b.label)
+    throw std::runtime_error(fmt::format("{}: table {}: rows of '{}' in the tables of '{}'", source,
+                                         table.name, brdf, b.label));
+  for (const Row& row : table.rows) {
+    const std::string& name = table.text(row, "parameterization");
+    if (std::none_of(b.params.begin(), b.params.end(), [&](Space s) { return name_of(s) == name; }))
+      throw std::runtime_error(
+          fmt::format("{}: table {}: the parameterization '{}' is not one of the run's ({})",
+                      source, table.name, name, joined(names_of(b.params))));
   }
 }
 
 }  // namespace
 
-BrdfResult from_tables(const StudyTables& t, const std::string& source) {
-  const TableReader head = read_table(t, "brdf", "brdf,isotropic,seconds", source);
-  if (head.rows.size() != 1)
-    throw std::runtime_error(fmt::format("{}: table brdf: expected one row", source));
+BrdfResult from_tables(const StudyTables& t, std::span<const Space> params,
+                       const std::string& source) {
   BrdfResult b;
-  b.label = head.rows[0][0];
-  b.isotropic = head.rows[0][1] == "1";
-  b.seconds = number_of<double>(head.rows[0][2], head.where(0));
-  for (Space s : kStudied) {
-    b.params.emplace_back();
-    b.params.back().space = s;
+  read_brdf_table(t, source, b);
+  b.params.assign(params.begin(), params.end());
+  b.tables = stored_tables();
+  for (MetricTable& table : b.tables) {
+    const auto it = t.find(table.name);
+    if (it == t.end())
+      throw std::runtime_error(fmt::format("{}: no table '{}'", source, table.name));
+    const std::string brdf = read_csv_rows(table, it->second, source);
+    check_rows(table, brdf, b, source);
   }
-  read_metric_tables(t, source, b);
-  read_gonio_tables(t, source, b);
   return b;
 }
 
@@ -484,7 +395,9 @@ BrdfResult from_tables(const StudyTables& t, const std::string& source) {
 
 namespace {
 
-constexpr std::string_view kPartMagic = "# halfback study part 2\n";
+// Version 3: the parameterizations of the run in its settings, a rank column in the separability
+// table (version 2 had the rank's index).
+constexpr std::string_view kPartMagic = "# halfback study part 3\n";
 
 // The example renderings side by side in one image (they share their size).
 render::Image strip_of(const std::vector<render::Image>& images) {
@@ -541,12 +454,12 @@ void write_part(const std::filesystem::path& parts, const std::string& key,
 }
 
 BrdfResult read_part(const std::filesystem::path& parts, const std::string& key,
-                     std::size_t* order) {
+                     std::span<const Space> params, std::size_t* order) {
   const std::filesystem::path file = parts / (key + ".part");
   const std::string text = read_text_file(file);
   const std::string source = file.string();
   if (text.rfind(kPartMagic, 0) != 0)
-    throw std::runtime_error(source + ": not a part of a halfback study");
+    throw std::runtime_error(source + ": not a part of a study by this version of halfback");
   std::istringstream in(text.substr(kPartMagic.size()));
   std::string line;
   std::getline(in, line);
@@ -563,7 +476,7 @@ BrdfResult read_part(const std::filesystem::path& parts, const std::string& key,
     else
       throw std::runtime_error(source + ": a row before the first table");
   }
-  BrdfResult b = from_tables(tables, source);
+  BrdfResult b = from_tables(tables, params, source);
   const std::filesystem::path exr = parts / (key + ".exr");
   std::error_code ec;
   if (std::filesystem::exists(exr, ec)) {
@@ -610,11 +523,13 @@ MergedParts read_parts(const std::vector<std::filesystem::path>& dirs) {
     if (!std::filesystem::exists(settings_file, ec))
       throw std::runtime_error(
           fmt::format("'{}': not the output of a study (no parts/settings.txt)", dir.string()));
+    const std::string settings = read_text_file(settings_file);
+    const StudyConfig config = config_from_description(settings, settings_file.string());
     std::vector<std::pair<std::size_t, BrdfResult>> in_dir;
     for (const auto& entry : std::filesystem::directory_iterator(parts)) {
       if (entry.path().extension() != ".part") continue;
       std::size_t order = 0;
-      BrdfResult b = read_part(parts, entry.path().stem().string(), &order);
+      BrdfResult b = read_part(parts, entry.path().stem().string(), config.params, &order);
       in_dir.emplace_back(order, std::move(b));
     }
     if (in_dir.empty())
@@ -623,7 +538,7 @@ MergedParts read_parts(const std::vector<std::filesystem::path>& dirs) {
                      [](const auto& a, const auto& b) { return a.first < b.first; });
     std::vector<BrdfResult> results;
     for (auto& [order, b] : in_dir) results.push_back(std::move(b));
-    merge_into(merged, read_text_file(settings_file), dir.string(), std::move(results));
+    merge_into(merged, settings, dir.string(), std::move(results));
   }
   return merged;
 }

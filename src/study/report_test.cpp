@@ -7,6 +7,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "fake_results.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::study {
@@ -17,15 +18,21 @@ std::string slurp(const std::filesystem::path& p) {
   return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
 }
 
-// A made-up result whose numbers the files must repeat.
-BrdfResult fake(const std::string& label, bool isotropic) {
-  BrdfResult b;
+using fakes::FakeBrdf;
+using fakes::FakeParam;
+using fakes::to_result;
+
+// A made-up result whose numbers the files must repeat; parameterization i has k = ks[i].
+FakeBrdf fake_numbers(const std::string& label, bool isotropic,
+                      const std::vector<double>& ks = {1, 2, 3, 4}) {
+  FakeBrdf b;
   b.label = label;
   b.isotropic = isotropic;
-  double k = 1;
-  for (Space s : kStudied) {
-    ParamResult p;
-    p.space = s;
+  const std::vector<Space> params = fakes::builtin_params();
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const double k = ks[i];
+    FakeParam p;
+    p.space = params[i];
     p.azimuthal = 0.1 * k;
     p.separability_2d = {0.2 * k, 0.1 * k, 0.05 * k, 0.01 * k};
     p.separability_3d = p.separability_2d;
@@ -41,9 +48,12 @@ BrdfResult fake(const std::string& label, bool isotropic) {
       p.gonio_4d = p.gonio;
     }
     b.params.push_back(p);
-    k += 1;
   }
   return b;
+}
+
+BrdfResult fake(const std::string& label, bool isotropic) {
+  return to_result(fake_numbers(label, isotropic));
 }
 
 // The settings the fakes were "studied" with (the report reads budgets and environments).
@@ -58,13 +68,8 @@ StudyConfig config_of_fakes() {
 // The network fitted to a measured file: the same material, its parameterizations' numbers in
 // the reverse order (so that its lowest errors are spherical's where the file's are halfdiff's).
 BrdfResult network_of(const BrdfResult& file) {
-  BrdfResult network = file;
-  network.label = "nbrdf:" + file.label.substr(file.label.find(':') + 1);
-  for (std::size_t i = 0; i < kStudied.size(); ++i) {
-    network.params[i] = file.params[kStudied.size() - 1 - i];
-    network.params[i].space = kStudied[i];
-  }
-  return network;
+  return to_result(fake_numbers("nbrdf:" + file.label.substr(file.label.find(':') + 1),
+                                file.isotropic, {4, 3, 2, 1}));
 }
 
 TEST(Report, FilesRepeatTheResults) {
@@ -76,7 +81,7 @@ TEST(Report, FilesRepeatTheResults) {
   c.environments.push_back({"sky", nullptr});  // only its label is used by the report
   BrdfResult with_images = fake("a,b", true);
   render::Image grey{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
-  with_images.example_images.assign(kStudied.size() + 1, grey);
+  with_images.example_images.assign(with_images.params.size() + 1, grey);
   const StudyOutput out = write_study(dir, {with_images, fake("aniso", false)}, c, 1.5);
   for (const char* f :
        {"azimuthal.csv", "separability.csv", "gonio.csv", "budget.csv", "image.csv", "report.md",
@@ -120,9 +125,9 @@ TEST(Report, DesignsSectionComparesBestAgainstBest) {
   StudyConfig c;
   c.budgets = {1000, 1000000};
   c.image_budget = 1000;
-  std::vector<BrdfResult> results{fake("x", true), fake("y", true)};
-  for (BrdfResult& b : results)
-    for (ParamResult& p : b.params) {
+  std::vector<FakeBrdf> fakes{fake_numbers("x", true), fake_numbers("y", true)};
+  for (FakeBrdf& b : fakes)
+    for (FakeParam& p : b.params) {
       const std::vector<GonioPoint> own = p.gonio;
       for (const GonioPoint& g : own) {
         if (g.design != Design::regular) continue;
@@ -131,7 +136,7 @@ TEST(Report, DesignsSectionComparesBestAgainstBest) {
         p.gonio.push_back({g.design, g.budget, g.samples, g.error * learned, Spacing::learned});
       }
     }
-  const StudyOutput out = write_study(tmp.path(), results, c, 1);
+  const StudyOutput out = write_study(tmp.path(), {to_result(fakes[0]), to_result(fakes[1])}, c, 1);
   const std::string& md = out.markdown;
   EXPECT_NE(md.find("## 3b. Designs"), std::string::npos);
   // hybrid (k = 3) at N = 1000: 1.5 own, 3 angle, 0.15 learned; its best is learned.
@@ -148,10 +153,12 @@ TEST(Report, DesignsSectionComparesBestAgainstBest) {
       << md;
   // Without the own design, best against best only.
   StudyConfig no_own = c;
-  std::vector<BrdfResult> without = results;
-  for (BrdfResult& b : without)
-    for (ParamResult& p : b.params)
+  std::vector<BrdfResult> without;
+  for (FakeBrdf b : fakes) {
+    for (FakeParam& p : b.params)
       std::erase_if(p.gonio, [](const GonioPoint& g) { return g.spacing == Spacing::own; });
+    without.push_back(to_result(b));
+  }
   const test::TempDir tmp2;
   const std::string md2 = write_study(tmp2.path(), without, no_own, 1).markdown;
   EXPECT_NE(md2.find("Lowest error, best against best (BRDFs): halfdiff 0, ortho 0, hybrid 2"),
@@ -171,9 +178,9 @@ TEST(Report, OnlyWhatWasComputedIsWrittenAndLinked) {
   c.budgets = {1000, 1000000};
   c.image_budget = 1000;
   c.environments.push_back({"sky", nullptr});
-  BrdfResult b = fake("aniso", false);
-  for (ParamResult& p : b.params) p.gonio.clear();
-  const StudyOutput out = write_study(dir, {b}, c, 1);
+  FakeBrdf b = fake_numbers("aniso", false);
+  for (FakeParam& p : b.params) p.gonio.clear();
+  const StudyOutput out = write_study(dir, {to_result(b)}, c, 1);
   EXPECT_TRUE(std::filesystem::exists(dir / "gonio.csv"));
   EXPECT_NE(slurp(dir / "gonio.csv").find("aniso,hybrid,regular,1000,"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir / "gonio4d.png"));

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <chrono>
 #include <initializer_list>
+#include <optional>
 #include <stdexcept>
 
 #include "halfback/core/parallel.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/study/image_metrics.hpp"
+#include "halfback/study/metric_tables.hpp"
 
 namespace halfback::study {
 
@@ -35,7 +37,31 @@ void check_grid(std::initializer_list<std::size_t> axes, const char* which) {
 
 }  // namespace
 
+std::vector<Space> default_studied() {
+  std::vector<Space> params = parameterizations();
+  // The baseline last, so that the tables read from the half-vector parameterizations to it.
+  std::stable_partition(params.begin(), params.end(),
+                        [](Space s) { return s != space_of<Spherical>; });
+  return params;
+}
+
+const MetricTable& BrdfResult::table(std::string_view name) const {
+  for (const MetricTable& t : tables)
+    if (t.name == name) return t;
+  throw std::invalid_argument(
+      fmt::format("study: the result of '{}' has no table '{}'", label, name));
+}
+
 void StudyConfig::validate() const {
+  if (params.empty()) throw std::invalid_argument("study: at least one parameterization");
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    if (params[i].is_dirs())
+      throw std::invalid_argument("study: 'dirs' is not a parameterization to study");
+    if (std::find(params.begin(), params.begin() + std::ptrdiff_t(i), params[i]) !=
+        params.begin() + std::ptrdiff_t(i))
+      throw std::invalid_argument(
+          fmt::format("study: the parameterization '{}' is given twice", name_of(params[i])));
+  }
   check_grid({grid.a, grid.b, grid.phi}, "isotropic grid");
   check_grid({full_grid[0], full_grid[1], full_grid[2], full_grid[3]}, "4D grid");
   for (const auto* b : {&budgets, &budgets_4d}) {
@@ -143,21 +169,33 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
       draw_test_pairs(brdf, config.test_pairs, config.seed, config.space, config.max_theta_deg);
   const bool gonio = !config.budgets.empty() && !test.pairs.empty();  // empty: metrics 1-2 only
 
-  // One task per parameterization; the reconstructions at the image budget are kept.
+  // One task per parameterization, with tables of its own rows; the reconstructions at the image
+  // budget are kept for the renderings.
   struct Task {
-    ParamResult r;
+    Space space;
+    std::vector<MetricTable> tables = stored_tables();
     std::vector<std::unique_ptr<GonioReconstruction>> for_images;  // one per design
+    MetricTable& table(std::string_view name) {
+      for (MetricTable& t : tables)
+        if (t.name == name) return t;
+      throw std::logic_error("study: no table " + std::string(name));
+    }
   };
   auto study_in = [&](Space s) {
     Task t;
-    t.r.space = s;
+    t.space = s;
     const IsoSamples x = sample_isotropic(brdf, s, config.grid, config.space);
-    t.r.azimuthal = azimuthal_error(x);
-    t.r.separability_2d = separability_2d(x, config.ranks);
-    t.r.separability_3d = separability_unfolded(x, config.ranks);
     const bool iso = brdf.isotropic();
+    std::optional<FullSamples> f;
+    if (!iso) f = sample_full(brdf, s, config.full_grid, config.space);
+    add_azimuthal(t.table("azimuthal"), s, azimuthal_error(x), 3);
+    if (f) add_azimuthal(t.table("azimuthal"), s, azimuthal_error(*f), 4);
+    MetricTable& separability = t.table("separability");
+    add_separability(separability, s, config.ranks, separability_2d(x, config.ranks), 2);
+    add_separability(separability, s, config.ranks, separability_unfolded(x, config.ranks), 3);
+    if (f) add_separability(separability, s, config.ranks, separability_4d(*f, config.ranks), 4);
     if (gonio) {
-      std::vector<GonioPoint>& points = iso ? t.r.gonio : t.r.gonio_4d;
+      std::vector<GonioPoint> points;
       for (const GonioRun& run : gonio_runs(s, iso, config)) {
         if (run.copy_of_own) {  // the same cells as own: the same numbers
           for (std::size_t k = 0, own = points.size(); k < own; ++k)
@@ -173,18 +211,14 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
             !config.environments.empty())
           t.for_images.push_back(std::move(rec));
       }
-    }
-    if (!iso) {
-      const FullSamples f = sample_full(brdf, s, config.full_grid, config.space);
-      t.r.azimuthal_4d = azimuthal_error(f);
-      t.r.separability_4d = separability_4d(f, config.ranks);
+      for (const GonioPoint& p : points) add_gonio(t.table("gonio"), s, p, iso ? 3 : 4);
     }
     say(fmt::format("{} {}", gonio ? "gonio" : "metrics", name_of(s)));
     return t;
   };
-  std::vector<Task> done(kStudied.size());
-  parallel_for(kStudied.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) done[k] = study_in(kStudied[k]);
+  std::vector<Task> done(config.params.size());
+  parallel_for(config.params.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) done[k] = study_in(config.params[k]);
   });
 
   if (gonio && !config.environments.empty()) {
@@ -206,13 +240,19 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
           const render::Image img = render::render_sampled(*rec, *env.map, settings).image;
           if (first && rec->setup().design == Design::regular) result.example_images.push_back(img);
           const ImageError e = compare_images(img, truth, mask);
-          t.r.images.push_back({rec->setup().design, rec->samples(), env.label, e.relative_rmse,
-                                e.mean_delta_e, e.p95_delta_e, e.mae, e.rmse, e.ssim});
+          add_image(t.table("image"), t.space,
+                    {rec->setup().design, rec->samples(), env.label, e.relative_rmse,
+                     e.mean_delta_e, e.p95_delta_e, e.mae, e.rmse, e.ssim});
         }
       say(fmt::format("images {}", env.label));
     }
   }
-  for (Task& t : done) result.params.push_back(std::move(t.r));
+  // Each table: the rows of the parameterizations one after the other.
+  result.params = config.params;
+  result.tables = stored_tables();
+  for (const Task& t : done)
+    for (std::size_t k = 0; k < result.tables.size(); ++k)
+      for (const Row& row : t.tables[k].rows) result.tables[k].rows.push_back(row);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }

@@ -1422,6 +1422,29 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
     EXPECT_GT(fs::file_size(path("st") / f), 100u) << f;
 }
 
+TEST_F(CliTest, StudyParamsChooseTheColumns) {
+  // --params: the parameterizations and their order, in the tables, the report and the settings.
+  Result r =
+      run({"study", "--quick", "--no-gonio", "--params", "hybrid,halfdiff", "-o", "st", "lambert"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<std::vector<std::string>> az = csv_rows(slurp(path("st") / "azimuthal.csv"));
+  ASSERT_EQ(az.size(), 3u);
+  EXPECT_EQ(az[1][1], "hybrid");
+  EXPECT_EQ(az[2][1], "halfdiff");
+  EXPECT_NE(slurp(path("st") / "report.md").find("| BRDF | hybrid | halfdiff |\n|---|---|---|"),
+            std::string::npos);
+  EXPECT_EQ(slurp(path("st") / "parts" / "settings.txt")
+                .rfind("parameterizations = hybrid,halfdiff\n", 0),
+            0u);
+  // --resume with other parameterizations is refused, as any other setting.
+  r = run({"study", "--quick", "--no-gonio", "--resume", "-o", "st", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("was run with other settings"), std::string::npos) << r.err;
+  r = run({"study", "--params", "hybrid,nope", "lambert"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("'nope' is not a parameterization"), std::string::npos) << r.err;
+}
+
 TEST_F(CliTest, StudyBadInput) {
   Result r = run({"study", "-o", "st", "nope"});
   EXPECT_EQ(r.status, 1);

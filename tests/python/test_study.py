@@ -77,6 +77,15 @@ def test_bad_settings_are_clear_errors():
         halfback.study_brdf("lambert", {"test_pairs": "many"})
 
 
+def test_params_choose_the_parameterizations():
+    d = halfback.study_brdf("lambert", {"params": ["hybrid", "halfdiff"], "no_gonio": True})
+    rows = d["azimuthal"].splitlines()
+    assert [r.split(",")[1] for r in rows[1:]] == ["hybrid", "halfdiff"]
+    assert d["settings"].startswith("parameterizations = hybrid,halfdiff\n")
+    with pytest.raises(ValueError, match="--params: 'nope' is not a parameterization"):
+        halfback.study_brdf("lambert", {"params": ["nope"]})
+
+
 def test_functions_travel_to_other_processes():
     # Engines pickle the task's function to send it to worker processes (a real cluster): by
     # name, so these are the same functions on arrival (a pybind11 built-in does not pickle).

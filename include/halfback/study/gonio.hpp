@@ -57,6 +57,7 @@ namespace halfback::study {
 enum class Design { regular, stratified };
 inline constexpr std::array<Design, 2> kDesigns{Design::regular, Design::stratified};
 std::string_view name_of(Design d);
+std::optional<Design> parse_design(std::string_view name);
 
 struct GonioSetup {
   Space space = space_of<Hybrid>;  // a parameterization, not dirs

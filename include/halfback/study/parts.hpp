@@ -22,6 +22,8 @@ namespace halfback::study {
 // The options of `halfback study` that decide the results (the Python settings dict has the same
 // keys, '-' spelled '_'). Zero or empty: the default (or --quick's).
 struct StudySettings {
+  // --params: names of parameterizations (space_from_name); empty: default_studied().
+  std::vector<std::string> params;
   std::string space = "log";  // --error-space: parse_error_space()
   // --designs: parse_spacing() names. `learned` needs the profiles of the study's BRDFs (below).
   std::vector<std::string> designs{"own", "angle", "merl", "learned"};
@@ -63,27 +65,33 @@ std::string learned_fingerprint(std::span<const LabeledProfile> profiles);
 void set_learned(StudyConfig& config, std::span<const LabeledProfile> profiles,
                  const std::string& label);
 
-// Every setting of `config` that the results depend on, as "key = value" lines in a fixed order:
-// two runs whose descriptions are equal give the same tables for the same BRDF.
+// Every setting of `config` that the results depend on, as "key = value" lines in a fixed order,
+// the parameterizations first: two runs whose descriptions are equal give the same tables for
+// the same BRDF.
 std::string describe_config(const StudyConfig& config);
 
 // The configuration a description was made from, for writing a report: environments by label
 // only (no map; they are not rendered again). Throws std::runtime_error naming `source` and the
-// line for text that describe_config() did not write.
+// line for text that describe_config() did not write, or for a parameterization that is not
+// known in this process (one registered at run time by the program that wrote it).
 StudyConfig config_from_description(std::string_view text, const std::string& source);
 
 // The label of a BRDF in the tables: a file by its BRDF's name (merl:..., rgl:..., nbrdf:...), a
 // model by its spec, which holds its parameters (two GGX of different roughness are both "ggx").
 std::string study_label(std::string_view spec, const Brdf& brdf);
 
-// One BRDF's result as tables of CSV text, keyed "brdf", "azimuthal", "separability", "gonio" and
-// "image": the rows of the study's CSV files (budget.csv is derived from gonio), the numbers
-// written in shortest round-trip form so that reading them back gives the same doubles. The
-// example renderings are not tables (see BrdfPart).
+// One BRDF's result as tables of CSV text, keyed "brdf" (its label, whether it is isotropic and
+// its seconds) and by the name of each stored table (metric_tables.hpp: "azimuthal",
+// "separability", "gonio", "image"): the rows of the study's CSV files (budget.csv is derived from
+// gonio), the numbers written in shortest round-trip form so that reading them back gives the
+// same doubles. The example renderings are not tables (see BrdfPart).
 using StudyTables = std::map<std::string, std::string>;
 StudyTables to_tables(const BrdfResult& result);
-// Throws std::runtime_error naming `source`, the table and the line on a malformed table.
-BrdfResult from_tables(const StudyTables& tables, const std::string& source);
+// The result of tables that to_tables() wrote for a study of `params` (the run's settings say
+// which). Throws std::runtime_error naming `source`, the table and the line on a malformed table,
+// or a row of a parameterization that is not one of `params`.
+BrdfResult from_tables(const StudyTables& tables, std::span<const Space> params,
+                       const std::string& source);
 
 // A run's directory of parts: DIR/parts/settings.txt (describe_config) and, per BRDF, KEY.part (its
 // tables and its position `order` in the run) and KEY.exr (its example renderings side by side),
@@ -96,10 +104,10 @@ std::string part_key(std::string_view spec);
 std::filesystem::path profiles_dir(const std::filesystem::path& out);
 void write_part(const std::filesystem::path& parts, const std::string& key,
                 const BrdfResult& result, std::size_t order);
-// The part of `key` (with its example renderings when their file is there). Throws
-// std::runtime_error naming the file when it is missing or malformed.
+// The part of `key` (with its example renderings when their file is there), of a run of
+// `params`. Throws std::runtime_error naming the file when it is missing or malformed.
 BrdfResult read_part(const std::filesystem::path& parts, const std::string& key,
-                     std::size_t* order = nullptr);
+                     std::span<const Space> params, std::size_t* order = nullptr);
 
 // Results gathered from several runs (directories of parts, or Python's tables) for one report.
 struct MergedParts {

@@ -7,21 +7,20 @@
 #include <string_view>
 #include <vector>
 
+#include "halfback/study/metric_tables.hpp"
 #include "halfback/study/study.hpp"
 
 namespace halfback::study {
-
-// The error targets of budget.csv: the samples each parameterization needs to reach them.
-inline constexpr double kTargetErrors[] = {0.05, 0.02, 0.01};
 
 struct StudyOutput {
   std::string markdown;            // report.md
   std::vector<std::string> files;  // the names written in the directory
 };
 
-// Writes the study of `results` into `dir` (which must exist). Every file is written to a
-// temporary file and renamed into place. Throws std::runtime_error naming a file that cannot be
-// written.
+// Writes the study of `results` into `dir` (which must exist); its columns are the
+// parameterizations of the results. Every file is written to a temporary file and renamed into
+// place. Throws std::invalid_argument when the BRDFs were studied with different
+// parameterizations, std::runtime_error naming a file that cannot be written.
 StudyOutput write_study(const std::filesystem::path& dir, const std::vector<BrdfResult>& results,
                         const StudyConfig& config, double seconds);
 

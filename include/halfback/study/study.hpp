@@ -1,6 +1,7 @@
 // The study of one BRDF in every parameterization (issue 6; docs/study.md): the metrics of
 // metrics.hpp, the virtual gonio-reflectometer of gonio.hpp and the image-space error of its
-// reconstructions (image_metrics.hpp). report.hpp writes the results of a set of BRDFs.
+// reconstructions (image_metrics.hpp), as one table per metric (metric_tables.hpp). report.hpp
+// writes the results of a set of BRDFs.
 #pragma once
 
 #include <array>
@@ -18,12 +19,14 @@
 #include "halfback/render/image.hpp"
 #include "halfback/study/gonio.hpp"
 #include "halfback/study/metrics.hpp"
+#include "halfback/study/table.hpp"
 
 namespace halfback::study {
 
-// The parameterizations compared, in the order of every table.
-inline constexpr std::array<Space, 4> kStudied{space_of<HalfDiff>, space_of<Ortho>,
-                                               space_of<Hybrid>, space_of<Spherical>};
+// The parameterizations a study compares by default: every parameterization (the built-in ones,
+// then those registered so far), in the registry's order but with the spherical baseline last;
+// for the built-in ones: halfdiff, ortho, hybrid, spherical.
+std::vector<Space> default_studied();
 
 // Stated maxima of a study's work (StudyConfig::validate refuses more): a budget's tables and the
 // test pairs take tens of bytes per sample, so these keep one study within a few GB and hours.
@@ -33,6 +36,8 @@ inline constexpr std::size_t kMaxGridCells = std::size_t(1) << 24;  // metrics 1
 inline constexpr std::size_t kMaxImageSize = 4096;                  // pixels a side, metric 4
 
 struct StudyConfig {
+  // The parameterizations compared, in the order of every table's rows and the report's columns.
+  std::vector<Space> params = default_studied();
   ErrorSpace space = ErrorSpace::log;
   IsoGrid grid{64, 64, 64};                              // metrics 1-2, isotropic form
   std::array<std::size_t, 4> full_grid{16, 32, 16, 32};  // metrics 1-2, full form (anisotropic)
@@ -69,11 +74,13 @@ struct StudyConfig {
   // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.
   std::function<void(std::string_view stage)> progress;
 
-  // Throws std::invalid_argument naming a bad setting (unsorted budgets, an image budget that
-  // is not one of them, sizes of 0). No budgets: no gonio-reflectometer and no images.
+  // Throws std::invalid_argument naming a bad setting (no parameterization or one given twice,
+  // unsorted budgets, an image budget that is not one of them, sizes of 0). No budgets: no
+  // gonio-reflectometer and no images.
   void validate() const;
 };
 
+// The typed records of the gonio and image tables' rows (metric_tables.hpp).
 struct GonioPoint {
   Design design = Design::regular;  // the layout
   std::size_t budget = 0, samples = 0;
@@ -89,30 +96,24 @@ struct ImagePoint {
   double mae = 0, rmse = 0, ssim = 0;  // Sztrajman et al. 2021's protocol (ImageError)
 };
 
-struct ParamResult {
-  Space space = space_of<Hybrid>;
-  double azimuthal = 0;
-  std::vector<double> separability_2d, separability_3d;  // one per rank
-  std::vector<GonioPoint> gonio;                         // designs × budgets (isotropic)
-  std::vector<ImagePoint> images;                        // designs × environments
-  // Anisotropic BRDFs only: the 4D metrics.
-  double azimuthal_4d = 0;
-  std::vector<double> separability_4d;
-  std::vector<GonioPoint> gonio_4d;
-};
-
 struct BrdfResult {
   std::string label;
   bool isotropic = true;
-  std::vector<ParamResult> params;  // in the order of kStudied
+  std::vector<Space> params;  // the parameterizations studied (StudyConfig::params)
+  // One table per metric, those of stored_tables() in its order; the rows of each
+  // parameterization together, in the order of `params`.
+  std::vector<MetricTable> tables;
   // Under the first environment: the BRDF's rendering, then its regular-design reconstructions
-  // at the image budget in the order of kStudied (empty when there are no images).
+  // at the image budget in the order of `params` (empty when there are no images).
   std::vector<render::Image> example_images;
   double seconds = 0;
+
+  // The table of that name; std::invalid_argument when there is none.
+  const MetricTable& table(std::string_view name) const;
 };
 
-// Every metric of `brdf` in every parameterization of kStudied (one task each; the renderings
-// then use all cores). Throws what the metrics throw.
+// Every metric of `brdf` in every parameterization of config.params (one task each; the
+// renderings then use all cores). Throws what the metrics throw.
 BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyConfig& config);
 
 }  // namespace halfback::study

@@ -1,0 +1,239 @@
+// The figures of the report (report_internal.hpp): bar charts of metrics 1, 2 and 4, the
+// gonio-reflectometer's curves, the designs and the summary, and the example renderings. A series
+// (a colour) per parameterization, in the order of the results'.
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "halfback/figure/chart.hpp"
+#include "halfback/figure/material.hpp"
+#include "halfback/figure/plot.hpp"
+#include "halfback/figure/render.hpp"
+#include "report_internal.hpp"
+
+namespace halfback::study::report {
+
+namespace {
+
+std::vector<std::string> param_names(const std::vector<Space>& params) {
+  std::vector<std::string> names;
+  for (Space s : params) names.emplace_back(name_of(s));
+  return names;
+}
+
+// A bar chart with a row per BRDF and a bar per parameterization: value(b, s) for each BRDF of
+// results that `shown` accepts.
+template <class Value, class Shown>
+figure::BarChart per_brdf_chart(const std::vector<BrdfResult>& results, Value value, Shown shown) {
+  figure::BarChart c;
+  c.series = param_names(params_of(results));
+  for (const BrdfResult& b : results) {
+    if (!shown(b)) continue;
+    c.rows.push_back(b.label);
+    c.values.emplace_back();
+    for (Space s : b.params) c.values.back().push_back(value(b, s));
+  }
+  return c;
+}
+
+figure::BarChart azimuthal_chart(const std::vector<BrdfResult>& results,
+                                 const StudyConfig& config) {
+  figure::BarChart c = per_brdf_chart(
+      results, [](const BrdfResult& b, Space s) { return azimuthal_error(b, s, 3); },
+      [](const BrdfResult&) { return true; });
+  c.title = fmt::format("Azimuthal dependence ({} error space)", name_of(config.space));
+  c.x_label = "relative error of dropping the relative azimuth";
+  return c;
+}
+
+figure::BarChart separability_chart(const std::vector<BrdfResult>& results,
+                                    const StudyConfig& config) {
+  figure::BarChart c = per_brdf_chart(
+      results,
+      [](const BrdfResult& b, Space s) {
+        const std::vector<double> e = separability_errors(b, s, 2);
+        return e.empty() ? 0.0 : e[0];
+      },
+      [](const BrdfResult&) { return true; });
+  c.title = fmt::format("Separability of the 2D projection, rank 1 ({} error space)",
+                        name_of(config.space));
+  c.x_label = "relative error of the best rank-1 approximation";
+  return c;
+}
+
+// The regular design's relative RMSE of the BRDFs that were rendered (0 where not finite).
+figure::BarChart image_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  figure::BarChart c = per_brdf_chart(
+      results,
+      [](const BrdfResult& b, Space s) {
+        const MeanImageError m = mean_image_error(image_points(b, s), Design::regular);
+        return m.count && std::isfinite(m.relative_rmse) ? m.relative_rmse : 0.0;
+      },
+      [](const BrdfResult& b) { return has_images(b); });
+  c.title = fmt::format("Image-space error of the reconstructions from {} measurements",
+                        config.image_budget);
+  c.x_label = "relative RMSE of the sphere renderings (regular design, mean over maps)";
+  return c;
+}
+
+// The gonio curves as small multiples: one panel per BRDF, a colour per parameterization, the
+// regular design solid and the stratified one dashed.
+figure::Scene gonio_chart(const std::vector<BrdfResult>& results, bool four_d,
+                          const StudyConfig& config) {
+  figure::LogLogChart c;
+  c.title = fmt::format("Virtual gonio-reflectometer{}: relative error ({} space) against samples",
+                        four_d ? " (4D, full form)" : "", name_of(config.space));
+  c.x_label = "measurements";
+  c.y_label = "relative error";
+  for (const BrdfResult& b : results) {
+    if (four_d && b.isotropic) continue;
+    figure::LogLogPanel panel{b.label, {}};
+    for (std::size_t i = 0; i < b.params.size(); ++i) {
+      const std::vector<GonioPoint> points = gonio_points(b, b.params[i], four_d ? 4 : 3);
+      for (Design d : kDesigns) {
+        GonioCurve curve = gonio_curve(points, d);
+        bool positive = !curve.samples.empty(), exact = true;
+        for (double v : curve.errors) {
+          positive &= v > 0 && std::isfinite(v);
+          exact &= v < 1e-12;
+        }
+        if (!positive || exact) continue;  // an exact reconstruction has no place on a log axis
+        panel.series.push_back({fmt::format("{} {}", name_of(b.params[i]), name_of(d)), int(i),
+                                d == Design::stratified, std::move(curve.samples),
+                                std::move(curve.errors)});
+      }
+    }
+    if (!panel.series.empty()) c.panels.push_back(std::move(panel));
+  }
+  if (c.panels.empty()) return {};
+  c.columns = int(std::min<std::size_t>(4, c.panels.size()));
+  return figure::loglog_chart(c);
+}
+
+// The renderings of the BRDFs and of their regular-design reconstructions under the first
+// environment, side by side (the same tone mapping for a row), for the eye.
+figure::Scene examples_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const std::vector<Space>& params = params_of(results);
+  const double cell = 66, gap = 4, label_w = 250, top = 78;
+  const std::size_t columns = params.size() + 1;  // the BRDF, then its reconstructions
+  std::size_t rows = 0;
+  for (const BrdfResult& b : results) rows += b.example_images.size() == columns;
+  if (rows == 0 || config.environments.empty()) return {};
+  figure::Scene sc;
+  sc.title = "Renderings of the reconstructions";
+  const std::string title = fmt::format(
+      "The BRDF and its reconstructions from {} measurements (regular design), under {}",
+      config.image_budget, config.environments.front().label);
+  const std::string note = fmt::format(
+      "{} environment samples per pixel, the same in every image: the noise is common to a row",
+      config.image_spp);
+  sc.width = figure::snap(std::max(label_w + double(columns) * (cell + gap) + 10,
+                                   24 + 13 * 0.62 * double(title.size())));
+  sc.height = figure::snap(top + 14 + double(rows) * (cell + gap) + 10);
+  sc.text({12, 24}, figure::escape_markup(title), 13, figure::HAlign::left,
+          figure::VAlign::baseline, figure::kBlack, 0, true);
+  sc.text({12, 42}, figure::escape_markup(note), 9.5);
+  std::vector<std::string> heads{"BRDF"};
+  for (const std::string& name : param_names(params)) heads.push_back(name);
+  for (std::size_t k = 0; k < heads.size(); ++k)
+    sc.text({label_w + double(k) * (cell + gap) + cell / 2, top - 8},
+            figure::escape_markup(heads[k]), 9, figure::HAlign::centre);
+  double y = top;
+  for (const BrdfResult& b : results) {
+    if (b.example_images.size() != columns) continue;
+    sc.text({label_w - 8, y + cell / 2}, figure::escape_markup(b.label), 8.5, figure::HAlign::right,
+            figure::VAlign::middle);
+    for (std::size_t k = 0; k < b.example_images.size(); ++k)
+      sc.add(
+          figure::rendering_item(b.example_images[k], label_w + double(k) * (cell + gap), y, cell));
+    y += cell + gap;
+  }
+  return sc;
+}
+
+// Each parameterization's median error per design (section 3b).
+figure::Scene designs_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const std::size_t ref = reference_budget(config);
+  const DesignComparison c = compare_designs(results, ref);
+  if (c.brdfs.empty() || c.keys.size() < 2) return {};
+  figure::BarChart chart;
+  chart.title = fmt::format("Designs: median relative error ({} space) at N = {}",
+                            name_of(config.space), ref);
+  chart.x_label =
+      fmt::format("median over {} BRDFs of the reconstruction's relative error", c.brdfs.size());
+  for (const DesignKey& k : c.keys) chart.series.push_back(design_name(k));
+  chart.rows = param_names(c.params);
+  chart.values = c.median;
+  figure::BarChartLayout layout;
+  layout.label_width = 110;  // the rows are parameterization names
+  return figure::bar_chart(chart, layout);
+}
+
+// The gonio-reflectometer's median per kind, in the own regular design and in the best ones.
+figure::Scene summary_chart(const std::vector<BrdfResult>& results,
+                            const std::vector<SummaryMetric>& metrics, const StudyConfig& config,
+                            const Contents& has) {
+  if (!has.gonio) return {};
+  figure::BarChart chart;
+  chart.title = fmt::format("Gonio-reflectometer at N = {}: median relative error per kind",
+                            reference_budget(config));
+  chart.x_label = "median over the BRDFs of the kind (own regular design; each in its best design)";
+  chart.series = param_names(params_of(results));
+  for (const auto& [kind, rows] : kinds_of(results))
+    for (const SummaryMetric& m : metrics) {
+      if (m.chart_row.empty()) continue;
+      const auto [med, n] = medians(m, rows);
+      if (n == 0) continue;
+      chart.rows.push_back(fmt::format("{} ({}), {}", kind, n, m.chart_row));
+      chart.values.push_back(med);
+    }
+  if (chart.rows.empty()) return {};
+  figure::BarChartLayout layout;
+  layout.label_width = 200;
+  return figure::bar_chart(chart, layout);
+}
+
+void save_plot(const figure::Scene& sc, const std::filesystem::path& dir, const std::string& stem,
+               std::vector<std::string>& files) {
+  if (sc.items.empty()) return;
+  for (const char* ext : {".png", ".svg"}) {
+    figure::save(sc, dir / (stem + ext));
+    files.push_back(stem + ext);
+  }
+}
+
+}  // namespace
+
+ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                         const Contents& has, const std::vector<SummaryMetric>& summary) {
+  ReportPlots p;
+  p.summary = summary_chart(results, summary, config, has);
+  p.azimuthal = figure::bar_chart(azimuthal_chart(results, config));
+  p.separability = figure::bar_chart(separability_chart(results, config));
+  if (has.gonio) p.gonio = gonio_chart(results, false, config);
+  if (has.gonio && has.anisotropic) p.gonio4d = gonio_chart(results, true, config);
+  if (has.gonio) p.designs = designs_chart(results, config);
+  if (has.images) {
+    p.image = figure::bar_chart(image_chart(results, config));
+    p.renderings = examples_chart(results, config);
+  }
+  return p;
+}
+
+void save_plots(const ReportPlots& p, const std::filesystem::path& dir,
+                std::vector<std::string>& files) {
+  save_plot(p.summary, dir, "summary", files);
+  save_plot(p.azimuthal, dir, "azimuthal", files);
+  save_plot(p.separability, dir, "separability", files);
+  save_plot(p.gonio, dir, "gonio", files);
+  save_plot(p.gonio4d, dir, "gonio4d", files);
+  save_plot(p.designs, dir, "designs", files);
+  save_plot(p.image, dir, "image", files);
+  save_plot(p.renderings, dir, "renderings", files);
+}
+
+std::string plot_link(const figure::Scene& sc, const char* alt, const char* stem) {
+  return sc.items.empty() ? std::string() : fmt::format("![{}]({}.png)\n\n", alt, stem);
+}
+
+}  // namespace halfback::study::report

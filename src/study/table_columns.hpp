@@ -1,0 +1,50 @@
+// Columns that several of the study's tables share (metric_tables.hpp), and reading a name back
+// from a cell whose column's choices already held it to those names.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "halfback/study/design.hpp"
+#include "halfback/study/gonio.hpp"
+#include "halfback/study/table.hpp"
+
+namespace halfback::study::columns {
+
+inline Column parameterization() {
+  return {"parameterization", ColumnKind::text, {}};  // the study's own list (from_tables checks)
+}
+
+inline Column design() {
+  std::vector<std::string> names;
+  for (Design d : kDesigns) names.emplace_back(name_of(d));
+  return {"design", ColumnKind::text, names};
+}
+
+inline Column spacing() {
+  std::vector<std::string> names;
+  for (Spacing s : kSpacings) names.emplace_back(name_of(s));
+  return {"spacing", ColumnKind::text, names};
+}
+
+inline Column integer(std::string name) {
+  return {std::move(name), ColumnKind::integer, {}};
+}
+
+inline Column real(std::string name) {
+  return {std::move(name), ColumnKind::real, {}};
+}
+
+inline Column text(std::string name) {
+  return {std::move(name), ColumnKind::text, {}};
+}
+
+inline Design design_of(const MetricTable& t, const Row& row) {
+  return parse_design(t.text(row, "design")).value();
+}
+
+inline Spacing spacing_of(const MetricTable& t, const Row& row) {
+  return parse_spacing(t.text(row, "spacing")).value();
+}
+
+}  // namespace halfback::study::columns
