@@ -41,6 +41,19 @@ const Axis& descriptor_axis(const GridSpec& g, const GridAxis& a) {
   throw std::invalid_argument(fmt::format("{} has no coordinate '{}'", name_of(g.space), a.name));
 }
 
+// The learned warp of a grid axis: the one learned for the isotropic coordinate of the same
+// name (a: 0, b: 1, the relative azimuth: 2); the identity for an azimuth of the full form and for
+// a coordinate the isotropic form does not have (the Cartesian ones of the stereographic maps).
+AxisWarp learned_warp(const GridSpec& cells, const GridAxis& a, const LearnedWarps& learned) {
+  const bool full = cells.kind == GridKind::full;
+  if (full && descriptor_axis(cells, a).kind == AxisKind::azimuth)
+    return AxisWarp(AxisWarp::Kind::identity, a.lo, a.hi);
+  const auto iso = cells.space.param().axes(true);
+  for (std::size_t k = 0; k < iso.size() && k < learned.axes.size(); ++k)
+    if (iso[k].column == a.name) return learned.axes[k];
+  return AxisWarp(AxisWarp::Kind::identity, a.lo, a.hi);
+}
+
 }  // namespace
 
 AxisWarp::AxisWarp(Kind kind, double lo, double hi) : kind_(kind), lo_(lo), hi_(hi) {
@@ -127,14 +140,10 @@ std::vector<AxisWarp> design_warps(const GridSpec& cells, Spacing spacing,
         fmt::format("the learned design of {} needs warps learned for {} (study::learn_warps)",
                     name_of(cells.space), name_of(cells.space)));
   std::vector<AxisWarp> warps;
-  std::size_t magnitude = 0;  // the learned warps' axis of each magnitude (a: 0, b: 1)
   for (const GridAxis& a : cells.axes) {
     using K = AxisWarp::Kind;
     if (spacing == Spacing::learned) {
-      const bool azimuth = descriptor_axis(cells, a).kind == AxisKind::azimuth;
-      const std::size_t k = azimuth ? 2 : magnitude++;
-      const bool full_azimuth = azimuth && cells.kind == GridKind::full;
-      warps.push_back(full_azimuth ? AxisWarp(K::identity, a.lo, a.hi) : learned->axes[k]);
+      warps.push_back(learned_warp(cells, a, *learned));
       continue;
     }
     const Axis& axis = descriptor_axis(cells, a);

@@ -132,6 +132,7 @@ TEST(StudyParts, PartFilesAndTheirMerge) {
   const auto a = tmp.path() / "a", b = tmp.path() / "b";
   for (const auto& d : {a, b}) std::filesystem::create_directories(parts_dir(d));
   StudyConfig c;
+  c.params = kParams;  // those of the fakes
   c.budgets = {1000, 10000};
   const std::string settings = describe_config(c);
   for (const auto& d : {a, b}) {
