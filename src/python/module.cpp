@@ -30,6 +30,7 @@
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/parts.hpp"
 #include "halfback/util/output_dir.hpp"
+#include "user_param.hpp"
 
 namespace py = pybind11;
 using namespace halfback;
@@ -809,4 +810,5 @@ PYBIND11_MODULE(_core, m) {
   bind_loading(m);
   bind_study(m);
   bind_image_metrics(m);
+  halfback::python::bind_user_parameterizations(m);
 }

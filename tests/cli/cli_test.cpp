@@ -1330,7 +1330,10 @@ TEST_F(CliTest, MessagesNameTheProblemAndExitCodesAgree) {
 
 TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
   // --quick, lighter still: the test runs under the sanitizers too.
-  const Result r = run({"study", "--quick", "--test-pairs", "5000", "--env", "sky", "--image-size",
+  // The paper's four parameterizations (the others are the same code path, and the test runs
+  // under the sanitizers too).
+  const Result r = run({"study", "--quick", "--params", "halfdiff,ortho,hybrid,spherical",
+                        "--test-pairs", "5000", "--env", "sky", "--image-size",
                         "32", "--image-spp", "4", "-o", "st", "test:S", "test:G",
                         "ggx:alpha_x=0.2,alpha_y=0.5,f0=0.9", "embedded:acrylic_felt_green"});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -1478,9 +1481,15 @@ TEST_F(CliTest, StudyBadInput) {
 
 // The options of the small studies below: a few seconds each, under the sanitizers too.
 std::vector<std::string> tiny_study(const std::string& out, std::vector<std::string> specs) {
-  std::vector<std::string> a{"study", "--quick", "--test-pairs", "3000", "--budgets",   "300,1000",
-                             "--env", "sky",     "--image-size", "16",   "--image-spp", "2",
-                             "-o",    out};
+  // Four parameterizations, one of them without SIMD kernels (its descriptors' path).
+  std::vector<std::string> a{"study",         "--quick",
+                             "--params",      "halfdiff,hybrid,stereographic,spherical",
+                             "--test-pairs",  "3000",
+                             "--budgets",     "300,1000",
+                             "--env",         "sky",
+                             "--image-size",  "16",
+                             "--image-spp",   "2",
+                             "-o",            out};
   a.insert(a.end(), specs.begin(), specs.end());
   return a;
 }
