@@ -15,7 +15,8 @@ ParamDescriptor::ParamDescriptor(const Names& n)
       summary_(keep(n.summary)),
       axes_(n.axes),
       iso_axes_(n.iso_axes),
-      chart_(n.chart) {
+      chart_(n.chart),
+      studied_by_default_(n.studied_by_default) {
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     axes_[i].column = columns_[i] = keep(axes_[i].column);
     axes_[i].label = keep(axes_[i].label);

@@ -2,9 +2,23 @@
 // its tables say, around the tables of report_tables.cpp and the figures of report_charts.cpp.
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "report_internal.hpp"
 
 namespace halfback::study::report {
+
+namespace {
+// The parameterizations that exist but were not compared, and how to compare them.
+std::string left_out(const StudyConfig& config) {
+  std::string names;
+  for (Space s : parameterizations())
+    if (std::find(config.params.begin(), config.params.end(), s) == config.params.end())
+      names += (names.empty() ? "" : ", ") + std::string(name_of(s));
+  if (names.empty()) return {};
+  return " Not compared here: " + names + " (`--params` names the parameterizations compared).";
+}
+}  // namespace
 
 std::string report_header(const std::vector<BrdfResult>& results, const StudyConfig& config,
                           bool any_aniso, double seconds) {
@@ -13,14 +27,14 @@ std::string report_header(const std::vector<BrdfResult>& results, const StudyCon
       "Measure: cos θi cos θo dωi dωo, through each parameterization's Jacobian. Values: the "
       "luminance of ρ in the **{}** error space. Metrics 1–2 on a {} × {} × {} grid of cell "
       "centres of each isotropic form (midpoint rule){}. Definitions: docs/study.md. {} BRDFs "
-      "in {:.1f} s.\n\n",
+      "in {:.1f} s.{}\n\n",
       name_of(config.space), config.grid.a, config.grid.b, config.grid.phi,
       any_aniso ? fmt::format(", and {} × {} × {} × {} cells of the full form for the anisotropic "
                               "ones",
                               config.full_grid[0], config.full_grid[1], config.full_grid[2],
                               config.full_grid[3])
                 : "",
-      results.size(), seconds);
+      results.size(), seconds, left_out(config));
 }
 
 namespace {

@@ -39,6 +39,7 @@ void check_grid(std::initializer_list<std::size_t> axes, const char* which) {
 
 std::vector<Space> default_studied() {
   std::vector<Space> params = parameterizations();
+  std::erase_if(params, [](Space s) { return !s.param().studied_by_default(); });
   // The baseline last, so that the tables read from the half-vector parameterizations to it.
   std::stable_partition(params.begin(), params.end(),
                         [](Space s) { return s != space_of<Spherical>; });

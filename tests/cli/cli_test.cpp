@@ -1332,10 +1332,10 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
   // --quick, lighter still: the test runs under the sanitizers too.
   // The paper's four parameterizations (the others are the same code path, and the test runs
   // under the sanitizers too).
-  const Result r = run({"study", "--quick", "--params", "halfdiff,ortho,hybrid,spherical",
-                        "--test-pairs", "5000", "--env", "sky", "--image-size",
-                        "32", "--image-spp", "4", "-o", "st", "test:S", "test:G",
-                        "ggx:alpha_x=0.2,alpha_y=0.5,f0=0.9", "embedded:acrylic_felt_green"});
+  const Result r =
+      run({"study", "--quick", "--params", "halfdiff,ortho,hybrid,spherical", "--test-pairs",
+           "5000", "--env", "sky", "--image-size", "32", "--image-spp", "4", "-o", "st", "test:S",
+           "test:G", "ggx:alpha_x=0.2,alpha_y=0.5,f0=0.9", "embedded:acrylic_felt_green"});
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string az = slurp(path("st") / "azimuthal.csv");
   EXPECT_EQ(az.substr(0, az.find('\n')), "brdf,parameterization,error,dims");
@@ -1482,16 +1482,20 @@ TEST_F(CliTest, StudyBadInput) {
 // The options of the small studies below: a few seconds each, under the sanitizers too.
 std::vector<std::string> tiny_study(const std::string& out, std::vector<std::string> specs) {
   // Four parameterizations, one of them without SIMD kernels (its descriptors' path).
-  std::vector<std::string> a{"study",         "--quick",
-                             "--params",      "halfdiff,hybrid,stereographic,spherical",
-                             "--test-pairs",  "3000",
-                             "--budgets",     "300,1000",
-                             "--env",         "sky",
-                             "--image-size",  "16",
-                             "--image-spp",   "2",
-                             "-o",            out};
+  std::vector<std::string> a{
+      "study",        "--quick", "--params",     "halfdiff,hybrid,stereographic,spherical",
+      "--test-pairs", "3000",    "--budgets",    "300,1000",
+      "--env",        "sky",     "--image-size", "16",
+      "--image-spp",  "2",       "-o",           out};
   a.insert(a.end(), specs.begin(), specs.end());
   return a;
+}
+
+// Sets the value of an option of a command line (the element after the option's name).
+void set_option(std::vector<std::string>& args, const std::string& option, const std::string& v) {
+  const auto it = std::find(args.begin(), args.end(), option);
+  ASSERT_TRUE(it != args.end() && it + 1 != args.end()) << option;
+  *(it + 1) = v;
 }
 
 const std::vector<std::string> kTinyPanel{"lambert", "ggx:alpha=0.3", "test:S",
@@ -1555,7 +1559,7 @@ TEST_F(CliTest, StudyResumeAfterAKillGivesTheSameTables) {
 
   // Other settings cannot resume the run: a usage error, the results untouched.
   std::vector<std::string> other = tiny_study("cut", kTinyPanel);
-  other[3] = "4000";  // --test-pairs
+  set_option(other, "--test-pairs", "4000");
   other.insert(other.begin() + 1, "--resume");
   const Result bad = run(other);
   EXPECT_EQ(bad.status, 2);
@@ -1601,7 +1605,7 @@ TEST_F(CliTest, StudyMergeOfTwoRunsIsOneRun) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("'nowhere': not the output of a study"), std::string::npos) << r.err;
   std::vector<std::string> other = no_learned(tiny_study("c", {"test:G"}));
-  other[5] = "4000";  // --test-pairs
+  set_option(other, "--test-pairs", "4000");
   ASSERT_EQ(run(other).status, 0);
   r = run({"study", "--merge", "a", "c", "-o", "m2"});
   EXPECT_EQ(r.status, 1);

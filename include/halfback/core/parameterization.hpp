@@ -146,6 +146,9 @@ class ParamDescriptor {
     std::array<Axis, 4> axes;
     std::array<Axis, 3> iso_axes;
     SamplerChart chart;
+    // Whether `halfback study` compares it without being asked (--params): see
+    // studied_by_default_of below.
+    bool studied_by_default = true;
   };
   explicit ParamDescriptor(const Names& names);  // copies every string
   virtual ~ParamDescriptor() = default;
@@ -163,6 +166,7 @@ class ParamDescriptor {
     return columns_;
   }
   const SamplerChart& sampler_chart() const { return chart_; }
+  bool studied_by_default() const { return studied_by_default_; }
 
   // Whether the maps may run on several threads at once (a Python callable may not).
   virtual bool concurrent() const { return true; }
@@ -196,6 +200,7 @@ class ParamDescriptor {
   std::array<std::string_view, 4> columns_;
   std::array<std::string_view, 3> iso_columns_;
   SamplerChart chart_;
+  bool studied_by_default_;
   std::string_view keep(std::string_view s);
 };
 

@@ -23,9 +23,10 @@
 
 namespace halfback::study {
 
-// The parameterizations a study compares by default: every parameterization (the built-in ones,
-// then those registered so far), in the registry's order but with the spherical baseline last;
-// for the built-in ones: halfdiff, ortho, hybrid, spherical.
+// The parameterizations a study compares by default: every parameterization studied by default
+// (ParamDescriptor::studied_by_default: the built-in ones but three that --params adds, then those
+// registered so far), in the registry's order but with the spherical baseline last: halfdiff,
+// ortho, hybrid, rectified-hybrid, ..., spherical.
 std::vector<Space> default_studied();
 
 // Stated maxima of a study's work (StudyConfig::validate refuses more): a budget's tables and the

@@ -17,6 +17,9 @@
 namespace halfback {
 
 struct HalfwayDisk {
+  // Compared by `halfback study` when asked (--params): each parameterization adds about a fifth
+  // to the full study's time (docs/study.md, "Results").
+  static constexpr bool studied_by_default = false;
   static constexpr std::string_view name = "halfway-disk";
   static constexpr std::string_view summary =
       "(θi, φi, ρ, ψ): ωi and the half vector on the unit disk under it (Edwards et al. 2006)";

@@ -63,6 +63,9 @@ constexpr Axis stereo_radius_axis(std::string_view column, std::string_view labe
 }  // namespace detail
 
 struct Stereographic {
+  // Compared by `halfback study` when asked (--params): each parameterization adds about a fifth
+  // to the full study's time (docs/study.md, "Results").
+  static constexpr bool studied_by_default = false;
   static constexpr std::string_view name = "stereographic";
   static constexpr std::string_view summary =
       "(s(ωi), s(ωo)), s(ω) = ω_xy/(1 + z): stereographic projections of the two directions "
@@ -155,6 +158,9 @@ struct Stereographic {
 };
 
 struct StereoHalfDiff {
+  // Compared by `halfback study` when asked (--params): each parameterization adds about a fifth
+  // to the full study's time (docs/study.md, "Results").
+  static constexpr bool studied_by_default = false;
   static constexpr std::string_view name = "stereo-halfdiff";
   static constexpr std::string_view summary =
       "(s(ĥ), s(d)): halfdiff's half and difference vectors in stereographic projection";
