@@ -281,6 +281,14 @@ void draw_key(Scene& scene, Space space, const Rect& rect, double ppp) {
 
 }  // namespace
 
+namespace {
+std::size_t utf8_length(std::string_view s) {
+  std::size_t n = 0;
+  for (unsigned char c : s) n += (c & 0xC0) != 0x80;
+  return n;
+}
+}  // namespace
+
 HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
   if (o.params.empty()) throw std::invalid_argument("hemisphere figure: no parameterization given");
   if (o.elevations_deg.empty())
@@ -300,7 +308,11 @@ HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
 
   HemisphereFigure fig;
   const double D = snap(o.disk_size), gap = 18, vgap = 22;
-  const double left = 92, top = 64, key_gap = 62, key = snap(0.62 * D), right = 24, bottom = 64;
+  // The row labels (names in bold 11 pt, about 0.62 em a character) fit in the left margin.
+  std::size_t longest = 0;
+  for (Space s : o.params) longest = std::max(longest, utf8_length(name_of(s)));
+  const double left = snap(std::max(92.0, 16 + 0.62 * 11 * double(longest)));
+  const double top = 64, key_gap = 62, key = snap(0.62 * D), right = 24, bottom = 64;
   const std::size_t rows = o.params.size(), cols = o.elevations_deg.size();
   Scene& sc = fig.scene;
   sc.width = snap(left + double(cols) * D + double(cols - 1) * gap + key_gap + key + right);
