@@ -6,6 +6,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "halfback/core/param.hpp"
 #include "halfback/core/space.hpp"
 
 namespace halfback::detail {

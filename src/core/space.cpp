@@ -1,5 +1,7 @@
 #include "halfback/core/space.hpp"
 
+#include "halfback/core/parameterization.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>

@@ -19,6 +19,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "halfback/core/param_descriptor.hpp"
+#include "halfback/core/param_list.hpp"
 #include "halfback/core/params/charts.hpp"
 #include "halfback/core/params/common.hpp"
 #include "halfback/core/params/halfdiff.hpp"
@@ -28,6 +30,7 @@
 #include "halfback/core/params/rectified_hybrid.hpp"
 #include "halfback/core/params/spherical.hpp"
 #include "halfback/core/params/stereographic.hpp"
+#include "halfback/core/space.hpp"
 
 namespace halfback {
 
@@ -66,58 +69,12 @@ concept Parameterization = MapsOnLanes<P, float> && MapsOnLanes<P, double> && re
   requires SamplerChartType<typename P::SamplerChart>;
 };
 
-template <Parameterization... Ps>
-struct ParamList {
-  static constexpr std::size_t size = sizeof...(Ps);
-};
-
-// The built-in parameterizations, in the order of every run-time list (space ids 1, 2, ...).
-// KernelParams have SIMD kernels in the batch engine's tables, one instantiation per instruction
-// set; PortableParams are converted through their descriptors, in double, a block of rows at a
-// time (batch_registered.cpp): each in the SIMD tables would add to every clean build's heaviest
-// translation units (docs/performance.md, "Building") for maps that are not on a hot path.
-using KernelParams = ParamList<Spherical, HalfDiff, Ortho, Hybrid>;
-using PortableParams = ParamList<RectifiedHybrid, StereoHalfDiff, Stereographic, HalfwayDisk>;
-
-inline constexpr std::size_t kKernelParamCount = KernelParams::size;
-inline constexpr std::size_t kBuiltinParamCount = KernelParams::size + PortableParams::size;
-
-namespace detail {
-template <class P, class List>
-struct IndexIn;
-template <class P, class... Ps>
-struct IndexIn<P, ParamList<Ps...>> {
-  static constexpr std::size_t value = [] {
-    constexpr bool same[] = {std::is_same_v<P, Ps>...};
-    for (std::size_t i = 0; i < sizeof...(Ps); ++i)
-      if (same[i]) return i;
-    return sizeof...(Ps);
-  }();
-  static constexpr bool found = value < sizeof...(Ps);
-};
-}  // namespace detail
-
-// The position of P in KernelParams.
-template <class P>
-inline constexpr std::size_t kernel_index = detail::IndexIn<P, KernelParams>::value;
-
-// The position of P among the built-in parameterizations: KernelParams, then PortableParams.
-template <class P>
-inline constexpr std::size_t builtin_index = [] {
-  using InKernels = detail::IndexIn<P, KernelParams>;
-  using InPortable = detail::IndexIn<P, PortableParams>;
-  static_assert(InKernels::found || InPortable::found, "not a built-in parameterization");
-  return InKernels::found ? InKernels::value : KernelParams::size + InPortable::value;
-}();
-
-// Calls f.template operator()<P, I>() for each P of the list, with I its index.
-template <class... Ps, class F>
-constexpr void for_each_param(ParamList<Ps...>, F&& f) {
-  [&]<std::size_t... I>(std::index_sequence<I...>) {
-    (f.template operator()<Ps, I>(), ...);
-  }
-  (std::index_sequence_for<Ps...>{});
+// Every built-in parameterization satisfies the concept.
+template <class... Ps>
+constexpr bool all_parameterizations(ParamList<Ps...>) {
+  return (Parameterization<Ps> && ...);
 }
+static_assert(all_parameterizations(KernelParams{}) && all_parameterizations(PortableParams{}));
 
 // Calls f(P{}) with the built-in parameterization at `index` (< kKernelParamCount).
 template <class F>
@@ -136,81 +93,22 @@ decltype(auto) visit_kernel_param(std::size_t index, F&& f) {
   }(KernelParams{});
 }
 
-// A parameterization at run time: its names and axes, and its maps in double precision, for code
-// that picks a parameterization from user input. For a C++ parameterization (CompiledParam) the
-// maps are the templates themselves, bit for bit; a run-time one (a Python user's) overrides them.
-// The checked forms: inverse() and inverse_iso() give NaN directions outside the valid domain.
-class ParamDescriptor {
- public:
-  struct Names {
-    std::string_view name, summary;
-    std::array<Axis, 4> axes;
-    std::array<Axis, 3> iso_axes;
-    SamplerChart chart;
-    // Whether `halfback study` compares it without being asked (--params): see
-    // studied_by_default_of below.
-    bool studied_by_default = true;
-  };
-  explicit ParamDescriptor(const Names& names);  // copies every string
-  virtual ~ParamDescriptor() = default;
-  ParamDescriptor(const ParamDescriptor&) = delete;
-  ParamDescriptor& operator=(const ParamDescriptor&) = delete;
-
-  std::string_view name() const { return name_; }
-  std::string_view summary() const { return summary_; }
-  std::span<const Axis> axes(bool isotropic) const {
-    if (isotropic) return iso_axes_;
-    return axes_;
-  }
-  std::span<const std::string_view> columns(bool isotropic) const {
-    if (isotropic) return iso_columns_;
-    return columns_;
-  }
-  const SamplerChart& sampler_chart() const { return chart_; }
-  bool studied_by_default() const { return studied_by_default_; }
-
-  // Whether the maps may run on several threads at once (a Python callable may not).
-  virtual bool concurrent() const { return true; }
-
-  virtual Tuple4<double> forward(const DirPair<double>& pair) const = 0;
-  virtual Tuple3<double> forward_iso(const DirPair<double>& pair) const = 0;
-  virtual Solved<double> inverse(const Tuple4<double>& q) const = 0;
-  virtual Solved<double> inverse_iso(const Tuple3<double>& q) const = 0;
-  virtual double jacobian(const Tuple4<double>& q) const = 0;
-  virtual double jacobian_iso(const Tuple3<double>& q) const = 0;
-  virtual Tuple4<double> reciprocal(const Tuple4<double>& q) const = 0;
-  virtual Tuple4<double> mirror(const Tuple4<double>& q) const = 0;
-  virtual Tuple3<double> reciprocal_iso(const Tuple3<double>& q) const = 0;
-  virtual Tuple3<double> mirror_iso(const Tuple3<double>& q) const = 0;
-
-  // Blocks of m rows, for the batch engine's path of a parameterization outside KernelParams
-  // (row-major: `coords` holds m tuples of 4, or 3 when isotropic). The defaults loop over the
-  // maps above; a run-time parameterization overrides them to call its vectorized code once.
-  virtual void forward_rows(bool isotropic, const DirPair<double>* pairs, std::size_t m,
-                            double* coords) const;
-  virtual void inverse_rows(bool isotropic, const double* coords, std::size_t m,
-                            DirPair<double>* pairs, std::uint8_t* in_domain) const;
-  virtual void jacobian_rows(bool isotropic, const double* coords, std::size_t m,
-                             double* jacobian) const;
-
- private:
-  std::deque<std::string> strings_;  // owns what the views below point into
-  std::string_view name_, summary_;
-  std::array<Axis, 4> axes_;
-  std::array<Axis, 3> iso_axes_;
-  std::array<std::string_view, 4> columns_;
-  std::array<std::string_view, 3> iso_columns_;
-  SamplerChart chart_;
-  bool studied_by_default_;
-  std::string_view keep(std::string_view s);
-};
+// A parameterization may set `static constexpr bool studied_by_default = false` to leave itself out
+// of the study's default list (each one adds to a full run's time; docs/study.md).
+template <class P>
+constexpr bool studied_by_default_of() {
+  if constexpr (requires { P::studied_by_default; })
+    return P::studied_by_default;
+  else
+    return true;
+}
 
 template <Parameterization P>
 class CompiledParam final : public ParamDescriptor {
  public:
   CompiledParam()
-      : ParamDescriptor(
-            {P::name, P::summary, P::axes, P::iso_axes, chart_of<typename P::SamplerChart>()}) {}
+      : ParamDescriptor({P::name, P::summary, P::axes, P::iso_axes,
+                         chart_of<typename P::SamplerChart>(), studied_by_default_of<P>()}) {}
   Tuple4<double> forward(const DirPair<double>& p) const override { return P::forward(p); }
   Tuple3<double> forward_iso(const DirPair<double>& p) const override { return P::forward_iso(p); }
   Solved<double> inverse(const Tuple4<double>& q) const override { return halfback::inverse<P>(q); }
@@ -260,5 +158,11 @@ class CompiledParam final : public ParamDescriptor {
     }
   }
 };
+
+// Registers a C++ parameterization at run time (space.hpp): a test's, a plug-in's.
+template <Parameterization P>
+Space register_parameterization() {
+  return register_parameterization(std::make_shared<CompiledParam<P>>());
+}
 
 }  // namespace halfback

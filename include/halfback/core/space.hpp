@@ -17,7 +17,8 @@
 #include <string_view>
 #include <vector>
 
-#include "halfback/core/parameterization.hpp"
+#include "halfback/core/param_descriptor.hpp"
+#include "halfback/core/param_list.hpp"
 
 namespace halfback {
 
@@ -70,12 +71,9 @@ std::vector<Space> parameterizations();
 
 // Adds a parameterization at run time and returns its space. Its name must not be "dirs" nor a
 // built-in one's (std::invalid_argument); registering a name again gives a new space, which the
-// name then denotes (spaces of the older one stay valid). Thread-safe; never unregistered.
+// name then denotes (spaces of the older one stay valid). Thread-safe; never unregistered. A C++
+// parameterization: register_parameterization<P>() (parameterization.hpp).
 Space register_parameterization(std::shared_ptr<const ParamDescriptor> descriptor);
-template <Parameterization P>
-Space register_parameterization() {
-  return register_parameterization(std::make_shared<CompiledParam<P>>());
-}
 
 // A space and whether its isotropic (3D, canonical-pose) form is meant. `dirs` has no isotropic
 // form: it is always the 6 Cartesian components (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z).
