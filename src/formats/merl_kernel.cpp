@@ -73,9 +73,9 @@ namespace {
 
 // Steps of kRows rows: the corners of the next step are prefetched, this step's corner values
 // copied into columns (a short loop of independent loads, so that many rows' cache misses are in
-// flight), then blended across rows in vectors. Blending row by row, each row's arithmetic filled
-// the out-of-order window (3.1-3.3 against 1.0-1.1 ms per 65536 rows for the table reads alone;
-// docs/performance.md).
+// flight), then blended across rows in vectors. Blended row by row, each row's arithmetic fills
+// the out-of-order window and the misses of the next rows wait: three times the time of the table
+// reads alone (docs/performance.md, "Measured lookups").
 [[gnu::always_inline]] inline void blend_rows_portable_body(const merl::BinValues* table,
                                                             const Cells& cells, std::size_t begin,
                                                             std::size_t end, Rgb* out) {
