@@ -109,7 +109,7 @@ HALFBACK_NBRDF_INLINE void evaluate_block_impl_body(const NbrdfNetwork& network,
 // their levels, any of which GCC may use) where simd_isa() asks for AVX-512 or AVX2 and the CPU
 // runs the whole level (simd_isa() checks AVX-512F, AVX2 and FMA only; a Xeon Phi has AVX-512F
 // but not v4), else the level below, down to the baseline.
-formats_isa::Version block_version() {
+[[maybe_unused]] formats_isa::Version block_version() {  // unused without the versions
   using formats_isa::Version;
 #if defined(HALFBACK_FORMATS_ISA_VERSIONS)
   static const bool v4 = (__builtin_cpu_init(), __builtin_cpu_supports("x86-64-v4"));
