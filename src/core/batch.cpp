@@ -287,8 +287,9 @@ void mask_jacobian(const T* mask, T* jac, std::size_t m, bool unit) {
   for (std::size_t i = 0; i < m; ++i) jac[i] = mask[i] > T(0) ? (unit ? T(1) : jac[i]) : nan;
 }
 
-// Scratch of one thread, reused by every call on it: allocating it per call cost ~0.3 µs, which
-// the renderer's and the RGL lookups' packets of 16 pairs paid each time. A call nested in another
+// Scratch of one thread, reused by every call on it: allocating it per call would cost ~0.3 µs,
+// which the renderer's and the RGL lookups' packets of 16 pairs would pay each time
+// (docs/performance.md, "Conversions", "Small calls"). A call nested in another
 // on the same thread (not done today: the tile loop calls nothing that could) gets its own.
 class ScratchLease {
  public:
@@ -479,9 +480,9 @@ class TileRunner {
 // Rows before the first tile, so that the other tiles start on a 64-byte line in every unit-stride
 // column, when they all have the same offset in a line (arrays allocated alike: malloc's large
 // blocks start 16 bytes into a page). Every whole-line vector then loads and stores one line
-// instead of two: 3-4 % of a forward conversion at 10^7 pairs (docs/performance.md, seventh
-// round). 0 for a small batch (one more partial tile would cost more), for columns that disagree,
-// and for row-major data (its rows are not lines).
+// instead of two: 3-4 % of a forward conversion at 10^7 pairs (docs/performance.md,
+// "Conversions", "The aligning head"). 0 for a small batch (one more partial tile would cost more),
+// for columns that disagree, and for row-major data (its rows are not lines).
 template <class T>
 std::size_t aligning_head(std::span<const ConstColumn<T>> in, const ConvertOutput<T>& out,
                           std::size_t n) {

@@ -79,7 +79,8 @@ struct StageKernels {
   // vector loops, for D = 3, 4, 6; where not, the engine transposes with gather and scatter.
   bool fused_rows[7];
   // The mask column (1 or 0) as ConvertOutput::valid's bytes; here so that each table's compiler
-  // flags vectorize it (the baseline build compared one double at a time: 5 % of a conversion).
+  // flags vectorize it (built for the baseline, GCC compares one double at a time: 5 % of a
+  // forward conversion in cache; docs/performance.md, "Conversions").
   using ValidFn = void (*)(const T* mask, std::uint8_t* valid, std::size_t m);
   ValidFn valid_bytes;
 };
@@ -122,9 +123,8 @@ bool set_batch_isa(std::optional<SimdIsa> isa);
 
 // Outputs are written with plain stores by default. Non-temporal stores (outputs assembled in
 // the tile's scratch, then copied past the caches) avoid the write-allocate reads of the output
-// lines, but measured slower in 14 of 16 conversions at 10^7 pairs on AMD Zen 5 (5-77 %, the
-// other two within noise) and within noise on Intel (docs/performance.md, "Conversions"): the
-// burst of copies at the end of each tile waits on the write-combining buffers, while plain
+// lines, but are slower on AMD Zen 5 and no faster on Intel (docs/performance.md, "Conversions"):
+// the burst of copies at the end of each tile waits on the write-combining buffers, while plain
 // stores overlap the kernels' arithmetic.
 // For tests and benchmarks: forces non-temporal output stores on (true) or off (false);
 // nullopt: the default (off). Not meant to race with convert().

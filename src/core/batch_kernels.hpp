@@ -88,8 +88,8 @@ struct RegisterRowTranspose {
 // Software prefetch of the columns kPrefetchBytes ahead of each vector step, every line of it:
 // the hardware prefetcher alone kept the 6 to 11 streams of a conversion too few lines ahead of
 // the arithmetic (docs/performance.md, "Conversions"). Only where a vector step is whole lines
-// (AVX-512). Outputs too for the decodes (the inverse conversions' last stage), where it measured
-// faster; the encodes were no faster with it.
+// (AVX-512). Outputs too for the decodes (the inverse conversions' last stage), where it is
+// faster; the encodes gain nothing from it.
 inline constexpr std::size_t kPrefetchBytes = 1024;
 enum class Prefetch { inputs, inputs_and_outputs };
 
@@ -229,10 +229,10 @@ void decode_stage(const ScalarOf<B>* const* in, ScalarOf<B>* const* dirs, Scalar
 // P output: the coordinates of the pair (NaN where the mask is 0), onto the unit hemisphere first
 // as convert_row() does: a decoded pair is unit only to rounding. Rows whose mask is kUnchecked
 // are the user's directions (dirs input): checked here, in the loop that computes, so that their
-// loads from memory overlap the arithmetic (a check pass of its own over the input left them
-// waiting, ~1.4 ns a float pair at 10^7 pairs), and put on the hemisphere twice, as the check
-// stage and this one did before (convert_row's accepted pair, then its unit pair). The mask
-// is rewritten, 1 or 0.
+// loads from memory overlap the arithmetic (a check pass of its own over the input waits on
+// memory at 10^7 pairs; docs/performance.md, "Conversions", "One pass over the input"), and put
+// on the hemisphere twice, as the check stage followed by this one would (convert_row's accepted
+// pair, then its unit pair): the same bits. The mask is rewritten, 1 or 0.
 template <class B, class P, bool Iso>
 void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask_in, ScalarOf<B>* mask_out,
                   ScalarOf<B>* const* out, std::size_t m, StageRows<ScalarOf<B>> rows) {
@@ -269,8 +269,8 @@ void encode_stage(const ScalarOf<B>* const* dirs, const ScalarOf<B>* mask_in, Sc
 }
 
 // The measure J(q) of coordinates of P at every row, not masked: the engine puts NaN where the
-// row is invalid. (decode and encode computed it from the same q in the same lanes before, so the
-// bits are those of convert_one.)
+// row is invalid. A stage of its own, from the same q in the same lanes as decode and encode see
+// it, so the bits are those of convert_one.
 template <class B, class P, bool Iso>
 void jacobian_stage(const ScalarOf<B>* const* coords, ScalarOf<B>* jac, std::size_t m) {
   using S = ScalarOf<B>;

@@ -21,9 +21,9 @@ namespace {
 
 // AVX2's two 128-bit lanes for the row transposes (lane_transposes.hpp). The loads are a 128-bit
 // load and an insert; the stores pair two registers' lanes with one cross-lane permute per
-// 256-bit store, measured faster than storing the lanes one by one (docs/performance.md, "Array
-// layouts", tenth round: rows / SoA at 10^7 pairs from 1.7-2.2 with GCC's transpose passes to
-// 0.96-1.16).
+// 256-bit store, which is faster than storing the lanes one by one. Transposed in registers
+// because transpose passes over scratch cost row-major data about twice the time of SoA at 10^7
+// pairs (docs/performance.md, "Array layouts", "AVX2 transposes in registers").
 struct AvxLanes {
   using F = __m256;
   using Dv = __m256d;

@@ -129,14 +129,14 @@ template <class S, int D>
 struct ZmmRows : PermuteRows<S, D> {};
 
 // 8 rows of 6 doubles to columns without two-source permutes, which on Zen 5 issue to the FMA
-// pipes the conversions need (docs/performance.md, "Array layouts", eighth round). A 128-bit
+// pipes the conversions need (docs/performance.md, "Array layouts", "Zen 5's pipes"). A 128-bit
 // piece is two values of a row (piece p: columns 2p, 2p + 1). r[k] = [chunk k of rows 0-3 | of
 // rows 4-7] (chunk: four values, pieces 2k and 2k + 1) comes from a 256-bit load and a broadcast
 // one, blended; swapping the two pieces of each 256-bit half (an in-half permute) and blending
 // gathers piece p of the even rows (even[p]) and of the odd rows (odd[p]) in row order, and
 // unpacklo and unpackhi of those are columns 2p and 2p + 1: 12 loads, 6 permutes, 12 blends and
-// 6 unpacks for 6 loads, 18 permutes and 12 index loads. The stores keep the permutes (this
-// order measured no faster there), and so do floats (measured no faster either).
+// 6 unpacks for 6 loads, 18 permutes and 12 index loads. The stores keep the permutes, and so
+// do floats: this order is no faster there.
 template <>
 struct ZmmRows<double, 6> : PermuteRows<double, 6> {
   using V = __m512d;
@@ -192,11 +192,10 @@ constexpr KernelSet make_avx512_set() {
   using A = xsimd::avx512f;
   using F = xsimd::batch<float, A>;
   using D = xsimd::batch<double, A>;
-  // Two vectors per step (Twin, batch_simd.hpp) for every decode (the inverses): measured in
-  // cache (32768 pairs, CPU time, the machine loaded) 5-10 % faster, and at 10^7 pairs 5-15 %.
-  // The encodes keep one vector: with two, spherical, ortho and hybrid were 4-13 % slower (more
-  // of their registers spill), and halfdiff, once its clamp's atan2 became rare, 3-8 % slower at
-  // 10^7 pairs.
+  // Two vectors per step (Twin, batch_simd.hpp) for every decode (the inverses), whose latency
+  // stalls the second vector hides. The encodes keep one vector: with two, more of their
+  // registers spill, which costs more than it hides (docs/performance.md, "Conversions": the
+  // measurements of both choices).
   return make_kernel_set<F, D, Twin<F>, Twin<D>>(SimdIsa::avx512, "avx512");
 }
 

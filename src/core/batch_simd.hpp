@@ -149,7 +149,7 @@ struct LaneOps<xsimd::batch<S, A>> {
   // kernels' latency feels. Beyond (atan2's 11 terms in double) by a second-order Horner rule,
   // even and odd terms as two chains in w = z²: N - 1 fmas and one product, two fewer than
   // Estrin's squares of z, which the forward kernels' throughput feels more than its longer chain
-  // (docs/performance.md, seventh round).
+  // (docs/performance.md, "Conversions").
   template <std::size_t N>
   static T polynomial(const std::array<S, N>& c, const T& z) {
     if constexpr (N <= 6) {

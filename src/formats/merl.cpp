@@ -296,9 +296,10 @@ void MerlBrdf::nearest_blocks(std::span<const DirPair<double>> pairs, std::span<
 }
 
 // Block by block: the conversion, the cells, then the blends (merl_kernel::blend_rows prefetches
-// its own corners a step ahead). Rows left to eval() get its values over the blend's. Converting
-// the next block before this block's blends (software pipelining) measured no faster, loaded or
-// idle (docs/performance.md, "MERL, fourth round").
+// its own corners a step ahead). Rows left to eval() get its values over the blend's. Not
+// pipelined (the next block's conversion before this block's blends): that is no faster, as the
+// prefetches wait for miss buffers and the out-of-order window cannot run the conversion under
+// them (docs/performance.md, "Measured lookups", "Software pipelining").
 void MerlBrdf::trilinear_blocks(std::span<const DirPair<double>> pairs, std::span<Rgb> out,
                                 std::size_t begin, std::size_t end) const {
   Coordinates c;
@@ -319,8 +320,9 @@ void MerlBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb>
                                 " pairs but " + std::to_string(out.size()) + " outputs");
   // Tasks of 4 blocks at most (1024 rows, 50-90 µs on a core: well above the cost of a task, and
   // fine enough that the last task leaves the other thread idle for a few percent of a 65536-row
-  // batch at most; 16 blocks left it up to 12 %). Blocks start at multiples of kBlock whatever
-  // the split, as the batch engine's tiles do.
+  // batch at most, where tasks of 16 blocks leave it up to 12 %: docs/performance.md, "Measured
+  // lookups"). Blocks start at multiples of kBlock whatever the split, as the batch engine's tiles
+  // do.
   const std::size_t n = pairs.size(), blocks = (n + kBlock - 1) / kBlock;
   parallel_for(blocks, 4, [&](std::size_t begin, std::size_t end) {
     if (options_.lookup == MerlLookup::nearest)

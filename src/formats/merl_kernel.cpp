@@ -1,14 +1,15 @@
-// The block loops of the MERL lookups, each compiled three times (AVX-512, AVX2, the baseline) and
-// chosen at load time by the CPU (GCC's target_clones). The loops are the formulas of
-// merl_kernel.hpp applied row by row; the compiler vectorizes them across rows. Compiled without
-// errno for sqrt, without trapping math and without contraction (src/formats/CMakeLists.txt): the
-// roundings are those of the one-row path. The blend and rows_apart also have hand-written
-// AVX-512 kernels (target attributes, chosen at run time by avx512_kernels()), the same bits.
+// The block loops of the MERL lookups, each compiled for AVX-512, AVX2 and the baseline and run as
+// simd_isa() says (isa_versions.hpp). The loops are the formulas of merl_kernel.hpp applied row
+// by row; the compiler vectorizes them across rows. Compiled without errno for sqrt, without
+// trapping math and without contraction (src/formats/CMakeLists.txt): the roundings are those of
+// the one-row path, in every version. The blend and rows_apart also have hand-written AVX-512
+// kernels (target attributes, run when avx512_kernels()), the same bits.
 #include "merl_kernel.hpp"
 
 #include <algorithm>
 #include <cstdlib>
 
+#include "formats/isa_versions.hpp"
 #include "halfback/core/simd.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -18,17 +19,12 @@
 
 namespace halfback::merl_kernel {
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define HALFBACK_MERL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define HALFBACK_MERL_CLONES
-#endif
+namespace {
 
-HALFBACK_MERL_CLONES
-void nearest_bins(const double* theta_h, const double* theta_d, const double* phi_d,
-                  const std::uint8_t* apart, std::size_t m, std::uint32_t apart_bin,
-                  std::uint32_t* bin) {
+[[gnu::always_inline]] inline void nearest_bins_body(const double* theta_h, const double* theta_d,
+                                                     const double* phi_d, const std::uint8_t* apart,
+                                                     std::size_t m, std::uint32_t apart_bin,
+                                                     std::uint32_t* bin) {
   for (std::size_t i = 0; i < m; ++i) {
     const std::uint32_t k = nearest_bin(theta_h[i], theta_d[i], phi_d[i]);
     bin[i] = apart[i] ? apart_bin : k;
@@ -36,9 +32,8 @@ void nearest_bins(const double* theta_h, const double* theta_d, const double* ph
 }
 
 // The axes in loops of their own: GCC 12 vectorizes each, not the three in one loop.
-HALFBACK_MERL_CLONES
-void cells(const double* theta_h, const double* theta_d, const double* phi_d, std::size_t m,
-           Cells& out) {
+[[gnu::always_inline]] inline void cells_body(const double* theta_h, const double* theta_d,
+                                              const double* phi_d, std::size_t m, Cells& out) {
   alignas(64) std::int32_t ih[kBlock], id[kBlock], ip[kBlock];
   for (std::size_t i = 0; i < m; ++i) {
     const Axis a = theta_h_axis(theta_h[i]);
@@ -78,12 +73,12 @@ void cells(const double* theta_h, const double* theta_d, const double* phi_d, st
 
 // Steps of kRows rows: the corners of the next step are prefetched, this step's corner values
 // copied into columns (a short loop of independent loads, so that many rows' cache misses are in
-// flight), then blended across rows in vectors. Blending row by row, each row's arithmetic filled
-// the out-of-order window (3.1-3.3 against 1.0-1.1 ms per 65536 rows for the table reads alone;
-// docs/performance.md).
-HALFBACK_MERL_CLONES
-void blend_rows_portable(const merl::BinValues* table, const Cells& cells, std::size_t begin,
-                         std::size_t end, Rgb* out) {
+// flight), then blended across rows in vectors. Blended row by row, each row's arithmetic fills
+// the out-of-order window and the misses of the next rows wait: three times the time of the table
+// reads alone (docs/performance.md, "Measured lookups").
+[[gnu::always_inline]] inline void blend_rows_portable_body(const merl::BinValues* table,
+                                                            const Cells& cells, std::size_t begin,
+                                                            std::size_t end, Rgb* out) {
   constexpr std::size_t kRows = 16;
   alignas(64) double x[8][3][kRows];
   alignas(64) double rgb[3][kRows];
@@ -109,15 +104,35 @@ void blend_rows_portable(const merl::BinValues* table, const Cells& cells, std::
   }
 }
 
-HALFBACK_MERL_CLONES
-void rows_apart_portable(const double* rows, const std::uint8_t* valid, std::size_t m,
-                         std::uint8_t* apart) {
+[[gnu::always_inline]] inline void rows_apart_portable_body(const double* rows,
+                                                            const std::uint8_t* valid,
+                                                            std::size_t m, std::uint8_t* apart) {
   for (std::size_t i = 0; i < m; ++i) {
     const double* p = rows + 6 * i;
     apart[i] =
         (valid[i] == 0) | (p[2] < 0) | (p[5] < 0) | ((p[0] + p[3] == 0) & (p[1] + p[4] == 0));
   }
 }
+
+}  // namespace
+
+HALFBACK_ISA_VERSIONS(nearest_bins,
+                      (const double* theta_h, const double* theta_d, const double* phi_d,
+                       const std::uint8_t* apart, std::size_t m, std::uint32_t apart_bin,
+                       std::uint32_t* bin),
+                      (theta_h, theta_d, phi_d, apart, m, apart_bin, bin))
+HALFBACK_ISA_VERSIONS(cells,
+                      (const double* theta_h, const double* theta_d, const double* phi_d,
+                       std::size_t m, Cells& out),
+                      (theta_h, theta_d, phi_d, m, out))
+HALFBACK_ISA_VERSIONS(blend_rows_portable,
+                      (const merl::BinValues* table, const Cells& cells, std::size_t begin,
+                       std::size_t end, Rgb* out),
+                      (table, cells, begin, end, out))
+HALFBACK_ISA_VERSIONS(rows_apart_portable,
+                      (const double* rows, const std::uint8_t* valid, std::size_t m,
+                       std::uint8_t* apart),
+                      (rows, valid, m, apart))
 
 #if defined(HALFBACK_MERL_AVX512)
 

@@ -1,8 +1,9 @@
 // The MERL lookups' index arithmetic and trilinear blend, shared by MerlBrdf::eval (one row) and
-// eval_batch (blocks of rows, compiled in merl_kernel.cpp for AVX-512, AVX2 and the baseline, and
-// vectorized across rows). One definition of each formula, so that a row gets the same bins,
-// cells and blended values on both paths for the same coordinates (docs/performance.md, "Measured
-// lookups"). Branch-free: every condition is a select, which the compiler turns into masks.
+// eval_batch (blocks of rows, compiled in merl_kernel.cpp for AVX-512, AVX2 and the baseline,
+// vectorized across rows, and run as simd_isa() says). One definition of each formula, so that a
+// row gets the same bins, cells and blended values on both paths for the same coordinates
+// (docs/performance.md, "Measured lookups"). Branch-free: every condition is a select, which the
+// compiler turns into masks.
 #pragma once
 
 #include <cstddef>
@@ -207,9 +208,10 @@ void blend_rows(const merl::BinValues* table, const Cells& cells, std::size_t be
 void rows_apart(const double* rows, const std::uint8_t* valid, std::size_t m, std::uint8_t* apart);
 
 // blend_rows and rows_apart run the AVX-512 kernels when avx512_kernels() (simd_isa() is avx512:
-// core/simd.hpp), else the portable loops (target_clones, vectorized by the compiler): the same
-// bits either way. Both are public for the tests; the *_avx512 ones only where avx512_kernels()
-// (they fall back to the portable loops where the build has no x86 kernels).
+// core/simd.hpp), else the portable loops (vectorized by the compiler, in the version simd_isa()
+// names: isa_versions.hpp): the same bits either way. Both are public for the tests; the *_avx512
+// ones only where avx512_kernels() (they fall back to the portable loops where the build has no x86
+// kernels).
 bool avx512_kernels();
 void blend_rows_portable(const merl::BinValues* table, const Cells& cells, std::size_t begin,
                          std::size_t end, Rgb* out);

@@ -16,9 +16,11 @@
 
 #include "core/batch_engine.hpp"
 #include "formats/binary_io.hpp"
+#include "formats/isa_versions.hpp"
 #include "formats/merl_kernel.hpp"
 #include "formats/merl_reference.hpp"
 #include "support/allocation_probe.hpp"
+#include "support/every_isa.hpp"
 #include "support/test_brdfs.hpp"
 #include "support/test_support.hpp"
 
@@ -653,11 +655,11 @@ TEST(MerlBatch, SameResultWhateverTheSplit) {
   }
 }
 
-// The block loops (vectorized across rows, for the instruction set of this CPU) against the one-row
+// The block loops (vectorized across rows, in the version simd_isa() names) against the one-row
 // formulas eval() uses: the same bins, cells and blends, bit for bit, on coordinates of every kind
 // (inside, on bin edges, at both ends, the φd fold and wrap, negative, NaN, infinite), in every
 // lane position and block length.
-TEST(MerlKernel, BlockLoopsAreTheOneRowFormulas) {
+void expect_block_loops_are_the_one_row_formulas() {
   using namespace merl_kernel;
   std::mt19937_64 rng(31);
   std::uniform_real_distribution<double> u(0, 1);
@@ -709,101 +711,120 @@ TEST(MerlKernel, BlockLoopsAreTheOneRowFormulas) {
   }
 }
 
+// The block loops against the one-row formulas, bit for bit, in the version of every instruction
+// set (isa_versions.hpp: what HALFBACK_ISA=scalar, sse2, avx2 or avx512 runs).
+TEST(MerlKernel, BlockLoopsAreTheOneRowFormulas) {
+  EXPECT_GE(test::under_every_isa([](SimdIsa) { expect_block_loops_are_the_one_row_formulas(); }),
+            1u);
+}
+
 // The blend kernels, each of them (the AVX-512 one where the CPU has it, the portable loop
-// always), against blend() of each row, bit for bit: every block length from 1 to kBlock (all
-// tails of the 8-row lane groups), a start inside the block, cells of every kind (the φd wrap, the
-// clamped ends, unmeasured corners, corners missing in one channel or all three, a cell with none
-// measured: NaN).
+// always, in the version of each instruction set), against blend() of each row, bit for bit: every
+// block length from 1 to kBlock (all tails of the 8-row lane groups), a start inside the block,
+// cells of every kind (the φd wrap, the clamped ends, unmeasured corners, corners missing in one
+// channel or all three, a cell with none measured: NaN).
 TEST(MerlKernel, BlendKernelsAreBlendBitForBit) {
-  using namespace merl_kernel;
-  static const std::vector<merl::BinValues> table = [] {
-    std::vector<merl::BinValues> t(merl::kBins);
-    for (std::size_t i = 0; i < merl::kBins; ++i)
-      for (int ch = 0; ch < 3; ++ch)
-        t[i].rgb[ch] = (i + ch) % 13 == 0 || i % 97 < 9 ? -1.0
-                       : i % 89 == 5                    ? 0.0  // measured zeros count
-                       : i % 89 == 6                    ? -0.0
-                                                        : 1.0 + std::sin(0.01 * double(i) + ch);
-    return t;
-  }();
-  std::mt19937_64 rng(37);
-  std::uniform_real_distribution<double> u(0, 1);
-  const double nan = std::nan(""), top = kPi / 2;
-  const std::vector<double> special = {0.0, -0.0, 1e-300, -1e-12, top, 2 * top, kPi, 7.0, nan};
-  alignas(64) double q[3][kBlock];
-  Cells cells;
-  using Kernel = void (*)(const merl::BinValues*, const Cells&, std::size_t, std::size_t, Rgb*);
-  std::vector<std::pair<const char*, Kernel>> kernels = {{"portable", blend_rows_portable},
-                                                         {"dispatched", blend_rows}};
-  if (avx512_kernels()) kernels.push_back({"avx512", blend_rows_avx512});
-  std::size_t rows = 0;
-  for (std::size_t m = 1; m <= kBlock; m += m < 40 ? 1 : 23) {
-    for (std::size_t i = 0; i < m; ++i)
-      for (int a = 0; a < 3; ++a)
-        q[a][i] = u(rng) < 0.15  ? special[rng() % special.size()]
-                  : u(rng) < 0.1 ? (a == 2 ? kPi * (1 - 1e-4 * u(rng)) : top * 1e-5 * u(rng))
-                                 : (a == 2 ? 2 * kPi : top) * u(rng);
-    merl_kernel::cells(q[0], q[1], q[2], m, cells);
-    const std::size_t begin = m > 9 ? m % 5 : 0;
-    for (const auto& [name, kernel] : kernels) {
-      std::vector<Rgb> out(m, Rgb{-7, -7, -7});
-      kernel(table.data(), cells, begin, m, out.data());
-      for (std::size_t i = 0; i < m; ++i) {
-        const Rgb one = i < begin ? Rgb{-7, -7, -7} : blend(table.data(), cells[i]);
-        ASSERT_TRUE(same_bits(out[i].r, one.r) && same_bits(out[i].g, one.g) &&
-                    same_bits(out[i].b, one.b))
-            << name << " m " << m << " row " << i << ": " << out[i].r << " " << one.r;
+  test::under_every_isa([&](SimdIsa) {
+    using namespace merl_kernel;
+    static const std::vector<merl::BinValues> table = [] {
+      std::vector<merl::BinValues> t(merl::kBins);
+      for (std::size_t i = 0; i < merl::kBins; ++i)
+        for (int ch = 0; ch < 3; ++ch)
+          t[i].rgb[ch] = (i + ch) % 13 == 0 || i % 97 < 9 ? -1.0
+                         : i % 89 == 5                    ? 0.0  // measured zeros count
+                         : i % 89 == 6                    ? -0.0
+                                                          : 1.0 + std::sin(0.01 * double(i) + ch);
+      return t;
+    }();
+    std::mt19937_64 rng(37);
+    std::uniform_real_distribution<double> u(0, 1);
+    const double nan = std::nan(""), top = kPi / 2;
+    const std::vector<double> special = {0.0, -0.0, 1e-300, -1e-12, top, 2 * top, kPi, 7.0, nan};
+    alignas(64) double q[3][kBlock];
+    Cells cells;
+    using Kernel = void (*)(const merl::BinValues*, const Cells&, std::size_t, std::size_t, Rgb*);
+    std::vector<std::pair<const char*, Kernel>> kernels = {{"portable", blend_rows_portable},
+                                                           {"dispatched", blend_rows}};
+    if (avx512_kernels()) kernels.push_back({"avx512", blend_rows_avx512});
+    std::size_t rows = 0;
+    for (std::size_t m = 1; m <= kBlock; m += m < 40 ? 1 : 23) {
+      for (std::size_t i = 0; i < m; ++i)
+        for (int a = 0; a < 3; ++a)
+          q[a][i] = u(rng) < 0.15  ? special[rng() % special.size()]
+                    : u(rng) < 0.1 ? (a == 2 ? kPi * (1 - 1e-4 * u(rng)) : top * 1e-5 * u(rng))
+                                   : (a == 2 ? 2 * kPi : top) * u(rng);
+      merl_kernel::cells(q[0], q[1], q[2], m, cells);
+      const std::size_t begin = m > 9 ? m % 5 : 0;
+      for (const auto& [name, kernel] : kernels) {
+        std::vector<Rgb> out(m, Rgb{-7, -7, -7});
+        kernel(table.data(), cells, begin, m, out.data());
+        for (std::size_t i = 0; i < m; ++i) {
+          const Rgb one = i < begin ? Rgb{-7, -7, -7} : blend(table.data(), cells[i]);
+          ASSERT_TRUE(same_bits(out[i].r, one.r) && same_bits(out[i].g, one.g) &&
+                      same_bits(out[i].b, one.b))
+              << name << " m " << m << " row " << i << ": " << out[i].r << " " << one.r;
+        }
       }
+      rows += m;
     }
-    rows += m;
-  }
-  EXPECT_GT(rows, 2000u);
+    EXPECT_GT(rows, 2000u);
+  });
 }
 
 // The AVX-512 kernels run when the library's one instruction-set choice is AVX-512 (core/simd.hpp:
 // the CPU's best, or HALFBACK_ISA's), and not when a lower set is forced.
 TEST(MerlKernel, AvxKernelsFollowTheLibrarysInstructionSet) {
+  using formats_isa::Version;
   for (SimdIsa isa : detail::kAllIsas) {
     if (!detail::set_batch_isa(isa)) continue;
     EXPECT_EQ(merl_kernel::avx512_kernels(), isa == SimdIsa::avx512) << simd_isa_name(isa);
+    // So do the versions of the block loops (isa_versions.hpp).
+    const Version v = isa == SimdIsa::avx512 ? Version::avx512
+                      : isa == SimdIsa::avx2 ? Version::avx2
+                                             : Version::baseline;
+    EXPECT_EQ(formats_isa::version(), v) << simd_isa_name(isa);
   }
   detail::set_batch_isa(std::nullopt);
   EXPECT_EQ(merl_kernel::avx512_kernels(), simd_isa() == SimdIsa::avx512);
 }
 
-// rows_apart, each kernel, against its definition, on rows of every kind at every lane position.
+// rows_apart, each kernel (the portable loop in the version of each instruction set), against its
+// definition, on rows of every kind at every lane position.
 TEST(MerlKernel, RowsApartKernelsAgree) {
-  using namespace merl_kernel;
-  std::mt19937_64 rng(41);
-  std::uniform_real_distribution<double> u(-1, 1);
-  const double nan = std::nan("");
-  using Kernel = void (*)(const double*, const std::uint8_t*, std::size_t, std::uint8_t*);
-  std::vector<std::pair<const char*, Kernel>> kernels = {{"portable", rows_apart_portable},
-                                                         {"dispatched", rows_apart}};
-  if (avx512_kernels()) kernels.push_back({"avx512", rows_apart_avx512});
-  for (std::size_t m = 1; m <= kBlock; m += m < 20 ? 1 : 29) {
-    std::vector<double> rows(6 * m);
-    std::vector<std::uint8_t> valid(m), expected(m);
-    for (std::size_t i = 0; i < m; ++i) {
-      double* p = rows.data() + 6 * i;
-      for (int c = 0; c < 6; ++c) p[c] = u(rng);
-      const int kind = int(rng() % 8);
-      if (kind == 0) p[2 + 3 * (rng() % 2)] = rng() % 2 ? -0.0 : 0.0;  // at the horizon: kept
-      if (kind == 1) p[3] = -p[0], p[4] = -p[1];                       // ωi + ωo along the normal
-      if (kind == 2) p[rng() % 6] = nan;                               // NaN compares false
-      if (kind == 3) p[3] = -p[0];                                     // one component only
-      if (kind >= 4) p[2] = std::abs(p[2]), p[5] = std::abs(p[5]);     // above
-      valid[i] = rng() % 9 ? std::uint8_t(1 + rng() % 255) : 0;        // any non-zero is valid
-      expected[i] = valid[i] == 0 || p[2] < 0 || p[5] < 0 || (p[0] + p[3] == 0 && p[1] + p[4] == 0);
+  test::under_every_isa([&](SimdIsa) {
+    using namespace merl_kernel;
+    std::mt19937_64 rng(41);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const double nan = std::nan("");
+    using Kernel = void (*)(const double*, const std::uint8_t*, std::size_t, std::uint8_t*);
+    std::vector<std::pair<const char*, Kernel>> kernels = {{"portable", rows_apart_portable},
+                                                           {"dispatched", rows_apart}};
+    if (avx512_kernels()) kernels.push_back({"avx512", rows_apart_avx512});
+    for (std::size_t m = 1; m <= kBlock; m += m < 20 ? 1 : 29) {
+      std::vector<double> rows(6 * m);
+      std::vector<std::uint8_t> valid(m), expected(m);
+      for (std::size_t i = 0; i < m; ++i) {
+        double* p = rows.data() + 6 * i;
+        for (int c = 0; c < 6; ++c) p[c] = u(rng);
+        const int kind = int(rng() % 8);
+        if (kind == 0) p[2 + 3 * (rng() % 2)] = rng() % 2 ? -0.0 : 0.0;  // at the horizon: kept
+        if (kind == 1) p[3] = -p[0], p[4] = -p[1];                    // ωi + ωo along the normal
+        if (kind == 2) p[rng() % 6] = nan;                            // NaN compares false
+        if (kind == 3) p[3] = -p[0];                                  // one component only
+        if (kind >= 4) p[2] = std::abs(p[2]), p[5] = std::abs(p[5]);  // above
+        valid[i] = rng() % 9 ? std::uint8_t(1 + rng() % 255) : 0;     // any non-zero is valid
+        expected[i] =
+            valid[i] == 0 || p[2] < 0 || p[5] < 0 || (p[0] + p[3] == 0 && p[1] + p[4] == 0);
+      }
+      for (const auto& [name, kernel] : kernels) {
+        std::vector<std::uint8_t> apart(m + 8, 0xee);
+        kernel(rows.data(), valid.data(), m, apart.data());
+        for (std::size_t i = 0; i < m; ++i)
+          ASSERT_EQ(apart[i], expected[i]) << name << " " << m << " " << i;
+        EXPECT_EQ(apart[m], 0xee) << name << ": wrote past the end";
+      }
     }
-    for (const auto& [name, kernel] : kernels) {
-      std::vector<std::uint8_t> apart(m + 8, 0xee);
-      kernel(rows.data(), valid.data(), m, apart.data());
-      for (std::size_t i = 0; i < m; ++i)
-        ASSERT_EQ(apart[i], expected[i]) << name << " " << m << " " << i;
-      EXPECT_EQ(apart[m], 0xee) << name << ": wrote past the end";
-    }
-  }
+  });
 }
 
 TEST(MerlWriter, RoundTripAtBinCentres) {

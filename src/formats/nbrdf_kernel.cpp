@@ -8,17 +8,11 @@
 #include <bit>
 #include <cstdint>
 
+#include "formats/isa_versions.hpp"
+
 namespace halfback::nbrdf_detail {
 namespace {
 
-// The block kernel is compiled for the baseline and for AVX2/AVX-512, and the loader picks the
-// clone the CPU runs (GCC function multi-versioning); the helpers below are inlined into each.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(HALFBACK_NO_FLATTEN)
-#define HALFBACK_NBRDF_CLONES \
-  __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
-#else
-#define HALFBACK_NBRDF_CLONES
-#endif
 #define HALFBACK_NBRDF_INLINE inline __attribute__((always_inline))
 
 // max(exp(y) − 1, 0) in float without a library call, so that a loop of it vectorizes: y ≤ 0
@@ -94,8 +88,8 @@ HALFBACK_NBRDF_INLINE void encode_block(const double* pairs, float* inputs) {
   }
 }
 
-HALFBACK_NBRDF_CLONES void evaluate_block_impl(const NbrdfNetwork& network, const double* pairs,
-                                               float* outputs) {
+HALFBACK_NBRDF_INLINE void evaluate_block_impl_body(const NbrdfNetwork& network,
+                                                    const double* pairs, float* outputs) {
   alignas(64) float inputs[nbrdf::kInputs * kBlock];
   alignas(64) float ping[nbrdf::kMaxWidth * kBlock];
   alignas(64) float pong[nbrdf::kMaxWidth * kBlock];
@@ -110,6 +104,28 @@ HALFBACK_NBRDF_CLONES void evaluate_block_impl(const NbrdfNetwork& network, cons
   for (std::size_t i = 0; i < nbrdf::kOutputs * kBlock; ++i)
     outputs[i] = exp_minus_one_clamped(in[i]);
 }
+
+// The version of the block kernel: x86-64-v4 or v3 (AVX-512 or AVX2 with FMA, and the rest of
+// their levels, any of which GCC may use) where simd_isa() asks for AVX-512 or AVX2 and the CPU
+// runs the whole level (simd_isa() checks AVX-512F, AVX2 and FMA only; a Xeon Phi has AVX-512F
+// but not v4), else the level below, down to the baseline.
+[[maybe_unused]] formats_isa::Version block_version() {  // unused without the versions
+  using formats_isa::Version;
+#if defined(HALFBACK_FORMATS_ISA_VERSIONS)
+  static const bool v4 = (__builtin_cpu_init(), __builtin_cpu_supports("x86-64-v4"));
+  static const bool v3 = (__builtin_cpu_init(), __builtin_cpu_supports("x86-64-v3"));
+  const Version v = formats_isa::version();
+  if (v == Version::avx512 && v4) return Version::avx512;
+  if (v != Version::baseline && v3) return Version::avx2;
+#endif
+  return Version::baseline;
+}
+
+// The block kernel in three versions (isa_versions.hpp); the helpers above are inlined into each.
+HALFBACK_ISA_VERSIONS_FOR(evaluate_block_impl,
+                          (const NbrdfNetwork& network, const double* pairs, float* outputs),
+                          (network, pairs, outputs), "arch=x86-64-v4", "arch=x86-64-v3",
+                          block_version())
 
 }  // namespace
 

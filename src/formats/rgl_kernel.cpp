@@ -1,10 +1,12 @@
 // The evaluation's block kernel of RGL materials (rgl_kernel.hpp). Compiled for AVX-512, AVX2 and
-// the baseline, chosen at load time by the CPU (GCC's target_clones, as merl_kernel.cpp); this
-// file is compiled without contraction (src/formats/CMakeLists.txt), so every lane rounds as the
-// one-row path does: the values are those of Impl::value() bit for bit.
+// the baseline and run as simd_isa() says (isa_versions.hpp); this file is compiled without
+// contraction (src/formats/CMakeLists.txt), so every lane of every version rounds as the one-row
+// path does: the values are those of Impl::value() bit for bit.
 #include "rgl_kernel.hpp"
 
 #include <cmath>
+
+#include "formats/isa_versions.hpp"
 
 namespace halfback::rgl_kernel {
 
@@ -138,18 +140,22 @@ template <int N>
   shade<N>(t, r, sx, sy);
 }
 
+[[gnu::always_inline]] inline void eval_rows_1_body(const EvalTables& t, EvalRows& r) {
+  eval_rows_n<1>(t, r);
+}
+[[gnu::always_inline]] inline void eval_rows_2_body(const EvalTables& t, EvalRows& r) {
+  eval_rows_n<2>(t, r);
+}
+[[gnu::always_inline]] inline void eval_rows_4_body(const EvalTables& t, EvalRows& r) {
+  eval_rows_n<4>(t, r);
+}
+
 }  // namespace
 
 // One function per slice count (1, 2 or 4: Impl::slices()).
-HALFBACK_RGL_CLONES void eval_rows_1(const EvalTables& t, EvalRows& r) {
-  eval_rows_n<1>(t, r);
-}
-HALFBACK_RGL_CLONES void eval_rows_2(const EvalTables& t, EvalRows& r) {
-  eval_rows_n<2>(t, r);
-}
-HALFBACK_RGL_CLONES void eval_rows_4(const EvalTables& t, EvalRows& r) {
-  eval_rows_n<4>(t, r);
-}
+HALFBACK_ISA_VERSIONS(eval_rows_1, (const EvalTables& t, EvalRows& r), (t, r))
+HALFBACK_ISA_VERSIONS(eval_rows_2, (const EvalTables& t, EvalRows& r), (t, r))
+HALFBACK_ISA_VERSIONS(eval_rows_4, (const EvalTables& t, EvalRows& r), (t, r))
 
 void eval_rows(const EvalTables& t, EvalRows& r, int slice_count) {
   switch (slice_count) {

@@ -16,15 +16,6 @@
 #include <numbers>
 #include <vector>
 
-// The block loops compiled for AVX-512, AVX2 and the baseline, chosen at load time by the CPU
-// (GCC's target_clones, as merl_kernel.cpp).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define HALFBACK_RGL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define HALFBACK_RGL_CLONES
-#endif
-
 namespace halfback::rgl_detail {
 
 // Rows per block of eval_batch, sample_batch and pdf_batch: the columns, angles and lookups of a

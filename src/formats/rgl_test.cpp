@@ -17,6 +17,7 @@
 #include "formats/binary_io.hpp"
 #include "formats/rgl_synthetic.hpp"
 #include "support/allocation_probe.hpp"
+#include "support/every_isa.hpp"
 #include "support/test_stats.hpp"
 #include "support/test_support.hpp"
 
@@ -788,7 +789,9 @@ TEST(RglBatch, EqualsEvalOnSyntheticAnisotropicData) {
   s.jacobian = 1;
   const RglBrdf b = s.brdf();
   ASSERT_FALSE(b.isotropic());
-  expect_batch_is_eval(b, batch_pairs(3000));
+  // The block kernel in the version of every instruction set (isa_versions.hpp: what HALFBACK_ISA
+  // runs; the conversion too runs that set's kernels).
+  test::under_every_isa([&](SimdIsa) { expect_batch_is_eval(b, batch_pairs(3000)); });
   // One pair at a time, and a batch split anywhere, give the same values as the whole batch (the
   // rows of a block are independent).
   const auto pairs = batch_pairs(500);
@@ -917,7 +920,9 @@ TEST(RglSampling, BatchesEqualOneAtATime) {
   s.vndf = [](std::size_t slice, std::size_t y, std::size_t x) {
     return float(1 + slice + 0.5 * std::sin(0.7 * double(x) + 0.3 * double(y)));
   };
-  expect_batches_are_one_at_a_time(s.brdf());
+  // The warp's block loops in the version of every instruction set (isa_versions.hpp).
+  const RglBrdf b = s.brdf();
+  test::under_every_isa([&](SimdIsa) { expect_batches_are_one_at_a_time(b); });
   HALFBACK_REQUIRE_SHARED(dir, "rgl");
   for (const char* m : {"ilm_l3_37_metallic", "chm_mint", "paper_white"})
     expect_batches_are_one_at_a_time(*load_rgl(dir / (std::string(m) + "_rgb.bsdf")));

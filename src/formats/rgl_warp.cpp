@@ -1,13 +1,15 @@
 // The 2D warp of RGL materials (rgl_warp.hpp): the construction of its CDFs and guide tables,
-// and its block loops (densities_at, draw_columns), compiled for AVX-512, AVX2 and the baseline,
-// chosen at load time by the CPU (GCC's target_clones, as merl_kernel.cpp). This file is compiled
-// without contraction (src/formats/CMakeLists.txt), so every lane rounds as the one-row path does.
+// and its block loops (densities_at, draw_columns), compiled for AVX-512, AVX2 and the baseline
+// and run as simd_isa() says (isa_versions.hpp). This file is compiled without contraction
+// (src/formats/CMakeLists.txt), so every lane of every version rounds as the one-row path does.
 #include "rgl_warp.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
+
+#include "formats/isa_versions.hpp"
 
 namespace halfback::rgl_detail {
 
@@ -124,10 +126,10 @@ template <int N>
   densities_in_cells<N>(
       wp, m, [&](std::size_t q) -> const Slices& { return s[q]; }, i, j, c.tx, c.ty, out);
 }
-}  // namespace
 
-HALFBACK_RGL_CLONES void densities_at(const Warp& wp, const Slices* s, const double* x,
-                                      const double* y, std::size_t m, double* out) {
+[[gnu::always_inline]] inline void densities_at_body(const Warp& wp, const Slices* s,
+                                                     const double* x, const double* y,
+                                                     std::size_t m, double* out) {
   if (m == 0) return;
   switch (s[0].count) {  // the same for every row (Impl::slices())
     case 1:
@@ -138,6 +140,13 @@ HALFBACK_RGL_CLONES void densities_at(const Warp& wp, const Slices* s, const dou
       return densities_at_n<4>(wp, s, x, y, m, out);
   }
 }
+
+}  // namespace
+
+HALFBACK_ISA_VERSIONS(densities_at,
+                      (const Warp& wp, const Slices* s, const double* x, const double* y,
+                       std::size_t m, double* out),
+                      (wp, s, x, y, m, out))
 
 namespace {
 
@@ -259,11 +268,17 @@ class ColumnDraws {
   alignas(64) double x_[kBlock], y_[kBlock], density_[kBlock];
 };
 
-}  // namespace
-
-HALFBACK_RGL_CLONES void draw_columns(const Warp& wp, const Slices* s, const Warp::Drawing* d,
-                                      const bool* apart, std::size_t n, Warp::Drawn* out) {
+[[gnu::always_inline]] inline void draw_columns_body(const Warp& wp, const Slices* s,
+                                                     const Warp::Drawing* d, const bool* apart,
+                                                     std::size_t n, Warp::Drawn* out) {
   ColumnDraws(wp, s, d).run(apart, n, out);
 }
+
+}  // namespace
+
+HALFBACK_ISA_VERSIONS(draw_columns,
+                      (const Warp& wp, const Slices* s, const Warp::Drawing* d, const bool* apart,
+                       std::size_t n, Warp::Drawn* out),
+                      (wp, s, d, apart, n, out))
 
 }  // namespace halfback::rgl_detail

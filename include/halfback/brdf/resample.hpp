@@ -73,7 +73,7 @@ GridSpec default_grid(Space space, GridKind kind, std::vector<std::size_t> count
                       double slice_azimuth = 0);
 
 // The most points a grid may have: a table keeps 25 bytes a point (RGB doubles and the mask), so
-// 1.7 GB at this limit (it was 2^31 = 54 GB, more than most machines have).
+// 1.7 GB at this limit, which an ordinary machine holds (2^31 points would take 54 GB).
 inline constexpr std::size_t kMaxGridPoints = std::size_t{1} << 26;
 
 // Checks a grid (the right axes for its kind, finite ranges with lo < hi, counts >= 1, nodes

@@ -1,10 +1,12 @@
-// The instruction set of halfback's hand-vectorized kernels: the batch conversions (core/batch.hpp)
-// and the MERL lookups. One choice for all of them: the best this CPU (and OS) supports, or the
-// one the environment variable HALFBACK_ISA names (scalar, sse2, avx2, avx512) when this CPU has
-// it. A lower one is for comparing speeds and results: the instruction sets agree within the
-// conversions' tested accuracy, not bit for bit (their atan2 and sincos differ). (Loops that
-// GCC vectorizes with target_clones, such as the MERL and RGL portable loops and the neural BRDFs,
-// are chosen by the CPU alone.)
+// The instruction set of halfback's SIMD code: the batch conversions (core/batch.hpp), the MERL
+// AVX-512 kernels, and the block loops of the MERL, RGL and neural-BRDF lookups, which the
+// compiler vectorizes in versions for AVX-512, AVX2 and the baseline (src/formats/
+// isa_versions.hpp; scalar and sse2 run the baseline version there). One choice for all of them:
+// the best this CPU (and OS) supports, or the one the environment variable HALFBACK_ISA names
+// (scalar, sse2, avx2, avx512) when this CPU has it. A lower one is for comparing speeds and
+// results: the conversions agree within their tested accuracy, not bit for bit (their atan2 and
+// sincos differ); the MERL and RGL loops give the same bits in every version, the neural BRDFs'
+// agree within float rounding (FMA contraction).
 #pragma once
 
 #include <string_view>
