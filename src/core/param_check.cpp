@@ -246,7 +246,7 @@ class Checker {
       }
     std::vector<std::uint8_t> ok;
     const Pairs p = inverse(qs, false, ok);
-    double a[4][6];
+    double a[4][6];  // the columns of the derivative
     for (int d = 0; d < 4; ++d) {
       if (!ok[2 * std::size_t(d)] || !ok[2 * std::size_t(d) + 1]) return NAN;
       const DirPair<double>&u = p[2 * std::size_t(d)], &v = p[2 * std::size_t(d) + 1];
@@ -254,24 +254,7 @@ class Checker {
                               u.wo.x - v.wo.x, u.wo.y - v.wo.y, u.wo.z - v.wo.z};
       for (int r = 0; r < 6; ++r) a[d][r] = diff[r] / (2 * step);
     }
-    double g[4][4] = {};
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        for (int r = 0; r < 6; ++r) g[i][j] += a[i][r] * a[j][r];
-    double det = 1;  // Gaussian elimination with partial pivoting
-    for (int c = 0; c < 4; ++c) {
-      int piv = c;
-      for (int r = c + 1; r < 4; ++r)
-        if (std::abs(g[r][c]) > std::abs(g[piv][c])) piv = r;
-      if (piv != c) std::swap(g[piv], g[c]), det = -det;
-      det *= g[c][c];
-      if (g[c][c] == 0) return 0;
-      for (int r = c + 1; r < 4; ++r) {
-        const double f = g[r][c] / g[c][c];
-        for (int k = c; k < 4; ++k) g[r][k] -= f * g[c][k];
-      }
-    }
-    return std::sqrt(std::abs(det));
+    return gram_volume(a);
   }
 
   // Points of the forward images well inside their ranges, where differences do not straddle.
@@ -406,6 +389,27 @@ class Checker {
 };
 
 }  // namespace
+
+double gram_volume(const double (&a)[4][6]) {
+  double g[4][4] = {};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int r = 0; r < 6; ++r) g[i][j] += a[i][r] * a[j][r];
+  double det = 1;  // Gaussian elimination with partial pivoting
+  for (int c = 0; c < 4; ++c) {
+    int piv = c;
+    for (int r = c + 1; r < 4; ++r)
+      if (std::abs(g[r][c]) > std::abs(g[piv][c])) piv = r;
+    if (piv != c) std::swap(g[piv], g[c]), det = -det;
+    det *= g[c][c];
+    if (g[c][c] == 0) return 0;
+    for (int r = c + 1; r < 4; ++r) {
+      const double f = g[r][c] / g[c][c];
+      for (int k = c; k < 4; ++k) g[r][k] -= f * g[c][k];
+    }
+  }
+  return std::sqrt(std::abs(det));
+}
 
 bool ParamCheckReport::passed() const {
   return std::all_of(checks.begin(), checks.end(), [](const ParamCheck& c) { return c.passed; });

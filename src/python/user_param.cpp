@@ -302,24 +302,7 @@ class PyParam final : public ParamDescriptor {
       }
       for (int r = 0; r < 6; ++r) a[k][r] = (hi[std::size_t(r)] - lo[std::size_t(r)]) / width;
     }
-    double g[4][4] = {};
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        for (int r = 0; r < 6; ++r) g[i][j] += a[i][r] * a[j][r];
-    double det = 1;
-    for (int c = 0; c < 4; ++c) {
-      int piv = c;
-      for (int r = c + 1; r < 4; ++r)
-        if (std::abs(g[r][c]) > std::abs(g[piv][c])) piv = r;
-      if (piv != c) std::swap(g[piv], g[c]), det = -det;
-      det *= g[c][c];
-      if (g[c][c] == 0) return 0;
-      for (int r = c + 1; r < 4; ++r) {
-        const double f = g[r][c] / g[c][c];
-        for (int k = c; k < 4; ++k) g[r][k] -= f * g[c][k];
-      }
-    }
-    return std::sqrt(std::abs(det));
+    return halfback::gram_volume(a);
   }
 
   Tuple4<double> user_reciprocal(const Tuple4<double>& q) const {

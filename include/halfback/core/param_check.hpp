@@ -45,6 +45,10 @@ struct ParamCheckOptions {
   double tolerance = 1e-8;  // on directions (unit vectors) of the round trips
 };
 
+// √det(AᵀA) for the 6×4 derivative A of q ↦ (ωi, ωo) ∈ R⁶ given by its columns a[k]: the volume
+// element dωi dωo / dq, since S²×S² sits isometrically in R⁶.
+double gram_volume(const double (&a)[4][6]);
+
 ParamCheckReport check_parameterization(const ParamDescriptor& param,
                                         const ParamCheckOptions& options = {});
 
