@@ -92,7 +92,8 @@ std::string design_name(const DesignKey& k) {
 }
 
 double design_error(const BrdfResult& b, Space space, const DesignKey& k, std::size_t ref) {
-  const GonioPoint* g = find_point(gonio_points(b, space, 3), k.layout, ref, k.spacing);
+  const std::vector<GonioPoint> points = gonio_points(b, space, 3);
+  const GonioPoint* g = find_point(points, k.layout, ref, k.spacing);
   return g ? g->error : INFINITY;
 }
 
@@ -105,8 +106,10 @@ std::vector<DesignKey> designs_measured(const std::vector<BrdfResult>& results, 
     for (Design d : kDesigns) {
       bool any = false;
       for (const BrdfResult& b : results)
-        for (Space s : b.params)
-          any |= find_point(gonio_points(b, s, 3), d, ref, spacing) != nullptr;
+        for (Space s : b.params) {
+          const std::vector<GonioPoint> points = gonio_points(b, s, 3);
+          any |= find_point(points, d, ref, spacing) != nullptr;
+        }
       if (any) keys.push_back({spacing, d});
     }
   return keys;
@@ -207,8 +210,8 @@ std::vector<std::vector<double>> paired_metric_values(const BrdfResult& b, std::
     const Space s = b.params[i];
     v[0][i] = azimuthal_error(b, s, 3);
     if (const auto sep = separability_errors(b, s, 2); !sep.empty()) v[1][i] = sep[0];
-    if (const GonioPoint* g = find_point(gonio_points(b, s, 3), Design::regular, ref))
-      v[2][i] = g->error;
+    const std::vector<GonioPoint> points = gonio_points(b, s, 3);
+    if (const GonioPoint* g = find_point(points, Design::regular, ref)) v[2][i] = g->error;
     v[3][i] = mean_image_error(image_points(b, s), Design::regular).relative_rmse;
   }
   return v;

@@ -40,6 +40,9 @@ Contents contents_of(const std::vector<BrdfResult>& results);
 // those of the own design). Null when not measured.
 const GonioPoint* find_point(const std::vector<GonioPoint>& points, Design layout,
                              std::size_t budget, Spacing spacing = Spacing::own);
+// The result points into `points`: never into a temporary (gonio_points() returns one).
+const GonioPoint* find_point(std::vector<GonioPoint>&& points, Design layout, std::size_t budget,
+                             Spacing spacing = Spacing::own) = delete;
 
 // The reference budget of the comparisons: the image budget when it is one of the budgets,
 // else the middle one.

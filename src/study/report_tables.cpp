@@ -63,12 +63,13 @@ std::string samples_text(double n, double smallest) {
 // (INFINITY when not measured).
 std::pair<double, double> best_regular_error(const BrdfResult& b, std::size_t ref) {
   double best = INFINITY, best_samples = 0;
-  for (Space s : b.params)
-    if (const GonioPoint* g = find_point(gonio_points(b, s, 3), Design::regular, ref);
-        g && g->error < best) {
+  for (Space s : b.params) {
+    const std::vector<GonioPoint> points = gonio_points(b, s, 3);
+    if (const GonioPoint* g = find_point(points, Design::regular, ref); g && g->error < best) {
       best = g->error;
       best_samples = double(g->samples);
     }
+  }
   return {best, best_samples};
 }
 
@@ -393,7 +394,8 @@ std::string file_network_gonio_table(const std::vector<BrdfResult>& results, std
     for (const std::size_t k : {f, nw}) {
       md += row_start(results[k].label);
       for (Space s : results[k].params) {
-        const GonioPoint* g = find_point(gonio_points(results[k], s, 3), Design::regular, ref);
+        const std::vector<GonioPoint> points = gonio_points(results[k], s, 3);
+        const GonioPoint* g = find_point(points, Design::regular, ref);
         md += g ? fmt::format(" {:.4f} |", g->error) : " – |";
       }
       md += "\n";
