@@ -96,7 +96,7 @@ inline Axis phi_d_axis(double phi_d) {
   const double p0 = phi_d < 0 ? phi_d + kPi : phi_d;
   const double pd = p0 >= kPi ? p0 - kPi : p0;
   const double x0 = pd / kPi * merl::kPhiD - 0.5;
-  const double x = (x0 >= -1) & (x0 < merl::kPhiD) ? x0 : 0.0;  // only for non-finite input
+  const double x = ((x0 >= -1) & (x0 < merl::kPhiD)) ? x0 : 0.0;  // only for non-finite input
   const int k = static_cast<int>(x);
   const int i = k - (double(k) > x ? 1 : 0);  // floor, without a libm call
   // i + 180 when i = -1 (a select here keeps GCC 12 from vectorizing the loops that use this).

@@ -126,7 +126,7 @@ template <int N>
       }
       const double value = sum * scale[k];
       // std::max(value, 0.0) on request, as a select.
-      fr[ch][k] = (clamp & (value < 0.0) ? 0.0 : value) * inverse_cos_o;
+      fr[ch][k] = ((clamp & (value < 0.0)) ? 0.0 : value) * inverse_cos_o;
     }
   }
   for (std::size_t ch = 0; ch < 3; ++ch)

@@ -195,7 +195,7 @@ class ColumnDraws {
     const double x = a * a + 2 * (b - a) * area;
     const double den = a + std::sqrt(x < 0.0 ? 0.0 : x);  // std::max(x, 0.0)
     const double t = unit(2 * area / den);
-    return (area > 0) & (den > 0) ? t : 0.0;
+    return ((area > 0) & (den > 0)) ? t : 0.0;
   }
 
   // The guided column bounds (Warp::column_bounds) and R, M of the drawn slice's rows j, j + 1.

@@ -83,11 +83,11 @@ decltype(auto) visit_kernel_param(std::size_t index, F&& f) {
     using R = decltype(f(Spherical{}));
     if constexpr (std::is_void_v<R>) {
       std::size_t i = 0;
-      ((i++ == index ? (f(Ps{}), true) : false) || ...);
+      (void)((i++ == index ? (f(Ps{}), true) : false) || ...);
     } else {
       R result{};
       std::size_t i = 0;
-      ((i++ == index ? (result = f(Ps{}), true) : false) || ...);
+      (void)((i++ == index ? (result = f(Ps{}), true) : false) || ...);
       return result;
     }
   }(KernelParams{});
