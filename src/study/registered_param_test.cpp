@@ -106,12 +106,12 @@ TEST(StudyRegistered, ParameterizationsAreChosenByName) {
   EXPECT_THROW(make_config(s), std::invalid_argument);
   s.params = {"dirs"};
   EXPECT_THROW(make_config(s), std::invalid_argument);
-  s.params = {"toy-hybrid"};  // not registered in this process
+  s.params = {"never-registered"};
   try {
     make_config(s);
     FAIL() << "no error";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("--params: 'toy-hybrid' is not a parameterization"),
+    EXPECT_NE(std::string(e.what()).find("--params: 'never-registered' is not a parameterization"),
               std::string::npos)
         << e.what();
   }
@@ -119,9 +119,10 @@ TEST(StudyRegistered, ParameterizationsAreChosenByName) {
   c.params = {space_of<Hybrid>, space_of<HalfDiff>};
   const std::string text = describe_config(c);
   EXPECT_EQ(config_from_description(text, "t").params, c.params);
-  EXPECT_THROW(config_from_description(
-                   "parameterizations = toy-hybrid\n" + text.substr(text.find('\n') + 1), "t"),
-               std::runtime_error);
+  EXPECT_THROW(
+      config_from_description(
+          "parameterizations = never-registered\n" + text.substr(text.find('\n') + 1), "t"),
+      std::runtime_error);
 }
 
 }  // namespace
