@@ -202,26 +202,18 @@ class PyParam final : public ParamDescriptor {
     std::copy(q.data(), q.data() + 4 * m, coords);
   }
 
+  // The user's inverse, then the declared ranges; valid pairs onto the hemisphere (as the built-in
+  // inverses, within their tolerance), the others NaN.
   void inverse4(const double* coords, std::size_t m, DirPair<double>* pairs,
                 std::uint8_t* in_domain) const {
-    py::gil_scoped_acquire gil;
-    const py::object r = s_.inverse(rows_of(coords, m, 4));
-    py::tuple t;
-    if (!py::isinstance<py::tuple>(r) || (t = r.cast<py::tuple>()).size() != 2)
-      throw py::value_error("inverse must return a tuple (wi, wo) of two (N, 3) arrays");
-    const Array wi = checked(t[0], m, 3, "inverse's wi"), wo = checked(t[1], m, 3, "inverse's wo");
+    inverse_rows_raw(coords, m, pairs, in_domain);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
     for (std::size_t i = 0; i < m; ++i) {
-      const double* a = wi.data() + 3 * i;
-      const double* b = wo.data() + 3 * i;
-      pairs[i] = {{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
-      bool ok = in_ranges(coords + 4 * i);
-      for (int k = 0; k < 3; ++k) ok = ok && std::isfinite(a[k]) && std::isfinite(b[k]);
-      in_domain[i] = ok ? 1 : 0;
-      if (ok) {  // onto the hemisphere, as the built-in inverses (within their tolerance)
+      in_domain[i] = in_domain[i] && in_ranges(coords + 4 * i);
+      if (in_domain[i]) {
         pairs[i].wi.z = std::max(pairs[i].wi.z, 0.0);
         pairs[i].wo.z = std::max(pairs[i].wo.z, 0.0);
       } else {
-        const double nan = std::numeric_limits<double>::quiet_NaN();
         pairs[i] = {{nan, nan, nan}, {nan, nan, nan}};
       }
     }
@@ -266,11 +258,15 @@ class PyParam final : public ParamDescriptor {
     for (std::size_t i = 0; i < m; ++i)
       jacobian[i] = gram_volume(&p[8 * i], &ok[8 * i], p[8 * m + i], ok[8 * m + i], step);
   }
-  // The user's inverse without the range test, so that differences at a range's end are taken.
+  // The user's inverse alone (no range test, so that differences at a range's end are taken):
+  // `ok` where both directions are finite.
   void inverse_rows_raw(const double* coords, std::size_t m, DirPair<double>* pairs,
                         std::uint8_t* ok) const {
     py::gil_scoped_acquire gil;
-    const py::tuple t = s_.inverse(rows_of(coords, m, 4)).cast<py::tuple>();
+    const py::object r = s_.inverse(rows_of(coords, m, 4));
+    py::tuple t;
+    if (!py::isinstance<py::tuple>(r) || (t = r.cast<py::tuple>()).size() != 2)
+      throw py::value_error("inverse must return a tuple (wi, wo) of two (N, 3) arrays");
     const Array wi = checked(t[0], m, 3, "inverse's wi"), wo = checked(t[1], m, 3, "inverse's wo");
     for (std::size_t i = 0; i < m; ++i) {
       const double *a = wi.data() + 3 * i, *b = wo.data() + 3 * i;

@@ -92,7 +92,10 @@ std::shared_ptr<const Brdf> with_cosine_sampling(const Brdf& brdf) {
 // --------------------------------------------------------------------------------------------
 
 TabulatedSampler::TabulatedSampler(const Brdf& brdf, const TabulationOptions& o)
-    : SamplingWrapper(brdf), options_(o), isotropic_(brdf.isotropic()) {
+    : SamplingWrapper(brdf),
+      options_(o),
+      chart_(o.param.param().sampler_chart()),
+      isotropic_(brdf.isotropic()) {
   const auto start = std::chrono::steady_clock::now();
   if (o.radial < 2 || o.azimuthal < 2 || o.theta_slices < 1 || o.aniso_theta_slices < 1 ||
       o.aniso_phi_slices < 1 || o.supersample < 1 || !(o.defensive >= 0 && o.defensive < 1))
@@ -101,7 +104,7 @@ TabulatedSampler::TabulatedSampler(const Brdf& brdf, const TabulationOptions& o)
   n_phi_ = isotropic_ ? 1 : o.aniso_phi_slices;
   n_radial_ = isotropic_ ? o.radial : std::max(2, o.radial / 2);
   n_azimuthal_ = isotropic_ ? o.azimuthal : std::max(2, o.azimuthal / 2);
-  const ParamMap map{o.param.param().sampler_chart(), o.warp};
+  const ParamMap map{chart_, o.warp};
   const int n_slices = n_theta_ * n_phi_, ss = o.supersample;
   slices_.resize(std::size_t(n_slices));
 
@@ -251,8 +254,7 @@ BrdfSample TabulatedSampler::sample(const Vec3<double>& wo_in, double u1, double
   const double tt = (double(cell.col) + cell.remapped_col) / n_azimuthal_;
   Vec3<double> wi{0, 0, 0};
   double jac = 0;
-  if (!ParamMap{options_.param.param().sampler_chart(), options_.warp}.forward(wo, ss, tt, wi, jac))
-    return {};
+  if (!ParamMap{chart_, options_.warp}.forward(wo, ss, tt, wi, jac)) return {};
   wi = rotate_z(wi, c, s);
   return {wi, pdf(wo_in, wi)};
 }
@@ -260,8 +262,7 @@ BrdfSample TabulatedSampler::sample(const Vec3<double>& wo_in, double u1, double
 double TabulatedSampler::table_pdf(const Vec3<double>& wo, const Vec3<double>& wi,
                                    const Blend& b) const {
   double s = 0, t = 0, jac = 0;
-  if (!ParamMap{options_.param.param().sampler_chart(), options_.warp}.inverse(wo, wi, s, t, jac))
-    return 0;
+  if (!ParamMap{chart_, options_.warp}.inverse(wo, wi, s, t, jac)) return 0;
   const std::size_t row = std::min(std::size_t(s * n_radial_), std::size_t(n_radial_ - 1));
   const std::size_t col = std::min(std::size_t(t * n_azimuthal_), std::size_t(n_azimuthal_ - 1));
   double p = 0;

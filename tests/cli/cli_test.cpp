@@ -254,6 +254,11 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
       {{"convert", "--from", "hybird", "--to", "dirs"},
        "halfback convert: error: --from: unknown coordinates 'hybird' (expected one of: " +
            space_names() + ")\n" + hint},
+      {{"render", "--brdf", "lambert", "--sampling-param", "polar", "-o", "never.png"},
+       "halfback render: error: --sampling-param: unknown parameterization 'polar' (expected one "
+       "of: " +
+           parameterization_names(", ") +
+           ")\nRun 'halfback render --help' for more information.\n"},
       {{"convert", "--from", "dirs", "--to", "polar"},
        "halfback convert: error: --to: unknown coordinates 'polar' (expected one of: " +
            space_names() + ")\n" + hint},

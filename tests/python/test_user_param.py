@@ -142,6 +142,22 @@ def test_bad_declarations_are_refused_at_once():
         halfback.Parameterization("x", hybrid_forward, hybrid_inverse, AXES, isotropic_drop=0)
     with pytest.raises(ValueError, match="four"):
         halfback.Parameterization("x", hybrid_forward, hybrid_inverse, AXES[:3])
+    with pytest.raises(ValueError, match="must be finite, lo < hi"):
+        halfback.Parameterization("x", hybrid_forward, hybrid_inverse,
+                                  [("hbar", "length", 0, float("nan"))] + AXES[1:])
+    with pytest.raises(ValueError, match="sampler_chart: 'polar'"):
+        halfback.Parameterization("x", hybrid_forward, hybrid_inverse, AXES, sampler_chart="polar")
+    with pytest.raises(ValueError, match="callables"):
+        halfback.Parameterization("x", 3, hybrid_inverse, AXES)
+    with pytest.raises(ValueError, match="not allowed"):
+        halfback.Parameterization("dirs", hybrid_forward, hybrid_inverse, AXES)
+
+
+def test_a_map_returning_the_wrong_shape_is_refused_as_not_vectorized():
+    assert "vectorized: forward must return an array of shape" in failure(
+        forward=lambda wi, wo: hybrid_forward(wi, wo)[:, :3])
+    assert "vectorized: inverse must return a tuple" in failure(
+        inverse=lambda q: np.concatenate(hybrid_inverse(q), 1))
 
 
 def test_the_study_gives_the_numbers_of_the_same_map_in_cpp(py_hybrid):

@@ -125,38 +125,6 @@ class CompiledParam final : public ParamDescriptor {
     return P::reciprocal_iso(q);
   }
   Tuple3<double> mirror_iso(const Tuple3<double>& q) const override { return P::mirror_iso(q); }
-
-  // The block maps as loops over the inlined templates (no virtual call a row).
-  void forward_rows(bool iso, const DirPair<double>* pairs, std::size_t m,
-                    double* coords) const override {
-    for (std::size_t i = 0; i < m; ++i) {
-      if (iso) {
-        const Tuple3<double> q = P::forward_iso(pairs[i]);
-        std::copy(q.begin(), q.end(), coords + 3 * i);
-      } else {
-        const Tuple4<double> q = P::forward(pairs[i]);
-        std::copy(q.begin(), q.end(), coords + 4 * i);
-      }
-    }
-  }
-  void inverse_rows(bool iso, const double* coords, std::size_t m, DirPair<double>* pairs,
-                    std::uint8_t* in_domain) const override {
-    for (std::size_t i = 0; i < m; ++i) {
-      const double* q = coords + (iso ? 3 : 4) * i;
-      const Solved<double> s = iso ? halfback::inverse_iso<P>(Tuple3<double>{q[0], q[1], q[2]})
-                                   : halfback::inverse<P>(Tuple4<double>{q[0], q[1], q[2], q[3]});
-      pairs[i] = s.pair;
-      in_domain[i] = s.in_domain ? 1 : 0;
-    }
-  }
-  void jacobian_rows(bool iso, const double* coords, std::size_t m,
-                     double* jacobian) const override {
-    for (std::size_t i = 0; i < m; ++i) {
-      const double* q = coords + (iso ? 3 : 4) * i;
-      jacobian[i] = iso ? halfback::jacobian_iso<P>(Tuple3<double>{q[0], q[1], q[2]})
-                        : P::jacobian(Tuple4<double>{q[0], q[1], q[2], q[3]});
-    }
-  }
 };
 
 // Registers a C++ parameterization at run time (space.hpp): a test's, a plug-in's.

@@ -97,6 +97,7 @@ class TabulatedSampler final : public SamplingWrapper {
   double table_pdf(const Vec3<double>& wo, const Vec3<double>& wi, const Blend& b) const;
 
   TabulationOptions options_;
+  SamplerChart chart_;  // options_.param's, looked up once: sample() and pdf() are per path vertex
   bool isotropic_;
   int n_theta_, n_phi_, n_radial_, n_azimuthal_;
   std::vector<Distribution2D> slices_;  // [theta][phi]

@@ -60,6 +60,15 @@ constexpr Axis stereo_radius_axis(std::string_view column, std::string_view labe
   return {column, label, AxisKind::length, 0, 1, 0.1};
 }
 
+// The 4D Cartesian tuple (ρa, 0, ρb cos Δφ, ρb sin Δφ) of isotropic polar coordinates
+// (ρa, ρb, Δφ): the first vector on +x.
+template <class T>
+inline Tuple4<T> polar_lift(const Tuple3<T>& q) {
+  T s, c;
+  LaneOps<T>::sincos(q[2], s, c);
+  return {q[0], T(0), q[1] * c, q[1] * s};
+}
+
 }  // namespace detail
 
 struct Stereographic {
@@ -110,9 +119,7 @@ struct Stereographic {
   }
   template <class T>
   static Tuple4<T> lift_iso(const Tuple3<T>& q) {
-    T s, c;
-    LaneOps<T>::sincos(q[2], s, c);
-    return {q[0], T(0), q[1] * c, q[1] * s};
+    return detail::polar_lift(q);
   }
   template <class T>
   static Solved<T> inverse_iso_raw(const Tuple3<T>& q) {
@@ -207,9 +214,7 @@ struct StereoHalfDiff {
   }
   template <class T>
   static Tuple4<T> lift_iso(const Tuple3<T>& q) {
-    T s, c;
-    LaneOps<T>::sincos(q[2], s, c);
-    return {q[0], T(0), q[1] * c, q[1] * s};
+    return detail::polar_lift(q);
   }
   template <class T>
   static Solved<T> inverse_iso_raw(const Tuple3<T>& q) {
