@@ -158,7 +158,7 @@ template <class T>
 void bm_convert(benchmark::State& state, Space space, bool forward, unsigned threads) {
   Data<T>& d = Data<T>::get();
   const Form dirs{Space::dirs, false}, param{space, false};
-  const Columns<T>& src = forward ? d.dirs : d.coords[static_cast<int>(space) - 1];
+  const Columns<T>& src = forward ? d.dirs : d.coords[space.kernel_index()];
   std::vector<ConstColumn<T>> ic;
   for (const auto& c : src) ic.push_back({c.data(), 1});
   std::vector<Column<T>> oc;
@@ -191,7 +191,7 @@ void bm_convert(benchmark::State& state, Space space, bool forward, unsigned thr
 template <class T>
 void bm_layout(benchmark::State& state, Space space, bool forward) {
   Data<T>& d = Data<T>::get();
-  const Columns<T>& src = forward ? d.dirs : d.coords[static_cast<int>(space) - 1];
+  const Columns<T>& src = forward ? d.dirs : d.coords[space.kernel_index()];
   const std::size_t nin = forward ? 6 : 4, nout = forward ? 4 : 6;
   std::vector<T> in_rows(nin * d.n), out_rows(nout * d.n, T(0));
   for (std::size_t r = 0; r < d.n; ++r)
@@ -319,7 +319,7 @@ void bm_scalar(benchmark::State& state, Space space, bool forward) {
   std::unique_ptr<VirtualParam<T>> param = make_parameterization<T>(space);
   const VirtualParam<T>* pp = param.get();
   benchmark::DoNotOptimize(pp);  // keep the call virtual
-  const Columns<T>& q = d.coords[static_cast<int>(space) - 1];
+  const Columns<T>& q = d.coords[space.kernel_index()];
   for (auto _ : state) {
     for (std::size_t i = 0; i < d.n; ++i) {
       if (forward) {

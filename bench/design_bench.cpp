@@ -49,7 +49,7 @@ GonioSetup setup_of(Space space, Spacing spacing) {
 
 // Measure and score one reconstruction; items = test pairs evaluated.
 void BM_Design(benchmark::State& state) {
-  const auto space = static_cast<Space>(state.range(0));
+  const auto space = Space::from_id(static_cast<std::uint16_t>(state.range(0)));
   const auto spacing = static_cast<Spacing>(state.range(1));
   const GonioSetup setup = setup_of(space, spacing);
   for (auto _ : state) {
@@ -62,7 +62,7 @@ void BM_Design(benchmark::State& state) {
 
 void designs(benchmark::internal::Benchmark* b) {
   for (Space s : {space_of<HalfDiff>, space_of<Hybrid>})
-    for (Spacing d : kSpacings) b->Args({static_cast<long>(s), static_cast<long>(d)});
+    for (Spacing d : kSpacings) b->Args({static_cast<long>(s.id()), static_cast<long>(d)});
 }
 BENCHMARK(BM_Design)->Apply(designs)->Unit(benchmark::kMillisecond);
 

@@ -314,8 +314,7 @@ int main(int argc, char** argv) {
     for (const Material& m : measured) {
       const render::Image reference = reference_image(*m.brdf, sky, quick);
       std::printf("| %s |", m.label.c_str());
-      for (render::TableParam tp : {render::TableParam::hybrid, render::TableParam::halfdiff,
-                                    render::TableParam::spherical}) {
+      for (Space tp : {space_of<Hybrid>, space_of<HalfDiff>, space_of<Spherical>}) {
         render::RenderSettings s = budgeted(budget);
         s.tabulation.param = tp;
         const auto tabulated = render::with_importance_sampling(*m.brdf, s.tabulation, true);
