@@ -151,15 +151,20 @@ std::vector<std::string> embedded_material_names() {
 
 BrdfPtr load_brdf(std::string_view spec) {
   if (path_exists(spec)) return load_one(spec);  // a file name may contain '+'
+  return load_sum(spec, load_one);
+}
+
+BrdfPtr load_sum(std::string_view spec,
+                 const std::function<BrdfPtr(std::string_view term)>& load_term) {
   const auto parts = split_sum(spec);
   const auto empty_term = [](std::string_view p) { return p.empty() || p.back() == '+'; };
   if (spec.find('+') != std::string_view::npos && std::ranges::any_of(parts, empty_term))
     throw std::invalid_argument("'" + std::string(spec) +
                                 "': a sum has an empty term (a sum is SPEC+SPEC+..., e.g. "
                                 "lambert:albedo=0.3+ggx:alpha=0.2)");
-  if (parts.size() == 1) return load_one(spec);
+  if (parts.size() == 1) return load_term(spec);
   std::vector<BrdfPtr> terms;
-  for (const auto part : parts) terms.push_back(load_one(part));
+  for (const auto part : parts) terms.push_back(load_term(part));
   return std::make_shared<models::Sum>(std::move(terms));
 }
 

@@ -197,6 +197,36 @@ TEST(ViewApi, BrdfEndpointAndSpecKinds) {
   EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "/etc/passwd"}})).status, 400);
 }
 
+// Sums as everywhere else (load_brdf): the value of each term is its own, and a term is loaded
+// by the explorer's rules (a file term confined to the roots, a model term never a path).
+TEST(ViewApi, SumsOfTermsAsEverywhere) {
+  test::TempDir root, outside;
+  { std::ofstream(outside.path() / "secret.hdr") << "x"; }
+  Api api(config({root.path()}));
+  const auto brdf = [&](const std::string& spec) {
+    return api.handle(get("/api/brdf", {{"brdf", spec}}));
+  };
+  const Response sum = brdf("lambert:albedo=0.3+ggx:alpha=0.1");
+  EXPECT_EQ(sum.status, 200) << sum.body;
+  EXPECT_NE(sum.body.find("lambert+ggx"), std::string::npos) << sum.body;
+  EXPECT_EQ(brdf("arg:0+embedded:pink-felt").status, 200);
+  EXPECT_TRUE(has_error(brdf("lambert+"), 400, "empty term"));
+  EXPECT_TRUE(has_error(brdf("lambert+ggx:alpha=-1"), 400, "alpha"));
+  EXPECT_TRUE(has_error(brdf("lambert+file:../secret.hdr"), 403, ".."));
+  EXPECT_EQ(brdf("lambert+" + (outside.path() / "secret.hdr").string()).status, 400);
+
+  // Its ρ is the sum of its terms' (the point endpoint, against Brdf::eval of each term).
+  const auto rho = [&](const std::string& spec) {
+    const Response r = api.handle(get(
+        "/api/point", {{"brdf", spec}, {"wi", "0.3,0.1,0.9486833"}, {"wo", "-0.2,0,0.9797959"}}));
+    EXPECT_EQ(r.status, 200) << r.body;
+    const std::size_t at = r.body.find("\"rgb\":[");
+    return at == std::string::npos ? -1.0 : std::stod(r.body.substr(at + 7));
+  };
+  EXPECT_NEAR(rho("lambert:albedo=0.3+ggx:alpha=0.1"),
+              rho("lambert:albedo=0.3") + rho("ggx:alpha=0.1"), 1e-6);
+}
+
 TEST(ViewApi, ManyBrdfsStayWithinTheCache) {
   Api api(config());
   for (int k = 0; k < int(kMaxCachedBrdfs) + 10; ++k)

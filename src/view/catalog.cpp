@@ -92,6 +92,17 @@ BrdfPtr Catalog::load(std::string_view spec) const {
   if (spec.empty()) throw RequestError(400, "empty BRDF spec");
   if (spec.size() > kMaxSpecBytes)
     throw RequestError(413, fmt::format("BRDF spec longer than {} bytes", kMaxSpecBytes));
+  if (starts_with(spec, "file:")) {  // a file name may contain '+': the whole spec first
+    try {
+      return load_term(spec);
+    } catch (const RequestError& e) {
+      if (e.status() != 404) throw;
+    }
+  }
+  return load_sum(spec, [this](std::string_view term) { return load_term(term); });
+}
+
+BrdfPtr Catalog::load_term(std::string_view spec) const {
   if (starts_with(spec, "arg:")) {
     const std::string_view n = spec.substr(4);
     std::size_t index = 0;

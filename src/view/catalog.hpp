@@ -71,7 +71,10 @@ class Catalog {
     BrdfPtr sampled;  // built on first use
     std::uint64_t used = 0;
   };
+  // A spec: one term, or a sum of terms (as load_brdf() splits it), each term loaded by
+  // load_term: arg:N, file: (confined to the roots), embedded:, or a model spec (never a path).
   BrdfPtr load(std::string_view spec) const;
+  BrdfPtr load_term(std::string_view spec) const;
   void evict_locked() const;  // drops the least recently used BRDFs beyond kMaxCachedBrdfs
 
   std::vector<std::string> specs_;

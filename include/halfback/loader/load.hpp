@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -38,6 +39,13 @@ std::vector<std::filesystem::path> brdf_files_in(const std::filesystem::path& di
 // measurements and MIT-licensed neural fits of MERL measurements, data/README.md), so that the
 // default figures need no file.
 BrdfPtr load_brdf(std::string_view spec);
+
+// A spec that may be a sum "lambert:albedo=0.3+ggx:alpha=0.2" ('+' followed by a lowercase
+// letter separates terms), each term loaded by `load_term`: load_brdf() is load_sum(spec,
+// <a file or a model>); the explorer passes its own term loader, which confines files to its
+// roots. Throws std::invalid_argument for an empty term.
+BrdfPtr load_sum(std::string_view spec,
+                 const std::function<BrdfPtr(std::string_view term)>& load_term);
 
 // The process-wide registry that load_brdf() reads model specs with, holding every built-in
 // model (analytic models and the paper's test functions). Models added to it become loadable.

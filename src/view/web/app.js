@@ -418,13 +418,22 @@ function specLabel(spec) {
 }
 
 // --- model sliders -----------------------------------------------------------------------------
-function parseModelSpec(spec) {
+// The terms of a spec as the server splits a sum (load_brdf: '+' followed by a lowercase letter;
+// a number's exponent sign, as in 1e+3, is followed by a digit).
+const sumTerms = (spec) => spec.split(/\+(?=[a-z])/);
+// A spec's terms, each a model with its values or a fixed term (a file, an embedded material);
+// null when no term is a model (nothing to slide).
+function parseSpec(spec) {
   const arg = /^arg:(\d+)$/.exec(spec);  // a model named on the command line has sliders too
   if (arg && info.specs[Number(arg[1])] !== undefined) spec = info.specs[Number(arg[1])];
-  if (/^(arg|file|embedded):/.test(spec)) return null;
-  const [name, rest] = spec.split(/:(.*)/s);
+  const terms = sumTerms(spec).map(parseTerm);
+  return terms.some((t) => t.model) ? terms : null;
+}
+function parseTerm(term) {
+  if (/^(arg|file|embedded):/.test(term)) return { fixed: term };
+  const [name, rest] = term.split(/:(.*)/s);
   const model = info.models.find((m) => m.name === name);
-  if (!model) return null;
+  if (!model) return { fixed: term };
   const values = {};
   (rest || '').split(',').filter((x) => x).forEach((item, k) => {
     const eq = item.indexOf('=');
@@ -433,82 +442,105 @@ function parseModelSpec(spec) {
   });
   return { model, values };
 }
+let sliderTerms = null;  // what buildSliders last built: the terms of state.a
 function buildSliders() {
-  const parsed = parseModelSpec(state.a);
-  $('model').hidden = !parsed;
-  if (!parsed) return;
-  const { model, values } = parsed;
-  $('model-name').textContent = `${model.name}: ${model.description}`;
+  sliderTerms = parseSpec(state.a);
   const box = $('sliders');
-  box.replaceChildren();
-  for (const p of model.params) {
-    const label = document.createElement('label');
-    label.title = p.description;
-    let input;
-    if (p.choices.length) {
-      input = document.createElement('select');
-      p.choices.forEach((c) => input.append(new Option(c, c)));
-      input.value = values[p.name] ?? p.choices[p.default];
-    } else {
-      input = Object.assign(document.createElement('input'), { type: 'range', min: 0, max: 1000, step: 1 });
-      const map = sliderMap(p);
-      const current = values[p.name] !== undefined ? Number(values[p.name])
-        : p.default_from ? Number(values[p.default_from] ?? model.params.find((q) => q.name === p.default_from).default) : p.default;
-      input.value = map.toSlider(current);
-      input.map = map;
-    }
-    input.dataset.param = p.name;
-    // A parameter that defaults to another (alpha_x to alpha) follows it until it is moved.
-    if (p.default_from && values[p.name] === undefined) input.dataset.follows = p.default_from;
-    const out = document.createElement('output');
-    out.textContent = p.choices.length ? '' : Number(input.map.fromSlider(input.value)).toPrecision(3);
-    input.out = out;
-    input.addEventListener('input', () => {
-      delete input.dataset.follows;  // moved by the user: it has its own value from now on
-      if (input.map) {
-        const value = input.map.fromSlider(input.value);
-        out.textContent = Number(value).toPrecision(3);
-        moveFollowers(p.name, value);
-      }
-      state.a = sliderSpec(model);
-      ensureOption($('brdf-a'), state.a);
-      interactive = true;
-      changed({ sphere: 'stale' });
-    });
-    input.addEventListener('change', () => { refineSoon(); });
-    label.append(p.name, input, out);
-    box.append(label);
-  }
+  box.replaceChildren();  // never the sliders of the BRDF shown before
+  $('model').hidden = !sliderTerms;
+  if (!sliderTerms) return;
+  const models = sliderTerms.filter((t) => t.model);
+  $('model-name').textContent = sliderTerms.length === 1
+    ? `${models[0].model.name}: ${models[0].model.description}`
+    : `sum of ${sliderTerms.length} terms`;
+  sliderTerms.forEach((term, t) => {
+    const group = Object.assign(document.createElement('fieldset'), { className: 'term' });
+    group.dataset.term = t;
+    group.append(Object.assign(document.createElement('legend'), {
+      textContent: term.model ? term.model.name : term.fixed,
+      title: term.model ? term.model.description : 'not a model: fixed',
+    }));
+    if (term.model) for (const p of term.model.params) group.append(paramControl(term, t, p));
+    box.append(group);
+  });
 }
-// The parameters that default to `name` and were not moved (alpha_x, alpha_y of alpha) take its
-// value: their sliders and numbers show it (sliderSpec leaves them out, so the server agrees).
-function moveFollowers(name, value) {
-  for (const f of document.querySelectorAll('#sliders [data-follows]')) {
+function paramControl(term, t, p) {
+  const { model, values } = term;
+  const label = document.createElement('label');
+  label.title = p.description;
+  let input;
+  if (p.choices.length) {
+    input = document.createElement('select');
+    p.choices.forEach((c) => input.append(new Option(c, c)));
+    input.value = values[p.name] ?? p.choices[p.default];
+  } else {
+    input = Object.assign(document.createElement('input'), { type: 'range', min: 0, max: 1000, step: 1 });
+    const map = sliderMap(p);
+    const current = values[p.name] !== undefined ? Number(values[p.name])
+      : p.default_from ? Number(values[p.default_from] ?? model.params.find((q) => q.name === p.default_from).default) : p.default;
+    input.value = map.toSlider(current);
+    input.map = map;
+  }
+  input.dataset.param = p.name;
+  input.dataset.term = t;
+  // A parameter that defaults to another (alpha_x to alpha) follows it until it is moved.
+  if (p.default_from && values[p.name] === undefined) input.dataset.follows = p.default_from;
+  const out = document.createElement('output');
+  out.textContent = p.choices.length ? '' : Number(input.map.fromSlider(input.value)).toPrecision(3);
+  input.out = out;
+  input.addEventListener('input', () => {
+    delete input.dataset.follows;  // moved by the user: it has its own value from now on
+    if (input.map) {
+      const value = input.map.fromSlider(input.value);
+      out.textContent = Number(value).toPrecision(3);
+      moveFollowers(t, p.name, value);
+    }
+    state.a = sliderSpec();
+    ensureOption($('brdf-a'), state.a);
+    interactive = true;
+    changed({ sphere: 'stale' });
+  });
+  input.addEventListener('change', () => { refineSoon(); });
+  label.append(p.name, input, out);
+  return label;
+}
+// The parameters of term t that default to `name` and were not moved (alpha_x, alpha_y of alpha)
+// take its value: their sliders and numbers show it (sliderSpec leaves them out, so the server
+// agrees).
+function moveFollowers(t, name, value) {
+  for (const f of document.querySelectorAll(`#sliders [data-term="${t}"][data-follows]`)) {
     if (f.dataset.follows !== name || !f.map) continue;
     f.value = f.map.toSlider(value);
     f.out.textContent = Number(value).toPrecision(3);
   }
 }
-// Linear over small ranges, logarithmic over wide ones (a slider position is 0 … 1000).
+// Logarithmic over ranges of two decades or more (a roughness in [0.001, 10]: α = 0.2 at 58 % of
+// the track; from 0, over [0.001, max] with the first position 0, when max > 100), linear
+// otherwise (albedos, f0); a position is 0 … 1000.
 function sliderMap(p) {
   const lo = p.min, hi = p.max;
-  if (hi - lo <= 100 || lo < 0) {
+  const log = lo > 0 ? hi / lo >= 100 : lo === 0 && hi > 100;
+  if (!log) {
     return { toSlider: (v) => 1000 * (v - lo) / (hi - lo), fromSlider: (s) => lo + (hi - lo) * s / 1000 };
   }
-  const a = Math.log10(Math.max(lo, 1e-3)), b = Math.log10(hi);
+  const floor = Math.max(lo, 1e-3), a = Math.log10(floor), b = Math.log10(hi);
   return {
-    toSlider: (v) => 1000 * (Math.log10(Math.max(v, 1e-3)) - a) / (b - a),
-    fromSlider: (s) => (Number(s) === 0 ? lo : Math.pow(10, a + (b - a) * s / 1000)),
+    toSlider: (v) => 1000 * (Math.log10(Math.min(Math.max(v, floor), hi)) - a) / (b - a),
+    fromSlider: (s) => (Number(s) === 0 ? lo : Math.min(hi, Math.pow(10, a + (b - a) * s / 1000))),
   };
 }
-function sliderSpec(model) {
-  const items = [];
-  for (const input of document.querySelectorAll('#sliders [data-param]')) {
-    if (input.dataset.follows) continue;
-    const v = input.map ? Number(Number(input.map.fromSlider(input.value)).toPrecision(4)) : input.value;
-    items.push(`${input.dataset.param}=${v}`);
-  }
-  return `${model.name}:${items.join(',')}`;
+// The spec the sliders show: every term, the fixed ones as they were, in their order.
+function sliderSpec() {
+  return sliderTerms.map((term, t) => {
+    if (!term.model) return term.fixed;
+    const items = [];
+    for (const input of document.querySelectorAll(`#sliders [data-term="${t}"][data-param]`)) {
+      if (input.dataset.follows) continue;
+      const v = input.map ? Number(Number(input.map.fromSlider(input.value)).toPrecision(4)) : input.value;
+      items.push(`${input.dataset.param}=${v}`);
+    }
+    return `${term.model.name}:${items.join(',')}`;
+  }).join('+');
 }
 
 // --- updates ------------------------------------------------------------------------------------
