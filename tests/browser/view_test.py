@@ -426,6 +426,30 @@ def check_roughness_slider(driver):
           f"one step moves α by less than 2 % ({alpha[1]} → {step[1]})")
 
 
+def type_into(driver, element_id, text):
+    from selenium.webdriver.common.keys import Keys
+    field = driver.find_element(By.ID, element_id)
+    field.send_keys(Keys.CONTROL, "a")
+    field.send_keys(text, Keys.ENTER)
+    wait_idle(driver)
+
+
+def check_typed_angles(driver):
+    """Issue 34: θo, φo and the relative azimuth typed in as numbers; a wrong one is refused with
+    a message and leaves the state as it was."""
+    type_into(driver, "theta-o", "30")
+    type_into(driver, "phi-o", "90")
+    type_into(driver, "azimuth-value", "45")
+    got = driver.execute_script("const s = window.halfback.state; return [s.to, s.po, s.az];")
+    check(got == [30, 90, 45], f"typed θo, φo and relative azimuth set the state ({got})")
+    check("to=30&po=90" in driver.current_url, "the typed ωo is in the URL")
+    type_into(driver, "theta-o", "95")
+    status = driver.find_element(By.ID, "status")
+    got = driver.execute_script("return window.halfback.state.to;")
+    check(got == 30 and "θo must be" in status.text,
+          f"θo = 95° is refused ({status.text!r}; θo stays {got})")
+
+
 def browser_checks(args, base, token, spec):
     driver = make_driver()
     driver.set_script_timeout(300)
@@ -481,7 +505,7 @@ def browser_checks(args, base, token, spec):
               f"moving the alpha slider changes the BRDF ({spec_now})")
         check_following_sliders(driver)
         for bug in [check_sliders_follow_the_brdf, check_sum_of_models, check_roughness_slider,
-                    check_hemisphere_drag]:
+                    check_hemisphere_drag, check_typed_angles]:
             try:  # each one checked even when another fails (they fail apart on the old page)
                 bug(driver)
             except Exception as e:  # pylint: disable=broad-except

@@ -221,9 +221,38 @@ function drawHemisphere() {
   const p = V.diskPoint(o), m = V.diskPoint([-o[0], -o[1], o[2]]);
   V.drawMarker(canvas, (p[0] + 1) / 2, (p[1] + 1) / 2, true, 'cross');
   V.drawMarker(canvas, (m[0] + 1) / 2, (m[1] + 1) / 2, false);
-  $('theta-o').textContent = `${state.to.toFixed(1)}°`;
-  $('phi-o').textContent = `${state.po.toFixed(1)}°`;
+  showNumber($('theta-o'), state.to.toFixed(1));
+  showNumber($('phi-o'), state.po.toFixed(1));
   markHemisphere();
+}
+// A number field shows the state unless the user is typing in it.
+function showNumber(input, text) {
+  if (document.activeElement !== input) input.value = text;
+}
+// A typed angle in [lo, hi] degrees, or null after saying in the status line what is wrong.
+function typedAngle(input, name, lo, hi) {
+  const v = input.value.trim() === '' ? NaN : Number(input.value);
+  if (Number.isFinite(v) && v >= lo && v <= hi) return v;
+  setStatus(`${name} must be a number of degrees in [${lo}, ${hi}], not '${input.value}'`, true);
+  return null;
+}
+function setupTypedAngles() {
+  const typedWo = (key, id, name, lo, hi) => $(id).addEventListener('change', (e) => {
+    const v = typedAngle(e.target, name, lo, hi);
+    if (v === null) return drawHemisphere();  // shows the current value again
+    setStatus('ready');
+    state[key] = v;
+    return changed({ slices: false, sphere: false });
+  });
+  typedWo('to', 'theta-o', 'θo', 0, 89.9);
+  typedWo('po', 'phi-o', 'φo', 0, 360);
+  $('azimuth-value').addEventListener('change', (e) => {
+    const v = typedAngle(e.target, 'the relative azimuth', 0, 360);
+    if (v === null) { e.target.value = state.az; return; }
+    setStatus('ready');
+    setAzimuth(v);
+    refineSoon();
+  });
 }
 function blackOutside(canvas) {  // the corners outside the disk
   const ctx = canvas.getContext('2d'), w = canvas.width;
@@ -594,6 +623,15 @@ function fillSelects() {
   for (const e of info.environments) $('env').append(new Option(e.replace(/^file:/, ''), e));
 }
 
+function setAzimuth(degrees) {
+  state.az = degrees;
+  $('azimuth').value = degrees;
+  showNumber($('azimuth-value'), degrees);
+  writeHash();
+  track(updateSlices());
+  if (cursor) markSlices();
+}
+
 function setup() {
   $('brdf-a').addEventListener('change', (e) => { state.a = e.target.value; changed({ sliders: true }); });
   $('brdf-b').addEventListener('change', (e) => {
@@ -614,12 +652,8 @@ function setup() {
     }).catch((err) => setStatus(err.message, true));
   });
   $('azimuth').addEventListener('input', (e) => {
-    state.az = Number(e.target.value);
-    $('azimuth-value').textContent = `${state.az}°`;
     interactive = true;
-    writeHash();
-    track(updateSlices());
-    if (cursor) markSlices();
+    setAzimuth(Number(e.target.value));
     refineSoon();
   });
   $('scale').addEventListener('change', (e) => { state.scale = e.target.value; writeHash(); drawSlices(); });
@@ -629,6 +663,7 @@ function setup() {
   $('env').addEventListener('change', (e) => { state.env = e.target.value; writeHash(); restartSphere(); });
   $('exposure').addEventListener('input', (e) => { state.exposure = Number(e.target.value); writeHash(); redrawSpheres(); });
   setupHemisphere();
+  setupTypedAngles();
   setupPolar();
   setupExports();
 }
@@ -701,7 +736,7 @@ async function main() {
   if (state.b) ensureOption($('brdf-b'), state.b);
   $('mode').value = state.mode;
   $('azimuth').value = state.az;
-  $('azimuth-value').textContent = `${state.az}°`;
+  $('azimuth-value').value = state.az;
   $('scale').value = state.scale;
   $('levels').value = state.levels === 'auto' ? '' : state.levels;
   for (const f of info.forms)  // the parameterizations come from the server (/api/info)
