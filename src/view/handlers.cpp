@@ -197,6 +197,10 @@ void write_forms(JsonWriter& w) {
     for (const auto c : column_names(Form{s, false})) w.value(c);
     w.end_array().key("iso_columns").begin_array();
     for (const auto c : column_names(Form{s, true})) w.value(c);
+    w.end_array().key("units").begin_array();  // of the columns: "rad" or "" (a length)
+    for (const Axis& a : s.param().axes(false)) w.value(a.unit());
+    w.end_array().key("iso_units").begin_array();
+    for (const Axis& a : s.param().axes(true)) w.value(a.unit());
     w.end_array().end_object();
   }
   w.end_array();

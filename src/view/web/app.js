@@ -384,16 +384,27 @@ function showCursor() {
   const c = cursor;
   if (!c) return;
   let html = `<p>${c.valid ? '' : 'outside the valid domain'}${pinned ? ' (pinned: click to release)' : ''}</p><table>`;
-  html += row('dirs', ['wi_x', 'wi_y', 'wi_z', 'wo_x', 'wo_y', 'wo_z'], [...c.wi, ...c.wo], 'dirs');
+  const dirNames = ['wi_x', 'wi_y', 'wi_z', 'wo_x', 'wo_y', 'wo_z'];
+  html += heading('directions', dirNames, dirNames.map(() => ''));
+  html += row('', dirNames, [...c.wi, ...c.wo], 'dirs');
   for (const f of c.forms) {
     const fi = formInfo(f.space);
-    html += row(f.space, fi.columns, f.coords, f.space, f.jacobian);
-    html += row(`${f.space} iso`, fi.iso_columns, f.iso, `${f.space}-iso`, f.iso_jacobian);
+    html += heading(f.space, fi.columns, fi.units, f.jacobian !== undefined);
+    html += row('', fi.columns, f.coords, f.space, f.jacobian);
+    html += heading(`${f.space}, isotropic`, fi.iso_columns, fi.iso_units, f.iso_jacobian !== undefined);
+    html += row('', fi.iso_columns, f.iso, `${f.space}-iso`, f.iso_jacobian);
   }
+  html += heading('ρ', ['r', 'g', 'b'], ['sr⁻¹', 'sr⁻¹', 'sr⁻¹']);
   c.rho.forEach((r, b) => {
-    html += row(`<span class="swatch-${b ? 'b' : 'a'}">ρ</span> ${escapeHtml(r.brdf)}`, ['r', 'g', 'b'], r.rgb, `rho-${b}`);
+    html += row(`<span class="swatch-${b ? 'b' : 'a'}">ρ</span> ${escapeHtml(specLabel(r.brdf))}`, ['r', 'g', 'b'], r.rgb, `rho-${b}`);
   });
   $('cursor').innerHTML = `${html}</table>`;
+}
+// The column names and units of the row below (angles in radians, as `halfback convert` prints).
+function heading(title, names, units, jacobian = false) {
+  let cells = names.map((n, k) => `<th scope="col">${escapeHtml(n)}${units[k] ? ` (${units[k]})` : ''}</th>`).join('');
+  if (jacobian) cells += '<th scope="col" title="|det| of the map from the coordinates to the directions">Jacobian</th>';
+  return `<tr class="names"><th>${escapeHtml(title)}</th>${cells}</tr>`;
 }
 function row(title, names, values, id, jacobian) {
   let cells = '';
@@ -497,7 +508,7 @@ function paramControl(term, t, p) {
   const { model, values } = term;
   const label = document.createElement('label');
   label.title = p.description;
-  let input;
+  let input, current;
   if (p.choices.length) {
     input = document.createElement('select');
     p.choices.forEach((c) => input.append(new Option(c, c)));
@@ -505,7 +516,7 @@ function paramControl(term, t, p) {
   } else {
     input = Object.assign(document.createElement('input'), { type: 'range', min: 0, max: 1000, step: 1 });
     const map = sliderMap(p);
-    const current = values[p.name] !== undefined ? Number(values[p.name])
+    current = values[p.name] !== undefined ? Number(values[p.name])
       : p.default_from ? Number(values[p.default_from] ?? model.params.find((q) => q.name === p.default_from).default) : p.default;
     input.value = map.toSlider(current);
     input.map = map;
@@ -515,7 +526,8 @@ function paramControl(term, t, p) {
   // A parameter that defaults to another (alpha_x to alpha) follows it until it is moved.
   if (p.default_from && values[p.name] === undefined) input.dataset.follows = p.default_from;
   const out = document.createElement('output');
-  out.textContent = p.choices.length ? '' : Number(input.map.fromSlider(input.value)).toPrecision(3);
+  // The spec's value, not the nearest slider position's (a logarithmic track has no 0.3 on it).
+  out.textContent = p.choices.length ? '' : Number(current).toPrecision(3);
   input.out = out;
   input.addEventListener('input', () => {
     delete input.dataset.follows;  // moved by the user: it has its own value from now on
