@@ -395,6 +395,8 @@ def check_hemisphere_drag(driver):
     """Issue 34, bug 3: during a drag the hemisphere keeps its size on screen (the old canvas
     shrank from 256 to 128 px at the drag's resolution, and the pointer fell off it)."""
     hemi = driver.find_element(By.ID, "hemisphere")
+    # Wholly in view: a pointer's origin at an element is the centre of its visible part.
+    driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", hemi)
     w = hemi.size["width"]
     chain = ActionChains(driver).move_to_element_with_offset(hemi, 0, 0).click_and_hold()
     thetas, sizes = [], []
@@ -495,7 +497,9 @@ def browser_checks(args, base, token, spec):
         driver.save_screenshot(os.path.join(args.screenshots, "view-page.png"))
         for id_, name in [("slices-panel", "slices"), ("hemisphere-panel", "hemisphere"),
                           ("polar-panel", "polar"), ("sphere-panel", "sphere"), ("cursor-panel", "cursor")]:
-            driver.find_element(By.ID, id_).screenshot(os.path.join(args.screenshots, f"view-{name}.png"))
+            panel = driver.find_element(By.ID, id_)
+            driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", panel)
+            panel.screenshot(os.path.join(args.screenshots, f"view-{name}.png"))
         # A model's slider: the spec follows, the views update.
         alpha = driver.find_element(By.CSS_SELECTOR, '#sliders input[data-param="alpha"]')
         ActionChains(driver).click_and_hold(alpha).move_by_offset(-25, 0).release().perform()
@@ -519,7 +523,13 @@ def browser_checks(args, base, token, spec):
         driver.execute_script("""const s = document.getElementById('brdf-b');
             s.value = 'arg:1'; s.dispatchEvent(new Event('change'));""")
         wait_idle(driver)
-        driver.find_element(By.ID, "slices-panel").screenshot(os.path.join(args.screenshots, "view-difference.png"))
+        panel = driver.find_element(By.ID, "slices-panel")
+        driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", panel)
+        panel.screenshot(os.path.join(args.screenshots, "view-difference.png"))
+        legend = driver.find_element(By.ID, "polar").text
+        check(spec in legend and "embedded:pink-felt" in legend,
+              f"the polar plot draws both BRDFs with their names ({legend!r})")
+        driver.find_element(By.ID, "polar-panel").screenshot(os.path.join(args.screenshots, "view-polar-two.png"))
         check("b=arg%3A1" in driver.current_url or "b=arg:1" in driver.current_url, "the second BRDF is in the URL")
         driver.execute_script("""const s = document.getElementById('mode');
             s.value = 'a'; s.dispatchEvent(new Event('change'));""")

@@ -107,6 +107,7 @@ window.halfback = { state, stats, idle, spheresDone, cursor: () => cursor };
 
 const specs = () => (state.b && state.mode !== 'a' ? [state.a, state.b] : [state.a]);
 const formInfo = (space) => info.forms.find((f) => f.space === space);
+const loaded = () => [state.a, state.b].filter(Boolean);  // every BRDF loaded, whatever the mode
 
 // --- slices ---------------------------------------------------------------------------------
 const sliceCanvases = {};
@@ -118,10 +119,12 @@ function buildSlices() {
     const canvas = document.createElement('canvas');
     canvas.id = `slice-${f.space}`;
     canvas.dataset.space = f.space;
-    div.append(Object.assign(document.createElement('h2'), { textContent: f.space }), canvas,
+    const plot = Object.assign(document.createElement('div'), { className: 'plot' });
+    plot.append(V.sliceAxes(f.axes, [plain(f.axes[0].label), plain(f.axes[1].label)]), canvas);
+    div.append(Object.assign(document.createElement('h2'), { textContent: f.space, title: f.summary }), plot,
       Object.assign(document.createElement('span'), {
         className: 'axis',
-        textContent: `x: ${plain(f.axes[0].label)} 0…${axisMax(f.axes[0])}, y: ${plain(f.axes[1].label)} 0…${axisMax(f.axes[1])}, azimuth ${plain(f.azimuth_label)}`,
+        textContent: `at the relative azimuth ${plain(f.azimuth_label)}`,
       }));
     box.append(div);
     sliceCanvases[f.space] = canvas;
@@ -130,7 +133,6 @@ function buildSlices() {
   }
 }
 const plain = (label) => label.replace(/_/g, '').replace(/[{}]/g, '');
-const axisMax = (a) => (a.angle ? '90°' : '1');
 
 let sliceFields = {};  // per form: [field of the first BRDF, of the second]
 // The four forms' slices of every BRDF shown, in one request (/api/slices).
@@ -169,14 +171,16 @@ function drawSlices() {
   markSlices();
 }
 function drawColourbar(scale) {
-  const box = $('colorbar');
-  box.replaceChildren();
-  const c = document.createElement('canvas');
-  V.colourbar(c, scale);
-  const unit = scale.mode === 'ratio' ? 'log₂ ratio'
-    : scale.mode === 'diff' ? (scale.kind === 'log' ? `signed log₁₀(1 + |Δ|/${scale.eps.toPrecision(2)}) of Δ luminance` : 'Δ luminance (sr⁻¹)')
-    : scale.kind === 'log' ? 'log₁₀ luminance of ρ (sr⁻¹)' : 'luminance of ρ (sr⁻¹)';
-  box.append(`${scale.lo.toPrecision(3)}`, c, `${scale.hi.toPrecision(3)}  ${unit}; hatched: outside the valid domain`);
+  $('colorbar').replaceChildren(V.colourbarSvg(scale, `${scaleUnit(scale)}; hatched: outside the valid domain`, 320));
+}
+// What a colour scale's ticks are, in words (the ticks are values of it, not of a transform).
+function scaleUnit(scale) {
+  const names = () => [specLabel(state.a), specLabel(state.b)];
+  if (scale.mode === 'ratio') return `ratio of luminances, ${names()[0]} / ${names()[1]} (log scale)`;
+  if (scale.mode === 'diff') {
+    return `difference of luminances, ${names()[0]} − ${names()[1]} (sr⁻¹${scale.kind === 'log' ? ', log scale beyond ±' + V.shortNumber(scale.eps) : ''})`;
+  }
+  return `luminance of ρ (sr⁻¹${scale.kind === 'log' ? ', log scale' : ''})`;
 }
 
 function pointerOnSlice(e, f, click) {
@@ -212,10 +216,14 @@ function drawHemisphere() {
     const mode = b ? state.mode : 'a';
     const s = Float32Array.from(V.sliceScalar(a, b, mode));
     for (let k = 0; k < s.length; ++k) if (!Number.isFinite(a.data[a.channels * k])) s[k] = NaN;
-    V.drawScalar(canvas, s, a.width, a.height, V.makeScale([s], mode, 'log'), []);
+    const scale = V.makeScale([s], mode, 'log');
+    V.drawScalar(canvas, s, a.width, a.height, scale, []);
     blackOutside(canvas);
+    $('hemi-colorbar').replaceChildren(V.colourbarSvg(scale, scaleUnit(scale)));
   } else {
-    V.drawCoordinates(canvas, hemiField.coords, formInfo(state.hemi).axes);
+    const axes = formInfo(state.hemi).axes;
+    V.drawCoordinates(canvas, hemiField.coords, axes);
+    $('hemi-colorbar').textContent = `red: ${plain(axes[0].label)} / its maximum, green: ${plain(axes[1].label)} / its maximum; black: outside the domain`;
   }
   const o = wo();
   const p = V.diskPoint(o), m = V.diskPoint([-o[0], -o[1], o[2]]);
@@ -239,7 +247,7 @@ function typedAngle(input, name, lo, hi) {
 function setupTypedAngles() {
   const typedWo = (key, id, name, lo, hi) => $(id).addEventListener('change', (e) => {
     const v = typedAngle(e.target, name, lo, hi);
-    if (v === null) return drawHemisphere();  // shows the current value again
+    if (v === null) { e.target.value = state[key].toFixed(1); return undefined; }  // as it was
     setStatus('ready');
     state[key] = v;
     return changed({ slices: false, sphere: false });
@@ -302,12 +310,12 @@ function hoverWi(e) {
 // --- polar plot ------------------------------------------------------------------------------
 let polarCurves = [];
 const updatePolar = coalesced(async () => {
-  polarCurves = await Promise.all(specs().map((s) => getJson(null, '/api/polar',
+  polarCurves = await Promise.all(loaded().map((s) => getJson(null, '/api/polar',
     [['brdf', s], ['theta_o', state.to], ['phi_o', state.po], ['n', interactive ? 91 : 181]])));
   drawPolar();
 });
 function drawPolar() {
-  V.drawPolar($('polar'), polarCurves, state.polar, COLOURS, polarCursorAngle());
+  V.drawPolar($('polar'), polarCurves, state.polar, COLOURS, polarCursorAngle(), loaded().map(specLabel));
 }
 function setupPolar() {
   const svg = $('polar');
@@ -720,8 +728,8 @@ function exportView(target, kind) {
     if (kind === 'SVG') return download(`${name}.svg`, new Blob([text], { type: 'image/svg+xml' }));
     const img = new Image();
     img.onload = () => {
-      const c = Object.assign(document.createElement('canvas'), { width: 640, height: 376 });
-      c.getContext('2d').drawImage(img, 0, 0, 640, 376);
+      const c = Object.assign(document.createElement('canvas'), { width: 920, height: 540 });
+      c.getContext('2d').drawImage(img, 0, 0, 920, 540);
       c.toBlob((blob) => download(`${name}.png`, blob));
     };
     img.src = `data:image/svg+xml;charset=utf-8,${encodeURIComponent(text)}`;

@@ -182,15 +182,103 @@ export function drawCoordinates(canvas, field, axes) {
   ctx.putImageData(img, 0, 0);
 }
 
-export function colourbar(canvas, scale) {
-  canvas.width = 256;
-  canvas.height = 1;
-  const ctx = canvas.getContext('2d'), img = ctx.createImageData(256, 1);
-  for (let i = 0; i < 256; ++i) {
-    const c = scale.map(i / 255);
-    img.data.set([c[0], c[1], c[2], 255], 4 * i);
+// Ticks of a colour scale in the units a reader knows: positions in transformed units (t, as
+// scale.lo … scale.hi) with labels in ρ's own units (a decade, a difference, a ratio).
+export function scaleTicks(scale) {
+  const inRange = (t) => t >= scale.lo - 1e-9 && t <= scale.hi + 1e-9;
+  const ticks = [];
+  if (scale.mode === 'ratio') {
+    const step = scale.hi - scale.lo > 8 ? 2 : 1;
+    for (let k = Math.ceil(scale.lo / step) * step; k <= scale.hi; k += step) ticks.push({ t: k, label: `×${shortNumber(2 ** k)}` });
+  } else if (scale.mode === 'diff' && scale.kind === 'log') {
+    ticks.push({ t: 0, label: '0' });
+    for (let k = -12; k <= 12; ++k) {
+      const v = 10 ** k, t = scale.tf(v);
+      if (inRange(t) && t >= 0.3) ticks.push({ t, label: shortNumber(v) }, { t: -t, label: shortNumber(-v) });
+    }
+  } else if (scale.kind === 'log' && !scale.diverge) {
+    // Decades; over less than two of them, also 2 and 5 (or every digit under half a decade).
+    const span = scale.hi - scale.lo;
+    const mantissas = span >= 2 ? [1] : span >= 0.5 ? [1, 2, 5] : [1, 2, 3, 4, 5, 6, 7, 8, 9];
+    for (let k = Math.floor(scale.lo); k <= Math.ceil(scale.hi); ++k) {
+      for (const m of mantissas) ticks.push({ t: k + Math.log10(m), label: shortNumber(m * 10 ** k) });
+    }
+  } else {
+    const step = niceStep((scale.hi - scale.lo) / 5);
+    for (let v = Math.ceil(scale.lo / step) * step; v <= scale.hi + 1e-9 * step; v += step) ticks.push({ t: v, label: shortNumber(Math.abs(v) < step / 2 ? 0 : v) });
   }
-  ctx.putImageData(img, 0, 0);
+  return ticks.filter((k) => inRange(k.t)).sort((a, b) => a.t - b.t);
+}
+export function niceStep(raw) {
+  if (!(raw > 0)) return 1;
+  const p = 10 ** Math.floor(Math.log10(raw)), f = raw / p;
+  return p * (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10);
+}
+export function shortNumber(v) {
+  if (v === 0) return '0';
+  const a = Math.abs(v);
+  if (a >= 1e4 || a < 1e-3) return v.toExponential(0).replace('e+', 'e');
+  return String(Number(v.toPrecision(3)));
+}
+
+// A colour bar as SVG (vector, so that it exports): the ramp, ticks with labels, a unit line.
+export function colourbarSvg(scale, unit, width = 256) {
+  const h = 46, barH = 12, pad = 14;
+  const svg = el('svg', { width: width + 2 * pad, height: h, viewBox: `0 0 ${width + 2 * pad} ${h}`, class: 'colourbar' });
+  const id = `ramp-${Math.random().toString(36).slice(2)}`;
+  const grad = el('linearGradient', { id });
+  for (let k = 0; k <= 32; ++k) {
+    const c = scale.map(k / 32).map(Math.round);
+    grad.append(el('stop', { offset: k / 32, 'stop-color': `rgb(${c})` }));
+  }
+  svg.append(el('defs', {}), el('rect', { x: pad, y: 0, width, height: barH, fill: `url(#${id})` }));
+  svg.firstChild.append(grad);
+  for (const tick of scaleTicks(scale)) {
+    const x = pad + width * (tick.t - scale.lo) / (scale.hi - scale.lo);
+    svg.append(el('line', { x1: x, x2: x, y1: barH, y2: barH + 4, stroke: '#9a9cab' }));
+    svg.append(text(tick.label, { x, y: barH + 14, 'text-anchor': 'middle' }));
+  }
+  svg.append(text(unit, { x: pad, y: h - 3 }));
+  return svg;
+}
+function text(content, attrs) {
+  const t = el('text', { fill: '#9a9cab', 'font-size': 10, 'font-family': 'system-ui, sans-serif', ...attrs });
+  t.textContent = content;
+  return t;
+}
+
+// Ticks of an axis of a parameterization (degrees for angles, plain numbers for lengths), as
+// fractions of the axis' extent [0, max].
+export function axisTicks(axis) {
+  if (axis.angle) {
+    const maxDeg = axis.max * 180 / Math.PI, step = maxDeg > 120 ? 60 : 30;
+    const out = [];
+    for (let d = 0; d <= maxDeg + 1e-9; d += step) out.push({ f: d / maxDeg, label: `${d}°` });
+    return out;
+  }
+  const step = niceStep(axis.max / 4), out = [];
+  for (let v = 0; v <= axis.max + 1e-9 * step; v += step) out.push({ f: v / axis.max, label: shortNumber(v) });
+  return out;
+}
+// The x and y axes of a slice as SVG around a square of `size` pixels: ticks and labels.
+export function sliceAxes(axes, labels, size = 256) {
+  const left = 34, bottom = 30;
+  const svg = el('svg', { width: size + left + 14, height: size + bottom + 4, class: 'slice-axes' });
+  const frame = '#6a6d7a';
+  axisTicks(axes[0]).forEach(({ f, label }) => {
+    const x = left + f * size;
+    svg.append(el('line', { x1: x, x2: x, y1: size + 2, y2: size + 6, stroke: frame }));
+    svg.append(text(label, { x, y: size + 16, 'text-anchor': 'middle' }));
+  });
+  axisTicks(axes[1]).forEach(({ f, label }) => {
+    const y = 2 + (1 - f) * size;
+    svg.append(el('line', { x1: left - 6, x2: left - 2, y1: y, y2: y, stroke: frame }));
+    svg.append(text(label, { x: left - 8, y: y + 3, 'text-anchor': 'end' }));
+  });
+  svg.append(text(labels[0], { x: left + size / 2, y: size + 28, 'text-anchor': 'middle', fill: '#e6e6ea' }));
+  const yl = text(labels[1], { x: 0, y: 0, 'text-anchor': 'middle', fill: '#e6e6ea', transform: `translate(9 ${2 + size / 2}) rotate(-90)` });
+  svg.append(yl);
+  return svg;
 }
 
 // A marker on a canvas at fractional position (x, y) in [0, 1]² (y up): filled when exact,
@@ -236,7 +324,7 @@ function el(name, attrs) {
 }
 
 // The polar plot: per BRDF, ρ along the two curves as the radius (t from the vertical).
-export function drawPolar(svg, curves, kind, colours, cursor) {
+export function drawPolar(svg, curves, kind, colours, cursor, names = []) {
   svg.replaceChildren();
   svg.append(el('rect', { x: -1.15, y: -1.15, width: 2.3, height: 1.35, fill: '#111217' }));
   for (const r of [0.25, 0.5, 0.75, 1]) {
@@ -264,12 +352,29 @@ export function drawPolar(svg, curves, kind, colours, cursor) {
       svg.append(el('path', { d, fill: 'none', stroke: colours[b], 'stroke-width': 0.012, 'stroke-dasharray': k === 'across' ? '0.04 0.025' : 'none' }));
     }
   });
+  // Angles from the normal along the arc; the radius' values (luminance of ρ) along the base.
+  const small = (content, x, y, anchor = 'middle') => {
+    const t = el('text', { x, y, fill: '#9a9cab', 'font-size': 0.055, 'text-anchor': anchor, 'font-family': 'system-ui, sans-serif' });
+    t.textContent = content;
+    svg.append(t);
+  };
+  for (let a = -90; a <= 90; a += 30) {
+    const t = a * Math.PI / 180;
+    small(`${Math.abs(a)}°`, 1.08 * Math.sin(t), -1.08 * Math.cos(t) + 0.02);
+  }
+  names.forEach((name, b) => {  // the legend
+    const y = -1.06 + 0.08 * b;
+    svg.append(el('line', { x1: -1.1, x2: -1.0, y1: y - 0.018, y2: y - 0.018, stroke: colours[b], 'stroke-width': 0.015 }));
+    small(name, -0.97, y, 'start');
+  });
+  const valueAt = (r) => (kind === 'log' ? 10 ** (lo + r * (Math.log10(max) - lo)) : r * max);
+  if (max > 0) for (const r of [0.25, 0.5, 0.75, 1]) small(shortNumber(Number(valueAt(r).toPrecision(2))), r, 0.06);
   if (cursor !== null && cursor !== undefined) {
     const t = cursor * Math.PI / 180;
     svg.append(el('line', { x1: 0, y1: 0, x2: 1.05 * Math.sin(t), y2: -1.05 * Math.cos(t), stroke: '#ff3b6b', 'stroke-width': 0.01 }));
   }
-  const label = el('text', { x: -1.1, y: 0.13, fill: '#9a9cab', 'font-size': 0.07 });
-  label.textContent = `max ρ (luminance) ${max.toPrecision(3)} sr⁻¹; ← back   mirror →`;
+  const label = el('text', { x: -1.1, y: 0.15, fill: '#9a9cab', 'font-size': 0.06, 'font-family': 'system-ui, sans-serif' });
+  label.textContent = `radius: luminance of ρ (sr⁻¹${kind === 'log' ? ', log scale' : ''}); ← back   mirror →`;
   svg.append(label);
 }
 const lum = (v) => (v[0] === null ? 0 : 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]);
