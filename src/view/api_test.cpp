@@ -269,6 +269,33 @@ TEST(ViewApi, SlicesAreRhoAtTheCanonicalPoseOfEachPixel) {
   EXPECT_GT(invalid, 0);  // at φd = 0 the pairs with θh + θd > 90° are outside the domain
 }
 
+// pose= turns the slices about the normal: an anisotropic GGX turned by 90° is the one with its
+// roughnesses swapped (its ρ depends on (h·t/αx)² + (h·b/αy)²); an isotropic BRDF does not change.
+TEST(ViewApi, SlicesAtAnotherPoseOfAnAnisotropicBrdf) {
+  Api api(config());
+  const auto slice = [&](const std::string& spec, const std::string& pose) {
+    const Response r = api.handle(get(
+        "/api/slices",
+        {{"brdf", spec}, {"forms", "halfdiff"}, {"azimuth", "30"}, {"n", "16"}, {"pose", pose}}));
+    EXPECT_EQ(r.status, 200) << r.body;
+    return floats_of(r);
+  };
+  const auto same = [](const std::vector<float>& a, const std::vector<float>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t k = 0; k < a.size(); ++k)
+      if (!(std::isnan(a[k]) && std::isnan(b[k])) &&
+          !(std::abs(a[k] - b[k]) <= 1e-4f * std::max(1.0f, std::abs(b[k]))))
+        return false;
+    return true;
+  };
+  const std::string xy = "ggx:alpha_x=0.1,alpha_y=0.4", yx = "ggx:alpha_x=0.4,alpha_y=0.1";
+  EXPECT_TRUE(same(slice(xy, "90"), slice(yx, "0")));
+  EXPECT_FALSE(same(slice(xy, "0"), slice(yx, "0")));  // the pose matters for this BRDF
+  EXPECT_TRUE(same(slice(kSpec, "57"), slice(kSpec, "0")));
+  EXPECT_TRUE(
+      has_error(api.handle(get("/api/slices", {{"brdf", kSpec}, {"pose", "400"}})), 400, "pose"));
+}
+
 std::string header_of(const Response& r, std::string_view name) {
   for (const auto& [k, v] : r.headers)
     if (k == name) return v;

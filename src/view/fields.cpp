@@ -57,7 +57,7 @@ void mirror_azimuth(const Vec3<double>& wo, double& cx, double& cy) {
 }  // namespace
 
 std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, std::size_t n,
-                               int threads, RhoValues values) {
+                               int threads, RhoValues values, double pose) {
   // The grid of figure/slices.hpp (pixel centres), converted to direction pairs by the core's
   // batch engine (SIMD, with the domain mask): the same pairs as figure::sample_slice, which
   // converts one tuple at a time and costs several times more (docs/performance.md, "Viewer").
@@ -81,6 +81,14 @@ std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, st
   BatchOptions options;
   options.threads = threads;
   convert<double>(Form{space, true}, Form{Space::dirs, false}, in, grid.size(), out, options);
+  if (pose != 0) {
+    const double c = std::cos(pose), s = std::sin(pose);
+    const auto turn = [&](Vec3<double>& w) { w = {c * w.x - s * w.y, s * w.x + c * w.y, w.z}; };
+    for (DirPair<double>& p : pairs) {
+      turn(p.wi);
+      turn(p.wo);
+    }
+  }
   return eval_where(brdf, pairs, valid, values);
 }
 

@@ -21,9 +21,11 @@ inline std::size_t channels_of(RhoValues v) {
 
 // ρ on an n × n slice of an isotropic form at relative azimuth `azimuth` (radians, in [0, 2π)):
 // x the first isotropic coordinate over [0, max], y the second (figure/slices.hpp; the pixel
-// centres of figure::Grid::pixel_centres).
+// centres of figure::Grid::pixel_centres). `pose` (radians) turns every pair about the normal
+// from the form's canonical pose (its first azimuth, φh or φi, = 0) to that azimuth: the slice
+// of an anisotropic BRDF at another orientation (an isotropic BRDF's does not change).
 std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, std::size_t n,
-                               int threads, RhoValues values = RhoValues::rgb);
+                               int threads, RhoValues values = RhoValues::rgb, double pose = 0);
 
 // The hemisphere of ωi for a given ωo, seen from above (x right, y up) in the equal-area
 // projection r = √2 sin(θi/2), on the n × n pixel centres of [−1, 1]²: ρ(ωi, ωo) when `space`

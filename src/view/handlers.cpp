@@ -250,6 +250,8 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
   if (azimuth < 0) azimuth += 360.0;
   double radians = azimuth * kDegree;
   if (radians >= 2 * std::numbers::pi) radians = 0;
+  // The orientation of the slices about the normal (anisotropic BRDFs), in degrees.
+  const double pose = number(request, "pose", 0, -360, 360) * kDegree;
   const std::size_t n = whole(request, "n", 256, 2, kMaxGridSide);
   const RhoValues values = values_param(request);
   const std::vector<const std::string*> specs = all_params(request, "brdf");
@@ -266,7 +268,7 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end; ++k)
           fields[k] = slice_field(*brdfs[k / forms.size()], forms[k % forms.size()], radians, n,
-                                  threads, values);
+                                  threads, values, pose);
       },
       threads);
   Response res = floats(fields, n, n, channels_of(values));

@@ -452,6 +452,25 @@ def check_typed_angles(driver):
           f"θo = 95° is refused ({status.text!r}; θo stays {got})")
 
 
+def check_anisotropic_orientation(driver):
+    """Issue 34: an anisotropic BRDF's slices at a chosen orientation, said on the page; no such
+    control for isotropic ones."""
+    select_brdf(driver, "ggx:alpha=0.2")
+    check(not driver.find_element(By.ID, "pose-box").is_displayed(),
+          "an isotropic BRDF has no orientation control")
+    select_brdf(driver, "ggx:alpha_x=0.1,alpha_y=0.4")
+    check(driver.find_element(By.ID, "pose-box").is_displayed(),
+          "an anisotropic BRDF has the orientation control")
+    before = driver.execute_script("return window.halfback.stats.sliceDraws;")
+    type_into(driver, "pose-value", "90")
+    note = driver.find_element(By.ID, "pose-note").text
+    after = driver.execute_script("return window.halfback.stats.sliceDraws;")
+    check("anisotropic" in note and "90°" in note and after > before,
+          f"the slices are redrawn at the orientation typed, and the page says it ({note!r})")
+    check("pose=90" in driver.current_url, "the orientation is in the URL")
+    type_into(driver, "pose-value", "0")
+
+
 def browser_checks(args, base, token, spec):
     driver = make_driver()
     driver.set_script_timeout(300)
@@ -509,7 +528,7 @@ def browser_checks(args, base, token, spec):
               f"moving the alpha slider changes the BRDF ({spec_now})")
         check_following_sliders(driver)
         for bug in [check_sliders_follow_the_brdf, check_sum_of_models, check_roughness_slider,
-                    check_hemisphere_drag, check_typed_angles]:
+                    check_hemisphere_drag, check_typed_angles, check_anisotropic_orientation]:
             try:  # each one checked even when another fails (they fail apart on the old page)
                 bug(driver)
             except Exception as e:  # pylint: disable=broad-except

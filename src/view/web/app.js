@@ -19,7 +19,7 @@ function adaptDragSide(ms) {
 
 const state = {
   a: '', b: '', mode: 'a', az: 0, scale: 'log', levels: 'auto', to: 45, po: 180,
-  hemi: 'rho', env: 'sky', exposure: 0, polar: 'linear',
+  hemi: 'rho', env: 'sky', exposure: 0, polar: 'linear', pose: 0,
 };
 let info = null;
 let cursor = null;      // the last /api/point answer
@@ -140,7 +140,7 @@ const updateSlices = coalesced(async () => {
   const list = specs(), moving = interactive, n = moving ? dragSide : FULL;
   const t0 = performance.now();
   const { fields, headers } = await getFields(null, '/api/slices',
-    [...list.map((s) => ['brdf', s]), ['azimuth', state.az], ['n', n], ['values', 'luminance']]);
+    [...list.map((s) => ['brdf', s]), ['azimuth', state.az], ['pose', state.pose], ['n', n], ['values', 'luminance']]);
   const forms = headers.get('X-Halfback-Forms').split(',');
   sliceFields = {};
   forms.forEach((space, f) => { sliceFields[space] = list.map((_, b) => fields[b * forms.length + f]); });
@@ -600,6 +600,7 @@ function changed({ slices = true, sphere = true, sliders = false } = {}) {
   track(updatePolar());
   if (sphere === true) restartSphere();
   if (sphere === 'stale') sphereStale = true;
+  if (sliders || sphere === true) track(showPoseControl());
   if (sliders) buildSliders();
   if (interactive) refineSoon();
 }
@@ -612,9 +613,10 @@ function refineSoon() {
     track(updateSlices());
     track(updateHemisphere());
     track(updatePolar());
-    if (sphereStale) {
+    if (sphereStale) {  // a model's parameters moved: its anisotropy may have changed too
       sphereStale = false;
       restartSphere();
+      track(showPoseControl());
     }
   }, 250);
 }
@@ -641,6 +643,25 @@ function fillSelects() {
     }
   }
   for (const e of info.environments) $('env').append(new Option(e.replace(/^file:/, ''), e));
+}
+
+// Anisotropic BRDFs get the orientation control, and the page says which orientation it shows.
+async function showPoseControl() {
+  const answers = await Promise.all(loaded().map((s) => getJson(null, '/api/brdf', [['brdf', s]])));
+  const anisotropic = answers.filter((r) => !r.isotropic).map((r) => r.name);
+  $('pose-box').hidden = !anisotropic.length;
+  $('pose-note').hidden = !anisotropic.length;
+  $('pose-note').textContent = anisotropic.length
+    ? `${anisotropic.join(', ')}: anisotropic; the slices show the pairs turned about the normal to the orientation ${state.pose}° (φh, φi … = ${state.pose}°), not every orientation.`
+    : '';
+}
+function setPose(degrees) {
+  state.pose = degrees;
+  $('pose').value = degrees;
+  showNumber($('pose-value'), degrees);
+  writeHash();
+  track(updateSlices());
+  track(showPoseControl());
 }
 
 function setAzimuth(degrees) {
@@ -675,6 +696,17 @@ function setup() {
     interactive = true;
     setAzimuth(Number(e.target.value));
     refineSoon();
+  });
+  $('pose').addEventListener('input', (e) => {
+    interactive = true;
+    setPose(Number(e.target.value));
+    refineSoon();
+  });
+  $('pose-value').addEventListener('change', (e) => {
+    const v = typedAngle(e.target, 'the orientation', 0, 360);
+    if (v === null) { e.target.value = state.pose; return; }
+    setStatus('ready');
+    setPose(v);
   });
   $('scale').addEventListener('change', (e) => { state.scale = e.target.value; writeHash(); drawSlices(); });
   $('levels').addEventListener('change', (e) => { state.levels = e.target.value || 'auto'; writeHash(); drawSlices(); });
@@ -757,6 +789,8 @@ async function main() {
   $('mode').value = state.mode;
   $('azimuth').value = state.az;
   $('azimuth-value').value = state.az;
+  $('pose').value = state.pose;
+  $('pose-value').value = state.pose;
   $('scale').value = state.scale;
   $('levels').value = state.levels === 'auto' ? '' : state.levels;
   for (const f of info.forms)  // the parameterizations come from the server (/api/info)
