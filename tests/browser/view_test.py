@@ -207,8 +207,9 @@ def main():
 def make_driver():
     options = webdriver.ChromeOptions()
     options.binary_location = "/usr/bin/chromium"
-    for a in ["--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1500,1250",
-              "--disable-dev-shm-usage"]:
+    # WebGL 2 (the 3D lobe) through SwiftShader, Chromium's software renderer.
+    for a in ["--headless=new", "--no-sandbox", "--use-angle=swiftshader",
+              "--enable-unsafe-swiftshader", "--window-size=1500,1250", "--disable-dev-shm-usage"]:
         options.add_argument(a)
     return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
 
@@ -471,6 +472,46 @@ def check_anisotropic_orientation(driver):
     type_into(driver, "pose-value", "0")
 
 
+def check_lobe(driver, token):
+    """Issue 34: the 3D lobe draws every BRDF loaded, and its radii are the server's ρ (a vertex's
+    value read back from the page against /api/point at its direction)."""
+    got = driver.execute_async_script("""
+        const done = arguments[arguments.length - 1], token = arguments[0];
+        const meshes = window.halfback.lobe();
+        if (!meshes.length) return done({ error: 'no lobe drawn' });
+        const s = window.halfback.state, D = Math.PI / 180;
+        const wo = [Math.sin(s.to * D) * Math.cos(s.po * D), Math.sin(s.to * D) * Math.sin(s.po * D), Math.cos(s.to * D)];
+        const checks = [];
+        for (const [b, m] of meshes.entries()) {
+          let best = -1;
+          for (let k = 0; k < m.values.length; ++k) if (m.values[k] > (best < 0 ? -1 : m.values[best])) best = k;
+          for (const k of [best, (m.n * m.n) >> 1, (m.n * (m.n + 1)) >> 2]) {
+            if (!Number.isFinite(m.values[k])) continue;
+            const wi = Array.from(m.dirs.slice(3 * k, 3 * k + 3));
+            checks.push({ b, wi, value: m.values[k], brdf: [s.a, s.b][b] });
+          }
+        }
+        // Pixels that are not the background: the lobe was drawn.
+        const c = document.getElementById('lobe'), copy = document.createElement('canvas');
+        copy.width = c.width; copy.height = c.height;
+        copy.getContext('2d').drawImage(c, 0, 0);
+        const px = copy.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let drawn = 0;
+        for (let k = 0; k < px.length; k += 4) drawn += Math.abs(px[k] - 17) + Math.abs(px[k + 2] - 23) > 30;
+        Promise.all(checks.map((q) => fetch(`/api/point?wi=${q.wi.join(',')}&wo=${wo.join(',')}&brdf=${encodeURIComponent(q.brdf)}&token=${token}`)
+          .then((r) => r.json()).then((j) => { const r = j.rho[0].rgb; q.server = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2]; }))
+        ).then(() => done({ checks, drawn, brdfs: meshes.length, pixels: px.length / 4 }));
+    """, token)
+    check("error" not in got, f"the page drew a lobe ({got.get('error', '')})")
+    if "error" in got:
+        return
+    ok = all(abs(q["value"] - q["server"]) <= 2e-5 * max(1e-3, abs(q["server"])) for q in got["checks"])
+    check(ok and len(got["checks"]) >= 4,
+          f"the lobe's radii are the server's ρ ({[(round(q['value'], 6), round(q['server'], 6)) for q in got['checks']]})")
+    check(got["brdfs"] == 2 and got["drawn"] > 0.03 * got["pixels"],
+          f"the lobe shows both BRDFs ({got['brdfs']}) and covers the canvas ({got['drawn']} of {got['pixels']} pixels)")
+
+
 def browser_checks(args, base, token, spec):
     driver = make_driver()
     driver.set_script_timeout(300)
@@ -548,6 +589,10 @@ def browser_checks(args, base, token, spec):
         legend = driver.find_element(By.ID, "polar").text
         check(spec in legend and "embedded:pink-felt" in legend,
               f"the polar plot draws both BRDFs with their names ({legend!r})")
+        check_lobe(driver, token)
+        lobe_panel = driver.find_element(By.ID, "lobe-panel")
+        driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", lobe_panel)
+        lobe_panel.screenshot(os.path.join(args.screenshots, "view-lobe.png"))
         driver.find_element(By.ID, "polar-panel").screenshot(os.path.join(args.screenshots, "view-polar-two.png"))
         check("b=arg%3A1" in driver.current_url or "b=arg:1" in driver.current_url, "the second BRDF is in the URL")
         driver.execute_script("""const s = document.getElementById('mode');

@@ -4,6 +4,7 @@
 // listed in every parameterization (the server's numbers, the same as `halfback convert/eval`).
 import { getJson, getField, getFields, isAbort } from './api.js';
 import * as V from './views.js';
+import { LobeView, lobeMesh } from './lobe.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = Math.PI / 180;
@@ -19,7 +20,7 @@ function adaptDragSide(ms) {
 
 const state = {
   a: '', b: '', mode: 'a', az: 0, scale: 'log', levels: 'auto', to: 45, po: 180,
-  hemi: 'rho', env: 'sky', exposure: 0, polar: 'linear', pose: 0,
+  hemi: 'rho', env: 'sky', exposure: 0, polar: 'linear', pose: 0, lobe: 'rho', lobeScale: 'linear',
 };
 let info = null;
 let cursor = null;      // the last /api/point answer
@@ -103,7 +104,7 @@ const spheres = new Set();  // the progressive renders, apart: they run for seco
 async function spheresDone() {
   while (spheres.size) await Promise.allSettled([...spheres]);
 }
-window.halfback = { state, stats, idle, spheresDone, cursor: () => cursor };
+window.halfback = { state, stats, idle, spheresDone, cursor: () => cursor, lobe: () => lobeData };
 
 const specs = () => (state.b && state.mode !== 'a' ? [state.a, state.b] : [state.a]);
 const formInfo = (space) => info.forms.find((f) => f.space === space);
@@ -305,6 +306,33 @@ function hoverWi(e) {
   const d = V.diskDirection(u, v);
   if (!d) return;
   setCursor([['wi', d.join(',')], ['wo', wo().join(',')]]);
+}
+
+// --- 3D lobe --------------------------------------------------------------------------------
+let lobe = null;
+let lobeData = [];  // per BRDF loaded: the lobeMesh drawn (for the test's read-back)
+const LOBE_N = 96;
+const updateLobe = coalesced(async () => {
+  if (!lobe || !lobe.available) return;
+  const list = loaded();
+  const fields = await Promise.all(list.map((s) => getField(null, '/api/hemisphere',
+    [['brdf', s], ['colour', 'rho'], ['values', 'luminance'], ['theta_o', state.to], ['phi_o', state.po],
+      ['n', LOBE_N]])));
+  const options = { cosine: state.lobe === 'cos', log: state.lobeScale === 'log' };
+  // One radius scale for all: the largest value of any BRDF shown is 1.
+  const meshes = fields.map((f) => lobeMesh(f, options));
+  const max = Math.max(...meshes.map((m) => m.max));
+  lobeData = fields.map((f) => lobeMesh(f, { ...options, max }));
+  lobe.set(lobeData.map((mesh, b) => ({ mesh, colour: hexColour(COLOURS[b]) })), wo());
+});
+const hexColour = (hex) => [1, 3, 5].map((k) => parseInt(hex.slice(k, k + 2), 16) / 255);
+function setupLobe() {
+  lobe = new LobeView($('lobe'));
+  if (!lobe.available) $('lobe-note').textContent = 'This browser has no WebGL 2: no 3D lobe.';
+  $('lobe-radius').addEventListener('change', (e) => { state.lobe = e.target.value; writeHash(); track(updateLobe()); });
+  $('lobe-scale').addEventListener('change', (e) => { state.lobeScale = e.target.value; writeHash(); track(updateLobe()); });
+  $('lobe-radius').value = state.lobe;
+  $('lobe-scale').value = state.lobeScale;
 }
 
 // --- polar plot ------------------------------------------------------------------------------
@@ -598,6 +626,9 @@ function changed({ slices = true, sphere = true, sliders = false } = {}) {
   if (slices) track(updateSlices());
   track(updateHemisphere());
   track(updatePolar());
+  // The lobe follows at rest only (refineSoon): with a software WebGL (no GPU) a drag would
+  // redraw it at each step and halve the other views' rate.
+  if (!interactive) track(updateLobe());
   if (sphere === true) restartSphere();
   if (sphere === 'stale') sphereStale = true;
   if (sliders || sphere === true) track(showPoseControl());
@@ -613,6 +644,7 @@ function refineSoon() {
     track(updateSlices());
     track(updateHemisphere());
     track(updatePolar());
+    track(updateLobe());
     if (sphereStale) {  // a model's parameters moved: its anisotropy may have changed too
       sphereStale = false;
       restartSphere();
@@ -716,6 +748,7 @@ function setup() {
   $('exposure').addEventListener('input', (e) => { state.exposure = Number(e.target.value); writeHash(); redrawSpheres(); });
   setupHemisphere();
   setupTypedAngles();
+  setupLobe();
   setupPolar();
   setupExports();
 }
@@ -731,6 +764,7 @@ function download(name, blob) {
 function targetCanvases(target) {
   if (target === 'slices') return info.forms.map((f) => sliceCanvases[f.space]);
   if (target === 'hemisphere') return [$('hemisphere')];
+  if (target === 'lobe') return [$('lobe')];
   return [...document.querySelectorAll('#spheres canvas')];
 }
 function combined(canvases) {
