@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "fields.hpp"
+#include "halfback/brdf/albedo.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/loader/load.hpp"
 #include "json.hpp"
@@ -294,6 +295,30 @@ TEST(ViewApi, SlicesAtAnotherPoseOfAnAnisotropicBrdf) {
   EXPECT_TRUE(same(slice(kSpec, "57"), slice(kSpec, "0")));
   EXPECT_TRUE(
       has_error(api.handle(get("/api/slices", {{"brdf", kSpec}, {"pose", "400"}})), 400, "pose"));
+}
+
+// /api/albedo: the estimates `halfback info` prints (directional_albedo, same seed), at angles
+// from 0° to 89°; Lambert's is its albedo; bounded sizes.
+TEST(ViewApi, AlbedoCurveIsTheLibrarysEstimate) {
+  Api api(config());
+  const auto albedo = [&](std::vector<std::pair<std::string, std::string>> q) {
+    return api.handle(get("/api/albedo", std::move(q)));
+  };
+  const Response r = albedo({{"brdf", kSpec}, {"angles", "4"}, {"n", "16"}});
+  ASSERT_EQ(r.status, 200) << r.body;
+  const double t = 89.0 / 3 * (std::numbers::pi / 180);  // the second angle, as the server
+  const AlbedoEstimate e = directional_albedo(*load_brdf(kSpec), {std::sin(t), 0, std::cos(t)}, 16);
+  EXPECT_NE(r.body.find("\"theta_deg\":[0,29.666666666666668,59.333333333333336,89]"),
+            std::string::npos)
+      << r.body;
+  EXPECT_NE(r.body.find(fmt::format("[{:.17g},{:.17g},{:.17g}]", e.mean.r, e.mean.g, e.mean.b)),
+            std::string::npos)
+      << r.body;
+  const Response lambert = albedo({{"brdf", "lambert:albedo=0.3"}, {"angles", "2"}});
+  EXPECT_NE(lambert.body.find("\"albedo\":[[0.3"), std::string::npos) << lambert.body;
+  EXPECT_TRUE(has_error(albedo({{"brdf", kSpec}, {"angles", "1"}}), 400, "angles"));
+  EXPECT_TRUE(has_error(albedo({{"brdf", kSpec}, {"n", "100000"}}), 400, "'n'"));
+  EXPECT_TRUE(has_error(albedo({}), 400, "brdf"));
 }
 
 std::string header_of(const Response& r, std::string_view name) {

@@ -10,6 +10,7 @@
 #include <span>
 
 #include "fields.hpp"
+#include "halfback/brdf/albedo.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
@@ -312,6 +313,45 @@ Response polar_response(const Catalog& catalog, const Request& request) {
   curve("in_plane", c.in_plane);
   curve("across", c.across);
   w.end_object();
+  return json(w);
+}
+
+Response albedo_response(const Catalog& catalog, const Request& request, int threads) {
+  const std::size_t angles = whole(request, "angles", 90, 2, kMaxAlbedoAngles);  // 0°, 1°, …, 89°
+  const int n = int(whole(request, "n", 64, 1, kMaxAlbedoSamples));
+  const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
+  // θi from 0° to 89° (90° itself grazes: the cosine-weighted integral is 0 there for most BRDFs
+  // and undefined for measured ones), each estimate the one `halfback info` prints (same seed).
+  std::vector<double> theta(angles);
+  std::vector<AlbedoEstimate> a(angles);
+  for (std::size_t k = 0; k < angles; ++k) theta[k] = 89.0 * double(k) / double(angles - 1);
+  parallel_for(
+      angles, 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) {
+          const double t = theta[k] * kDegree;
+          a[k] = directional_albedo(*brdf, {std::sin(t), 0, std::cos(t)}, n);
+        }
+      },
+      threads);
+  JsonWriter w;
+  w.begin_object().field("brdf", brdf->name()).field("samples", n * n);
+  w.key("theta_deg").begin_array();
+  for (const double t : theta) w.value(t);
+  w.end_array();
+  const auto rgbs = [&](std::string_view name, auto member) {
+    w.key(name).begin_array();
+    for (const AlbedoEstimate& e : a) {
+      const Rgb& x = e.*member;
+      w.begin_array().value(x.r).value(x.g).value(x.b).end_array();
+    }
+    w.end_array();
+  };
+  rgbs("albedo", &AlbedoEstimate::mean);
+  rgbs("standard_error", &AlbedoEstimate::standard_error);
+  w.key("measured").begin_array();
+  for (const AlbedoEstimate& e : a) w.value(e.measured);
+  w.end_array().end_object();
   return json(w);
 }
 

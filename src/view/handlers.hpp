@@ -13,6 +13,7 @@ Response brdf_response(const Catalog& catalog, const Request& request);
 Response slices_response(const Catalog& catalog, const Request& request, int threads);
 Response hemisphere_response(const Catalog& catalog, const Request& request, int threads);
 Response polar_response(const Catalog& catalog, const Request& request);
+Response albedo_response(const Catalog& catalog, const Request& request, int threads);
 Response point_response(const Catalog& catalog, const Request& request);
 Response render_response(const Catalog& catalog, const Request& request, int threads);
 

@@ -512,6 +512,24 @@ def check_lobe(driver, token):
           f"the lobe shows both BRDFs ({got['brdfs']}) and covers the canvas ({got['drawn']} of {got['pixels']} pixels)")
 
 
+def check_albedo(driver, halfback):
+    """Issue 34: the albedo plot shows every BRDF loaded, and its points are `halfback info`'s."""
+    curves = driver.execute_script("return window.halfback.albedo();")
+    specs = driver.execute_script("const s = window.halfback.state; return [s.a, s.b].filter(Boolean);")
+    check(len(curves) == len(specs) == 2, f"the albedo plot has a curve per BRDF ({len(curves)})")
+    legend = driver.find_element(By.ID, "albedo").text
+    check(all(s in legend for s in ["ggx:alpha=0.3,f0=0.9", "embedded:pink-felt"]),
+          f"the albedo plot names the BRDFs ({legend!r})")
+    text = subprocess.run([halfback, "info", "--albedo-samples", "64", "ggx:alpha=0.3,f0=0.9"],
+                          capture_output=True, text=True, check=True).stdout
+    cli = {float(m.group(1)): [float(v) for v in m.group(2).split(", ")]
+           for m in re.finditer(r"albedo at θi = ([0-9.]+)°: +([-0-9.e, ]+?)  ", text)}
+    page = {t: a for t, a in zip(curves[0]["theta_deg"], curves[0]["albedo"])}
+    pairs = [(page[t], cli[t]) for t in cli if t in page]
+    check(len(pairs) == 4 and all(close(p, c, 1e-5) for pp, cc in pairs for p, c in zip(pp, cc)),
+          f"the albedo curve's points are halfback info's ({pairs})")
+
+
 def browser_checks(args, base, token, spec):
     driver = make_driver()
     driver.set_script_timeout(300)
@@ -590,6 +608,10 @@ def browser_checks(args, base, token, spec):
         check(spec in legend and "embedded:pink-felt" in legend,
               f"the polar plot draws both BRDFs with their names ({legend!r})")
         check_lobe(driver, token)
+        check_albedo(driver, args.halfback)
+        albedo_panel = driver.find_element(By.ID, "albedo-panel")
+        driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", albedo_panel)
+        albedo_panel.screenshot(os.path.join(args.screenshots, "view-albedo.png"))
         lobe_panel = driver.find_element(By.ID, "lobe-panel")
         driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", lobe_panel)
         lobe_panel.screenshot(os.path.join(args.screenshots, "view-lobe.png"))

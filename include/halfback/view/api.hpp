@@ -29,6 +29,9 @@ inline constexpr std::size_t kMaxTargetBytes = 8192;   // path + query
 inline constexpr std::size_t kMaxSpecBytes = 1024;     // one BRDF or environment spec
 inline constexpr std::size_t kMaxGridSide = 512;       // slice and hemisphere side
 inline constexpr std::size_t kMaxPolarSamples = 2001;  // polar plot samples per curve
+// The albedo plot: angles θi (from 0° to 89°) and samples per axis of each estimate (n², as
+// `halfback info --albedo-samples`): at the limits 181 × 256² ≈ 12 M evaluations a request.
+inline constexpr std::size_t kMaxAlbedoAngles = 181, kMaxAlbedoSamples = 256;
 inline constexpr int kMaxRenderSide = 512;             // sphere render side
 inline constexpr int kMaxRenderSpp = 64;               // samples per pixel of one pass
 inline constexpr std::size_t kMaxBrdfsPerRequest = 8;  // brdf= repeated in /api/point

@@ -104,7 +104,7 @@ const spheres = new Set();  // the progressive renders, apart: they run for seco
 async function spheresDone() {
   while (spheres.size) await Promise.allSettled([...spheres]);
 }
-window.halfback = { state, stats, idle, spheresDone, cursor: () => cursor, lobe: () => lobeData };
+window.halfback = { state, stats, idle, spheresDone, cursor: () => cursor, lobe: () => lobeData, albedo: () => albedoCurves };
 
 const specs = () => (state.b && state.mode !== 'a' ? [state.a, state.b] : [state.a]);
 const formInfo = (space) => info.forms.find((f) => f.space === space);
@@ -334,6 +334,14 @@ function setupLobe() {
   $('lobe-radius').value = state.lobe;
   $('lobe-scale').value = state.lobeScale;
 }
+
+// --- albedo plot ------------------------------------------------------------------------------
+let albedoCurves = [];  // per BRDF loaded: the /api/albedo answer
+const updateAlbedo = coalesced(async () => {
+  const list = loaded();
+  albedoCurves = await Promise.all(list.map((s) => getJson('albedo-' + s, '/api/albedo', [['brdf', s], ['n', 64]])));
+  V.drawAlbedo($('albedo'), albedoCurves, COLOURS, list.map(specLabel));
+});
 
 // --- polar plot ------------------------------------------------------------------------------
 let polarCurves = [];
@@ -629,7 +637,10 @@ function changed({ slices = true, sphere = true, sliders = false } = {}) {
   // The lobe follows at rest only (refineSoon): with a software WebGL (no GPU) a drag would
   // redraw it at each step and halve the other views' rate.
   if (!interactive) track(updateLobe());
-  if (sphere === true) restartSphere();
+  if (sphere === true) {  // a BRDF changed: the views that do not depend on ωo too
+    restartSphere();
+    track(updateAlbedo());
+  }
   if (sphere === 'stale') sphereStale = true;
   if (sliders || sphere === true) track(showPoseControl());
   if (sliders) buildSliders();
@@ -648,6 +659,7 @@ function refineSoon() {
     if (sphereStale) {  // a model's parameters moved: its anisotropy may have changed too
       sphereStale = false;
       restartSphere();
+      track(updateAlbedo());
       track(showPoseControl());
     }
   }, 250);
@@ -789,8 +801,8 @@ function setupExports() {
 }
 function exportView(target, kind) {
   const name = `halfback-${target}`;
-  if (target === 'polar') {
-    const text = new XMLSerializer().serializeToString($('polar'));
+  if (target === 'polar' || target === 'albedo') {
+    const text = new XMLSerializer().serializeToString($(target));
     if (kind === 'SVG') return download(`${name}.svg`, new Blob([text], { type: 'image/svg+xml' }));
     const img = new Image();
     img.onload = () => {

@@ -409,3 +409,43 @@ export function canvasSvg(canvases, titles) {
   });
   return `<svg xmlns="http://www.w3.org/2000/svg" width="${w}" height="${h}">${body}</svg>`;
 }
+
+// The albedo plot: per BRDF, the luminance of its directional albedo against θi (degrees), with
+// a band of ±2 standard errors; axes ticked; a legend; the dashed line at 1.
+export function drawAlbedo(svg, curves, colours, names) {
+  svg.replaceChildren();
+  const W = 460, H = 270, left = 48, right = 12, top = 12, bottom = 40;
+  const lumOf = (v) => 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
+  let ymax = 0;
+  for (const c of curves) c.albedo.forEach((a, k) => { ymax = Math.max(ymax, lumOf(a) + 2 * lumOf(c.standard_error[k])); });
+  const step = niceStep(Math.max(ymax, 0.05) / 4);
+  ymax = Math.ceil(Math.max(ymax, 0.05) / step) * step;
+  const x = (deg) => left + (W - left - right) * deg / 90, y = (v) => top + (H - top - bottom) * (1 - v / ymax);
+  svg.append(el('rect', { x: left, y: top, width: W - left - right, height: H - top - bottom, fill: '#111217' }));
+  for (let d = 0; d <= 90; d += 15) {
+    svg.append(el('line', { x1: x(d), x2: x(d), y1: y(0), y2: y(0) + 4, stroke: '#6a6d7a' }));
+    svg.append(text(`${d}°`, { x: x(d), y: y(0) + 15, 'text-anchor': 'middle' }));
+  }
+  for (let v = 0; v <= ymax + 1e-9 * step; v += step) {
+    svg.append(el('line', { x1: left, x2: W - right, y1: y(v), y2: y(v), stroke: '#262932' }));
+    svg.append(text(shortNumber(Number(v.toPrecision(6))), { x: left - 6, y: y(v) + 3, 'text-anchor': 'end' }));
+  }
+  if (ymax >= 1) svg.append(el('line', { x1: left, x2: W - right, y1: y(1), y2: y(1), stroke: '#9a9cab', 'stroke-dasharray': '4 3' }));
+  svg.append(text('θi', { x: (left + W - right) / 2, y: H - 6, 'text-anchor': 'middle', fill: '#e6e6ea' }));
+  svg.append(text('albedo', { x: 0, y: 0, 'text-anchor': 'middle', fill: '#e6e6ea', transform: `translate(12 ${(top + H - bottom) / 2}) rotate(-90)` }));
+  curves.forEach((c, b) => {
+    const lum = c.albedo.map(lumOf), se = c.standard_error.map(lumOf);
+    const finite = (k) => Number.isFinite(lum[k]);
+    let band = '', line = '';
+    c.theta_deg.forEach((t, k) => { if (finite(k)) line += `${line ? 'L' : 'M'}${x(t).toFixed(2)},${y(lum[k]).toFixed(2)} `; });
+    c.theta_deg.forEach((t, k) => { if (finite(k)) band += `${band ? 'L' : 'M'}${x(t).toFixed(2)},${y(Math.min(ymax, lum[k] + 2 * se[k])).toFixed(2)} `; });
+    [...c.theta_deg].reverse().forEach((t, r) => {
+      const k = c.theta_deg.length - 1 - r;
+      if (finite(k)) band += `L${x(t).toFixed(2)},${y(Math.max(0, lum[k] - 2 * se[k])).toFixed(2)} `;
+    });
+    svg.append(el('path', { d: `${band}Z`, fill: colours[b], 'fill-opacity': 0.25, stroke: 'none' }));
+    svg.append(el('path', { d: line, fill: 'none', stroke: colours[b], 'stroke-width': 2 }));
+    svg.append(el('line', { x1: left + 8, x2: left + 26, y1: top + 12 + 14 * b, y2: top + 12 + 14 * b, stroke: colours[b], 'stroke-width': 2 }));
+    svg.append(text(names[b] || c.brdf, { x: left + 30, y: top + 16 + 14 * b, fill: '#e6e6ea' }));
+  });
+}
