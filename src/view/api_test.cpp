@@ -80,6 +80,24 @@ TEST(ViewApi, TokenIsRequiredFromQueryOrCookie) {
   EXPECT_EQ(api.handle(r).status, 403);
 }
 
+// Every endpoint refuses a request without the token, from a foreign Origin or to a foreign Host
+// (the checks come before the routing; a new endpoint is listed here).
+TEST(ViewApi, EveryEndpointChecksTokenOriginAndHost) {
+  Api api(config());
+  for (const char* path : {"/api/info", "/api/brdf", "/api/slices", "/api/hemisphere",
+                           "/api/polar", "/api/point", "/api/render", "/api/albedo"}) {
+    Request r = get(path, {{"brdf", "arg:0"}});
+    r.query.pop_back();  // the token
+    EXPECT_TRUE(has_error(api.handle(r), 403, "token")) << path;
+    Request origin = get(path, {{"brdf", "arg:0"}});
+    origin.headers["origin"] = "http://evil.example";
+    EXPECT_EQ(api.handle(origin).status, 403) << path;
+    Request host = get(path, {{"brdf", "arg:0"}});
+    host.headers["host"] = fmt::format("evil.example:{}", kPort);
+    EXPECT_EQ(api.handle(host).status, 403) << path;
+  }
+}
+
 TEST(ViewApi, EmptyConfiguredTokenRefusesEverything) {
   ApiConfig c = config();
   c.token.clear();
