@@ -475,6 +475,8 @@ def check_anisotropic_orientation(driver):
 def check_lobe(driver, token):
     """Issue 34: the 3D lobe draws every BRDF loaded, and its radii are the server's ρ (a vertex's
     value read back from the page against /api/point at its direction)."""
+    time.sleep(0.4)  # the views that follow at rest (the lobe) after the last move
+    wait_idle(driver)
     got = driver.execute_async_script("""
         const done = arguments[arguments.length - 1], token = arguments[0];
         const meshes = window.halfback.lobe();
@@ -488,7 +490,7 @@ def check_lobe(driver, token):
           for (const k of [best, (m.n * m.n) >> 1, (m.n * (m.n + 1)) >> 2]) {
             if (!Number.isFinite(m.values[k])) continue;
             const wi = Array.from(m.dirs.slice(3 * k, 3 * k + 3));
-            checks.push({ b, wi, value: m.values[k], brdf: [s.a, s.b][b] });
+            checks.push({ b, wi, value: m.values[k], brdf: [s.a, s.b, ...s.more].filter(Boolean)[b] });
           }
         }
         // Pixels that are not the background: the lobe was drawn.
@@ -500,7 +502,8 @@ def check_lobe(driver, token):
         for (let k = 0; k < px.length; k += 4) drawn += Math.abs(px[k] - 17) + Math.abs(px[k + 2] - 23) > 30;
         Promise.all(checks.map((q) => fetch(`/api/point?wi=${q.wi.join(',')}&wo=${wo.join(',')}&brdf=${encodeURIComponent(q.brdf)}&token=${token}`)
           .then((r) => r.json()).then((j) => { const r = j.rho[0].rgb; q.server = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2]; }))
-        ).then(() => done({ checks, drawn, brdfs: meshes.length, pixels: px.length / 4 }));
+        ).then(() => done({ checks, drawn, brdfs: meshes.length, pixels: px.length / 4 }),
+               (e) => done({ error: String(e) }));
     """, token)
     check("error" not in got, f"the page drew a lobe ({got.get('error', '')})")
     if "error" in got:
@@ -528,6 +531,35 @@ def check_albedo(driver, halfback):
     pairs = [(page[t], cli[t]) for t in cli if t in page]
     check(len(pairs) == 4 and all(close(p, c, 1e-5) for pp, cc in pairs for p, c in zip(pp, cc)),
           f"the albedo curve's points are halfback info's ({pairs})")
+
+
+def check_three_brdfs(driver):
+    """Issue 34: a measured file, a neural BRDF and a model at once: every plot shows the three
+    with their names; removing one takes it out of every plot."""
+    third = "embedded:acrylic_felt_green"
+    driver.execute_async_script("window.halfback.addBrdf(arguments[0]).then(arguments[1]);", third)
+    wait_idle(driver)
+    driver.execute_async_script("window.halfback.spheresDone().then(arguments[0]);")
+    names = ["ggx:alpha=0.3,f0=0.9", "embedded:pink-felt", third]
+    for plot in ["polar", "albedo", "more"]:
+        text = driver.find_element(By.ID, plot).text
+        shown = [n for n in names if n in text]
+        check(third in shown and (plot == "more" or len(shown) == 3),
+              f"the {plot} legend names the BRDFs shown ({shown})")
+    lobes = driver.execute_script("return window.halfback.lobe().length;")
+    spheres = driver.find_elements(By.CSS_SELECTOR, "#spheres figure")
+    check(lobes == 3 and len(spheres) == 3, f"three lobes ({lobes}) and three spheres ({len(spheres)})")
+    hemi = driver.find_element(By.ID, "hemisphere")
+    driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", hemi)
+    ActionChains(driver).move_to_element_with_offset(hemi, 20, -10).perform()  # hover: a cursor
+    wait_idle(driver)
+    rows = driver.find_elements(By.CSS_SELECTOR, "#cursor td[id^='cur-rho-'][id$='-r']")
+    check(len(rows) == 3, f"the configuration lists ρ of the three BRDFs ({len(rows)})")
+    driver.find_element(By.CSS_SELECTOR, "#more .chip button").click()
+    wait_idle(driver)
+    text = driver.find_element(By.ID, "polar").text
+    check(third not in text and driver.execute_script("return window.halfback.state.more.length;") == 0,
+          "the × of a chip removes that BRDF from the plots")
 
 
 def browser_checks(args, base, token, spec):
@@ -607,6 +639,7 @@ def browser_checks(args, base, token, spec):
         legend = driver.find_element(By.ID, "polar").text
         check(spec in legend and "embedded:pink-felt" in legend,
               f"the polar plot draws both BRDFs with their names ({legend!r})")
+        check_three_brdfs(driver)
         check_lobe(driver, token)
         check_albedo(driver, args.halfback)
         albedo_panel = driver.find_element(By.ID, "albedo-panel")

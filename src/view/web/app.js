@@ -8,7 +8,9 @@ import { LobeView, lobeMesh } from './lobe.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = Math.PI / 180;
-const COLOURS = ['#ff9a3c', '#3cc8ff'];
+// One colour per BRDF shown, in the order of loaded(): the first, the compare one, the others.
+const COLOURS = ['#ff9a3c', '#3cc8ff', '#9be37a', '#e879f9', '#f7d154', '#ff6b6b', '#a0a4ff', '#5eead4'];
+const MAX_MORE = COLOURS.length - 2;  // BRDFs added beside the first and the compare one
 const FULL = 256, DRAG = 128;  // slice resolution at rest and (at most) while dragging
 // While a slider moves, the slices' side adapts (64 … 128): smaller when an update (request and
 // drawing) took longer than 45 ms, larger again below 25 ms.
@@ -21,6 +23,7 @@ function adaptDragSide(ms) {
 const state = {
   a: '', b: '', mode: 'a', az: 0, scale: 'log', levels: 'auto', to: 45, po: 180,
   hemi: 'rho', env: 'sky', exposure: 0, polar: 'linear', pose: 0, lobe: 'rho', lobeScale: 'linear',
+  more: [],  // further BRDFs, drawn in the plots (not in the slices, which show one or a pair)
 };
 let info = null;
 let cursor = null;      // the last /api/point answer
@@ -36,7 +39,8 @@ function readHash() {
   const h = new URLSearchParams(location.hash.slice(1));
   for (const k of Object.keys(state)) {
     if (!h.has(k)) continue;
-    state[k] = typeof state[k] === 'number' ? Number(h.get(k)) : h.get(k);
+    if (Array.isArray(state[k])) state[k] = h.getAll(k).filter(Boolean).slice(0, MAX_MORE);
+    else state[k] = typeof state[k] === 'number' ? Number(h.get(k)) : h.get(k);
   }
 }
 // At most ten writes a second (the last one always made): a moving slider sends ~60 input events
@@ -51,7 +55,10 @@ function writeHash() {
   }
   lastHashWrite = performance.now();
   const h = new URLSearchParams();
-  for (const [k, v] of Object.entries(state)) h.set(k, String(v));
+  for (const [k, v] of Object.entries(state)) {
+    if (Array.isArray(v)) v.forEach((x) => h.append(k, x));
+    else h.set(k, String(v));
+  }
   history.replaceState(null, '', `${location.pathname}${location.search}#${h}`);
 }
 
@@ -104,11 +111,13 @@ const spheres = new Set();  // the progressive renders, apart: they run for seco
 async function spheresDone() {
   while (spheres.size) await Promise.allSettled([...spheres]);
 }
-window.halfback = { state, stats, idle, spheresDone, cursor: () => cursor, lobe: () => lobeData, albedo: () => albedoCurves };
+window.halfback = { addBrdf, state, stats, idle, spheresDone, cursor: () => cursor, lobe: () => lobeData, albedo: () => albedoCurves };
 
 const specs = () => (state.b && state.mode !== 'a' ? [state.a, state.b] : [state.a]);
 const formInfo = (space) => info.forms.find((f) => f.space === space);
-const loaded = () => [state.a, state.b].filter(Boolean);  // every BRDF loaded, whatever the mode
+const loaded = () => [state.a, state.b, ...state.more].filter(Boolean);  // every BRDF shown
+// style.css has the classes swatch-0 … swatch-7 in COLOURS (the page's policy forbids inline styles).
+const swatch = (b) => `<span class="swatch-${b}">■</span>`;
 
 // --- slices ---------------------------------------------------------------------------------
 const sliceCanvases = {};
@@ -377,13 +386,12 @@ function restartSphere() {
   const gen = ++sphereGeneration;
   const box = $('spheres');
   box.replaceChildren();
-  const list = state.b ? [state.a, state.b] : [state.a];
-  list.forEach((s, b) => {
+  loaded().forEach((s, b) => {
     const fig = document.createElement('figure');
     const canvas = document.createElement('canvas');
     canvas.id = `sphere-${b}`;
     const cap = document.createElement('figcaption');
-    cap.innerHTML = `<span class="swatch-${b ? 'b' : 'a'}">■</span> ${escapeHtml(specLabel(s))}`;
+    cap.innerHTML = `${swatch(b)} ${escapeHtml(specLabel(s))}`;
     fig.append(canvas, cap);
     box.append(fig);
     const p = sphereLoop(gen, s, b, canvas).catch((e) => { if (!isAbort(e)) setStatus(e.message, true); })
@@ -414,7 +422,7 @@ function redrawSpheres() {
 
 // --- the linked cursor -----------------------------------------------------------------------
 async function setCursor(params) {
-  const brdfs = (state.b ? [state.a, state.b] : [state.a]).map((s) => ['brdf', s]);
+  const brdfs = loaded().map((s) => ['brdf', s]);
   return track((async () => {
     cursor = await getJson('point', '/api/point', [...params, ...brdfs]);
     showCursor();
@@ -440,7 +448,7 @@ function showCursor() {
   }
   html += heading('ρ', ['r', 'g', 'b'], ['sr⁻¹', 'sr⁻¹', 'sr⁻¹']);
   c.rho.forEach((r, b) => {
-    html += row(`<span class="swatch-${b ? 'b' : 'a'}">ρ</span> ${escapeHtml(specLabel(r.brdf))}`, ['r', 'g', 'b'], r.rgb, `rho-${b}`);
+    html += row(`${swatch(b)} ρ ${escapeHtml(specLabel(r.brdf))}`, ['r', 'g', 'b'], r.rgb, `rho-${b}`);
   });
   $('cursor').innerHTML = `${html}</table>`;
 }
@@ -708,6 +716,30 @@ function setPose(degrees) {
   track(showPoseControl());
 }
 
+// The BRDFs added to the plots: a chip each (its colour, its name, × to remove it).
+function showMore() {
+  const box = $('more');
+  box.replaceChildren();
+  state.more.forEach((spec, k) => {
+    const chip = Object.assign(document.createElement('span'), { className: 'chip' });
+    chip.innerHTML = `${swatch(loaded().indexOf(spec))} ${escapeHtml(specLabel(spec))}`;
+    const x = Object.assign(document.createElement('button'), { type: 'button', textContent: '×', title: 'remove from the plots' });
+    x.addEventListener('click', () => { state.more.splice(k, 1); showMore(); changed(); });
+    chip.append(x);
+    box.append(chip);
+  });
+}
+function addBrdf(spec) {
+  if (loaded().includes(spec)) return setStatus(`${spec} is already shown`);
+  if (state.more.length >= MAX_MORE) return setStatus(`at most ${COLOURS.length} BRDFs at once`, true);
+  return getJson(null, '/api/brdf', [['brdf', spec]]).then((r) => {
+    state.more.push(spec);
+    setStatus(`added ${r.name}`);
+    showMore();
+    changed();
+  }).catch((err) => setStatus(err.message, true));
+}
+
 function setAzimuth(degrees) {
   state.az = degrees;
   $('azimuth').value = degrees;
@@ -725,6 +757,10 @@ function setup() {
     changed();
   });
   $('mode').addEventListener('change', (e) => { state.mode = e.target.value; changed({ sphere: false }); });
+  $('add-brdf').addEventListener('click', () => {
+    const spec = $('load-spec').value.trim();
+    if (spec) addBrdf(spec);
+  });
   $('load-form').addEventListener('submit', (e) => {
     e.preventDefault();
     const spec = $('load-spec').value.trim();
@@ -848,6 +884,7 @@ async function main() {
   $('exposure').value = state.exposure;
   buildSlices();
   setup();
+  showMore();
   changed({ sliders: true });
   setStatus('ready');
 }
