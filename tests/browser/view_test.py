@@ -582,6 +582,7 @@ def browser_checks(args, base, token, spec):
         check(f"az={az:g}" in driver.current_url, "the azimuth is in the page's URL")
         # Drag on the hemisphere: ωo moves.
         hemi = driver.find_element(By.ID, "hemisphere")
+        driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", hemi)
         before = driver.execute_script("return [window.halfback.state.to, window.halfback.state.po];")
         w = hemi.size["width"]
         ActionChains(driver).move_to_element_with_offset(hemi, -w // 3, w // 6).click_and_hold() \
@@ -593,12 +594,14 @@ def browser_checks(args, base, token, spec):
         wait_idle(driver)
         # Hover a slice: the listed numbers against the CLI.
         sl = driver.find_element(By.ID, "slice-halfdiff")
+        driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", sl)
         ActionChains(driver).move_to_element_with_offset(sl, -40, 30).perform()
         wait_idle(driver)
         check(driver.execute_script("return window.halfback.cursor() && window.halfback.cursor().valid;"),
               "hovering a slice sets a valid configuration")
         check_against_cli(driver, args.halfback, spec, "slice hover")
         # Hover the hemisphere (the pair the page computed from the pointer).
+        driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", hemi)
         ActionChains(driver).move_to_element_with_offset(hemi, w // 5, -w // 7).perform()
         wait_idle(driver)
         check_against_cli(driver, args.halfback, spec, "hemisphere hover")

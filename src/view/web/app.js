@@ -11,7 +11,16 @@ const DEG = Math.PI / 180;
 // One colour per BRDF shown, in the order of loaded(): the first, the compare one, the others.
 const COLOURS = ['#ff9a3c', '#3cc8ff', '#9be37a', '#e879f9', '#f7d154', '#ff6b6b', '#a0a4ff', '#5eead4'];
 const MAX_MORE = COLOURS.length - 2;  // BRDFs added beside the first and the compare one
-const FULL = 256, DRAG = 128;  // slice resolution at rest and (at most) while dragging
+const DRAG = 128;  // slice resolution (at most) while dragging; at rest: the side on screen
+// The slices' side on screen (CSS pixels): as large as the panel allows with at least 256 px and
+// at most 480 px each; their resolution at rest is that side in device pixels (at most 512).
+let sliceSide = 256;
+const fullSide = () => Math.min(512, Math.round(sliceSide * (window.devicePixelRatio || 1)));
+function fitSliceSide() {
+  const available = $('slices').clientWidth || 1200, axes = 48 + 12;  // axes and the gap
+  const columns = Math.max(1, Math.floor((available + 12) / (256 + axes)));
+  return Math.max(200, Math.min(480, Math.floor((available + 12) / columns) - axes - 4));
+}
 // While a slider moves, the slices' side adapts (64 … 128): smaller when an update (request and
 // drawing) took longer than 45 ms, larger again below 25 ms.
 let dragSide = DRAG;
@@ -123,14 +132,17 @@ const swatch = (b) => `<span class="swatch-${b}">■</span>`;
 const sliceCanvases = {};
 function buildSlices() {
   const box = $('slices');
+  box.replaceChildren();
+  sliceSide = fitSliceSide();
   for (const f of info.forms) {
     const div = document.createElement('div');
     div.className = 'slice';
     const canvas = document.createElement('canvas');
     canvas.id = `slice-${f.space}`;
     canvas.dataset.space = f.space;
+    canvas.style.width = canvas.style.height = `${sliceSide}px`;
     const plot = Object.assign(document.createElement('div'), { className: 'plot' });
-    plot.append(V.sliceAxes(f.axes, [plain(f.axes[0].label), plain(f.axes[1].label)]), canvas);
+    plot.append(V.sliceAxes(f.axes, [plain(f.axes[0].label), plain(f.axes[1].label)], sliceSide), canvas);
     div.append(Object.assign(document.createElement('h2'), { textContent: f.space, title: f.summary }), plot,
       Object.assign(document.createElement('span'), {
         className: 'axis',
@@ -142,12 +154,22 @@ function buildSlices() {
     canvas.addEventListener('click', (e) => pointerOnSlice(e, f, true));
   }
 }
+// A window resized: slices of the side that fits, drawn again.
+let resizeTimer = 0;
+window.addEventListener('resize', () => {
+  clearTimeout(resizeTimer);
+  resizeTimer = setTimeout(() => {
+    if (!info || fitSliceSide() === sliceSide) return;
+    buildSlices();
+    track(updateSlices());
+  }, 200);
+});
 const plain = (label) => label.replace(/_/g, '').replace(/[{}]/g, '');
 
 let sliceFields = {};  // per form: [field of the first BRDF, of the second]
 // The four forms' slices of every BRDF shown, in one request (/api/slices).
 const updateSlices = coalesced(async () => {
-  const list = specs(), moving = interactive, n = moving ? dragSide : FULL;
+  const list = specs(), moving = interactive, n = moving ? dragSide : fullSide();
   const t0 = performance.now();
   const { fields, headers } = await getFields(null, '/api/slices',
     [...list.map((s) => ['brdf', s]), ['azimuth', state.az], ['pose', state.pose], ['n', n], ['values', 'luminance']]);
@@ -207,7 +229,7 @@ const wo = () => [Math.sin(state.to * DEG) * Math.cos(state.po * DEG),
   Math.sin(state.to * DEG) * Math.sin(state.po * DEG), Math.cos(state.to * DEG)];
 let hemiField = null;
 const updateHemisphere = coalesced(async () => {
-  const n = interactive ? DRAG : FULL;
+  const n = interactive ? DRAG : 256;
   const common = [['theta_o', state.to], ['phi_o', state.po], ['n', n]];
   if (state.hemi === 'rho') {
     const fields = await Promise.all(specs().map((s) => getField(null, '/api/hemisphere',
@@ -381,7 +403,8 @@ function setupPolar() {
 
 // --- sphere ----------------------------------------------------------------------------------
 let sphereGeneration = 0;
-const SPHERE = 160, PASSES = 32, SPP = 4;
+// The spheres are rendered at their size on screen (256 CSS pixels) in device pixels: sharp.
+const SPHERE = Math.min(512, Math.round(256 * (window.devicePixelRatio || 1))), PASSES = 32, SPP = 4;
 function restartSphere() {
   const gen = ++sphereGeneration;
   const box = $('spheres');
