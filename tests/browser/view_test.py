@@ -562,6 +562,35 @@ def check_three_brdfs(driver):
           "the × of a chip removes that BRDF from the plots")
 
 
+def check_exports(driver, spec, screenshots):
+    """Issue 34: each view's export is a figure: a title naming the view and the BRDFs, the
+    pictures, axes, colour bars and legends as on the page; the SVG is valid (an image of it
+    loads) and the PNG is drawn from it (saved as view-export-*.png)."""
+    import base64
+    for target, parts in [("slices", ["<image", "relative azimuth", "luminance"]),
+                          ("hemisphere", ["<image", "θo ="]), ("polar", ["0°", "radius"]),
+                          ("lobe", ["<image"]), ("albedo", ["θi", "albedo"]),
+                          ("sphere", ["<image", "samples per pixel"])]:
+        got = driver.execute_async_script("""
+            const done = arguments[1], svg = window.halfback.figure(arguments[0]);
+            const img = new Image();
+            img.onload = () => {
+              const c = document.createElement('canvas');
+              c.width = img.width; c.height = img.height;
+              c.getContext('2d').drawImage(img, 0, 0);
+              done({ svg, png: c.toDataURL('image/png') });
+            };
+            img.onerror = () => done({ svg, png: null });
+            img.src = URL.createObjectURL(new Blob([svg], { type: 'image/svg+xml' }));""", target)
+        svg = got["svg"]
+        missing = [p for p in ["halfback view", spec] + parts if p not in svg]
+        check(not missing and got["png"], f"the {target} export is a figure (missing: {missing}, "
+              f"SVG loads: {bool(got['png'])})")
+        if got["png"]:
+            with open(os.path.join(screenshots, f"view-export-{target}.png"), "wb") as f:
+                f.write(base64.b64decode(got["png"].split(",", 1)[1]))
+
+
 def browser_checks(args, base, token, spec):
     driver = make_driver()
     driver.set_script_timeout(300)
@@ -643,6 +672,7 @@ def browser_checks(args, base, token, spec):
         check(spec in legend and "embedded:pink-felt" in legend,
               f"the polar plot draws both BRDFs with their names ({legend!r})")
         check_three_brdfs(driver)
+        check_exports(driver, spec, args.screenshots)
         check_lobe(driver, token)
         check_albedo(driver, args.halfback)
         albedo_panel = driver.find_element(By.ID, "albedo-panel")

@@ -832,21 +832,6 @@ function download(name, blob) {
   a.click();
   setTimeout(() => URL.revokeObjectURL(a.href), 1000);
 }
-function targetCanvases(target) {
-  if (target === 'slices') return info.forms.map((f) => sliceCanvases[f.space]);
-  if (target === 'hemisphere') return [$('hemisphere')];
-  if (target === 'lobe') return [$('lobe')];
-  return [...document.querySelectorAll('#spheres canvas')];
-}
-function combined(canvases) {
-  const out = document.createElement('canvas');
-  out.width = canvases.reduce((s, c) => s + c.width + 8, -8);
-  out.height = Math.max(...canvases.map((c) => c.height));
-  const ctx = out.getContext('2d');
-  let x = 0;
-  for (const c of canvases) { ctx.drawImage(c, x, 0); x += c.width + 8; }
-  return out;
-}
 function setupExports() {
   for (const span of document.querySelectorAll('.export')) {
     const target = span.dataset.target;
@@ -858,25 +843,72 @@ function setupExports() {
     }
   }
 }
-function exportView(target, kind) {
-  const name = `halfback-${target}`;
-  if (target === 'polar' || target === 'albedo') {
-    const text = new XMLSerializer().serializeToString($(target));
-    if (kind === 'SVG') return download(`${name}.svg`, new Blob([text], { type: 'image/svg+xml' }));
-    const img = new Image();
-    img.onload = () => {
-      const c = Object.assign(document.createElement('canvas'), { width: 920, height: 540 });
-      c.getContext('2d').drawImage(img, 0, 0, 920, 540);
-      c.toBlob((blob) => download(`${name}.png`, blob));
-    };
-    img.src = `data:image/svg+xml;charset=utf-8,${encodeURIComponent(text)}`;
-    return undefined;
-  }
-  const canvases = targetCanvases(target);
-  if (kind === 'PNG') return combined(canvases).toBlob((blob) => download(`${name}.png`, blob));
-  const titles = target === 'slices' ? info.forms.map((f) => f.space) : [];
-  return download(`${name}.svg`, new Blob([V.canvasSvg(canvases, titles)], { type: 'image/svg+xml' }));
+// What a figure of the view says above it: the view, the BRDFs, the state that picks the slice.
+function figureTitle(target) {
+  const names = (target === 'slices' || target === 'hemisphere' ? specs() : loaded()).map(specLabel);
+  const wo = `θo = ${state.to.toFixed(1)}°, φo = ${state.po.toFixed(1)}°`;
+  const what = {
+    slices: `slices at the relative azimuth ${state.az}°${$('pose-box').hidden ? '' : `, orientation ${state.pose}°`}`,
+    hemisphere: `hemisphere of ωi, ${wo}`, polar: `polar plot of ρ, ${wo}`, lobe: `lobe of ρ(·, ωo), ${wo}`,
+    albedo: 'directional albedo', sphere: `lit sphere, environment ${state.env}, exposure ${state.exposure}`,
+  }[target];
+  const shown = state.mode !== 'a' && state.b && (target === 'slices' || target === 'hemisphere')
+    ? `${{ b: 'second', diff: 'difference', ratio: 'ratio' }[state.mode]} of ${names.join(' and ')}` : names.join(', ');
+  return `halfback view: ${what}; ${shown}`;
 }
+// The panel as an SVG figure: its pictures (canvases), plots and colour bars (SVG) and texts
+// (headings, axis notes, captions, legends) where the page shows them, under a title; controls
+// are left out.
+function panelFigure(target) {
+  const panel = $(`${target}-panel`), box = panel.getBoundingClientRect();
+  const top = 28, parts = [];
+  const at = (e) => { const r = e.getBoundingClientRect(); return { x: r.left - box.left, y: r.top - box.top + top, w: r.width, h: r.height }; };
+  const esc = (t) => t.replace(/[&<>"]/g, (ch) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[ch]));
+  const text = (t, x, y, size, colour) => `<text x="${x}" y="${y}" font-family="sans-serif" font-size="${size}" fill="${colour}">${esc(t)}</text>`;
+  const title = figureTitle(target);
+  parts.push(text(title, 8, 18, 13, '#e6e6ea'));
+  for (const e of panel.querySelectorAll('canvas, svg, h2, .axis, figcaption, .note')) {
+    if (e.closest('svg') !== e && e.closest('svg')) continue;  // inside a plot: part of it
+    if (e.closest('.panel-head') && e.tagName !== 'H2') continue;  // controls
+    const r = at(e);
+    if (!r.w || !r.h) continue;
+    if (e.tagName === 'CANVAS') {
+      parts.push(`<image x="${r.x}" y="${r.y}" width="${r.w}" height="${r.h}" preserveAspectRatio="none" href="${e.toDataURL('image/png')}"/>`);
+    } else if (e.tagName.toLowerCase() === 'svg') {
+      const copy = e.cloneNode(true);
+      copy.setAttribute('x', r.x); copy.setAttribute('y', r.y);
+      copy.setAttribute('width', r.w); copy.setAttribute('height', r.h);
+      copy.setAttribute('overflow', 'visible');  // a colour bar's unit line is wider than its bar
+      if (!copy.getAttribute('viewBox')) copy.setAttribute('viewBox', `0 0 ${r.w} ${r.h}`);
+      parts.push(new XMLSerializer().serializeToString(copy));
+    } else if (!e.querySelector('svg, canvas')) {  // a text (a colour bar's box is drawn as its SVG)
+      parts.push(text(textOf(e).replace(/\s+/g, ' ').trim(), r.x, r.y + 12, e.tagName === 'H2' ? 13 : 11, e.tagName === 'H2' ? '#e6e6ea' : '#9a9cab'));
+    }
+  }
+  const w = Math.ceil(Math.max(box.width, 16 + 7 * title.length)), h = Math.ceil(box.height + top);
+  return { svg: `<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="${w}" height="${h}" viewBox="0 0 ${w} ${h}">`
+    + `<rect width="${w}" height="${h}" fill="#202229"/>${parts.join('')}</svg>`, w, h };
+}
+// An element's text with the values of its fields (θo = 45.0°, not θo = °).
+function textOf(e) {
+  if (e.nodeType === Node.TEXT_NODE) return e.textContent;
+  if (e.tagName === 'INPUT') return e.value;
+  if (e.tagName === 'SELECT') return e.selectedOptions[0]?.textContent || '';
+  return [...e.childNodes].map(textOf).join('');
+}
+function exportView(target, kind) {
+  const name = `halfback-${target}`, { svg, w, h } = panelFigure(target);
+  if (kind === 'SVG') return download(`${name}.svg`, new Blob([svg], { type: 'image/svg+xml' }));
+  const img = new Image();
+  img.onload = () => {  // twice the page's size
+    const c = Object.assign(document.createElement('canvas'), { width: 2 * w, height: 2 * h });
+    c.getContext('2d').drawImage(img, 0, 0, 2 * w, 2 * h);
+    c.toBlob((blob) => download(`${name}.png`, blob));
+  };
+  img.src = URL.createObjectURL(new Blob([svg], { type: 'image/svg+xml' }));
+  return undefined;
+}
+window.halfback.figure = (target) => panelFigure(target).svg;
 
 async function main() {
   readHash();

@@ -398,17 +398,6 @@ export function drawSphere(canvas, sum, passes, w, h, exposure) {
   ctx.putImageData(img, 0, 0);
 }
 
-// An SVG holding a canvas' picture (and its size), for the SVG export of raster views.
-export function canvasSvg(canvases, titles) {
-  const w = canvases.reduce((s, c) => s + c.width + 10, 0), h = Math.max(...canvases.map((c) => c.height)) + 20;
-  let x = 0, body = '';
-  canvases.forEach((c, i) => {
-    body += `<text x="${x}" y="12" font-family="sans-serif" font-size="12">${titles[i] || ''}</text>`;
-    body += `<image x="${x}" y="18" width="${c.width}" height="${c.height}" href="${c.toDataURL('image/png')}"/>`;
-    x += c.width + 10;
-  });
-  return `<svg xmlns="http://www.w3.org/2000/svg" width="${w}" height="${h}">${body}</svg>`;
-}
 
 // The albedo plot: per BRDF, the luminance of its directional albedo against θi (degrees), with
 // a band of ±2 standard errors; axes ticked; a legend; the dashed line at 1.
