@@ -57,6 +57,30 @@ Frame shading_frame(const V3& n) {
   return {t, cross(n, t), n};
 }
 
+// The sphere (unit radius, at the origin) under the camera ray through `ndc` (x right, y up,
+// x scaled by the aspect): its normal n and the direction towards the camera wo, or false when
+// the ray misses it. Orthographic: the view along −z, half-height kOrthoHalfHeight; perspective:
+// from (0, 0, kCameraDistance) with tan(fov/2) = tan_persp. One camera for every render.
+bool sphere_point(Projection projection, double ndc_x, double ndc_y, double tan_persp, V3& n,
+                  V3& wo) {
+  if (projection == Projection::orthographic) {
+    const double x = ndc_x * kOrthoHalfHeight, y = ndc_y * kOrthoHalfHeight;
+    const double r2 = x * x + y * y;
+    if (r2 >= 1) return false;
+    n = {x, y, std::sqrt(1 - r2)};
+    wo = {0, 0, 1};
+    return true;
+  }
+  const V3 d = normalize({ndc_x * tan_persp, ndc_y * tan_persp, -1});
+  const V3 o{0, 0, kCameraDistance};
+  const double b = dot(o, d), c = dot(o, o) - 1, disc = b * b - c;
+  if (disc <= 0) return false;
+  const double t = -b - std::sqrt(disc);
+  n = normalize({o.x + t * d.x, o.y + t * d.y, o.z + t * d.z});
+  wo = {-d.x, -d.y, -d.z};
+  return true;
+}
+
 // The MIS weight over the strategy's density, w(a, b)/a, with one division: 1/(a + b) for the
 // balance heuristic, a/(a² + b²) for the power heuristic (the ratio form where the squares
 // would overflow or vanish), 1/a when the other density is 0.
@@ -197,28 +221,13 @@ class Renderer {
       const double ndc_x = ((px + jx) * two_over_width_ - 1) * aspect_;
       const double ndc_y = 1 - (py + jy) * two_over_height_;
       V3 n, wo;
-      if (s_.projection == Projection::orthographic) {
-        const double x = ndc_x * kOrthoHalfHeight, y = ndc_y * kOrthoHalfHeight;
-        const double r2 = x * x + y * y;
-        if (r2 >= 1) {
-          bg.dir[bg.size] = normalize({ndc_x * tan_bg_, ndc_y * tan_bg_, -1});
-          bg.sample[bg.size++] = k;
-          continue;
-        }
-        n = {x, y, std::sqrt(1 - r2)};
-        wo = {0, 0, 1};
-      } else {
-        const V3 d = normalize({ndc_x * tan_persp_, ndc_y * tan_persp_, -1});
-        const V3 o{0, 0, kCameraDistance};
-        const double b = dot(o, d), c = dot(o, o) - 1, disc = b * b - c;
-        if (disc <= 0) {
-          bg.dir[bg.size] = d;
-          bg.sample[bg.size++] = k;
-          continue;
-        }
-        const double t = -b - std::sqrt(disc);
-        n = normalize({o.x + t * d.x, o.y + t * d.y, o.z + t * d.z});
-        wo = {-d.x, -d.y, -d.z};
+      if (!sphere_point(s_.projection, ndc_x, ndc_y, tan_persp_, n, wo)) {
+        // The background: the orthographic view shows it through a field of view of its own.
+        const bool ortho = s_.projection == Projection::orthographic;
+        const double t = ortho ? tan_bg_ : tan_persp_;
+        bg.dir[bg.size] = normalize({ndc_x * t, ndc_y * t, -1});
+        bg.sample[bg.size++] = k;
+        continue;
       }
       p.frame[k] = shading_frame(n);
       p.wo[k] = p.frame[k].to_local(wo);
@@ -467,6 +476,54 @@ RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& s
 RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSettings& s) {
   validate(s);
   return render_passes(brdf, env, s, Clock::now());
+}
+
+RenderResult render_point_light(const Brdf& brdf, const Vec3<double>& light,
+                                const RenderSettings& s) {
+  validate(s);
+  const double length = std::sqrt(dot(light, light));
+  if (!std::isfinite(length) || std::abs(length - 1) > 1e-6)
+    throw std::invalid_argument("render: the light's direction must be a finite unit vector");
+  const auto start = Clock::now();
+  const int k = std::max(1, int(std::sqrt(double(s.spp))));  // k × k positions in each pixel
+  const double aspect = double(s.width) / s.height;
+  const double tan_persp = std::tan(0.5 * kPerspectiveFov * kPi / 180);
+  RenderResult r;
+  r.image.width = s.width;
+  r.image.height = s.height;
+  r.image.rgb.assign(3 * std::size_t(s.width) * std::size_t(s.height), 0.0f);
+  parallel_for(
+      std::size_t(s.height), 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t py = begin; py < end; ++py)
+          for (int px = 0; px < s.width; ++px) {
+            Rgb sum;
+            for (int j = 0; j < k; ++j)
+              for (int i = 0; i < k; ++i) {
+                const double ndc_x = ((px + (i + 0.5) / k) * 2.0 / s.width - 1) * aspect;
+                const double ndc_y = 1 - (double(py) + (j + 0.5) / k) * 2.0 / s.height;
+                V3 n, wo;
+                if (!sphere_point(s.projection, ndc_x, ndc_y, tan_persp, n, wo)) continue;
+                const Frame f = shading_frame(n);
+                const DirPair<double> pair{f.to_local(light), f.to_local(wo)};
+                if (!(pair.wi.z > 0 && pair.wo.z > 0)) continue;
+                sum += brdf.eval(pair) * pair.wi.z;
+              }
+            float* out = &r.image.rgb[3 * (py * std::size_t(s.width) + std::size_t(px))];
+            const double inv = 1.0 / (k * k);
+            out[0] = float(sum.r * inv);
+            out[1] = float(sum.g * inv);
+            out[2] = float(sum.b * inv);
+          }
+      },
+      s.threads);
+  for (std::size_t p = 0; p < r.image.rgb.size(); p += 3)
+    r.nonfinite_pixels += !(std::isfinite(r.image.rgb[p]) && std::isfinite(r.image.rgb[p + 1]) &&
+                            std::isfinite(r.image.rgb[p + 2]));
+  r.spp = k * k;
+  r.sampler = "none: a point light, evaluated";
+  r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return r;
 }
 
 namespace {

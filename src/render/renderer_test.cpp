@@ -649,3 +649,54 @@ TEST(Renderer, PixelsBeyondTheFloatRangeAreCounted) {
 
 }  // namespace
 }  // namespace halfback::render
+
+namespace halfback::render {
+namespace {
+
+// A point light from the camera on a Lambertian sphere (orthographic): each pixel centre shows
+// (albedo/π) n·l, n the normal there (computed here from the pixel's position); 0 outside.
+TEST(PointLight, LambertIsAlbedoOverPiTimesTheCosine) {
+  const auto lambert = load_brdf("lambert:albedo=0.6");
+  RenderSettings s;
+  s.width = s.height = 32;
+  s.spp = 1;  // the pixel centres
+  s.threads = 2;
+  const RenderResult r = render_point_light(*lambert, {0, 0, 1}, s);
+  int lit = 0;
+  for (int py = 0; py < s.height; ++py)
+    for (int px = 0; px < s.width; ++px) {
+      const double x = ((px + 0.5) * 2.0 / s.width - 1) * 1.25,
+                   y = (1 - (py + 0.5) * 2.0 / s.height) * 1.25;
+      const double r2 = x * x + y * y,
+                   expected = r2 < 1 ? 0.6 / std::numbers::pi * std::sqrt(1 - r2) : 0;
+      const float* v = &r.image.rgb[3 * (py * s.width + px)];
+      EXPECT_NEAR(v[1], expected, 1e-6) << px << "," << py;
+      lit += expected > 0;
+    }
+  EXPECT_GT(lit, 400);
+  EXPECT_EQ(r.spp, 1);
+}
+
+// A light from the right lights the right half only; a mirror-like GGX is brightest where the
+// half vector of light and camera is the normal: at the normal halfway between them.
+TEST(PointLight, LightFromTheSideAndTheHighlight) {
+  RenderSettings s;
+  s.width = s.height = 65;
+  s.spp = 4;
+  const Vec3<double> side{std::sqrt(0.5), 0, std::sqrt(0.5)};  // 45° to the right
+  const RenderResult r = render_point_light(*load_brdf("ggx:alpha=0.05,f0=1"), side, s);
+  int best = 0;
+  for (int p = 0; p < s.width * s.height; ++p)
+    if (r.image.rgb[3 * p] > r.image.rgb[3 * best]) best = p;
+  // The normal at 22.5° to the right: x = sin(22.5°) in [-1.25, 1.25] across 65 pixels.
+  const double x = std::sin(std::numbers::pi / 8);
+  const int expected_px = int((x / 1.25 + 1) / 2 * s.width);
+  EXPECT_NEAR(best % s.width, expected_px, 1);
+  EXPECT_NEAR(best / s.width, s.height / 2, 1);
+  EXPECT_EQ(r.image.rgb[3 * (32 * s.width + 3)], 0.0f);  // far left: the light is behind
+  EXPECT_THROW(render_point_light(*load_brdf("lambert"), {0, 0, 2}, s), std::invalid_argument);
+  EXPECT_THROW(render_point_light(*load_brdf("lambert"), {NAN, 0, 1}, s), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace halfback::render

@@ -242,6 +242,7 @@ Response route(const Catalog& catalog, const Request& r, const ApiConfig& c) {
   if (p == "/api/albedo") return albedo_response(catalog, r, c.threads);
   if (p == "/api/point") return point_response(catalog, r);
   if (p == "/api/render") return render_response(catalog, r, c.threads);
+  if (p == "/api/pointlight") return point_light_response(catalog, r, c.threads);
   return error(404, fmt::format("no such resource '{}'", p.substr(0, 128)));
 }
 

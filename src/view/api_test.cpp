@@ -16,6 +16,7 @@
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/loader/load.hpp"
+#include "halfback/render/renderer.hpp"
 #include "json.hpp"
 #include "support/test_support.hpp"
 
@@ -84,8 +85,8 @@ TEST(ViewApi, TokenIsRequiredFromQueryOrCookie) {
 // (the checks come before the routing; a new endpoint is listed here).
 TEST(ViewApi, EveryEndpointChecksTokenOriginAndHost) {
   Api api(config());
-  for (const char* path : {"/api/info", "/api/brdf", "/api/slices", "/api/hemisphere",
-                           "/api/polar", "/api/point", "/api/render", "/api/albedo"}) {
+  for (const char* path : {"/api/info", "/api/brdf", "/api/slices", "/api/hemisphere", "/api/polar",
+                           "/api/point", "/api/render", "/api/albedo", "/api/pointlight"}) {
     Request r = get(path, {{"brdf", "arg:0"}});
     r.query.pop_back();  // the token
     EXPECT_TRUE(has_error(api.handle(r), 403, "token")) << path;
@@ -337,6 +338,29 @@ TEST(ViewApi, AlbedoCurveIsTheLibrarysEstimate) {
   EXPECT_TRUE(has_error(albedo({{"brdf", kSpec}, {"angles", "1"}}), 400, "angles"));
   EXPECT_TRUE(has_error(albedo({{"brdf", kSpec}, {"n", "100000"}}), 400, "'n'"));
   EXPECT_TRUE(has_error(albedo({}), 400, "brdf"));
+}
+
+// /api/pointlight: render_point_light's image, the light given in degrees; bounded sizes.
+TEST(ViewApi, PointLightIsTheRenderersImage) {
+  Api api(config());
+  const Response r = api.handle(
+      get("/api/pointlight",
+          {{"brdf", kSpec}, {"theta_l", "30"}, {"phi_l", "90"}, {"size", "16"}, {"spp", "4"}}));
+  ASSERT_EQ(r.status, 200) << r.body;
+  render::RenderSettings s;
+  s.width = s.height = 16;
+  s.spp = 4;
+  const double t = 30 * (std::numbers::pi / 180.0), p = 90 * (std::numbers::pi / 180.0);
+  const auto expected = render::render_point_light(
+      *load_brdf(kSpec), {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)}, s);
+  EXPECT_EQ(floats_of(r), expected.image.rgb);
+  const auto bad = [&](std::string key, std::string value) {
+    return api.handle(
+        get("/api/pointlight", {{"brdf", kSpec}, {std::move(key), std::move(value)}}));
+  };
+  EXPECT_TRUE(has_error(bad("theta_l", "91"), 400, "theta_l"));
+  EXPECT_TRUE(has_error(bad("size", "100000"), 400, "size"));
+  EXPECT_TRUE(has_error(bad("spp", "nan"), 400, "spp"));
 }
 
 std::string header_of(const Response& r, std::string_view name) {

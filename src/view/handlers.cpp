@@ -439,4 +439,22 @@ Response render_response(const Catalog& catalog, const Request& request, int thr
   return res;
 }
 
+// The sphere under a distant light from (theta_l, phi_l) in camera space (degrees; θ = 0: from
+// the camera, φ = 0: from the right), evaluated at k × k positions per pixel (no noise).
+Response point_light_response(const Catalog& catalog, const Request& request, int threads) {
+  render::RenderSettings s;
+  s.width = s.height = int(whole(request, "size", 128, 8, std::size_t(kMaxRenderSide)));
+  s.spp = int(whole(request, "spp", 4, 1, std::size_t(kMaxRenderSpp)));
+  s.threads = threads;
+  const double theta = number(request, "theta_l", 0, 0, 90) * kDegree;
+  const double phi = number(request, "phi_l", 0, -360, 360) * kDegree;
+  const Vec3<double> light{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                           std::cos(theta)};
+  const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
+  const render::RenderResult result = render::render_point_light(*brdf, light, s);
+  Response res = floats(result.image.rgb, std::size_t(s.width), std::size_t(s.height), 3);
+  res.headers.emplace_back("X-Halfback-Spp", std::to_string(result.spp));
+  return res;
+}
+
 }  // namespace halfback::view

@@ -16,5 +16,6 @@ Response polar_response(const Catalog& catalog, const Request& request);
 Response albedo_response(const Catalog& catalog, const Request& request, int threads);
 Response point_response(const Catalog& catalog, const Request& request);
 Response render_response(const Catalog& catalog, const Request& request, int threads);
+Response point_light_response(const Catalog& catalog, const Request& request, int threads);
 
 }  // namespace halfback::view

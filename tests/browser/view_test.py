@@ -547,7 +547,9 @@ def check_three_brdfs(driver):
         check(third in shown and (plot == "more" or len(shown) == 3),
               f"the {plot} legend names the BRDFs shown ({shown})")
     lobes = driver.execute_script("return window.halfback.lobe().length;")
-    spheres = driver.find_elements(By.CSS_SELECTOR, "#spheres figure")
+    spheres = driver.find_elements(By.CSS_SELECTOR, "#spheres canvas[id^='sphere-']")
+    lights = driver.find_elements(By.CSS_SELECTOR, "#spheres canvas[id^='pointlight-']")
+    check(len(lights) == 3, f"a sphere under a point light beside each ({len(lights)})")
     check(lobes == 3 and len(spheres) == 3, f"three lobes ({lobes}) and three spheres ({len(spheres)})")
     hemi = driver.find_element(By.ID, "hemisphere")
     driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", hemi)
@@ -589,6 +591,27 @@ def check_exports(driver, spec, screenshots):
         if got["png"]:
             with open(os.path.join(screenshots, f"view-export-{target}.png"), "wb") as f:
                 f.write(base64.b64decode(got["png"].split(",", 1)[1]))
+
+
+def check_point_light(driver):
+    """Issue 34: the sphere under a point light from ωo: drawn, and its light moves with ωo (the
+    brightest pixel of a glossy sphere moves when φo turns by 180°)."""
+    brightest = """
+        const c = document.getElementById('pointlight-0'), px = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let best = 0;
+        for (let k = 0; k < px.length; k += 4) if (px[k] + px[k + 1] > px[best] + px[best + 1]) best = k;
+        return [(best / 4) % c.width, Math.floor(best / 4 / c.width), px[best]];"""
+    type_into(driver, "theta-o", "40")
+    type_into(driver, "phi-o", "0")
+    time.sleep(0.4)
+    wait_idle(driver)
+    right = driver.execute_script(brightest)
+    type_into(driver, "phi-o", "180")
+    time.sleep(0.4)
+    wait_idle(driver)
+    left = driver.execute_script(brightest)
+    check(right[2] > 0 and right[0] > left[0] + 20,
+          f"the point light's highlight follows ωo (φo = 0°: x = {right[0]}, 180°: x = {left[0]})")
 
 
 def browser_checks(args, base, token, spec):
@@ -651,7 +674,8 @@ def browser_checks(args, base, token, spec):
               f"moving the alpha slider changes the BRDF ({spec_now})")
         check_following_sliders(driver)
         for bug in [check_sliders_follow_the_brdf, check_sum_of_models, check_roughness_slider,
-                    check_hemisphere_drag, check_typed_angles, check_anisotropic_orientation]:
+                    check_hemisphere_drag, check_typed_angles, check_anisotropic_orientation,
+                    check_point_light]:
             try:  # each one checked even when another fails (they fail apart on the old page)
                 bug(driver)
             except Exception as e:  # pylint: disable=broad-except

@@ -86,4 +86,14 @@ RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& s
 // TabulatedSampler for a BRDF that has its own, or a BRDF rendered by environment sampling only.
 RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings);
 
+// The sphere of render() under one distant light instead of the environment: irradiance 1 (at
+// normal incidence) from the unit direction `light` in camera space (+z towards the camera, +x
+// right, +y up; (0, 0, 1): from the camera). A pixel is the mean of ρ(ωi, ωo) cos θi over a
+// stratified k × k grid of positions in it (k² = spp rounded down to a square): ωi the light, ωo
+// the camera, in the shading frame of render(); 0 in the background and where the light or the
+// camera is below the surface. No sampling: no noise. Uses width, height, spp, projection and
+// threads of `settings`; throws std::invalid_argument for invalid settings or light.
+RenderResult render_point_light(const Brdf& brdf, const Vec3<double>& light,
+                                const RenderSettings& settings);
+
 }  // namespace halfback::render

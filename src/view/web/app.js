@@ -414,13 +414,14 @@ function restartSphere() {
     const canvas = document.createElement('canvas');
     canvas.id = `sphere-${b}`;
     const cap = document.createElement('figcaption');
-    cap.innerHTML = `${swatch(b)} ${escapeHtml(specLabel(s))}`;
+    cap.innerHTML = `${swatch(b)} ${escapeHtml(specLabel(s))}, the environment`;
     fig.append(canvas, cap);
-    box.append(fig);
+    box.append(fig, pointLightFigure(s, b));
     const p = sphereLoop(gen, s, b, canvas).catch((e) => { if (!isAbort(e)) setStatus(e.message, true); })
       .finally(() => spheres.delete(p));
     spheres.add(p);
   });
+  track(updatePointLights());
 }
 async function sphereLoop(gen, spec, b, canvas) {
   const sum = new Float32Array(SPHERE * SPHERE * 3);
@@ -437,6 +438,28 @@ async function sphereLoop(gen, spec, b, canvas) {
     if (pass === 0) await idleFrame();  // let the other views through first
   }
 }
+// Beside each environment-lit sphere, the same sphere under one distant light from ωo's
+// direction as seen from the camera (θo from the view axis, φo from the right): evaluated, not
+// sampled (/api/pointlight), drawn again when ωo moves (at rest).
+function pointLightFigure(spec, b) {
+  const fig = document.createElement('figure');
+  const canvas = Object.assign(document.createElement('canvas'), { id: `pointlight-${b}` });
+  canvas.dataset.spec = spec;
+  const cap = document.createElement('figcaption');
+  cap.innerHTML = `${swatch(b)} ${escapeHtml(specLabel(spec))}, a light from ωo`;
+  fig.append(canvas, cap);
+  return fig;
+}
+const updatePointLights = coalesced(async () => {
+  const canvases = [...document.querySelectorAll('#spheres canvas[id^="pointlight-"]')];
+  const fields = await Promise.all(canvases.map((c) => getField(null, '/api/pointlight',
+    [['brdf', c.dataset.spec], ['theta_l', state.to], ['phi_l', state.po], ['size', SPHERE], ['spp', 4]])));
+  canvases.forEach((c, k) => {
+    c.sum = Float32Array.from(fields[k].data);
+    c.dataset.passes = 1;
+    V.drawSphere(c, c.sum, 1, SPHERE, SPHERE, state.exposure);
+  });
+});
 const idleFrame = () => new Promise((r) => setTimeout(r, 30));
 function redrawSpheres() {
   for (const c of document.querySelectorAll('#spheres canvas'))
@@ -667,7 +690,10 @@ function changed({ slices = true, sphere = true, sliders = false } = {}) {
   track(updatePolar());
   // The lobe follows at rest only (refineSoon): with a software WebGL (no GPU) a drag would
   // redraw it at each step and halve the other views' rate.
-  if (!interactive) track(updateLobe());
+  if (!interactive) {
+    track(updateLobe());
+    track(updatePointLights());
+  }
   if (sphere === true) {  // a BRDF changed: the views that do not depend on ωo too
     restartSphere();
     track(updateAlbedo());
@@ -687,6 +713,7 @@ function refineSoon() {
     track(updateHemisphere());
     track(updatePolar());
     track(updateLobe());
+    if (!sphereStale) track(updatePointLights());
     if (sphereStale) {  // a model's parameters moved: its anisotropy may have changed too
       sphereStale = false;
       restartSphere();
