@@ -63,7 +63,9 @@ Rgb eval_at(const Brdf& brdf, Form form, std::span<const double> coords) {
   bool ok;
   if (form.space == Space::dirs) {
     std::copy(coords.begin(), coords.end(), d.begin());
-    ok = check_pair({{d[0], d[1], d[2]}, {d[3], d[4], d[5]}}) == PairStatus::ok;
+    DirPair<double> pair{{d[0], d[1], d[2]}, {d[3], d[4], d[5]}};
+    ok = accept_pair(pair) == PairStatus::ok;
+    d = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
   } else {
     ok = convert_one<double>(form, Form{Space::dirs, false}, coords, d);
   }

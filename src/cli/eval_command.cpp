@@ -30,7 +30,7 @@ void eval_block(const Brdf& brdf, const CsvTable& block, const std::string& sour
   std::vector<DirPair<double>> pairs(n);
   for (std::size_t r = 0; r < n; ++r) {
     pairs[r] = {{c[0][r], c[1][r], c[2][r]}, {c[3][r], c[4][r], c[5][r]}};
-    const PairStatus status = check_pair(pairs[r]);
+    const PairStatus status = accept_pair(pairs[r]);  // near-unit directions normalized
     if (status == PairStatus::ok || status == PairStatus::wi_below_horizon ||
         status == PairStatus::wo_below_horizon)
       continue;

@@ -211,3 +211,32 @@ TEST(NearUnitDirections, EveryAcceptedPairRoundTripsBatchFloat) {
 
 }  // namespace
 }  // namespace halfback
+
+namespace halfback {
+namespace {
+
+// accept_pair, the rule of every entry point that takes directions: check_pair()'s status, an
+// accepted pair put onto the unit upper hemisphere (what the conversions use), others untouched.
+TEST(AcceptPair, NormalizesAcceptedPairsAndLeavesTheOthers) {
+  DirPair<double> p{{0.6 * (1 + 4e-7), 0, 0.8 * (1 + 4e-7)}, {0, 0, 1}};
+  EXPECT_EQ(accept_pair(p), PairStatus::ok);
+  EXPECT_NEAR(p.wi.x * p.wi.x + p.wi.z * p.wi.z, 1.0, 4e-16);
+  DirPair<double> unit{{0.6, 0, 0.8}, {0, 0.28, 0.96}};
+  const DirPair<double> before = unit;
+  EXPECT_EQ(accept_pair(unit), PairStatus::ok);
+  EXPECT_EQ(unit.wi.x, before.wi.x);  // unit to rounding: kept bit for bit
+  EXPECT_EQ(unit.wo.z, before.wo.z);
+  DirPair<double> grazing{{1, 0, -0.5 * kDomainTolerance<double>},
+                          {0, 0, 1}};  // below, within tolerance
+  EXPECT_EQ(accept_pair(grazing), PairStatus::ok);
+  EXPECT_EQ(grazing.wi.z, 0.0);
+  DirPair<double> below{{0.6, 0, -0.8}, {0, 0, 1}};
+  EXPECT_EQ(accept_pair(below), PairStatus::wi_below_horizon);
+  EXPECT_EQ(below.wi.z, -0.8);
+  DirPair<double> off{{0.6, 0, 0.9}, {0, 0, 1}};
+  EXPECT_EQ(accept_pair(off), PairStatus::wi_not_unit);
+  EXPECT_EQ(off.wi.z, 0.9);
+}
+
+}  // namespace
+}  // namespace halfback

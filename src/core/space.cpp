@@ -1,6 +1,7 @@
 #include "halfback/core/space.hpp"
 
 #include "halfback/core/parameterization.hpp"
+#include "row_kernels.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -196,6 +197,12 @@ PairStatus check_pair(const DirPair<double>& p) {
   if (p.wi.z < -kDomainTolerance<double>) return PairStatus::wi_below_horizon;
   if (p.wo.z < -kDomainTolerance<double>) return PairStatus::wo_below_horizon;
   return PairStatus::ok;
+}
+
+PairStatus accept_pair(DirPair<double>& pair) {
+  const PairStatus status = check_pair(pair);
+  if (status == PairStatus::ok) pair = detail::accepted_pair(pair);
+  return status;
 }
 
 std::string_view describe(PairStatus status) {

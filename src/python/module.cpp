@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -226,14 +227,21 @@ std::vector<DirPair<double>> pairs_of(const py::object& wi_obj, const py::object
       pairs[i] = {{p[0], p[1], p[2]}, {q[0], q[1], q[2]}};
     }
   }
-  // Unit vectors are required (a typo in a direction is a bug, not a query); NaN rows and
-  // directions below the horizon are answered (NaN, 0).
+  // The CLI's rule (accept_pair): unit vectors are required (a typo in a direction is a bug, not
+  // a query) and near-unit ones normalized; directions below the horizon are answered (0). A
+  // row with a NaN or an infinity is answered NaN (NumPy's convention: eval_brdf), where the
+  // CLI, reading a file, names its line.
   for (std::size_t i = 0; i < pairs.size(); ++i) {
-    const PairStatus st = check_pair(pairs[i]);
+    const PairStatus st = accept_pair(pairs[i]);
     if (st == PairStatus::wi_not_unit || st == PairStatus::wo_not_unit)
       throw py::value_error("row " + std::to_string(i) + ": " + std::string(describe(st)));
   }
   return pairs;
+}
+
+bool finite_pair(const DirPair<double>& p) {
+  return std::isfinite(p.wi.x) && std::isfinite(p.wi.y) && std::isfinite(p.wi.z) &&
+         std::isfinite(p.wo.x) && std::isfinite(p.wo.y) && std::isfinite(p.wo.z);
 }
 
 py::array_t<double> eval_brdf(const PyBrdf& b, const py::object& wi, const py::object& wo) {
@@ -243,6 +251,9 @@ py::array_t<double> eval_brdf(const PyBrdf& b, const py::object& wi, const py::o
     py::gil_scoped_release release;
     b.brdf->eval_batch(pairs, rho);
   }
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < pairs.size(); ++i)  // not a BRDF's answer: NaN in, NaN out
+    if (!finite_pair(pairs[i])) rho[i] = {nan, nan, nan};
   py::array_t<double> out({py::ssize_t(pairs.size()), py::ssize_t(3)});
   double* o = out.mutable_data();
   for (std::size_t i = 0; i < rho.size(); ++i) {

@@ -361,7 +361,7 @@ namespace {
 bool point_pair(const Request& request, DirPair<double>& pair) {
   if (request.param("wi") || request.param("wo")) {
     pair = {direction_param(request, "wi"), direction_param(request, "wo")};
-    const PairStatus status = check_pair(pair);
+    const PairStatus status = accept_pair(pair);
     if (status == PairStatus::not_finite || status == PairStatus::wi_not_unit ||
         status == PairStatus::wo_not_unit)
       throw RequestError(400, std::string(describe(status)));

@@ -29,6 +29,7 @@
 #include "halfback/core/space.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/util/csv.hpp"
 #include "support/fifo_reader.hpp"
 #include "support/test_support.hpp"
@@ -778,6 +779,25 @@ TEST_F(CliTest, EvalGivesClosedFormValuesAndZeroBelowTheHorizon) {
   ASSERT_EQ(r.status, 0) << r.err;
   t = parse(slurp(path("out.csv")));
   EXPECT_NEAR(t.columns[0][0], 0.9 / (kPi * 0.09) / 4, 1e-12);
+}
+
+// Issue 35, class A: eval takes a direction within the unit tolerance as `convert` does, put
+// onto the unit sphere (accept_pair): a grazing mirror pair with |ωi| = 1 + 4e-7 gives the ρ of
+// the unit pair (GGX α = 0.001: 6.55e12, not the 2.48e6 of the tilted half vector), and sheen's
+// value at a pair off unit length by −4e-7 is that of the unit pair.
+TEST_F(CliTest, EvalNormalizesNearUnitDirectionsAsConvertDoes) {
+  const double t = 89 * kPi / 180, s = std::sin(t), c = std::cos(t);
+  for (const auto& [spec, scale] :
+       {std::pair{"ggx:alpha=0.001", 1 + 4e-7}, std::pair{"sheen:alpha=0.3", 1 - 4e-7}}) {
+    const std::array<double, 6> near{s * scale, 0, c * scale, -s, 0, c};
+    const Result got =
+        run({"eval", "--brdf", spec}, std::string(kDirsHeader) + fmt_row(near) + "\n");
+    ASSERT_EQ(got.status, 0) << got.err;
+    const double norm = std::sqrt(near[0] * near[0] + near[2] * near[2]);
+    const Rgb unit = load_brdf(spec)->eval({{near[0] / norm, 0, near[2] / norm}, {-s, 0, c}});
+    const double value = parse(got.out).columns[1][0];
+    EXPECT_NEAR(value, unit.g, 1e-9 * std::abs(unit.g) + 1e-12) << spec;
+  }
 }
 
 TEST_F(CliTest, EvalBadInput) {

@@ -245,3 +245,24 @@ def test_an_all_invalid_table_warns():
     with pytest.warns(RuntimeWarning, match="no grid point is inside the domain"):
         t = halfback.load("lambert").resample("hybrid", "slice", 4, ranges={"k": (1.5, 2)})
     assert not t["valid"].any()
+
+
+def test_eval_normalizes_near_unit_directions_as_convert_does():
+    # Issue 35, class A: the CLI's rule (accept_pair) in Python: a grazing mirror pair with
+    # |wi| = 1 + 4e-7 gives the unit pair's rho (GGX alpha = 0.001: the mirror peak, 2.4e8).
+    t = np.radians(89.0)
+    wi = np.array([[np.sin(t), 0.0, np.cos(t)]])
+    wo = np.array([[-np.sin(t), 0.0, np.cos(t)]])
+    b = halfback.load("ggx:alpha=0.001")
+    unit = b.eval(wi, wo)
+    near = b.eval(wi * (1 + 4e-7), wo)
+    np.testing.assert_allclose(near, unit, rtol=1e-9)
+    assert unit[0, 0] > 1e8  # the mirror peak (unnormalized: its half vector tilts off it)
+
+
+def test_all_nan_rows_evaluate_to_nan():
+    # Issue 35, class D: a row of NaN is answered NaN, as a row with one NaN (not 0, 0, 0).
+    b = halfback.load("ggx:alpha=0.2")
+    pairs = np.array([[np.nan] * 6, [0, 0, 1, 0, 0, 1], [np.inf, 0, 0, 0, 0, 1]])
+    rho = b.eval(pairs)
+    assert np.isnan(rho[0]).all() and np.isnan(rho[2]).all() and np.isfinite(rho[1]).all()
