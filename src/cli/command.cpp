@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <system_error>
 
 #include <unistd.h>
@@ -118,6 +119,62 @@ std::vector<std::size_t> count_list(const std::string& list, const char* option,
     counts.push_back(v);
   }
   return counts;
+}
+
+namespace {
+
+std::string finite_number_error(const std::string& value) {
+  std::string_view text = value;
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  double v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec == std::errc() && end == text.data() + text.size() && std::isfinite(v)) return "";
+  return fmt::format("'{}' is not a finite number", value);
+}
+
+std::string whole_number_error(const std::string& value, bool allow_negative) {
+  std::string_view text = value;
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  const bool negative = !text.empty() && text.front() == '-';
+  const std::string_view digits = negative ? text.substr(1) : text;
+  const bool all_digits =
+      !digits.empty() && std::ranges::all_of(digits, [](char c) { return c >= '0' && c <= '9'; });
+  if (!all_digits || (negative && !allow_negative))
+    return fmt::format("'{}' is not a whole number{}", value, allow_negative ? "" : " >= 0");
+  std::uint64_t magnitude = 0;
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), magnitude);
+  const std::uint64_t limit =
+      allow_negative ? (std::uint64_t{1} << 63) - (negative ? 0 : 1) : ~std::uint64_t{0};
+  if (ec != std::errc() || end != digits.data() + digits.size() || magnitude > limit)
+    return fmt::format("'{}' is too large (at most {})", value, limit);
+  return "";
+}
+
+}  // namespace
+
+void harden_options(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    const std::string type = option->get_type_name();
+    option->check(CLI::Validator(
+        [type](std::string& value) -> std::string {
+          if (value.empty()) return "an empty value: give one, or leave the option out";
+          if (type == "FLOAT") return finite_number_error(value);
+          if (type == "INT") return whole_number_error(value, true);
+          if (type == "UINT") return whole_number_error(value, false);
+          return "";
+        },
+        "", "value rule"));
+  }
+  for (CLI::App* sub : app.get_subcommands({})) harden_options(*sub);
+}
+
+CLI::Validator non_negative_integer() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        const std::string e = whole_number_error(value, false);
+        return e;
+      },
+      "INT >= 0", "non-negative integer");
 }
 
 CLI::Validator space_name_validator() {

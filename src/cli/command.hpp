@@ -113,6 +113,16 @@ double parse_number(std::string_view text, const std::string& what);
 
 // A CLI11 validator for parameterization names ("dirs", "hybrid", ...), with a message listing
 // the names.
+// One rule for the values of every option of every command (docs/reliability-round3.md, class
+// G), added to the whole tree of apps after registration: a value given empty is refused (an
+// empty --env or --budgets is not the default); a FLOAT option takes a finite number (no nan,
+// no inf); an INT or UINT option a whole number written as one and within 64 bits (no 1e3, no
+// −1 for a UINT, no 2⁶⁴ quietly saturated). Violations are usage errors (exit status 2).
+void harden_options(CLI::App& app);
+
+// For counts that may be 0 (--threads): "a whole number >= 0", with a readable message.
+CLI::Validator non_negative_integer();
+
 CLI::Validator space_name_validator();
 // The same for a parameterization (not "dirs").
 CLI::Validator parameterization_validator();

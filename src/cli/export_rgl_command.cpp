@@ -92,7 +92,7 @@ Command register_export_rgl(CLI::App& parent) {
                   "the file's description field (default: the source and how it was made)");
   app->add_option("--threads", o->table.threads,
                   "Threads: 0 all cores, 1 the calling thread, n at most n")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_integer())
       ->capture_default_str();
   app->add_flag("-q,--quiet", o->quiet, "no progress or summary on stderr");
   app->footer(

@@ -103,6 +103,7 @@ int run(int argc, char** argv) {
 
   std::vector<Command> commands;
   for (RegisterCommand add : command_table()) commands.push_back(add(app));
+  harden_options(app);  // one rule for every option's value (class G)
 
   try {
     app.parse(argc, argv);
