@@ -113,6 +113,9 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
     if (ec) fail(ec.value(), target_);
     resolved_ = to.is_absolute() ? to : resolved_.parent_path() / to;
   }
+  // Still a link after 40: a loop (or a chain longer than the system follows). Renaming onto it
+  // would replace a link of the loop with a regular file: refuse, as open(2) would (ELOOP).
+  if (fs::is_symlink(fs::symlink_status(resolved_, ec))) fail(ELOOP, target_);
   struct stat st {};
   const bool exists = ::stat(resolved_.c_str(), &st) == 0;
   if (exists && is_direct_destination(st, resolved_, target_)) {

@@ -191,6 +191,31 @@ TEST_F(AtomicFileTest, SymbolicLinkIsKept) {
   EXPECT_EQ(entries(), (std::vector<std::string>{"link.csv", "real.csv"}));
 }
 
+// Issue 35, class K: a destination in a loop of symbolic links is refused (ELOOP, naming it)
+// and the links stay links (it was replaced by a regular file, status 0); an output directory
+// in a loop too.
+TEST_F(AtomicFileTest, SymbolicLinkLoopIsRefusedAndKept) {
+  const fs::path a = dir_ / "a.csv", b = dir_ / "b.csv", self = dir_ / "self.csv";
+  fs::create_symlink("b.csv", a);
+  fs::create_symlink("a.csv", b);
+  fs::create_symlink("self.csv", self);
+  for (const fs::path& target : {a, self}) {
+    try {
+      write_file_atomically(target, "new");
+      ADD_FAILURE() << "no error for the loop " << target;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(target.filename().string()), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("symbolic links"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(a)));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(b)));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(self)));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"a.csv", "b.csv", "self.csv"}));
+  EXPECT_THROW(create_output_directory(self / "sub"), std::runtime_error);
+}
+
 TEST_F(AtomicFileTest, RelativePathInTheCurrentDirectory) {
   const fs::path cwd = fs::current_path();
   fs::current_path(dir_);
