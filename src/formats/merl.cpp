@@ -341,6 +341,12 @@ std::shared_ptr<const MerlBrdf> load_merl(const std::filesystem::path& path, Mer
 // ---------------------------------------------------------------------------------------------
 
 MerlData tabulate_merl(const Brdf& brdf) {
+  // The φh = 0 slice of an anisotropic BRDF would be read back as the whole BRDF: refuse, as the
+  // RGL writer does (issue 35, class L).
+  if (!brdf.isotropic())
+    throw std::invalid_argument(brdf.name() +
+                                " is anisotropic: a MERL file holds an isotropic BRDF only (its "
+                                "φh = 0 slice would be read back as the whole BRDF)");
   MerlData data;
   data.values.assign(3 * merl::kBins, -1.0);
   constexpr std::size_t kSlab = std::size_t(merl::kThetaD) * merl::kPhiD;  // bins per θh index

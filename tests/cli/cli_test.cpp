@@ -1011,6 +1011,14 @@ TEST_F(CliTest, ExportMerlBadInputKeepsTheOutput) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("x.binary"), std::string::npos) << r.err;
   EXPECT_EQ(entries(), (std::vector<std::string>{"x.binary"}));
+  // Issue 35, class L: an anisotropic BRDF is refused (its φh = 0 slice was written silently),
+  // as export-rgl refuses it; the old file stays.
+  r = run({"export-merl", "--brdf", "ggx:alpha_x=0.1,alpha_y=0.4", "-o", "x.binary"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("is anisotropic: a MERL file holds an isotropic BRDF only"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(slurp(path("x.binary")), "old");
 }
 
 TEST_F(CliTest, ExportRglWritesAFileTheReaderReads) {

@@ -160,7 +160,8 @@ std::shared_ptr<const MerlBrdf> load_merl(const std::filesystem::path& path,
 // back gives ρ at every bin centre up to the rounding of the division. Bins whose centre is not a
 // valid configuration (a direction below the horizon) and non-finite values of ρ are written as
 // -1 (unmeasured). Writes to a temporary file in the same directory and renames it into place, so
-// that no partial file is left on error. Throws FormatError on I/O errors.
+// that no partial file is left on error. Throws FormatError on I/O errors, std::invalid_argument
+// for an anisotropic BRDF (a MERL file is isotropic; its φh = 0 slice would pass for the whole).
 void write_merl(const std::filesystem::path& path, const Brdf& brdf);
 // The same, tabulated in memory (the file's content as MerlData, without sha256).
 MerlData tabulate_merl(const Brdf& brdf);
