@@ -50,14 +50,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       (target.find("size") != std::string_view::npos ||
        target.find("spp") != std::string_view::npos))
     return 0;
-  std::map<std::string, std::string> headers{{"host", "127.0.0.1:8765"}};
+  Api::RawHeaders headers{{"host", "127.0.0.1:8765"}};
   while (!input.empty()) {
     const std::string_view line = next_line(input);
     const std::size_t colon = line.find(':');
     if (colon == std::string_view::npos) continue;
     std::string_view value = line.substr(colon + 1);
     while (!value.empty() && value.front() == ' ') value.remove_prefix(1);
-    headers[std::string(line.substr(0, colon))] = std::string(value);
+    headers.emplace_back(line.substr(0, colon), value);  // repeated ones too (a 400)
   }
   const Response r = api().handle_target(method, target, headers);
   if (r.status < 200 || r.status >= 600) std::abort();

@@ -284,10 +284,17 @@ Response Api::handle(const Request& request) const {
 }
 
 Response Api::handle_target(std::string method, std::string_view target,
-                            std::map<std::string, std::string> headers) const {
+                            const RawHeaders& headers) const {
   Request request;
   request.method = std::move(method);
-  request.headers = std::move(headers);
+  for (const auto& [name, value] : headers) {
+    std::string lower = name;
+    std::ranges::transform(lower, lower.begin(),
+                           [](unsigned char c) { return char(std::tolower(c)); });
+    const bool checked = lower == "host" || lower == "origin" || lower == "cookie";
+    if (!request.headers.emplace(lower, value).second && checked)
+      return error(400, fmt::format("the {} header is given more than once", lower));
+  }
   const std::size_t mark = target.find('?');
   request.path = std::string(target.substr(0, mark));
   if (target.size() > kMaxTargetBytes) {

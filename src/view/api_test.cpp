@@ -167,7 +167,7 @@ TEST(ViewApi, OnlyGetAndHead) {
 
 TEST(ViewApi, MalformedAndOversizedTargets) {
   Api api(config());
-  const std::map<std::string, std::string> host{{"host", fmt::format("127.0.0.1:{}", kPort)}};
+  const Api::RawHeaders host{{"Host", fmt::format("127.0.0.1:{}", kPort)}};
   EXPECT_TRUE(has_error(api.handle_target("GET", "/api/info?token=" + kToken + "&x=%zz", host), 400,
                         "percent"));
   EXPECT_TRUE(has_error(api.handle_target("GET", "/api/info?token=" + kToken + "&x=%00", host), 400,
@@ -179,6 +179,26 @@ TEST(ViewApi, MalformedAndOversizedTargets) {
           .status,
       414);
   EXPECT_EQ(api.handle(get("/no/such")).status, 404);
+}
+
+// Issue 35, class J: a Host, Origin or Cookie header given twice is refused (a repeated header
+// kept its first value, and the second was never checked); other headers may repeat.
+TEST(ViewApi, RepeatedSecurityHeadersAreRefused) {
+  Api api(config());
+  const std::string own = fmt::format("127.0.0.1:{}", kPort), target = "/api/info?token=" + kToken;
+  EXPECT_EQ(
+      api.handle_target("GET", target, {{"Host", own}, {"Accept", "a"}, {"accept", "b"}}).status,
+      200);
+  EXPECT_TRUE(has_error(api.handle_target("GET", target, {{"Host", own}, {"host", "evil.example"}}),
+                        400, "the host header is given more than once"));
+  EXPECT_TRUE(has_error(
+      api.handle_target(
+          "GET", target,
+          {{"Host", own}, {"Origin", "http://" + own}, {"Origin", "http://evil.example"}}),
+      400, "more than once"));
+  EXPECT_TRUE(has_error(
+      api.handle_target("GET", target, {{"Host", own}, {"Cookie", "a=1"}, {"cookie", "b=2"}}), 400,
+      "more than once"));
 }
 
 TEST(ViewApi, ParseQueryDecodes) {
@@ -615,6 +635,19 @@ TEST(ViewApi, FilesOnlyUnderTheRoots) {
   const Response info = api.handle(get("/api/info"));
   EXPECT_EQ(info.body.find("secret"), std::string::npos);  // links out are not listed
   EXPECT_THROW(Api(config({outside.path() / "none"})), std::invalid_argument);
+}
+
+// Issue 35, class J: a file name that is not UTF-8 is listed in /api/info as valid JSON text
+// (U+FFFD for its bad byte), not as the raw byte.
+TEST(ViewApi, InfoListsFileNamesAsValidUtf8) {
+  test::TempDir root;
+  { std::ofstream(root.path() / "bad\xFFname.bsdf") << "x"; }
+  Api api(config({root.path()}));
+  const Response info = api.handle(get("/api/info"));
+  ASSERT_EQ(info.status, 200);
+  EXPECT_EQ(info.body.find('\xFF'), std::string::npos);
+  EXPECT_NE(info.body.find("bad\xEF\xBF\xBDname.bsdf"), std::string::npos) << info.body;
+  EXPECT_EQ(valid_utf8(info.body), info.body);
 }
 
 TEST(ViewApi, LoadsAFileUnderARoot) {

@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "halfback/util/text_encoding.hpp"
+
 namespace halfback::view {
 
 class JsonWriter {
@@ -86,7 +88,8 @@ class JsonWriter {
     if (!first_) out_ += ',';
     first_ = false;
   }
-  void append_string(std::string_view s) {
+  void append_string(std::string_view text) {
+    const std::string s = valid_utf8(text);  // JSON is UTF-8: a file name may not be
     out_ += '"';
     for (const char ch : s) {
       const auto c = static_cast<unsigned char>(ch);

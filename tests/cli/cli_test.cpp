@@ -317,6 +317,7 @@ TEST_F(CliTest, OptionValuesFollowOneRule) {
       {{"study", "--budgets", "", "lambert"}, "--budgets: an empty value"},
       {{"study", "--budgets-4d", "", "lambert"}, "--budgets-4d: an empty value"},
       {{"study", "--env", "", "lambert"}, "--env: an empty value"},
+      {{"view", "--host", "", "lambert"}, "--host: an empty value"},
       {{"export-rgl", "--brdf", "lambert", "--threads", "-1", "-o", path("x.bsdf")},
        "--threads: '-1' is not a whole number >= 0"},
   };

@@ -90,10 +90,12 @@ class Api {
   // The response to a request; never throws (an internal failure is a 500 with a message).
   Response handle(const Request& request) const;
   // The same for a raw request target "/path?query" (the path is taken as it is, the query
-  // decoded by parse_query): what the socket adapter and the fuzzer call. A malformed query is
-  // a 400.
+  // decoded by parse_query) and the headers as received (names in any case, in order): what the
+  // socket adapter and the fuzzer call. A malformed query is a 400; so is a Host, Origin or
+  // Cookie header given twice (which one would the checks read?).
+  using RawHeaders = std::vector<std::pair<std::string, std::string>>;
   Response handle_target(std::string method, std::string_view target,
-                         std::map<std::string, std::string> headers) const;
+                         const RawHeaders& headers) const;
 
  private:
   struct State;
