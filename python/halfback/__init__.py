@@ -28,6 +28,8 @@ from ._core import (
 )
 from . import _core
 
+__version__ = _core.__version__
+
 
 # Python functions, not the module's built-ins: pickle sends a Python function by its name, so
 # that engines which ship tasks to other processes (Dask workers) can send these; a pybind11

@@ -186,9 +186,20 @@ Outputs dispatch(const py::object& obj, Form from, Form to, Wanted want,
 }
 
 // A loaded BRDF (the C++ object is immutable and shared).
+// A BRDF and the spec it was loaded from (a file as an absolute path): what pickling sends and
+// what two Brdf objects compare by (load(x) == load(x)).
 struct PyBrdf {
   BrdfPtr brdf;
+  std::string spec;
 };
+
+PyBrdf load_py_brdf(const std::string& spec) {
+  std::error_code ec;
+  const std::filesystem::path path(spec);
+  std::string kept = spec;  // a file, absolute: a worker in another directory finds it
+  if (std::filesystem::exists(path, ec)) kept = std::filesystem::absolute(path, ec).string();
+  return PyBrdf{load_brdf(spec), kept};
+}
 
 // (N, 3) float64 copies of wi and wo (or of the halves of an (N, 6) array).
 std::vector<DirPair<double>> pairs_of(const py::object& wi_obj, const py::object& wo_obj) {
@@ -311,12 +322,16 @@ std::pair<double, double> range_bounds(const py::handle& value, const std::strin
 }
 
 py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::string& kind,
-                       const py::object& size, double azimuth_deg, bool nodes,
+                       const py::object& size, double azimuth, bool nodes,
                        const py::dict& ranges) {
   const Space space = parse_space(param, "param");
   const std::vector<std::size_t> counts = grid_counts(size);
-  const double azimuth = wrap_azimuth_degrees(azimuth_deg, "azimuth");  // as the CLI (class 8)
-  GridSpec g = default_grid(space, parse_kind(kind), counts, azimuth * std::numbers::pi / 180);
+  // Radians, as every angle of the Python API (the CLI's --azimuth is in degrees); wrapped into
+  // [0, 2π) as the CLI wraps (class 8).
+  if (!std::isfinite(azimuth))
+    throw py::value_error("azimuth: " + python_repr(py::float_(azimuth)) +
+                          " is not a finite angle in radians");
+  GridSpec g = default_grid(space, parse_kind(kind), counts, wrap_azimuth_radians(azimuth));
   g.sampling = nodes ? GridSampling::nodes : GridSampling::centres;
   for (const auto& [key, value] : ranges) {
     GridAxis* axis = nullptr;
@@ -520,10 +535,12 @@ a direction that is not a unit vector raises ValueError naming the row.)doc")
           "albedo",
           [](const PyBrdf& b, double theta_i, int n) {
             if (n < 1) throw py::value_error("n must be positive");
-            if (!std::isfinite(theta_i))
+            // Radians in [0, π/2]: albedo(30.0), degrees by mistake, gave a plausible number.
+            if (!(theta_i >= 0 && theta_i <= std::numbers::pi / 2))
               throw py::value_error(
                   "theta_i: " + py::repr(py::float_(theta_i)).cast<std::string>() +
-                  " is not a finite angle in radians");
+                  " is not an angle of incidence in radians, in [0, pi/2] (degrees? use "
+                  "math.radians)");
             AlbedoEstimate a;
             {
               py::gil_scoped_release release;
@@ -542,7 +559,7 @@ a direction that is not a unit vector raises ValueError naming the row.)doc")
            R"doc(The BRDF on a regular grid of a parameterization (as `halfback resample`).
 
 kind: "full" (4 axes), "isotropic" (3 axes, phi_h = 0) or "slice" (2 axes at relative azimuth
-`azimuth`, in degrees). size: samples per axis, an int or one per axis. Samples at cell centres,
+`azimuth`, in radians, wrapped into [0, 2 pi): every angle of the Python API is in radians). size: samples per axis, an int or one per axis. Samples at cell centres,
 or at nodes including both ends with nodes=True. ranges: {axis name: (lo, hi)}.
 Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape...) bool, axes
 (sample positions), axis_names, metadata.)doc")
@@ -552,7 +569,24 @@ Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape
            R"doc(A unit sphere of the BRDF under an environment (as `halfback render`): an (H, W, 3)
 float32 array of linear radiance, row 0 at the top. env: "default", "studio", "sunset",
 "constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".)doc")
-      .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; });
+      .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; })
+      .def_property_readonly("spec", [](const PyBrdf& b) { return b.spec; },
+                             "The spec it was loaded from (a file: its absolute path).")
+      .def(
+          "__eq__",
+          [](const PyBrdf& a, const py::object& other) {
+            if (!py::isinstance<PyBrdf>(other)) return false;
+            const PyBrdf& b = other.cast<const PyBrdf&>();
+            return a.brdf == b.brdf || (!a.spec.empty() && a.spec == b.spec);
+          },
+          "Equal when loaded from the same spec (or the same object).")
+      .def("__hash__", [](const PyBrdf& b) { return py::hash(py::str(b.spec)); })
+      .def(py::pickle(
+          [](const PyBrdf& b) { return py::make_tuple(b.spec); },  // rebuilt from its spec
+          [](const py::tuple& t) {
+            if (t.size() != 1) throw std::runtime_error("Brdf: a pickled Brdf is (spec,)");
+            return load_py_brdf(t[0].cast<std::string>());
+          }));
 }
 
 void bind_hemisphere(py::module_& m) {
@@ -567,15 +601,42 @@ and wo; row j of the arrays is at v = v[j] (row 0 is the bottom). projection: "e
 "back".)doc");
 }
 
+py::dict models_dict() {
+  py::dict out;
+  for (const std::string& name : model_registry().names()) {
+    const ModelInfo* m = model_registry().find(name);
+    if (!m) continue;
+    py::list params;
+    for (const ModelParam& p : m->params) {
+      py::dict d;
+      d["name"] = p.name;
+      d["description"] = p.description;
+      d["default"] = p.default_from.empty() ? py::object(py::float_(p.default_value)) : py::none();
+      d["min"] = p.min;
+      d["max"] = p.max;
+      d["default_from"] = p.default_from;
+      d["choices"] = p.choices;
+      params.append(d);
+    }
+    py::dict model;
+    model["description"] = m->description;
+    model["params"] = params;
+    out[py::str(name)] = model;
+  }
+  return out;
+}
+
 void bind_loading(py::module_& m) {
   m.def(
-      "load", [](const std::string& spec) { return PyBrdf{load_brdf(spec)}; }, py::arg("spec"),
+      "load", &load_py_brdf, py::arg("spec"),
       R"doc(Loads a BRDF from a SPEC: a MERL/RGL/ALTA file, a neural BRDF (.h5, or the folder or
 NAME_fc1.npy of its NumPy form), a model such as "ggx:alpha=0.2" or
 "lambert:albedo=0.5", a sum "a+b", or "embedded:NAME" (as on the command line).)doc");
-  m.def(
-      "models", [] { return model_registry().names(); },
-      "The names of the analytic models (see `halfback models` for their parameters).");
+  m.def("models", &models_dict,
+        R"doc(The analytic models: a dict name -> {"description", "params"}, each parameter a dict
+of "name", "description", "default", "min", "max", "default_from" (the parameter whose value it
+takes when not given, or "") and "choices" (named values, or []). Iterating it gives the
+names, as before.)doc");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -598,54 +659,63 @@ struct PySettings {
   study::StudySettings settings;
   std::vector<std::string> profiles;
   bool has_profiles = false;
+  bool designs_given = false;
 };
+
+// One key of the settings dict.
+void read_setting(PySettings& out, const std::string& key, const py::handle& v) {
+  study::StudySettings& s = out.settings;
+  if (key == "params")
+    s.params = setting<std::vector<std::string>>(v, key);
+  else if (key == "space" || key == "error_space")
+    s.space = setting<std::string>(v, key);
+  else if (key == "designs") {
+    s.designs = setting<std::vector<std::string>>(v, key);
+    out.designs_given = true;
+  } else if (key == "profiles") {
+    out.profiles = setting<std::vector<std::string>>(v, key);
+    out.has_profiles = true;
+  } else if (key == "quick")
+    s.quick = setting<bool>(v, key);
+  else if (key == "no_gonio")
+    s.no_gonio = setting<bool>(v, key);
+  else if (key == "no_images")
+    s.no_images = setting<bool>(v, key);
+  else if (key == "budgets")
+    s.budgets = setting<std::vector<std::size_t>>(v, key);
+  else if (key == "budgets_4d")
+    s.budgets_4d = setting<std::vector<std::size_t>>(v, key);
+  else if (key == "test_pairs")
+    s.test_pairs = setting<std::size_t>(v, key);
+  else if (key == "image_budget")
+    s.image_budget = setting<std::size_t>(v, key);
+  else if (key == "image_size")
+    s.image_size = setting<int>(v, key);
+  else if (key == "image_spp")
+    s.image_spp = setting<int>(v, key);
+  else if (key == "max_theta")
+    s.max_theta = setting<double>(v, key);
+  else if (key == "seed")
+    s.seed = setting<std::uint64_t>(v, key);
+  else if (key == "env")
+    s.environments = setting<std::vector<std::string>>(v, key);
+  else
+    throw py::value_error(
+        "settings: unknown key '" + key +
+        "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
+        "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
+        "seed, no_gonio, no_images)");
+}
 
 PySettings study_settings(const py::object& settings) {
   PySettings out;
   study::StudySettings& s = out.settings;
-  if (settings.is_none()) return out;
-  for (const auto& [k, v] : settings.cast<py::dict>()) {
-    const std::string key = py::str(k);
-    if (key == "params")
-      s.params = setting<std::vector<std::string>>(v, key);
-    else if (key == "space" || key == "error_space")
-      s.space = setting<std::string>(v, key);
-    else if (key == "designs")
-      s.designs = setting<std::vector<std::string>>(v, key);
-    else if (key == "profiles") {
-      out.profiles = setting<std::vector<std::string>>(v, key);
-      out.has_profiles = true;
-    } else if (key == "quick")
-      s.quick = setting<bool>(v, key);
-    else if (key == "no_gonio")
-      s.no_gonio = setting<bool>(v, key);
-    else if (key == "no_images")
-      s.no_images = setting<bool>(v, key);
-    else if (key == "budgets")
-      s.budgets = setting<std::vector<std::size_t>>(v, key);
-    else if (key == "budgets_4d")
-      s.budgets_4d = setting<std::vector<std::size_t>>(v, key);
-    else if (key == "test_pairs")
-      s.test_pairs = setting<std::size_t>(v, key);
-    else if (key == "image_budget")
-      s.image_budget = setting<std::size_t>(v, key);
-    else if (key == "image_size")
-      s.image_size = setting<int>(v, key);
-    else if (key == "image_spp")
-      s.image_spp = setting<int>(v, key);
-    else if (key == "max_theta")
-      s.max_theta = setting<double>(v, key);
-    else if (key == "seed")
-      s.seed = setting<std::uint64_t>(v, key);
-    else if (key == "env")
-      s.environments = setting<std::vector<std::string>>(v, key);
-    else
-      throw py::value_error(
-          "settings: unknown key '" + key +
-          "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
-          "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
-          "seed, no_gonio, no_images)");
-  }
+  if (!settings.is_none())
+    for (const auto& [k, v] : settings.cast<py::dict>()) read_setting(out, py::str(k), v);
+  // The defaults work alone (issue 35): without profiles, the default designs leave out the
+  // learned one, which needs the profiles of the study's other BRDFs; asked for by name, it
+  // still needs them.
+  if (!out.has_profiles && !out.designs_given) std::erase(s.designs, std::string("learned"));
   return out;
 }
 
@@ -814,6 +884,7 @@ whole window is inside the image and where mask (same shape; default all) is non
 
 // The class before the functions that return it, so that their signatures name it.
 PYBIND11_MODULE(_core, m) {
+  m.attr("__version__") = HALFBACK_VERSION;
   m.doc() = "halfback: exact, fast changes of variables between BRDF parameterizations";
   bind_conversions(m);
   bind_brdf_class(m);

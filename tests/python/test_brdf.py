@@ -1,6 +1,7 @@
 """halfback.load / Brdf: values against closed forms and the CLI, shapes, dtypes, errors."""
 
 import os
+import pickle
 import subprocess
 
 import numpy as np
@@ -80,7 +81,7 @@ def test_info_albedo_and_models():
 
 
 def test_resample_slice_matches_the_closed_form_and_the_cli(tmp_path):
-    t = halfback.load("test:S").resample("hybrid", "slice", (20, 10), azimuth=30)
+    t = halfback.load("test:S").resample("hybrid", "slice", (20, 10), azimuth=np.radians(30))
     assert t["rho"].shape == (20, 10, 3) and t["valid"].shape == (20, 10)
     assert t["axis_names"] == ["hbar", "k"]
     hbar = t["axes"][0][:, None]
@@ -227,15 +228,17 @@ def test_isotropic_needs_a_parameterization_on_one_side():
         assert r.returncode == 2 and "isotropic needs a parameterization" in r.stderr
 
 
-def test_slice_azimuths_wrap_into_0_360_and_nan_raises():
+def test_slice_azimuths_wrap_into_0_2pi_and_nan_raises():
+    # Radians, as every angle of the Python API (issue 35, class D).
     b = halfback.load("ggx:alpha=0.3")
-    ref = b.resample("hybrid", "slice", 12, azimuth=270)
+    ref = b.resample("hybrid", "slice", 12, azimuth=1.5 * np.pi)
     assert ref["valid"].any()
-    for az in (-90, 630, 270 - 3600):
+    assert ref["metadata"]["slice_azimuth"] == pytest.approx(1.5 * np.pi)
+    for az in (-0.5 * np.pi, 3.5 * np.pi, 1.5 * np.pi - 20 * np.pi):
         t = b.resample("hybrid", "slice", 12, azimuth=az)
         np.testing.assert_array_equal(t["valid"], ref["valid"])
-        np.testing.assert_array_equal(t["rho"], ref["rho"])
-        assert t["metadata"]["slice_azimuth"] == ref["metadata"]["slice_azimuth"]
+        np.testing.assert_allclose(t["rho"], ref["rho"], rtol=1e-12)  # fmod's last bit
+        assert t["metadata"]["slice_azimuth"] == pytest.approx(ref["metadata"]["slice_azimuth"])
     for az in (float("nan"), float("inf")):
         with pytest.raises(ValueError, match="azimuth"):
             b.resample("hybrid", "slice", 12, azimuth=az)
@@ -266,3 +269,33 @@ def test_all_nan_rows_evaluate_to_nan():
     pairs = np.array([[np.nan] * 6, [0, 0, 1, 0, 0, 1], [np.inf, 0, 0, 0, 0, 1]])
     rho = b.eval(pairs)
     assert np.isnan(rho[0]).all() and np.isnan(rho[2]).all() and np.isfinite(rho[1]).all()
+
+
+def test_albedo_takes_radians_in_its_range():
+    # Issue 35, class D: albedo(30.0), degrees by mistake, and negative angles gave plausible
+    # numbers; every angle of the Python API is in radians, checked against its range.
+    b = halfback.load("lambert:albedo=0.5")
+    (mean, _) = b.albedo(np.radians(30.0), 16)
+    assert mean[0] == pytest.approx(0.5, rel=1e-12)
+    for theta in (30.0, -0.1, 2.0):
+        with pytest.raises(ValueError, match=r"radians, in \[0, pi/2\].*math.radians"):
+            b.albedo(theta)
+
+
+def test_a_new_users_conveniences():
+    # Issue 35: __version__; models() with parameters; a Brdf pickles (Dask ships objects) and
+    # compares by its spec, a file by its absolute path.
+    assert halfback.__version__.count(".") == 2
+    ggx = halfback.models()["ggx"]
+    alpha = next(p for p in ggx["params"] if p["name"] == "alpha")
+    assert alpha["min"] == 0.001 and alpha["max"] == 10 and alpha["default"] == 0.2
+    assert next(p for p in ggx["params"] if p["name"] == "alpha_x")["default_from"] == "alpha"
+    assert "ggx" in list(halfback.models())
+    for spec in ("ggx:alpha=0.2", "lambert:albedo=0.3+ggx:alpha=0.1", "embedded:pink-felt"):
+        b = halfback.load(spec)
+        assert b == halfback.load(spec) and hash(b) == hash(halfback.load(spec))
+        c = pickle.loads(pickle.dumps(b))
+        assert c == b and c.name == b.name
+        pairs = np.hstack([unit_rows(20, 1), unit_rows(20, 2)])
+        np.testing.assert_array_equal(c.eval(pairs), b.eval(pairs))
+    assert halfback.load("ggx:alpha=0.2") != halfback.load("ggx:alpha=0.3")

@@ -68,9 +68,10 @@ def test_bad_settings_are_clear_errors():
         halfback.study_brdf("lambert", {"space": "sqrt"})
     with pytest.raises(ValueError, match="--designs: 'sqrt' is not a design"):
         halfback.study_brdf("lambert", {"designs": ["own", "sqrt"]})
-    # The learned design (a default one) without the profiles it learns from.
+    # The learned design, asked for, without the profiles it learns from (left out of the
+    # defaults when there are none: test_study_brdf_defaults_work_alone).
     with pytest.raises(ValueError, match=r"learned design needs settings\['profiles'\]"):
-        halfback.study_brdf("lambert", {"quick": True})
+        halfback.study_brdf("lambert", {"quick": True, "designs": ["learned"]})
     with pytest.raises(ValueError, match="no profile of 'lambert'"):
         profile = halfback.study_profile("test:S", {"quick": True})
         halfback.study_brdf("lambert", {"quick": True, "profiles": [profile]})
@@ -190,3 +191,12 @@ def test_learned_design_on_dask_equals_the_cli_run(tmp_path):
     assert sorted(p.read_text() for p in profile_files) == sorted(profiles)
     halfback.merge_study(str(tmp_path / "dask"), remote)
     assert csvs(tmp_path / "dask") == csvs(tmp_path / "cli")
+
+
+def test_study_brdf_defaults_work_alone():
+    # Issue 35 (a new user's first call): without profiles the default designs leave out the
+    # learned one (it needs the other BRDFs' profiles); asked for by name, it still needs them.
+    r = halfback.study_brdf("ggx:alpha=0.2", {"quick": True, "no_images": True})
+    assert "designs = own,angle,merl" in r["settings"]
+    with pytest.raises(ValueError, match="learned design needs"):
+        halfback.study_brdf("ggx:alpha=0.2", {"quick": True, "designs": ["own", "learned"]})
