@@ -58,11 +58,14 @@ int run_info(const InfoOptions& o) {
   if (best >= 0) {
     const double deg = 180 / std::numbers::pi;
     const std::array<double, 4> q = grid.point(where);
+    // At θh = 0 every φd is the same pair turned about n: the scan's first maximum is one of
+    // equals (it printed 34.5° once and 0° after), so say "any".
+    const std::string phi_d = q[0] == 0 ? "any" : fmt::format("{:.3g}°", q[2] * deg);
     lines.push_back(
         {"max ρ (θ ≤ 89°)",
-         fmt::format("{} sr⁻¹ at θh = {:.3g}°, θd = {:.3g}°, φd = {:.3g}° ({} grid points)",
+         fmt::format("{} sr⁻¹ at θh = {:.3g}°, θd = {:.3g}°, φd = {} ({} grid points)",
                      rgb_text({t.rgb[3 * where], t.rgb[3 * where + 1], t.rgb[3 * where + 2]}),
-                     q[0] * deg, q[1] * deg, q[2] * deg, t.valid_count())});
+                     q[0] * deg, q[1] * deg, phi_d, t.valid_count())});
   }
 
   for (const double theta_deg : {0.0, 30.0, 60.0, 80.0}) {

@@ -34,6 +34,7 @@ struct StudyOptions {
   std::string designs = "own,angle,merl,learned";
   study::StudySettings settings;
   bool resume = false;
+  bool quiet = false, full_report = false;  // what goes to stdout (print_written)
 };
 
 // The configuration of the options; a bad value is a usage error.
@@ -168,10 +169,24 @@ class Progress {
   std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 
-void print_written(const study::StudyOutput& out, const std::string& dir) {
+// The report's head: the title, the header and the Summary section (what a terminal can show;
+// the whole data's report is 2 000 lines).
+std::string report_head(const std::string& markdown) {
+  const std::size_t summary = markdown.find("\n## Summary");
+  if (summary == std::string::npos) return markdown;
+  const std::size_t next = markdown.find("\n## ", summary + 1);
+  return next == std::string::npos ? markdown : markdown.substr(0, next + 1);
+}
+
+// On stdout: the report's head (or all of it with --full-report, nothing with --quiet) and
+// where the files are.
+void print_written(const study::StudyOutput& out, const std::string& dir, const StudyOptions& o) {
+  if (o.quiet) return;
   std::string files;
   for (const std::string& f : out.files) files += (files.empty() ? "" : ", ") + f;
-  fmt::print("{}\nwritten in {}: {}\n", out.markdown, dir, files);
+  const bool whole = o.full_report || report_head(out.markdown).size() == out.markdown.size();
+  fmt::print("{}\n{}written in {}: {}\n", whole ? out.markdown : report_head(out.markdown),
+             whole ? "" : fmt::format("(the whole report: {}/report.md)\n", dir), dir, files);
 }
 
 // The BRDF of a spec, studied, its part written; or the part of an earlier run (--resume).
@@ -272,7 +287,7 @@ int run_study(StudyOptions& o) {
           specs[k], results.back().label));
   }
   const study::StudyOutput out = study::write_study(o.out, results, config, progress.elapsed());
-  print_written(out, o.out);
+  print_written(out, o.out, o);
   return kExitOk;
 }
 
@@ -286,7 +301,7 @@ int run_merge(const StudyOptions& o) {
   check_writable((std::filesystem::path(o.out) / "report.md").string());
   double seconds = 0;
   for (const study::BrdfResult& b : merged.results) seconds += b.seconds;
-  print_written(study::write_study(o.out, merged.results, merged.config, seconds), o.out);
+  print_written(study::write_study(o.out, merged.results, merged.config, seconds), o.out, o);
   return kExitOk;
 }
 
@@ -351,6 +366,9 @@ Command register_study(CLI::App& parent) {
   app->add_flag("--no-gonio", o->settings.no_gonio,
                 "Metrics 1-2 only (no gonio-reflectometer, no images)");
   app->add_flag("--no-images", o->settings.no_images, "No image-space error");
+  app->add_flag("-q,--quiet", o->quiet, "Nothing on stdout (the report is in the output folder)");
+  app->add_flag("--full-report", o->full_report,
+                "The whole report on stdout (by default: its summary and where the files are)");
   app->add_flag("--resume", o->resume,
                 "Continue an interrupted run in --out: the BRDFs whose results it holds "
                 "(OUT/parts/) are not studied again (same options required)");

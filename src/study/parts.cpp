@@ -21,6 +21,7 @@ namespace halfback::study {
 namespace {
 
 void apply_quick(StudyConfig& c) {
+  c.quick = true;
   c.grid = {24, 24, 32};
   c.full_grid = {8, 16, 8, 16};
   c.budgets = {1000, 10000};

@@ -27,14 +27,19 @@ std::string report_header(const std::vector<BrdfResult>& results, const StudyCon
       "Measure: cos θi cos θo dωi dωo, through each parameterization's Jacobian. Values: the "
       "luminance of ρ in the **{}** error space. Metrics 1–2 on a {} × {} × {} grid of cell "
       "centres of each isotropic form (midpoint rule){}. Definitions: docs/study.md. {} BRDFs "
-      "in {:.1f} s.{}\n\n",
+      "in {:.1f} s.{}{}\n\n",
       name_of(config.space), config.grid.a, config.grid.b, config.grid.phi,
       any_aniso ? fmt::format(", and {} × {} × {} × {} cells of the full form for the anisotropic "
                               "ones",
                               config.full_grid[0], config.full_grid[1], config.full_grid[2],
                               config.full_grid[3])
                 : "",
-      results.size(), seconds, left_out(config));
+      results.size(), seconds, left_out(config),
+      config.quick
+          ? "\n\n**A quick run** (`--quick`: smaller grids, fewer budgets and test pairs): "
+            "its headline can differ from a full run's; do not quote it as the study's "
+            "result."
+          : "");
 }
 
 namespace {

@@ -1487,6 +1487,12 @@ TEST_F(CliTest, StudyWritesItsCsvFilesAndReport) {
        {"## 1. Azimuthal dependence", "## 2. Separability", "## 3. Virtual gonio-reflectometer",
         "## 3b. Designs", "## 4. Image-space error"})
     EXPECT_NE(report.find(h), std::string::npos) << h;
+  // Issue 35 (a new user): a quick run says so, and stdout has the report's summary and where
+  // the whole report is, not the whole report.
+  EXPECT_NE(report.find("**A quick run**"), std::string::npos);
+  EXPECT_NE(r.out.find("## Summary"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("## 1. Azimuthal dependence"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(the whole report: st/report.md)"), std::string::npos) << r.out;
   EXPECT_NE(slurp(path("st") / "report.html").find("src=\"data:image/png;base64,"),
             std::string::npos);
   for (const char* f :
@@ -1665,6 +1671,12 @@ TEST_F(CliTest, StudyMergeOfTwoRunsIsOneRun) {
   const std::string report = slurp(path("merged") / "report.md");
   EXPECT_NE(report.find("## 4. Image-space error"), std::string::npos);
   EXPECT_TRUE(fs::exists(path("merged") / "renderings.png"));
+  r = run({"study", "--merge", "a", "b", "-o", "quiet", "--quiet"});  // nothing on stdout
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  r = run({"study", "--merge", "a", "b", "-o", "full", "--full-report"});  // all of it
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.substr(0, report.size()), report);
 
   // A BRDF in two of the runs, a directory that is not a study, different settings, BRDFs
   // given with --merge: each a clear error, and nothing written.

@@ -40,6 +40,9 @@ struct StudyConfig {
   // The parameterizations compared, in the order of every table's rows and the report's columns.
   std::vector<Space> params = default_studied();
   ErrorSpace space = ErrorSpace::log;
+  // Made smaller by --quick (parts.hpp, apply_quick): the report says so (its headline can differ
+  // from a full run's).
+  bool quick = false;
   IsoGrid grid{64, 64, 64};                              // metrics 1-2, isotropic form
   std::array<std::size_t, 4> full_grid{16, 32, 16, 32};  // metrics 1-2, full form (anisotropic)
   std::vector<int> ranks{1, 2, 4, 8};
