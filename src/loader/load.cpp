@@ -110,13 +110,18 @@ void register_test_functions(ModelRegistry& registry) {
                 }});
 }
 
-// The separators of a sum "lambert:albedo=0.3+sheen:alpha=0.4": '+' followed by a model name
-// (a number's exponent sign, as in 1e+3, is followed by a digit).
+// The separators of a sum "lambert:albedo=0.3+sheen:alpha=0.4+./felt.bsdf": '+' followed by a
+// letter (a model's name, a file's) or by '.', '/' or '~' (a path); a number's exponent sign,
+// as in 1e+3, is followed by a digit.
+bool starts_a_term(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '.' || c == '/' || c == '~';
+}
+
 std::vector<std::string_view> split_sum(std::string_view spec) {
   std::vector<std::string_view> parts;
   std::size_t start = 0;
   for (std::size_t i = 0; i + 1 < spec.size(); ++i)
-    if (spec[i] == '+' && spec[i + 1] >= 'a' && spec[i + 1] <= 'z') {
+    if (spec[i] == '+' && starts_a_term(spec[i + 1])) {
       parts.push_back(spec.substr(start, i - start));
       start = i + 1;
     }

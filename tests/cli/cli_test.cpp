@@ -1000,6 +1000,23 @@ TEST_F(CliTest, UnmeasuredMerlBinsAreMissingInEvalAndInfo) {
   EXPECT_EQ(r.out.find("-0.0"), std::string::npos) << r.out;
 }
 
+// Issue 35, class J: a file term in a sum ('ggx:alpha=0.2+./x.binary') is a term, loaded as a
+// file (it was read as part of alpha's value: "not a finite number").
+TEST_F(CliTest, FileTermsInSums) {
+  ASSERT_EQ(run({"export-merl", "--brdf", "lambert:albedo=0.2", "-o", "x.binary"}).status, 0);
+  const std::string pair = std::string(kDirsHeader) + "0,0,1,0,0,1\n";
+  const Result sum = run({"eval", "--brdf", "ggx:alpha=0.2+./x.binary"}, pair);
+  ASSERT_EQ(sum.status, 0) << sum.err;
+  const Result a = run({"eval", "--brdf", "ggx:alpha=0.2"}, pair);
+  const Result b = run({"eval", "--brdf", "./x.binary"}, pair);
+  const double expected = parse(a.out).columns[1][0] + parse(b.out).columns[1][0];
+  EXPECT_NEAR(parse(sum.out).columns[1][0], expected, 1e-12 * expected);
+  const Result missing = run({"info", "ggx:alpha=0.2+./none.bsdf"});
+  EXPECT_NE(missing.status, 0);
+  EXPECT_EQ(missing.err.find("not a finite number"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("none.bsdf"), std::string::npos) << missing.err;
+}
+
 TEST_F(CliTest, ExportMerlBadInputKeepsTheOutput) {
   put(path("x.binary"), "old");
   Result r = run({"export-merl", "--brdf", "nope", "-o", "x.binary"});

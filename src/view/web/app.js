@@ -556,9 +556,9 @@ function specLabel(spec) {
 }
 
 // --- model sliders -----------------------------------------------------------------------------
-// The terms of a spec as the server splits a sum (load_brdf: '+' followed by a lowercase letter;
-// a number's exponent sign, as in 1e+3, is followed by a digit).
-const sumTerms = (spec) => spec.split(/\+(?=[a-z])/);
+// The terms of a spec as the server splits a sum (load_brdf: '+' followed by a letter, '.', '/'
+// or '~'; a number's exponent sign, as in 1e+3, is followed by a digit).
+const sumTerms = (spec) => spec.split(/\+(?=[a-zA-Z./~])/);
 // A spec's terms, each a model with its values or a fixed term (a file, an embedded material);
 // null when no term is a model (nothing to slide).
 function parseSpec(spec) {
