@@ -659,6 +659,7 @@ def browser_checks(args, base, token, spec):
         check_against_cli(driver, args.halfback, spec, "hemisphere hover")
         driver.execute_async_script("window.halfback.spheresDone().then(arguments[0]);")
         wait_idle(driver)
+        driver.execute_script("window.scrollTo(0, 0);")
         driver.save_screenshot(os.path.join(args.screenshots, "view-page.png"))
         for id_, name in [("slices-panel", "slices"), ("hemisphere-panel", "hemisphere"),
                           ("polar-panel", "polar"), ("sphere-panel", "sphere"), ("cursor-panel", "cursor")]:
