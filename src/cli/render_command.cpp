@@ -16,8 +16,7 @@ namespace halfback::cli {
 namespace {
 
 struct RenderOptions {
-  std::string brdf, env = "default", output, strategy = "mis", heuristic = "power",
-                    sampling = "hybrid";
+  std::string brdf, env = "sky", output, strategy = "mis", heuristic = "power", sampling = "hybrid";
   int width = 512, height = 512, spp = 64, threads = 0;
   std::uint64_t seed = 1;
   double time_budget = 0, exposure = 0, env_rotation = 0, env_exposure = 0;
@@ -100,7 +99,8 @@ Command register_render(CLI::App& parent) {
       ->required();
   app->add_option("--env", o->env,
                   "environment: a latitude-longitude .hdr or .exr file, constant:V, "
-                  "constant:R,G,B, or a built-in: default (a sky with a sun), studio, sunset")
+                  "constant:R,G,B, or a built-in: sky (a sky with a sun; \"default\" is its older "
+                  "name), studio, sunset")
       ->capture_default_str();
   app->add_option("-o,--output", o->output, "output image: .exr (linear) or .png (sRGB)")
       ->required();

@@ -322,8 +322,7 @@ std::pair<double, double> range_bounds(const py::handle& value, const std::strin
 }
 
 py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::string& kind,
-                       const py::object& size, double azimuth, bool nodes,
-                       const py::dict& ranges) {
+                       const py::object& size, double azimuth, bool nodes, const py::dict& ranges) {
   const Space space = parse_space(param, "param");
   const std::vector<std::size_t> counts = grid_counts(size);
   // Radians, as every angle of the Python API (the CLI's --azimuth is in degrees); wrapped into
@@ -563,15 +562,16 @@ kind: "full" (4 axes), "isotropic" (3 axes, phi_h = 0) or "slice" (2 axes at rel
 or at nodes including both ends with nodes=True. ranges: {axis name: (lo, hi)}.
 Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape...) bool, axes
 (sample positions), axis_names, metadata.)doc")
-      .def("render", &render_brdf, py::arg("env") = "default", py::arg("width") = 256,
+      .def("render", &render_brdf, py::arg("env") = "sky", py::arg("width") = 256,
            py::arg("height") = 256, py::arg("spp") = 64, py::arg("seed") = 1,
            py::arg("strategy") = "mis", py::arg("threads") = 0,
            R"doc(A unit sphere of the BRDF under an environment (as `halfback render`): an (H, W, 3)
-float32 array of linear radiance, row 0 at the top. env: "default", "studio", "sunset",
+float32 array of linear radiance, row 0 at the top. env: "sky" (a sky with a sun; "default" is its older name), "studio", "sunset",
 "constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".)doc")
       .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; })
-      .def_property_readonly("spec", [](const PyBrdf& b) { return b.spec; },
-                             "The spec it was loaded from (a file: its absolute path).")
+      .def_property_readonly(
+          "spec", [](const PyBrdf& b) { return b.spec; },
+          "The spec it was loaded from (a file: its absolute path).")
       .def(
           "__eq__",
           [](const PyBrdf& a, const py::object& other) {
@@ -627,9 +627,8 @@ py::dict models_dict() {
 }
 
 void bind_loading(py::module_& m) {
-  m.def(
-      "load", &load_py_brdf, py::arg("spec"),
-      R"doc(Loads a BRDF from a SPEC: a MERL/RGL/ALTA file, a neural BRDF (.h5, or the folder or
+  m.def("load", &load_py_brdf, py::arg("spec"),
+        R"doc(Loads a BRDF from a SPEC: a MERL/RGL/ALTA file, a neural BRDF (.h5, or the folder or
 NAME_fc1.npy of its NumPy form), a model such as "ggx:alpha=0.2" or
 "lambert:albedo=0.5", a sum "a+b", or "embedded:NAME" (as on the command line).)doc");
   m.def("models", &models_dict,

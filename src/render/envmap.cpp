@@ -804,7 +804,7 @@ EnvMap EnvMap::default_sky(EnvOptions options) {
   auto edge = [&](const Vec3<double>& d) {
     return d.x * sun.x + d.y * sun.y + d.z * sun.z > cos_edge;
   };
-  return EnvMap(W, H, procedural_map(W, H, radiance, edge, 8), "default", options);
+  return EnvMap(W, H, procedural_map(W, H, radiance, edge, 8), "sky", options);
 }
 
 EnvMap EnvMap::studio(EnvOptions options) {
@@ -863,14 +863,14 @@ EnvMap EnvMap::sunset(EnvOptions options) {
 }
 
 std::vector<std::string> EnvMap::builtin_names() {
-  return {"default", "sky", "studio", "sunset"};
+  return {"sky", "studio", "sunset"};  // and "default", sky's older name (from_spec)
 }
 
 Environment load_environment(const std::string& spec) {
   auto map = std::make_shared<const EnvMap>(EnvMap::from_spec(spec));
   const auto builtins = EnvMap::builtin_names();
   std::string label;
-  if (std::find(builtins.begin(), builtins.end(), spec) != builtins.end())
+  if (spec == "default" || std::find(builtins.begin(), builtins.end(), spec) != builtins.end())
     label = (spec == "default" ? std::string("sky") : spec) + " (built-in)";
   else if (spec.rfind("constant:", 0) == 0)
     label = spec;

@@ -204,6 +204,18 @@ TEST(EnvMap, BuiltInStudioAndSunset) {
   EXPECT_THROW(EnvMap::from_spec("studio2"), std::exception);
 }
 
+// Issue 35: one name for the default environment everywhere ("sky": the CLI and Python said
+// "default", the explorer "sky"); "default" is still taken, and is the same map.
+TEST(EnvMap, TheSkyHasOneName) {
+  EXPECT_EQ(EnvMap::builtin_names(), (std::vector<std::string>{"sky", "studio", "sunset"}));
+  const EnvMap sky = EnvMap::from_spec("sky"), old = EnvMap::from_spec("default");
+  EXPECT_EQ(sky.name(), "sky");
+  EXPECT_EQ(old.name(), "sky");
+  for (const Vec3<double>& d : {Vec3<double>{0, 1, 0}, Vec3<double>{0.6, 0, 0.8}})
+    EXPECT_EQ(sky.eval(d).g, old.eval(d).g);
+  EXPECT_EQ(load_environment("default").label, "sky (built-in)");
+}
+
 TEST(EnvMap, DefaultSkyHasASun) {
   const EnvMap d = EnvMap::from_spec("default");
   EXPECT_EQ(d.width(), 1024);

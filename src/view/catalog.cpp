@@ -186,7 +186,7 @@ std::shared_ptr<const render::EnvMap> Catalog::environment(std::string_view spec
   }
   std::shared_ptr<const render::EnvMap> map;
   const auto builtins = render::EnvMap::builtin_names();
-  if (std::find(builtins.begin(), builtins.end(), spec) != builtins.end() ||
+  if (std::find(builtins.begin(), builtins.end(), spec) != builtins.end() || spec == "default" ||
       starts_with(spec, "constant:")) {
     map = std::make_shared<const render::EnvMap>(render::EnvMap::from_spec(spec));
   } else if (starts_with(spec, "file:")) {

@@ -42,8 +42,8 @@ class EnvMap {
   // NaN or infinite (the message names `name`, the pixel and the channel).
   EnvMap(int width, int height, std::vector<float> rgb, std::string name, EnvOptions options = {});
 
-  // A built-in ("default" or "sky", "studio", "sunset"), "constant:V" or "constant:R,G,B", or a
-  // file name.
+  // A built-in ("sky", "studio", "sunset"; "default" is sky's older name, still taken),
+  // "constant:V" or "constant:R,G,B", or a file name.
   static EnvMap from_spec(std::string_view spec, EnvOptions options = {});
   // A Radiance .hdr or OpenEXR file, recognized by its content. Throws FormatError naming the file
   // and the problem: unreadable, not an HDR image, zero size, not 2:1, more pixels than the file
@@ -60,7 +60,8 @@ class EnvMap {
   // low orange sun to the right under a sky going from orange at the horizon to deep blue.
   static EnvMap studio(EnvOptions options = {});
   static EnvMap sunset(EnvOptions options = {});
-  // The names of the built-in environments that from_spec() takes.
+  // The names of the built-in environments (one name each, "sky" the default everywhere: the
+  // CLI, Python, the explorer); from_spec() also takes "default" for sky.
   static std::vector<std::string> builtin_names();
 
   // Radiance arriving from world direction `dir` (unit), scaled by the exposure.
