@@ -89,6 +89,7 @@ TEST(FitModel, GivenValuesAreHeldAndTheSpecRoundTrips) {
     EXPECT_NE(p.name, "albedo");   // a grey value with channels: its channels are fitted
     EXPECT_NE(p.name, "alpha_x");  // follows alpha: the fitted models are isotropic
     EXPECT_NE(p.name, "eta");      // switches Schlick to exact Fresnel: held by rule
+    EXPECT_NE(p.name, "f0_r");     // follows the given f0
   }
   EXPECT_NO_THROW(load_brdf(spec_of(m)));
 }
@@ -111,10 +112,11 @@ TEST(FitSamples, LayoutInTheHemisphereWithMeanWeightOne) {
 }
 
 // A sum of a sharp and a broad GGX lobe fitted by one GGX lobe of roughness alone: under the log
-// loss, the loss has a minimum near each (α ≈ 0.027 and, lower, α ≈ 0.47). A start in the sharp
-// basin stays there; the automatic starts find the lower one, the minimum of a fine scan.
+// loss, the loss has a minimum near each (α ≈ 0.03 and, higher, α ≈ 0.40). A start at α = 1
+// falls into the broad basin and stays there; the automatic starts find the lower minimum, that
+// of a fine scan.
 TEST(FitMultistart, TwoMinimaOneStartFailsTheStartsSucceed) {
-  const BrdfPtr target = load_brdf("ggx:alpha=0.02,f0=0.5+ggx:alpha=0.7,f0=1");
+  const BrdfPtr target = load_brdf("ggx:alpha=0.02,f0=1+ggx:alpha=0.7,f0=0.5");
   const std::string model = "ggx:f0=0.75";
   FitOptions o;
   o.samples = 3000;
@@ -128,12 +130,12 @@ TEST(FitMultistart, TwoMinimaOneStartFailsTheStartsSucceed) {
     const double l = loss_value(t, *load_brdf(with_alpha(model, std::exp(la))), o.loss, s);
     if (l < scan_best) scan_best = l, scan_alpha = std::exp(la);
   }
-  o.starts = {"ggx:alpha=0.01"};
+  o.starts = {"ggx:alpha=1"};
   const FitResult one = fit(*target, model, o);
   o.starts.clear();
   const FitResult multi = fit(*target, model, o);
   EXPECT_GT(one.loss_value, 1.5 * multi.loss_value) << one.spec;
-  EXPECT_LT(value_of(one.model, 0, "alpha"), 0.05) << "the single start left the sharp basin";
+  EXPECT_GT(value_of(one.model, 0, "alpha"), 0.2) << "the single start left the broad basin";
   EXPECT_LE(multi.loss_value, scan_best * (1 + 1e-9)) << multi.spec;
   EXPECT_NEAR(value_of(multi.model, 0, "alpha"), scan_alpha, 0.02 * scan_alpha);
 }
