@@ -209,7 +209,7 @@ std::string term_spec(const Model& m, std::size_t term) {
   char sep = ':';
   for (const Param& p : m.params)
     if (p.term == term) {
-      s += fmt::format("{}{}={:.17g}", sep, p.name, p.value);
+      s += fmt::format("{}{}={}", sep, p.name, p.value);  // shortest form that reads back exactly
       sep = ',';
     }
   return s;

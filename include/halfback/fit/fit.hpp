@@ -60,7 +60,8 @@ struct Model {
 Model parse_model(std::string_view model);
 
 // The spec of the model at its parameters' values ("lambert:albedo_r=...+ggx:alpha=..."),
-// readable by load_brdf(), exact to the last bit ({:.17g}).
+// readable by load_brdf(), exact to the last bit (the shortest decimal that reads back as the same
+// double).
 std::string spec_of(const Model& model);
 
 struct FitOptions {
