@@ -314,8 +314,8 @@ Blocks blocks_of(const Model& m) {
   return b;
 }
 
-// Residuals of the loss at the block values, and their Jacobian by central differences (one-
-// sided at a bound), each difference re-evaluating only the term the parameter belongs to.
+// Residuals of the loss at the block values, and their Jacobian by forward differences (backward
+// at the upper bound), each difference re-evaluating only the term the parameter belongs to.
 // Derivatives are numeric because the models are not templated (docs/fit.md).
 class FitCost final : public ceres::CostFunction {
  public:
@@ -368,7 +368,7 @@ class FitCost final : public ceres::CostFunction {
     }
     residuals(loss_, s_, target_, sum, r, threads_);
     if (!jacobians) return true;
-    std::vector<double> rp(3 * n), rm(3 * n);
+    std::vector<double> rs(3 * n);
     for (std::size_t b = 0; b < nb; ++b) {
       if (!jacobians[b]) continue;
       const std::size_t np = blocks_.params[b].size();
@@ -376,12 +376,12 @@ class FitCost final : public ceres::CostFunction {
       for (std::size_t j = 0; j < np; ++j) {
         const Param& p = model_.params[blocks_.params[b][j]];
         const double x = v[j];
-        const double h = 1e-6 * std::max(std::abs(x), 1e-3 * std::max(1.0, p.max - p.min));
-        const double hi = std::min(x + h, p.max), lo = std::max(x - h, p.min);
-        shifted_residuals(b, v, j, hi, sum, terms[b], rp);
-        shifted_residuals(b, v, j, lo, sum, terms[b], rm);
-        for (std::size_t k = 0; k < 3 * n; ++k)
-          jacobians[b][k * np + j] = (rp[k] - rm[k]) / (hi - lo);
+        // Forward difference (one term evaluation), backward at the upper bound; the step is
+        // about sqrt(machine epsilon) relative, or of the range where x is near 0.
+        double h = 1e-7 * std::max(std::abs(x), 1e-3 * std::max(1.0, p.max - p.min));
+        if (x + h > p.max) h = -h;
+        shifted_residuals(b, v, j, x + h, sum, terms[b], rs);
+        for (std::size_t k = 0; k < 3 * n; ++k) jacobians[b][k * np + j] = (rs[k] - r[k]) / h;
         v[j] = x;
       }
     }
@@ -437,9 +437,9 @@ Solved solve_from(const Model& start, const Samples& s, std::span<const Rgb> tar
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
   options.max_num_iterations = o.max_iterations;
-  options.function_tolerance = 1e-15;
-  options.gradient_tolerance = 1e-15;
-  options.parameter_tolerance = 1e-12;
+  options.function_tolerance = 1e-12;
+  options.gradient_tolerance = 1e-12;
+  options.parameter_tolerance = 1e-10;
   options.logging_type = ceres::SILENT;
   options.num_threads = 1;  // the residuals run on the project's parallel loop
   ceres::Solver::Summary summary;

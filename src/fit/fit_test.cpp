@@ -137,6 +137,9 @@ TEST(FitMultistart, TwoMinimaOneStartFailsTheStartsSucceed) {
   EXPECT_GT(one.loss_value, 1.5 * multi.loss_value) << one.spec;
   EXPECT_GT(value_of(one.model, 0, "alpha"), 0.2) << "the single start left the broad basin";
   EXPECT_LE(multi.loss_value, scan_best * (1 + 1e-9)) << multi.spec;
+  // The value reported is the loss of the spec reported.
+  EXPECT_NEAR(multi.loss_value, loss_value(t, *load_brdf(multi.spec), o.loss, s),
+              1e-12 * multi.loss_value);
   EXPECT_NEAR(value_of(multi.model, 0, "alpha"), scan_alpha, 0.02 * scan_alpha);
 }
 
