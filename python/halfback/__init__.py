@@ -46,7 +46,12 @@ def study_profile(spec, settings=None):
     return _core.study_profile(spec, settings)
 
 
+def fit(brdf, model, loss="ngan", samples=20000, threads=0):
+    return _core.fit(brdf, model, loss, samples, threads)
+
+
 study_brdf.__doc__ = _core.study_brdf.__doc__
+fit.__doc__ = _core.fit.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
 study_profile.__doc__ = _core.study_profile.__doc__
 
@@ -54,6 +59,7 @@ __all__ = [
     "Brdf",
     "columns",
     "convert",
+    "fit",
     "hemisphere",
     "jacobian",
     "load",

@@ -24,6 +24,7 @@
 #include "halfback/core/batch.hpp"
 #include "halfback/core/simd.hpp"
 #include "halfback/figure/hemisphere.hpp"
+#include "halfback/fit/fit.hpp"
 #include "halfback/formats/table_file.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
@@ -823,6 +824,66 @@ py::dict merge_study(const std::string& out, const py::list& parts) {
   return d;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Fitting (issue 37): halfback.fit, the GIL released while it runs
+// ---------------------------------------------------------------------------------------------
+
+py::dict fit_result_dict(const fit::FitResult& r) {
+  py::list params;
+  for (const fit::Param& p : r.model.params) {
+    py::dict d;
+    d["term"] = p.term;
+    d["model"] = r.model.terms[p.term];
+    d["name"] = p.name;
+    d["value"] = p.value;
+    d["fitted"] = p.fitted;
+    d["min"] = p.min;
+    d["max"] = p.max;
+    params.append(d);
+  }
+  py::dict out;
+  out["spec"] = r.spec;
+  out["loss"] = std::string(fit::name_of(r.loss));
+  out["loss_value"] = r.loss_value;
+  out["layout"] = std::string(fit::kLayoutName);
+  out["samples"] = r.samples;
+  out["parameters"] = params;
+  out["starts"] = r.starts;
+  out["iterations"] = r.iterations;
+  out["seconds"] = r.seconds;
+  return out;
+}
+
+py::dict fit_brdf(const py::object& brdf, const std::string& model, const std::string& loss,
+                  std::size_t samples, int threads) {
+  fit::FitOptions o;
+  const auto l = fit::parse_loss(loss);
+  if (!l) throw py::value_error("loss '" + loss + "': expected " + fit::loss_names());
+  o.loss = *l;
+  o.samples = samples;
+  o.threads = threads;
+  const BrdfPtr target = py::isinstance<py::str>(brdf) ? load_brdf(brdf.cast<std::string>())
+                                                       : brdf.cast<const PyBrdf&>().brdf;
+  fit::FitResult r;
+  {
+    py::gil_scoped_release release;
+    r = fit::fit(*target, model, o);
+  }
+  return fit_result_dict(r);
+}
+
+void bind_fit(py::module_& m) {
+  m.def("fit", &fit_brdf, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
+        py::arg("samples") = 20000, py::arg("threads") = 0,
+        R"doc(Fits an analytic model or a sum of lobes ("lambert+ggx"; values given, as in
+"ggx:f0=0.9", are held) to a BRDF (a spec, as for load(), or a Brdf), as `halfback fit`
+(docs/fit.md), the GIL released while it runs. loss: ngan, low-e1, low-e2, cube-root or log.
+Returns a dict: spec (load() reads it), loss, loss_value, layout, samples, parameters (a list of
+dicts: term, model, name, value, fitted, min, max), starts, iterations, seconds. A bad model or
+loss raises ValueError; a target the fit cannot use (not finite, negative or zero where sampled,
+anisotropic) raises RuntimeError.)doc");
+}
+
 void bind_study(py::module_& m) {
   m.def("study_brdf", &study_one_brdf, py::arg("spec"), py::arg("settings") = py::none(),
         R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
@@ -890,6 +951,7 @@ PYBIND11_MODULE(_core, m) {
   bind_hemisphere(m);
   bind_loading(m);
   bind_study(m);
+  bind_fit(m);
   bind_image_metrics(m);
   halfback::python::bind_user_parameterizations(m);
 }

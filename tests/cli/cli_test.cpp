@@ -1886,5 +1886,65 @@ TEST_F(CliTest, ViewRefusesBadOptionsBeforeServing) {
       << r.err;
 }
 
+// `halfback fit`: the spec it prints is the fitted model, which `info` and `eval` read back, and
+// which reproduces the BRDF it was fitted to (a Lambert + GGX sum with colours, recovered).
+TEST_F(CliTest, FitPrintsASpecThatEveryCommandReadsBack) {
+  const std::string truth =
+      "lambert:albedo_r=0.6,albedo_g=0.2,albedo_b=0.1+ggx:alpha=0.08,f0_r=0.95,f0_g=0.7,f0_b=0.4";
+  Result r = run({"fit", "--brdf", truth, "--model", "lambert+ggx", "--samples", "2000",
+                  "--threads", "1", "-o", "fit.json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_FALSE(r.out.empty());
+  const std::string spec = r.out.substr(0, r.out.find('\n'));
+  EXPECT_EQ(r.out, spec + "\n");
+  const std::string json = slurp(path("fit.json"));
+  for (const std::string& part :
+       {"\"spec\":\"" + spec + "\"", "\"name\":\"ngan\""s, "\"layout\":\"halfdiff-halton\""s,
+        "\"count\":2000"s, "\"name\":\"f0_b\""s, "\"iterations\":"s, "\"seconds\":"s})
+    EXPECT_NE(json.find(part), std::string::npos) << part << " not in " << json;
+  EXPECT_EQ(run({"info", spec}).status, 0);
+  const std::string input = std::string(kDirsHeader) + "0,0,1,0,0,1\n0.6,0,0.8,-0.48,0.36,0.8\n";
+  const CsvTable want = parse(run({"eval", "--brdf", truth}, input).out);
+  r = run({"eval", "--brdf", spec}, input);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const CsvTable got = parse(r.out);
+  ASSERT_EQ(got.rows(), 2u);
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < 2; ++i)
+      EXPECT_NEAR(got.columns[c][i], want.columns[c][i], 1e-4 * want.columns[c][i]);
+}
+
+// Bad models and losses are usage errors (2); a bad --brdf (as in every command) and a target the
+// fit cannot use are data errors (1); none leaves a file, and an existing output is kept.
+TEST_F(CliTest, FitBadInputLeavesNoOutput) {
+  put(path("old.json"), "old");
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    std::string words;
+  };
+  const std::vector<Case> cases{
+      {{"--brdf", "ggx", "--model", "phong"}, 2, "phong"},
+      {{"--brdf", "ggx", "--model", "ggx:roughness=1"}, 2, "roughness"},
+      {{"--brdf", "ggx", "--model", "ggx", "--loss", "l2"}, 2, "--loss 'l2'"},
+      {{"--brdf", "nosuchmodel:x=1", "--model", "ggx"}, 1, "nosuchmodel"},
+      {{"--brdf", "ggx", "--model", "ggx:alpha=0.1,f0=0.5"}, 2, "nothing to fit"},
+      {{"--brdf", "lambert:albedo=0", "--model", "ggx"}, 1, "zero at all"},
+      {{"--brdf", "ggx:alpha_x=0.1,alpha_y=0.4", "--model", "ggx"}, 1, "anisotropic"},
+  };
+  for (const Case& c : cases) {
+    for (const char* out : {"new.json", "old.json"}) {
+      std::vector<std::string> args{"fit", "--samples", "200", "-o", out};
+      args.insert(args.end(), c.args.begin(), c.args.end());
+      const Result r = run(args);
+      EXPECT_EQ(r.status, c.status) << c.words << ": " << r.err;
+      EXPECT_NE(r.err.find(c.words), std::string::npos) << r.err;
+      EXPECT_TRUE(r.out.empty()) << r.out;
+    }
+  }
+  EXPECT_EQ(entries(), std::vector<std::string>{"old.json"});
+  EXPECT_EQ(slurp(path("old.json")), "old");
+}
+
 }  // namespace
 }  // namespace halfback

@@ -1,0 +1,144 @@
+// A recursive-descent reader of BBM's fit lines (include/halfback/fit/published.hpp).
+#include "halfback/fit/published.hpp"
+
+#include <fmt/format.h>
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "halfback/util/format_error.hpp"
+
+namespace halfback::fit {
+
+namespace {
+
+// One line's cursor; every error names the source, the line and the column.
+class LineReader {
+ public:
+  LineReader(std::string_view text, const std::string& source, std::size_t line)
+      : text_(text), source_(source), line_(line) {}
+
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw FormatError(source_, fmt::format("line {}, column {}", line_, pos_ + 1), problem);
+  }
+  void skip_space() {
+    while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+  }
+  bool at_end() {
+    skip_space();
+    return pos_ == text_.size();
+  }
+  bool accept(char c) {
+    skip_space();
+    if (pos_ < text_.size() && text_[pos_] == c) return ++pos_, true;
+    return false;
+  }
+  void expect(char c) {
+    if (!accept(c))
+      fail(pos_ < text_.size() ? fmt::format("expected '{}', found '{}'", c, text_[pos_])
+                               : fmt::format("expected '{}' at the end of the line", c));
+  }
+  // A name: letters, digits, '_', '-' (material names such as "blue-acrylic").
+  std::string name(const char* what) {
+    skip_space();
+    const std::size_t start = pos_;
+    while (pos_ < text_.size() && (std::isalnum(static_cast<unsigned char>(text_[pos_])) ||
+                                   text_[pos_] == '_' || text_[pos_] == '-'))
+      ++pos_;
+    if (pos_ == start) fail(fmt::format("expected {}", what));
+    return std::string(text_.substr(start, pos_ - start));
+  }
+  double number() {
+    skip_space();
+    double v = 0;
+    const char* first = text_.data() + pos_;
+    const auto [end, ec] = std::from_chars(first, text_.data() + text_.size(), v);
+    if (ec != std::errc() || !std::isfinite(v)) fail("expected a finite number");
+    pos_ += std::size_t(end - first);
+    return v;
+  }
+  std::vector<double> value() {
+    if (!accept('[')) return {number()};
+    std::vector<double> v{number()};
+    while (accept(',')) v.push_back(number());
+    expect(']');
+    return v;
+  }
+  // MODEL(key = value, ...) after its name.
+  PublishedLobe lobe(std::string model) {
+    PublishedLobe l{std::move(model), {}};
+    expect('(');
+    std::set<std::string> seen;
+    if (!accept(')')) {
+      do {
+        std::string key = name("a parameter name");
+        if (!seen.insert(key).second) fail(fmt::format("parameter '{}' repeated", key));
+        expect('=');
+        l.params.emplace_back(std::move(key), value());
+      } while (accept(','));
+      expect(')');
+    }
+    return l;
+  }
+
+  PublishedFit fit() {
+    PublishedFit f;
+    f.line = line_;
+    f.material = name("a material name");
+    expect('=');
+    std::string model = name("a model name");
+    if (model == "Aggregate") {
+      expect('(');
+      do f.lobes.push_back(lobe(name("a model name")));
+      while (accept(','));
+      expect(')');
+    } else {
+      f.lobes.push_back(lobe(std::move(model)));
+    }
+    if (!at_end()) fail("unexpected text after the expression");
+    return f;
+  }
+
+ private:
+  std::string_view text_;
+  const std::string& source_;
+  std::size_t line_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace
+
+std::vector<PublishedFit> parse_published_fits(std::string_view text, const std::string& source) {
+  std::vector<PublishedFit> fits;
+  std::set<std::string> materials;
+  std::size_t number = 0;
+  while (!text.empty()) {
+    const std::size_t nl = text.find('\n');
+    std::string_view line = text.substr(0, nl);
+    text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    LineReader r(line, source, number);
+    if (r.at_end() || line.find_first_not_of(" \t") == line.find('#')) continue;  // blank, comment
+    PublishedFit f = r.fit();
+    if (!materials.insert(f.material).second)
+      throw FormatError(source, fmt::format("line {}", number),
+                        fmt::format("material '{}' repeated", f.material));
+    fits.push_back(std::move(f));
+  }
+  return fits;
+}
+
+std::vector<PublishedFit> read_published_fits(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FormatError(path.string(), "file", "cannot be read");
+  std::stringstream s;
+  s << in.rdbuf();
+  return parse_published_fits(s.str(), path.string());
+}
+
+}  // namespace halfback::fit

@@ -1,0 +1,74 @@
+// The reader of the published fits (Ngan et al. 2005, as BBM distributes them).
+#include "halfback/fit/published.hpp"
+
+#include <gtest/gtest.h>
+
+#include "halfback/util/format_error.hpp"
+#include "support/test_support.hpp"
+
+namespace halfback::fit {
+namespace {
+
+TEST(PublishedFits, ReadsAnAggregateLine) {
+  const auto fits = parse_published_fits(
+      "# comment\n\nblue-acrylic = Aggregate(Lambertian(albedo = [0.0143, 0.033, 0.0639]), "
+      "NganCookTorrance(albedo = [0.0291, 0.0193, 0.0118], eta = 0.117, roughness = 1.37e-2))\r\n"
+      "x = NganLafortune(Cxy = -0.577, sharpness = 4060.0)\n",
+      "t.fit");
+  ASSERT_EQ(fits.size(), 2u);
+  EXPECT_EQ(fits[0].material, "blue-acrylic");
+  EXPECT_EQ(fits[0].line, 3u);
+  ASSERT_EQ(fits[0].lobes.size(), 2u);
+  EXPECT_EQ(fits[0].lobes[0].model, "Lambertian");
+  EXPECT_EQ(fits[0].lobes[0].params[0].second, (std::vector<double>{0.0143, 0.033, 0.0639}));
+  EXPECT_EQ(fits[0].lobes[1].model, "NganCookTorrance");
+  EXPECT_EQ(fits[0].lobes[1].params[2].first, "roughness");
+  EXPECT_EQ(fits[0].lobes[1].params[2].second, (std::vector<double>{0.0137}));
+  ASSERT_EQ(fits[1].lobes.size(), 1u);
+  EXPECT_EQ(fits[1].lobes[0].params[0].second, (std::vector<double>{-0.577}));
+}
+
+void expect_error(const std::string& text, const std::string& words) {
+  try {
+    parse_published_fits(text, "bad.fit");
+    ADD_FAILURE() << text << ": no error; expected " << words;
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    EXPECT_EQ(e.file(), "bad.fit");
+  }
+}
+
+TEST(PublishedFits, MalformedLinesAreErrorsNamingTheLineAndColumn) {
+  expect_error("a = Aggregate(Lambertian(albedo = [0.1, 0.2, 0.3])",
+               "line 1, column 51: expected ')'");
+  expect_error("# c\na = Ward(alpha = )", "line 2, column 18: expected a finite number");
+  expect_error("a = Ward(alpha = nan)", "finite number");
+  expect_error("a = Ward(alpha = 1e999)", "finite number");
+  expect_error("a Ward(alpha = 1)", "expected '='");
+  expect_error("a = Ward(alpha = 1, alpha = 2)", "parameter 'alpha' repeated");
+  expect_error("a = Ward(alpha = 1) junk", "unexpected text");
+  expect_error("a = Ward(alpha = [0.1, 0.2)", "expected ']'");
+  expect_error("a = Ward(alpha = 1)\na = Ward(alpha = 2)", "line 2: material 'a' repeated");
+  EXPECT_THROW(read_published_fits("/nonexistent/x.fit"), FormatError);
+}
+
+TEST(PublishedFits, EveryFileOfTheSharedData) {
+  HALFBACK_REQUIRE_SHARED(dir, "fits");
+  std::size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    if (e.path().extension() != ".fit") continue;
+    ++files;
+    const auto fits = read_published_fits(e.path());
+    SCOPED_TRACE(e.path().string());
+    EXPECT_EQ(fits.size(), 86u);  // 88 lines: two comments and 86 materials
+    for (const PublishedFit& f : fits) {
+      ASSERT_EQ(f.lobes.size(), 2u) << f.material;
+      EXPECT_EQ(f.lobes[0].model, "Lambertian");
+      EXPECT_EQ(f.lobes[0].params.at(0).second.size(), 3u);
+    }
+  }
+  EXPECT_EQ(files, 7u);
+}
+
+}  // namespace
+}  // namespace halfback::fit

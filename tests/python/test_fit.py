@@ -1,0 +1,58 @@
+"""halfback.fit: the fitted spec reads back, parameters are recovered, errors are Python errors."""
+
+import threading
+
+import numpy as np
+import pytest
+
+import halfback
+
+
+def test_fit_recovers_a_lambert_plus_ggx_sum_and_its_spec_loads():
+    truth = "lambert:albedo_r=0.6,albedo_g=0.2,albedo_b=0.1+ggx:alpha=0.08,f0_r=0.95,f0_g=0.7,f0_b=0.4"
+    r = halfback.fit(truth, "lambert+ggx", samples=2000, threads=1)
+    assert r["loss"] == "ngan" and r["layout"] == "halfdiff-halton" and r["samples"] == 2000
+    assert r["loss_value"] < 1e-12
+    values = {(p["model"], p["name"]): p["value"] for p in r["parameters"] if p["fitted"]}
+    assert values[("ggx", "alpha")] == pytest.approx(0.08, rel=1e-4)
+    assert values[("lambert", "albedo_g")] == pytest.approx(0.2, rel=1e-4)
+    wi = np.array([[0.6, 0.0, 0.8]])
+    wo = np.array([[-0.48, 0.36, 0.8]])
+    np.testing.assert_allclose(
+        halfback.load(r["spec"]).eval(wi, wo), halfback.load(truth).eval(wi, wo), rtol=1e-4
+    )
+    # A Brdf object is a target too.
+    assert halfback.fit(halfback.load("ggx:alpha=0.3"), "ggx", samples=500)["spec"].startswith("ggx:")
+
+
+def test_fit_errors():
+    with pytest.raises(ValueError, match="phong"):
+        halfback.fit("ggx", "phong", samples=500)
+    with pytest.raises(ValueError, match="loss 'l2'"):
+        halfback.fit("ggx", "ggx", loss="l2", samples=500)
+    with pytest.raises(RuntimeError, match="zero at all"):
+        halfback.fit("lambert:albedo=0", "ggx", samples=500)
+    with pytest.raises(RuntimeError, match="anisotropic"):
+        halfback.fit("ggx:alpha_x=0.1,alpha_y=0.3", "ggx", samples=500)
+
+
+def test_fit_releases_the_gil():
+    # While one thread is inside fit (about a second of work), this thread keeps running Python
+    # code: with the GIL held for the whole call, it could not run until the call returned.
+    started = threading.Event()
+    done = []
+
+    def work():
+        started.set()
+        done.append(halfback.fit("embedded:pink-felt", "lambert+ggx", samples=4000, threads=1))
+
+    t = threading.Thread(target=work)
+    t.start()
+    started.wait()
+    turns = 0
+    while t.is_alive() and turns < 1000:
+        turns += 1
+        threading.Event().wait(0.0005)  # yields the GIL, runs again when it gets it back
+    t.join()
+    assert done and done[0]["spec"].startswith("lambert:")
+    assert turns >= 20, "the main thread did not run during fit: the GIL was held"
