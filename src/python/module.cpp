@@ -115,12 +115,37 @@ struct Wanted {
   bool result = false, valid = false, jacobian = false;
 };
 
+// The bytes an array's elements span, [first, last).
+std::pair<const char*, const char*> byte_span(const py::array& a) {
+  const char* first = static_cast<const char*>(a.data());
+  const char* last = first + a.itemsize();
+  for (py::ssize_t k = 0; k < a.ndim(); ++k) {
+    if (a.shape(k) == 0) return {first, first};
+    const py::ssize_t reach = (a.shape(k) - 1) * a.strides(k);
+    (reach < 0 ? first : last) += reach;
+  }
+  return {first, last};
+}
+
+// Whether `out` shares memory with x other than as x itself (same start, shape and strides: the
+// engine then reads each row before writing it). A row of out written before a later row of x
+// is read gave wrong answers (issue 35, class D: errors up to 6): x is then copied first.
+bool overlaps_unsafely(const py::array& x, const py::array& out) {
+  const auto [a0, a1] = byte_span(x);
+  const auto [b0, b1] = byte_span(out);
+  if (!(a0 < b1 && b0 < a1)) return false;
+  const bool same = x.data() == out.data() && x.ndim() == out.ndim() &&
+                    std::equal(x.shape(), x.shape() + x.ndim(), out.shape()) &&
+                    std::equal(x.strides(), x.strides() + x.ndim(), out.strides());
+  return !same;
+}
+
 template <class T>
 Outputs run(const py::array& x_any, Form from, Form to, Wanted want,
             const py::object& out_obj = py::none()) {
   const bool want_result = want.result, want_jacobian = want.jacobian;
   // A view when x is already an aligned array of T with element-multiple strides; else one copy.
-  const auto x = py::array_t<T>::ensure(x_any);
+  auto x = py::array_t<T>::ensure(x_any);
   if (!x) throw py::type_error("x must be convertible to a floating-point array");
   if (x.strides(0) % py::ssize_t(sizeof(T)) != 0 || x.strides(1) % py::ssize_t(sizeof(T)) != 0)
     throw py::value_error("x has strides that are not a multiple of its item size");
@@ -142,6 +167,8 @@ Outputs run(const py::array& x_any, Form from, Form to, Wanted want,
     if (result.strides(0) % py::ssize_t(sizeof(T)) != 0 ||
         result.strides(1) % py::ssize_t(sizeof(T)) != 0)
       throw py::value_error("out has strides that are not a multiple of its item size");
+    if (overlaps_unsafely(x, result))
+      x = py::array_t<T>::ensure(py::array(x).attr("copy")());  // read from a copy
   } else {
     result = py::array_t<T>({static_cast<py::ssize_t>(n), want_result ? dim_out : py::ssize_t(0)});
   }
@@ -466,7 +493,8 @@ isotropic: use the 3-coordinate isotropic form of every parameterization side.
 Returns an array of the same dtype (float32 stays float32, anything else becomes float64); rows
 whose input is invalid (not unit, below the horizon, outside the domain, NaN) are NaN.
 out: an existing (N, dim) array of the result's dtype to write into (and return), e.g. to convert
-many batches without allocating.)doc");
+many batches without allocating; when it overlaps x (other than being x itself), x is copied
+first, so the result is always that of a separate out.)doc");
 
   m.def(
       "valid",

@@ -221,3 +221,33 @@ def test_parameterizations_describe_every_space_and_the_stubs_name_them():
     public = [n for n in dir(halfback._core) if not n.startswith("_")]
     missing = [n for n in public if not re.search(rf"^(def|class) {n}\b", stubs, re.M)]
     assert missing == []
+
+
+def test_out_overlapping_the_input_gives_the_separate_result():
+    # Issue 35, class D: out sharing x's memory (one row ahead, strides swapped) gave errors up
+    # to 6; x is copied first, so every layout gives the result of a separate out.
+    from numpy.lib.stride_tricks import as_strided
+
+    rng = np.random.default_rng(7)
+
+    def unit_rows(k):
+        v = rng.normal(size=(k, 3))
+        v[:, 2] = np.abs(v[:, 2]) + 0.05
+        return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+    q = halfback.convert(np.hstack([unit_rows(1000), unit_rows(1000)]), "dirs", "halfdiff")
+    q = q[halfback.valid(q, "halfdiff")][:500]
+    n = len(q)
+    expected = halfback.convert(q, "halfdiff", "spherical")
+    same = q.copy()
+    np.testing.assert_allclose(halfback.convert(same, "halfdiff", "spherical", out=same), expected, rtol=0, atol=1e-12)
+    buf = np.zeros((n + 1, 4))
+    buf[:-1] = q  # input b[:-1], out b[1:]: out one row ahead
+    got = halfback.convert(buf[:-1], "halfdiff", "spherical", out=buf[1:])
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
+    flat = np.zeros(4 * n)
+    x = as_strided(flat, shape=(n, 4), strides=(32, 8))
+    x[:] = q
+    out = as_strided(flat, shape=(n, 4), strides=(8, 8 * n))  # the same bytes, other strides
+    got = halfback.convert(x, "halfdiff", "spherical", out=out)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
