@@ -169,12 +169,8 @@ void harden_options(CLI::App& app) {
 }
 
 CLI::Validator non_negative_integer() {
-  return CLI::Validator(
-      [](std::string& value) -> std::string {
-        const std::string e = whole_number_error(value, false);
-        return e;
-      },
-      "INT >= 0", "non-negative integer");
+  return CLI::Validator([](std::string& value) { return whole_number_error(value, false); },
+                        "INT >= 0", "non-negative integer");
 }
 
 CLI::Validator space_name_validator() {

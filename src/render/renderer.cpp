@@ -25,6 +25,10 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kOrthoHalfHeight = 1.25;
 constexpr double kCameraDistance = 4.5, kPerspectiveFov = 30;
+// tan(fov/2) of the perspective camera (sphere_point's tan_persp).
+double perspective_tan() {
+  return std::tan(0.5 * kPerspectiveFov * kPi / 180);
+}
 constexpr int kTile = 16;
 
 using V3 = Vec3<double>;
@@ -151,7 +155,7 @@ class Renderer {
         two_over_width_(2.0 / s.width),
         two_over_height_(2.0 / s.height),
         tan_bg_(std::tan(0.5 * s.background_fov_deg * kPi / 180)),
-        tan_persp_(std::tan(0.5 * kPerspectiveFov * kPi / 180)) {
+        tan_persp_(perspective_tan()) {
     for (std::uint32_t d = 0; d < kPairs; ++d) keys_[d] = detail::dimension_key(s.seed, d);
   }
 
@@ -487,7 +491,7 @@ RenderResult render_point_light(const Brdf& brdf, const Vec3<double>& light,
   const auto start = Clock::now();
   const int k = std::max(1, int(std::sqrt(double(s.spp))));  // k × k positions in each pixel
   const double aspect = double(s.width) / s.height;
-  const double tan_persp = std::tan(0.5 * kPerspectiveFov * kPi / 180);
+  const double tan_persp = perspective_tan();
   RenderResult r;
   r.image.width = s.width;
   r.image.height = s.height;

@@ -1,11 +1,10 @@
 """halfback.fit: the fitted spec reads back, parameters are recovered, errors are Python errors."""
 
-import threading
-
 import numpy as np
 import pytest
 
 import halfback
+from helpers import main_thread_turns_during
 
 
 def test_fit_recovers_a_lambert_plus_ggx_sum_and_its_spec_loads():
@@ -39,20 +38,7 @@ def test_fit_errors():
 def test_fit_releases_the_gil():
     # While one thread is inside fit (about a second of work), this thread keeps running Python
     # code: with the GIL held for the whole call, it could not run until the call returned.
-    started = threading.Event()
-    done = []
-
-    def work():
-        started.set()
-        done.append(halfback.fit("embedded:pink-felt", "lambert+ggx", samples=4000, threads=1))
-
-    t = threading.Thread(target=work)
-    t.start()
-    started.wait()
-    turns = 0
-    while t.is_alive() and turns < 1000:
-        turns += 1
-        threading.Event().wait(0.0005)  # yields the GIL, runs again when it gets it back
-    t.join()
-    assert done and done[0]["spec"].startswith("lambert:")
+    result, turns = main_thread_turns_during(
+        lambda: halfback.fit("embedded:pink-felt", "lambert+ggx", samples=4000, threads=1))
+    assert result["spec"].startswith("lambert:")
     assert turns >= 20, "the main thread did not run during fit: the GIL was held"

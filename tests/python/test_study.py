@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import halfback
+from helpers import main_thread_turns_during
 
 # Small settings: a few seconds per BRDF. Without the learned design, each BRDF's study is
 # independent of the others (LEARNED below: with it, from the profiles of all of them).
@@ -145,24 +146,9 @@ def test_merge_equals_one_cli_run(local, tmp_path):
 def test_study_brdf_releases_the_gil():
     # While one thread is inside study_brdf (about a second of work), this thread keeps running
     # Python code: with the GIL held for the whole call, it could not run until the call returned.
-    import threading
-
-    started = threading.Event()
-    done = []
-
-    def work():
-        started.set()
-        done.append(halfback.study_brdf("embedded:acrylic_felt_green", SETTINGS))
-
-    t = threading.Thread(target=work)
-    t.start()
-    started.wait()
-    turns = 0
-    while t.is_alive() and turns < 1000:
-        turns += 1
-        threading.Event().wait(0.0005)  # yields the GIL, runs again when it gets it back
-    t.join()
-    assert done and done[0]["gonio"].count("\n") == 33
+    result, turns = main_thread_turns_during(
+        lambda: halfback.study_brdf("embedded:acrylic_felt_green", SETTINGS))
+    assert result["gonio"].count("\n") == 33
     assert turns >= 20, "the main thread did not run during study_brdf: the GIL was held"
 
 
