@@ -28,7 +28,9 @@ for seed in "/api/info?token=t" "/?token=t" "/static/app.js?token=t" \
     "/api/point?token=t&brdf=arg:0&wi=0,0,1&wo=0.6,0,0.8" \
     "/api/point?token=t&brdf=lambert&form=hybrid&iso=1&coords=0.2,0.3,1" \
     "/api/brdf?token=t&brdf=file:../x" "/api/render?token=t&brdf=arg:1&pass=3" \
-    "/api/albedo?token=t&brdf=arg:0&angles=4&n=8" "/api/slices?token=t&brdf=arg:0&pose=45&n=4" \
+    "/api/albedo?token=t&brdf=arg:0&angles=4&n=8" \
+    "/api/fit?token=t&brdf=arg:1&model=lambert%2Bggx:f0=0.9&loss=low-e2&samples=100" \
+    "/api/slices?token=t&brdf=arg:0&pose=45&n=4" \
     "/api/brdf?token=t&brdf=lambert:albedo=0.3%2Bggx:alpha=0.1%2Bfile:../x" \
     $'/api/info\ncookie: halfback_token_8765=t\norigin: http://127.0.0.1:8765'; do
   printf '%s' "$seed" > "$corpus/view/seed$k"

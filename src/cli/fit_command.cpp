@@ -7,7 +7,7 @@
 #include "command.hpp"
 #include "halfback/fit/fit.hpp"
 #include "halfback/loader/load.hpp"
-#include "view/json.hpp"
+#include "view/fit_json.hpp"
 
 namespace halfback::cli {
 
@@ -18,37 +18,6 @@ struct FitCommandOptions {
   std::size_t samples = 20000;
   int threads = 0;
 };
-
-// The unit of a parameter, where it has one (docs/fit.md); dimensionless otherwise.
-std::string_view unit_of(std::string_view model, std::string_view param) {
-  if (model == "abc" && param == "a") return "1/sr";
-  return "1";
-}
-
-std::string fit_json(const fit::FitResult& r, const FitCommandOptions& o) {
-  view::JsonWriter j;
-  j.begin_object();
-  j.field("brdf", o.brdf).field("model", o.model).field("spec", r.spec);
-  j.key("loss").begin_object();
-  j.field("name", fit::name_of(r.loss)).field("value", r.loss_value).end_object();
-  j.key("samples").begin_object();
-  j.field("layout", fit::kLayoutName).field("count", r.samples).end_object();
-  j.key("terms").begin_array();
-  for (std::size_t t = 0; t < r.model.terms.size(); ++t) {
-    j.begin_object().field("model", r.model.terms[t]).key("parameters").begin_array();
-    for (const fit::Param& p : r.model.params) {
-      if (p.term != t) continue;
-      j.begin_object().field("name", p.name).field("value", p.value);
-      j.field("unit", unit_of(r.model.terms[t], p.name)).field("fitted", p.fitted);
-      j.field("min", p.min).field("max", p.max).end_object();
-    }
-    j.end_array().end_object();
-  }
-  j.end_array();
-  j.field("starts", r.starts).field("iterations", r.iterations).field("seconds", r.seconds);
-  j.end_object();
-  return j.str() + "\n";
-}
 
 int run_fit(const FitCommandOptions& o) {
   if (o.output == "-")
@@ -73,7 +42,9 @@ int run_fit(const FitCommandOptions& o) {
   } catch (const std::invalid_argument& e) {  // a model with nothing to fit
     throw UsageError(fmt::format("--model: {}", e.what()));
   }
-  out.write(fit_json(r, o));
+  view::JsonWriter j;
+  view::write_fit(j, r, o.brdf, o.model);
+  out.write(j.str() + "\n");
   out.commit();
   fmt::print("{}\n", r.spec);
   fmt::print(stderr,

@@ -85,6 +85,7 @@ std::vector<std::pair<std::string, std::string>> parse_query(std::string_view qu
 struct Api::State {
   ApiConfig config;
   Catalog catalog;
+  std::atomic<int> fits_running = 0;
   explicit State(ApiConfig c) : config(std::move(c)), catalog(config.specs, config.roots) {}
 };
 
@@ -223,7 +224,8 @@ std::optional<Response> asset(std::string_view name) {
   return std::nullopt;
 }
 
-Response route(const Catalog& catalog, const Request& r, const ApiConfig& c) {
+Response route(const Catalog& catalog, const Request& r, const ApiConfig& c,
+               std::atomic<int>& fits_running) {
   const std::string& p = r.path;
   if (p == "/" || p == "/index.html") {
     Response res = *asset("index.html");
@@ -243,6 +245,7 @@ Response route(const Catalog& catalog, const Request& r, const ApiConfig& c) {
   if (p == "/api/point") return point_response(catalog, r);
   if (p == "/api/render") return render_response(catalog, r, c.threads);
   if (p == "/api/pointlight") return point_light_response(catalog, r, c.threads);
+  if (p == "/api/fit") return fit_response(catalog, r, c.threads, fits_running);
   return error(404, fmt::format("no such resource '{}'", p.substr(0, 128)));
 }
 
@@ -259,7 +262,7 @@ Response Api::handle(const Request& request) const {
     else if (auto refused = refusal(request, c))
       res = std::move(*refused);
     else
-      res = route(state_->catalog, request, c);
+      res = route(state_->catalog, request, c, state_->fits_running);
   } catch (const RequestError& e) {
     res = error(e.status(), e.what());
   } catch (const FormatError& e) {

@@ -15,6 +15,7 @@
 #include "fields.hpp"
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/core/batch.hpp"
+#include "halfback/fit/fit.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/renderer.hpp"
 #include "json.hpp"
@@ -86,7 +87,8 @@ TEST(ViewApi, TokenIsRequiredFromQueryOrCookie) {
 TEST(ViewApi, EveryEndpointChecksTokenOriginAndHost) {
   Api api(config());
   for (const char* path : {"/api/info", "/api/brdf", "/api/slices", "/api/hemisphere", "/api/polar",
-                           "/api/point", "/api/render", "/api/albedo", "/api/pointlight"}) {
+                           "/api/point", "/api/render", "/api/albedo", "/api/pointlight",
+                           "/api/fit"}) {
     Request r = get(path, {{"brdf", "arg:0"}});
     r.query.pop_back();  // the token
     EXPECT_TRUE(has_error(api.handle(r), 403, "token")) << path;
@@ -358,6 +360,42 @@ TEST(ViewApi, AlbedoCurveIsTheLibrarysEstimate) {
   EXPECT_TRUE(has_error(albedo({{"brdf", kSpec}, {"angles", "1"}}), 400, "angles"));
   EXPECT_TRUE(has_error(albedo({{"brdf", kSpec}, {"n", "100000"}}), 400, "'n'"));
   EXPECT_TRUE(has_error(albedo({}), 400, "brdf"));
+}
+
+// /api/fit: fit::fit's result under the request's model, loss and sample count (the same spec to
+// the last bit), a model recovered from its own values, its spec loadable; every bad parameter
+// named.
+TEST(ViewApi, FitIsTheLibrarysFit) {
+  Api api(config());
+  const auto fit = [&](std::vector<std::pair<std::string, std::string>> q) {
+    return api.handle(get("/api/fit", std::move(q)));
+  };
+  const Response r = fit({{"brdf", "arg:0"}, {"model", "ggx"}, {"loss", "low-e2"}, {"samples", "500"}});
+  ASSERT_EQ(r.status, 200) << r.body;
+  fit::FitOptions o;
+  o.loss = fit::Loss::low_e2;
+  o.samples = 500;
+  o.threads = 1;
+  const fit::FitResult direct = fit::fit(*load_brdf(kSpec), "ggx", o);
+  EXPECT_NE(r.body.find(fmt::format("\"spec\":\"{}\"", direct.spec)), std::string::npos) << r.body;
+  EXPECT_NE(r.body.find("\"loss\":{\"name\":\"low-e2\""), std::string::npos) << r.body;
+  EXPECT_NEAR(direct.model.params[0].value, 0.3, 1e-4);  // alpha of ggx:alpha=0.3,f0=0.9
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", direct.spec}})).status, 200);
+
+  const auto with = [](std::string key, std::string value) {
+    std::vector<std::pair<std::string, std::string>> q = {
+        {"brdf", "arg:0"}, {"model", "ggx"}, {"samples", "500"}};
+    for (auto& [k, v] : q)
+      if (k == key) v = value;
+    if (key == "loss") q.emplace_back(key, value);
+    return q;
+  };
+  EXPECT_TRUE(has_error(fit(with("loss", "l2")), 400, "'loss'"));
+  EXPECT_TRUE(has_error(fit(with("model", "no-such-model")), 400, "no-such-model"));
+  EXPECT_TRUE(has_error(fit(with("model", std::string(kMaxSpecBytes + 1, 'a'))), 413, "model"));
+  EXPECT_TRUE(has_error(fit(with("samples", std::to_string(kMaxFitSamples + 1))), 400, "'samples'"));
+  EXPECT_TRUE(has_error(fit(with("brdf", "lambert:albedo=0")), 422, "cannot be fitted"));
+  EXPECT_TRUE(has_error(fit({{"brdf", "arg:0"}}), 400, "'model'"));
 }
 
 // /api/pointlight: render_point_light's image, the light given in degrees; bounded sizes.

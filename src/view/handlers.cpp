@@ -10,10 +10,12 @@
 #include <span>
 
 #include "fields.hpp"
+#include "fit_json.hpp"
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
+#include "halfback/fit/fit.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/renderer.hpp"
 #include "json.hpp"
@@ -227,8 +229,11 @@ Response info_response(const Catalog& catalog) {
   for (const std::string& f : files.environments) w.value("file:" + f);
   w.end_array().key("limits").begin_object();
   w.field("grid", kMaxGridSide).field("polar", kMaxPolarSamples);
-  w.field("render", kMaxRenderSide).field("spp", kMaxRenderSpp).end_object();
-  w.end_object();
+  w.field("render", kMaxRenderSide).field("spp", kMaxRenderSpp);
+  w.field("fit_samples", kMaxFitSamples).end_object();
+  w.key("losses").begin_array();
+  for (const fit::Loss l : fit::kLosses) w.value(fit::name_of(l));
+  w.end_array().end_object();
   return json(w);
 }
 
@@ -455,6 +460,60 @@ Response point_light_response(const Catalog& catalog, const Request& request, in
   Response res = floats(result.image.rgb, std::size_t(s.width), std::size_t(s.height), 3);
   res.headers.emplace_back("X-Halfback-Spp", std::to_string(result.spp));
   return res;
+}
+
+namespace {
+
+// Counts a fit in progress for its lifetime; a second one at the same time is refused (503).
+class FitSlot {
+ public:
+  explicit FitSlot(std::atomic<int>& running) : running_(running) {
+    if (running_.fetch_add(1) > 0) {
+      running_.fetch_sub(1);
+      throw RequestError(503, "another fit is running (one at a time): try again when it ends");
+    }
+  }
+  ~FitSlot() { running_.fetch_sub(1); }
+  FitSlot(const FitSlot&) = delete;
+  FitSlot& operator=(const FitSlot&) = delete;
+
+ private:
+  std::atomic<int>& running_;
+};
+
+}  // namespace
+
+// The model of `model=` (a sum of lobes of the registry) fitted to `brdf=` under `loss=`, with
+// `samples=` pairs (docs/fit.md); the answer is the JSON `halfback fit` writes.
+Response fit_response(const Catalog& catalog, const Request& request, int threads,
+                      std::atomic<int>& running) {
+  const std::string& spec = required(request, "brdf");
+  const std::string& model = required(request, "model");
+  if (model.size() > kMaxSpecBytes)
+    throw RequestError(413, fmt::format("model longer than {} bytes", kMaxSpecBytes));
+  fit::FitOptions options;
+  const std::string* loss = request.param("loss");
+  if (loss) {
+    const auto parsed = fit::parse_loss(*loss);
+    if (!parsed)
+      throw RequestError(400, fmt::format("parameter 'loss': '{}' is not one of {}",
+                                          loss->substr(0, 64), fit::loss_names()));
+    options.loss = *parsed;
+  }
+  options.samples = whole(request, "samples", 5000, 100, kMaxFitSamples);
+  options.threads = threads;
+  (void)fit::parse_model(model);  // a bad model is a 400 before the BRDF is loaded
+  const BrdfPtr target = catalog.brdf(spec);
+  const FitSlot slot(running);
+  fit::FitResult result;
+  try {
+    result = fit::fit(*target, model, options);
+  } catch (const fit::FitDataError& e) {
+    throw RequestError(422, fmt::format("'{}' cannot be fitted: {}", spec.substr(0, 128), e.what()));
+  }
+  JsonWriter w;
+  write_fit(w, result, spec, model);
+  return json(w);
 }
 
 }  // namespace halfback::view

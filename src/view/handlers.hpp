@@ -3,6 +3,8 @@
 // turns that and the library's own exceptions into responses.
 #pragma once
 
+#include <atomic>
+
 #include "catalog.hpp"
 #include "halfback/view/api.hpp"
 
@@ -17,5 +19,8 @@ Response albedo_response(const Catalog& catalog, const Request& request, int thr
 Response point_response(const Catalog& catalog, const Request& request);
 Response render_response(const Catalog& catalog, const Request& request, int threads);
 Response point_light_response(const Catalog& catalog, const Request& request, int threads);
+// `running` counts the fits in progress: a request made while one runs is answered 503.
+Response fit_response(const Catalog& catalog, const Request& request, int threads,
+                      std::atomic<int>& running);
 
 }  // namespace halfback::view

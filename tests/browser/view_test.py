@@ -15,6 +15,7 @@ Usage: view_test.py --halfback PATH [--screenshots DIR] [--measure-only]
 import argparse
 import csv
 import io
+import json
 import os
 import re
 import signal
@@ -614,6 +615,67 @@ def check_point_light(driver):
           f"the point light's highlight follows ωo (φo = 0°: x = {right[0]}, 180°: x = {left[0]})")
 
 
+def check_fit(driver, halfback, screenshots):
+    """Issue 34: a measured BRDF and its fit overlaid: the page's fit is `halfback fit`'s, its
+    parameters are listed, it is the compare BRDF of every plot, and a fit with another model and
+    loss replaces it."""
+    select_brdf(driver, "arg:1")  # embedded:pink-felt, measured (RGL)
+
+    def fit(model, loss):
+        driver.execute_script("""document.getElementById('fit-model').value = arguments[0];
+            document.getElementById('fit-loss').value = arguments[1];""", model, loss)
+        before = driver.execute_script("const f = window.halfback.fit(); return f && f.spec;")
+        driver.find_element(By.ID, "fit-run").click()
+        WebDriverWait(driver, 120).until(lambda d: d.execute_script(
+            "const f = window.halfback.fit(); return f && f.spec !== arguments[0];", before))
+        time.sleep(0.3)
+        wait_idle(driver)
+        return driver.execute_script("return window.halfback.fit();")
+
+    got = fit("lambert+ggx", "ngan")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "fit.json")
+        printed = subprocess.run([halfback, "fit", "--brdf", "embedded:pink-felt", "--model",
+                                  "lambert+ggx", "--loss", "ngan", "--samples", "5000", "-o", out],
+                                 capture_output=True, text=True, check=True).stdout.strip()
+        with open(out, encoding="utf-8") as f:
+            cli = json.load(f)
+    values = lambda r: [p["value"] for t in r["terms"] for p in t["parameters"]]
+    check(all(close(a, b, 1e-6) for a, b in zip(values(got), values(cli))) and
+          close(got["loss"]["value"], cli["loss"]["value"], 1e-6),
+          f"the page's fit is halfback fit's ({got['spec']} vs {printed})")
+    state = driver.execute_script("return window.halfback.state;")
+    check(state["b"] == got["spec"] and state["mode"] == "diff",
+          f"the fit is the compare BRDF, shown as the difference ({state['b'][:40]}, {state['mode']})")
+    table = driver.find_element(By.ID, "fit-result").text
+    names = [p["name"] for t in got["terms"] for p in t["parameters"]]
+    check(all(n in table for n in names) and "ngan loss" in table and f"{got['starts']} starts" in table,
+          f"the fit's parameters, loss and starts are listed ({names})")
+    shown = [f"{float(v):.6g}" for v in re.findall(r"^\S+ \S+ ([-0-9.e]+)", table, re.M)]
+    check(shown == [f"{v:.6g}" for v in values(got)], f"the listed values are the fit's ({shown})")
+    for plot in ["polar", "albedo"]:
+        legend = driver.find_element(By.ID, plot).text
+        check("fit of embedded:pink-felt: lambert+ggx (ngan)" in legend,
+              f"the {plot} plot overlays the fit with its name ({legend[-80:]!r})")
+    panel = driver.find_element(By.ID, "fit-panel")
+    driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", panel)
+    panel.screenshot(os.path.join(screenshots, "view-fit.png"))
+    driver.find_element(By.ID, "polar-panel").screenshot(os.path.join(screenshots, "view-fit-polar.png"))
+    slices = driver.find_element(By.ID, "slices-panel")
+    driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", slices)
+    slices.screenshot(os.path.join(screenshots, "view-fit-difference.png"))
+
+    again = fit("ggx", "low-e2")
+    table = driver.find_element(By.ID, "fit-result").text
+    check(again["loss"]["name"] == "low-e2" and again["model"] == "ggx" and "albedo_r" not in table
+          and "low-e2 loss" in table and driver.execute_script("return window.halfback.state.b;") == again["spec"],
+          f"a fit with another model and loss replaces the first ({again['spec'][:60]})")
+    select_brdf(driver, "arg:0")
+    driver.execute_script("""const s = document.getElementById('brdf-b');
+        s.value = 'arg:1'; s.dispatchEvent(new Event('change'));""")
+    wait_idle(driver)
+
+
 def browser_checks(args, base, token, spec):
     driver = make_driver()
     driver.set_script_timeout(300)
@@ -700,6 +762,7 @@ def browser_checks(args, base, token, spec):
         check_exports(driver, spec, args.screenshots)
         check_lobe(driver, token)
         check_albedo(driver, args.halfback)
+        check_fit(driver, args.halfback, args.screenshots)
         albedo_panel = driver.find_element(By.ID, "albedo-panel")
         driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", albedo_panel)
         albedo_panel.screenshot(os.path.join(args.screenshots, "view-albedo.png"))

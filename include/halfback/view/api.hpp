@@ -32,6 +32,9 @@ inline constexpr std::size_t kMaxPolarSamples = 2001;  // polar plot samples per
 // The albedo plot: angles θi (from 0° to 89°) and samples per axis of each estimate (n², as
 // `halfback info --albedo-samples`): at the limits 181 × 256² ≈ 12 M evaluations a request.
 inline constexpr std::size_t kMaxAlbedoAngles = 181, kMaxAlbedoSamples = 256;
+// A fit (/api/fit): at most this many sample pairs (about 1 s for an embedded material, 6 starts),
+// and one fit at a time in the server (a second one is answered 503 while the first runs).
+inline constexpr std::size_t kMaxFitSamples = 20000;
 inline constexpr int kMaxRenderSide = 512;             // sphere render side
 inline constexpr int kMaxRenderSpp = 64;               // samples per pixel of one pass
 inline constexpr std::size_t kMaxBrdfsPerRequest = 8;  // brdf= repeated in /api/point

@@ -551,6 +551,7 @@ function polarCursorAngle() {
 
 // What a user recognizes: a BRDF named on the command line by its spec, not by its "arg:N" id.
 function specLabel(spec) {
+  if (fitLabels.has(spec)) return fitLabels.get(spec);
   const arg = /^arg:(\d+)$/.exec(spec);
   return arg && info && info.specs[Number(arg[1])] !== undefined ? info.specs[Number(arg[1])] : spec;
 }
@@ -849,7 +850,53 @@ function setup() {
   setupLobe();
   setupPolar();
   setupExports();
+  setupFit();
 }
+
+// --- fit ---------------------------------------------------------------------------------------
+const fitLabels = new Map();  // a fitted spec -> "fit of TARGET: MODEL (LOSS)"
+let fitAnswer = null;  // the last /api/fit answer (the JSON `halfback fit` writes)
+function setupFit() {
+  for (const m of info.models) $('fit-models').append(new Option(m.description, m.name));
+  $('fit-models').append(new Option('diffuse + specular lobe', 'lambert+ggx'));
+  for (const l of info.losses) $('fit-loss').append(new Option(l, l));
+  $('fit-form').addEventListener('submit', (e) => { e.preventDefault(); runFit(); });
+}
+async function runFit() {
+  const target = state.a, model = $('fit-model').value.trim(), loss = $('fit-loss').value;
+  if (!model) return setStatus('fit: name a model (lambert+ggx, ggx, …)', true);
+  $('fit-run').disabled = true;
+  setStatus(`fitting ${model} to ${specLabel(target)} (${loss}) …`);
+  try {
+    const r = await getJson(null, '/api/fit', [['brdf', target], ['model', model], ['loss', loss], ['samples', $('fit-samples').value]]);
+    fitAnswer = r;
+    fitLabels.set(r.spec, `fit of ${specLabel(target)}: ${model} (${loss})`);
+    state.b = r.spec;
+    ensureOption($('brdf-b'), r.spec, fitLabels.get(r.spec));
+    if (state.mode === 'a') { state.mode = 'diff'; $('mode').value = 'diff'; }
+    showFit();
+    setStatus(`fitted ${model} to ${specLabel(target)}: ${loss} loss ${r.loss.value.toPrecision(4)} in ${r.seconds.toFixed(2)} s`);
+    changed();
+  } catch (e) {
+    setStatus(`fit: ${e.message}`, true);
+  } finally {
+    $('fit-run').disabled = false;
+  }
+  return undefined;
+}
+// The fitted parameters by term (held ones dimmed), the loss and what the fit did.
+function showFit() {
+  const r = fitAnswer, box = $('fit-result');
+  const rows = r.terms.flatMap((t) => t.parameters.map((p) => `<tr><th>${escapeHtml(t.model)}</th><th>${escapeHtml(p.name)}</th>`
+    + `<td${p.fitted ? '' : ' class="held"'}>${Number(p.value.toPrecision(6))}</td><td>${escapeHtml(p.unit)}</td>`
+    + `<td${p.fitted ? '' : ' class="held"'}>${p.fitted ? 'fitted' : 'held'}</td><td>[${p.min}, ${p.max}]</td></tr>`));
+  box.innerHTML = `<p class="note">${swatch(1)} fit of ${escapeHtml(specLabel(r.brdf))}: ${escapeHtml(r.loss.name)} loss `
+    + `${r.loss.value.toPrecision(4)}; ${r.samples.count} samples (${escapeHtml(r.samples.layout)}), ${r.starts} starts, `
+    + `${r.iterations} iterations, ${r.seconds.toFixed(2)} s</p>`
+    + `<table><tr class="names"><th>term</th><th>parameter</th><th>value</th><th>unit</th><th></th><th>range</th></tr>${rows.join('')}</table>`
+    + `<p class="spec" title="the fitted spec: every halfback command reads it">${escapeHtml(r.spec)}</p>`;
+}
+window.halfback.fit = () => fitAnswer;
 
 // --- export ------------------------------------------------------------------------------------
 function download(name, blob) {
