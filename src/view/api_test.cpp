@@ -6,11 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <thread>
 
 #include "fields.hpp"
 #include "halfback/brdf/albedo.hpp"
@@ -396,6 +398,38 @@ TEST(ViewApi, FitIsTheLibrarysFit) {
   EXPECT_TRUE(has_error(fit(with("samples", std::to_string(kMaxFitSamples + 1))), 400, "'samples'"));
   EXPECT_TRUE(has_error(fit(with("brdf", "lambert:albedo=0")), 422, "cannot be fitted"));
   EXPECT_TRUE(has_error(fit({{"brdf", "arg:0"}}), 400, "'model'"));
+}
+
+// One fit at a time: while a long fit runs, another request is answered 503 at once (a quick
+// request that would fail as unfittable, 422, otherwise).
+TEST(ViewApi, OneFitAtATime) {
+  Api api(config());
+  std::atomic<bool> done = false;
+  int long_status = 0;
+  std::thread long_fit([&] {
+    do {  // a poll below may hold the slot at the moment this one asks
+      long_status = api.handle(get("/api/fit", {{"brdf", "embedded:pink-felt"},
+                                                {"model", "lambert+ggx"},
+                                                {"samples", "4000"}}))
+                        .status;
+    } while (long_status == 503);
+    done = true;
+  });
+  int refused = 0, polls = 0;
+  while (!done) {
+    const Response r = api.handle(
+        get("/api/fit", {{"brdf", "lambert:albedo=0"}, {"model", "ggx"}, {"samples", "100"}}));
+    ++polls;
+    if (r.status == 503) {
+      ++refused;
+      EXPECT_TRUE(has_error(r, 503, "another fit is running"));
+    } else {
+      EXPECT_EQ(r.status, 422) << r.body;
+    }
+  }
+  long_fit.join();
+  EXPECT_EQ(long_status, 200);
+  EXPECT_GT(refused, 0) << polls << " polls";
 }
 
 // /api/pointlight: render_point_light's image, the light given in degrees; bounded sizes.
