@@ -619,7 +619,8 @@ def check_fit(driver, halfback, screenshots):
     """Issue 34: a measured BRDF and its fit overlaid: the page's fit is `halfback fit`'s, its
     parameters are listed, it is the compare BRDF of every plot, and a fit with another model and
     loss replaces it."""
-    select_brdf(driver, "arg:1")  # embedded:pink-felt, measured (RGL)
+    measured = "embedded:acrylic_felt_green"  # an RGL measurement (the embedded file)
+    select_brdf(driver, measured)
 
     def fit(model, loss):
         driver.execute_script("""document.getElementById('fit-model').value = arguments[0];
@@ -635,7 +636,7 @@ def check_fit(driver, halfback, screenshots):
     got = fit("lambert+ggx", "ngan")
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "fit.json")
-        printed = subprocess.run([halfback, "fit", "--brdf", "embedded:pink-felt", "--model",
+        printed = subprocess.run([halfback, "fit", "--brdf", measured, "--model",
                                   "lambert+ggx", "--loss", "ngan", "--samples", "5000", "-o", out],
                                  capture_output=True, text=True, check=True).stdout.strip()
         with open(out, encoding="utf-8") as f:
@@ -655,7 +656,7 @@ def check_fit(driver, halfback, screenshots):
     check(shown == [f"{v:.6g}" for v in values(got)], f"the listed values are the fit's ({shown})")
     for plot in ["polar", "albedo"]:
         legend = driver.find_element(By.ID, plot).text
-        check("fit of embedded:pink-felt: lambert+ggx (ngan)" in legend,
+        check(f"fit of {measured}: lambert+ggx (ngan)" in legend,
               f"the {plot} plot overlays the fit with its name ({legend[-80:]!r})")
     panel = driver.find_element(By.ID, "fit-panel")
     driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", panel)
