@@ -54,22 +54,20 @@ std::string describe_halfdiff(const DirPair<double>& pair) {
   return s;
 }
 
-std::optional<RhoExcess> find_rho_above_bound(const Brdf& brdf) {
+RhoProbe probe_rho(const Brdf& brdf) {
   const std::vector<DirPair<double>> pairs = probe_pairs(brdf.isotropic());
   std::vector<Rgb> rho(pairs.size());
   brdf.eval_batch(pairs, rho);
-  for (std::size_t p = 0; p < pairs.size(); ++p)
-    if (!rho_within_bound(rho[p])) return RhoExcess{pairs[p], rho[p]};
-  return std::nullopt;
+  RhoProbe r;
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    r.largest = std::max(r.largest, rho[p].max_channel());
+    if (!r.excess && !rho_within_bound(rho[p])) r.excess = RhoExcess{pairs[p], rho[p]};
+  }
+  return r;
 }
 
-double largest_rho_on_probe(const Brdf& brdf) {
-  const std::vector<DirPair<double>> pairs = probe_pairs(brdf.isotropic());
-  std::vector<Rgb> rho(pairs.size());
-  brdf.eval_batch(pairs, rho);
-  double m = 0;
-  for (const Rgb& v : rho) m = std::max(m, v.max_channel());
-  return m;
+std::optional<RhoExcess> find_rho_above_bound(const Brdf& brdf) {
+  return probe_rho(brdf).excess;
 }
 
 void require_rho_bound(const Brdf& brdf, const std::string& why) {

@@ -52,7 +52,8 @@ TEST(RhoBound, ProbeFindsAValueAboveTheBoundAndNamesTheBrdf) {
   }
   const test::FunctionBrdf within([](const DirPair<double>&) { return 1e10; });
   EXPECT_FALSE(find_rho_above_bound(within).has_value());
-  EXPECT_EQ(largest_rho_on_probe(within), 1e10);
+  EXPECT_EQ(probe_rho(within).largest, 1e10);
+  EXPECT_EQ(probe_rho(spike).largest, 1e12);
   EXPECT_NO_THROW(require_rho_bound(within, ""));
 }
 

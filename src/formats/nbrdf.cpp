@@ -220,7 +220,8 @@ void NbrdfBrdf::check_rho_bound() {
         fmt::format("ρ ≤ {:.4g} sr⁻¹ everywhere (interval arithmetic through the layers)", proven);
     return;
   }
-  if (const auto excess = find_rho_above_bound(*this))
+  const RhoProbe probe = probe_rho(*this);
+  if (const auto& excess = probe.excess)
     throw FormatError(
         network_.source, "network",
         rho_above_bound(excess->rho.max_channel(), describe_halfdiff(excess->pair)) +
@@ -228,7 +229,7 @@ void NbrdfBrdf::check_rho_bound() {
   rho_bound_ = fmt::format(
       "within the bound of {:g} sr⁻¹ on the probe set (largest {:.4g} sr⁻¹); "
       "not proven everywhere",
-      kMaxRho, largest_rho_on_probe(*this));
+      kMaxRho, probe.largest);
 }
 
 std::string NbrdfBrdf::name() const {

@@ -42,10 +42,14 @@ struct RhoExcess {
 // The probe set: an isotropic halfdiff grid (32 θh, denser near the specular peak, × 32 θd ×
 // 32 φd, φh = 0; for an anisotropic BRDF also φh = π/4, π/2, 3π/4) of the pairs whose directions
 // are both within 89° of the normal (beyond, ρ of many models grows without bound while ρ·cos θ
-// stays finite). The first pair where ρ is above the bound, or none.
-std::optional<RhoExcess> find_rho_above_bound(const Brdf& brdf);
-// The largest channel of ρ over the probe set.
-double largest_rho_on_probe(const Brdf& brdf);
+// stays finite). What one evaluation of it finds: the first pair where ρ is above the bound (or
+// none), and the largest channel of ρ over it.
+struct RhoProbe {
+  std::optional<RhoExcess> excess;
+  double largest = 0;
+};
+RhoProbe probe_rho(const Brdf& brdf);
+std::optional<RhoExcess> find_rho_above_bound(const Brdf& brdf);  // probe_rho(brdf).excess
 
 // (θh, θd, φd, φh) of a pair in degrees: "θh = 1.2°, θd = 30°, φd = 90°" (φh when not 0).
 std::string describe_halfdiff(const DirPair<double>& pair);
