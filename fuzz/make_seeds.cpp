@@ -1,15 +1,20 @@
-// Writes small valid inputs for the fuzzers into DIR/{merl,rgl,alta}/ (see fuzz/run.sh): a
-// synthetic RGL material with tiny grids (RGB and spectral), ALTA files, and MERL headers.
+// Writes small valid inputs for the fuzzers into DIR/{merl,rgl,alta,npy,envmap}/ (see
+// fuzz/run.sh): a synthetic RGL material with tiny grids (RGB and spectral), ALTA files, MERL
+// headers, .npy arrays, environment maps (Radiance and OpenEXR); and of each, a copy with trailing
+// data and one extended by zeros, as `truncate -s` extends a file (issue 35, class C: every reader
+// ends where its header says, and a text reader refuses a NUL byte).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <string>
 #include <vector>
 
 #include "halfback/formats/rgl.hpp"
+#include "halfback/render/image.hpp"
 
 using namespace halfback;
 namespace fs = std::filesystem;
@@ -26,6 +31,14 @@ std::vector<std::byte> le(const std::vector<T>& v) {  // the fuzzers run on litt
 void write(const fs::path& p, const void* data, std::size_t n) {
   std::ofstream(p, std::ios::binary)
       .write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
+  // The same followed by trailing data, and extended by zeros (a sparse extension, shortened to
+  // what the fuzzers' -max_len lets through).
+  std::string junk(static_cast<const char*>(data), n);
+  const fs::path stem = p.parent_path() / p.stem();
+  std::ofstream(stem.string() + "-trailing" + p.extension().string(), std::ios::binary)
+      << junk << "junk";
+  std::ofstream(stem.string() + "-zeros" + p.extension().string(), std::ios::binary)
+      << junk << std::string(2048, '\0');
 }
 
 // `spectral`: the spectral variant, `wavelengths` and `spectra` (3 wavelengths) instead of `rgb`.
@@ -70,7 +83,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path dir = argv[1];
-  for (const char* sub : {"merl", "rgl", "alta", "npy"}) fs::create_directories(dir / sub);
+  for (const char* sub : {"merl", "rgl", "alta", "npy", "envmap"})
+    fs::create_directories(dir / sub);
 
   const auto iso = rgl_material(3, 4, 2, {0.0f});
   write(dir / "rgl" / "iso.bsdf", iso.data(), iso.size());
@@ -115,5 +129,29 @@ int main(int argc, char** argv) {
   const std::string kernel = npy("(6, 3)", 18), bias = npy("(3,)", 3);
   write(dir / "npy" / "kernel.npy", kernel.data(), kernel.size());
   write(dir / "npy" / "bias.npy", bias.data(), bias.size());
+
+  // Environment maps: a flat Radiance file (a width below 8 is never run-length encoded), a
+  // run-length encoded one (width 8), and an OpenEXR file.
+  auto radiance = [](int w, int h, bool rle) {
+    std::string out = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " +
+                      std::to_string(w) + "\n";
+    for (int y = 0; y < h; ++y) {
+      if (rle) {  // per channel: one run of w equal bytes
+        out += std::string{'\x02', '\x02', char(w >> 8), char(w & 0xff)};
+        for (const char c : {'\x80', '\x40', '\x20', '\x81'}) out += std::string{char(128 + w), c};
+      } else {
+        for (int x = 0; x < w; ++x) out += std::string("\x80\x40\x20\x81", 4);
+      }
+    }
+    return out;
+  };
+  const std::string flat = radiance(4, 2, false), rle = radiance(8, 4, true);
+  write(dir / "envmap" / "flat.hdr", flat.data(), flat.size());
+  write(dir / "envmap" / "rle.hdr", rle.data(), rle.size());
+  const fs::path exr = dir / "envmap" / "map.exr";
+  render::write_exr(exr, render::Image{8, 4, std::vector<float>(8 * 4 * 3, 0.5f)});
+  std::ifstream in(exr, std::ios::binary);
+  const std::string exr_bytes((std::istreambuf_iterator<char>(in)), {});
+  write(exr, exr_bytes.data(), exr_bytes.size());
   return 0;
 }

@@ -11,11 +11,21 @@ build="${FUZZ_BUILD_DIR:-build/fuzz}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 
 cmake --preset fuzz -B "$build" >/dev/null
-cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz view_fuzz make_fuzz_seeds
+cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz h5_fuzz envmap_fuzz \
+  view_fuzz make_fuzz_seeds
 
 corpus="$build/corpus"
 mkdir -p "$corpus"
 "$build/fuzz/make_fuzz_seeds" "$corpus"
+# Keras .h5 seeds: the embedded networks, each also with trailing data and extended by zeros.
+mkdir -p "$corpus/h5"
+for h5 in data/nbrdf/*.h5; do
+  name="$(basename "$h5" .h5)"
+  cp "$h5" "$corpus/h5/$name.h5"
+  { cat "$h5"; printf 'junk'; } > "$corpus/h5/$name-trailing.h5"
+  cp "$h5" "$corpus/h5/$name-zeros.h5"
+  truncate -s +2048 "$corpus/h5/$name-zeros.h5"
+done
 # Seeds of the view's request handler: one request per file (fuzz/view_fuzz.cpp).
 mkdir -p "$corpus/view"
 k=0
@@ -40,12 +50,14 @@ artifacts="$build/artifacts"
 mkdir -p "$artifacts"
 
 status=0
-for target in merl rgl alta npy view; do
+for target in merl rgl alta npy h5 envmap view; do
   case "$target" in
     merl) max_len=4096 ;;     # full-size files are built inside the target
     rgl)  max_len=65536 ;;
     alta) max_len=65536 ;;
     npy)  max_len=4096 ;;
+    h5)   max_len=32768 ;;
+    envmap) max_len=32768 ;;
     view) max_len=2048 ;;
   esac
   dict=()

@@ -6,10 +6,9 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 
+#include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 
 namespace halfback::fit {
@@ -134,11 +133,13 @@ std::vector<PublishedFit> parse_published_fits(std::string_view text, const std:
 }
 
 std::vector<PublishedFit> read_published_fits(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FormatError(path.string(), "file", "cannot be read");
-  std::stringstream s;
-  s << in.rdbuf();
-  return parse_published_fits(s.str(), path.string());
+  // Text read line by line within bounds (util/bounded_read.hpp): a NUL byte (binary data, the
+  // zeros of a file extended past its end) or a file above 64 MB (the published ones are 15 KB)
+  // is refused before it is held.
+  TextLines lines(path, std::uint64_t(64) << 20);
+  std::string text;
+  for (std::string_view line; lines.next(line);) (text += line) += '\n';
+  return parse_published_fits(text, path.string());
 }
 
 }  // namespace halfback::fit

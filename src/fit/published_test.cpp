@@ -52,6 +52,21 @@ TEST(PublishedFits, MalformedLinesAreErrorsNamingTheLineAndColumn) {
   EXPECT_THROW(read_published_fits("/nonexistent/x.fit"), FormatError);
 }
 
+// Issue 35, class C (docs/reliability-round3-readers.md): the file is read line by line; the zeros
+// of a file extended past its end are binary data, refused at the first line holding one.
+TEST(PublishedFits, BinaryDataIsRefusedUnread) {
+  test::TempDir tmp;
+  const std::string text = "a = Ward(alpha = 1)\n";
+  test::write_bytes(tmp / "x.fit", text.data(), text.size());
+  EXPECT_EQ(read_published_fits(tmp / "x.fit").size(), 1u);
+  std::filesystem::resize_file(tmp / "x.fit", std::uintmax_t(1) << 20);
+  EXPECT_FORMAT_ERROR(read_published_fits(tmp / "x.fit"), "x.fit", "line 2",
+                      "a NUL byte at column 1");
+  std::filesystem::resize_file(tmp / "x.fit", std::uintmax_t(1) << 30);
+  EXPECT_FORMAT_ERROR(read_published_fits(tmp / "x.fit"), "x.fit", "file size",
+                      "1073741824 bytes is more than this format allows");
+}
+
 TEST(PublishedFits, EveryFileOfTheSharedData) {
   HALFBACK_REQUIRE_SHARED(dir, "fits");
   std::size_t files = 0;

@@ -10,6 +10,8 @@
 #include <stdexcept>
 
 #include "binary_io.hpp"
+#include "halfback/brdf/rho_bound.hpp"
+#include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 #include "kdtree.hpp"
 
@@ -90,73 +92,93 @@ std::size_t alta_param_dimension(std::string_view name) {
   return 0;
 }
 
-AltaData parse_alta(std::string_view text, std::string_view name_view) {
-  const std::string name(name_view);
-  AltaData d;
-  bool have_dim = false;
-  std::size_t line_no = 0, expected = 0;
-  auto fail = [&](const std::string& problem) -> void {
-    throw FormatError(name, "line " + std::to_string(line_no), problem);
-  };
-  // Editors on Windows start UTF-8 text with a byte-order mark; it is not part of the header.
-  constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
-  if (text.substr(0, kUtf8Bom.size()) == kUtf8Bom) text.remove_prefix(kUtf8Bom.size());
-  while (!text.empty()) {
-    const std::size_t eol = text.find('\n');
-    std::string_view line = text.substr(0, eol);
-    text.remove_prefix(eol == std::string_view::npos ? text.size() : eol + 1);
-    ++line_no;
+namespace {
+
+// The parser of an ALTA file, fed one line at a time (from memory or from a file read line by
+// line), so that a file is never held whole.
+class AltaParser {
+ public:
+  explicit AltaParser(std::string name) : name_(std::move(name)) {}
+
+  void line(std::string_view line) {
+    ++line_no_;
+    require_text_line(name_, line_no_, line);
+    // Editors on Windows start UTF-8 text with a byte-order mark; it is not part of the header.
+    constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+    if (line_no_ == 1 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom)
+      line.remove_prefix(kUtf8Bom.size());
     line = trim(line);
-    if (line.empty()) continue;
-    if (line.front() == '#') {
-      std::string_view rest = line.substr(1);
-      const std::string_view key = next_token(rest);
-      const std::string_view value = trim(rest);
-      if (key == "FUNC" || (key == "ALTA" && value.rfind("FUNC", 0) == 0))
-        fail("an ALTA function file (a fitted model, '#" + printable(trim(line.substr(1))) +
-             "'), not ALTA data: halfback reads ALTA data files (#DIM, #PARAM_IN, #PARAM_OUT, "
-             "then one sample per line)");
-      if (key == "DIM" || key == "PARAM_IN" || key == "PARAM_OUT" || key == "VS" ||
-          key == "FORMAT") {
-        if (d.rows() > 0) fail("header entry #" + std::string(key) + " after the first data line");
-        if (d.header.count(std::string(key))) fail("#" + std::string(key) + " given twice");
-      }
-      if (key == "DIM") {
-        std::string_view r = value;
-        const std::string_view a = next_token(r), b = next_token(r);
-        if (!parse_size(a, d.dim_in) || !parse_size(b, d.dim_out) || !trim(r).empty())
-          fail("#DIM expects two integers, got '" + printable(value) + "'");
-        if (d.dim_in < 1 || d.dim_in > 6) fail("#DIM: input dimension must be 1 to 6");
-        if (d.dim_out < 1 || d.dim_out > 3) fail("#DIM: output dimension must be 1 to 3");
-        have_dim = true;
-      } else if (key == "PARAM_IN") {
-        if (alta_param_dimension(value) == 0)
-          fail("#PARAM_IN: unknown input parameterization '" + printable(value) + "'");
-        d.param_in = std::string(value);
-      } else if (key == "PARAM_OUT") {
-        if (std::find(std::begin(kOutputs), std::end(kOutputs), value) == std::end(kOutputs))
-          fail("#PARAM_OUT: unknown output parameterization '" + printable(value) + "'");
-        d.param_out = std::string(value);
-      } else if (key == "VS") {
-        std::size_t vs;
-        if (!parse_size(value, vs) || vs > 2)
-          fail("#VS expects 0, 1 or 2, got '" + printable(value) + "'");
-        d.vs = static_cast<int>(vs);
-      } else if (key == "FORMAT") {
-        if (value != "text")
-          fail("#FORMAT " + printable(value) + ": only text ALTA files are supported");
-      }
-      if (!key.empty() && d.rows() == 0) d.header[std::string(key)] = std::string(value);
-      continue;
+    if (line.empty()) return;
+    if (line.front() == '#')
+      header_line(line);
+    else
+      data_line(line);
+  }
+
+  AltaData finish() {
+    if (!have_dim_) throw FormatError(name_, "header", "no #DIM line (not an ALTA data file)");
+    if (d_.rows() == 0) throw FormatError(name_, "data", "no data lines");
+    return std::move(d_);
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw FormatError(name_, "line " + std::to_string(line_no_), problem);
+  }
+
+  void header_line(std::string_view line) {
+    std::string_view rest = line.substr(1);
+    const std::string_view key = next_token(rest);
+    const std::string_view value = trim(rest);
+    if (key == "FUNC" || (key == "ALTA" && value.rfind("FUNC", 0) == 0))
+      fail("an ALTA function file (a fitted model, '#" + printable(trim(line.substr(1))) +
+           "'), not ALTA data: halfback reads ALTA data files (#DIM, #PARAM_IN, #PARAM_OUT, "
+           "then one sample per line)");
+    if (key == "DIM" || key == "PARAM_IN" || key == "PARAM_OUT" || key == "VS" || key == "FORMAT") {
+      if (d_.rows() > 0) fail("header entry #" + std::string(key) + " after the first data line");
+      if (d_.header.count(std::string(key))) fail("#" + std::string(key) + " given twice");
     }
-    // A data line.
-    if (d.rows() == 0) {
-      if (!have_dim) fail("data before #DIM (an ALTA file starts with a #DIM line)");
-      if (!d.param_in.empty() && alta_param_dimension(d.param_in) != d.dim_in)
-        fail("#PARAM_IN " + d.param_in + " has dimension " +
-             std::to_string(alta_param_dimension(d.param_in)) + " but #DIM says " +
-             std::to_string(d.dim_in));
-      expected = d.dim_in + d.dim_out + static_cast<std::size_t>(d.vs);
+    if (key == "DIM") {
+      std::string_view r = value;
+      const std::string_view a = next_token(r), b = next_token(r);
+      if (!parse_size(a, d_.dim_in) || !parse_size(b, d_.dim_out) || !trim(r).empty())
+        fail("#DIM expects two integers, got '" + printable(value) + "'");
+      if (d_.dim_in < 1 || d_.dim_in > 6) fail("#DIM: input dimension must be 1 to 6");
+      if (d_.dim_out < 1 || d_.dim_out > 3) fail("#DIM: output dimension must be 1 to 3");
+      have_dim_ = true;
+    } else if (key == "PARAM_IN") {
+      if (alta_param_dimension(value) == 0)
+        fail("#PARAM_IN: unknown input parameterization '" + printable(value) + "'");
+      d_.param_in = std::string(value);
+    } else if (key == "PARAM_OUT") {
+      if (std::find(std::begin(kOutputs), std::end(kOutputs), value) == std::end(kOutputs))
+        fail("#PARAM_OUT: unknown output parameterization '" + printable(value) + "'");
+      d_.param_out = std::string(value);
+    } else if (key == "VS") {
+      std::size_t vs;
+      if (!parse_size(value, vs) || vs > 2)
+        fail("#VS expects 0, 1 or 2, got '" + printable(value) + "'");
+      d_.vs = static_cast<int>(vs);
+    } else if (key == "FORMAT") {
+      if (value != "text")
+        fail("#FORMAT " + printable(value) + ": only text ALTA files are supported");
+    }
+    if (!key.empty() && d_.rows() == 0) d_.header[std::string(key)] = std::string(value);
+  }
+
+  std::string counts() const {
+    return std::to_string(d_.dim_in) + " inputs, " + std::to_string(d_.dim_out) + " outputs" +
+           (d_.vs ? ", " + std::to_string(d_.vs) + " for #VS" : std::string());
+  }
+
+  void data_line(std::string_view line) {
+    if (d_.rows() == 0) {
+      if (!have_dim_) fail("data before #DIM (an ALTA file starts with a #DIM line)");
+      if (!d_.param_in.empty() && alta_param_dimension(d_.param_in) != d_.dim_in)
+        fail("#PARAM_IN " + d_.param_in + " has dimension " +
+             std::to_string(alta_param_dimension(d_.param_in)) + " but #DIM says " +
+             std::to_string(d_.dim_in));
+      expected_ = d_.dim_in + d_.dim_out + static_cast<std::size_t>(d_.vs);
     }
     double values[6 + 3 + 2];
     std::size_t n = 0;
@@ -164,10 +186,8 @@ AltaData parse_alta(std::string_view text, std::string_view name_view) {
     while (true) {
       const std::string_view tok = next_token(rest);
       if (tok.empty()) break;
-      if (n == expected)
-        fail("more than the " + std::to_string(expected) + " numbers expected (" +
-             std::to_string(d.dim_in) + " inputs, " + std::to_string(d.dim_out) + " outputs" +
-             (d.vs ? ", " + std::to_string(d.vs) + " for #VS" : std::string()) + ")");
+      if (n == expected_)
+        fail("more than the " + std::to_string(expected_) + " numbers expected (" + counts() + ")");
       double v;
       const auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
       if (r.ec != std::errc() || r.ptr != tok.data() + tok.size())
@@ -176,30 +196,46 @@ AltaData parse_alta(std::string_view text, std::string_view name_view) {
         fail("column " + std::to_string(n + 1) + ": '" + printable(tok) + "' is not finite");
       values[n++] = v;
     }
-    if (n != expected)
-      fail(std::to_string(n) + " numbers, expected " + std::to_string(expected) + " (" +
-           std::to_string(d.dim_in) + " inputs, " + std::to_string(d.dim_out) + " outputs" +
-           (d.vs ? ", " + std::to_string(d.vs) + " for #VS" : std::string()) + ")");
-    d.x.insert(d.x.end(), values, values + d.dim_in);
-    d.y.insert(d.y.end(), values + d.dim_in, values + d.dim_in + d.dim_out);
-    if (d.vs == 1) {
-      const double v0 = values[d.dim_in], dt = values[d.dim_in + d.dim_out];
-      d.interval.push_back(v0 - dt);
-      d.interval.push_back(v0 + dt);
-    } else if (d.vs == 2) {
-      d.interval.push_back(values[d.dim_in + d.dim_out]);
-      d.interval.push_back(values[d.dim_in + d.dim_out + 1]);
+    if (n != expected_)
+      fail(std::to_string(n) + " numbers, expected " + std::to_string(expected_) + " (" + counts() +
+           ")");
+    d_.x.insert(d_.x.end(), values, values + d_.dim_in);
+    d_.y.insert(d_.y.end(), values + d_.dim_in, values + d_.dim_in + d_.dim_out);
+    if (d_.vs == 1) {
+      const double v0 = values[d_.dim_in], dt = values[d_.dim_in + d_.dim_out];
+      d_.interval.push_back(v0 - dt);
+      d_.interval.push_back(v0 + dt);
+    } else if (d_.vs == 2) {
+      d_.interval.push_back(values[d_.dim_in + d_.dim_out]);
+      d_.interval.push_back(values[d_.dim_in + d_.dim_out + 1]);
     }
-    d.line.push_back(line_no);
+    d_.line.push_back(line_no_);
   }
-  if (!have_dim) throw FormatError(name, "header", "no #DIM line (not an ALTA data file)");
-  if (d.rows() == 0) throw FormatError(name, "data", "no data lines");
-  return d;
+
+  std::string name_;
+  AltaData d_;
+  bool have_dim_ = false;
+  std::size_t line_no_ = 0, expected_ = 0;
+};
+
+}  // namespace
+
+AltaData parse_alta(std::string_view text, std::string_view name) {
+  AltaParser parser{std::string(name)};
+  while (!text.empty()) {
+    const std::size_t eol = text.find('\n');
+    parser.line(text.substr(0, eol));
+    text.remove_prefix(eol == std::string_view::npos ? text.size() : eol + 1);
+  }
+  return parser.finish();
 }
 
 AltaData read_alta(const std::filesystem::path& path) {
-  const std::string text = io_detail::read_file_bytes(path, kMaxFileBytes);
-  return parse_alta(text, path.string());
+  TextLines lines(path, kMaxFileBytes);
+  AltaParser parser(lines.name());
+  std::string_view line;
+  while (lines.next(line)) parser.line(line);
+  return parser.finish();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -293,6 +329,10 @@ AltaBrdf::AltaBrdf(const AltaData& data, std::string file, std::string label, Al
       }
       for (double& v : rho) v /= c;
     }
+    // The bound on ρ (brdf/rho_bound.hpp), on the value as read, after the division by cos θv.
+    for (double v : rho)
+      if (!rho_within_bound(v))
+        throw FormatError(file, field, "the sample's value gives " + rho_above_bound(v));
     rows.push_back({std::clamp(x[0], 0.0, kPi / 2), x[1], x[2], rho});
   }
   std::sort(rows.begin(), rows.end(),

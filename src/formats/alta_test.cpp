@@ -347,5 +347,44 @@ TEST(AltaAllocation, BoundedByTheFile) {
   EXPECT_LT(small.growth(), 64 * text.size() + 4096) << small.growth();
 }
 
+// Class B of issue 35 (docs/reliability-round3-readers.md): a sample whose ρ is above the bound
+// on a BRDF's value (a value of 1e308 gave "max ρ: inf" and then vanished from the albedo as
+// unmeasured) is refused, naming the line; with the cosine factor, on ρ = value / cos θv.
+TEST(AltaBound, SampleAboveTheBoundIsRefused) {
+  const std::string head =
+      "#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN\n"
+      "0.5 0 0 1\n0.5 0.1 0 2\n";
+  EXPECT_NO_THROW(brdf_of(head + "0.5 0 0.1 1e10\n"));
+  EXPECT_FORMAT_ERROR(brdf_of(head + "0.5 0 0.1 1e308\n"), "line 6",
+                      "ρ = 1e+308 sr⁻¹, above the bound of 1e+10 sr⁻¹ on a BRDF's value");
+  // ρ·cos θv = 1e8: at θv = 1.5 rad ρ = 1.4e9, within; at θv = 1.5697 (cos 1.1e-3) ρ = 9.1e10.
+  const std::string cosine =
+      "#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN_COSINE_FACTOR\n"
+      "0.5 0 0 1\n0.5 0.1 0 2\n";
+  EXPECT_NO_THROW(brdf_of(cosine + "0.5 0 1.5 1e8\n"));
+  EXPECT_FORMAT_ERROR(brdf_of(cosine + "0.5 0 1.5697 1e8\n"), "line 6", "ρ = 9.",
+                      "above the bound of 1e+10");
+}
+
+// Class C of issue 35: a text file is read line by line; the zeros of a file extended past its
+// end (truncate -s) are binary data, refused at the first line that holds one, without reading
+// the rest.
+TEST(AltaTrailingData, NulBytesAreRefusedWithoutReadingTheRest) {
+  test::TempDir tmp;
+  const std::string text =
+      "#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN\n"
+      "0.5 0 0 1\n0.5 0.1 0 2\n0.5 0 0.1 3\n";
+  const auto sparse = tmp / "sparse.dat";
+  test::write_bytes(sparse, text.data(), text.size());
+  EXPECT_NO_THROW(load_alta(sparse));
+  std::filesystem::resize_file(sparse, std::uintmax_t(1) << 30);
+  test::AllocationProbe probe;
+  EXPECT_FORMAT_ERROR(load_alta(sparse), "sparse.dat", "line 7", "a NUL byte at column 1",
+                      "binary data");
+  EXPECT_LT(probe.growth(), std::size_t(4) << 20) << probe.growth();
+  EXPECT_FORMAT_ERROR(parse_alta(text + std::string("0.5 0.1 0.1\0 4\n", 15), "m.dat"), "m.dat",
+                      "line 7", "a NUL byte at column 12");
+}
+
 }  // namespace
 }  // namespace halfback

@@ -21,6 +21,7 @@
 #include "halfback/core/parallel.hpp"
 #include "halfback/core/param.hpp"
 #include "halfback/util/atomic_file.hpp"
+#include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 #include "halfback/util/sha256.hpp"
 #include "merl_kernel.hpp"
@@ -59,12 +60,7 @@ void check_header(std::span<const std::byte> head, std::uintmax_t size, const st
                         "is " + std::to_string(dim) + ", expected " + std::to_string(kDims[i]) +
                             " (not a MERL file, or a different resolution)");
   }
-  if (size != merl::kFileBytes)
-    throw FormatError(name, "file size",
-                      std::to_string(size) + " bytes, expected exactly " +
-                          std::to_string(merl::kFileBytes) +
-                          " (12-byte header + 3 x 90*90*180 float64): " +
-                          (size < merl::kFileBytes ? "truncated" : "trailing data"));
+  require_declared_size(name, merl::kFileBytes, size, "12-byte header + 3 × 90·90·180 float64");
 }
 
 }  // namespace
@@ -103,12 +99,11 @@ MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name_view
       const double v = load_le<double>(p + 8 * (c * merl::kBins + i));
       if (!std::isfinite(v))
         throw FormatError(name, bin_field(c, i), std::isnan(v) ? "is NaN" : "is infinite");
-      if (v * merl::kScale[c] > merl::kMaxRho)
+      if (!rho_within_bound(v * merl::kScale[c]))
         throw FormatError(name, bin_field(c, i),
-                          fmt::format("is {:g}, i.e. ρ = {:g} sr⁻¹, above the {:g} sr⁻¹ a "
-                                      "measured bin can hold (a corrupt file, or big-endian "
-                                      "values: MERL files are little-endian)",
-                                      v, v * merl::kScale[c], merl::kMaxRho));
+                          fmt::format("is {:g}: {} (a corrupt file, or big-endian values: MERL "
+                                      "files are little-endian)",
+                                      v, rho_above_bound(v * merl::kScale[c])));
       if (v < 0) ++data.missing[c];
       data.values[c * merl::kBins + i] = v;
     }
@@ -122,21 +117,13 @@ MerlData parse_merl(std::span<const std::byte> bytes, std::string_view name_view
 }
 
 MerlData read_merl(const std::filesystem::path& path, bool identify) {
-  const std::string name = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw FormatError(name, "file", ec ? ec.message() : "not a regular file");
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) throw FormatError(name, "file", "cannot get its size: " + ec.message());
-  if (size != merl::kFileBytes) {
-    // Diagnose from the header without reading a file of the wrong size.
-    std::array<std::byte, merl::kHeaderBytes> head{};
-    std::ifstream in(path, std::ios::binary);
-    in.read(reinterpret_cast<char*>(head.data()), head.size());
-    check_header(std::span(head).first(static_cast<std::size_t>(in.gcount())), size, name);
-  }
-  const std::string bytes = io_detail::read_file_bytes(path, merl::kFileBytes);
-  return parse_merl(io_detail::as_bytes(bytes), name, identify);
+  // The header and the size first: a file of the wrong size is refused without reading it.
+  BoundedFile file(path);
+  const std::vector<std::byte> head = file.head(merl::kHeaderBytes);
+  check_header(head, file.size(), file.name());
+  std::vector<std::byte> bytes = head;
+  file.extend(bytes, merl::kFileBytes, "data");
+  return parse_merl(bytes, file.name(), identify);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -372,14 +359,10 @@ MerlData tabulate_merl(const Brdf& brdf) {
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       const double v[3] = {rho[k].r, rho[k].g, rho[k].b};
       for (int ch = 0; ch < 3; ++ch) {
-        if (v[ch] > merl::kMaxRho) {
-          const Tuple4<double> q = HalfDiff::forward(pairs[k]);
-          throw std::invalid_argument(fmt::format(
-              "{}: ρ = {:g} sr⁻¹ at θh = {:.4g}°, θd = {:.4g}°, φd = {:.4g}°, above the {:g} "
-              "sr⁻¹ a MERL bin can hold",
-              brdf.name(), v[ch], q[0] * 180 / kPi, q[2] * 180 / kPi, q[3] * 180 / kPi,
-              merl::kMaxRho));
-        }
+        if (!rho_within_bound(v[ch]))
+          throw std::invalid_argument(
+              fmt::format("{}: {}: a MERL file cannot hold it", brdf.name(),
+                          rho_above_bound(v[ch], describe_halfdiff(pairs[k]))));
         const double stored = v[ch] / merl::kScale[ch];
         data.values[where[k] + ch * merl::kBins] = std::isfinite(stored) ? stored : -1.0;
       }

@@ -313,7 +313,7 @@ TEST(MerlErrors, SizeHeaderAndValues) {
   // channel.
   EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(0, 4, 5, 6, 1e308)), "huge"),
                       "red value at bin (theta_h 4, theta_d 5, phi_d 6)", "is 1e+308",
-                      "above the 1e+10 sr⁻¹", "little-endian");
+                      "above the bound of 1e+10 sr⁻¹", "little-endian");
   const double largest_blue = merl::kMaxRho / merl::kScale[2];
   EXPECT_NO_THROW(parse_merl(bytes_of(poke(2, 4, 5, 6, 0.999 * largest_blue)), "edge"));
   EXPECT_FORMAT_ERROR(parse_merl(bytes_of(poke(2, 4, 5, 6, largest_blue * 1.001)), "edge"),

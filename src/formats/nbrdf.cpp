@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "formats/nbrdf_kernel.hpp"
+#include "halfback/brdf/rho_bound.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/util/format_error.hpp"
 
@@ -125,6 +126,32 @@ void validate(const NbrdfNetwork& net) {
   }
 }
 
+// An upper bound of ρ over every input the encoding can give, by interval arithmetic through the
+// layers from the box sin θh, cos θh ∈ [0, 1], 0, d ∈ [−1, 1]³: each output's interval is the
+// bias plus each weight times the end of its input's interval that maximizes (or minimizes) the
+// product; ReLU clamps both ends at 0. Loose (it ignores that the inputs are tied), but rigorous.
+double interval_rho_bound(const NbrdfNetwork& net) {
+  std::vector<double> lo{0, 0, 0, -1, -1, -1}, hi{1, 0, 1, 1, 1, 1};
+  for (std::size_t l = 0; l < net.layers.size(); ++l) {
+    const NbrdfLayer& layer = net.layers[l];
+    std::vector<double> out_lo(layer.outputs), out_hi(layer.outputs);
+    for (std::size_t j = 0; j < layer.outputs; ++j) {
+      double a = layer.bias[j], b = layer.bias[j];
+      for (std::size_t k = 0; k < layer.inputs; ++k) {
+        const double w = layer.kernel[k * layer.outputs + j];
+        a += std::min(w * lo[k], w * hi[k]);
+        b += std::max(w * lo[k], w * hi[k]);
+      }
+      const bool hidden = l + 1 < net.layers.size();
+      out_lo[j] = hidden ? std::max(a, 0.0) : a;
+      out_hi[j] = hidden ? std::max(b, 0.0) : b;
+    }
+    lo = std::move(out_lo);
+    hi = std::move(out_hi);
+  }
+  return std::expm1(*std::max_element(hi.begin(), hi.end()));  // ρ = exp(y) − 1, increasing
+}
+
 }  // namespace
 
 bool is_nbrdf_npy(const std::filesystem::path& path) {
@@ -179,6 +206,30 @@ std::shared_ptr<const NbrdfBrdf> load_nbrdf(const std::filesystem::path& path) {
 NbrdfBrdf::NbrdfBrdf(NbrdfNetwork network, std::string label)
     : network_(std::move(network)), label_(std::move(label)) {
   validate(network_);
+  check_rho_bound();
+}
+
+// The bound on ρ (brdf/rho_bound.hpp): proven everywhere by interval arithmetic when it can be,
+// else checked on the probe set, where a network with an absurd output (a last bias of 100 gives
+// ρ = e¹⁰⁰) is refused. Between the probe's pairs the writers and the renderer check the values
+// they use.
+void NbrdfBrdf::check_rho_bound() {
+  const double proven = interval_rho_bound(network_);
+  if (rho_within_bound(proven)) {
+    rho_bound_ =
+        fmt::format("ρ ≤ {:.4g} sr⁻¹ everywhere (interval arithmetic through the layers)", proven);
+    return;
+  }
+  const RhoProbe probe = probe_rho(*this);
+  if (const auto& excess = probe.excess)
+    throw FormatError(
+        network_.source, "network",
+        rho_above_bound(excess->rho.max_channel(), describe_halfdiff(excess->pair)) +
+            " (ρ = exp(y) − 1 of the last layer's outputs y: a corrupt or diverging network)");
+  rho_bound_ = fmt::format(
+      "within the bound of {:g} sr⁻¹ on the probe set (largest {:.4g} sr⁻¹); "
+      "not proven everywhere",
+      kMaxRho, probe.largest);
 }
 
 std::string NbrdfBrdf::name() const {
@@ -202,12 +253,12 @@ std::size_t NbrdfBrdf::parameter_count() const {
 }
 
 std::vector<Brdf::Fact> NbrdfBrdf::facts() const {
-  return {
-      {"format", "neural BRDF (Sztrajman et al. 2021), " + network_.form},
-      {"source", network_.source},
-      {"architecture", architecture() + " (ReLU hidden layers, linear output, exp(y) - 1)"},
-      {"parameters", std::to_string(parameter_count()) + " float32"},
-      {"input", "(sin θh, 0, cos θh, d): d = ωo (the view direction) in the half-vector frame"}};
+  return {{"format", "neural BRDF (Sztrajman et al. 2021), " + network_.form},
+          {"source", network_.source},
+          {"architecture", architecture() + " (ReLU hidden layers, linear output, exp(y) - 1)"},
+          {"parameters", std::to_string(parameter_count()) + " float32"},
+          {"input", "(sin θh, 0, cos θh, d): d = ωo (the view direction) in the half-vector frame"},
+          {"ρ bound", rho_bound_}};
 }
 
 Rgb NbrdfBrdf::eval(const DirPair<double>& pair) const {

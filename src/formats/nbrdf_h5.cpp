@@ -8,16 +8,24 @@
 // weightless output layer of the authors' networks (their Lambda y ↦ exp(y) − 1).
 #include <hdf5.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "halfback/formats/nbrdf.hpp"
+#include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 
 namespace halfback {
 namespace {
+
+// The superblock is looked for in the file's first bytes (a user block of up to 32 KiB before it).
+constexpr std::size_t kSuperblockSearch = std::size_t(1) << 16;
 
 // Debian's serial HDF5 is not thread-safe: every use of it holds this lock.
 std::mutex& hdf5_mutex() {
@@ -155,10 +163,44 @@ class KerasReader {
   std::string name_;
 };
 
-NbrdfNetwork read_open_file(hid_t file, const std::string& name) {
+// The end of the file its superblock declares (base address + "end of file address"), read from
+// the file's first bytes `b` (HDF5's H5Fget_eoa refuses the in-memory driver of the embedded
+// files). HDF5 reads only what it needs and accepts any data after that end; this reader does
+// not. The superblock is at 0, or after a user block at 512, 1024, 2048, ... bytes; its versions
+// 0 and 1 hold the address after 24 (28) bytes and two addresses, versions 2 and 3 after 12 bytes
+// and two addresses (the HDF5 file format specification, "Superblock").
+void require_declared_end(std::span<const std::byte> b, std::uint64_t size,
+                          const std::string& name) {
+  auto u8 = [&](std::size_t i) { return static_cast<unsigned>(b[i]); };
+  for (std::size_t at = 0; at + 64 <= b.size(); at = at ? 2 * at : 512) {
+    if (std::memcmp(b.data() + at, nbrdf::kHdf5Magic.data(), nbrdf::kHdf5Magic.size()) != 0)
+      continue;
+    const unsigned version = u8(at + 8);
+    if (version > 3) break;
+    const unsigned offsets = u8(at + (version < 2 ? 13 : 9));
+    if (offsets != 2 && offsets != 4 && offsets != 8) break;
+    auto address = [&](std::size_t i) {
+      std::uint64_t v = 0;
+      for (unsigned k = offsets; k-- > 0;) v = v << 8 | u8(i + k);
+      return v;
+    };
+    const std::size_t fields = at + (version == 0 ? 24 : version == 1 ? 28 : 12);
+    const std::uint64_t base = address(fields), end = address(fields + 2 * offsets);
+    require_declared_size(name, base + end, size, "the end of file address in its superblock");
+    return;
+  }
+  throw FormatError(
+      name, "HDF5 superblock",
+      "not found, or of an unknown version, in the first " + std::to_string(b.size()) + " bytes");
+}
+
+// `head`: the file's first bytes, of `size`.
+NbrdfNetwork read_open_file(hid_t file, const std::string& name, std::span<const std::byte> head,
+                            std::uint64_t size) {
   Handle handle(file, H5Fclose);
   if (!handle.valid())
     throw FormatError(name, "HDF5", "cannot be opened (truncated or corrupt HDF5 file)");
+  require_declared_end(head, size, name);
   return KerasReader(handle.get(), name).read();
 }
 
@@ -178,7 +220,9 @@ NbrdfNetwork read_nbrdf_h5(const std::filesystem::path& path) {
   silence_hdf5_errors();
   if (H5Fis_hdf5(name.c_str()) <= 0)
     throw FormatError(name, "HDF5", "not an HDF5 file (no HDF5 signature)");
-  return read_open_file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), name);
+  BoundedFile file(path);
+  return read_open_file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), name,
+                        file.head(kSuperblockSearch), file.size());
 }
 
 NbrdfNetwork parse_nbrdf_h5(std::span<const std::byte> image, std::string_view name_view) {
@@ -194,7 +238,8 @@ NbrdfNetwork parse_nbrdf_h5(std::span<const std::byte> image, std::string_view n
   if (!fapl.valid() || H5Pset_fapl_core(fapl.get(), 1 << 16, false) < 0 ||
       H5Pset_file_image(fapl.get(), const_cast<std::byte*>(image.data()), image.size()) < 0)
     throw FormatError(name, "HDF5", "cannot set up an in-memory file");
-  return read_open_file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, fapl.get()), name);
+  return read_open_file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, fapl.get()), name,
+                        image.first(std::min(image.size(), kSuperblockSearch)), image.size());
 }
 
 }  // namespace halfback

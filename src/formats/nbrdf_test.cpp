@@ -282,8 +282,10 @@ TEST(Npy, RejectsOtherDtypesOrdersAndSizes) {
   EXPECT_FORMAT_ERROR(parse(npy("(2,)", {1, 2}, "<f8")), "a.npy", "dtype", "'<f8'");
   EXPECT_FORMAT_ERROR(parse(npy("(2,)", {1, 2}, ">f4")), "dtype", "'>f4'");
   EXPECT_FORMAT_ERROR(parse(npy("(2, 1)", {1, 2}, "<f4", "True")), "fortran_order");
-  EXPECT_FORMAT_ERROR(parse(npy("(3,)", {1, 2})), "data", "truncated");
-  EXPECT_FORMAT_ERROR(parse(npy("(1,)", {1, 2})), "data", "trailing");
+  EXPECT_FORMAT_ERROR(parse(npy("(3,)", {1, 2})), "file size", "declares 140 bytes",
+                      "has 136 bytes", "truncated");
+  EXPECT_FORMAT_ERROR(parse(npy("(1,)", {1, 2})), "file size", "declares 132 bytes",
+                      "has 136 bytes", "4 bytes of trailing data");
   EXPECT_FORMAT_ERROR(parse(npy("(4000000000, 4000000000)", {1})), "shape");
   EXPECT_FORMAT_ERROR(parse("\x93NUMPZ\x01\x00\x00\x00"), "not a NumPy");
   std::string cut = npy("(2,)", {1, 2});
@@ -440,6 +442,58 @@ TEST(NbrdfH5, BadFilesGiveErrorsNamingTheProblem) {
   EXPECT_FORMAT_ERROR(
       parse_nbrdf_h5({reinterpret_cast<const std::byte*>(bytes.data()), bytes.size() / 2}, "mem"),
       "mem");
+}
+
+// Class C of issue 35 (docs/reliability-round3-readers.md): an HDF5 file ends at the end of file
+// address of its superblock, a .npy file after the data its header declares; anything after is
+// refused with both byte counts, unread (a file extended to a gigabyte by truncate -s).
+TEST(NbrdfTrailingData, RefusedWithBothCounts) {
+  TempDir tmp;
+  write_keras_h5(tmp / "t.h5", tiny_network());
+  const std::string bytes = test::read_file(tmp / "t.h5");
+  const std::string more = bytes + "junk";
+  test::write_bytes(tmp / "j.h5", more.data(), more.size());
+  EXPECT_FORMAT_ERROR(read_nbrdf_h5(tmp / "j.h5"), std::string("j.h5: file size"),
+                      "declares " + std::to_string(bytes.size()) + " bytes",
+                      std::string("4 bytes of trailing data"));
+  EXPECT_FORMAT_ERROR(
+      parse_nbrdf_h5({reinterpret_cast<const std::byte*>(more.data()), more.size()}, "mem"), "mem",
+      "4 bytes of trailing data");
+  std::filesystem::resize_file(tmp / "j.h5", std::uintmax_t(1) << 30);
+  EXPECT_FORMAT_ERROR(load_nbrdf(tmp / "j.h5"), "j.h5", "has 1073741824 bytes", "trailing data");
+
+  write_npy_network(tmp.path(), "n", tiny_network());
+  std::filesystem::resize_file(tmp / "n_b2.npy", std::uintmax_t(1) << 30);
+  EXPECT_FORMAT_ERROR(load_nbrdf(tmp / "n_fc1.npy"), "n_b2.npy", "declares 140 bytes",
+                      "has 1073741824 bytes", "trailing data");
+}
+
+// Class B of issue 35: a network whose outputs are absurd (a last bias of 100: ρ = e¹⁰⁰ − 1,
+// 1.65e38 sr⁻¹ in float, everywhere) is refused at load, naming the file; its ρ is checked on the
+// probe set when interval arithmetic through the layers cannot prove it bounded everywhere.
+TEST(NbrdfBound, DivergingNetworkIsRefusedAtLoad) {
+  TempDir tmp;
+  NbrdfNetwork net = tiny_network();
+  {
+    const NbrdfBrdf tiny(net, "tiny");  // y ≤ 2.6 on the inputs' box: proven
+    const auto facts = tiny.facts();
+    EXPECT_NE(facts.back().value.find("everywhere (interval arithmetic"), std::string::npos)
+        << facts.back().value;
+  }
+  net.layers[1].bias = {100, 100, 100};
+  write_npy_network(tmp.path(), "hot", net);
+  EXPECT_FORMAT_ERROR(load_nbrdf(tmp.path()), "hot_fc1.npy", "network",
+                      "above the bound of 1e+10 sr⁻¹ on a BRDF's value", "last layer");
+  write_keras_h5(tmp / "hot.h5", net);
+  EXPECT_FORMAT_ERROR(load_nbrdf(tmp / "hot.h5"), "hot.h5", "network", "above the bound");
+  // y = 16 (sin θh + cos θh) ≤ 16√2 = 22.6, ρ ≤ 6.6e9: within the bound, but interval arithmetic,
+  // which takes sin θh and cos θh as independent, gives y ≤ 32, ρ ≤ 7.9e13: checked on the probe.
+  net.layers = {{6, 2, std::vector<float>(12, 0.0f), {0, 0}},
+                {2, 3, {1, 0, 0, 0, 0, 0}, {0, 0, 0}}};
+  net.layers[0].kernel[0] = net.layers[0].kernel[4] = 16;  // x0 and x2 → h0
+  const NbrdfBrdf loose(net, "loose");
+  EXPECT_NE(loose.facts().back().value.find("on the probe set"), std::string::npos)
+      << loose.facts().back().value;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -8,9 +8,11 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "formats/binary_io.hpp"
 #include "halfback/formats/nbrdf.hpp"
+#include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 
 namespace halfback {
@@ -120,23 +122,50 @@ constexpr std::string_view kNpyMagic{"\x93NUMPY", 6};
 
 }  // namespace
 
-NpyArray parse_npy_float32(std::span<const std::byte> bytes, std::string_view name) {
-  const std::string file(name);
-  const auto* p = bytes.data();
-  if (bytes.size() < 10 || std::string_view(reinterpret_cast<const char*>(p), 6) != kNpyMagic)
+namespace {
+
+// A header longer than this is not a float32 array's (NumPy writes about 128 bytes; its own reader
+// refuses more than 10000 by default).
+constexpr std::size_t kMaxHeaderBytes = 65536;
+// A neural BRDF's arrays are a few KB; 64 MB is far beyond any plausible one.
+constexpr std::uint64_t kMaxNpyBytes = std::uint64_t(64) << 20;
+
+// What the prefix and header declare: the shape, where the data starts and how many bytes it has.
+struct Layout {
+  std::vector<std::size_t> shape;
+  std::size_t count = 0;         // values
+  std::uint64_t data_start = 0;  // bytes before the data
+  std::uint64_t declared_size() const { return data_start + 4 * std::uint64_t(count); }
+};
+
+// The prefix (magic, version, header length): the header's length and where it starts. `p` holds
+// min(size, 12) bytes of a file of `size` bytes.
+std::pair<std::size_t, std::size_t> parse_prefix(std::span<const std::byte> p, std::uint64_t size,
+                                                 const std::string& file) {
+  if (size < 10 || std::string_view(reinterpret_cast<const char*>(p.data()), 6) != kNpyMagic)
     throw FormatError(file, "magic", "not a NumPy .npy file (no \\x93NUMPY signature)");
   const int major = int(p[6]);
   if (major < 1 || major > 3)
     throw FormatError(file, "version", "unknown .npy version " + std::to_string(major));
   const std::size_t prefix = major == 1 ? 10 : 12;
-  if (bytes.size() < prefix) throw FormatError(file, "header", "truncated before the header");
-  const std::size_t header_len = major == 1 ? io_detail::load_le<std::uint16_t>(p + 8)
-                                            : io_detail::load_le<std::uint32_t>(p + 8);
-  if (header_len > bytes.size() - prefix)
+  if (size < prefix) throw FormatError(file, "header", "truncated before the header");
+  const std::size_t header_len = major == 1 ? io_detail::load_le<std::uint16_t>(p.data() + 8)
+                                            : io_detail::load_le<std::uint32_t>(p.data() + 8);
+  if (header_len > size - prefix)
     throw FormatError(
         file, "header",
         "header length " + std::to_string(header_len) + " runs past the end of the file");
-  std::string_view text(reinterpret_cast<const char*>(p + prefix), header_len);
+  if (header_len > kMaxHeaderBytes)
+    throw FormatError(file, "header",
+                      "header length " + std::to_string(header_len) + " is above the limit of " +
+                          std::to_string(kMaxHeaderBytes) + " bytes");
+  return {prefix, header_len};
+}
+
+// The header dict (`text`, after the prefix) of a file of `size` bytes.
+Layout parse_header(std::string_view text, std::size_t prefix, std::uint64_t size,
+                    const std::string& file) {
+  const std::size_t header_len = text.size();
   if (text.empty() || text.back() != '\n')
     throw FormatError(file, "header", "does not end with a newline");
   text.remove_suffix(1);
@@ -149,28 +178,58 @@ NpyArray parse_npy_float32(std::span<const std::byte> bytes, std::string_view na
                       "'" + *header.descr + "', expected little-endian float32 ('<f4')");
   if (*header.fortran_order)
     throw FormatError(file, "fortran_order", "True; only C-order arrays are read");
-  std::size_t count = 1;
-  for (const std::size_t d : *header.shape) {
-    if (d != 0 && count > (bytes.size() / 4 + 1) / d)
+  Layout layout{*header.shape, 1, prefix + header_len};
+  for (const std::size_t d : layout.shape) {
+    if (d != 0 && layout.count > (size / 4 + 1) / d)
       throw FormatError(file, "shape", "more values than the file holds");
-    count *= d;
+    layout.count *= d;
   }
-  const std::size_t data_bytes = bytes.size() - prefix - header_len;
-  if (data_bytes != count * 4)
-    throw FormatError(file, "data",
-                      std::to_string(data_bytes) + " bytes, the shape needs " +
-                          std::to_string(count * 4) +
-                          (data_bytes < count * 4 ? " (truncated)" : " (trailing bytes)"));
-  NpyArray array{*header.shape, std::vector<float>(count)};
-  const std::byte* data = p + prefix + header_len;
-  for (std::size_t i = 0; i < count; ++i) array.values[i] = io_detail::load_le<float>(data + 4 * i);
+  return layout;
+}
+
+NpyArray decode(const Layout& layout, const std::byte* data) {
+  NpyArray array{layout.shape, std::vector<float>(layout.count)};
+  for (std::size_t i = 0; i < layout.count; ++i)
+    array.values[i] = io_detail::load_le<float>(data + 4 * i);
   return array;
 }
 
+std::string layout_text(const Layout& layout) {
+  return std::to_string(layout.data_start) + "-byte header + " + std::to_string(layout.count) +
+         " float32";
+}
+
+}  // namespace
+
+NpyArray parse_npy_float32(std::span<const std::byte> bytes, std::string_view name) {
+  const std::string file(name);
+  const auto [prefix, header_len] =
+      parse_prefix(bytes.first(std::min<std::size_t>(bytes.size(), 12)), bytes.size(), file);
+  const Layout layout = parse_header(
+      std::string_view(reinterpret_cast<const char*>(bytes.data() + prefix), header_len), prefix,
+      bytes.size(), file);
+  require_declared_size(file, layout.declared_size(), bytes.size(), layout_text(layout));
+  return decode(layout, bytes.data() + layout.data_start);
+}
+
 NpyArray read_npy_float32(const std::filesystem::path& path) {
-  // A neural BRDF's arrays are a few KB; 64 MB is far beyond any plausible one.
-  const std::string bytes = io_detail::read_file_bytes(path, std::uintmax_t(64) << 20);
-  return parse_npy_float32(io_detail::as_bytes(bytes), path.string());
+  // The prefix, then the header, then the size check: only then the data.
+  BoundedFile in(path);
+  std::vector<std::byte> bytes = in.head(12);
+  const auto [prefix, header_len] = parse_prefix(bytes, in.size(), in.name());
+  in.extend(bytes, prefix + header_len, "header");
+  const Layout layout = parse_header(
+      std::string_view(reinterpret_cast<const char*>(bytes.data() + prefix), header_len), prefix,
+      in.size(), in.name());
+  require_declared_size(in.name(), layout.declared_size(), in.size(), layout_text(layout));
+  if (in.size() > kMaxNpyBytes)
+    throw FormatError(in.name(), "file size",
+                      std::to_string(in.size()) +
+                          " bytes is more than a neural BRDF's array may "
+                          "have (" +
+                          std::to_string(kMaxNpyBytes) + " bytes)");
+  in.extend(bytes, layout.declared_size(), "data");
+  return decode(layout, bytes.data() + layout.data_start);
 }
 
 }  // namespace halfback

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "binary_io.hpp"
+#include "halfback/brdf/rho_bound.hpp"
 #include "halfback/core/spectrum.hpp"
 #include "halfback/formats/rgl.hpp"
 #include "halfback/util/format_error.hpp"
@@ -89,6 +90,8 @@ class Validator {
                        ", must be at least " + std::to_string(min));
   }
 
+  const std::string& file() const { return file_; }
+
   [[noreturn]] void fail(std::string_view field, const std::string& problem) const {
     throw FormatError(file_, "field '" + std::string(field) + "'", problem);
   }
@@ -152,6 +155,7 @@ class MaterialReader {
     const TensorField& lum = check_luminance();
     read_rgb(lum);
     read_jacobian();
+    check_rho_bound();
     constexpr std::size_t kSide = INT32_MAX;
     m_.lanes = std::max({m_.vndf.w, m_.vndf.h, m_.rgb.w, m_.rgb.h, m_.ndf.w, m_.ndf.h, m_.sigma.w,
                          m_.sigma.h}) < kSide;
@@ -277,6 +281,38 @@ class MaterialReader {
     m_.rgb.assign(planar, m_.n_slices);
     m_.rgb_negative = static_cast<std::size_t>(
         std::count_if(planar.begin(), planar.end(), [](double x) { return x < 0; }));
+    largest_rgb_ = largest(planar, [](double x) { return std::abs(x); });
+  }
+
+  // The index and value of the largest of f(v[i]).
+  template <class F>
+  static std::pair<std::size_t, double> largest(const std::vector<double>& v, F f) {
+    std::size_t at = 0;
+    for (std::size_t i = 1; i < v.size(); ++i)
+      if (f(v[i]) > f(v[at])) at = i;
+    return {at, v.empty() ? 0.0 : v[at]};
+  }
+
+  // rgl_rho_cos_bound (|rgb| alone without the Jacobian) within the bound on ρ, the fields'
+  // extremes named.
+  void check_rho_bound() const {
+    const auto [rgb_at, rgb] = largest_rgb_;
+    double bound = std::abs(rgb);
+    std::string why = fmt::format("the largest |rgb|, value {} of field '{}', is {:g}", rgb_at,
+                                  m_.wavelengths ? "spectra" : "rgb", std::abs(rgb));
+    if (m_.jacobian) {
+      const auto [ndf_at, ndf] = largest(m_.ndf.v, [](double x) { return x; });
+      const auto [sigma_at, sigma] = largest(m_.sigma.v, [](double x) { return -x; });
+      bound = rgl_rho_cos_bound(std::abs(rgb), ndf, sigma);
+      why +=
+          fmt::format("; the largest 'ndf', value {}, {:g}; the smallest 'sigma', value {}, {:g}",
+                      ndf_at, ndf, sigma_at, sigma);
+    }
+    if (!rho_within_bound(bound))
+      throw FormatError(v_.file(), m_.jacobian ? "fields 'rgb', 'ndf' and 'sigma'" : "field 'rgb'",
+                        fmt::format("{} (ρ·cos θo ≤ |rgb|{}: {})",
+                                    rho_above_bound(bound, "the tables' extremes", "ρ·cos θo"),
+                                    m_.jacobian ? " × ndf / (4 sigma)" : "", why));
   }
 
   // Whether ρ carries the NDF over 4 sigma: a single flag, 0 or 1.
@@ -292,6 +328,7 @@ class MaterialReader {
   Validator v_;
   RglBrdf::Impl& m_;
   std::size_t n_theta_ = 0, n_phi_ = 0;
+  std::pair<std::size_t, double> largest_rgb_{0, 0.0};  // index and value of the largest |rgb|
 };
 
 }  // namespace

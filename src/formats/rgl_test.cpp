@@ -993,5 +993,62 @@ TEST(RglAllocation, BoundedByTheFile) {
   EXPECT_LT(probe.growth(), 8 * std::filesystem::file_size(real)) << probe.growth();
 }
 
+// Class C of issue 35 (docs/reliability-round3-readers.md): a tensor file ends where its last
+// field does (the writers' zero padding to 8 bytes aside). Trailing data is refused with both byte
+// counts, and a small file extended to a gigabyte (sparse, as `truncate -s` makes it) is refused
+// without reading the extension.
+TEST(RglTrailingData, RefusedUnreadWithBothCounts) {
+  test::TempDir tmp;
+  std::vector<std::byte> bytes = Synthetic{}.bytes();
+  const TensorFile tf = parse_tensor_file(bytes, "m");
+  std::uint64_t end = 0;
+  for (const TensorField& f : tf.fields) end = std::max(end, f.offset + f.bytes.size());
+  // The published files end at their last field, halfback's writer pads it to 8 bytes.
+  bytes.resize(end);
+  EXPECT_NO_THROW(parse_tensor_file(bytes, "exact"));
+  bytes.resize((end + 7) / 8 * 8 + 1);
+  EXPECT_FORMAT_ERROR(parse_tensor_file(bytes, "m.bsdf"), std::string("m.bsdf: file size"),
+                      "declares " + std::to_string(end) + " bytes",
+                      "has " + std::to_string(bytes.size()) + " bytes",
+                      std::string("of trailing data"));
+  bytes.resize(end + 1);
+  bytes.back() = std::byte{7};  // not the writers' zero padding
+  EXPECT_FORMAT_ERROR(parse_tensor_file(bytes, "m.bsdf"), "1 byte of trailing data");
+
+  bytes.resize(end);
+  const auto sparse = tmp / "sparse.bsdf";
+  test::write_bytes(sparse, bytes.data(), bytes.size());
+  std::filesystem::resize_file(sparse, std::uintmax_t(1) << 30);
+  test::AllocationProbe probe;
+  EXPECT_FORMAT_ERROR(load_rgl(sparse), "sparse.bsdf", "has 1073741824 bytes", "trailing data");
+  EXPECT_LT(probe.growth(), 4 * end + 64 * 1024) << probe.growth();
+}
+
+// Class B of issue 35: ρ·cos θo = rgb · ndf / (4 sigma) can reach at most the largest |rgb| times
+// the largest ndf over 4 times the smallest sigma: a file where that exceeds the bound on ρ is
+// refused, naming the fields and their extremes (an ndf value of 1e30 gave ρ = 1e31).
+TEST(RglBound, TablesAboveTheBoundAreRefused) {
+  Synthetic s;
+  s.jacobian = 1;
+  EXPECT_NO_THROW(s.brdf());
+  auto fields = s.fields();
+  std::vector<float> ndf(2 * s.w, 1.0f);
+  ndf[17] = 1e30f;
+  *find(fields, "ndf") = test::f32("ndf", {2, s.w}, ndf);
+  EXPECT_FORMAT_ERROR(brdf_of(fields), "m.bsdf", "fields 'rgb', 'ndf' and 'sigma'",
+                      "ρ·cos θo = 7.5e+28 sr⁻¹ at the tables' extremes",
+                      "above the bound of 1e+10 sr⁻¹ on a BRDF's value",
+                      "the largest 'ndf', value 17, 1e+30");
+  s.sigma = 1e-12f;  // divides ρ
+  EXPECT_FORMAT_ERROR(s.brdf(), "the smallest 'sigma', value 0, 1e-12");
+  // Without the Jacobian, rgb alone is ρ·cos θo.
+  Synthetic plain;
+  plain.rgb = [](auto, auto, auto, auto) { return 2e10f; };
+  EXPECT_FORMAT_ERROR(plain.brdf(), "field 'rgb'", "ρ·cos θo = 2e+10 sr⁻¹");
+  // The published materials are far below the bound (chm_mint, the sharpest, 7e6).
+  HALFBACK_REQUIRE_SHARED(dir, "rgl");
+  EXPECT_NO_THROW(load_rgl(dir / "chm_mint_rgb.bsdf"));
+}
+
 }  // namespace
 }  // namespace halfback

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "binary_io.hpp"
+#include "halfback/brdf/rho_bound.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/core/spectrum.hpp"
 #include "halfback/util/atomic_file.hpp"
@@ -293,6 +294,12 @@ void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, st
               throw std::invalid_argument(
                   fmt::format("{}: ρ is not finite at ωi = {}, ωo = {}: cannot tabulate it",
                               brdf.name(), format_dir(wi), format_dir(wo)));
+            // What the file stores is ρ·cos θo (ρ itself grows without bound at grazing ωo).
+            if (!rho_within_bound(rho * wo.z))
+              throw std::invalid_argument(
+                  fmt::format("{}: {}: an RGL file cannot hold it", brdf.name(),
+                              rho_above_bound((rho * wo.z).max_channel(),
+                                              describe_halfdiff({wi, wo}), "ρ·cos θo")));
             const double scale = table_at(g.ndf, um.x) / (4 * sigma);
             if (scale > 0) value = rho * (wo.z / scale);
           }
@@ -303,6 +310,21 @@ void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, st
         }
       },
       threads);
+}
+
+// The reader's bound on the tables (rgl_rho_cos_bound), checked before anything is written: the
+// values are each within the bound on ρ, but their extremes may come from different places.
+void require_tables_within_bound(const Brdf& brdf, const std::vector<double>& rgb,
+                                 const Geometry& g) {
+  double largest_rgb = 0;
+  for (double v : rgb) largest_rgb = std::max(largest_rgb, std::abs(v));
+  const double bound = rgl_rho_cos_bound(largest_rgb, *std::max_element(g.ndf.begin(), g.ndf.end()),
+                                         *std::min_element(g.sigma.begin(), g.sigma.end()));
+  if (!rho_within_bound(bound))
+    throw std::invalid_argument(fmt::format(
+        "{}: its RGL tables would give {} (ρ·cos θo ≤ |rgb| × ndf / (4 sigma): the largest "
+        "|rgb| {:g}), which the reader refuses",
+        brdf.name(), rho_above_bound(bound, "the tables' extremes", "ρ·cos θo"), largest_rgb));
 }
 
 // The spectra of the RGB tables (slices × 3 × res², channel-major per slice), one sigmoid
@@ -368,6 +390,7 @@ std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions
                    luminance.data() + s * res * res);
     if (o.progress) o.progress(int(s + 1), int(slices));
   }
+  require_tables_within_bound(brdf, rgb, g);
   g.fields.push_back(float_field("luminance", {1, slices, res, res}, luminance));
   if (o.variant != RglVariant::spectral)
     g.fields.push_back(float_field("rgb", {1, slices, 3, res, res}, rgb));

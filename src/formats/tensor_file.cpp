@@ -10,6 +10,7 @@
 
 #include "binary_io.hpp"
 #include "halfback/formats/rgl.hpp"
+#include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 
 namespace halfback {
@@ -74,26 +75,31 @@ const TensorField* TensorFile::find(std::string_view name) const {
   return nullptr;
 }
 
-TensorFile parse_tensor_file(std::vector<std::byte> bytes, std::string_view name_view) {
-  const std::string name(name_view);
-  const std::uint64_t size = bytes.size();
+namespace {
+
+// Parses a tensor file from its first bytes, `storage`, reading more through `more(end)` (which
+// grows `storage` to the file's first `end` bytes) only as far as the header and then the fields
+// it declares go: the file's size is checked against the declared one before its data is read.
+// `size` is the file's size.
+template <class More>
+TensorFile parse(std::vector<std::byte> storage, std::uint64_t size, const std::string& name,
+                 More&& more) {
   TensorFile tf;
   tf.name = name;
-  tf.storage = std::move(bytes);
-  const std::byte* base = tf.storage.data();
-
-  if (size < sizeof(kMagic) || std::memcmp(base, kMagic, sizeof(kMagic)) != 0)
+  auto at = [&](std::uint64_t pos) { return storage.data() + pos; };
+  more(storage, std::min<std::uint64_t>(size, kPreambleBytes));
+  if (size < sizeof(kMagic) || std::memcmp(at(0), kMagic, sizeof(kMagic)) != 0)
     throw FormatError(name, "magic",
                       "does not start with \"tensor_file\\0\" (not an RGL tensor file)");
   if (size < kPreambleBytes)
     throw FormatError(name, "header", "truncated: " + std::to_string(size) + " bytes");
-  tf.version_major = static_cast<std::uint8_t>(base[12]);
-  tf.version_minor = static_cast<std::uint8_t>(base[13]);
+  tf.version_major = static_cast<std::uint8_t>(*at(12));
+  tf.version_minor = static_cast<std::uint8_t>(*at(13));
   if (tf.version_major != 1 || tf.version_minor != 0)
     throw FormatError(name, "version",
                       "is " + std::to_string(tf.version_major) + "." +
                           std::to_string(tf.version_minor) + ", only 1.0 is supported");
-  const auto n_fields = load_le<std::uint32_t>(base + 14);
+  const auto n_fields = load_le<std::uint32_t>(at(14));
   if (n_fields == 0) throw FormatError(name, "field count", "is 0");
   if (n_fields > (size - kPreambleBytes) / kMinEntryBytes)
     throw FormatError(name, "field count",
@@ -104,29 +110,30 @@ TensorFile parse_tensor_file(std::vector<std::byte> bytes, std::string_view name
   auto need = [&](std::uint64_t n, const std::string& what) {
     if (n > size - pos)
       throw FormatError(name, what, "truncated: the field table runs past the end of the file");
+    more(storage, pos + n);
   };
   std::set<std::string, std::less<>> names;
   tf.fields.reserve(n_fields);
   for (std::uint32_t k = 0; k < n_fields; ++k) {
     const std::string entry = "field table entry " + std::to_string(k);
     need(2, entry);
-    const auto len = load_le<std::uint16_t>(base + pos);
+    const auto len = load_le<std::uint16_t>(at(pos));
     pos += 2;
     if (len == 0) throw FormatError(name, entry, "has an empty name");
     need(len, entry);
     TensorField f;
-    f.name.assign(reinterpret_cast<const char*>(base + pos), len);
+    f.name.assign(reinterpret_cast<const char*>(at(pos)), len);
     pos += len;
     if (!std::all_of(f.name.begin(), f.name.end(), valid_name_char))
       throw FormatError(name, entry, "name has characters outside [A-Za-z0-9_.-]");
     const std::string field = "field '" + f.name + "'";
     if (!names.insert(f.name).second) throw FormatError(name, field, "appears twice");
     need(2 + 1 + 8, field);
-    const auto ndim = load_le<std::uint16_t>(base + pos);
+    const auto ndim = load_le<std::uint16_t>(at(pos));
     pos += 2;
-    const auto dtype = static_cast<std::uint8_t>(base[pos]);
+    const auto dtype = static_cast<std::uint8_t>(*at(pos));
     pos += 1;
-    f.offset = load_le<std::uint64_t>(base + pos);
+    f.offset = load_le<std::uint64_t>(at(pos));
     pos += 8;
     if (dtype < 1 || dtype > 11)
       throw FormatError(name, field, "unknown dtype code " + std::to_string(dtype));
@@ -138,13 +145,16 @@ TensorFile parse_tensor_file(std::vector<std::byte> bytes, std::string_view name
     need(8 * std::uint64_t(ndim), field);
     f.shape.resize(ndim);
     for (auto& s : f.shape) {
-      s = load_le<std::uint64_t>(base + pos);
+      s = load_le<std::uint64_t>(at(pos));
       pos += 8;
     }
     tf.fields.push_back(std::move(f));
   }
   const std::uint64_t table_end = pos;
 
+  // The fields' extents, each checked against the file; the file ends with the last of them.
+  std::uint64_t declared_end = table_end;
+  std::vector<std::uint64_t> field_bytes;
   for (auto& f : tf.fields) {
     const std::string field = "field '" + f.name + "'";
     // Byte size, with overflow checks: every factor must keep the product within the file.
@@ -164,16 +174,44 @@ TensorFile parse_tensor_file(std::vector<std::byte> bytes, std::string_view name
                         "truncated data: needs " + std::to_string(bytes_needed) +
                             " bytes at offset " + std::to_string(f.offset) + ", the file has " +
                             std::to_string(size) + " bytes");
-    f.bytes = std::span<const std::byte>(base + f.offset, static_cast<std::size_t>(bytes_needed));
+    field_bytes.push_back(bytes_needed);
+    declared_end = std::max(declared_end, f.offset + bytes_needed);
   }
+  // The writers pad the last field to a multiple of 8 bytes with zeros; nothing else may follow.
+  const std::uint64_t padded = (declared_end + 7) / 8 * 8;
+  if (size > declared_end && size <= padded) {
+    more(storage, size);
+    if (std::any_of(at(declared_end), at(size), [](std::byte b) { return b != std::byte{0}; }))
+      require_declared_size(name, declared_end, size, "the end of its last field");
+  } else {
+    require_declared_size(name, declared_end, size, "the end of its last field");
+  }
+  more(storage, size);
+  tf.storage = std::move(storage);
+  for (std::size_t k = 0; k < tf.fields.size(); ++k)
+    tf.fields[k].bytes = std::span<const std::byte>(tf.storage.data() + tf.fields[k].offset,
+                                                    static_cast<std::size_t>(field_bytes[k]));
   return tf;
 }
 
+}  // namespace
+
+TensorFile parse_tensor_file(std::vector<std::byte> bytes, std::string_view name) {
+  const std::uint64_t size = bytes.size();
+  return parse(std::move(bytes), size, std::string(name),
+               [](std::vector<std::byte>&, std::uint64_t) {});  // all in memory
+}
+
 TensorFile read_tensor_file(const std::filesystem::path& path) {
-  const std::string s = io_detail::read_file_bytes(path, kMaxFileBytes);
-  std::vector<std::byte> bytes(s.size());
-  if (!s.empty()) std::memcpy(bytes.data(), s.data(), s.size());
-  return parse_tensor_file(std::move(bytes), path.string());
+  BoundedFile file(path);
+  if (file.size() > kMaxFileBytes)
+    throw FormatError(file.name(), "file size",
+                      std::to_string(file.size()) + " bytes is more than this format allows (" +
+                          std::to_string(kMaxFileBytes) + " bytes)");
+  return parse({}, file.size(), file.name(),
+               [&](std::vector<std::byte>& storage, std::uint64_t end) {
+                 file.extend(storage, end, "file");
+               });
 }
 
 std::vector<std::byte> serialize_tensor_file(std::span<const TensorFieldData> fields) {

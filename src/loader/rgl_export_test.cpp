@@ -303,6 +303,12 @@ TEST(RglExport, BadInputWritesNothing) {
   bad = {};
   bad.variant = RglVariant::spectral;
   expect_refused(nan_off_specular, "ρ is not finite at ωi =", bad);
+  // Issue 35, class B: a value above the bound on ρ (what the file stores, ρ·cos θo) is refused,
+  // naming the BRDF, before a file its reader would refuse is written.
+  const test::FunctionBrdf hot([](const DirPair<double>& p) { return p.wo.y > 0.3 ? 1e12 : 0.3; });
+  expect_refused(hot, "function: ρ·cos θo = ");
+  expect_refused(hot,
+                 "above the bound of 1e+10 sr⁻¹ on a BRDF's value: an RGL file cannot hold it");
 }
 
 // write_rgl writes what rgl_fields gives, and halfback's reader reads it.

@@ -6,9 +6,11 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
+#include <fmt/format.h>
 #include <stb_image.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -20,6 +22,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 
 namespace halfback::render {
@@ -72,17 +75,15 @@ std::size_t clamp_noise(std::vector<float>& rgb) {
   return clamped;
 }
 
-std::vector<unsigned char> read_bytes(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw FormatError(path.string(), "file", "is a directory, not an image");
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw FormatError(path.string(), "file", std::string("cannot open: ") + std::strerror(errno));
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
-                                   std::istreambuf_iterator<char>());
-  if (in.bad()) throw FormatError(path.string(), "file", "read error");
-  return bytes;
+// A file's first bytes are read into this much at most before its format is known; a Radiance
+// header must end within it, an OpenEXR header within kMaxExrHeader.
+constexpr std::size_t kHeadBytes = std::size_t(1) << 16;
+constexpr std::uint64_t kMaxExrHeader = std::uint64_t(1) << 24;
+
+using Bytes = std::vector<std::byte>;
+
+unsigned char byte_at(const Bytes& b, std::size_t i) {
+  return static_cast<unsigned char>(b[i]);
 }
 
 // The size a header declares, checked before anything is allocated from it: pixels, the limit on
@@ -100,18 +101,20 @@ void check_map_size(const std::string& file, const std::string& field, long long
                           " is not a latitude-longitude map (width must be twice the height)");
 }
 
-bool is_exr(std::span<const unsigned char> b) {
-  return b.size() >= 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01;
+bool is_exr(const Bytes& b) {
+  return b.size() >= 4 && byte_at(b, 0) == 0x76 && byte_at(b, 1) == 0x2f && byte_at(b, 2) == 0x31 &&
+         byte_at(b, 3) == 0x01;
 }
 
-bool is_radiance(std::span<const unsigned char> b) {
-  return b.size() >= 2 && b[0] == '#' && b[1] == '?';
+bool is_radiance(const Bytes& b) {
+  return b.size() >= 2 && byte_at(b, 0) == '#' && byte_at(b, 1) == '?';
 }
 
 // Walks the scanlines of Radiance pixel data (flat RGBE, or the run-length encoding of each
-// channel) and checks that they are complete: stb_image reads past a truncated file as zeros.
-void check_radiance_data(const std::string& file, std::span<const unsigned char> d,
-                         std::size_t width, std::size_t height) {
+// channel), checks that they are complete (stb_image reads past a truncated file as zeros), and
+// returns where they end.
+std::size_t radiance_data_end(const std::string& file, std::span<const unsigned char> d,
+                              std::size_t width, std::size_t height) {
   auto truncated = [&](std::size_t y) {
     throw FormatError(file, "Radiance data",
                       "truncated: the pixel data ends in scanline " + std::to_string(y) + " of " +
@@ -123,7 +126,7 @@ void check_radiance_data(const std::string& file, std::span<const unsigned char>
                      d[pos + 1] == 2 && !(d[pos + 2] & 0x80);
     if (!rle) {  // flat pixels from here to the end of the image
       if (d.size() - std::min(pos, d.size()) < 4 * width * (height - y)) truncated(y);
-      return;
+      return pos + 4 * width * (height - y);
     }
     if ((std::size_t(d[pos + 2]) << 8 | d[pos + 3]) != width)
       throw FormatError(file, "Radiance data",
@@ -146,11 +149,19 @@ void check_radiance_data(const std::string& file, std::span<const unsigned char>
         x += count;
       }
   }
+  return pos;
 }
 
-// The resolution line of a Radiance file ("-Y H +X W" after the blank line ending the header), so
-// that a zero-size image gets its own message rather than stb's generic one.
-void check_radiance_resolution(const std::string& file, std::span<const unsigned char> b) {
+// Where a Radiance file's pixels start and how many there are: the header lines up to an empty
+// one, then the resolution line ("-Y H +X W"), parsed here so that a zero-size image gets its own
+// message rather than stb's generic one. `b` holds the file's first bytes, of `size`.
+struct RadianceLayout {
+  std::size_t data_start = 0;
+  long long width = 0, height = 0;
+};
+
+RadianceLayout radiance_layout(const std::string& file, std::span<const unsigned char> b,
+                               std::uint64_t size) {
   std::size_t i = 0;
   bool blank = false;
   while (i < b.size() && !blank) {  // header lines up to an empty one
@@ -159,7 +170,11 @@ void check_radiance_resolution(const std::string& file, std::span<const unsigned
     blank = (i == start);
     ++i;
   }
-  if (!blank) throw FormatError(file, "Radiance header", "no blank line ends the header");
+  if (!blank)
+    throw FormatError(file, "Radiance header",
+                      b.size() < size ? "no blank line ends the header within its first " +
+                                            std::to_string(b.size()) + " bytes"
+                                      : std::string("no blank line ends the header"));
   std::string line;
   while (i < b.size() && b[i] != '\n' && line.size() < 100) line.push_back(char(b[i++]));
   ++i;  // the data starts after the resolution line
@@ -176,7 +191,7 @@ void check_radiance_resolution(const std::string& file, std::span<const unsigned
     throw FormatError(file, "Radiance resolution line",
                       "unsupported orientation '" + line + "' (expected -Y H +X W)");
   check_map_size(file, "Radiance resolution line", n2, n1);
-  check_radiance_data(file, b.subspan(std::min(i, b.size())), std::size_t(n2), std::size_t(n1));
+  return {std::min(i, b.size()), n2, n1};
 }
 
 struct Loaded {
@@ -184,24 +199,44 @@ struct Loaded {
   std::vector<float> rgb;
 };
 
-Loaded load_radiance(const std::string& file, std::span<const unsigned char> bytes) {
-  check_radiance_resolution(file, bytes);
-  if (!stbi_is_hdr_from_memory(bytes.data(), int(bytes.size())))
+// The header, then the size check (a file larger than its pixels can take is refused unread),
+// then the pixel data, whose end must be the file's.
+Loaded load_radiance(BoundedFile& in, Bytes bytes) {
+  const std::string& file = in.name();
+  const auto head = [&] {
+    return std::span(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+  };
+  const RadianceLayout layout = radiance_layout(file, head(), in.size());
+  const auto w = std::uint64_t(layout.width), h = std::uint64_t(layout.height);
+  // A run-length encoded scanline takes at most 4 + 8w bytes (2 bytes a pixel and channel).
+  const std::uint64_t most = h * (4 + 8 * w), after = in.size() - layout.data_start;
+  if (after > most)
+    throw FormatError(file, "file size",
+                      fmt::format("{} × {} pixels take at most {} bytes after the {}-byte header, "
+                                  "the file has {} bytes after it: at least {} bytes of trailing "
+                                  "data",
+                                  w, h, most, layout.data_start, after, after - most));
+  if (in.size() > std::uint64_t(std::numeric_limits<int>::max()))
+    throw FormatError(file, "file", "too large");
+  in.extend(bytes, in.size(), "Radiance data");
+  const std::size_t end = radiance_data_end(file, head().subspan(layout.data_start), w, h);
+  require_declared_size(
+      file, layout.data_start + end, in.size(),
+      fmt::format("{} × {} RGBE pixels after a {}-byte header", w, h, layout.data_start));
+  if (!stbi_is_hdr_from_memory(head().data(), int(bytes.size())))
     throw FormatError(file, "Radiance header",
                       "not a Radiance HDR file (expected '#?RADIANCE' or '#?RGBE')");
-  if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
-    throw FormatError(file, "file", "too large");
-  int w = 0, h = 0, comp = 0;
-  float* data = stbi_loadf_from_memory(bytes.data(), int(bytes.size()), &w, &h, &comp, 3);
+  int width = 0, height = 0, comp = 0;
+  float* data = stbi_loadf_from_memory(head().data(), int(bytes.size()), &width, &height, &comp, 3);
   if (!data) {
     const char* why = stbi_failure_reason();
     throw FormatError(file, "Radiance data",
                       std::string("cannot decode: ") + (why ? why : "unknown error"));
   }
   Loaded out;
-  out.width = w;
-  out.height = h;
-  out.rgb.assign(data, data + std::size_t(w) * std::size_t(h) * 3);
+  out.width = width;
+  out.height = height;
+  out.rgb.assign(data, data + std::size_t(width) * std::size_t(height) * 3);
   stbi_image_free(data);
   return out;
 }
@@ -225,56 +260,78 @@ int exr_lines_per_chunk(Imf::Compression c) {
 }
 
 // Checks, before OpenEXR or this reader allocate anything from the header's sizes, that a
-// single-part scanline file holds the chunks its header declares. Its chunks follow the offset
-// table (8 bytes a chunk) one after the other, each an int32 y, an int32 data size and the data;
-// they are walked as OpenEXR walks them when the table is incomplete, which also covers files
-// whose table was left zero. Tiled and multi-part files, and headers this walk cannot follow, are
-// left to OpenEXR and to the incremental decoding.
-void check_exr_chunks(const std::string& file, std::span<const unsigned char> b) {
-  if (b.size() < 8 || (b[5] & 0x1a) != 0) return;  // tiled, deep or multi-part: not checked here
+// single-part scanline file holds the chunks its header declares and nothing after them. Its
+// chunks follow the offset table (8 bytes a chunk) one after the other, each an int32 y, an int32
+// data size and the data; they are walked as OpenEXR walks them when the table is incomplete,
+// which also covers files whose table was left zero, reading 8 bytes a chunk. Tiled, deep and
+// multi-part files, and headers this walk cannot follow, are left to OpenEXR and to the
+// incremental decoding. `b` holds the file's first bytes; it grows to hold the whole header.
+void check_exr_chunks(BoundedFile& in, Bytes& b) {
+  const std::string& file = in.name();
+  if (b.size() < 8 || (byte_at(b, 5) & 0x1a) != 0) return;  // tiled, deep or multi-part
+  // Makes b hold the file's first `end` bytes; false past the end of the file.
+  auto have = [&](std::uint64_t end) {
+    if (end <= b.size()) return true;
+    if (end > in.size()) return false;
+    if (end > kMaxExrHeader)
+      throw FormatError(file, "OpenEXR header",
+                        fmt::format("longer than the limit of {} bytes", kMaxExrHeader));
+    in.extend(b, std::min<std::uint64_t>(in.size(), std::max<std::uint64_t>(end, 2 * b.size())),
+              "OpenEXR header");
+    return true;
+  };
   auto u32 = [&](std::size_t at) {
     std::uint32_t v = 0;
-    for (int i = 3; i >= 0; --i) v = v << 8 | b[at + std::size_t(i)];
+    for (int i = 3; i >= 0; --i) v = v << 8 | byte_at(b, at + std::size_t(i));
     return v;
   };
   std::size_t pos = 8;
   long long height = -1, width = -1;
   auto compression = Imf::NUM_COMPRESSION_METHODS;
-  while (pos < b.size() && b[pos] != 0) {  // attributes: name\0 type\0 size value
+  while (have(pos + 1) && b[pos] != std::byte{0}) {  // attributes: name\0 type\0 size value
     const std::size_t name = pos;
     for (int strings = 0; strings < 2; ++strings) {
-      while (pos < b.size() && b[pos] != 0) ++pos;
+      while (have(pos + 1) && b[pos] != std::byte{0}) ++pos;
       ++pos;
     }
-    if (pos + 4 > b.size()) return;
+    if (!have(pos + 4)) return;
     const std::uint32_t size = u32(pos);
     pos += 4;
-    if (size > b.size() - pos) return;
+    if (!have(pos + std::uint64_t(size))) return;
     const std::string_view key(reinterpret_cast<const char*>(&b[name]));
     if (key == "dataWindow" && size == 16) {
       width = (long long)std::int32_t(u32(pos + 8)) - std::int32_t(u32(pos)) + 1;
       height = (long long)std::int32_t(u32(pos + 12)) - std::int32_t(u32(pos + 4)) + 1;
-    } else if (key == "compression" && size == 1 && b[pos] < Imf::NUM_COMPRESSION_METHODS) {
-      compression = Imf::Compression(b[pos]);
+    } else if (key == "compression" && size == 1 &&
+               byte_at(b, pos) < Imf::NUM_COMPRESSION_METHODS) {
+      compression = Imf::Compression(byte_at(b, pos));
     }
     pos += size;
   }
-  if (pos >= b.size() || height < 0 || compression == Imf::NUM_COMPRESSION_METHODS) return;
+  if (!have(pos + 1) || height < 0 || compression == Imf::NUM_COMPRESSION_METHODS) return;
   check_map_size(file, "dataWindow", width, height);
   const int lines = exr_lines_per_chunk(compression);
   const auto chunks = std::uint64_t((height + lines - 1) / lines);
   std::uint64_t found = 0;
   std::uint64_t at = std::uint64_t(pos) + 1 + 8 * chunks;  // after the offset table
-  while (found < chunks && at + 8 <= b.size() && u32(std::size_t(at) + 4) <= b.size() - at - 8) {
-    at += 8 + u32(std::size_t(at) + 4);
+  const std::uint64_t size = in.size();
+  std::array<std::byte, 8> chunk_head;
+  while (found < chunks && at + 8 <= size) {
+    in.read_at(at, chunk_head, "OpenEXR chunk");
+    std::uint32_t data_size = 0;
+    for (int i = 7; i >= 4; --i) data_size = data_size << 8 | std::uint8_t(chunk_head[i]);
+    if (data_size > size - at - 8) break;
+    at += 8 + data_size;
     ++found;
   }
   if (found < chunks)
     throw FormatError(file, "dataWindow",
                       "the file is too short for its header: " + std::to_string(width) + " x " +
                           std::to_string(height) + " pixels in " + std::to_string(chunks) +
-                          " chunks, the file (" + std::to_string(b.size()) + " bytes) holds " +
+                          " chunks, the file (" + std::to_string(size) + " bytes) holds " +
                           std::to_string(found));
+  require_declared_size(file, at, size,
+                        fmt::format("{} × {} pixels in {} chunks", width, height, chunks));
 }
 
 // Decodes the pixels in bands of scanlines, growing the output as the bands decode, so that a
@@ -313,8 +370,9 @@ void read_exr_pixels(Imf::InputFile& in, bool rgb, Loaded& out, std::size_t file
       out.rgb[i + 1] = out.rgb[i + 2] = out.rgb[i];
 }
 
-Loaded load_openexr(const std::string& file, std::span<const unsigned char> bytes) {
-  check_exr_chunks(file, bytes);
+Loaded load_openexr(BoundedFile& file_in, Bytes head) {
+  const std::string& file = file_in.name();
+  check_exr_chunks(file_in, head);
   try {
     Imf::InputFile in(file.c_str());
     const Imf::Header& header = in.header();
@@ -339,7 +397,7 @@ Loaded load_openexr(const std::string& file, std::span<const unsigned char> byte
     Loaded out;
     out.width = int(w);
     out.height = int(h);
-    read_exr_pixels(in, rgb, out, bytes.size());
+    read_exr_pixels(in, rgb, out, std::size_t(file_in.size()));
     return out;
   } catch (const FormatError&) {
     throw;
@@ -462,13 +520,19 @@ EnvMap EnvMap::from_spec(std::string_view spec, EnvOptions options) {
 
 EnvMap EnvMap::load(const std::filesystem::path& path, EnvOptions options) {
   const std::string file = path.string();
-  const std::vector<unsigned char> bytes = read_bytes(path);
-  if (bytes.empty()) throw FormatError(file, "file", "empty file, not an HDR image");
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw FormatError(file, "file", "is a directory, not an image");
+  if (!std::filesystem::exists(path, ec))
+    throw FormatError(file, "file", std::string("cannot open: ") + std::strerror(ENOENT));
+  BoundedFile in(path);  // read as far as the header declares (class C of issue 35)
+  Bytes head = in.head(kHeadBytes);
+  if (head.empty()) throw FormatError(file, "file", "empty file, not an HDR image");
   Loaded img;
-  if (is_exr(bytes)) {
-    img = load_openexr(file, bytes);
-  } else if (is_radiance(bytes)) {
-    img = load_radiance(file, bytes);
+  if (is_exr(head)) {
+    img = load_openexr(in, std::move(head));
+  } else if (is_radiance(head)) {
+    img = load_radiance(in, std::move(head));
   } else {
     throw FormatError(file, "content",
                       "not an HDR image: expected a Radiance .hdr ('#?RADIANCE' header) or an "

@@ -380,6 +380,48 @@ TEST(EnvMap, TinyNegativeRadianceIsNoise) {
   expect_error(p, "-0.001");
 }
 
+// Class C of issue 35 (docs/reliability-round3-readers.md): a map's file ends where its pixel
+// data does: trailing data is refused with both byte counts, and a small map extended to a
+// gigabyte (truncate -s) is refused without reading the extension (it was read whole: 2.1 GB).
+void expect_refused_unread(const std::filesystem::path& p, const std::string& words) {
+  test::AllocationProbe probe;
+  expect_error(p, words);
+  EXPECT_LT(probe.growth(), std::size_t(1) << 20) << p;
+}
+
+TEST(EnvMapTrailingData, RefusedUnreadWithBothCounts) {
+  const test::TempDir tmp;
+  // Radiance, flat RGBE (a width below 8 is never run-length encoded): 4 × 2 pixels.
+  const std::string header = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n";
+  std::string hdr = header;
+  for (int i = 0; i < 8; ++i) hdr += std::string("\x80\x40\x20\x81", 4);
+  const auto flat = tmp / "flat.hdr";
+  write_text(flat, hdr);
+  EXPECT_EQ(EnvMap::load(flat).width(), 4);
+  write_text(flat, hdr + "x");
+  expect_error(flat, "file size: the header declares " + std::to_string(hdr.size()) + " bytes");
+  expect_error(flat, "1 byte of trailing data");
+  write_text(flat, hdr);
+  std::filesystem::resize_file(flat, std::uintmax_t(1) << 30);
+  expect_refused_unread(flat, "4 × 2 pixels take at most 72 bytes after the " +
+                                  std::to_string(header.size()) + "-byte header");
+  // OpenEXR, one chunk per 16 scanlines (ZIP).
+  const auto exr = tmp / "map.exr";
+  write_exr(exr, Image{8, 4, std::vector<float>(8 * 4 * 3, 0.5f)});
+  const std::string bytes = test::read_file(exr);
+  write_text(exr, bytes + "junk");
+  expect_error(exr, "file size: the header declares " + std::to_string(bytes.size()) +
+                        " bytes (8 × 4 pixels in 1 chunks)");
+  expect_error(exr, "4 bytes of trailing data");
+  write_text(exr, bytes);
+  std::filesystem::resize_file(exr, std::uintmax_t(1) << 30);
+  expect_refused_unread(exr, "has 1073741824 bytes");
+  // The real maps end where their pixels do.
+  HALFBACK_REQUIRE_SHARED(dir, "envmaps");
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    EXPECT_NO_THROW(EnvMap::load(e.path())) << e.path();
+}
+
 TEST(EnvMap, BadInput) {
   const test::TempDir tmp;
   expect_error(tmp / "does_not_exist.hdr", "cannot open");

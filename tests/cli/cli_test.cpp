@@ -1948,3 +1948,76 @@ TEST_F(CliTest, FitBadInputLeavesNoOutput) {
 
 }  // namespace
 }  // namespace halfback
+
+namespace halfback {
+namespace {
+
+// A float32 .npy array (format 1.0) of the given shape.
+void put_npy(const fs::path& p, const std::string& shape, const std::vector<float>& values) {
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': " + shape + ", }";
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string bytes("\x93NUMPY\x01\x00", 8);
+  bytes += char(header.size() & 0xff);
+  bytes += char(header.size() >> 8);
+  bytes += header;
+  bytes.append(reinterpret_cast<const char*>(values.data()), 4 * values.size());
+  put(p, bytes);
+}
+
+// Issue 35, class B (docs/reliability-round3-readers.md): a BRDF whose ρ is above the bound on a
+// BRDF's value is refused by every command, naming the file and the bound: a neural BRDF whose
+// last bias is 100 (ρ = 1.65e38 everywhere: `info` printed it, `export-rgl` wrote a file its own
+// reader refused, `render` blamed --env-exposure) and an ALTA sample of 1e308 (`max ρ: inf`).
+TEST_F(CliTest, BrdfAboveTheBoundIsRefusedByEveryCommand) {
+  put_npy(path("hot_fc1.npy"), "(6, 2)", std::vector<float>(12, 0.1f));
+  put_npy(path("hot_b1.npy"), "(2,)", {0, 0});
+  put_npy(path("hot_fc2.npy"), "(2, 3)", std::vector<float>(6, 0.1f));
+  put_npy(path("hot_b2.npy"), "(3,)", {100, 100, 100});
+  const std::string why = "above the bound of 1e+10 sr⁻¹ on a BRDF's value";
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"info", "hot_fc1.npy"},
+        {"render", "--brdf", "hot_fc1.npy", "-o", "hot.png", "--width", "8", "--height", "8"},
+        {"export-rgl", "--brdf", "hot_fc1.npy", "-o", "hot.bsdf"},
+        {"export-merl", "--brdf", "hot_fc1.npy", "-o", "hot.binary"}}) {
+    const Result r = run(args);
+    EXPECT_EQ(r.status, 1) << args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find("hot_fc1.npy: network: ρ = 1.65"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("exposure"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(path("hot.png")) || fs::exists(path("hot.bsdf")) ||
+               fs::exists(path("hot.binary")));
+  put(path("hot.dat"),
+      "#DIM 3 1\n#PARAM_IN ISOTROPIC_TL_TV_PROJ_DPHI\n#PARAM_OUT INV_STERADIAN\n"
+      "0.5 0 0 1\n0.5 0.1 0 1e308\n0.5 0 0.1 1\n");
+  const Result r = run({"info", "hot.dat"});
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.err.find("hot.dat: line 5: the sample's value gives ρ = 1e+308 sr⁻¹, " + why),
+            std::string::npos)
+      << r.err;
+}
+
+// Issue 35, class C: `info` on a small RGL file extended to 1.5 GB by truncate -s (sparse) read it
+// whole (3.1 GB of memory, 25 s) and accepted it; it is refused with both byte counts, within
+// 100 MB of resident memory.
+TEST_F(CliTest, SparseExtensionOfAFileIsRefusedInLittleMemory) {
+  const fs::path small = HALFBACK_SOURCE_DIR "/data/rgl/acrylic_felt_green_rgb.bsdf";
+  fs::copy_file(small, path("big.bsdf"));
+  fs::permissions(path("big.bsdf"), fs::perms::owner_write, fs::perm_options::add);
+  fs::resize_file(path("big.bsdf"), 1'500'000'000);
+  long rss_kb = 0;
+  const Result r = run({"info", "big.bsdf"}, "", &rss_kb);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("big.bsdf: file size: the header declares " +
+                       std::to_string(fs::file_size(small)) +
+                       " bytes (the end of its last field), the file has 1500000000 bytes"),
+            std::string::npos)
+      << r.err;
+  EXPECT_GT(rss_kb, 0);  // measured
+  EXPECT_LT(rss_kb, 100 * 1024) << rss_kb << " KB";
+  fs::remove(path("big.bsdf"));
+}
+
+}  // namespace
+}  // namespace halfback

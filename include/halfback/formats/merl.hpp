@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
+#include "halfback/brdf/rho_bound.hpp"
 
 namespace halfback {
 
@@ -32,10 +33,11 @@ inline constexpr std::size_t kHeaderBytes = 12;
 inline constexpr std::size_t kFileBytes = kHeaderBytes + 3 * kBins * sizeof(double);  // 34992012
 // The reference reader's scale factors, as the same double expressions.
 inline constexpr std::array<double, 3> kScale{1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0};
-// The largest ρ (sr⁻¹) a bin may hold. A perfect mirror averaged over MERL's smallest bin reaches
-// about 2e6; a stored value far above that is a corrupt file or the wrong byte order, and would
-// overflow every integral (albedo, renderings) to infinity.
-inline constexpr double kMaxRho = 1e10;
+// The largest ρ (sr⁻¹) a bin may hold: the bound on every BRDF's value (brdf/rho_bound.hpp). A
+// perfect mirror averaged over MERL's smallest bin reaches about 2e6; a stored value far above that
+// is a corrupt file or the wrong byte order, and would overflow every integral (albedo, renderings)
+// to infinity.
+inline constexpr double kMaxRho = halfback::kMaxRho;
 
 // Flat index of a bin in one channel's block.
 constexpr std::size_t bin(int th, int td, int pd) {

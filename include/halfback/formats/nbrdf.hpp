@@ -83,8 +83,9 @@ bool is_nbrdf_npy(const std::filesystem::path& path);
 class NbrdfBrdf final : public Brdf {
  public:
   // Validates the network: 1 to kMaxLayers layers, input width 6, output 3, each layer's inputs
-  // the previous one's outputs, widths ≤ kMaxWidth, kernel and bias sizes, every weight finite.
-  // Throws FormatError naming network.source.
+  // the previous one's outputs, widths ≤ kMaxWidth, kernel and bias sizes, every weight finite,
+  // and ρ within the bound on a BRDF's value (brdf/rho_bound.hpp: proven everywhere by interval
+  // arithmetic, or else checked on its probe set). Throws FormatError naming network.source.
   NbrdfBrdf(NbrdfNetwork network, std::string label);
 
   std::string name() const override;
@@ -104,8 +105,11 @@ class NbrdfBrdf final : public Brdf {
   std::size_t parameter_count() const;
 
  private:
+  void check_rho_bound();
+
   NbrdfNetwork network_;
   std::string label_;
+  std::string rho_bound_;  // what is known of the bound on ρ (a fact)
 };
 
 // Reads either form (the .h5 file by its HDF5 signature, else the NumPy form); the BRDF's name is

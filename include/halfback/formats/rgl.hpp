@@ -81,6 +81,15 @@ std::vector<std::byte> serialize_tensor_file(std::span<const TensorFieldData> fi
 // (docs/formats.md, "Negative values").
 inline constexpr double kRglNoiseFraction = 1e-3;
 
+// The bound on ρ·cos θo that a material's tables imply, each table interpolated between its nodes
+// (ρ·cos θo = rgb · ndf / (4 sigma)): the largest |rgb| times the largest ndf over 4 times the
+// smallest sigma. The reader refuses a file, and the writer a BRDF's tables, where it is above
+// the bound on ρ (brdf/rho_bound.hpp). The published materials reach 7e6 (chm_mint), the writer's
+// tables of GGX α = 0.001 8e7.
+inline double rgl_rho_cos_bound(double largest_abs_rgb, double largest_ndf, double smallest_sigma) {
+  return largest_abs_rgb * largest_ndf / (4 * smallest_sigma);
+}
+
 struct RglOptions {
   // The RGB data holds small negative values where the spectral measurement falls outside the
   // sRGB gamut (e.g. down to -2% of the maximum in chm_mint); by default ρ is clamped at 0.
@@ -96,7 +105,7 @@ class RglBrdf final : public Brdf {
  public:
   // Validates the material fields of a parsed tensor file (names, dtypes, shapes, values: finite,
   // densities >= 0 up to noise (kRglNoiseFraction), sigma > 0, incidence grids increasing and in
-  // range). Throws FormatError.
+  // range, rgl_rho_cos_bound within the bound on ρ). Throws FormatError.
   RglBrdf(const TensorFile& file, std::string label, RglOptions options = {});
   ~RglBrdf() override;
 
