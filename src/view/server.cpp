@@ -128,10 +128,13 @@ int milliseconds_until(Clock::time_point t) {
   return int(std::clamp<long long>(ms, 0, 1 << 30));
 }
 
-// Whether `sock` has data (or an end) to read before `t`.
+// Whether `sock` has data (or an end) to read before `t` (a signal does not end the wait).
 bool readable_before(socket_t sock, Clock::time_point t) {
   pollfd p{sock, POLLIN, 0};
-  return ::poll(&p, 1, milliseconds_until(t)) > 0;
+  int ready = 0;
+  do ready = ::poll(&p, 1, milliseconds_until(t));
+  while (ready < 0 && errno == EINTR);
+  return ready > 0;
 }
 
 // The numeric address and port of a socket's peer (`peer`) or its own end.
@@ -302,6 +305,8 @@ class HttpServer : public httplib::Server {
   // other clients, otherwise saw connections dropped by the kernel and set up again 1 to 3 s
   // later.
   void widen_backlog() { ::listen(svr_sock_, ConnectionQueue::kMaxConnections); }
+  // Serves a connected socket as an accepted one (Server::serve_connection).
+  void serve_accepted(socket_t sock) { process_and_close_socket(sock); }
 
  private:
   bool process_and_close_socket(socket_t sock) override {
@@ -408,6 +413,10 @@ bool Server::run() {
 
 void Server::stop() {
   impl_->http.stop();
+}
+
+void Server::serve_connection(int fd) {
+  impl_->http.serve_accepted(fd);
 }
 
 bool keep_freed_memory() {

@@ -34,6 +34,10 @@ class Server {
   bool run();
   // Stops run() from another thread.
   void stop();
+  // Serves one connected socket on the calling thread, as run() serves an accepted connection
+  // (its requests, with every limit above), and closes it; after bind(), without run(). For the
+  // wire-level fuzzer (fuzz/view_wire_fuzz.cpp).
+  void serve_connection(int fd);
 
  private:
   struct Impl;
