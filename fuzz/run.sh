@@ -12,7 +12,7 @@ jobs="$(nproc 2>/dev/null || echo 2)"
 
 cmake --preset fuzz -B "$build" >/dev/null
 cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz h5_fuzz envmap_fuzz \
-  view_fuzz make_fuzz_seeds
+  view_fuzz view_wire_fuzz make_fuzz_seeds
 
 corpus="$build/corpus"
 mkdir -p "$corpus"
@@ -42,15 +42,36 @@ for seed in "/api/info?token=t" "/?token=t" "/static/app.js?token=t" \
     "/api/fit?token=t&brdf=arg:1&model=lambert%2Bggx:f0=0.9&loss=low-e2&samples=100" \
     "/api/slices?token=t&brdf=arg:0&pose=45&n=4" \
     "/api/brdf?token=t&brdf=lambert:albedo=0.3%2Bggx:alpha=0.1%2Bfile:../x" \
-    $'/api/info\ncookie: halfback_token_8765=t\norigin: http://127.0.0.1:8765'; do
+    $'/api/info\ncookie: halfback_token_8765=t\norigin: http://127.0.0.1:8765' \
+    $'/api/info?token=t\nHost: 127.0.0.1:8765' \
+    $'/api/info?token=t\norigin: http://127.0.0.1:8765\nOrigin: http://localhost:8765' \
+    $'/api/info\ncookie: halfback_token_8765=t\nCookie: halfback_token_8765=t'; do
   printf '%s' "$seed" > "$corpus/view/seed$k"
+  k=$((k + 1))
+done
+# Seeds of the view's socket side: a connection's bytes, cut at "~~\n" into pieces sent apart
+# (fuzz/view_wire_fuzz.cpp): pipelined, trickled, cut mid-line, repeated Host/Origin, unfinished.
+mkdir -p "$corpus/view_wire"
+host=$'Host: 127.0.0.1:8765\r\n'
+k=0
+for seed in $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'\r\n' \
+    $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'\r\nGET /api/point?token=t&brdf=arg:0&wi=0,0,1&wo=0,0,1 HTTP/1.1\r\n'"$host"$'Connection: close\r\n\r\n' \
+    $'GET /api/info?token=t HTTP/1.1\r\n'"$host$host"$'\r\n' \
+    $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'Origin: http://127.0.0.1:8765\r\norigin: http://localhost:8765\r\n\r\n' \
+    $'GET /api/info?token=t HTTP/1.1\r\n~~\n'"$host"$'~~\nX-A: b\r\n~~\nX-A: b\r\n~~\n\r\n' \
+    $'GE~~\nT /api/slices?token=t&brdf=arg:0&n=8 HTTP/1.1\r\nHo~~\nst: 127.0.0.1:8765\r\n\r~~\n\n' \
+    $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'X-Unfinished: ' \
+    $'GET /api/info?token=t HTTP/1.0\r\n'"$host"$'\r\n' \
+    $'POST /api/info?token=t HTTP/1.1\r\n'"$host"$'Content-Length: 5\r\n\r\nhello' \
+    $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'Expect: 100-continue\r\nRange: bytes=0-3\r\n\r\n'; do
+  printf '%s' "$seed" > "$corpus/view_wire/seed$k"
   k=$((k + 1))
 done
 artifacts="$build/artifacts"
 mkdir -p "$artifacts"
 
 status=0
-for target in merl rgl alta npy h5 envmap view; do
+for target in merl rgl alta npy h5 envmap view view_wire; do
   case "$target" in
     merl) max_len=4096 ;;     # full-size files are built inside the target
     rgl)  max_len=65536 ;;
@@ -59,6 +80,7 @@ for target in merl rgl alta npy h5 envmap view; do
     h5)   max_len=32768 ;;
     envmap) max_len=32768 ;;
     view) max_len=2048 ;;
+    view_wire) max_len=4096 ;;
   esac
   dict=()
   [ -f "fuzz/$target.dict" ] && dict=("-dict=fuzz/$target.dict")

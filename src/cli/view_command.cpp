@@ -124,7 +124,8 @@ Command register_view(CLI::App& parent) {
   app->add_flag("--open", o->open, "Open the page in the system browser");
   app->add_option("--threads", o->threads, "Threads per computation (0: all cores)");
   app->add_option("--workers", o->workers,
-                  "Connections served at once (default 16; a browser tab opens up to 6)");
+                  "Requests answered at once (default 16; each connection has a thread of "
+                  "its own)");
   app->footer(
       "Prints the URL to open, with a random token that every request must carry; Ctrl-C\n"
       "stops the server. See docs/view.md for the page, the API and the security model.\n"

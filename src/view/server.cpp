@@ -2,18 +2,31 @@
 // halfback::view::Request and Response.
 #include "halfback/view/server.hpp"
 
+#include <fmt/format.h>
 #include <httplib.h>
 #include <malloc.h>
+#include <netdb.h>
+#include <poll.h>
 #include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cerrno>
+#include <chrono>
 #include <condition_variable>
+#include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <semaphore>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
+
+#include "json.hpp"
 
 namespace halfback::view {
 
@@ -21,8 +34,9 @@ namespace {
 
 // A thread for each connection, up to kMaxConnections at once (more wait their turn): a client
 // that trickles its request's header lines holds only its own connection's thread, where with a
-// pool of --workers threads twenty such clients stalled every request for 30 s. The work of the
-// requests is bounded apart (Server::Impl::handling: --workers at once).
+// pool of --workers threads twenty such clients stalled every request for 30 s; and it holds it
+// for kRequestHeadSeconds at most (HttpServer::serve). The work of the requests is bounded apart
+// (Server::Impl::handling: --workers at once).
 class ConnectionQueue : public httplib::TaskQueue {
  public:
   static constexpr std::size_t kMaxConnections = 256;
@@ -72,11 +86,282 @@ void exclusive_socket_options(socket_t sock) {
   setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
 }
 
+// Why host:port cannot be bound, in the system's words (httplib reports only that it failed):
+// the reason of a bind of a socket of our own, with the same options.
+std::string bind_failure(const std::string& host, int port) {
+  const std::string where = fmt::format("cannot listen on {}:{}", host, port);
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE;
+  addrinfo* found = nullptr;
+  if (const int e = ::getaddrinfo(host.c_str(), std::to_string(port).c_str(), &hints, &found))
+    return fmt::format("{}: {}", where, ::gai_strerror(e));
+  int error = 0;
+  const int sock = ::socket(found->ai_family, found->ai_socktype, found->ai_protocol);
+  if (sock < 0) {
+    error = errno;
+  } else {
+    exclusive_socket_options(sock);
+    if (::bind(sock, found->ai_addr, found->ai_addrlen) != 0) error = errno;
+    ::close(sock);
+  }
+  ::freeaddrinfo(found);
+  std::string reason = error != 0 ? std::strerror(error) : "it could not be bound";
+  if (error == EADDRINUSE)
+    reason +=
+        " (another server has this port: stop it, or choose another with --port; "
+        "--port 0 takes any free one)";
+  return fmt::format("{}: {}", where, reason);
+}
+
 }  // namespace
+
+// Named, not anonymous: Server::Impl holds an HttpServer.
+namespace http_detail {
+
+using Clock = std::chrono::steady_clock;
+
+// Milliseconds from now to `t` (0 if past), for poll().
+int milliseconds_until(Clock::time_point t) {
+  const auto ms = std::chrono::ceil<std::chrono::milliseconds>(t - Clock::now()).count();
+  return int(std::clamp<long long>(ms, 0, 1 << 30));
+}
+
+// Whether `sock` has data (or an end) to read before `t` (a signal does not end the wait).
+bool readable_before(socket_t sock, Clock::time_point t) {
+  pollfd p{sock, POLLIN, 0};
+  int ready = 0;
+  do ready = ::poll(&p, 1, milliseconds_until(t));
+  while (ready < 0 && errno == EINTR);
+  return ready > 0;
+}
+
+// The numeric address and port of a socket's peer (`peer`) or its own end.
+void socket_address(socket_t sock, bool peer, std::string& ip, int& port) {
+  sockaddr_storage a{};
+  socklen_t size = sizeof a;
+  auto* sa = reinterpret_cast<sockaddr*>(&a);
+  char host[NI_MAXHOST] = "", service[NI_MAXSERV] = "0";
+  if ((peer ? ::getpeername(sock, sa, &size) : ::getsockname(sock, sa, &size)) != 0 ||
+      ::getnameinfo(sa, size, host, sizeof host, service, sizeof service,
+                    NI_NUMERICHOST | NI_NUMERICSERV) != 0)
+    host[0] = '\0';
+  ip = host;
+  port = std::atoi(service);
+}
+
+// The stream of one connection, for all its requests (httplib's own is per request, and loses
+// the bytes of a pipelined request). While a request head is being read (set_head_deadline()
+// until head_done()), every read ends at that deadline, however the bytes trickle: httplib's
+// own stream only bounds the wait of each read, which a client sending a line a second extends
+// forever. Past the deadline the stream swallows what httplib writes (its 400), and the server
+// answers 408 itself.
+class ConnectionStream : public httplib::Stream {
+ public:
+  ConnectionStream(socket_t sock, std::chrono::microseconds read_timeout,
+                   std::chrono::microseconds write_timeout)
+      : sock_(sock), read_timeout_(read_timeout), write_timeout_(write_timeout) {}
+
+  // Whether the next request's first byte arrives before `t` (or is already buffered).
+  bool request_arrives_before(Clock::time_point t) const {
+    return offset_ < size_ || readable_before(sock_, t);
+  }
+  void set_head_deadline(Clock::time_point t) {
+    head_deadline_ = t;
+    in_head_ = true;
+  }
+  void head_done() { in_head_ = false; }
+  bool head_too_late() const { return too_late_; }
+
+  bool is_readable() const override { return offset_ < size_ || readable_before(sock_, limit()); }
+  bool is_writable() const override {
+    pollfd p{sock_, POLLOUT, 0};
+    return ::poll(&p, 1,
+                  int(std::chrono::ceil<std::chrono::milliseconds>(write_timeout_).count())) > 0;
+  }
+
+  ssize_t read(char* ptr, std::size_t size) override {
+    if (offset_ == size_ && !fill()) return -1;
+    if (offset_ == size_) return 0;  // the peer closed
+    const std::size_t n = std::min(size, size_ - offset_);
+    std::memcpy(ptr, buffer_.data() + offset_, n);
+    offset_ += n;
+    return ssize_t(n);
+  }
+
+  ssize_t write(const char* ptr, std::size_t size) override {
+    if (too_late_) return ssize_t(size);  // the 408 replaces httplib's answer
+    if (!is_writable()) return -1;
+    return ::send(sock_, ptr, size, MSG_NOSIGNAL);
+  }
+
+  void get_remote_ip_and_port(std::string& ip, int& port) const override {
+    socket_address(sock_, true, ip, port);
+  }
+  void get_local_ip_and_port(std::string& ip, int& port) const override {
+    socket_address(sock_, false, ip, port);
+  }
+  socket_t socket() const override { return sock_; }
+
+ private:
+  // The time a read may wait until: the read timeout, and the head's deadline while in a head.
+  Clock::time_point limit() const {
+    const Clock::time_point t = Clock::now() + read_timeout_;
+    return in_head_ ? std::min(t, head_deadline_) : t;
+  }
+  // Reads what the socket has into the empty buffer: false on a timeout or an error (a timeout
+  // past the head's deadline marks the stream too late), true with size_ == 0 at the peer's end.
+  bool fill() {
+    offset_ = size_ = 0;
+    if (!readable_before(sock_, limit())) {
+      too_late_ = in_head_ && Clock::now() >= head_deadline_;
+      return false;
+    }
+    const ssize_t n = ::recv(sock_, buffer_.data(), buffer_.size(), 0);
+    if (n < 0) return false;
+    size_ = std::size_t(n);
+    return true;
+  }
+
+  socket_t sock_;
+  std::chrono::microseconds read_timeout_, write_timeout_;
+  std::array<char, 4096> buffer_{};
+  std::size_t offset_ = 0, size_ = 0;
+  Clock::time_point head_deadline_{};
+  bool in_head_ = false, too_late_ = false;
+};
+
+// Writes a whole response that closes the connection, with a JSON {"error": message} body (as the
+// Api's), then waits briefly for the client's end so that the unread rest of its request does
+// not turn the close into a reset that would lose the response.
+void answer_and_close(socket_t sock, int status, const char* reason, std::string_view message) {
+  JsonWriter w;
+  w.begin_object().field("error", message).end_object();
+  const std::string body = w.str();
+  const std::string response = fmt::format(
+      "HTTP/1.1 {} {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n"
+      "Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n{}",
+      status, reason, body.size(), body);
+  for (std::size_t sent = 0; sent < response.size();) {
+    pollfd p{sock, POLLOUT, 0};
+    if (::poll(&p, 1, 1000) <= 0) return;
+    const ssize_t n = ::send(sock, response.data() + sent, response.size() - sent, MSG_NOSIGNAL);
+    if (n <= 0) return;
+    sent += std::size_t(n);
+  }
+  ::shutdown(sock, SHUT_WR);
+  const Clock::time_point until = Clock::now() + std::chrono::milliseconds(200);
+  char drain[4096];
+  for (std::size_t total = 0; total < (1 << 16) && readable_before(sock, until);) {
+    const ssize_t n = ::recv(sock, drain, sizeof drain, 0);
+    if (n <= 0) return;
+    total += std::size_t(n);
+  }
+}
+
+// The open connections of each client address, each held by a Slot; at most
+// kConnectionsPerClient per address.
+class ClientConnections {
+ public:
+  class Slot {
+   public:
+    Slot(ClientConnections& owner, std::string address)
+        : owner_(owner), address_(std::move(address)) {
+      std::lock_guard lock(owner_.mutex_);
+      int& open = owner_.open_[address_];
+      taken_ = open < kConnectionsPerClient;
+      if (taken_) ++open;
+    }
+    ~Slot() {
+      if (!taken_) return;
+      std::lock_guard lock(owner_.mutex_);
+      const auto it = owner_.open_.find(address_);
+      if (--it->second == 0) owner_.open_.erase(it);
+    }
+    Slot(const Slot&) = delete;
+    Slot& operator=(const Slot&) = delete;
+    bool taken() const { return taken_; }
+
+   private:
+    ClientConnections& owner_;
+    std::string address_;
+    bool taken_ = false;
+  };
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, int> open_;
+};
+
+// httplib's server with its connection handling replaced (process_and_close_socket, a virtual
+// function of httplib::Server that may be overridden although private): the bound on
+// connections per client, and the stream whose request heads have a deadline. The requests
+// themselves go through httplib's process_request (parsing, routing, writing).
+class HttpServer : public httplib::Server {
+ public:
+  // Widens the bound socket's queue of connections not yet accepted from httplib's 5 (Linux
+  // takes a second listen() for that): a burst of more, such as a page's requests with a few
+  // other clients, otherwise saw connections dropped by the kernel and set up again 1 to 3 s
+  // later.
+  void widen_backlog() { ::listen(svr_sock_, ConnectionQueue::kMaxConnections); }
+  // Serves a connected socket as an accepted one (Server::serve_connection).
+  void serve_accepted(socket_t sock) { process_and_close_socket(sock); }
+
+ private:
+  bool process_and_close_socket(socket_t sock) override {
+    std::string address;
+    int port = 0;
+    socket_address(sock, true, address, port);
+    bool ok = false;
+    if (const ClientConnections::Slot slot(clients_, address); slot.taken())
+      ok = serve(sock);
+    else
+      answer_and_close(sock, 503, "Service Unavailable",
+                       fmt::format("too many connections from {} (at most {} at once)", address,
+                                   kConnectionsPerClient));
+    ::shutdown(sock, SHUT_RDWR);
+    ::close(sock);
+    return ok;
+  }
+
+  // The requests of one connection, up to httplib's keep-alive count: each must begin within
+  // the keep-alive timeout and have its head read within kRequestHeadSeconds of the wait's start.
+  bool serve(socket_t sock) {
+    using std::chrono::microseconds, std::chrono::seconds;
+    ConnectionStream stream(sock, seconds(read_timeout_sec_) + microseconds(read_timeout_usec_),
+                            seconds(write_timeout_sec_) + microseconds(write_timeout_usec_));
+    const auto head_time = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(kRequestHeadSeconds));
+    bool ok = false;
+    for (std::size_t k = 0; k < keep_alive_max_count_ && svr_sock_ != INVALID_SOCKET; ++k) {
+      const Clock::time_point deadline = Clock::now() + head_time;
+      if (!stream.request_arrives_before(
+              std::min(deadline, Clock::now() + seconds(keep_alive_timeout_sec_))))
+        break;  // an idle connection: closed quietly
+      stream.set_head_deadline(deadline);
+      bool closed = false;
+      ok = process_request(stream, k + 1 == keep_alive_max_count_, closed,
+                           [&stream](httplib::Request&) { stream.head_done(); });
+      if (stream.head_too_late()) {
+        answer_and_close(sock, 408, "Request Timeout",
+                         fmt::format("the request line and headers did not arrive within {} s",
+                                     kRequestHeadSeconds));
+        return false;
+      }
+      if (!ok || closed) break;
+    }
+    return ok;
+  }
+
+  ClientConnections clients_;
+};
+
+}  // namespace http_detail
 
 struct Server::Impl {
   Api& api;
-  httplib::Server http;
+  http_detail::HttpServer http;
   std::counting_semaphore<> handling;  // requests answered at once: --workers
   Impl(Api& a, int workers) : api(a), handling(workers) {}
 };
@@ -116,9 +401,8 @@ Server::~Server() = default;
 int Server::bind(const std::string& host, int port) {
   const int bound = port == 0 ? impl_->http.bind_to_any_port(host)
                               : (impl_->http.bind_to_port(host, port) ? port : -1);
-  if (bound <= 0)
-    throw std::runtime_error("cannot listen on " + host + ":" + std::to_string(port) +
-                             " (address in use, or not an address of this machine?)");
+  if (bound <= 0) throw std::runtime_error(bind_failure(host, port));
+  impl_->http.widen_backlog();
   impl_->api.set_port(bound);
   return bound;
 }
@@ -129,6 +413,10 @@ bool Server::run() {
 
 void Server::stop() {
   impl_->http.stop();
+}
+
+void Server::serve_connection(int fd) {
+  impl_->http.serve_accepted(fd);
 }
 
 bool keep_freed_memory() {

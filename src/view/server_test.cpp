@@ -42,14 +42,9 @@ int connect_to(int port) {
   return fd;
 }
 
-// The status line of one GET of /api/info (Connection: close), read within `seconds`; "" if none.
-std::string get_info(int port, double seconds) {
-  const int fd = connect_to(port);
-  if (fd < 0) return "";
-  const std::string request = "GET /api/info?token=" + kToken +
-                              " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
-                              "\r\nConnection: close\r\n\r\n";
-  (void)!::write(fd, request.data(), request.size());
+// The status line the server writes on `fd` within `seconds` ("" if none, or the connection
+// closed without one).
+std::string status_line(int fd, double seconds) {
   std::string answer;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   char buf[4096];
@@ -62,8 +57,28 @@ std::string get_info(int port, double seconds) {
     if (n <= 0) break;
     answer.append(buf, std::size_t(n));
   }
-  ::close(fd);
   return answer.substr(0, answer.find("\r\n"));
+}
+
+// A GET of /api/info with the token, Connection: close, and `extra` header lines.
+std::string info_request(int port, const std::string& extra = "") {
+  return "GET /api/info?token=" + kToken + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+         "\r\n" + extra + "Connection: close\r\n\r\n";
+}
+
+// The status line of one GET of /api/info (Connection: close), read within `seconds`; "" if none.
+std::string get_info(int port, double seconds, const std::string& extra = "") {
+  const int fd = connect_to(port);
+  if (fd < 0) return "";
+  const std::string request = info_request(port, extra);
+  (void)!::write(fd, request.data(), request.size());
+  const std::string status = status_line(fd, seconds);
+  ::close(fd);
+  return status;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 struct Running {
@@ -81,7 +96,14 @@ TEST(ViewServer, APortIsNotShared) {
   Running first;
   Api other_api(config());
   Server second(other_api, 2);
-  EXPECT_THROW(second.bind("127.0.0.1", first.port), std::runtime_error);
+  try {
+    second.bind("127.0.0.1", first.port);
+    ADD_FAILURE() << "a second server bound the port";
+  } catch (const std::runtime_error& e) {  // the message names the port and the reason
+    const std::string expected =
+        "cannot listen on 127.0.0.1:" + std::to_string(first.port) + ": Address already in use";
+    EXPECT_EQ(std::string(e.what()).rfind(expected, 0), 0u) << e.what();
+  }
   for (int k = 0; k < 20; ++k) EXPECT_EQ(get_info(first.port, 5), "HTTP/1.1 200 OK") << k;
 }
 
@@ -107,6 +129,83 @@ TEST(ViewServer, TricklingClientsDoNotStallTheOthers) {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
   }
   for (const int fd : slow) ::close(fd);
+}
+
+// A client that trickles header lines (one every 250 ms, each well within the read timeout)
+// cannot keep its request open: the head has one deadline from the start of the wait, after
+// which the server answers 408 and closes.
+TEST(ViewServer, ARequestHeadHasADeadlineThatTricklingCannotExtend) {
+  Running s;
+  const int fd = connect_to(s.port);
+  ASSERT_GE(fd, 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string start = "GET /api/info?token=" + kToken + " HTTP/1.1\r\n";
+  (void)!::write(fd, start.data(), start.size());
+  std::string status;
+  while (status.empty() && seconds_since(t0) < kRequestHeadSeconds + 4) {
+    (void)!::send(fd, "X-A: b\r\n", 8, MSG_NOSIGNAL);
+    status = status_line(fd, 0.25);
+  }
+  const double seconds = seconds_since(t0);
+  ::close(fd);
+  EXPECT_EQ(status, "HTTP/1.1 408 Request Timeout");
+  EXPECT_GT(seconds, kRequestHeadSeconds - 0.5);
+  EXPECT_LT(seconds, kRequestHeadSeconds + 1.0);
+}
+
+// One client address holds at most kConnectionsPerClient connections: one more is refused at
+// once (503, closed), and a request gets through again when the others close.
+TEST(ViewServer, ConnectionsOfOneClientAreBounded) {
+  Running s;
+  std::vector<int> held;
+  for (int k = 0; k < kConnectionsPerClient; ++k) {
+    const int fd = connect_to(s.port);
+    ASSERT_GE(fd, 0);
+    (void)!::write(fd, "GET /api/info", 13);  // a request begun, not finished
+    held.push_back(fd);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // every connection counted
+  auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(get_info(s.port, 2), "HTTP/1.1 503 Service Unavailable");
+  EXPECT_LT(seconds_since(t0), 1.0);
+  for (const int fd : held) ::close(fd);
+  t0 = std::chrono::steady_clock::now();
+  std::string status;
+  while (status != "HTTP/1.1 200 OK" && seconds_since(t0) < 2) {
+    status = get_info(s.port, 2);
+    if (status != "HTTP/1.1 200 OK") std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_EQ(status, "HTTP/1.1 200 OK");
+}
+
+// A burst of connections (as many as one client may hold) is answered at once: none waits for
+// the kernel to set it up again after dropping it from a full queue of unaccepted connections.
+TEST(ViewServer, ABurstOfConnectionsIsAnsweredAtOnce) {
+  Running s;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<int> burst;
+  for (int k = 0; k < kConnectionsPerClient - 2; ++k) {
+    const int fd = connect_to(s.port);
+    ASSERT_GE(fd, 0);
+    const std::string request = info_request(s.port);
+    (void)!::write(fd, request.data(), request.size());
+    burst.push_back(fd);
+  }
+  for (const int fd : burst) {
+    EXPECT_EQ(status_line(fd, 3), "HTTP/1.1 200 OK");
+    ::close(fd);
+  }
+  EXPECT_LT(seconds_since(t0), 0.9);
+}
+
+// Two Host or two Origin headers on the wire are refused (httplib keeps both; the Api refuses).
+TEST(ViewServer, RepeatedHostOrOriginHeadersAreRefused) {
+  Running s;
+  const std::string host = "Host: 127.0.0.1:" + std::to_string(s.port) + "\r\n";
+  EXPECT_EQ(get_info(s.port, 5, host), "HTTP/1.1 400 Bad Request");
+  const std::string origin = "Origin: http://127.0.0.1:" + std::to_string(s.port) + "\r\n";
+  EXPECT_EQ(get_info(s.port, 5, origin), "HTTP/1.1 200 OK");
+  EXPECT_EQ(get_info(s.port, 5, origin + origin), "HTTP/1.1 400 Bad Request");
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
 // Tests of the `halfback` binary (its path is HALFBACK_CLI_PATH): runs it with arguments and
 // standard input, and checks its standard output, standard error, exit status and files.
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <sys/wait.h>
@@ -1884,6 +1887,29 @@ TEST_F(CliTest, ViewRefusesBadOptionsBeforeServing) {
   EXPECT_NE(r.err.find("--root '/nonexistent/halfback-root': not a readable directory"),
             std::string::npos)
       << r.err;
+}
+
+// A second server on a port that is taken fails at once with status 1 (a runtime error), naming
+// the address, the port and the reason (here the port is held by a plain listening socket, so
+// that the command cannot serve even where it would share the port).
+TEST_F(CliTest, ViewOnATakenPortFailsNamingThePort) {
+  const int held = ::socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(held, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t size = sizeof a;
+  ASSERT_EQ(::bind(held, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  ASSERT_EQ(::listen(held, 1), 0);
+  ASSERT_EQ(::getsockname(held, reinterpret_cast<sockaddr*>(&a), &size), 0);
+  const std::string port = std::to_string(ntohs(a.sin_port));
+  const Result r = run({"view", "lambert", "--port", port});
+  ::close(held);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("cannot listen on 127.0.0.1:" + port + ": Address already in use"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out, "");
 }
 
 // `halfback fit`: the spec it prints is the fitted model, which `info` and `eval` read back, and

@@ -9,6 +9,15 @@
 
 namespace halfback::view {
 
+// Limits of the connections (docs/view.md, "Security model"):
+// a request's line and headers arrive within kRequestHeadSeconds of the moment the server starts
+// waiting for it (the connection's opening, or the end of the previous response), however they
+// trickle in: after it, 408 and the connection closed;
+inline constexpr double kRequestHeadSeconds = 4;
+// one client address holds at most kConnectionsPerClient connections at once: another is
+// answered 503 and closed at once.
+inline constexpr int kConnectionsPerClient = 32;
+
 class Server {
  public:
   // `workers`: threads answering connections (a browser opens up to six per host, and a kept-
@@ -25,6 +34,10 @@ class Server {
   bool run();
   // Stops run() from another thread.
   void stop();
+  // Serves one connected socket on the calling thread, as run() serves an accepted connection
+  // (its requests, with every limit above), and closes it; after bind(), without run(). For the
+  // wire-level fuzzer (fuzz/view_wire_fuzz.cpp).
+  void serve_connection(int fd);
 
  private:
   struct Impl;
