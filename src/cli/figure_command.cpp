@@ -308,7 +308,7 @@ Command add_hemisphere(CLI::App& figure) {
       "Figure 1: every incoming direction of the hemisphere for fixed outgoing directions, "
       "coloured by the pair's two non-azimuthal coordinates (red, green)");
   h->add_option("--param", hemi->params,
-                "Parameterizations, one row each (spherical, halfdiff, ortho, hybrid)")
+                "Parameterizations, one row each (" + parameterization_names(", ") + ")")
       ->capture_default_str();
   h->add_option("--elevations", hemi->elevations,
                 "Polar angles θo of ωo from the normal, in degrees, one column each")

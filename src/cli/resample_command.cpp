@@ -31,8 +31,7 @@ int run_resample(const ResampleOptions& o) {
   const auto space = space_from_name(o.param);
   if (!space || *space == Space::dirs)
     throw UsageError(fmt::format(
-        "--param '{}': expected a parameterization: spherical, halfdiff, ortho or hybrid",
-        o.param));
+        "--param '{}': expected a parameterization: {}", o.param, parameterization_names()));
   const GridKind kind = o.kind == "full"        ? GridKind::full
                         : o.kind == "isotropic" ? GridKind::isotropic
                                                 : GridKind::slice;
@@ -93,7 +92,7 @@ Command register_resample(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand(
       "resample", "Tabulate a BRDF on a regular grid of a parameterization (.exr, .npz, .npy)");
   app->add_option("--brdf", o->brdf, "BRDF SPEC: a MERL, RGL or ALTA file, or a model")->required();
-  app->add_option("--param", o->param, "Parameterization: spherical, halfdiff, ortho or hybrid")
+  app->add_option("--param", o->param, "Parameterization: " + parameterization_names())
       ->capture_default_str();
   app->add_option("--kind", o->kind,
                   "full (4D), isotropic (3D, phi_h = 0) or slice (2D, at --azimuth)")

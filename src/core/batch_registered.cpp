@@ -59,6 +59,7 @@ class Block {
   void decode() {
     const std::size_t d = dimension(from_);
     if (!from_.space.is_dirs() && !from_.space.has_kernels()) {
+      wrap_azimuth_rows(from_.space.param().axes(from_.isotropic), qin_.data(), m_);
       from_.space.param().inverse_rows(from_.isotropic, qin_.data(), m_, pairs_.data(),
                                        valid_.data());
       return;

@@ -142,6 +142,7 @@ struct LaneOps<xsimd::batch<S, A>> {
   static T abs(const T& x) {
     return xsimd::abs(x);
   }
+  static T floor(const T& x) { return xsimd::floor(x); }
 
   // The polynomial with coefficients c (highest degree first) at z. Up to 6 terms by Horner's
   // rule. For 7 and 8 (sincos) by Estrin's scheme: terms paired at each level (a + b z, then with
@@ -414,6 +415,7 @@ struct LaneOps<Twin<B>> {
   }
   static T sqrt(const T& x) { return {O::sqrt(x.lo), O::sqrt(x.hi)}; }
   static T abs(const T& x) { return {O::abs(x.lo), O::abs(x.hi)}; }
+  static T floor(const T& x) { return {O::floor(x.lo), O::floor(x.hi)}; }
   static T atan2(const T& y, const T& x) { return {O::atan2(y.lo, x.lo), O::atan2(y.hi, x.hi)}; }
   static T atan2_nonneg(const T& y, const T& x) {
     return {O::atan2_nonneg(y.lo, x.lo), O::atan2_nonneg(y.hi, x.hi)};

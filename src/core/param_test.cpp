@@ -204,12 +204,12 @@ TYPED_TEST(ParamTest, IsotropicFormIsRotationInvariant) {
 
 // Independent reference for the domain: textbook inverse formulas in long double, "the inverse
 // gives z >= 0 for both directions" (plus the coordinate ranges).
-bool reference_valid(const Spherical&, const Tuple4<long double>& q) {
-  return q[0] >= 0 && q[0] <= kPi / 2 && q[2] >= 0 && q[2] <= kPi / 2 && q[1] >= 0 &&
-         q[1] < kTwoPiD && q[3] >= 0 && q[3] < kTwoPiD;
-}
+// Azimuths are periodic: any finite value is one (the maps reduce it to [0, 2π)).
 bool azimuths_ok(const Tuple4<long double>& q) {
-  return q[1] >= 0 && q[1] < kTwoPiD && q[3] >= 0 && q[3] < kTwoPiD;
+  return std::isfinite(q[1]) && std::isfinite(q[3]);
+}
+bool reference_valid(const Spherical&, const Tuple4<long double>& q) {
+  return q[0] >= 0 && q[0] <= kPi / 2 && q[2] >= 0 && q[2] <= kPi / 2 && azimuths_ok(q);
 }
 bool reference_valid(const HalfDiff&, const Tuple4<long double>& q) {
   if (!(q[0] >= 0 && q[0] <= kPi / 2 && q[2] >= 0 && q[2] <= kPi / 2 && azimuths_ok(q)))
@@ -292,9 +292,9 @@ TYPED_TEST(ParamTest, InvalidTuplesGiveNaNDirections) {
   std::vector<Tuple4<double>> bad;
   for (std::size_t c = 0; c < 4; ++c) {
     const Axis& a = P::axes[c];
+    const double inf = std::numeric_limits<double>::infinity();
     const std::vector<double> values = a.kind == AxisKind::azimuth
-                                           ? std::vector<double>{nan, kTwoPiD, -1e-9}
-                                           // 2π: not an azimuth
+                                           ? std::vector<double>{nan, inf, -inf}  // else periodic
                                            : std::vector<double>{nan, a.lo - 1e-3, a.hi + 1e-3};
     for (double v : values) {
       bad.push_back(base);
@@ -307,6 +307,37 @@ TYPED_TEST(ParamTest, InvalidTuplesGiveNaNDirections) {
                               << q[3] << ")";
     EXPECT_TRUE(std::isnan(s.pair.wi.x) && std::isnan(s.pair.wo.z)) << P::name;
   }
+}
+
+// Azimuths are periodic (issue 35, class I): a tuple whose azimuths are moved by whole turns,
+// negative ones included, is the same pair, in the 4D and the isotropic forms; within the
+// rounding of the turn's subtraction. On the code before, φ < 0 or ≥ 2π was invalid.
+TYPED_TEST(ParamTest, AzimuthsArePeriodic) {
+  using P = TypeParam;
+  const DirPair<double> p{test::direction(0.8, 0.3), test::direction(0.6, 2.1)};
+  const Tuple4<double> q = P::forward(p);
+  const Tuple3<double> q3 = P::forward_iso(p);
+  const auto near = [](const DirPair<double>& a, const DirPair<double>& b) {
+    return std::abs(a.wi.x - b.wi.x) + std::abs(a.wi.y - b.wi.y) + std::abs(a.wi.z - b.wi.z) +
+               std::abs(a.wo.x - b.wo.x) + std::abs(a.wo.y - b.wo.y) + std::abs(a.wo.z - b.wo.z) <
+           1e-12;
+  };
+  int azimuths = 0;
+  for (const int turns : {-3, -1, 1, 2, 100}) {
+    Tuple4<double> moved = q;
+    for (std::size_t c = 0; c < 4; ++c)
+      if (P::axes[c].kind == AxisKind::azimuth) moved[c] += turns * kTwoPiD, ++azimuths;
+    const Solved<double> s = inverse<P>(moved);
+    EXPECT_TRUE(s.in_domain && near(s.pair, inverse<P>(q).pair)) << P::name << " " << turns;
+    EXPECT_TRUE(valid<P>(moved)) << P::name;
+    Tuple3<double> moved3 = q3;
+    for (std::size_t c = 0; c < 3; ++c)
+      if (P::iso_axes[c].kind == AxisKind::azimuth) moved3[c] += turns * kTwoPiD, ++azimuths;
+    const Solved<double> s3 = inverse_iso<P>(moved3);
+    EXPECT_TRUE(s3.in_domain && near(s3.pair, inverse_iso<P>(q3).pair)) << P::name << " " << turns;
+    EXPECT_TRUE(valid_iso<P>(moved3)) << P::name;
+  }
+  if (azimuths == 0) GTEST_SKIP() << P::name << " has no azimuth coordinate";
 }
 
 // Outside the disk/hemisphere, specific to each parameterization.

@@ -652,6 +652,16 @@ TEST(ViewApi, PointFromIsotropicCoordinatesAndItsErrors) {
       "/api/point", {{"brdf", "arg:0"}, {"form", "ortho"}, {"iso", "1"}, {"coords", "0.9,0.9,0"}}));
   ASSERT_EQ(out.status, 200);  // outside the domain: an answer, not an error
   EXPECT_NE(out.body.find("\"valid\":false"), std::string::npos);
+  // A relative azimuth is periodic (issue 35, class I): φd = -π/2 is 3π/2, the same pair.
+  const auto wi_of = [&](const std::string& coords) {
+    const Response r = api.handle(get(
+        "/api/point", {{"brdf", "arg:0"}, {"form", "halfdiff"}, {"iso", "1"}, {"coords", coords}}));
+    EXPECT_NE(r.body.find("\"valid\":true"), std::string::npos) << coords << ": " << r.body;
+    const std::size_t at = r.body.find("\"wi\":[");
+    return at == std::string::npos ? std::string() : r.body.substr(at, 40);
+  };
+  EXPECT_EQ(wi_of("0.3,0.5,-1.5707963267948966").substr(0, 20),
+            wi_of("0.3,0.5,4.7123889803846897").substr(0, 20));
   EXPECT_EQ(api.handle(get("/api/point", {{"form", "ortho"}, {"coords", "0.1,0.2"}})).status, 400);
   EXPECT_EQ(api.handle(get("/api/point", {{"wi", "0,0,2"}, {"wo", "0,0,1"}})).status, 400);
   EXPECT_EQ(api.handle(get("/api/point", {{"wi", "0,0,1"}})).status, 400);

@@ -66,7 +66,7 @@ Space space_param(const Request& r, std::string_view key, bool allow_dirs) {
     throw RequestError(
         400,
         fmt::format("parameter '{}': '{}' is not one of {}", key, name.substr(0, 64),
-                    allow_dirs ? "rho, " + space_names() : "spherical, halfdiff, ortho, hybrid"));
+                    allow_dirs ? "rho, " + space_names() : parameterization_names(", ")));
   return *s;
 }
 

@@ -569,7 +569,7 @@ TEST_F(CliTest, OutOfDomainTuplesAreValidZeroRows) {
       "hbar,phi_h,k,phi_k\n"
       "0.3,0,0.3,0\n"   // valid
       "0.9,0,0.9,0\n"   // outside the domain
-      "0.3,7,0.3,0\n"   // azimuth out of range
+      "0.3,1e9,0.3,0\n" // an azimuth beyond 65536 rad (7 is 7 − 2π: periodic)
       "0.3,1,0.2,2\n";  // valid
   const Result r = run({"convert", "--from", "hybrid", "--to", "dirs", "--jacobian"}, in);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -585,6 +585,22 @@ TEST_F(CliTest, OutOfDomainTuplesAreValidZeroRows) {
       EXPECT_TRUE(std::isfinite(t.columns[c][row]));
   // The invalid rows print `nan` (not -nan).
   EXPECT_NE(r.out.find("\nnan,nan,nan,nan,nan,nan,0,nan\n"), std::string::npos);
+}
+
+// Relative azimuths are periodic (issue 35, class I): φd = -π/2 and 3π/2 are the same pair, both
+// valid (the first was invalid before, without a word).
+TEST_F(CliTest, RelativeAzimuthsArePeriodic) {
+  const Result r = run({"convert", "--from", "halfdiff", "--isotropic", "--to", "dirs"},
+                       "theta_h,theta_d,phi_d\n0.3,0.5,-1.5707963267948966\n"
+                       "0.3,0.5,4.7123889803846897\n0.3,0.5,-20\n0.3,0.5,5.1327412287183449\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const CsvTable t = parse(r.out);
+  ASSERT_EQ(t.rows(), 4u);
+  for (std::size_t row = 0; row < 4; ++row) EXPECT_EQ(t.columns[6][row], 1) << row;
+  for (std::size_t c = 0; c < 6; ++c) {
+    EXPECT_NEAR(t.columns[c][0], t.columns[c][1], 1e-12) << c;
+    EXPECT_NEAR(t.columns[c][2], t.columns[c][3], 1e-12) << c;  // -20 = -20 + 4·2π
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -47,6 +47,7 @@ struct LaneOps<T> {
     return x == T(0) && y == T(0) ? T(0) : phi;
   }
   static T abs(T x) { return std::abs(x); }
+  static T floor(T x) { return std::floor(x); }
   static T min(T a, T b) { return std::fmin(a, b); }
   static T max(T a, T b) { return std::fmax(a, b); }
   static void sincos(T x, T& s, T& c) {

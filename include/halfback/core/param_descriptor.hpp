@@ -16,6 +16,11 @@
 
 namespace halfback {
 
+// Wraps the azimuth coordinates (AxisKind::azimuth) of m rows of `axes.size()` coordinates to
+// [0, 2π), as the built-in maps' inverses do (params/common.hpp): the batch engine applies it
+// before a run-time parameterization's inverse_rows.
+void wrap_azimuth_rows(std::span<const Axis> axes, double* coords, std::size_t m);
+
 // A parameterization at run time: its names and axes, and its maps in double precision, for code
 // that picks a parameterization from user input. For a C++ parameterization (CompiledParam) the
 // maps are the templates themselves, bit for bit; a run-time one (a Python user's) overrides them.

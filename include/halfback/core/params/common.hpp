@@ -209,10 +209,40 @@ inline void finish_inverse(Solved<T>& s) {
 }
 }  // namespace detail
 
+namespace detail {
+
+// An azimuth reduced to [0, 2π), its period being the double (or float) 2π: azimuths are
+// periodic, so φd = -π/2 is 3π/2 (docs/math.md, "Valid domain"). Lanes already in range are
+// returned as they are (bit for bit), the others through floor(a / 2π). NaN, infinities and
+// |a| > kMaxAzimuth (where a float's turn is no longer resolved to a hundredth of a radian) give
+// NaN: invalid.
+inline constexpr double kMaxAzimuth = 65536;
+template <class T>
+inline T wrap_azimuth(T a) {
+  using L = LaneOps<T>;
+  using S = ScalarOf<T>;
+  if (all_lanes(is_azimuth(a))) return a;
+  const T turns = L::floor(a * T(S(1) / kTwoPi<S>));
+  const T wrapped = wrap_two_pi(a - turns * T(kTwoPi<S>));  // a rounding off: into range
+  const T bad(std::numeric_limits<S>::quiet_NaN());
+  return L::select(is_azimuth(a), a,
+                   L::select(L::abs(a) <= T(S(kMaxAzimuth)), wrapped, bad));
+}
+
+// q with its azimuth coordinates (those of kind AxisKind::azimuth in `axes`) wrapped.
+template <class T, std::size_t N>
+inline std::array<T, N> with_azimuths_wrapped(std::array<T, N> q, const std::array<Axis, N>& axes) {
+  for (std::size_t k = 0; k < N; ++k)
+    if (axes[k].kind == AxisKind::azimuth) q[k] = wrap_azimuth(q[k]);
+  return q;
+}
+
+}  // namespace detail
+
 // The pair with coordinates q; NaN directions when q is outside the valid domain.
 template <class P, class T>
 inline Solved<T> inverse(const Tuple4<T>& q) {
-  Solved<T> s = P::inverse_raw(q);
+  Solved<T> s = P::inverse_raw(detail::with_azimuths_wrapped(q, P::axes));
   detail::finish_inverse(s);
   return s;
 }
@@ -220,19 +250,19 @@ inline Solved<T> inverse(const Tuple4<T>& q) {
 // The canonical pose with isotropic coordinates q (NaN when invalid).
 template <class P, class T>
 inline Solved<T> inverse_iso(const Tuple3<T>& q) {
-  Solved<T> s = P::inverse_iso_raw(q);
+  Solved<T> s = P::inverse_iso_raw(detail::with_azimuths_wrapped(q, P::iso_axes));
   detail::finish_inverse(s);
   return s;
 }
 
 template <class P, class T>
 inline MaskOf<T> valid(const Tuple4<T>& q) {
-  return P::inverse_raw(q).in_domain;
+  return P::inverse_raw(detail::with_azimuths_wrapped(q, P::axes)).in_domain;
 }
 
 template <class P, class T>
 inline MaskOf<T> valid_iso(const Tuple3<T>& q) {
-  return P::inverse_iso_raw(q).in_domain;
+  return P::inverse_iso_raw(detail::with_azimuths_wrapped(q, P::iso_axes)).in_domain;
 }
 
 // The measure of the isotropic coordinates: ∫ over the rotation about n of dωi dωo = J3 dq3.
