@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "halfback/core/space.hpp"
+#include "halfback/loader/load.hpp"
 
 namespace halfback::cli {
 
@@ -90,6 +91,14 @@ void rethrow_environment_error(const char* option, const std::string& spec) {
     throw;
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("{} '{}': {}", option, spec, e.what()));
+  }
+}
+
+BrdfPtr brdf_argument(const std::string& spec, const char* option) {
+  try {
+    return load_brdf(spec);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("{}: {}", option, e.what()));
   }
 }
 

@@ -4,9 +4,11 @@
 // function that adds its CLI::App to the main app and returns a Command; main.cpp calls the
 // functions listed in command_table() (commands.cpp), parses, and runs the selected command.
 //
-// Errors: a command throws. UsageError (a command line that parses but makes no sense) exits
-// with code 2, like the CLI11 parse errors; any other exception (bad data, a file that cannot be
-// read or written) exits with code 1. main.cpp prints "halfback NAME: error: MESSAGE" on stderr.
+// Errors: a command throws. UsageError (a command line that parses but makes no sense: an
+// option's value, options together, a BRDF or environment spec that names nothing or holds a bad
+// value) exits with code 2, like the CLI11 parse errors; any other exception (bad data, a file
+// that cannot be read or written, a failure while running) exits with code 1 (docs/cli.md, "Exit
+// status"). main.cpp prints "halfback NAME: error: MESSAGE" on stderr.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -21,6 +23,7 @@
 #include <string_view>
 #include <vector>
 
+#include "halfback/brdf/brdf.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/csv.hpp"
 
@@ -109,6 +112,10 @@ std::vector<std::string> environment_list(const std::string& list, const char* o
 // (std::invalid_argument) becomes a UsageError naming the option; anything else (an unreadable
 // or malformed file: a data error) is rethrown as it is.
 [[noreturn]] void rethrow_environment_error(const char* option, const std::string& spec);
+// A BRDF given on the command line (`option`: "--brdf", "SPEC", "--material"), by load_brdf(): a
+// spec that names nothing or a model with a bad value (std::invalid_argument) is a usage error,
+// status 2; a file that cannot be read or holds bad data is rethrown as it is, status 1.
+BrdfPtr brdf_argument(const std::string& spec, const char* option);
 // One finite number; the message names `what` (e.g. "--range k=0:x").
 double parse_number(std::string_view text, const std::string& what);
 

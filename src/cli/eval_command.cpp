@@ -51,7 +51,7 @@ void eval_block(const Brdf& brdf, const CsvTable& block, const std::string& sour
 
 int run_eval(const EvalOptions& o) {
   Output out(o.output);
-  const BrdfPtr brdf = load_brdf(o.brdf);
+  const BrdfPtr brdf = brdf_argument(o.brdf, "--brdf");
   const std::unique_ptr<CsvStreamReader> reader = open_csv_input(o.input);
   reader->require_header(column_names(Form{Space::dirs, false}));
   // The header goes out with the first block (a bad row in a one-block input writes nothing).

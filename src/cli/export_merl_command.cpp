@@ -20,7 +20,7 @@ int run_export_merl(const ExportMerlOptions& o) {
   if (o.output == "-") throw UsageError("-o: export-merl writes a file, not standard output");
   AtomicFile probe(o.output);  // an unwritable destination fails before tabulating
   probe.discard();
-  const BrdfPtr brdf = load_brdf(o.brdf);
+  const BrdfPtr brdf = brdf_argument(o.brdf, "--brdf");
   const MerlData data = tabulate_merl(*brdf);
   write_merl(o.output, data);
   const auto missing = data.missing[0];

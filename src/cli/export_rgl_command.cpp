@@ -32,7 +32,7 @@ int run_export_rgl(ExportRglOptions& o) {
   AtomicFile probe(o.output);  // an unwritable destination fails before the work
   probe.discard();
   const auto start = std::chrono::steady_clock::now();
-  const BrdfPtr brdf = load_brdf(o.brdf);
+  const BrdfPtr brdf = brdf_argument(o.brdf, "--brdf");
   o.table.description =
       o.description.empty()
           ? fmt::format("{} (exported by halfback export-rgl from '{}'; NDF by power iteration{})",

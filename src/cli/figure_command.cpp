@@ -67,7 +67,7 @@ struct PaperArgs {
   std::string formats = "png,svg,pdf";
   std::vector<std::string> materials;  // replace the default Figures 3-5
   std::string merl_dir;                // every MERL file in it: Figures 3, 4, 5...
-  std::string envs = "default,studio,sunset";
+  std::string envs = "sky,studio,sunset";
   bool no_materials = false;
   int render_pixels = 176, spp = 48;
   int threads = 0;
@@ -75,7 +75,7 @@ struct PaperArgs {
 
 struct MaterialArgs {
   std::string brdf, heading;
-  std::string envs = "default,studio,sunset";
+  std::string envs = "sky,studio,sunset";
   std::string params = "halfdiff,ortho,hybrid";
   std::string azimuths = "0,45,90";
   std::string colour = "rgb";
@@ -117,6 +117,16 @@ void finish(const figure::Scene& scene, const std::string& out, double scale, do
 
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A figure whose options make it larger than an image can be: the command line's fault (status 2).
+template <class Make>
+auto built(Make&& make) {
+  try {
+    return make();
+  } catch (const figure::FigureSizeError& e) {
+    throw UsageError(e.what());
+  }
 }
 
 int run_hemisphere(const HemisphereArgs& a) {
@@ -194,9 +204,9 @@ int run_slices(const SliceArgs& a) {
     }
   }
   check_writable(a.out);
-  if (!isolines) o.brdf = load_brdf(a.brdf);
+  if (!isolines) o.brdf = brdf_argument(a.brdf, "--brdf");
   const auto t0 = std::chrono::steady_clock::now();
-  const auto fig = figure::slice_figure(o);
+  const auto fig = built([&] { return figure::slice_figure(o); });
   finish(fig.scene, a.out, a.scale, since(t0));
   return kExitOk;
 }
@@ -233,9 +243,9 @@ int run_material(const MaterialArgs& a) {
   o.spp = a.spp;
   o.heading = a.heading;
   check_writable(a.out);
-  o.brdf = load_brdf(a.brdf);
+  o.brdf = brdf_argument(a.brdf, "--brdf");
   const auto t0 = std::chrono::steady_clock::now();
-  const auto fig = figure::material_figure(o);
+  const auto fig = built([&] { return figure::material_figure(o); });
   finish(fig.scene, a.out, a.scale, since(t0));
   return kExitOk;
 }
@@ -274,7 +284,7 @@ int run_paper(const PaperArgs& a) {
     // Each SPEC must load before any figure is drawn.
     o.materials.clear();
     for (std::size_t k = 0; k < specs.size(); ++k) {
-      const BrdfPtr b = load_brdf(specs[k]);
+      const BrdfPtr b = brdf_argument(specs[k], "--material");
       std::string stem = fmt::format("fig{}-", 3 + k);
       for (const char c : b->name()) stem += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
       o.materials.push_back({stem, specs[k],
@@ -401,7 +411,7 @@ Command add_material(CLI::App& figure) {
   m->add_option("--brdf", ma->brdf, "BRDF SPEC: a file (MERL, RGL, ALTA) or a model")->required();
   m->add_option("--title", ma->heading, "Figure title (default: the BRDF's name)");
   m->add_option("--env", ma->envs,
-                "Environments: default, studio, sunset, constant:V, constant:R,G,B or .hdr/.exr "
+                "Environments: sky, studio, sunset, constant:V, constant:R,G,B or .hdr/.exr "
                 "files, comma-separated")
       ->capture_default_str();
   m->add_option("--param", ma->params, "Parameterizations, one row of slices each")

@@ -34,7 +34,7 @@ int run_fit(const FitCommandOptions& o) {
     throw UsageError(fmt::format("--model: {}", e.what()));
   }
   // A bad --brdf SPEC is an error of status 1, as in every command that reads one.
-  const BrdfPtr target = load_brdf(o.brdf);
+  const BrdfPtr target = brdf_argument(o.brdf, "--brdf");
   Output out(o.output);  // an unwritable destination fails before the fit
   fit::FitResult r;
   try {

@@ -25,7 +25,7 @@ std::string rgb_text(const Rgb& v) {
 }
 
 int run_info(const InfoOptions& o) {
-  const BrdfPtr brdf = load_brdf(o.brdf);
+  const BrdfPtr brdf = brdf_argument(o.brdf, "SPEC");
   std::vector<Brdf::Fact> lines;
   lines.push_back({"name", brdf->name()});
   lines.push_back({"description", brdf->description()});

@@ -54,7 +54,7 @@ int run_render(const RenderOptions& o) {
   s.tabulation.param = *space_from_name(o.sampling);  // checked by the parser
   s.progress = !o.quiet;                              // drawn only when stderr is a terminal
 
-  const BrdfPtr brdf = load_brdf(o.brdf);
+  const BrdfPtr brdf = brdf_argument(o.brdf, "--brdf");
   const render::EnvMap env = [&] {
     try {
       return render::EnvMap::from_spec(o.env, {o.env_rotation, o.env_exposure});

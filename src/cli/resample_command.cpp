@@ -72,7 +72,7 @@ int run_resample(const ResampleOptions& o) {
   if (!table_format_from_path(o.output))
     throw UsageError(fmt::format("-o '{}': the table is written as .exr, .npz or .npy", o.output));
   check_writable(o.output);  // an unwritable destination fails before any work
-  const BrdfPtr brdf = load_brdf(o.brdf);
+  const BrdfPtr brdf = brdf_argument(o.brdf, "--brdf");
   halfback::ResampleOptions ro;
   ro.threads = o.threads;
   const ResampledTable t = resample(*brdf, grid, ro);

@@ -70,10 +70,10 @@ std::vector<std::string> expand_specs(const std::vector<std::string>& specs) {
                         spec));
       for (const auto& f : files) out.push_back(f.string());
     } else if (std::filesystem::exists(spec, ec)) {
-      if (detect_brdf_format(spec) == BrdfFileFormat::unknown) load_brdf(spec);  // its error
+      if (detect_brdf_format(spec) == BrdfFileFormat::unknown) brdf_argument(spec, "SPEC");
       out.push_back(spec);
     } else {
-      load_brdf(spec);
+      brdf_argument(spec, "SPEC");
       out.push_back(spec);
     }
   }
@@ -248,7 +248,7 @@ std::vector<study::LabeledProfile> profile_pass(const std::vector<std::string>& 
   std::set<std::string> labels;
   for (std::size_t k = 0; k < specs.size(); ++k)
     if (!labels.insert(profiles[k].label).second)
-      throw std::runtime_error(fmt::format(
+      throw UsageError(fmt::format(
           "'{}': a second BRDF named '{}' (the tables would mix them); study it separately",
           specs[k], profiles[k].label));
   const auto kept = std::count(reused.begin(), reused.end(), 1);
@@ -282,7 +282,7 @@ int run_study(StudyOptions& o) {
     if (!profiles.empty()) study::set_learned(config, profiles, profiles[k].label);
     results.push_back(study_one(specs[k], k, parts, config, o.resume, progress));
     if (!labels.insert(results.back().label).second)
-      throw std::runtime_error(fmt::format(
+      throw UsageError(fmt::format(
           "'{}': a second BRDF named '{}' (the tables would mix them); study it separately",
           specs[k], results.back().label));
   }

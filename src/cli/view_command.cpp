@@ -76,7 +76,11 @@ int run_view(const ViewOptions& o) {
   for (const std::string& r : o.roots) config.roots.emplace_back(r);
   view::keep_freed_memory();
   view::Api api(std::move(config));  // throws for a --root that is not a directory
-  api.load_specs();                  // a bad command-line BRDF fails here, not in the page
+  try {
+    api.load_specs();  // a bad command-line BRDF fails here, not in the page
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("SPEC: {}", e.what()));
+  }
   if (!view::is_loopback(o.host))
     warn("view", fmt::format("--host {} is not a loopback address: anyone who can reach it and "
                              "learns the token can use the server",

@@ -405,7 +405,7 @@ Raster decode_png(std::string_view png) {
 void check_raster_size(double width, double height, double scale, std::string_view hint) {
   const double w = std::ceil(width * scale), h = std::ceil(height * scale);
   if (!(w <= kMaxRasterSide && h <= kMaxRasterSide))
-    throw std::invalid_argument(fmt::format(
+    throw FigureSizeError(fmt::format(
         "the figure would be {:.0f} x {:.0f} pixels ({:.0f} x {:.0f} pt at {:g} pixels per point), "
         "above the {} pixels per side an image can have: ask for {}",
         w, h, width, height, scale, kMaxRasterSide, hint));

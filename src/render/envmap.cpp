@@ -515,7 +515,14 @@ EnvMap EnvMap::from_spec(std::string_view spec, EnvOptions options) {
     return v.size() == 1 ? constant({v[0], v[0], v[0]}, options)
                          : constant({v[0], v[1], v[2]}, options);
   }
-  return load(std::filesystem::path(std::string(spec)), options);
+  const std::filesystem::path path{std::string(spec)};
+  std::error_code ec;
+  if (spec.empty() || !std::filesystem::exists(path, ec))
+    throw std::invalid_argument(fmt::format(
+        "environment '{}': neither a built-in ({}), constant:V or constant:R,G,B, nor an "
+        "existing file",
+        spec, fmt::join(builtin_names(), ", ")));
+  return load(path, options);
 }
 
 EnvMap EnvMap::load(const std::filesystem::path& path, EnvOptions options) {
@@ -945,7 +952,7 @@ Environment load_environment(const std::string& spec) {
 
 const std::vector<Environment>& default_environments() {
   static const std::vector<Environment> envs{
-      load_environment("default"), load_environment("studio"), load_environment("sunset")};
+      load_environment("sky"), load_environment("studio"), load_environment("sunset")};
   return envs;
 }
 

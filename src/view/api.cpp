@@ -103,6 +103,8 @@ void Api::load_specs() const {
   for (std::size_t i = 0; i < state_->config.specs.size(); ++i) {
     try {
       state_->catalog.brdf("arg:" + std::to_string(i));
+    } catch (const std::invalid_argument& e) {  // the spec names nothing: a usage error
+      throw std::invalid_argument(fmt::format("'{}': {}", state_->config.specs[i], e.what()));
     } catch (const std::exception& e) {
       throw std::runtime_error(fmt::format("'{}': {}", state_->config.specs[i], e.what()));
     }

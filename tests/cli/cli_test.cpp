@@ -603,6 +603,93 @@ TEST_F(CliTest, RelativeAzimuthsArePeriodic) {
   }
 }
 
+// One rule for the exit status of every command (issue 35, class H; docs/cli.md, "Exit status"):
+// 2 for the command line — an option or its value, options together, a BRDF or environment spec
+// that names nothing or holds a bad value, a figure its options make too large, the same BRDF
+// twice; 1 for what is read, written or computed — a file that cannot be read or holds bad data,
+// a destination that cannot be written. Each row fails on the code before where the status was
+// the other one (a model spec out of range was 1 in info, eval, render, ...; a missing
+// environment file 1; a figure too large 1 in slices and material; the same BRDF twice 1).
+TEST_F(CliTest, ExitStatusesFollowOneRule) {
+  put(path("junk.bsdf"), "junk, not a BRDF file\n");
+  put(path("junk.hdr"), "#?RADIANCE\njunk\n");
+  const std::string pair_csv = "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n0,0,1,0,0,1\n";
+  const std::string bad_csv = "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n0,0,x,0,0,1\n";
+  std::string many;
+  for (int k = 0; k < 200; ++k) many += (k ? "," : "") + std::to_string(k);
+  const std::string no_dir = path("no/such/dir/x").string();
+  struct Row {
+    std::vector<std::string> args;
+    int status;
+    std::string input = "";
+  };
+  const std::vector<Row> rows = {
+      // The command line: options and their values.
+      {{"convert", "--nope"}, 2},
+      {{"convert", "--from", "hybird", "--to", "dirs"}, 2},
+      {{"info", "lambert", "--albedo-samples", "x"}, 2},
+      {{"models", "--nope"}, 2},
+      {{"render", "--brdf", "lambert", "--spp", "-3", "-o", "x.png"}, 2},
+      {{"fit", "--brdf", "lambert", "--model", "ggx", "--loss", "l2", "-o", "f.json"}, 2},
+      {{"fit", "--brdf", "lambert", "--model", "nosuch", "-o", "f.json"}, 2},
+      // BRDF specs that name nothing or hold a bad value, for every command that takes one.
+      {{"info", "ggx:alpha=-1"}, 2},
+      {{"info", "nosuch"}, 2},
+      {{"eval", "--brdf", "ggx:alpha=-1"}, 2, pair_csv},
+      {{"resample", "--brdf", "ggx:alpha=-1", "-o", "x.npy"}, 2},
+      {{"export-merl", "--brdf", "ggx:alpha=-1", "-o", "x.binary"}, 2},
+      {{"export-rgl", "--brdf", "ggx:alpha=-1", "-o", "x.bsdf"}, 2},
+      {{"render", "--brdf", "ggx:alpha=-1", "-o", "x.png"}, 2},
+      {{"figure", "slices", "--brdf", "ggx:alpha=-1", "--out", "x.png"}, 2},
+      {{"figure", "material", "--brdf", "nosuch", "--out", "x.png"}, 2},
+      {{"figure", "paper", "--material", "ggx:alpha=-1", "--out", "figs"}, 2},
+      {{"study", "ggx:alpha=-1", "-o", "st"}, 2},
+      {{"study", "lambert", "lambert", "-o", "st"}, 2},
+      {{"view", "ggx:alpha=-1", "--port", "0"}, 2},
+      {{"fit", "--brdf", "ggx:alpha=-1", "--model", "ggx", "-o", "f.json"}, 2},
+      // Environment specs, in both commands that take one.
+      {{"render", "--brdf", "lambert", "--env", "nosuch", "-o", "x.png"}, 2},
+      {{"render", "--brdf", "lambert", "--env", "constant:-1", "-o", "x.png"}, 2},
+      {{"figure", "material", "--brdf", "lambert", "--env", "nosuch", "--out", "x.png"}, 2},
+      // Figures their options make larger than an image can be.
+      {{"figure", "hemisphere", "--elevations", many, "--scale", "8", "--out", "x.png"}, 2},
+      {{"figure", "slices", "--brdf", "lambert", "--azimuths", many, "--scale", "8", "--out",
+        "x.png"},
+       2},
+      {{"figure", "material", "--brdf", "lambert", "--azimuths", many, "--scale", "8",
+        "--render-size", "16", "--out", "x.png"},
+       2},
+      // Data: files that cannot be read or hold bad data; destinations that cannot be written.
+      {{"convert", "--from", "dirs", "--to", "hybrid"}, 1, bad_csv},
+      {{"info", "junk.bsdf"}, 1},
+      {{"eval", "--brdf", "junk.bsdf"}, 1, pair_csv},
+      {{"eval", "--brdf", "lambert"}, 1, bad_csv},
+      {{"resample", "--brdf", "junk.bsdf", "-o", "x.npy"}, 1},
+      {{"export-merl", "--brdf", "junk.bsdf", "-o", "x.binary"}, 1},
+      {{"export-rgl", "--brdf", "junk.bsdf", "-o", "x.bsdf"}, 1},
+      {{"render", "--brdf", "junk.bsdf", "-o", "x.png"}, 1},
+      {{"render", "--brdf", "lambert", "--env", "junk.hdr", "-o", "x.png"}, 1},
+      {{"render", "--brdf", "lambert", "--width", "16", "-o", no_dir + ".png"}, 1},
+      {{"figure", "slices", "--brdf", "junk.bsdf", "--out", "x.png"}, 1},
+      {{"figure", "material", "--brdf", "lambert", "--env", "junk.hdr", "--out", "x.png"}, 1},
+      {{"study", "junk.bsdf", "-o", "st"}, 1},
+      {{"view", "junk.bsdf", "--port", "0"}, 1},
+      {{"fit", "--brdf", "junk.bsdf", "--model", "ggx", "-o", "f.json"}, 1},
+      {{"fit", "--brdf", "lambert", "--model", "ggx", "--samples", "100", "-o", no_dir + ".json"},
+       1},
+  };
+  for (const Row& row : rows) {
+    const Result r = run(row.args, row.input);
+    std::string line;
+    for (const std::string& a : row.args) line += " " + a.substr(0, 40);
+    EXPECT_EQ(r.status, row.status) << "halfback" << line << "\n" << r.err.substr(0, 300);
+    EXPECT_NE(r.err.find("error:"), std::string::npos) << "halfback" << line;
+    if (row.status == 2) {
+      EXPECT_NE(r.err.find("--help' for more information"), std::string::npos) << line;
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input
 // ---------------------------------------------------------------------------------------------
@@ -864,12 +951,12 @@ TEST_F(CliTest, EvalBadInput) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("header does not match"), std::string::npos) << r.err;
   r = run({"eval", "--brdf", "glossy:alpha=2"}, std::string(kDirsHeader));
-  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.status, 2);  // a spec that names nothing: the command line's (class H)
   EXPECT_NE(r.err.find("'glossy:alpha=2' is neither an existing file nor a known BRDF model"),
             std::string::npos)
       << r.err;
   r = run({"eval", "--brdf", "ggx:alpha=-1"}, std::string(kDirsHeader));
-  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("alpha"), std::string::npos) << r.err;
   put(path("out.csv"), "keep me\n");
   r = run({"eval", "--brdf", "lambert", "-o", "out.csv"}, std::string(kDirsHeader) + "1,2,3\n");
@@ -1039,7 +1126,7 @@ TEST_F(CliTest, FileTermsInSums) {
 TEST_F(CliTest, ExportMerlBadInputKeepsTheOutput) {
   put(path("x.binary"), "old");
   Result r = run({"export-merl", "--brdf", "nope", "-o", "x.binary"});
-  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.status, 2);
   EXPECT_EQ(slurp(path("x.binary")), "old");
   r = run({"export-merl", "--brdf", "lambert", "-o", "missing/x.binary"});
   EXPECT_EQ(r.status, 1);
@@ -1105,7 +1192,7 @@ TEST_F(CliTest, ExportRglBadInputKeepsTheOutput) {
   const Case cases[] = {
       {{"--brdf", "ggx:alpha_x=0.1,alpha_y=0.3"}, 1, "anisotropic"},
       {{"--brdf", "lambert:albedo=0"}, 1, "zero in every backscattering direction"},
-      {{"--brdf", "nope"}, 1, "nope"},
+      {{"--brdf", "nope"}, 2, "nope"},
       {{"--brdf", "lambert", "--theta-i", "1"}, 2, "--theta-i"},
       {{"--brdf", "lambert", "--resolution", "1"}, 2, "--resolution"},
       {{"--brdf", "lambert", "--vndf-resolution", "x"}, 2, "--vndf-resolution"},
@@ -1363,13 +1450,13 @@ TEST_F(CliTest, FigurePaperTakesTheMerlFilesOfAFolder) {
 
 TEST_F(CliTest, FigureBadInputLeavesNothing) {
   Result r = run({"figure", "paper", "--out", "figs", "--material", "nope"});
-  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("'nope' is neither an existing file nor a known BRDF model"),
             std::string::npos)
       << r.err;
   r = run({"figure", "paper", "--out", "figs", "--env", "default,missing.hdr"});
-  EXPECT_EQ(r.status, 1);  // a file that cannot be read: a data error, as in `halfback render`
-  EXPECT_NE(r.err.find("missing.hdr: file: cannot open"), std::string::npos) << r.err;
+  EXPECT_EQ(r.status, 2);  // a spec that names nothing, as in `halfback render` (class H)
+  EXPECT_NE(r.err.find("'missing.hdr': neither a built-in"), std::string::npos) << r.err;
   r = run({"figure", "material", "--brdf", "lambert", "--azimuths", "", "-o", "m.png"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--azimuths: an empty value"), std::string::npos) << r.err;
@@ -1397,14 +1484,14 @@ TEST_F(CliTest, MessagesNameTheProblemAndExitCodesAgree) {
         "hemisphere, slices, paper, material)"}},
       {{"figure"}, 2, {"a subcommand is required (one of: hemisphere, slices"}},
       {{"eval", "--brdf", "+ggx", "-i", "pairs.csv"},
-       1,
+       2,
        {"'+ggx': a sum has an empty term (a sum is SPEC+SPEC+..."}},
       {{"render", "--brdf", "ggx", "--env", "missing.hdr", "-o", "r.exr"},
-       1,
-       {"missing.hdr: file: cannot open"}},
+       2,
+       {"--env 'missing.hdr'", "neither a built-in (sky, studio, sunset)"}},
       {{"figure", "material", "--brdf", "ggx", "--env", "missing.hdr", "-o", "m.png"},
-       1,
-       {"missing.hdr: file: cannot open"}},
+       2,
+       {"--env 'missing.hdr'", "nor an existing file"}},
       {{"render", "--brdf", "ggx", "--env", "constant:1,x", "-o", "r.exr"},
        2,
        {"--env 'constant:1,x'", "'x' is not a number"}},
@@ -1562,7 +1649,7 @@ TEST_F(CliTest, StudyParamsChooseTheColumns) {
 
 TEST_F(CliTest, StudyBadInput) {
   Result r = run({"study", "-o", "st", "nope"});
-  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("'nope' is neither"), std::string::npos) << r.err;
   r = run({"study", "--space", "sqrt", "lambert"});
   EXPECT_EQ(r.status, 2);
@@ -1895,7 +1982,7 @@ TEST_F(CliTest, ViewRefusesBadOptionsBeforeServing) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--port: expected 0 ... 65535"), std::string::npos) << r.err;
   r = run({"view", "ggx:alpha=-1", "--port", "0"});
-  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("'ggx:alpha=-1'"), std::string::npos) << r.err;
   EXPECT_EQ(r.out, "");
   r = run({"view", "--root", "/nonexistent/halfback-root", "--port", "0"});
@@ -1956,8 +2043,8 @@ TEST_F(CliTest, FitPrintsASpecThatEveryCommandReadsBack) {
       EXPECT_NEAR(got.columns[c][i], want.columns[c][i], 1e-4 * want.columns[c][i]);
 }
 
-// Bad models and losses are usage errors (2); a bad --brdf (as in every command) and a target the
-// fit cannot use are data errors (1); none leaves a file, and an existing output is kept.
+// Bad models, losses and --brdf specs are usage errors (2, as in every command); a target the fit
+// cannot use is a data error (1); none leaves a file, and an existing output is kept.
 TEST_F(CliTest, FitBadInputLeavesNoOutput) {
   put(path("old.json"), "old");
   struct Case {
@@ -1969,7 +2056,7 @@ TEST_F(CliTest, FitBadInputLeavesNoOutput) {
       {{"--brdf", "ggx", "--model", "phong"}, 2, "phong"},
       {{"--brdf", "ggx", "--model", "ggx:roughness=1"}, 2, "roughness"},
       {{"--brdf", "ggx", "--model", "ggx", "--loss", "l2"}, 2, "--loss 'l2'"},
-      {{"--brdf", "nosuchmodel:x=1", "--model", "ggx"}, 1, "nosuchmodel"},
+      {{"--brdf", "nosuchmodel:x=1", "--model", "ggx"}, 2, "nosuchmodel"},
       {{"--brdf", "ggx", "--model", "ggx:alpha=0.1,f0=0.5"}, 2, "nothing to fit"},
       {{"--brdf", "lambert:albedo=0", "--model", "ggx"}, 1, "zero at all"},
       {{"--brdf", "ggx:alpha_x=0.1,alpha_y=0.4", "--model", "ggx"}, 1, "anisotropic"},

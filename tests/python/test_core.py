@@ -98,10 +98,13 @@ def test_valid_and_nan_handling():
 
 
 def test_domain_mask_for_tuples():
-    q = np.array([[0.6, 0.0, 0.6, 0.0], [0.6, 0.0, 0.6, np.pi / 2], [0.5, 0.0, 0.5, 7.0]])
-    assert halfback.valid(q, "ortho").tolist() == [False, True, False]
+    # Azimuths are periodic (π/2 − 2π is π/2); beyond 65536 rad they are no angle.
+    q = np.array([[0.6, 0.0, 0.6, 0.0], [0.6, 0.0, 0.6, np.pi / 2], [0.5, 0.0, 0.5, 1e9],
+                  [0.6, 0.0, 0.6, np.pi / 2 - 2 * np.pi]])
+    assert halfback.valid(q, "ortho").tolist() == [False, True, False, True]
     d = halfback.convert(q, "ortho", "dirs")
     assert np.isnan(d[[0, 2]]).all() and (d[1, [2, 5]] >= 0).all()
+    assert np.allclose(d[3], d[1], atol=1e-12)
 
 
 def test_jacobian_integrates_to_the_measure_of_pairs():

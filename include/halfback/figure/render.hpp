@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -28,8 +29,13 @@ struct RenderOptions {
 
 // Cairo's image surfaces have at most this many pixels per side.
 inline constexpr int kMaxRasterSide = 32767;
-// Throws std::invalid_argument when a page of width × height points at `scale` pixels per point
-// is wider or taller than kMaxRasterSide pixels; `hint` says what makes the page smaller. Figures
+// A figure that its options make larger than an image can be (a usage error for the CLI).
+class FigureSizeError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+// Throws FigureSizeError when a page of width × height points at `scale` pixels per point is
+// wider or taller than kMaxRasterSide pixels; `hint` says what makes the page smaller. Figures
 // call it with their layout, before sampling any raster, so an oversized request costs nothing.
 void check_raster_size(double width, double height, double scale, std::string_view hint);
 

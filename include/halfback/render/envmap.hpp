@@ -43,7 +43,9 @@ class EnvMap {
   EnvMap(int width, int height, std::vector<float> rgb, std::string name, EnvOptions options = {});
 
   // A built-in ("sky", "studio", "sunset"; "default" is sky's older name, still taken),
-  // "constant:V" or "constant:R,G,B", or a file name.
+  // "constant:V" or "constant:R,G,B", or a file name. Throws std::invalid_argument for a spec that
+  // is none of these (no such file included) or a bad constant, and what load() throws for a
+  // file.
   static EnvMap from_spec(std::string_view spec, EnvOptions options = {});
   // A Radiance .hdr or OpenEXR file, recognized by its content. Throws FormatError naming the file
   // and the problem: unreadable, not an HDR image, zero size, not 2:1, more pixels than the file

@@ -86,8 +86,9 @@ class Api {
   // Sets the port once the server knows it (port 0 picks one when binding).
   void set_port(int port);
   const ApiConfig& config() const;
-  // Loads every BRDF of config().specs (they are then cached). Throws what loading throws, the
-  // message naming the spec.
+  // Loads every BRDF of config().specs (they are then cached). Throws, the message naming the
+  // spec: std::invalid_argument for a spec that names nothing or holds a bad value (load_brdf's),
+  // std::runtime_error for a file that cannot be read.
   void load_specs() const;
 
   // The response to a request; never throws (an internal failure is a 500 with a message).
