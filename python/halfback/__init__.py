@@ -50,8 +50,18 @@ def fit(brdf, model, loss="ngan", samples=20000, threads=0):
     return _core.fit(brdf, model, loss, samples, threads)
 
 
+def fit_loss(brdf, model, loss="ngan", samples=20000, threads=0):
+    return _core.fit_loss(brdf, model, loss, samples, threads)
+
+
+def published_fits(path):
+    return _core.published_fits(str(path))
+
+
 study_brdf.__doc__ = _core.study_brdf.__doc__
 fit.__doc__ = _core.fit.__doc__
+fit_loss.__doc__ = _core.fit_loss.__doc__
+published_fits.__doc__ = _core.published_fits.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
 study_profile.__doc__ = _core.study_profile.__doc__
 
@@ -60,11 +70,13 @@ __all__ = [
     "columns",
     "convert",
     "fit",
+    "fit_loss",
     "hemisphere",
     "jacobian",
     "load",
     "merge_study",
     "models",
+    "published_fits",
     "simd_isa",
     "ssim",
     "study_brdf",

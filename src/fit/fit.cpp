@@ -551,6 +551,15 @@ void check_target(std::span<const Rgb> v, const Samples& s) {
 
 }  // namespace
 
+double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t samples,
+               int threads) {
+  const Samples s = halfdiff_samples(samples);
+  std::vector<Rgb> t(s.pairs.size());
+  eval_all(target, s, t, threads);
+  check_target(t, s);
+  return loss_value(t, model, loss, s, threads);
+}
+
 FitResult fit(const Brdf& target, std::string_view model_spec, const FitOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   const Model model = parse_model(model_spec);

@@ -208,3 +208,24 @@ TEST(FitErrors, BadModelsAndStarts) {
 
 }  // namespace
 }  // namespace halfback::fit
+
+namespace halfback::fit {
+namespace {
+
+// loss_of is the loss fit() reports: of the fitted spec, against the same target and layout.
+TEST(FitLoss, LossOfTheFittedSpecIsTheReportedLoss) {
+  const BrdfPtr target = load_brdf("lambert:albedo=0.2+ggx:alpha=0.25,f0=0.6");
+  FitOptions o;
+  o.samples = 1500;
+  o.loss = Loss::low_e2;
+  const FitResult r = fit(*target, "ggx", o);  // a lobe short: a loss well above zero
+  EXPECT_GT(r.loss_value, 1e-4);
+  EXPECT_NEAR(loss_of(*target, *load_brdf(r.spec), Loss::low_e2, 1500), r.loss_value,
+              1e-12 * r.loss_value);
+  EXPECT_EQ(loss_of(*target, *target, Loss::ngan, 1500), 0.0);
+  EXPECT_THROW((void)loss_of(*load_brdf("lambert:albedo=0"), *target, Loss::ngan, 100),
+               FitDataError);
+}
+
+}  // namespace
+}  // namespace halfback::fit

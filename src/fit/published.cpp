@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <set>
+#include <stdexcept>
 
 #include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
@@ -140,6 +141,83 @@ std::vector<PublishedFit> read_published_fits(const std::filesystem::path& path)
   std::string text;
   for (std::string_view line; lines.next(line);) (text += line) += '\n';
   return parse_published_fits(text, path.string());
+}
+
+std::string_view registry_name_of(std::string_view bbm_model) {
+  // BBM's classes of Ngan et al.'s models (bsdfmodel/ngan.h) and the registry's restatements.
+  static constexpr std::pair<std::string_view, std::string_view> kNames[] = {
+      {"Lambertian", "lambert"},
+      {"NganWard", "ward"},
+      {"NganWardDuer", "ward-duer"},
+      {"NganBlinnPhong", "blinn-phong"},
+      {"NganLafortune", "lafortune"},
+      {"NganCookTorrance", "cook-torrance"},
+      {"NganAshikhminShirley", "ashikhmin-shirley"},
+      {"NganHe", "he"},
+  };
+  for (const auto& [bbm, ours] : kNames)
+    if (bbm == bbm_model) return ours;
+  return {};
+}
+
+namespace {
+
+std::string parameter_name(std::string_view bbm) {
+  if (bbm == "fresnelReflectance") return "f0";
+  std::string name(bbm);
+  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return name;
+}
+
+std::string term_spec(const PublishedLobe& lobe, const PublishedFit& fit) {
+  const std::string_view model = registry_name_of(lobe.model);
+  if (model.empty())
+    throw std::invalid_argument(fmt::format("{}: halfback has no model for BBM's '{}'",
+                                            fit.material, lobe.model));
+  std::string spec(model);
+  char separator = ':';
+  const auto add = [&](const std::string& key, double value) {
+    spec += fmt::format("{}{}={}", separator, key, value);  // the shortest exact decimal
+    separator = ',';
+  };
+  for (const auto& [key, values] : lobe.params) {
+    const std::string name = parameter_name(key);
+    if (values.size() == 1) {
+      add(name, values[0]);
+    } else if (values.size() == 3) {
+      add(name + "_r", values[0]);
+      add(name + "_g", values[1]);
+      add(name + "_b", values[2]);
+    } else {
+      throw std::invalid_argument(fmt::format("{}: {}'s '{}' has {} values (one or three)",
+                                              fit.material, lobe.model, key, values.size()));
+    }
+  }
+  return spec;
+}
+
+}  // namespace
+
+std::string spec_of(const PublishedFit& fit) {
+  std::string spec;
+  for (const PublishedLobe& lobe : fit.lobes) {
+    if (!spec.empty()) spec += '+';
+    spec += term_spec(lobe, fit);
+  }
+  return spec;
+}
+
+std::string model_of(const PublishedFit& fit) {
+  std::string model;
+  for (const PublishedLobe& lobe : fit.lobes) {
+    const std::string_view name = registry_name_of(lobe.model);
+    if (name.empty())
+      throw std::invalid_argument(fmt::format("{}: halfback has no model for BBM's '{}'",
+                                              fit.material, lobe.model));
+    if (!model.empty()) model += '+';
+    model += name;
+  }
+  return model;
 }
 
 }  // namespace halfback::fit

@@ -9,6 +9,46 @@
 namespace halfback::fit {
 namespace {
 
+// A published line as a halfback spec: BBM's models by the registry's names, its parameters in
+// lower case, [r, g, b] as NAME_r/_g/_b, values exact; a model halfback lacks is named.
+TEST(PublishedFits, SpecOfALine) {
+  const auto fits = parse_published_fits(
+      "m = Aggregate(Lambertian(albedo = [0.0143, 0.033, 0.0639]), "
+      "NganAshikhminShirley(albedo = [0.0366, 0.0241, 0.0147], fresnelReflectance = 0.0949, "
+      "sharpness = 11600.0))\n"
+      "n = NganLafortune(albedo = 0.5, Cxy = -0.577, Cz = 0.577, sharpness = 4060.0)\n"
+      "o = Aggregate(Lambertian(albedo = 0.1), Phong(sharpness = 2))\n"
+      "p = NganWard(albedo = [1, 2], roughness = 0.1)\n",
+      "t.fit");
+  ASSERT_EQ(fits.size(), 4u);
+  EXPECT_EQ(spec_of(fits[0]),
+            "lambert:albedo_r=0.0143,albedo_g=0.033,albedo_b=0.0639+ashikhmin-shirley:"
+            "albedo_r=0.0366,albedo_g=0.0241,albedo_b=0.0147,f0=0.0949,sharpness=11600");
+  EXPECT_EQ(model_of(fits[0]), "lambert+ashikhmin-shirley");
+  EXPECT_EQ(spec_of(fits[1]), "lafortune:albedo=0.5,cxy=-0.577,cz=0.577,sharpness=4060");
+  EXPECT_EQ(model_of(fits[1]), "lafortune");
+  const auto refused = [](const PublishedFit& f, const std::string& words) {
+    try {
+      (void)spec_of(f);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what()).find(words) != std::string::npos;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused(fits[2], "o: halfback has no model for BBM's 'Phong'"));
+  EXPECT_TRUE(refused(fits[3], "p: NganWard's 'albedo' has 2 values (one or three)"));
+  EXPECT_THROW((void)model_of(fits[2]), std::invalid_argument);
+  // Every line of the shared files maps (the models themselves: the loader's tests).
+  HALFBACK_REQUIRE_SHARED(dir, "fits");
+  for (const char* name : {"ngan_ashikhminshirley", "ngan_blinnphong", "ngan_cooktorrance",
+                           "ngan_he", "ngan_lafortune", "ngan_ward", "ngan_wardduer"}) {
+    for (const PublishedFit& f : read_published_fits(dir / (std::string(name) + ".fit"))) {
+      EXPECT_NE(spec_of(f).find("lambert:albedo_r="), std::string::npos) << f.material;
+      EXPECT_EQ(model_of(f).substr(0, 8), "lambert+") << f.material;
+    }
+  }
+}
+
 TEST(PublishedFits, ReadsAnAggregateLine) {
   const auto fits = parse_published_fits(
       "# comment\n\nblue-acrylic = Aggregate(Lambertian(albedo = [0.0143, 0.033, 0.0639]), "

@@ -25,6 +25,7 @@
 #include "halfback/core/simd.hpp"
 #include "halfback/figure/hemisphere.hpp"
 #include "halfback/fit/fit.hpp"
+#include "halfback/fit/published.hpp"
 #include "halfback/formats/table_file.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
@@ -882,6 +883,12 @@ py::dict fit_result_dict(const fit::FitResult& r) {
   return out;
 }
 
+// A BRDF argument: a spec, as for load(), or a Brdf.
+BrdfPtr brdf_of(const py::object& brdf) {
+  return py::isinstance<py::str>(brdf) ? load_brdf(brdf.cast<std::string>())
+                                       : brdf.cast<const PyBrdf&>().brdf;
+}
+
 py::dict fit_brdf(const py::object& brdf, const std::string& model, const std::string& loss,
                   std::size_t samples, int threads) {
   fit::FitOptions o;
@@ -890,14 +897,36 @@ py::dict fit_brdf(const py::object& brdf, const std::string& model, const std::s
   o.loss = *l;
   o.samples = samples;
   o.threads = threads;
-  const BrdfPtr target = py::isinstance<py::str>(brdf) ? load_brdf(brdf.cast<std::string>())
-                                                       : brdf.cast<const PyBrdf&>().brdf;
+  const BrdfPtr target = brdf_of(brdf);
   fit::FitResult r;
   {
     py::gil_scoped_release release;
     r = fit::fit(*target, model, o);
   }
   return fit_result_dict(r);
+}
+
+double fit_loss(const py::object& brdf, const py::object& model, const std::string& loss,
+                std::size_t samples, int threads) {
+  const auto l = fit::parse_loss(loss);
+  if (!l) throw py::value_error("loss '" + loss + "': expected " + fit::loss_names());
+  if (samples < 1) throw py::value_error("samples must be at least 1");
+  const BrdfPtr target = brdf_of(brdf), m = brdf_of(model);
+  py::gil_scoped_release release;
+  return fit::loss_of(*target, *m, *l, samples, threads);
+}
+
+py::list published_fits(const std::string& path) {
+  py::list out;
+  for (const fit::PublishedFit& f : fit::read_published_fits(path)) {
+    py::dict d;
+    d["material"] = f.material;
+    d["line"] = f.line;
+    d["spec"] = fit::spec_of(f);
+    d["model"] = fit::model_of(f);
+    out.append(d);
+  }
+  return out;
 }
 
 void bind_fit(py::module_& m) {
@@ -910,6 +939,17 @@ Returns a dict: spec (load() reads it), loss, loss_value, layout, samples, param
 dicts: term, model, name, value, fitted, min, max), starts, iterations, seconds. A bad model or
 loss raises ValueError; a target the fit cannot use (not finite, negative or zero where sampled,
 anisotropic) raises RuntimeError.)doc");
+  m.def("fit_loss", &fit_loss, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
+        py::arg("samples") = 20000, py::arg("threads") = 0,
+        R"doc(The loss of `model` (a spec or a Brdf) against `brdf` on fit()'s layout of `samples`
+pairs, as fit() measures it: fit(b, m, loss, n)["loss_value"] is fit_loss(b, its spec, loss, n).
+The GIL is released while it runs. A bad loss raises ValueError; a target the fit cannot use,
+RuntimeError.)doc");
+  m.def("published_fits", &published_fits, py::arg("path"),
+        R"doc(The published fits of a BBM .fit file (Ngan et al. 2005; ../shared/data/fits/): a list of
+dicts material, line, spec (a halfback spec of the registry's restatements of BBM's models,
+load() reads it) and model (its terms, as fit() takes them: "lambert+ward"). A malformed file
+raises RuntimeError naming the line; a model halfback lacks, ValueError.)doc");
 }
 
 void bind_study(py::module_& m) {

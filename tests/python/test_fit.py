@@ -42,3 +42,29 @@ def test_fit_releases_the_gil():
         lambda: halfback.fit("embedded:pink-felt", "lambert+ggx", samples=4000, threads=1))
     assert result["spec"].startswith("lambert:")
     assert turns >= 20, "the main thread did not run during fit: the GIL was held"
+
+
+def test_fit_loss_is_the_loss_fit_reports():
+    target = "lambert:albedo=0.2+ggx:alpha=0.25,f0=0.6"
+    r = halfback.fit(target, "ggx", loss="low-e1", samples=800, threads=1)
+    assert halfback.fit_loss(target, r["spec"], "low-e1", 800) == pytest.approx(r["loss_value"], rel=1e-12)
+    assert halfback.fit_loss(halfback.load(target), target, samples=800) == 0
+    with pytest.raises(ValueError, match="loss 'l2'"):
+        halfback.fit_loss(target, target, loss="l2")
+    with pytest.raises(RuntimeError, match="zero at all"):
+        halfback.fit_loss("lambert:albedo=0", target, samples=100)
+
+
+def test_published_fits_as_specs(tmp_path):
+    f = tmp_path / "x.fit"
+    f.write_text("# c\nm = Aggregate(Lambertian(albedo = [0.1, 0.2, 0.3]), "
+                 "NganWard(albedo = 0.05, roughness = 0.2))\n")
+    fits = halfback.published_fits(f)
+    assert fits == [{"material": "m", "line": 2, "model": "lambert+ward",
+                     "spec": "lambert:albedo_r=0.1,albedo_g=0.2,albedo_b=0.3+ward:albedo=0.05,roughness=0.2"}]
+    f.write_text("m = Phong(sharpness = 2)\n")
+    with pytest.raises(ValueError, match="no model for BBM's 'Phong'"):
+        halfback.published_fits(f)
+    f.write_text("m = NganWard(albedo = \n")
+    with pytest.raises(RuntimeError, match="line 1"):
+        halfback.published_fits(f)

@@ -95,4 +95,10 @@ FitResult fit(const Brdf& target, std::string_view model, const FitOptions& opti
 double loss_value(std::span<const Rgb> target_rgb, const Brdf& model, Loss loss,
                   const Samples& samples, int threads = 0);
 
+// The loss of `model` against `target` on the layout of `samples` pairs, as fit() measures it
+// (FitResult::loss_value is loss_of(target, the fitted spec's BRDF, ...) for the same samples).
+// Throws FitDataError for a target the fit cannot use.
+double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t samples,
+               int threads = 0);
+
 }  // namespace halfback::fit
