@@ -115,11 +115,111 @@ GridSpec gonio_cells(const GonioSetup& s) {
   return cells_for(s, n);
 }
 
+namespace {
+
+// Where a cell is measured at a try, in cell units from its lower corner.
+std::array<float, 4> measurement_offset(const GonioSetup& s, std::size_t dim, std::size_t cell,
+                                        int attempt) {
+  std::array<float, 4> offset{0.5f, 0.5f, 0.5f, 0.5f};
+  if (s.design == Design::stratified)
+    for (std::size_t a = 0; a < dim; ++a)
+      offset[a] = std::min(float(uniform(s.seed, cell, std::uint64_t(attempt), a)),
+                           std::nextafter(1.0f, 0.0f));
+  return offset;
+}
+
+// The points of `cells` at a try that the instrument reaches, into `plan`; the others into
+// `missed`.
+void locate_block(GonioPlan& plan, std::span<const std::size_t> cells, int attempt, double min_z,
+                  std::vector<std::size_t>& missed) {
+  const GridSpec& g = plan.cells;
+  const std::size_t m = cells.size(), dim = g.axes.size();
+  std::vector<std::vector<double>> coords(dim, std::vector<double>(m));
+  std::vector<std::array<float, 4>> offsets(m);
+  for (std::size_t j = 0; j < m; ++j) {
+    offsets[j] = measurement_offset(plan.setup, dim, cells[j], attempt);
+    for (std::size_t a = 0, stride = g.points(); a < dim; ++a) {
+      const GridAxis& ax = g.axes[a];
+      stride /= ax.count;
+      const std::size_t i = cells[j] / stride % ax.count;
+      coords[a][j] = plan.warps[a].inverse(ax.lo + (double(i) + offsets[j][a]) * (ax.hi - ax.lo) /
+                                                       double(ax.count));
+    }
+  }
+  std::vector<DirPair<double>> pairs(m);
+  std::vector<std::uint8_t> ok(m);
+  const std::vector<std::span<const double>> columns(coords.begin(), coords.end());
+  coordinates_to_pairs(g.form(), columns, pairs, ok);
+  for (std::size_t j = 0; j < m; ++j) {
+    if (ok[j] && pairs[j].wi.z >= min_z && pairs[j].wo.z >= min_z)
+      plan.points.push_back({cells[j], offsets[j], pairs[j]});
+    else
+      missed.push_back(cells[j]);
+  }
+}
+
+}  // namespace
+
+GonioPlan gonio_plan(const GonioSetup& setup) {
+  GonioPlan plan{setup, gonio_cells(setup), {}, {}};
+  plan.warps = design_warps(plan.cells, setup.spacing, learned_of(setup));
+  const std::size_t n = plan.cells.points();
+  std::vector<std::size_t> todo(n);
+  for (std::size_t c = 0; c < n; ++c) todo[c] = c;
+  const int tries = setup.design == Design::regular ? 1 : kStratifiedTries;
+  // The instrument's reach (a full reach takes every pair the inverse map accepts).
+  const double min_z = setup.max_theta_deg >= 90
+                           ? -std::numeric_limits<double>::infinity()
+                           : std::cos(setup.max_theta_deg * std::numbers::pi / 180);
+  for (int attempt = 0; attempt < tries && !todo.empty(); ++attempt) {
+    std::vector<std::size_t> again;
+    for (std::size_t b = 0; b < todo.size(); b += kBlock)
+      locate_block(plan, std::span<const std::size_t>(todo).subspan(b, std::min(kBlock, todo.size() - b)),
+                   attempt, min_z, again);
+    todo = std::move(again);
+  }
+  std::sort(plan.points.begin(), plan.points.end(),
+            [](const PlannedPoint& a, const PlannedPoint& b) { return a.cell < b.cell; });
+  return plan;
+}
+
+namespace {
+
+// The truth at every point of the plan.
+std::vector<Rgb> measured_values(const Brdf& truth, const GonioPlan& plan) {
+  std::vector<DirPair<double>> pairs(plan.points.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k] = plan.points[k].pair;
+  std::vector<Rgb> values(pairs.size());
+  for (std::size_t b = 0; b < pairs.size(); b += kBlock) {
+    const std::size_t m = std::min(kBlock, pairs.size() - b);
+    truth.eval_batch(std::span(pairs).subspan(b, m), std::span(values).subspan(b, m));
+  }
+  return values;
+}
+
+}  // namespace
+
 GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& setup)
-    : setup_(setup),
-      cells_(gonio_cells(setup)),
-      warps_(design_warps(cells_, setup.spacing, learned_of(setup))),
-      truth_name_(truth.name()) {
+    : truth_name_(truth.name()) {
+  GonioPlan plan = gonio_plan(setup);
+  const std::vector<Rgb> values = measured_values(truth, plan);
+  init(std::move(plan), values);
+}
+
+GonioReconstruction::GonioReconstruction(GonioPlan plan, std::span<const Rgb> values,
+                                         std::string measured)
+    : truth_name_(std::move(measured)) {
+  if (values.size() != plan.points.size())
+    throw std::invalid_argument(fmt::format("gonio-reflectometer: {} values for the {} points of "
+                                            "the plan",
+                                            values.size(), plan.points.size()));
+  init(std::move(plan), values);
+}
+
+void GonioReconstruction::init(GonioPlan plan, std::span<const Rgb> values) {
+  setup_ = plan.setup;
+  cells_ = std::move(plan.cells);
+  warps_ = std::move(plan.warps);
   dim_ = cells_.axes.size();
   for (std::size_t a = dim_, stride = 1; a-- > 0;) {
     periodic_[a] = is_azimuth(cells_.axes[a]);
@@ -129,87 +229,20 @@ GonioReconstruction::GonioReconstruction(const Brdf& truth, const GonioSetup& se
   const std::size_t n = cells_.points();
   offset_.assign(n, {0.5f, 0.5f, 0.5f, 0.5f});
   value_.assign(n, Rgb{});
-  std::vector<std::uint8_t> filled = measure(truth);
+  std::vector<std::uint8_t> filled(n, 0);
+  for (std::size_t k = 0; k < plan.points.size(); ++k) {
+    if (!finite(values[k])) continue;  // no data there: the cell is filled by fill_unmeasured()
+    const PlannedPoint& p = plan.points[k];
+    value_[p.cell] = values[k];
+    offset_[p.cell] = p.offset;
+    filled[p.cell] = 1;
+    ++samples_;
+  }
   if (samples_ == 0)
     throw std::runtime_error(
         fmt::format("gonio-reflectometer: {} has no finite value at any of the {} cells of {}",
                     truth_name_, n, name_of(setup_.space)));
   fill_unmeasured(filled);
-}
-
-// Where each cell is measured: its centre, or random points for the stratified design (drawn
-// again, up to kStratifiedTries times, while one falls outside the domain or the reach).
-std::vector<std::uint8_t> GonioReconstruction::measure(const Brdf& truth) {
-  const std::size_t n = cells_.points();
-  std::vector<std::uint8_t> filled(n, 0);
-  std::vector<std::size_t> todo(n);
-  for (std::size_t c = 0; c < n; ++c) todo[c] = c;
-  const int tries = setup_.design == Design::regular ? 1 : kStratifiedTries;
-  // The instrument's reach (a full reach takes every pair the inverse map accepts).
-  const double min_z = setup_.max_theta_deg >= 90
-                           ? -std::numeric_limits<double>::infinity()
-                           : std::cos(setup_.max_theta_deg * std::numbers::pi / 180);
-  for (int attempt = 0; attempt < tries && !todo.empty(); ++attempt) {
-    std::vector<std::size_t> again;
-    for (std::size_t b = 0; b < todo.size(); b += kBlock) {
-      const std::span<const std::size_t> block =
-          std::span<const std::size_t>(todo).subspan(b, std::min(kBlock, todo.size() - b));
-      measure_block(truth, block, attempt, min_z, filled, again);
-    }
-    todo = std::move(again);
-  }
-  return filled;
-}
-
-std::array<float, 4> GonioReconstruction::measurement_offset(std::size_t cell, int attempt) const {
-  std::array<float, 4> offset{0.5f, 0.5f, 0.5f, 0.5f};
-  if (setup_.design == Design::stratified)
-    for (std::size_t a = 0; a < dim_; ++a)
-      offset[a] = std::min(float(uniform(setup_.seed, cell, std::uint64_t(attempt), a)),
-                           std::nextafter(1.0f, 0.0f));
-  return offset;
-}
-
-void GonioReconstruction::measure_block(const Brdf& truth, std::span<const std::size_t> cells,
-                                        int attempt, double min_z,
-                                        std::vector<std::uint8_t>& filled,
-                                        std::vector<std::size_t>& missed) {
-  const std::size_t m = cells.size();
-  std::vector<std::vector<double>> coords(dim_, std::vector<double>(m));
-  std::vector<std::array<float, 4>> offsets(m);
-  for (std::size_t j = 0; j < m; ++j) {
-    offsets[j] = measurement_offset(cells[j], attempt);
-    for (std::size_t a = 0; a < dim_; ++a) {
-      const GridAxis& ax = cells_.axes[a];
-      const std::size_t i = cells[j] / stride_[a] % ax.count;
-      coords[a][j] = warps_[a].inverse(ax.lo + (double(i) + offsets[j][a]) * (ax.hi - ax.lo) /
-                                                   double(ax.count));
-    }
-  }
-  std::vector<DirPair<double>> pairs(m);
-  std::vector<std::uint8_t> ok(m);
-  const std::vector<std::span<const double>> columns(coords.begin(), coords.end());
-  coordinates_to_pairs(cells_.form(), columns, pairs, ok);
-  std::vector<DirPair<double>> inside;
-  std::vector<std::size_t> which;
-  for (std::size_t j = 0; j < m; ++j) {
-    if (ok[j] && pairs[j].wi.z >= min_z && pairs[j].wo.z >= min_z) {
-      inside.push_back(pairs[j]);
-      which.push_back(j);
-    } else {
-      missed.push_back(cells[j]);
-    }
-  }
-  std::vector<Rgb> rho(inside.size());
-  truth.eval_batch(inside, rho);
-  for (std::size_t k = 0; k < inside.size(); ++k) {
-    if (!finite(rho[k])) continue;  // no data there: the cell is filled by fill_unmeasured()
-    const std::size_t cell = cells[which[k]];
-    value_[cell] = rho[k];
-    offset_[cell] = offsets[which[k]];
-    filled[cell] = 1;
-    ++samples_;
-  }
 }
 
 std::optional<std::size_t> GonioReconstruction::neighbour(std::size_t c, std::size_t a,

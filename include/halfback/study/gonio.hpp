@@ -79,13 +79,37 @@ struct GonioSetup {
 // azimuth, n such that the cells inside the domain are nearest the budget in ratio.
 GridSpec gonio_cells(const GonioSetup& setup);
 
+// Where a setup measures, known before anything is measured: its cells (in the warped
+// coordinates), their warps, and one point per cell that the instrument reaches — the cell's
+// centre, or the stratified design's random point, drawn again up to 8 times while it falls
+// outside the domain or the reach — in cell order. A cell no point reaches has none: it is
+// filled by dilation. `halfback plan` writes it; GonioReconstruction measures it.
+struct PlannedPoint {
+  std::size_t cell = 0;
+  std::array<float, 4> offset{};  // where in the cell, in cell units from its lower corner
+  DirPair<double> pair{};
+};
+struct GonioPlan {
+  GonioSetup setup;
+  GridSpec cells;
+  std::vector<AxisWarp> warps;  // one per axis of `cells`
+  std::vector<PlannedPoint> points;
+};
+// Throws what gonio_cells() throws.
+GonioPlan gonio_plan(const GonioSetup& setup);
+
 // A BRDF measured by the virtual gonio-reflectometer and reconstructed (a Brdf, so that it can be
 // evaluated, resampled and rendered like any other).
 class GonioReconstruction final : public Brdf {
  public:
-  // Measures `truth` (which need not outlive this). Throws std::invalid_argument for dirs or a
-  // budget of 0, std::runtime_error when no measurement has a finite value.
+  // Measures `truth` (which need not outlive this) at the points of gonio_plan(setup). Throws
+  // std::invalid_argument for dirs or a budget of 0, std::runtime_error when no measurement has
+  // a finite value.
   GonioReconstruction(const Brdf& truth, const GonioSetup& setup);
+  // The values measured at a plan's points (values[k] at plan.points[k]; NaN: not measured,
+  // filled by dilation like a cell out of reach), of a BRDF called `measured`. Throws
+  // std::invalid_argument when the counts differ, std::runtime_error when no value is finite.
+  GonioReconstruction(GonioPlan plan, std::span<const Rgb> values, std::string measured);
 
   std::string name() const override;
   std::string description() const override;
@@ -100,14 +124,9 @@ class GonioReconstruction final : public Brdf {
   std::size_t samples() const { return samples_; }  // measurements taken (finite values)
 
  private:
-  // The constructor's steps: measure the cells (filled[c] = 1 where a finite value was taken),
-  // then fill the others by dilation.
-  std::vector<std::uint8_t> measure(const Brdf& truth);
-  void measure_block(const Brdf& truth, std::span<const std::size_t> cells, int attempt,
-                     double min_z, std::vector<std::uint8_t>& filled,
-                     std::vector<std::size_t>& missed);
-  // Where a cell is measured at a try, in cell units from its lower corner.
-  std::array<float, 4> measurement_offset(std::size_t cell, int attempt) const;
+  // The constructors' work: the measured values into their cells (filled[c] = 1 where a finite
+  // value was taken), then the others filled by dilation.
+  void init(GonioPlan plan, std::span<const Rgb> values);
   void fill_unmeasured(std::vector<std::uint8_t>& filled);
   // An empty cell's value from its filled neighbours (none when it has no filled neighbour).
   std::optional<Rgb> dilated_value(std::size_t cell, const std::vector<std::uint8_t>& filled) const;
