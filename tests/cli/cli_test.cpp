@@ -690,6 +690,40 @@ TEST_F(CliTest, ExitStatusesFollowOneRule) {
   }
 }
 
+// `halfback plan` (issue 33): the positions to measure, each configuration once, with a JSON
+// sidecar saying which row each point of the design takes; bad options leave nothing.
+TEST_F(CliTest, PlanWritesPositionsAndItsSidecar) {
+  Result r = run({"plan", "--param", "halfdiff", "--budget", "500", "-o", "p.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const CsvTable t = parse(slurp(path("p.csv")));
+  ASSERT_GT(t.rows(), 100u);
+  EXPECT_EQ(t.header[1], "light_theta_deg");
+  for (std::size_t k = 0; k < t.rows(); ++k) {
+    EXPECT_EQ(t.columns[2][k], 0) << k;  // the light at azimuth 0: isotropy
+    EXPECT_LE(t.columns[1][k], t.columns[3][k] + 1e-7) << k;  // reciprocity: the lower light
+    const double z = t.columns[7][k], theta = std::acos(z) * 180 / std::numbers::pi;
+    EXPECT_NEAR(theta, t.columns[1][k], 1e-6) << k;
+  }
+  const std::string json = slurp(path("p.json"));
+  EXPECT_NE(json.find("\"format\":\"halfback-plan\""), std::string::npos);
+  EXPECT_NE(json.find("\"rows\":" + std::to_string(t.rows())), std::string::npos)
+      << json.substr(0, 600);
+  EXPECT_NE(json.find("\"row_of_point\":["), std::string::npos);
+  EXPECT_NE(r.err.find("fewer by reciprocity"), std::string::npos) << r.err;
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {"plan", "--param", "dirs", "-o", "q.csv"},
+           {"plan", "--design", "sobol", "-o", "q.csv"},
+           {"plan", "--spacing", "learned", "-o", "q.csv"},
+           {"plan", "--max-theta", "0", "-o", "q.csv"},
+           {"plan", "-o", "q.txt"}}) {
+    r = run(args);
+    EXPECT_EQ(r.status, 2) << args[1] << ": " << r.err;
+  }
+  r = run({"plan", "-o", "missing/q.csv"});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(entries(), (std::vector<std::string>{"p.csv", "p.json"}));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input
 // ---------------------------------------------------------------------------------------------

@@ -1,0 +1,49 @@
+// Measurement plans for a real gonio-reflectometer (issue 33; docs/acquisition.md): the points of
+// a design of the virtual gonio-reflectometer (gonio.hpp) as the positions of an instrument, each
+// configuration measured once, in an order that keeps the motors' travel short.
+//
+// The instrument: a four-axis light/detector gonio-reflectometer with the sample fixed — the
+// light at zenith θl and azimuth φl about the sample's normal, the detector at (θv, φv). A pair
+// (ωi, ωo) is the light along ωi and the detector along ωo.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "halfback/study/gonio.hpp"
+
+namespace halfback::study {
+
+// An instrument's position, in radians.
+struct GonioPosition {
+  double light_theta = 0, light_phi = 0, detector_theta = 0, detector_phi = 0;
+};
+GonioPosition position_of(const DirPair<double>& pair);
+
+// The motors' travel from one position to the next: the sum of the four axes' moves (radians),
+// each azimuth the short way round.
+double travel(const GonioPosition& from, const GonioPosition& to);
+
+struct AcquisitionPlan {
+  GonioPlan plan;
+  // The positions to measure, in the order to measure them.
+  std::vector<DirPair<double>> measured;
+  std::vector<GonioPosition> positions;  // the same, as the motors' angles
+  // plan.points[k] takes the value measured at measured[row_of_point[k]].
+  std::vector<std::size_t> row_of_point;
+  // The motors' travel through `measured` in this order, and through the plan's points in the
+  // order of its cells (before reciprocity and the isotropic turn).
+  double travel = 0, cell_order_travel = 0;
+};
+
+// The plan of a setup for the instrument:
+//   * an isotropic setup's pairs are turned about the normal so that the light's azimuth is 0
+//     (the BRDF is the same at every turn: a three-axis instrument suffices);
+//   * by reciprocity, a pair whose swap (ωo, ωi) is also in the plan (to 1e-9 rad) is measured
+//     once: the one whose light is nearer the normal;
+//   * the order is a serpentine: the light's zenith in bands, the detector's azimuth in strips
+//     within a band, its zenith along a strip, each band and strip run back and forth.
+// Throws what gonio_plan() throws.
+AcquisitionPlan acquisition_plan(const GonioSetup& setup);
+
+}  // namespace halfback::study

@@ -1,0 +1,154 @@
+#include "halfback/study/acquisition.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+namespace halfback::study {
+
+namespace {
+
+constexpr double kFullTurn = 2 * std::numbers::pi;
+constexpr double kRightAngle = std::numbers::pi / 2;
+// Configurations closer than this (radians, every angle) are the same measurement.
+constexpr double kSameAngle = 1e-9;
+
+double azimuth(const Vec3<double>& w) {
+  const double phi = std::atan2(w.y, w.x);
+  return phi < 0 ? phi + kFullTurn : phi;
+}
+
+double zenith(const Vec3<double>& w) {
+  return std::atan2(std::hypot(w.x, w.y), w.z);
+}
+
+Vec3<double> turned(const Vec3<double>& w, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c * w.x - s * w.y, s * w.x + c * w.y, w.z};
+}
+
+// The pair turned about the normal so that the light's azimuth is 0 (the detector's, when the
+// light is at the normal).
+DirPair<double> light_at_azimuth_zero(const DirPair<double>& p) {
+  const double r = std::hypot(p.wi.x, p.wi.y);
+  const double angle = -azimuth(r == 0 ? p.wo : p.wi);
+  DirPair<double> q{turned(p.wi, angle), turned(p.wo, angle)};
+  if (r > 0) q.wi = {r, 0, p.wi.z};  // exactly at azimuth 0, not a rounding away from it
+  else q.wo = {std::hypot(p.wo.x, p.wo.y), 0, p.wo.z};
+  return q;
+}
+
+// Of a pair and its swap (ωo, ωi), the one a plan measures: the light nearer the normal; at equal
+// zeniths, the smaller light azimuth, else (an isotropic plan, both at azimuth 0) the detector's
+// azimuth in [0, π].
+DirPair<double> reciprocal_representative(const DirPair<double>& p, bool isotropic) {
+  DirPair<double> swap{p.wo, p.wi};
+  if (isotropic) swap = light_at_azimuth_zero(swap);
+  const GonioPosition a = position_of(p), b = position_of(swap);
+  if (std::abs(a.light_theta - b.light_theta) > kSameAngle) return a.light_theta < b.light_theta ? p : swap;
+  if (std::abs(a.light_phi - b.light_phi) > kSameAngle) return a.light_phi < b.light_phi ? p : swap;
+  return a.detector_phi <= b.detector_phi ? p : swap;
+}
+
+// The configuration's angles on a lattice of kSameAngle, to find repeats.
+std::array<long long, 4> key_of(const GonioPosition& g) {
+  const auto q = [](double x) { return std::llround(x / kSameAngle); };
+  return {q(g.light_theta), q(g.light_phi), q(g.detector_theta), q(g.detector_phi)};
+}
+
+// The serpentine order of positions: per level a bin (the last level's value itself), each level
+// run forwards or backwards by the parity of the bins above it.
+std::vector<std::size_t> serpentine(const std::vector<GonioPosition>& positions, bool isotropic) {
+  const std::size_t n = positions.size();
+  const std::size_t levels = isotropic ? 3 : 4;
+  const auto bins = std::size_t(std::max(1.0, std::round(std::pow(double(n), 1.0 / double(levels)))));
+  const auto bin = [&](double x, double range) {
+    return std::min(bins - 1, std::size_t(std::max(0.0, x / range * double(bins))));
+  };
+  struct Key {
+    std::array<std::size_t, 3> bin{};
+    double last = 0;
+  };
+  std::vector<Key> keys(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const GonioPosition& g = positions[k];
+    std::array<double, 4> v{g.light_theta, g.light_phi, g.detector_phi, g.detector_theta};
+    std::array<double, 4> range{kRightAngle, kFullTurn, kFullTurn, kRightAngle};
+    if (isotropic) {  // no light azimuth: θl, φv, θv
+      v = {g.light_theta, g.detector_phi, g.detector_theta, 0};
+      range = {kRightAngle, kFullTurn, kRightAngle, 1};
+    }
+    std::size_t parity = 0;
+    for (std::size_t l = 0; l + 1 < levels; ++l) {
+      const std::size_t b = bin(v[l], range[l]);
+      keys[k].bin[l] = parity % 2 == 0 ? b : bins - 1 - b;
+      parity += b;
+    }
+    keys[k].last = parity % 2 == 0 ? v[levels - 1] : -v[levels - 1];
+  }
+  std::vector<std::size_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    if (keys[a].bin != keys[b].bin) return keys[a].bin < keys[b].bin;
+    return keys[a].last < keys[b].last;
+  });
+  return order;
+}
+
+double path_travel(const std::vector<GonioPosition>& path) {
+  double sum = 0;
+  for (std::size_t k = 1; k < path.size(); ++k) sum += travel(path[k - 1], path[k]);
+  return sum;
+}
+
+}  // namespace
+
+GonioPosition position_of(const DirPair<double>& p) {
+  return {zenith(p.wi), azimuth(p.wi), zenith(p.wo), azimuth(p.wo)};
+}
+
+double travel(const GonioPosition& a, const GonioPosition& b) {
+  const auto around = [](double x, double y) {
+    const double d = std::abs(x - y);
+    return std::min(d, kFullTurn - d);
+  };
+  return std::abs(a.light_theta - b.light_theta) + around(a.light_phi, b.light_phi) +
+         std::abs(a.detector_theta - b.detector_theta) + around(a.detector_phi, b.detector_phi);
+}
+
+AcquisitionPlan acquisition_plan(const GonioSetup& setup) {
+  AcquisitionPlan out;
+  out.plan = gonio_plan(setup);
+  const bool iso = setup.isotropic;
+  // Each point's configuration, once: the first point of a configuration adds a row.
+  std::map<std::array<long long, 4>, std::size_t> row_of_key;
+  std::vector<DirPair<double>> rows;
+  std::vector<GonioPosition> cell_order;
+  out.row_of_point.resize(out.plan.points.size());
+  for (std::size_t k = 0; k < out.plan.points.size(); ++k) {
+    const DirPair<double>& pair = out.plan.points[k].pair;
+    cell_order.push_back(position_of(pair));
+    const DirPair<double> p =
+        reciprocal_representative(iso ? light_at_azimuth_zero(pair) : pair, iso);
+    const auto [it, fresh] = row_of_key.try_emplace(key_of(position_of(p)), rows.size());
+    if (fresh) rows.push_back(p);
+    out.row_of_point[k] = it->second;
+  }
+  std::vector<GonioPosition> positions(rows.size());
+  for (std::size_t r = 0; r < rows.size(); ++r) positions[r] = position_of(rows[r]);
+  const std::vector<std::size_t> order = serpentine(positions, iso);
+  std::vector<std::size_t> new_row(rows.size());
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    new_row[order[j]] = j;
+    out.measured.push_back(rows[order[j]]);
+    out.positions.push_back(positions[order[j]]);
+  }
+  for (std::size_t& r : out.row_of_point) r = new_row[r];
+  out.travel = path_travel(out.positions);
+  out.cell_order_travel = path_travel(cell_order);
+  return out;
+}
+
+}  // namespace halfback::study
