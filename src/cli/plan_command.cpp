@@ -10,7 +10,6 @@
 
 #include "command.hpp"
 #include "halfback/study/acquisition.hpp"
-#include "view/json.hpp"
 
 namespace halfback::cli {
 
@@ -63,49 +62,6 @@ std::string plan_csv(const study::AcquisitionPlan& a) {
   return out;
 }
 
-std::string_view warp_name(study::AxisWarp::Kind k) {
-  using K = study::AxisWarp::Kind;
-  switch (k) {
-    case K::identity: return "identity";
-    case K::arcsine: return "arcsine";
-    case K::merl_angle: return "merl-angle";
-    case K::merl_arcsine: return "merl-arcsine";
-    case K::table: return "table";
-  }
-  return "identity";
-}
-
-std::string plan_json(const study::AcquisitionPlan& a, const std::string& csv_name) {
-  const study::GonioSetup& s = a.plan.setup;
-  view::JsonWriter j;
-  j.begin_object().field("format", "halfback-plan").field("version", 1);
-  j.field("measurements", csv_name);
-  j.field("instrument",
-          "four-axis light/detector gonio-reflectometer, the sample fixed: the light along wi at "
-          "(light_theta, light_phi), the detector along wo at (detector_theta, detector_phi), "
-          "degrees from the normal and about it");
-  j.key("setup").begin_object();
-  j.field("param", name_of(s.space)).field("isotropic", s.isotropic);
-  j.field("design", study::name_of(s.design)).field("budget", s.budget);
-  j.field("spacing", study::name_of(s.spacing)).field("seed", s.seed);
-  j.field("max_theta_deg", s.max_theta_deg).end_object();
-  j.key("cells").begin_array();
-  for (std::size_t k = 0; k < a.plan.cells.axes.size(); ++k) {
-    const GridAxis& ax = a.plan.cells.axes[k];
-    j.begin_object().field("name", ax.name).field("lo", ax.lo).field("hi", ax.hi);
-    j.field("count", ax.count).field("warp", warp_name(a.plan.warps[k].kind())).end_object();
-  }
-  j.end_array();
-  j.field("points", a.plan.points.size()).field("rows", a.measured.size());
-  j.key("travel_deg").begin_object();
-  j.field("serpentine", a.travel * kDeg).field("cell_order", a.cell_order_travel * kDeg);
-  j.end_object();
-  j.key("row_of_point").begin_array();
-  for (const std::size_t r : a.row_of_point) j.value(r);
-  j.end_array().end_object();
-  return j.str() + "\n";
-}
-
 int run_plan(const PlanOptions& o) {
   const study::GonioSetup setup = setup_of(o);
   const std::filesystem::path csv(o.output);
@@ -117,7 +73,7 @@ int run_plan(const PlanOptions& o) {
   Output csv_out(csv.string()), json_out(json.string());  // both writable before any work
   const study::AcquisitionPlan a = study::acquisition_plan(setup);
   csv_out.write(plan_csv(a));
-  json_out.write(plan_json(a, csv.filename().string()));
+  json_out.write(study::plan_sidecar(a, csv.filename().string()));
   csv_out.commit();
   json_out.commit();
   fmt::print(stderr,

@@ -1,10 +1,16 @@
 #include "halfback/study/acquisition.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <nlohmann/json.hpp>
+
+#include "halfback/util/bounded_read.hpp"
+#include "halfback/util/format_error.hpp"
 
 namespace halfback::study {
 
@@ -149,6 +155,137 @@ AcquisitionPlan acquisition_plan(const GonioSetup& setup) {
   out.travel = path_travel(out.positions);
   out.cell_order_travel = path_travel(cell_order);
   return out;
+}
+
+namespace {
+
+std::string_view warp_name(AxisWarp::Kind k) {
+  switch (k) {
+    case AxisWarp::Kind::identity: return "identity";
+    case AxisWarp::Kind::arcsine: return "arcsine";
+    case AxisWarp::Kind::merl_angle: return "merl-angle";
+    case AxisWarp::Kind::merl_arcsine: return "merl-arcsine";
+    case AxisWarp::Kind::table: return "table";
+  }
+  return "identity";
+}
+
+constexpr double kDegree = 180 / std::numbers::pi;
+// The largest budget a sidecar may ask to plan again (`halfback plan --budget`'s limit).
+constexpr std::size_t kMaxPlanBudget = 10000000;
+
+}  // namespace
+
+std::string plan_sidecar(const AcquisitionPlan& a, std::string_view measurements) {
+  const GonioSetup& s = a.plan.setup;
+  if (s.spacing == Spacing::learned)
+    throw std::invalid_argument("a plan of a learned spacing cannot be planned again from its "
+                                "sidecar: use own, angle or merl");
+  nlohmann::ordered_json j;
+  j["format"] = "halfback-plan";
+  j["version"] = 1;
+  j["measurements"] = std::string(measurements);
+  j["instrument"] =
+      "four-axis light/detector gonio-reflectometer, the sample fixed: the light along wi at "
+      "(light_theta, light_phi), the detector along wo at (detector_theta, detector_phi), degrees "
+      "from the normal and about it";
+  j["setup"] = {{"param", std::string(name_of(s.space))},  {"isotropic", s.isotropic},
+                {"design", std::string(name_of(s.design))}, {"budget", s.budget},
+                {"spacing", std::string(name_of(s.spacing))}, {"seed", s.seed},
+                {"max_theta_deg", s.max_theta_deg}};
+  j["cells"] = nlohmann::ordered_json::array();
+  for (std::size_t k = 0; k < a.plan.cells.axes.size(); ++k) {
+    const GridAxis& ax = a.plan.cells.axes[k];
+    j["cells"].push_back({{"name", ax.name}, {"lo", ax.lo}, {"hi", ax.hi}, {"count", ax.count},
+                          {"warp", std::string(warp_name(a.plan.warps[k].kind()))}});
+  }
+  j["points"] = a.plan.points.size();
+  j["rows"] = a.measured.size();
+  j["travel_deg"] = {{"serpentine", a.travel * kDegree},
+                     {"cell_order", a.cell_order_travel * kDegree}};
+  j["row_of_point"] = a.row_of_point;
+  return j.dump() + "\n";
+}
+
+namespace {
+
+// A field of the sidecar, of the kind asked for; FormatError naming it otherwise.
+template <class T>
+T field(const nlohmann::json& j, const char* key, const std::string& file) {
+  const auto it = j.find(key);
+  if (it == j.end()) throw FormatError(file, key, "missing");
+  try {
+    return it->get<T>();
+  } catch (const nlohmann::json::exception&) {
+    throw FormatError(file, key, "not of the expected kind");
+  }
+}
+
+GonioSetup setup_from(const nlohmann::json& j, const std::string& file) {
+  GonioSetup s;
+  const auto text = [&](const char* key) { return field<std::string>(j, key, file); };
+  const auto space = space_from_name(text("param"));
+  if (!space || space->is_dirs()) throw FormatError(file, "setup.param", "not a parameterization");
+  s.space = *space;
+  const auto design = parse_design(text("design"));
+  if (!design) throw FormatError(file, "setup.design", "not regular or stratified");
+  s.design = *design;
+  const auto spacing = parse_spacing(text("spacing"));
+  if (!spacing || *spacing == Spacing::learned)
+    throw FormatError(file, "setup.spacing", "not own, angle or merl");
+  s.spacing = *spacing;
+  s.isotropic = field<bool>(j, "isotropic", file);
+  s.budget = field<std::size_t>(j, "budget", file);
+  if (s.budget < 1 || s.budget > kMaxPlanBudget)
+    throw FormatError(file, "setup.budget", fmt::format("not in [1, {}]", kMaxPlanBudget));
+  s.seed = field<std::uint64_t>(j, "seed", file);
+  s.max_theta_deg = field<double>(j, "max_theta_deg", file);
+  return s;
+}
+
+}  // namespace
+
+AcquisitionPlan read_plan_sidecar(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  TextLines lines(path, std::uint64_t(256) << 20);  // 10⁷ points at most: under 100 MB
+  std::string text;
+  for (std::string_view line; lines.next(line);) (text += line) += '\n';
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw FormatError(file, "json", e.what());
+  }
+  if (!j.is_object() || j.value("format", "") != "halfback-plan")
+    throw FormatError(file, "format", "not a halfback plan (no \"format\": \"halfback-plan\")");
+  if (field<int>(j, "version", file) != 1)
+    throw FormatError(file, "version", "a version this halfback does not read (1)");
+  const auto setup = j.find("setup");
+  if (setup == j.end() || !setup->is_object()) throw FormatError(file, "setup", "missing");
+  GonioSetup s;
+  try {
+    s = setup_from(*setup, file);
+    AcquisitionPlan a = acquisition_plan(s);
+    if (field<std::size_t>(j, "points", file) != a.plan.points.size() ||
+        field<std::size_t>(j, "rows", file) != a.measured.size() ||
+        field<std::vector<std::size_t>>(j, "row_of_point", file) != a.row_of_point)
+      throw FormatError(file, "row_of_point",
+                        "the setup, planned again, gives other points or rows (a plan of another "
+                        "version of halfback, or edited)");
+    return a;
+  } catch (const std::invalid_argument& e) {  // a budget of 0, a reach out of range
+    throw FormatError(file, "setup", e.what());
+  }
+}
+
+GonioReconstruction reconstruct(const AcquisitionPlan& a, std::span<const Rgb> row_values,
+                                std::string name) {
+  if (row_values.size() != a.measured.size())
+    throw std::invalid_argument(
+        fmt::format("{} values for the {} rows of the plan", row_values.size(), a.measured.size()));
+  std::vector<Rgb> values(a.plan.points.size());
+  for (std::size_t k = 0; k < values.size(); ++k) values[k] = row_values[a.row_of_point[k]];
+  return GonioReconstruction(a.plan, values, std::move(name));
 }
 
 }  // namespace halfback::study

@@ -724,6 +724,59 @@ TEST_F(CliTest, PlanWritesPositionsAndItsSidecar) {
   EXPECT_EQ(entries(), (std::vector<std::string>{"p.csv", "p.json"}));
 }
 
+// `halfback reconstruct` (issue 33): a lab's values at a plan's rows, some missing, back to a
+// BRDF that every command reads; a constant ρ comes back as itself. Bad measurements and a plan
+// that does not match its setup are data errors naming the line or field; nothing is left.
+TEST_F(CliTest, ReconstructFromAPlansMeasurements) {
+  Result r = run({"plan", "--param", "hybrid", "--budget", "800", "-o", "p.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const CsvTable plan = parse(slurp(path("p.csv")));
+  std::string lab = "row,value\n";
+  const double rho = 0.3 / std::numbers::pi;  // Lambert, albedo 0.3
+  for (std::size_t k = 0; k < plan.rows(); ++k)
+    if (k % 10 != 3) lab += std::to_string(k) + "," + std::to_string(rho) + "\n";  // 10 % missing
+  lab += "3,nan\n";
+  put(path("lab.csv"), lab);
+  r = run({"reconstruct", "--plan", "p.json", "--measurements", "lab.csv", "-o", "m.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("rows measured"), std::string::npos) << r.err;
+  r = run({"eval", "--brdf", "m.binary"}, std::string(kDirsHeader) + "0.6,0,0.8,-0.3,0.2,0.9327379\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NEAR(std::stod(r.out.substr(r.out.find('\n') + 1)), rho, 1e-6) << r.out;
+
+  put(path("twice.csv"), "row,value\n1,0.1\n1,0.2\n");
+  put(path("far.csv"), "row,value\n100000,0.1\n");
+  put(path("header.csv"), "index,value\n1,0.1\n");
+  std::string edited = slurp(path("p.json"));
+  edited.replace(edited.find("\"budget\":800"), 12, "\"budget\":900");
+  put(path("edited.json"), edited);
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    std::string words;
+  };
+  for (const Case& c : std::vector<Case>{
+           {{"--plan", "p.json", "--measurements", "twice.csv"}, 1, "row 1 is given twice"},
+           {{"--plan", "p.json", "--measurements", "far.csv"}, 1, "not a row of the plan"},
+           {{"--plan", "p.json", "--measurements", "header.csv"}, 1, "expected the columns row"},
+           {{"--plan", "edited.json", "--measurements", "lab.csv"}, 1, "row_of_point"},
+           {{"--plan", "lab.csv", "--measurements", "lab.csv"}, 1, "lab.csv: json"},
+           {{"--plan", "none.json", "--measurements", "lab.csv"}, 1, "none.json"}}) {
+    std::vector<std::string> args{"reconstruct", "-o", "n.bsdf"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    r = run(args);
+    EXPECT_EQ(r.status, c.status) << c.words << ": " << r.err;
+    EXPECT_NE(r.err.find(c.words), std::string::npos) << r.err;
+  }
+  r = run({"reconstruct", "--plan", "p.json", "--measurements", "lab.csv", "-o", "n.exr"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  ASSERT_EQ(run({"plan", "--full", "--budget", "500", "-o", "f.csv"}).status, 0);
+  r = run({"reconstruct", "--plan", "f.json", "--measurements", "lab.csv", "-o", "n.binary"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("n.bsdf")));
+  EXPECT_FALSE(std::filesystem::exists(path("n.binary")));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input
 // ---------------------------------------------------------------------------------------------

@@ -8,6 +8,10 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "halfback/study/gonio.hpp"
@@ -45,5 +49,22 @@ struct AcquisitionPlan {
 //     within a band, its zenith along a strip, each band and strip run back and forth.
 // Throws what gonio_plan() throws.
 AcquisitionPlan acquisition_plan(const GonioSetup& setup);
+
+// The plan's sidecar, PLAN.json beside PLAN.csv (docs/acquisition.md, "Files"): the setup, the
+// cells and warps, the counts, the travel, and row_of_point. `measurements` names the CSV file.
+// A learned spacing (warps that a study learns from other BRDFs) is not planned: the setup must
+// be plannable again from the sidecar alone.
+std::string plan_sidecar(const AcquisitionPlan& plan, std::string_view measurements);
+// The plan a sidecar describes: its setup planned again (the points depend on the setup alone),
+// checked against the sidecar's counts and rows. Throws FormatError naming the file and the
+// field (unreadable, not JSON, a field missing or of the wrong kind, a plan that does not
+// match: made by another version of halfback, or edited).
+AcquisitionPlan read_plan_sidecar(const std::filesystem::path& path);
+
+// The values measured at a plan's rows (row_values[r] at measured[r]; NaN where a row was not
+// measured), spread back to its points, reconstructed as the study does. Throws
+// std::invalid_argument when the counts differ, std::runtime_error when no value is finite.
+GonioReconstruction reconstruct(const AcquisitionPlan& plan, std::span<const Rgb> row_values,
+                                std::string name);
 
 }  // namespace halfback::study
