@@ -12,7 +12,7 @@ jobs="$(nproc 2>/dev/null || echo 2)"
 
 cmake --preset fuzz -B "$build" >/dev/null
 cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz h5_fuzz envmap_fuzz \
-  view_fuzz view_wire_fuzz make_fuzz_seeds
+  view_fuzz view_wire_fuzz plan_fuzz make_fuzz_seeds make_plan_seeds
 
 corpus="$build/corpus"
 mkdir -p "$corpus"
@@ -71,7 +71,9 @@ artifacts="$build/artifacts"
 mkdir -p "$artifacts"
 
 status=0
-for target in merl rgl alta npy h5 envmap view view_wire; do
+# Seeds of the plans' sidecars: small plans written by the planner itself, and broken ones.
+"$build/fuzz/make_plan_seeds" "$corpus/plan"
+for target in merl rgl alta npy h5 envmap view view_wire plan; do
   case "$target" in
     merl) max_len=4096 ;;     # full-size files are built inside the target
     rgl)  max_len=65536 ;;
@@ -81,6 +83,7 @@ for target in merl rgl alta npy h5 envmap view view_wire; do
     envmap) max_len=32768 ;;
     view) max_len=2048 ;;
     view_wire) max_len=4096 ;;
+    plan) max_len=16384 ;;
   esac
   dict=()
   [ -f "fuzz/$target.dict" ] && dict=("-dict=fuzz/$target.dict")

@@ -171,8 +171,7 @@ std::string_view warp_name(AxisWarp::Kind k) {
 }
 
 constexpr double kDegree = 180 / std::numbers::pi;
-// The largest budget a sidecar may ask to plan again (`halfback plan --budget`'s limit).
-constexpr std::size_t kMaxPlanBudget = 10000000;
+
 
 }  // namespace
 
@@ -221,7 +220,7 @@ T field(const nlohmann::json& j, const char* key, const std::string& file) {
   }
 }
 
-GonioSetup setup_from(const nlohmann::json& j, const std::string& file) {
+GonioSetup setup_from(const nlohmann::json& j, const std::string& file, std::size_t max_budget) {
   GonioSetup s;
   const auto text = [&](const char* key) { return field<std::string>(j, key, file); };
   const auto space = space_from_name(text("param"));
@@ -236,26 +235,14 @@ GonioSetup setup_from(const nlohmann::json& j, const std::string& file) {
   s.spacing = *spacing;
   s.isotropic = field<bool>(j, "isotropic", file);
   s.budget = field<std::size_t>(j, "budget", file);
-  if (s.budget < 1 || s.budget > kMaxPlanBudget)
-    throw FormatError(file, "setup.budget", fmt::format("not in [1, {}]", kMaxPlanBudget));
+  if (s.budget < 1 || s.budget > max_budget)
+    throw FormatError(file, "setup.budget", fmt::format("not in [1, {}]", max_budget));
   s.seed = field<std::uint64_t>(j, "seed", file);
   s.max_theta_deg = field<double>(j, "max_theta_deg", file);
   return s;
 }
 
-}  // namespace
-
-AcquisitionPlan read_plan_sidecar(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  TextLines lines(path, std::uint64_t(256) << 20);  // 10⁷ points at most: under 100 MB
-  std::string text;
-  for (std::string_view line; lines.next(line);) (text += line) += '\n';
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw FormatError(file, "json", e.what());
-  }
+AcquisitionPlan plan_of(const nlohmann::json& j, const std::string& file, std::size_t max_budget) {
   if (!j.is_object() || j.value("format", "") != "halfback-plan")
     throw FormatError(file, "format", "not a halfback plan (no \"format\": \"halfback-plan\")");
   if (field<int>(j, "version", file) != 1)
@@ -264,7 +251,7 @@ AcquisitionPlan read_plan_sidecar(const std::filesystem::path& path) {
   if (setup == j.end() || !setup->is_object()) throw FormatError(file, "setup", "missing");
   GonioSetup s;
   try {
-    s = setup_from(*setup, file);
+    s = setup_from(*setup, file, max_budget);
     AcquisitionPlan a = acquisition_plan(s);
     if (field<std::size_t>(j, "points", file) != a.plan.points.size() ||
         field<std::size_t>(j, "rows", file) != a.measured.size() ||
@@ -275,6 +262,30 @@ AcquisitionPlan read_plan_sidecar(const std::filesystem::path& path) {
     return a;
   } catch (const std::invalid_argument& e) {  // a budget of 0, a reach out of range
     throw FormatError(file, "setup", e.what());
+  }
+}
+
+}  // namespace
+
+AcquisitionPlan read_plan_sidecar(const std::filesystem::path& path) {
+  TextLines lines(path, std::uint64_t(256) << 20);  // 10⁷ points at most: under 100 MB
+  std::string text;
+  for (std::string_view line; lines.next(line);) (text += line) += '\n';
+  return parse_plan_sidecar(text, path.string());
+}
+
+AcquisitionPlan parse_plan_sidecar(std::string_view text, const std::string& file,
+                                   std::size_t max_budget) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw FormatError(file, "json", e.what());
+  }
+  try {
+    return plan_of(j, file, max_budget);
+  } catch (const nlohmann::json::exception& e) {  // a field of another kind deep inside
+    throw FormatError(file, "json", e.what());
   }
 }
 

@@ -60,6 +60,10 @@ std::string plan_sidecar(const AcquisitionPlan& plan, std::string_view measureme
 // field (unreadable, not JSON, a field missing or of the wrong kind, a plan that does not
 // match: made by another version of halfback, or edited).
 AcquisitionPlan read_plan_sidecar(const std::filesystem::path& path);
+// The same from the sidecar's text (`source` names it in errors); a budget above `max_budget`
+// (planning it again is the planner's cost, not the reader's) is refused like a bad field.
+AcquisitionPlan parse_plan_sidecar(std::string_view text, const std::string& source,
+                                   std::size_t max_budget = 10000000);
 
 // The values measured at a plan's rows (row_values[r] at measured[r]; NaN where a row was not
 // measured), spread back to its points, reconstructed as the study does. Throws
