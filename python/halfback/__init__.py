@@ -58,8 +58,25 @@ def published_fits(path):
     return _core.published_fits(str(path))
 
 
+def plan(param="hybrid", design="regular", budget=10000, spacing="own", full=False, max_theta=90.0,
+         seed=1):
+    return _core.plan(param, design, budget, spacing, full, max_theta, seed)
+
+
+def reconstruct(plan, values, out, name="measured"):
+    """A BRDF from the values measured at a plan's rows (docs/acquisition.md), as `halfback
+    reconstruct`: plan is a PLAN.json path or plan()'s "sidecar" text; values (rows, 3) or
+    (rows,), NaN where a row was not measured (filled from the neighbouring cells); out a MERL
+    .binary or RGL .bsdf file, written; returns load(out). The GIL is released while it runs."""
+    import os
+    _core._reconstruct(os.fspath(plan) if not isinstance(plan, str) else plan, values,
+                       os.fspath(out), name)
+    return load(os.fspath(out))
+
+
 study_brdf.__doc__ = _core.study_brdf.__doc__
 fit.__doc__ = _core.fit.__doc__
+plan.__doc__ = _core.plan.__doc__
 fit_loss.__doc__ = _core.fit_loss.__doc__
 published_fits.__doc__ = _core.published_fits.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
@@ -75,8 +92,10 @@ __all__ = [
     "jacobian",
     "load",
     "merge_study",
+    "plan",
     "models",
     "published_fits",
+    "reconstruct",
     "simd_isa",
     "ssim",
     "study_brdf",

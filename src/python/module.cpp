@@ -33,6 +33,7 @@
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/parts.hpp"
 #include "halfback/util/output_dir.hpp"
+#include "acquisition.hpp"
 #include "user_param.hpp"
 
 namespace py = pybind11;
@@ -1022,4 +1023,5 @@ PYBIND11_MODULE(_core, m) {
   bind_fit(m);
   bind_image_metrics(m);
   halfback::python::bind_user_parameterizations(m);
+  halfback::python::bind_acquisition(m);
 }

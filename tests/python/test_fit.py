@@ -68,3 +68,27 @@ def test_published_fits_as_specs(tmp_path):
     f.write_text("m = NganWard(albedo = \n")
     with pytest.raises(RuntimeError, match="line 1"):
         halfback.published_fits(f)
+
+
+def test_plan_and_reconstruct(tmp_path):
+    p = halfback.plan("halfdiff", budget=400, max_theta=85)
+    rows = p["positions_deg"].shape[0]
+    assert p["wi"].shape == (rows, 3) and p["wo"].shape == (rows, 3)
+    assert (p["positions_deg"][:, 1] == 0).all()  # the light at azimuth 0 (isotropy)
+    assert len(p["row_of_point"]) > rows  # reciprocity: fewer rows than points
+    assert p["travel_deg"] < p["cell_order_travel_deg"]
+    truth = halfback.load("lambert:albedo=0.3+ggx:alpha=0.3")
+    values = truth.eval(p["wi"], p["wo"])
+    values[::7] = np.nan  # not measured: filled from the neighbours
+    b = halfback.reconstruct(p["sidecar"], values, tmp_path / "m.binary", "lab")
+    wi, wo = np.array([[0.3, 0.0, 0.9539392]]), np.array([[-0.2, 0.3, 0.9327379]])
+    assert b.eval(wi, wo)[0, 1] == pytest.approx(truth.eval(wi, wo)[0, 1], rel=0.05)
+    (tmp_path / "p.json").write_text(p["sidecar"])
+    assert halfback.reconstruct(tmp_path / "p.json", values[:, 1], tmp_path / "g.bsdf").spec.endswith("g.bsdf")
+    with pytest.raises(ValueError, match="expected"):
+        halfback.reconstruct(p["sidecar"], values[:5], tmp_path / "x.binary")
+    with pytest.raises(ValueError, match="design 'sobol'"):
+        halfback.plan(design="sobol")
+    with pytest.raises(RuntimeError, match="row_of_point"):
+        halfback.reconstruct(p["sidecar"].replace('"param":"halfdiff"', '"param":"hybrid"'), values,
+                             tmp_path / "y.binary")
