@@ -24,9 +24,14 @@
 // 5. The RGL file's sampling-interface calls as the renderer makes them (packets of 64 rows
 //    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N;
 //    --hash prints a hash of each call's outputs, to check that two builds compute the same bits).
+// 6. Samplers compared (issue 36, render/sampling_metric.hpp): the relative variance of the
+//    one-sample albedo estimator over ωo, time per sample and efficiency against the cosine, for
+//    each material's own sampler and the tabulated sampler in every parameterization at 64 KB,
+//    1 MB and 16 MB of tables (--part 6; not in the default parts).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -43,6 +48,7 @@
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
+#include "halfback/render/sampling_metric.hpp"
 
 namespace {
 
@@ -218,6 +224,43 @@ void rgl_calls(const ThroughputOptions& o) {
 
 }  // namespace
 
+// Part 6: every sampler of each material, at equal table memory.
+void compare_samplers(bool quick) {
+  const std::vector<std::string> specs{"ggx:alpha=0.08,f0=0.9", "embedded:ilm_l3_37_metallic",
+                                       "embedded:acrylic_felt_green", "embedded:pink-felt"};
+  const render::SamplingMetricOptions o{.samples = quick ? std::size_t(1024) : std::size_t(8192)};
+  std::printf("## Samplers at equal table memory (relative variance of the albedo estimator)\n\n");
+  std::printf("| material | sampler | tables | relative variance | ns per sample | efficiency vs "
+              "cosine |\n|---|---|---|---|---|---|\n");
+  for (const std::string& spec : specs) {
+    const BrdfPtr b = load_brdf(spec);
+    const auto cosine = render::with_cosine_sampling(*b);
+    const render::SamplingMeasure cos = render::measure_sampling(*b, *cosine, o);
+    const auto row = [&](const std::string& sampler, const std::string& memory,
+                         const render::SamplingMeasure& m) {
+      std::printf("| %s | %s | %s | %.4g ± %.2g | %.0f | %.3g |\n", spec.c_str(), sampler.c_str(),
+                  memory.c_str(), m.relative_variance, m.relative_variance_error,
+                  1e9 * m.seconds_per_sample, render::relative_efficiency(m, cos));
+    };
+    row("cosine", "—", cos);
+    if (b->has_importance_sampling()) row("own: " + b->describe_sampling(), "—", render::measure_sampling(*b, *b, o));
+    for (const std::size_t kb : {std::size_t(64), std::size_t(1024), std::size_t(16384)}) {
+      if (quick && kb > 64) break;
+      std::vector<std::string> charts;  // parameterizations sharing a chart share the sampler
+      for (const Space p : parameterizations()) {
+        const std::string chart(p.param().sampler_chart().name);
+        if (std::find(charts.begin(), charts.end(), chart) != charts.end()) continue;
+        charts.push_back(chart);
+        const render::TabulatedSampler t(*b, render::tabulation_for_memory(p, kb * 1024));
+        row(std::string("tabulated ") + std::string(name_of(p)) + " (" + chart + ")",
+            kb >= 1024 ? std::to_string(kb / 1024) + " MB" : std::to_string(kb) + " KB",
+            render::measure_sampling(*b, t, o));
+      }
+    }
+  }
+  std::printf("\n");
+}
+
 int main(int argc, char** argv) {
   bool quick = false;
   int only = 0;
@@ -239,6 +282,10 @@ int main(int argc, char** argv) {
   }
   if (only == 5) {
     rgl_calls(tp);
+    return 0;
+  }
+  if (only == 6) {
+    compare_samplers(quick);
     return 0;
   }
   const unsigned all = std::max(1u, std::thread::hardware_concurrency());
