@@ -352,6 +352,7 @@ int main(int argc, char** argv) {
         {"RGL metallic paint", rgl},
         {"RGL felt", load_brdf("embedded:acrylic_felt_green")},
         {"RGL wall paint", load_brdf("embedded:colodur_azure_4e")},
+        {"neural felt (MERL network)", load_brdf("embedded:pink-felt")},
         {"GGX α = 0.05, tabulated", load_brdf("ggx:alpha=0.05,f0=0.9")}};
     std::printf(
         "\n## Tabulated sampler: parameterization of the table (MIS, %.1f s, 128 × 128, "

@@ -76,7 +76,7 @@ TEST(TabulatedSampler, OwnSamplerIsPreferred) {
   EXPECT_NE(with_importance_sampling(o)->describe_sampling().find("tabulated"), std::string::npos);
   EXPECT_NE(with_importance_sampling(*g, {}, true)->describe_sampling().find("tabulated"),
             std::string::npos);
-  EXPECT_NE(TabulatedSampler(o, {}).describe_sampling().find("hybrid"), std::string::npos);
+  EXPECT_NE(TabulatedSampler(o, {}).describe_sampling().find("halfdiff"), std::string::npos);
 }
 
 TEST(TabulatedSampler, SampleAndPdfAgree) {
