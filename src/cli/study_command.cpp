@@ -30,7 +30,7 @@ namespace {
 struct StudyOptions {
   std::vector<std::string> specs, merge;
   std::string out = "study";
-  std::string budgets, budgets_4d, environments, params;
+  std::string budgets, budgets_4d, environments, params, sampler_kib;
   std::string designs = "own,angle,merl,learned";
   study::StudySettings settings;
   bool resume = false;
@@ -44,6 +44,8 @@ study::StudyConfig make_config(const StudyOptions& o) {
   if (!o.budgets_4d.empty())
     s.budgets_4d = count_list(o.budgets_4d, "--budgets-4d", "sample budget");
   if (!o.environments.empty()) s.environments = split_list(o.environments, "--env", "environment");
+  if (!o.sampler_kib.empty())
+    s.sampler_kib = count_list(o.sampler_kib, "--sampler-kib", "table size");
   s.designs = split_list(o.designs, "--designs", "design");
   if (!o.params.empty()) s.params = split_list(o.params, "--params", "parameterization");
   try {
@@ -366,6 +368,13 @@ Command register_study(CLI::App& parent) {
   app->add_flag("--no-gonio", o->settings.no_gonio,
                 "Metrics 1-2 only (no gonio-reflectometer, no images)");
   app->add_flag("--no-images", o->settings.no_images, "No image-space error");
+  app->add_option("--sampler-kib", o->sampler_kib,
+                  "Sizes of the tabulated samplers' tables compared by the sampling metric, KiB, "
+                  "comma-separated (default 64,1024; --quick 64)");
+  app->add_option("--sampler-samples", o->settings.sampler_samples,
+                  "Samples per outgoing direction of the sampling metric (default 4096)")
+      ->check(CLI::Range(std::size_t(2), study::kMaxSamplerSamples));
+  app->add_flag("--no-sampling", o->settings.no_sampling, "No sampling metric");
   app->add_flag("-q,--quiet", o->quiet, "Nothing on stdout (the report is in the output folder)");
   app->add_flag("--full-report", o->full_report,
                 "The whole report on stdout (by default: its summary and where the files are)");

@@ -86,10 +86,12 @@ SamplingMeasure measure_sampling(const Brdf& brdf, const Brdf& sampler,
 }
 
 double relative_efficiency(const SamplingMeasure& a, const SamplingMeasure& b) {
-  const double cost_a = a.relative_variance * a.seconds_per_sample;
-  const double cost_b = b.relative_variance * b.seconds_per_sample;
+  // A variance below the rounding of the estimates (Lambert by the cosine) counts as that floor,
+  // so that two exact samplers are equally efficient rather than 0/0.
+  constexpr double kFloor = 1e-20;
+  const double cost_a = std::max(a.relative_variance, kFloor) * a.seconds_per_sample;
+  const double cost_b = std::max(b.relative_variance, kFloor) * b.seconds_per_sample;
   if (!std::isfinite(cost_a)) return 0;
-  if (cost_a == 0) return std::numeric_limits<double>::infinity();
   return cost_b / cost_a;
 }
 

@@ -29,6 +29,8 @@ void apply_quick(StudyConfig& c) {
   c.test_pairs = 20000;
   c.image_size = 48;
   c.image_spp = 8;
+  c.sampler_kib = {64};
+  c.sampler_samples = 1024;
 }
 
 void check_ascending(const std::vector<std::size_t>& v, const char* option) {
@@ -98,6 +100,9 @@ StudyConfig make_config(const StudySettings& o) {
   if (o.test_pairs) c.test_pairs = o.test_pairs;
   if (o.image_size) c.image_size = o.image_size;
   if (o.image_spp) c.image_spp = o.image_spp;
+  if (!o.sampler_kib.empty()) c.sampler_kib = o.sampler_kib;
+  if (o.sampler_samples) c.sampler_samples = o.sampler_samples;
+  if (o.no_sampling) c.sampler_kib.clear();
   c.seed = o.seed;
   c.max_theta_deg = o.max_theta;
   // The image budget: as asked, else 10^4 if it is a budget, else the middle budget.
@@ -129,12 +134,13 @@ std::string describe_config(const StudyConfig& c) {
       "{}\nbudgets_4d = {}\n"
       "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
       "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
-      "learned_from = {}\n",
+      "learned_from = {}\nsampler_kib = {}\nsampler_samples = {}\n",
       joined(names_of(c.params)), name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
       joined(std::vector<std::size_t>(c.full_grid.begin(), c.full_grid.end())), joined(c.ranks),
       joined(c.budgets), joined(c.budgets_4d), c.test_pairs, format_csv_number(c.max_theta_deg),
       c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(names_of(c.spacings)),
-      c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from);
+      c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from, joined(c.sampler_kib),
+      c.sampler_samples);
 }
 
 namespace {
@@ -214,6 +220,11 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
     throw std::runtime_error(fmt::format("{}: a grid has the wrong number of axes", source));
   c.profile_grid = {profile_grid[0], profile_grid[1], profile_grid[2]};
   c.learned_from = get("learned_from");
+  // Parts written before the sampling metric (issue 36) have neither line: no sampling metric.
+  c.sampler_kib.clear();
+  if (kv.count("sampler_kib") && !kv.at("sampler_kib").empty())
+    c.sampler_kib = numbers_of<std::size_t>(get("sampler_kib"), where);
+  if (kv.count("sampler_samples")) c.sampler_samples = number_of<std::size_t>(get("sampler_samples"), where);
   return c;
 }
 

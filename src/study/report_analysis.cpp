@@ -39,6 +39,7 @@ Contents contents_of(const std::vector<BrdfResult>& results) {
     has.anisotropic |= !b.isotropic;
     has.gonio |= !b.table("gonio").rows.empty();
     has.images |= has_images(b);
+    has.sampling |= !b.table("sampling").rows.empty();
   }
   return has;
 }

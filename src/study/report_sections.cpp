@@ -225,6 +225,20 @@ std::string image_section(const std::vector<BrdfResult>& results, const StudyCon
   return md;
 }
 
+// Importance sampling (issue 36): the tabulated sampler of each parameterization's chart.
+std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  std::string md = fmt::format(
+      "## Importance sampling\n\nThe BRDF sampled by a table of ρ cos θi in each "
+      "parameterization's sampler chart (the renderer's tabulated sampler, docs/render.md), "
+      "tables of equal memory: the relative variance of the one-sample estimator of the "
+      "directional albedo, mean over 8 outgoing directions from the normal to 89° ({} samples "
+      "each; lower is better; sampling.csv has its standard error, the time per sample and the "
+      "efficiency against the cosine and the BRDF's own sampler). Parameterizations that share "
+      "a chart share the sampler.\n\n",
+      config.sampler_samples);
+  return md + sampling_tables(results, config);
+}
+
 // 5. The same materials as measured files and as their neural fits, side by side: does the
 // network representation change which parameterization wins?
 std::string files_and_networks_section(const std::vector<BrdfResult>& results,

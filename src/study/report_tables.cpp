@@ -425,4 +425,44 @@ std::string summary_table(const SummaryMetric& m, const std::vector<Space>& para
   return md + "\n";
 }
 
+// ---------------------------------------------------------------------------------------------
+// Metric 5: importance sampling
+// ---------------------------------------------------------------------------------------------
+
+std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const std::vector<Space>& params = params_of(results);
+  std::string md;
+  for (const std::size_t kib : config.sampler_kib) {
+    std::string rows;
+    Wins wins(params);
+    int beats_own = 0, with_own = 0;
+    for (const BrdfResult& b : results) {
+      if (b.table("sampling").rows.empty()) continue;
+      std::vector<double> variance;
+      rows += row_start(b.label);
+      bool better_than_own = false, has_own = false;
+      for (Space s : params) {
+        double v = NAN;
+        for (const SamplingPoint& p : sampling_points(b, s))
+          if (p.kib == kib) {
+            v = p.relative_variance;
+            has_own = p.own_sampler != "none";
+            better_than_own |= has_own && p.efficiency_vs_own > 1;
+          }
+        variance.push_back(v);
+        rows += std::isfinite(v) ? fmt::format(" {:.3g} |", v) : " – |";
+      }
+      rows += "\n";
+      wins.add(variance);
+      with_own += has_own;
+      beats_own += better_than_own;
+    }
+    md += fmt::format("Tables of {} KiB:\n\n", kib) + table_header("BRDF", params) + rows +
+          fmt::format("\nLowest variance (BRDFs): {}. BRDFs with a sampler of their own: {}, of "
+                      "which some table here is more efficient than it for {}.\n\n",
+                      wins.text(), with_own, beats_own);
+  }
+  return md;
+}
+
 }  // namespace halfback::study::report

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <chrono>
 #include <initializer_list>
+#include <map>
 #include <optional>
 #include <stdexcept>
 
 #include "halfback/core/parallel.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
+#include "halfback/render/sampling_metric.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metric_tables.hpp"
 
@@ -87,6 +89,14 @@ void StudyConfig::validate() const {
   if (!(max_theta_deg > 0 && max_theta_deg <= 90))
     throw std::invalid_argument(
         "study: the gonio-reflectometer's reach must be in (0, 90] degrees");
+  for (const std::size_t kib : sampler_kib)
+    if (kib < 1 || kib > kMaxSamplerKib)
+      throw std::invalid_argument(
+          fmt::format("study: sampler tables of {} KiB: expected 1 to {}", kib, kMaxSamplerKib));
+  if (!sampler_kib.empty() && (sampler_samples < 2 || sampler_samples > kMaxSamplerSamples))
+    throw std::invalid_argument(fmt::format("study: {} samples per direction for the sampling "
+                                            "metric: expected 2 to {}",
+                                            sampler_samples, kMaxSamplerSamples));
   if (!environments.empty() && !budgets.empty()) {
     if (std::find(budgets.begin(), budgets.end(), image_budget) == budgets.end())
       throw std::invalid_argument(
@@ -152,6 +162,39 @@ std::vector<GonioRun> gonio_runs(Space s, bool iso, const StudyConfig& config) {
   for (Spacing spacing : config.spacings)
     if (spacing != Spacing::own) add(spacing, Design::regular);
   return runs;
+}
+
+// Metric 5: the tabulated sampler in each parameterization's chart at each table size, measured
+// once per chart (parameterizations that share a chart share the sampler: their rows copy it),
+// against the cosine and the BRDF's own sampler.
+std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
+                                                             const StudyConfig& config) {
+  const render::SamplingMetricOptions o{.samples = config.sampler_samples, .seed = config.seed};
+  const render::SamplingMeasure cosine =
+      render::measure_sampling(brdf, *render::with_cosine_sampling(brdf), o);
+  std::optional<render::SamplingMeasure> own;
+  if (brdf.has_importance_sampling()) own = render::measure_sampling(brdf, brdf, o);
+  std::map<std::pair<std::string, std::size_t>, SamplingPoint> by_chart;
+  std::vector<std::pair<Space, SamplingPoint>> rows;
+  for (const Space space : config.params)
+    for (const std::size_t kib : config.sampler_kib) {
+      const std::string chart(space.param().sampler_chart().name);
+      auto it = by_chart.find({chart, kib});
+      if (it == by_chart.end()) {
+        const render::TabulatedSampler table(brdf, render::tabulation_for_memory(space, kib * 1024));
+        const render::SamplingMeasure m = render::measure_sampling(brdf, table, o);
+        it = by_chart
+                 .emplace(std::pair{chart, kib},
+                          SamplingPoint{kib, chart, m.relative_variance, m.relative_variance_error,
+                                        1e9 * m.seconds_per_sample,
+                                        render::relative_efficiency(m, cosine),
+                                        own ? brdf.describe_sampling() : "none",
+                                        own ? render::relative_efficiency(m, *own) : 0})
+                 .first;
+      }
+      rows.emplace_back(space, it->second);
+    }
+  return rows;
 }
 
 }  // namespace
@@ -247,6 +290,12 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
         }
       say(fmt::format("images {}", env.label));
     }
+  }
+  if (!config.sampler_kib.empty()) {
+    for (const auto& [space, point] : sampling_metric(brdf, config))
+      for (Task& t : done)
+        if (t.space == space) add_sampling(t.table("sampling"), space, point);
+    say("sampling");
   }
   // Each table: the rows of the parameterizations one after the other.
   result.params = config.params;

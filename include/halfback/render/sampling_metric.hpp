@@ -45,7 +45,8 @@ SamplingMeasure measure_sampling(const Brdf& brdf, const Brdf& sampler,
                                  const SamplingMetricOptions& options = {});
 
 // Efficiency of `a` relative to `b`: (relative variance × time) of b over that of a; > 1 when a
-// is better. 0 when a's variance is infinite.
+// is better. 0 when a's variance is infinite; a variance below 1e-20 (exact sampling up to
+// rounding) counts as 1e-20.
 double relative_efficiency(const SamplingMeasure& a, const SamplingMeasure& b);
 
 // Tabulation options whose tables take about `bytes` of memory (the cells of an isotropic

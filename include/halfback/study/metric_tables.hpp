@@ -24,7 +24,8 @@ struct TableDef {
   void (*derive)(const BrdfResult& result, MetricTable& into) = nullptr;
 };
 
-// Every table, in the order of the CSV files: azimuthal, separability, gonio, budget, image.
+// Every table, in the order of the CSV files: azimuthal, separability, gonio, budget, image,
+// sampling.
 std::span<const TableDef> study_tables();
 // The stored tables (those of study_tables() that are not derived), without rows, in order.
 std::vector<MetricTable> stored_tables();
@@ -66,5 +67,10 @@ void derive_budget(const BrdfResult& result, MetricTable& into);
 MetricTable image_table();
 void add_image(MetricTable& table, Space space, const ImagePoint& point);
 std::vector<ImagePoint> image_points(const BrdfResult& result, Space space);
+
+// sampling: the tabulated importance sampler in the parameterization's chart, per table size.
+MetricTable sampling_table();
+void add_sampling(MetricTable& table, Space space, const SamplingPoint& point);
+std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space);
 
 }  // namespace halfback::study

@@ -27,7 +27,10 @@ struct StudySettings {
   std::string space = "log";  // --error-space: parse_error_space()
   // --designs: parse_spacing() names. `learned` needs the profiles of the study's BRDFs (below).
   std::vector<std::string> designs{"own", "angle", "merl", "learned"};
-  bool quick = false, no_gonio = false, no_images = false;
+  bool quick = false, no_gonio = false, no_images = false, no_sampling = false;
+  // --sampler-kib: the sampling metric's table sizes (KiB); empty: the default (64, 1024).
+  std::vector<std::size_t> sampler_kib;
+  std::size_t sampler_samples = 0;  // per outgoing direction; 0: the default
   std::vector<std::size_t> budgets, budgets_4d;
   std::size_t test_pairs = 0, image_budget = 0;
   int image_size = 0, image_spp = 0;

@@ -35,6 +35,8 @@ inline constexpr std::size_t kMaxSampleBudget = 10'000'000;         // 10x the d
 inline constexpr std::size_t kMaxTestPairs = 10'000'000;            // 50x the default
 inline constexpr std::size_t kMaxGridCells = std::size_t(1) << 24;  // metrics 1-2, either form
 inline constexpr std::size_t kMaxImageSize = 4096;                  // pixels a side, metric 4
+inline constexpr std::size_t kMaxSamplerKib = 256 * 1024;           // a table of metric 5
+inline constexpr std::size_t kMaxSamplerSamples = 1 << 20;          // per ωo, metric 5
 
 struct StudyConfig {
   // The parameterizations compared, in the order of every table's rows and the report's columns.
@@ -75,6 +77,11 @@ struct StudyConfig {
   // empty without them: part of the settings of a run, so that parts learned from other BRDFs
   // are never resumed or merged with these.
   std::string learned_from;
+  // Metric 5 (issue 36): the tabulated importance sampler of the BRDF in each parameterization's
+  // chart, tables of each of these sizes (KiB; empty: no sampling metric), measured by
+  // render::measure_sampling with `sampler_samples` samples per ωo.
+  std::vector<std::size_t> sampler_kib{64, 1024};
+  std::size_t sampler_samples = 4096;
   // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.
   std::function<void(std::string_view stage)> progress;
 
@@ -98,6 +105,18 @@ struct ImagePoint {
   std::string environment;
   double relative_rmse = 0, mean_delta_e = 0, p95_delta_e = 0;
   double mae = 0, rmse = 0, ssim = 0;  // Sztrajman et al. 2021's protocol (ImageError)
+};
+
+// A row of the sampling table: the tabulated sampler in a parameterization's chart at a table
+// size, against the cosine and the BRDF's own sampler (`own_sampler` "none" and efficiency 0 when
+// it has none).
+struct SamplingPoint {
+  std::size_t kib = 0;
+  std::string chart;
+  double relative_variance = 0, relative_variance_error = 0, ns_per_sample = 0;
+  double efficiency_vs_cosine = 0;
+  std::string own_sampler = "none";
+  double efficiency_vs_own = 0;
 };
 
 struct BrdfResult {

@@ -1,0 +1,33 @@
+// The table of metric 5, importance sampling (metric_tables.hpp).
+#include "halfback/study/metric_tables.hpp"
+#include "table_columns.hpp"
+
+namespace halfback::study {
+
+MetricTable sampling_table() {
+  return {"sampling",
+          {columns::parameterization(), columns::integer("table_kib"), columns::text("chart"),
+           columns::real("relative_variance"), columns::real("relative_variance_error"),
+           columns::real("ns_per_sample"), columns::real("efficiency_vs_cosine"),
+           columns::text("own_sampler"), columns::real("efficiency_vs_own")},
+          {}};
+}
+
+void add_sampling(MetricTable& table, Space space, const SamplingPoint& p) {
+  table.add({std::string(name_of(space)), std::int64_t(p.kib), p.chart, p.relative_variance,
+             p.relative_variance_error, p.ns_per_sample, p.efficiency_vs_cosine, p.own_sampler,
+             p.efficiency_vs_own});
+}
+
+std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space) {
+  const MetricTable& t = result.table("sampling");
+  std::vector<SamplingPoint> points;
+  for (const Row* row : rows_of(t, space))
+    points.push_back({std::size_t(t.integer(*row, "table_kib")), t.text(*row, "chart"),
+                      t.real(*row, "relative_variance"), t.real(*row, "relative_variance_error"),
+                      t.real(*row, "ns_per_sample"), t.real(*row, "efficiency_vs_cosine"),
+                      t.text(*row, "own_sampler"), t.real(*row, "efficiency_vs_own")});
+  return points;
+}
+
+}  // namespace halfback::study
