@@ -113,7 +113,8 @@ Command register_info(CLI::App& parent) {
       ->capture_default_str();
   app->footer(
       "The albedo a(wi) = integral of rho(wi, wo) cos(theta_o) dwo is estimated by stratified\n"
-      "cosine-weighted sampling (± one standard error, of the largest channel). The largest\n"
+      "sampling, cosine-weighted and, when the BRDF samples itself, combined with its sampler\n"
+      "(MIS; ± one standard error, of the largest channel). The largest\n"
       "value is searched on a 91 x 91 x 73 grid of (theta_h, theta_d, phi_d), peaks included,\n"
       "over the pairs with both directions within 89 degrees of the normal.\n"
       "Example:\n"

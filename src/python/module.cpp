@@ -582,7 +582,8 @@ a direction that is not a unit vector raises ValueError naming the row.)doc")
           },
           py::arg("theta_i"), py::arg("n") = 256,
           "Directional albedo at incidence theta_i (radians): ((r, g, b), (standard errors)), by "
-          "n x n stratified cosine sampling.")
+          "n x n stratified samples, cosine-weighted and, when the BRDF samples itself, combined with "
+          "its sampler (MIS).")
       .def("resample", &resample_brdf, py::arg("param") = "hybrid", py::arg("kind") = "isotropic",
            py::arg("size") = 64, py::arg("azimuth") = 0.0, py::arg("nodes") = false,
            py::arg("ranges") = py::dict(),

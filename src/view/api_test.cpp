@@ -358,7 +358,9 @@ TEST(ViewApi, AlbedoCurveIsTheLibrarysEstimate) {
             std::string::npos)
       << r.body;
   const Response lambert = albedo({{"brdf", "lambert:albedo=0.3"}, {"angles", "2"}});
-  EXPECT_NE(lambert.body.find("\"albedo\":[[0.3"), std::string::npos) << lambert.body;
+  const std::size_t at = lambert.body.find("\"albedo\":[[");
+  ASSERT_NE(at, std::string::npos) << lambert.body;
+  EXPECT_NEAR(std::stod(lambert.body.substr(at + 11)), 0.3, 1e-12) << lambert.body;
   EXPECT_TRUE(has_error(albedo({{"brdf", kSpec}, {"angles", "1"}}), 400, "angles"));
   EXPECT_TRUE(has_error(albedo({{"brdf", kSpec}, {"n", "100000"}}), 400, "'n'"));
   EXPECT_TRUE(has_error(albedo({}), 400, "brdf"));
