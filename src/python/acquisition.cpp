@@ -20,9 +20,9 @@ namespace {
 
 constexpr double kDeg = 180 / std::numbers::pi;
 
-study::GonioSetup setup_of(const std::string& param, const std::string& design,
-                           std::size_t budget, const std::string& spacing, bool full,
-                           double max_theta, std::uint64_t seed) {
+study::GonioSetup setup_of(const std::string& param, const std::string& design, std::size_t budget,
+                           const std::string& spacing, bool full, double max_theta,
+                           std::uint64_t seed) {
   study::GonioSetup s;
   const auto space = space_from_name(param);
   if (!space || space->is_dirs())
@@ -72,8 +72,8 @@ py::dict plan(const std::string& param, const std::string& design, std::size_t b
   out["positions_deg"] = positions;
   out["wi"] = wi;
   out["wo"] = wo;
-  out["row_of_point"] = py::array_t<std::size_t>(py::ssize_t(a.row_of_point.size()),
-                                                 a.row_of_point.data());
+  out["row_of_point"] =
+      py::array_t<std::size_t>(py::ssize_t(a.row_of_point.size()), a.row_of_point.data());
   out["travel_deg"] = a.travel * kDeg;
   out["cell_order_travel_deg"] = a.cell_order_travel * kDeg;
   out["sidecar"] = study::plan_sidecar(a, "measurements.csv");
@@ -101,8 +101,8 @@ py::dict reconstruct(const std::string& sidecar, const py::object& values, const
   if (ext != ".binary" && ext != ".bsdf")
     throw py::value_error("out '" + out + "': write a MERL .binary or an RGL .bsdf file");
   const bool text = !sidecar.empty() && sidecar.front() == '{';
-  const study::AcquisitionPlan a = text ? study::parse_plan_sidecar(sidecar, "<sidecar>")
-                                        : study::read_plan_sidecar(sidecar);
+  const study::AcquisitionPlan a =
+      text ? study::parse_plan_sidecar(sidecar, "<sidecar>") : study::read_plan_sidecar(sidecar);
   if (!a.plan.setup.isotropic)
     throw py::value_error("a full (4D) plan's reconstruction is anisotropic: not written yet");
   const std::vector<Rgb> v = row_values(values, a.measured.size());
@@ -123,10 +123,11 @@ py::dict reconstruct(const std::string& sidecar, const py::object& values, const
 }  // namespace
 
 void bind_acquisition(py::module_& m) {
-  m.def("plan", &plan, py::arg("param") = "hybrid", py::arg("design") = "regular",
-        py::arg("budget") = 10000, py::arg("spacing") = "own", py::arg("full") = false,
-        py::arg("max_theta") = 90.0, py::arg("seed") = 1,
-        R"doc(The measurement plan of a design for a four-axis gonio-reflectometer, as `halfback plan`
+  m.def(
+      "plan", &plan, py::arg("param") = "hybrid", py::arg("design") = "regular",
+      py::arg("budget") = 10000, py::arg("spacing") = "own", py::arg("full") = false,
+      py::arg("max_theta") = 90.0, py::arg("seed") = 1,
+      R"doc(The measurement plan of a design for a four-axis gonio-reflectometer, as `halfback plan`
 (docs/acquisition.md): a dict of positions_deg (rows x 4: light zenith, light azimuth, detector
 zenith, detector azimuth, degrees), wi and wo (rows x 3), row_of_point (the row each point of the
 design takes), travel_deg and cell_order_travel_deg, and sidecar (the JSON text that

@@ -18,26 +18,42 @@
 #include <string>
 #include <vector>
 
+#include "acquisition.hpp"
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/brdf/registry.hpp"
 #include "halfback/brdf/resample.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/core/simd.hpp"
 #include "halfback/figure/hemisphere.hpp"
-#include "halfback/fit/fit.hpp"
-#include "halfback/fit/published.hpp"
 #include "halfback/formats/table_file.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
-#include "halfback/study/image_metrics.hpp"
-#include "halfback/study/parts.hpp"
-#include "halfback/util/output_dir.hpp"
-#include "acquisition.hpp"
+#include "py_brdf.hpp"
 #include "user_param.hpp"
 
 namespace py = pybind11;
 using namespace halfback;
+
+namespace halfback::python {
+
+PyBrdf load_py_brdf(const std::string& spec) {
+  std::error_code ec;
+  const std::filesystem::path path(spec);
+  std::string kept = spec;  // a file, absolute: a worker in another directory finds it
+  if (std::filesystem::exists(path, ec)) kept = std::filesystem::absolute(path, ec).string();
+  return PyBrdf{load_brdf(spec), kept};
+}
+
+BrdfPtr brdf_of(const py::object& brdf) {
+  return py::isinstance<py::str>(brdf) ? load_brdf(brdf.cast<std::string>())
+                                       : brdf.cast<const PyBrdf&>().brdf;
+}
+
+}  // namespace halfback::python
+
+using halfback::python::load_py_brdf;
+using halfback::python::PyBrdf;
 
 namespace {
 
@@ -213,22 +229,6 @@ Outputs dispatch(const py::object& obj, Form from, Form to, Wanted want,
     return run<double>(x, from, to, want, out);
   throw py::type_error("x must be a float32 or float64 array (got dtype " +
                        std::string(py::str(x.dtype())) + ")");
-}
-
-// A loaded BRDF (the C++ object is immutable and shared).
-// A BRDF and the spec it was loaded from (a file as an absolute path): what pickling sends and
-// what two Brdf objects compare by (load(x) == load(x)).
-struct PyBrdf {
-  BrdfPtr brdf;
-  std::string spec;
-};
-
-PyBrdf load_py_brdf(const std::string& spec) {
-  std::error_code ec;
-  const std::filesystem::path path(spec);
-  std::string kept = spec;  // a file, absolute: a worker in another directory finds it
-  if (std::filesystem::exists(path, ec)) kept = std::filesystem::absolute(path, ec).string();
-  return PyBrdf{load_brdf(spec), kept};
 }
 
 // (N, 3) float64 copies of wi and wo (or of the halves of an (N, 6) array).
@@ -582,7 +582,8 @@ a direction that is not a unit vector raises ValueError naming the row.)doc")
           },
           py::arg("theta_i"), py::arg("n") = 256,
           "Directional albedo at incidence theta_i (radians): ((r, g, b), (standard errors)), by "
-          "n x n stratified samples, cosine-weighted and, when the BRDF samples itself, combined with "
+          "n x n stratified samples, cosine-weighted and, when the BRDF samples itself, combined "
+          "with "
           "its sampler (MIS).")
       .def("resample", &resample_brdf, py::arg("param") = "hybrid", py::arg("kind") = "isotropic",
            py::arg("size") = 64, py::arg("azimuth") = 0.0, py::arg("nodes") = false,
@@ -670,352 +671,6 @@ takes when not given, or "") and "choices" (named values, or []). Iterating it g
 names, as before.)doc");
 }
 
-// ---------------------------------------------------------------------------------------------
-// The study (issue 14): one BRDF at a time, for engines such as Dask, and the merge
-// ---------------------------------------------------------------------------------------------
-
-template <class T>
-T setting(const py::handle& value, const std::string& key) {
-  try {
-    return value.cast<T>();
-  } catch (const py::cast_error&) {
-    throw py::value_error("settings['" + key + "']: expected " + py::type_id<T>() + ", got " +
-                          py::repr(value).cast<std::string>());
-  }
-}
-
-// The settings dict: the options of `halfback study`, '-' spelled '_', and the profiles of the
-// study's BRDFs for the learned design (study_profile()'s texts, in the study's order).
-struct PySettings {
-  study::StudySettings settings;
-  std::vector<std::string> profiles;
-  bool has_profiles = false;
-  bool designs_given = false;
-};
-
-// One key of the settings dict.
-void read_setting(PySettings& out, const std::string& key, const py::handle& v) {
-  study::StudySettings& s = out.settings;
-  if (key == "params")
-    s.params = setting<std::vector<std::string>>(v, key);
-  else if (key == "space" || key == "error_space")
-    s.space = setting<std::string>(v, key);
-  else if (key == "designs") {
-    s.designs = setting<std::vector<std::string>>(v, key);
-    out.designs_given = true;
-  } else if (key == "profiles") {
-    out.profiles = setting<std::vector<std::string>>(v, key);
-    out.has_profiles = true;
-  } else if (key == "quick")
-    s.quick = setting<bool>(v, key);
-  else if (key == "no_gonio")
-    s.no_gonio = setting<bool>(v, key);
-  else if (key == "no_images")
-    s.no_images = setting<bool>(v, key);
-  else if (key == "no_sampling")
-    s.no_sampling = setting<bool>(v, key);
-  else if (key == "sampler_kib")
-    s.sampler_kib = setting<std::vector<std::size_t>>(v, key);
-  else if (key == "sampler_samples")
-    s.sampler_samples = setting<std::size_t>(v, key);
-  else if (key == "budgets")
-    s.budgets = setting<std::vector<std::size_t>>(v, key);
-  else if (key == "budgets_4d")
-    s.budgets_4d = setting<std::vector<std::size_t>>(v, key);
-  else if (key == "test_pairs")
-    s.test_pairs = setting<std::size_t>(v, key);
-  else if (key == "image_budget")
-    s.image_budget = setting<std::size_t>(v, key);
-  else if (key == "image_size")
-    s.image_size = setting<int>(v, key);
-  else if (key == "image_spp")
-    s.image_spp = setting<int>(v, key);
-  else if (key == "max_theta")
-    s.max_theta = setting<double>(v, key);
-  else if (key == "seed")
-    s.seed = setting<std::uint64_t>(v, key);
-  else if (key == "env")
-    s.environments = setting<std::vector<std::string>>(v, key);
-  else
-    throw py::value_error(
-        "settings: unknown key '" + key +
-        "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
-        "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
-        "seed, no_gonio, no_images, sampler_kib, sampler_samples, no_sampling)");
-}
-
-PySettings study_settings(const py::object& settings) {
-  PySettings out;
-  study::StudySettings& s = out.settings;
-  if (!settings.is_none())
-    for (const auto& [k, v] : settings.cast<py::dict>()) read_setting(out, py::str(k), v);
-  // The defaults work alone (issue 35): without profiles, the default designs leave out the
-  // learned one, which needs the profiles of the study's other BRDFs; asked for by name, it
-  // still needs them.
-  if (!out.has_profiles && !out.designs_given) std::erase(s.designs, std::string("learned"));
-  return out;
-}
-
-// The configuration of the settings for the BRDF labeled `label`: with the learned design, its
-// warps from the profiles of the others.
-study::StudyConfig config_for(const PySettings& s, const std::string& label) {
-  study::StudyConfig config = study::make_config(s.settings);
-  if (!study::wants_learned(config)) return config;
-  if (!s.has_profiles)
-    throw std::invalid_argument(
-        "settings: the learned design needs settings['profiles'], the study_profile() of every "
-        "BRDF of the study in its order (or leave 'learned' out of settings['designs'])");
-  std::vector<study::LabeledProfile> profiles;
-  for (std::size_t i = 0; i < s.profiles.size(); ++i)
-    profiles.push_back(
-        study::profile_from_text(s.profiles[i], "settings['profiles'][" + std::to_string(i) + "]"));
-  study::set_learned(config, profiles, label);
-  return config;
-}
-
-py::dict study_one_brdf(const std::string& spec, const py::object& settings) {
-  const PySettings s = study_settings(settings);
-  study::BrdfResult result;
-  std::string described;
-  {
-    py::gil_scoped_release release;
-    const BrdfPtr brdf = load_brdf(spec);
-    const std::string label = study::study_label(spec, *brdf);
-    const study::StudyConfig config = config_for(s, label);
-    result = study::study_brdf(*brdf, label, config);
-    described = study::describe_config(config);
-  }
-  py::dict d;
-  for (const auto& [name, table] : study::to_tables(result)) d[py::str(name)] = table;
-  d["settings"] = described;
-  py::list images;
-  for (const render::Image& im : result.example_images) {
-    py::array_t<float> a({py::ssize_t(im.height), py::ssize_t(im.width), py::ssize_t(3)});
-    std::copy(im.rgb.begin(), im.rgb.end(), a.mutable_data());
-    images.append(a);
-  }
-  d["renderings"] = images;
-  return d;
-}
-
-// A result dict of study_one_brdf as a BrdfResult, of a study of `params` (its settings').
-study::BrdfResult result_of(const py::dict& d, const std::vector<Space>& params,
-                            const std::string& source) {
-  study::StudyTables tables;
-  std::vector<std::string> names{"brdf"};
-  for (const study::MetricTable& t : study::stored_tables()) names.push_back(t.name);
-  for (const std::string& name : names) {
-    if (!d.contains(name)) throw py::value_error(source + ": no table '" + name + "'");
-    tables[name] = d[name.c_str()].cast<std::string>();
-  }
-  study::BrdfResult b = study::from_tables(tables, params, source);
-  if (d.contains("renderings"))
-    for (const auto& item : d["renderings"].cast<py::list>()) {
-      const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(item);
-      if (!a || a.ndim() != 3 || a.shape(2) != 3)
-        throw py::value_error(source + ": a rendering is not an (H, W, 3) array");
-      render::Image im{int(a.shape(1)), int(a.shape(0)), {}};
-      im.rgb.assign(a.data(), a.data() + a.size());
-      b.example_images.push_back(std::move(im));
-    }
-  return b;
-}
-
-std::string study_one_profile(const std::string& spec, const py::object& settings) {
-  const PySettings s = study_settings(settings);
-  py::gil_scoped_release release;
-  const study::StudyConfig config = study::make_config(s.settings);
-  const BrdfPtr brdf = load_brdf(spec);
-  return study::profile_text(study::study_profile(*brdf, study::study_label(spec, *brdf), config));
-}
-
-py::dict merge_study(const std::string& out, const py::list& parts) {
-  study::MergedParts merged;
-  for (std::size_t i = 0; i < parts.size(); ++i) {
-    const py::handle item = parts[i];
-    if (py::isinstance<py::dict>(item)) {
-      const py::dict d = item.cast<py::dict>();
-      const std::string source = "parts[" + std::to_string(i) + "]";
-      if (!d.contains("settings")) throw py::value_error(source + ": no 'settings'");
-      const std::string settings = d["settings"].cast<std::string>();
-      const auto params = study::config_from_description(settings, source).params;
-      study::merge_into(merged, settings, source, {result_of(d, params, source)});
-    } else {
-      const std::string dir = py::str(py::module_::import("os").attr("fspath")(item));
-      study::MergedParts one = study::read_parts({dir});
-      study::merge_into(merged, one.settings, dir, std::move(one.results));
-    }
-  }
-  if (merged.results.empty()) throw py::value_error("parts: no result to merge");
-  study::StudyOutput written;
-  {
-    py::gil_scoped_release release;
-    create_output_directory(out);
-    double seconds = 0;
-    for (const study::BrdfResult& b : merged.results) seconds += b.seconds;
-    written = study::write_study(out, merged.results, merged.config, seconds);
-  }
-  py::dict d;
-  d["markdown"] = written.markdown;
-  d["files"] = written.files;
-  return d;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Fitting (issue 37): halfback.fit, the GIL released while it runs
-// ---------------------------------------------------------------------------------------------
-
-py::dict fit_result_dict(const fit::FitResult& r) {
-  py::list params;
-  for (const fit::Param& p : r.model.params) {
-    py::dict d;
-    d["term"] = p.term;
-    d["model"] = r.model.terms[p.term];
-    d["name"] = p.name;
-    d["value"] = p.value;
-    d["fitted"] = p.fitted;
-    d["min"] = p.min;
-    d["max"] = p.max;
-    params.append(d);
-  }
-  py::dict out;
-  out["spec"] = r.spec;
-  out["loss"] = std::string(fit::name_of(r.loss));
-  out["loss_value"] = r.loss_value;
-  out["layout"] = std::string(fit::kLayoutName);
-  out["samples"] = r.samples;
-  out["parameters"] = params;
-  out["starts"] = r.starts;
-  out["iterations"] = r.iterations;
-  out["seconds"] = r.seconds;
-  return out;
-}
-
-// A BRDF argument: a spec, as for load(), or a Brdf.
-BrdfPtr brdf_of(const py::object& brdf) {
-  return py::isinstance<py::str>(brdf) ? load_brdf(brdf.cast<std::string>())
-                                       : brdf.cast<const PyBrdf&>().brdf;
-}
-
-py::dict fit_brdf(const py::object& brdf, const std::string& model, const std::string& loss,
-                  std::size_t samples, int threads) {
-  fit::FitOptions o;
-  const auto l = fit::parse_loss(loss);
-  if (!l) throw py::value_error("loss '" + loss + "': expected " + fit::loss_names());
-  o.loss = *l;
-  o.samples = samples;
-  o.threads = threads;
-  const BrdfPtr target = brdf_of(brdf);
-  fit::FitResult r;
-  {
-    py::gil_scoped_release release;
-    r = fit::fit(*target, model, o);
-  }
-  return fit_result_dict(r);
-}
-
-double fit_loss(const py::object& brdf, const py::object& model, const std::string& loss,
-                std::size_t samples, int threads) {
-  const auto l = fit::parse_loss(loss);
-  if (!l) throw py::value_error("loss '" + loss + "': expected " + fit::loss_names());
-  if (samples < 1) throw py::value_error("samples must be at least 1");
-  const BrdfPtr target = brdf_of(brdf), m = brdf_of(model);
-  py::gil_scoped_release release;
-  return fit::loss_of(*target, *m, *l, samples, threads);
-}
-
-py::list published_fits(const std::string& path) {
-  py::list out;
-  for (const fit::PublishedFit& f : fit::read_published_fits(path)) {
-    py::dict d;
-    d["material"] = f.material;
-    d["line"] = f.line;
-    d["spec"] = fit::spec_of(f);
-    d["model"] = fit::model_of(f);
-    out.append(d);
-  }
-  return out;
-}
-
-void bind_fit(py::module_& m) {
-  m.def("fit", &fit_brdf, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
-        py::arg("samples") = 20000, py::arg("threads") = 0,
-        R"doc(Fits an analytic model or a sum of lobes ("lambert+ggx"; values given, as in
-"ggx:f0=0.9", are held) to a BRDF (a spec, as for load(), or a Brdf), as `halfback fit`
-(docs/fit.md), the GIL released while it runs. loss: ngan, low-e1, low-e2, cube-root or log.
-Returns a dict: spec (load() reads it), loss, loss_value, layout, samples, parameters (a list of
-dicts: term, model, name, value, fitted, min, max), starts, iterations, seconds. A bad model or
-loss raises ValueError; a target the fit cannot use (not finite, negative or zero where sampled,
-anisotropic) raises RuntimeError.)doc");
-  m.def("fit_loss", &fit_loss, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
-        py::arg("samples") = 20000, py::arg("threads") = 0,
-        R"doc(The loss of `model` (a spec or a Brdf) against `brdf` on fit()'s layout of `samples`
-pairs, as fit() measures it: fit(b, m, loss, n)["loss_value"] is fit_loss(b, its spec, loss, n).
-The GIL is released while it runs. A bad loss raises ValueError; a target the fit cannot use,
-RuntimeError.)doc");
-  m.def("published_fits", &published_fits, py::arg("path"),
-        R"doc(The published fits of a BBM .fit file (Ngan et al. 2005; ../shared/data/fits/): a list of
-dicts material, line, spec (a halfback spec of the registry's restatements of BBM's models,
-load() reads it) and model (its terms, as fit() takes them: "lambert+ward"). A malformed file
-raises RuntimeError naming the line; a model halfback lacks, ValueError.)doc");
-}
-
-void bind_study(py::module_& m) {
-  m.def("study_brdf", &study_one_brdf, py::arg("spec"), py::arg("settings") = py::none(),
-        R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
-
-spec: a file or model spec, as for load(). settings: a dict of the options of `halfback study`
-with '-' spelled '_': params (a list of parameterization names; missing: all of them, spherical
-last), space (the error space), designs (a list), quick, budgets, budgets_4d,
-test_pairs, env (a list), image_budget, image_size, image_spp, max_theta, seed, no_gonio,
-no_images, sampler_kib (a list), sampler_samples, no_sampling (missing: the defaults), and, for the learned design (a default design), profiles: the
-study_profile() texts of every BRDF of the study, this one's included, in the study's order (the
-warps are learned from all but this one's; without them, a ValueError).
-Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image": one
-row per parameterization and measurement, as in the CSV files of the study, numbers in exact round-trip form, e.g. for
-pandas.read_csv(io.StringIO(t))), "settings" (the resolved settings, which merge_study checks)
-and "renderings" (the example images, (H, W, 3) float32). Independent of any other BRDF: map it
-over BRDFs with any engine (docs/study.md, "Scaling out").)doc");
-  m.def("study_profile", &study_one_profile, py::arg("spec"), py::arg("settings") = py::none(),
-        R"doc(The profile of one BRDF for the learned design (as text), the GIL released: what the
-learned warps of the other BRDFs are fitted on. settings: as for study_brdf (its error space
-matters). Map it over the study's BRDFs first, then pass the list as settings["profiles"].)doc");
-  m.def("merge_study", &merge_study, py::arg("out"), py::arg("parts"),
-        R"doc(Writes the study's report of several results into directory `out` (as
-`halfback study --merge`): parts is a list of result dicts of study_brdf and of output directories
-of `halfback study`, in the order of the report. All must have the same settings, and a BRDF may
-appear once. Returns {"markdown": report.md's text, "files": the files written}.)doc");
-}
-
-// The study's SSIM (Wang et al. 2004), for checking it against other implementations.
-void bind_image_metrics(py::module_& m) {
-  using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
-  m.def(
-      "ssim",
-      [](const Doubles& x, const Doubles& y, std::optional<Doubles> mask) {
-        if (x.ndim() != 2 || y.ndim() != 2 || x.shape(0) != y.shape(0) || x.shape(1) != y.shape(1))
-          throw py::value_error("ssim: x and y must be 2D arrays of the same shape");
-        const auto h = int(x.shape(0)), w = int(x.shape(1));
-        const std::size_t n = std::size_t(x.size());
-        std::vector<std::uint8_t> selected(n, 1);
-        if (mask) {
-          if (mask->ndim() != 2 || mask->shape(0) != h || mask->shape(1) != w)
-            throw py::value_error("ssim: the mask must have the shape of the images");
-          for (std::size_t k = 0; k < n; ++k) selected[k] = mask->data()[k] != 0;
-        }
-        try {
-          return study::ssim({x.data(), n}, {y.data(), n}, w, h, selected);
-        } catch (const std::invalid_argument& e) {
-          throw py::value_error(e.what());
-        }
-      },
-      py::arg("x"), py::arg("y"), py::arg("mask") = py::none(),
-      R"doc(The structural similarity of two 2D images with values in [0, 1] (Wang et al. 2004:
-11 x 11 Gaussian window of sigma 1.5, K1 = 0.01, K2 = 0.03, L = 1), averaged over the pixels whose
-whole window is inside the image and where mask (same shape; default all) is nonzero. The SSIM of
-`halfback study`'s image-space error (docs/study.md).)doc");
-}
-
 }  // namespace
 
 // The class before the functions that return it, so that their signatures name it.
@@ -1026,9 +681,8 @@ PYBIND11_MODULE(_core, m) {
   bind_brdf_class(m);
   bind_hemisphere(m);
   bind_loading(m);
-  bind_study(m);
-  bind_fit(m);
-  bind_image_metrics(m);
+  halfback::python::bind_study(m);
+  halfback::python::bind_fit(m);
   halfback::python::bind_user_parameterizations(m);
   halfback::python::bind_acquisition(m);
 }

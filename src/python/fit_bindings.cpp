@@ -1,0 +1,113 @@
+// halfback.fit, fit_loss and published_fits (issue 37; docs/fit.md).
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+
+#include "halfback/fit/fit.hpp"
+#include "halfback/fit/published.hpp"
+#include "py_brdf.hpp"
+
+namespace py = pybind11;
+
+namespace halfback::python {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Fitting (issue 37): halfback.fit, the GIL released while it runs
+// ---------------------------------------------------------------------------------------------
+
+py::dict fit_result_dict(const fit::FitResult& r) {
+  py::list params;
+  for (const fit::Param& p : r.model.params) {
+    py::dict d;
+    d["term"] = p.term;
+    d["model"] = r.model.terms[p.term];
+    d["name"] = p.name;
+    d["value"] = p.value;
+    d["fitted"] = p.fitted;
+    d["min"] = p.min;
+    d["max"] = p.max;
+    params.append(d);
+  }
+  py::dict out;
+  out["spec"] = r.spec;
+  out["loss"] = std::string(fit::name_of(r.loss));
+  out["loss_value"] = r.loss_value;
+  out["layout"] = std::string(fit::kLayoutName);
+  out["samples"] = r.samples;
+  out["parameters"] = params;
+  out["starts"] = r.starts;
+  out["iterations"] = r.iterations;
+  out["seconds"] = r.seconds;
+  return out;
+}
+
+py::dict fit_brdf(const py::object& brdf, const std::string& model, const std::string& loss,
+                  std::size_t samples, int threads) {
+  fit::FitOptions o;
+  const auto l = fit::parse_loss(loss);
+  if (!l) throw py::value_error("loss '" + loss + "': expected " + fit::loss_names());
+  o.loss = *l;
+  o.samples = samples;
+  o.threads = threads;
+  const BrdfPtr target = brdf_of(brdf);
+  fit::FitResult r;
+  {
+    py::gil_scoped_release release;
+    r = fit::fit(*target, model, o);
+  }
+  return fit_result_dict(r);
+}
+
+double fit_loss(const py::object& brdf, const py::object& model, const std::string& loss,
+                std::size_t samples, int threads) {
+  const auto l = fit::parse_loss(loss);
+  if (!l) throw py::value_error("loss '" + loss + "': expected " + fit::loss_names());
+  if (samples < 1) throw py::value_error("samples must be at least 1");
+  const BrdfPtr target = brdf_of(brdf), m = brdf_of(model);
+  py::gil_scoped_release release;
+  return fit::loss_of(*target, *m, *l, samples, threads);
+}
+
+py::list published_fits(const std::string& path) {
+  py::list out;
+  for (const fit::PublishedFit& f : fit::read_published_fits(path)) {
+    py::dict d;
+    d["material"] = f.material;
+    d["line"] = f.line;
+    d["spec"] = fit::spec_of(f);
+    d["model"] = fit::model_of(f);
+    out.append(d);
+  }
+  return out;
+}
+
+}  // namespace
+
+void bind_fit(py::module_& m) {
+  m.def("fit", &fit_brdf, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
+        py::arg("samples") = 20000, py::arg("threads") = 0,
+        R"doc(Fits an analytic model or a sum of lobes ("lambert+ggx"; values given, as in
+"ggx:f0=0.9", are held) to a BRDF (a spec, as for load(), or a Brdf), as `halfback fit`
+(docs/fit.md), the GIL released while it runs. loss: ngan, low-e1, low-e2, cube-root or log.
+Returns a dict: spec (load() reads it), loss, loss_value, layout, samples, parameters (a list of
+dicts: term, model, name, value, fitted, min, max), starts, iterations, seconds. A bad model or
+loss raises ValueError; a target the fit cannot use (not finite, negative or zero where sampled,
+anisotropic) raises RuntimeError.)doc");
+  m.def("fit_loss", &fit_loss, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
+        py::arg("samples") = 20000, py::arg("threads") = 0,
+        R"doc(The loss of `model` (a spec or a Brdf) against `brdf` on fit()'s layout of `samples`
+pairs, as fit() measures it: fit(b, m, loss, n)["loss_value"] is fit_loss(b, its spec, loss, n).
+The GIL is released while it runs. A bad loss raises ValueError; a target the fit cannot use,
+RuntimeError.)doc");
+  m.def(
+      "published_fits", &published_fits, py::arg("path"),
+      R"doc(The published fits of a BBM .fit file (Ngan et al. 2005; ../shared/data/fits/): a list of
+dicts material, line, spec (a halfback spec of the registry's restatements of BBM's models,
+load() reads it) and model (its terms, as fit() takes them: "lambert+ward"). A malformed file
+raises RuntimeError naming the line; a model halfback lacks, ValueError.)doc");
+}
+
+}  // namespace halfback::python
