@@ -32,10 +32,10 @@
 #include "formats/merl_reference.hpp"
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/core/batch.hpp"
-#include "halfback/loader/load.hpp"
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl.hpp"
+#include "halfback/loader/load.hpp"
 
 #if defined(HALFBACK_RGL_REFERENCE)
 #define POWITACQ_IMPLEMENTATION

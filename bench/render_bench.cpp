@@ -230,8 +230,9 @@ void compare_samplers(bool quick) {
                                        "embedded:acrylic_felt_green", "embedded:pink-felt"};
   const render::SamplingMetricOptions o{.samples = quick ? std::size_t(1024) : std::size_t(8192)};
   std::printf("## Samplers at equal table memory (relative variance of the albedo estimator)\n\n");
-  std::printf("| material | sampler | tables | relative variance | ns per sample | efficiency vs "
-              "cosine |\n|---|---|---|---|---|---|\n");
+  std::printf(
+      "| material | sampler | tables | relative variance | ns per sample | efficiency vs "
+      "cosine |\n|---|---|---|---|---|---|\n");
   for (const std::string& spec : specs) {
     const BrdfPtr b = load_brdf(spec);
     const auto cosine = render::with_cosine_sampling(*b);
@@ -243,7 +244,8 @@ void compare_samplers(bool quick) {
                   1e9 * m.seconds_per_sample, render::relative_efficiency(m, cos));
     };
     row("cosine", "—", cos);
-    if (b->has_importance_sampling()) row("own: " + b->describe_sampling(), "—", render::measure_sampling(*b, *b, o));
+    if (b->has_importance_sampling())
+      row("own: " + b->describe_sampling(), "—", render::measure_sampling(*b, *b, o));
     for (const std::size_t kb : {std::size_t(64), std::size_t(1024), std::size_t(16384)}) {
       if (quick && kb > 64) break;
       std::vector<std::string> charts;  // parameterizations sharing a chart share the sampler

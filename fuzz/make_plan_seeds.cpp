@@ -32,12 +32,12 @@ int main(int argc, char** argv) {
       s.max_theta_deg = 80;
       const std::string text = study::plan_sidecar(study::acquisition_plan(s), "p.csv");
       write(text);
-      write(text.substr(0, text.size() / 2));                                 // cut
+      write(text.substr(0, text.size() / 2));  // cut
       std::string other = text;
-      other.replace(other.find("\"budget\":"), 9, "\"budget\":\"");          // a string
+      other.replace(other.find("\"budget\":"), 9, "\"budget\":\"");  // a string
       write(other);
       std::string rows = text;
-      rows.replace(rows.find("\"row_of_point\":[") + 16, 1, "9");            // does not match
+      rows.replace(rows.find("\"row_of_point\":[") + 16, 1, "9");  // does not match
       write(rows);
     }
   return 0;

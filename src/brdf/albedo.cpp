@@ -141,8 +141,8 @@ AlbedoEstimate directional_albedo(const Brdf& brdf, const Vec3<double>& wi, int 
         "directional albedo: the incident direction ({:g}, {:g}, {:g}) is not a finite unit vector",
         wi.x, wi.y, wi.z));
   if (n < 1 || n > kMaxAlbedoSide)
-    throw std::invalid_argument(fmt::format(
-        "directional albedo: n = {} samples per axis (1 to {})", n, kMaxAlbedoSide));
+    throw std::invalid_argument(
+        fmt::format("directional albedo: n = {} samples per axis (1 to {})", n, kMaxAlbedoSide));
   if (sampling == AlbedoSampling::automatic)
     sampling = brdf.has_importance_sampling() && brdf.reciprocal() ? AlbedoSampling::mis
                                                                    : AlbedoSampling::cosine;

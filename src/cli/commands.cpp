@@ -8,9 +8,9 @@ namespace halfback::cli {
 
 namespace {
 constexpr std::array<RegisterCommand, 14> kCommands{
-    &register_convert,     &register_info,       &register_eval,   &register_resample,
-    &register_export_merl, &register_export_rgl, &register_models, &register_render,
-    &register_figure,      &register_study,      &register_view,   &register_fit,
+    &register_convert,     &register_info,        &register_eval,   &register_resample,
+    &register_export_merl, &register_export_rgl,  &register_models, &register_render,
+    &register_figure,      &register_study,       &register_view,   &register_fit,
     &register_plan,        &register_reconstruct,
 };
 }  // namespace

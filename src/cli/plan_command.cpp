@@ -33,13 +33,15 @@ study::GonioSetup setup_of(const PlanOptions& o) {
                                  parameterization_names()));
   s.space = *space;
   const auto design = study::parse_design(o.design);
-  if (!design) throw UsageError(fmt::format("--design '{}': expected regular or stratified", o.design));
+  if (!design)
+    throw UsageError(fmt::format("--design '{}': expected regular or stratified", o.design));
   s.design = *design;
   const auto spacing = study::parse_spacing(o.spacing);
   if (!spacing || *spacing == study::Spacing::learned)
-    throw UsageError(fmt::format("--spacing '{}': expected own, angle or merl (a learned spacing "
-                                 "needs the profiles of a study)",
-                                 o.spacing));
+    throw UsageError(
+        fmt::format("--spacing '{}': expected own, angle or merl (a learned spacing "
+                    "needs the profiles of a study)",
+                    o.spacing));
   s.spacing = *spacing;
   s.isotropic = !o.full;
   s.budget = o.budget;
@@ -55,9 +57,10 @@ std::string plan_csv(const study::AcquisitionPlan& a) {
   for (std::size_t r = 0; r < a.measured.size(); ++r) {
     const study::GonioPosition& g = a.positions[r];
     const DirPair<double>& p = a.measured[r];
-    out += fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n",
-                       r, g.light_theta * kDeg, g.light_phi * kDeg, g.detector_theta * kDeg,
-                       g.detector_phi * kDeg, p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z);
+    out += fmt::format(
+        "{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n", r,
+        g.light_theta * kDeg, g.light_phi * kDeg, g.detector_theta * kDeg, g.detector_phi * kDeg,
+        p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z);
   }
   return out;
 }
@@ -66,9 +69,10 @@ int run_plan(const PlanOptions& o) {
   const study::GonioSetup setup = setup_of(o);
   const std::filesystem::path csv(o.output);
   if (csv.extension() != ".csv")
-    throw UsageError(fmt::format("-o '{}': the plan is a .csv file (its .json sidecar is written "
-                                 "beside it)",
-                                 o.output));
+    throw UsageError(
+        fmt::format("-o '{}': the plan is a .csv file (its .json sidecar is written "
+                    "beside it)",
+                    o.output));
   const std::filesystem::path json = std::filesystem::path(csv).replace_extension(".json");
   Output csv_out(csv.string()), json_out(json.string());  // both writable before any work
   const study::AcquisitionPlan a = study::acquisition_plan(setup);
@@ -96,11 +100,13 @@ Command register_plan(CLI::App& parent) {
       "plan", "Measurement plan of a design for a real gonio-reflectometer (CSV + JSON sidecar)");
   app->add_option("--param", o->param, "Parameterization whose cells are measured")
       ->capture_default_str();
-  app->add_option("--design", o->design, "regular (cell centres) or stratified (a random point "
-                                         "in each cell)")
+  app->add_option("--design", o->design,
+                  "regular (cell centres) or stratified (a random point "
+                  "in each cell)")
       ->capture_default_str();
-  app->add_option("--spacing", o->spacing, "Spacing of the cells: own, angle or merl "
-                                           "(docs/study.md, Designs)")
+  app->add_option("--spacing", o->spacing,
+                  "Spacing of the cells: own, angle or merl "
+                  "(docs/study.md, Designs)")
       ->capture_default_str();
   app->add_option("--budget", o->budget, "Cells wanted inside the domain")
       ->check(CLI::Range(std::size_t{1}, std::size_t{10000000}))

@@ -67,13 +67,14 @@ int run_reconstruct(const ReconstructOptions& o) {
   check_writable(o.output);
   const study::AcquisitionPlan plan = study::read_plan_sidecar(o.plan);
   if (!plan.plan.setup.isotropic)
-    throw UsageError(fmt::format("--plan '{}': a full (4D) plan's reconstruction is anisotropic; "
-                                 "MERL and RGL files are isotropic (not written yet)",
-                                 o.plan));
+    throw UsageError(
+        fmt::format("--plan '{}': a full (4D) plan's reconstruction is anisotropic; "
+                    "MERL and RGL files are isotropic (not written yet)",
+                    o.plan));
   std::size_t measured = 0;
   const std::vector<Rgb> values = read_measurements(o.measurements, plan.measured.size(), measured);
-  const std::string name = o.name.empty() ? std::filesystem::path(o.measurements).stem().string()
-                                          : o.name;
+  const std::string name =
+      o.name.empty() ? std::filesystem::path(o.measurements).stem().string() : o.name;
   const study::GonioReconstruction brdf = study::reconstruct(plan, values, name);
   if (ext == ".binary")
     write_merl(out, brdf);

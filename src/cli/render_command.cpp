@@ -16,7 +16,8 @@ namespace halfback::cli {
 namespace {
 
 struct RenderOptions {
-  std::string brdf, env = "sky", output, strategy = "mis", heuristic = "power", sampling = "halfdiff";
+  std::string brdf, env = "sky", output, strategy = "mis", heuristic = "power",
+                    sampling = "halfdiff";
   int width = 512, height = 512, spp = 64, threads = 0;
   std::uint64_t seed = 1;
   double time_budget = 0, exposure = 0, env_rotation = 0, env_exposure = 0;

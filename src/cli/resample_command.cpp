@@ -30,8 +30,8 @@ struct ResampleOptions {
 int run_resample(const ResampleOptions& o) {
   const auto space = space_from_name(o.param);
   if (!space || *space == Space::dirs)
-    throw UsageError(fmt::format(
-        "--param '{}': expected a parameterization: {}", o.param, parameterization_names()));
+    throw UsageError(fmt::format("--param '{}': expected a parameterization: {}", o.param,
+                                 parameterization_names()));
   const GridKind kind = o.kind == "full"        ? GridKind::full
                         : o.kind == "isotropic" ? GridKind::isotropic
                                                 : GridKind::slice;

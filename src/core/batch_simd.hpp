@@ -142,7 +142,9 @@ struct LaneOps<xsimd::batch<S, A>> {
   static T abs(const T& x) {
     return xsimd::abs(x);
   }
-  static T floor(const T& x) { return xsimd::floor(x); }
+  static T floor(const T& x) {
+    return xsimd::floor(x);
+  }
 
   // The polynomial with coefficients c (highest degree first) at z. Up to 6 terms by Horner's
   // rule. For 7 and 8 (sincos) by Estrin's scheme: terms paired at each level (a + b z, then with

@@ -761,10 +761,10 @@ std::vector<std::vector<T>> invalid_rows(Form from) {
                     : angular                  ? std::nextafter(T(kHalfPi<T>), T(4))
                                                : std::nextafter(T(1), T(2));
     // Azimuths are periodic: only non-finite and absurdly large ones are invalid.
-    const std::vector<T> bads = is_azimuth_column(from, c)
-                                    ? std::vector<T>{nan, inf, -inf, T(1e30f), T(-7e4f)}
-                                    : std::vector<T>{nan, inf, -inf, T(-0.1f), T(-1e-30f), upper,
-                                                     T(1e30f)};
+    const std::vector<T> bads =
+        is_azimuth_column(from, c)
+            ? std::vector<T>{nan, inf, -inf, T(1e30f), T(-7e4f)}
+            : std::vector<T>{nan, inf, -inf, T(-0.1f), T(-1e-30f), upper, T(1e30f)};
     for (T bad : bads) {
       rows.push_back(ok);
       rows.back()[c] = bad;

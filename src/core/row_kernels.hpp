@@ -92,8 +92,8 @@ inline Solved<T> decode_registered(Form from, const T* in) {
   const ParamDescriptor& d = from.space.param();
   double q[4] = {double(in[0]), double(in[1]), double(in[2]), from.isotropic ? 0 : double(in[3])};
   wrap_azimuth_rows(d.axes(from.isotropic), q, 1);
-  const Solved<double> s = from.isotropic ? d.inverse_iso({q[0], q[1], q[2]})
-                                          : d.inverse({q[0], q[1], q[2], q[3]});
+  const Solved<double> s =
+      from.isotropic ? d.inverse_iso({q[0], q[1], q[2]}) : d.inverse({q[0], q[1], q[2], q[3]});
   const auto& p = s.pair;
   return {{{T(p.wi.x), T(p.wi.y), T(p.wi.z)}, {T(p.wo.x), T(p.wo.y), T(p.wo.z)}}, s.in_domain};
 }

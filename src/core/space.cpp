@@ -51,7 +51,8 @@ void wrap_azimuth_rows(std::span<const Axis> axes, double* coords, std::size_t m
   const std::size_t d = axes.size();
   for (std::size_t c = 0; c < d; ++c)
     if (axes[c].kind == AxisKind::azimuth)
-      for (std::size_t i = 0; i < m; ++i) coords[i * d + c] = detail::wrap_azimuth(coords[i * d + c]);
+      for (std::size_t i = 0; i < m; ++i)
+        coords[i * d + c] = detail::wrap_azimuth(coords[i * d + c]);
 }
 
 void ParamDescriptor::inverse_rows(bool isotropic, const double* coords, std::size_t m,

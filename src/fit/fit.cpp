@@ -551,8 +551,7 @@ void check_target(std::span<const Rgb> v, const Samples& s) {
 
 }  // namespace
 
-double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t samples,
-               int threads) {
+double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t samples, int threads) {
   const Samples s = halfdiff_samples(samples);
   std::vector<Rgb> t(s.pairs.size());
   eval_all(target, s, t, threads);

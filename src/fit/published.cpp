@@ -172,8 +172,8 @@ std::string parameter_name(std::string_view bbm) {
 std::string term_spec(const PublishedLobe& lobe, const PublishedFit& fit) {
   const std::string_view model = registry_name_of(lobe.model);
   if (model.empty())
-    throw std::invalid_argument(fmt::format("{}: halfback has no model for BBM's '{}'",
-                                            fit.material, lobe.model));
+    throw std::invalid_argument(
+        fmt::format("{}: halfback has no model for BBM's '{}'", fit.material, lobe.model));
   std::string spec(model);
   char separator = ':';
   const auto add = [&](const std::string& key, double value) {
@@ -212,8 +212,8 @@ std::string model_of(const PublishedFit& fit) {
   for (const PublishedLobe& lobe : fit.lobes) {
     const std::string_view name = registry_name_of(lobe.model);
     if (name.empty())
-      throw std::invalid_argument(fmt::format("{}: halfback has no model for BBM's '{}'",
-                                              fit.material, lobe.model));
+      throw std::invalid_argument(
+          fmt::format("{}: halfback has no model for BBM's '{}'", fit.material, lobe.model));
     if (!model.empty()) model += '+';
     model += name;
   }

@@ -951,8 +951,8 @@ Environment load_environment(const std::string& spec) {
 }
 
 const std::vector<Environment>& default_environments() {
-  static const std::vector<Environment> envs{
-      load_environment("sky"), load_environment("studio"), load_environment("sunset")};
+  static const std::vector<Environment> envs{load_environment("sky"), load_environment("studio"),
+                                             load_environment("sunset")};
   return envs;
 }
 

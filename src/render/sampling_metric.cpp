@@ -35,7 +35,8 @@ std::vector<double> estimates(const Brdf& brdf, const Brdf& sampler, const Vec3<
   std::vector<BrdfSample> s(n);
   sampler.sample_batch(wos, u1, u2, s);
   std::vector<DirPair<double>> pairs(n);
-  for (std::size_t k = 0; k < n; ++k) pairs[k] = {s[k].pdf > 0 ? s[k].wi : Vec3<double>{0, 0, 1}, wo};
+  for (std::size_t k = 0; k < n; ++k)
+    pairs[k] = {s[k].pdf > 0 ? s[k].wi : Vec3<double>{0, 0, 1}, wo};
   std::vector<Rgb> rho(n);
   brdf.eval_batch(pairs, rho);
   std::vector<double> f(n, 0.0);
@@ -69,8 +70,10 @@ SamplingMeasure measure_sampling(const Brdf& brdf, const Brdf& sampler,
   std::mt19937_64 rng(o.seed);
   const auto t0 = std::chrono::steady_clock::now();
   for (const Vec3<double>& wo : outgoing_directions(brdf, o))
-    m.per_wo.push_back(moments(wo, estimates(brdf, sampler, wo, std::max<std::size_t>(2, o.samples), rng)));
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m.per_wo.push_back(
+        moments(wo, estimates(brdf, sampler, wo, std::max<std::size_t>(2, o.samples), rng)));
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   m.seconds_per_sample = seconds / double(m.per_wo.size() * std::max<std::size_t>(2, o.samples));
   double sum = 0, err2 = 0;
   std::size_t counted = 0;
@@ -104,7 +107,8 @@ TabulationOptions tabulation_for_memory(Space param, std::size_t bytes) {
   t.radial = std::max(4, int(std::lround(r)));
   t.azimuthal = 2 * t.radial;
   t.theta_slices = std::max(2, t.radial / 2);
-  t.aniso_theta_slices = t.aniso_phi_slices = std::max(2, int(std::lround(std::sqrt(t.theta_slices * 2.0))));
+  t.aniso_theta_slices = t.aniso_phi_slices =
+      std::max(2, int(std::lround(std::sqrt(t.theta_slices * 2.0))));
   return t;
 }
 

@@ -55,8 +55,8 @@ TEST(SamplingMetric, GgxByItsVisibleNormalsHasTheKnownWeight) {
     EXPECT_NEAR(e.variance, var, 1e-12);
     // And the mean is the albedo (an independent estimate, within its errors).
     const AlbedoEstimate a = directional_albedo(ggx, e.wo, 256);
-    EXPECT_NEAR(e.mean, a.mean.luminance(), 4 * (std::sqrt(var / double(o.samples)) +
-                                                 a.standard_error.luminance()));
+    EXPECT_NEAR(e.mean, a.mean.luminance(),
+                4 * (std::sqrt(var / double(o.samples)) + a.standard_error.luminance()));
   }
 }
 

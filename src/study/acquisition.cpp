@@ -6,8 +6,8 @@
 #include <array>
 #include <cmath>
 #include <map>
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
@@ -41,8 +41,10 @@ DirPair<double> light_at_azimuth_zero(const DirPair<double>& p) {
   const double r = std::hypot(p.wi.x, p.wi.y);
   const double angle = -azimuth(r == 0 ? p.wo : p.wi);
   DirPair<double> q{turned(p.wi, angle), turned(p.wo, angle)};
-  if (r > 0) q.wi = {r, 0, p.wi.z};  // exactly at azimuth 0, not a rounding away from it
-  else q.wo = {std::hypot(p.wo.x, p.wo.y), 0, p.wo.z};
+  if (r > 0)
+    q.wi = {r, 0, p.wi.z};  // exactly at azimuth 0, not a rounding away from it
+  else
+    q.wo = {std::hypot(p.wo.x, p.wo.y), 0, p.wo.z};
   return q;
 }
 
@@ -53,7 +55,8 @@ DirPair<double> reciprocal_representative(const DirPair<double>& p, bool isotrop
   DirPair<double> swap{p.wo, p.wi};
   if (isotropic) swap = light_at_azimuth_zero(swap);
   const GonioPosition a = position_of(p), b = position_of(swap);
-  if (std::abs(a.light_theta - b.light_theta) > kSameAngle) return a.light_theta < b.light_theta ? p : swap;
+  if (std::abs(a.light_theta - b.light_theta) > kSameAngle)
+    return a.light_theta < b.light_theta ? p : swap;
   if (std::abs(a.light_phi - b.light_phi) > kSameAngle) return a.light_phi < b.light_phi ? p : swap;
   return a.detector_phi <= b.detector_phi ? p : swap;
 }
@@ -69,7 +72,8 @@ std::array<long long, 4> key_of(const GonioPosition& g) {
 std::vector<std::size_t> serpentine(const std::vector<GonioPosition>& positions, bool isotropic) {
   const std::size_t n = positions.size();
   const std::size_t levels = isotropic ? 3 : 4;
-  const auto bins = std::size_t(std::max(1.0, std::round(std::pow(double(n), 1.0 / double(levels)))));
+  const auto bins =
+      std::size_t(std::max(1.0, std::round(std::pow(double(n), 1.0 / double(levels)))));
   const auto bin = [&](double x, double range) {
     return std::min(bins - 1, std::size_t(std::max(0.0, x / range * double(bins))));
   };
@@ -161,25 +165,30 @@ namespace {
 
 std::string_view warp_name(AxisWarp::Kind k) {
   switch (k) {
-    case AxisWarp::Kind::identity: return "identity";
-    case AxisWarp::Kind::arcsine: return "arcsine";
-    case AxisWarp::Kind::merl_angle: return "merl-angle";
-    case AxisWarp::Kind::merl_arcsine: return "merl-arcsine";
-    case AxisWarp::Kind::table: return "table";
+    case AxisWarp::Kind::identity:
+      return "identity";
+    case AxisWarp::Kind::arcsine:
+      return "arcsine";
+    case AxisWarp::Kind::merl_angle:
+      return "merl-angle";
+    case AxisWarp::Kind::merl_arcsine:
+      return "merl-arcsine";
+    case AxisWarp::Kind::table:
+      return "table";
   }
   return "identity";
 }
 
 constexpr double kDegree = 180 / std::numbers::pi;
 
-
 }  // namespace
 
 std::string plan_sidecar(const AcquisitionPlan& a, std::string_view measurements) {
   const GonioSetup& s = a.plan.setup;
   if (s.spacing == Spacing::learned)
-    throw std::invalid_argument("a plan of a learned spacing cannot be planned again from its "
-                                "sidecar: use own, angle or merl");
+    throw std::invalid_argument(
+        "a plan of a learned spacing cannot be planned again from its "
+        "sidecar: use own, angle or merl");
   nlohmann::ordered_json j;
   j["format"] = "halfback-plan";
   j["version"] = 1;
@@ -188,14 +197,20 @@ std::string plan_sidecar(const AcquisitionPlan& a, std::string_view measurements
       "four-axis light/detector gonio-reflectometer, the sample fixed: the light along wi at "
       "(light_theta, light_phi), the detector along wo at (detector_theta, detector_phi), degrees "
       "from the normal and about it";
-  j["setup"] = {{"param", std::string(name_of(s.space))},  {"isotropic", s.isotropic},
-                {"design", std::string(name_of(s.design))}, {"budget", s.budget},
-                {"spacing", std::string(name_of(s.spacing))}, {"seed", s.seed},
+  j["setup"] = {{"param", std::string(name_of(s.space))},
+                {"isotropic", s.isotropic},
+                {"design", std::string(name_of(s.design))},
+                {"budget", s.budget},
+                {"spacing", std::string(name_of(s.spacing))},
+                {"seed", s.seed},
                 {"max_theta_deg", s.max_theta_deg}};
   j["cells"] = nlohmann::ordered_json::array();
   for (std::size_t k = 0; k < a.plan.cells.axes.size(); ++k) {
     const GridAxis& ax = a.plan.cells.axes[k];
-    j["cells"].push_back({{"name", ax.name}, {"lo", ax.lo}, {"hi", ax.hi}, {"count", ax.count},
+    j["cells"].push_back({{"name", ax.name},
+                          {"lo", ax.lo},
+                          {"hi", ax.hi},
+                          {"count", ax.count},
                           {"warp", std::string(warp_name(a.plan.warps[k].kind()))}});
   }
   j["points"] = a.plan.points.size();

@@ -174,7 +174,8 @@ GonioPlan gonio_plan(const GonioSetup& setup) {
   for (int attempt = 0; attempt < tries && !todo.empty(); ++attempt) {
     std::vector<std::size_t> again;
     for (std::size_t b = 0; b < todo.size(); b += kBlock)
-      locate_block(plan, std::span<const std::size_t>(todo).subspan(b, std::min(kBlock, todo.size() - b)),
+      locate_block(plan,
+                   std::span<const std::size_t>(todo).subspan(b, std::min(kBlock, todo.size() - b)),
                    attempt, min_z, again);
     todo = std::move(again);
   }
@@ -210,9 +211,10 @@ GonioReconstruction::GonioReconstruction(GonioPlan plan, std::span<const Rgb> va
                                          std::string measured)
     : truth_name_(std::move(measured)) {
   if (values.size() != plan.points.size())
-    throw std::invalid_argument(fmt::format("gonio-reflectometer: {} values for the {} points of "
-                                            "the plan",
-                                            values.size(), plan.points.size()));
+    throw std::invalid_argument(
+        fmt::format("gonio-reflectometer: {} values for the {} points of "
+                    "the plan",
+                    values.size(), plan.points.size()));
   init(std::move(plan), values);
 }
 

@@ -224,7 +224,8 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
   c.sampler_kib.clear();
   if (kv.count("sampler_kib") && !kv.at("sampler_kib").empty())
     c.sampler_kib = numbers_of<std::size_t>(get("sampler_kib"), where);
-  if (kv.count("sampler_samples")) c.sampler_samples = number_of<std::size_t>(get("sampler_samples"), where);
+  if (kv.count("sampler_samples"))
+    c.sampler_samples = number_of<std::size_t>(get("sampler_samples"), where);
   return c;
 }
 

@@ -458,9 +458,10 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
       beats_own += better_than_own;
     }
     md += fmt::format("Tables of {} KiB:\n\n", kib) + table_header("BRDF", params) + rows +
-          fmt::format("\nLowest variance (BRDFs): {}. BRDFs with a sampler of their own: {}, of "
-                      "which some table here is more efficient than it for {}.\n\n",
-                      wins.text(), with_own, beats_own);
+          fmt::format(
+              "\nLowest variance (BRDFs): {}. BRDFs with a sampler of their own: {}, of "
+              "which some table here is more efficient than it for {}.\n\n",
+              wins.text(), with_own, beats_own);
   }
   return md;
 }

@@ -35,16 +35,19 @@ TEST(SamplingTable, ChartsRankedAndSharedCharts) {
     ASSERT_EQ(hybrid.size(), 2u);
     EXPECT_EQ(hybrid[0].chart, ortho[0].chart);  // one chart: the same sampler, the same numbers
     EXPECT_EQ(hybrid[0].relative_variance, ortho[0].relative_variance);
-    EXPECT_NE(hybrid[0].own_sampler, "none");                            // both sample themselves
+    EXPECT_NE(hybrid[0].own_sampler, "none");  // both sample themselves
     EXPECT_GT(hybrid[0].relative_variance_error, 0);
   }
   // More memory, less variance on the glossy lobe (not always between near sizes: the projected
   // chart gave 0.356 at 64 KiB and 0.361 at 256).
   for (Space s : c.params)
-    EXPECT_LT(sampling_points(g, s)[1].relative_variance, sampling_points(g, s)[0].relative_variance)
+    EXPECT_LT(sampling_points(g, s)[1].relative_variance,
+              sampling_points(g, s)[0].relative_variance)
         << name_of(s);
   // A broad lobe: the spherical chart; a glossy one: the half-vector chart.
-  const auto v = [](const BrdfResult& r, Space s) { return sampling_points(r, s)[1].relative_variance; };
+  const auto v = [](const BrdfResult& r, Space s) {
+    return sampling_points(r, s)[1].relative_variance;
+  };
   EXPECT_LT(v(b, space_of<Spherical>), v(b, space_of<HalfDiff>));
   EXPECT_LT(v(g, space_of<HalfDiff>), v(g, space_of<Spherical>));
   EXPECT_LT(v(g, space_of<HalfDiff>), v(g, space_of<Hybrid>));

@@ -94,9 +94,10 @@ void StudyConfig::validate() const {
       throw std::invalid_argument(
           fmt::format("study: sampler tables of {} KiB: expected 1 to {}", kib, kMaxSamplerKib));
   if (!sampler_kib.empty() && (sampler_samples < 2 || sampler_samples > kMaxSamplerSamples))
-    throw std::invalid_argument(fmt::format("study: {} samples per direction for the sampling "
-                                            "metric: expected 2 to {}",
-                                            sampler_samples, kMaxSamplerSamples));
+    throw std::invalid_argument(
+        fmt::format("study: {} samples per direction for the sampling "
+                    "metric: expected 2 to {}",
+                    sampler_samples, kMaxSamplerSamples));
   if (!environments.empty() && !budgets.empty()) {
     if (std::find(budgets.begin(), budgets.end(), image_budget) == budgets.end())
       throw std::invalid_argument(
@@ -181,7 +182,8 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
       const std::string chart(space.param().sampler_chart().name);
       auto it = by_chart.find({chart, kib});
       if (it == by_chart.end()) {
-        const render::TabulatedSampler table(brdf, render::tabulation_for_memory(space, kib * 1024));
+        const render::TabulatedSampler table(brdf,
+                                             render::tabulation_for_memory(space, kib * 1024));
         const render::SamplingMeasure m = render::measure_sampling(brdf, table, o);
         it = by_chart
                  .emplace(std::pair{chart, kib},

@@ -88,9 +88,9 @@ TEST(ViewApi, TokenIsRequiredFromQueryOrCookie) {
 // (the checks come before the routing; a new endpoint is listed here).
 TEST(ViewApi, EveryEndpointChecksTokenOriginAndHost) {
   Api api(config());
-  for (const char* path : {"/api/info", "/api/brdf", "/api/slices", "/api/hemisphere", "/api/polar",
-                           "/api/point", "/api/render", "/api/albedo", "/api/pointlight",
-                           "/api/fit"}) {
+  for (const char* path :
+       {"/api/info", "/api/brdf", "/api/slices", "/api/hemisphere", "/api/polar", "/api/point",
+        "/api/render", "/api/albedo", "/api/pointlight", "/api/fit"}) {
     Request r = get(path, {{"brdf", "arg:0"}});
     r.query.pop_back();  // the token
     EXPECT_TRUE(has_error(api.handle(r), 403, "token")) << path;
@@ -374,7 +374,8 @@ TEST(ViewApi, FitIsTheLibrarysFit) {
   const auto fit = [&](std::vector<std::pair<std::string, std::string>> q) {
     return api.handle(get("/api/fit", std::move(q)));
   };
-  const Response r = fit({{"brdf", "arg:0"}, {"model", "ggx"}, {"loss", "low-e2"}, {"samples", "500"}});
+  const Response r =
+      fit({{"brdf", "arg:0"}, {"model", "ggx"}, {"loss", "low-e2"}, {"samples", "500"}});
   ASSERT_EQ(r.status, 200) << r.body;
   fit::FitOptions o;
   o.loss = fit::Loss::low_e2;
@@ -397,7 +398,8 @@ TEST(ViewApi, FitIsTheLibrarysFit) {
   EXPECT_TRUE(has_error(fit(with("loss", "l2")), 400, "'loss'"));
   EXPECT_TRUE(has_error(fit(with("model", "no-such-model")), 400, "no-such-model"));
   EXPECT_TRUE(has_error(fit(with("model", std::string(kMaxSpecBytes + 1, 'a'))), 413, "model"));
-  EXPECT_TRUE(has_error(fit(with("samples", std::to_string(kMaxFitSamples + 1))), 400, "'samples'"));
+  EXPECT_TRUE(
+      has_error(fit(with("samples", std::to_string(kMaxFitSamples + 1))), 400, "'samples'"));
   EXPECT_TRUE(has_error(fit(with("brdf", "lambert:albedo=0")), 422, "cannot be fitted"));
   EXPECT_TRUE(has_error(fit({{"brdf", "arg:0"}}), 400, "'model'"));
 }

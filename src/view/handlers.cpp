@@ -64,9 +64,8 @@ Space space_param(const Request& r, std::string_view key, bool allow_dirs) {
   const auto s = space_from_name(name);
   if (!s || (*s == Space::dirs && !allow_dirs))
     throw RequestError(
-        400,
-        fmt::format("parameter '{}': '{}' is not one of {}", key, name.substr(0, 64),
-                    allow_dirs ? "rho, " + space_names() : parameterization_names(", ")));
+        400, fmt::format("parameter '{}': '{}' is not one of {}", key, name.substr(0, 64),
+                         allow_dirs ? "rho, " + space_names() : parameterization_names(", ")));
   return *s;
 }
 
@@ -509,7 +508,8 @@ Response fit_response(const Catalog& catalog, const Request& request, int thread
   try {
     result = fit::fit(*target, model, options);
   } catch (const fit::FitDataError& e) {
-    throw RequestError(422, fmt::format("'{}' cannot be fitted: {}", spec.substr(0, 128), e.what()));
+    throw RequestError(422,
+                       fmt::format("'{}' cannot be fitted: {}", spec.substr(0, 128), e.what()));
   }
   JsonWriter w;
   write_fit(w, result, spec, model);

@@ -26,9 +26,9 @@ struct SamplingMetricOptions {
 // The estimator at one ωo, in luminance (Rgb::luminance).
 struct OutgoingEstimate {
   Vec3<double> wo{};
-  double mean = 0;                 // the albedo's estimate
-  double variance = 0;             // of one sample of f
-  double variance_error = 0;       // the standard error of `variance` (from the 4th moment)
+  double mean = 0;            // the albedo's estimate
+  double variance = 0;        // of one sample of f
+  double variance_error = 0;  // the standard error of `variance` (from the 4th moment)
 };
 
 struct SamplingMeasure {

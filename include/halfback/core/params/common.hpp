@@ -225,8 +225,7 @@ inline T wrap_azimuth(T a) {
   const T turns = L::floor(a * T(S(1) / kTwoPi<S>));
   const T wrapped = wrap_two_pi(a - turns * T(kTwoPi<S>));  // a rounding off: into range
   const T bad(std::numeric_limits<S>::quiet_NaN());
-  return L::select(is_azimuth(a), a,
-                   L::select(L::abs(a) <= T(S(kMaxAzimuth)), wrapped, bad));
+  return L::select(is_azimuth(a), a, L::select(L::abs(a) <= T(S(kMaxAzimuth)), wrapped, bad));
 }
 
 // q with its azimuth coordinates (those of kind AxisKind::azimuth in `axes`) wrapped.
