@@ -3,6 +3,7 @@
 #include "halfback/models/register.hpp"
 
 #include "halfback/models/analytic.hpp"
+#include "halfback/models/ngan_lobes.hpp"
 
 namespace halfback::models {
 
@@ -88,6 +89,7 @@ void register_analytic_models(ModelRegistry& registry) {
                 [](const ModelArgs& a) {
                   return std::make_shared<Sheen>(SheenParams{colour(a, "color"), a["alpha"]});
                 }});
+  register_ngan_lobe_models(registry);
 }
 
 }  // namespace halfback::models
