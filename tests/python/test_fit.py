@@ -92,3 +92,27 @@ def test_plan_and_reconstruct(tmp_path):
     with pytest.raises(RuntimeError, match="row_of_point"):
         halfback.reconstruct(p["sidecar"].replace('"param":"halfdiff"', '"param":"hybrid"'), values,
                              tmp_path / "y.binary")
+
+
+def test_published_fits_script_on_two_materials(tmp_path):
+    # scripts/published_fits.py: the published Ward parameters of two MERL materials and
+    # halfback's own fit of the same model, under the same loss, in a CSV and a table.
+    import csv, os, pathlib, subprocess, sys
+    shared = pathlib.Path(os.environ.get("HALFBACK_SHARED_DIR", "/nonexistent")) / "data"
+    if not (shared / "fits" / "ngan_ward.fit").exists():
+        if os.environ.get("CI") == "true":
+            pytest.fail("../shared/data/fits is missing under CI")
+        pytest.skip("../shared/data not found (set HALFBACK_SHARED_DIR)")
+    script = pathlib.Path(__file__).resolve().parents[2] / "scripts" / "published_fits.py"
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(halfback.__file__) + "/..")
+    r = subprocess.run([sys.executable, str(script), "--fits", str(shared / "fits"), "--nbrdf",
+                        str(shared / "nbrdf" / "merl_nbrdf"), "--out", str(tmp_path), "--models",
+                        "ward", "--materials", "2", "--samples", "1000", "--workers", "1"],
+                       capture_output=True, text=True, env=env, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    rows = list(csv.DictReader(open(tmp_path / "published-fits.csv")))
+    assert len(rows) == 2 and all(row["model"] == "lambert+ward" for row in rows)
+    for row in rows:
+        assert 0 < float(row["published_loss"]) < 10 and 0 < float(row["halfback_loss"]) < 10
+        halfback.load(row["published_spec"])
+    assert "| lambert+ward | 2 |" in (tmp_path / "published-fits.md").read_text()
