@@ -228,11 +228,22 @@ inline T wrap_azimuth(T a) {
   return L::select(is_azimuth(a), a, L::select(L::abs(a) <= T(S(kMaxAzimuth)), wrapped, bad));
 }
 
-// q with its azimuth coordinates (those of kind AxisKind::azimuth in `axes`) wrapped.
-template <class T, std::size_t N>
-inline std::array<T, N> with_azimuths_wrapped(std::array<T, N> q, const std::array<Axis, N>& axes) {
+// The azimuth coordinates (AxisKind::azimuth) of `axes` as a bit mask, at compile time: the
+// kernels of every instruction set then refer to no axis table at run time (a table referred to
+// would be a weak symbol shared across them: test halfback_isa_symbols).
+template <std::size_t N>
+constexpr unsigned azimuth_mask(const std::array<Axis, N>& axes) {
+  unsigned mask = 0;
   for (std::size_t k = 0; k < N; ++k)
-    if (axes[k].kind == AxisKind::azimuth) q[k] = wrap_azimuth(q[k]);
+    if (axes[k].kind == AxisKind::azimuth) mask |= 1u << k;
+  return mask;
+}
+
+// q with the coordinates of `Mask` (azimuth_mask) wrapped.
+template <unsigned Mask, class T, std::size_t N>
+inline std::array<T, N> with_azimuths_wrapped(std::array<T, N> q) {
+  for (std::size_t k = 0; k < N; ++k)
+    if ((Mask >> k) & 1u) q[k] = wrap_azimuth(q[k]);
   return q;
 }
 
@@ -241,7 +252,7 @@ inline std::array<T, N> with_azimuths_wrapped(std::array<T, N> q, const std::arr
 // The pair with coordinates q; NaN directions when q is outside the valid domain.
 template <class P, class T>
 inline Solved<T> inverse(const Tuple4<T>& q) {
-  Solved<T> s = P::inverse_raw(detail::with_azimuths_wrapped(q, P::axes));
+  Solved<T> s = P::inverse_raw(detail::with_azimuths_wrapped<detail::azimuth_mask(P::axes)>(q));
   detail::finish_inverse(s);
   return s;
 }
@@ -249,19 +260,21 @@ inline Solved<T> inverse(const Tuple4<T>& q) {
 // The canonical pose with isotropic coordinates q (NaN when invalid).
 template <class P, class T>
 inline Solved<T> inverse_iso(const Tuple3<T>& q) {
-  Solved<T> s = P::inverse_iso_raw(detail::with_azimuths_wrapped(q, P::iso_axes));
+  Solved<T> s =
+      P::inverse_iso_raw(detail::with_azimuths_wrapped<detail::azimuth_mask(P::iso_axes)>(q));
   detail::finish_inverse(s);
   return s;
 }
 
 template <class P, class T>
 inline MaskOf<T> valid(const Tuple4<T>& q) {
-  return P::inverse_raw(detail::with_azimuths_wrapped(q, P::axes)).in_domain;
+  return P::inverse_raw(detail::with_azimuths_wrapped<detail::azimuth_mask(P::axes)>(q)).in_domain;
 }
 
 template <class P, class T>
 inline MaskOf<T> valid_iso(const Tuple3<T>& q) {
-  return P::inverse_iso_raw(detail::with_azimuths_wrapped(q, P::iso_axes)).in_domain;
+  return P::inverse_iso_raw(detail::with_azimuths_wrapped<detail::azimuth_mask(P::iso_axes)>(q))
+      .in_domain;
 }
 
 // The measure of the isotropic coordinates: ∫ over the rotation about n of dωi dωo = J3 dq3.
