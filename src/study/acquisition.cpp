@@ -294,7 +294,7 @@ AcquisitionPlan parse_plan_sidecar(std::string_view text, const std::string& fil
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // malformed, or a number out of range
     throw FormatError(file, "json", e.what());
   }
   try {
