@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <type_traits>
 
 #include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
@@ -224,10 +226,20 @@ std::string plan_sidecar(const AcquisitionPlan& a, std::string_view measurements
 namespace {
 
 // A field of the sidecar, of the kind asked for; FormatError naming it otherwise.
+// Whole numbers must be written as non-negative integers: nlohmann converts a float (2e115) to
+// an integer type by a cast whose overflow is undefined behaviour.
 template <class T>
 T field(const nlohmann::json& j, const char* key, const std::string& file) {
   const auto it = j.find(key);
   if (it == j.end()) throw FormatError(file, key, "missing");
+  const auto whole = [](const nlohmann::json& v) { return v.is_number_unsigned(); };
+  bool fits = true;
+  if constexpr (std::is_same_v<T, std::vector<std::size_t>>)
+    fits = it->is_array() && std::all_of(it->begin(), it->end(), whole);
+  else if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>)
+    fits = whole(*it) &&
+           it->template get<std::uint64_t>() <= std::uint64_t(std::numeric_limits<T>::max());
+  if (!fits) throw FormatError(file, key, "not a whole number >= 0 (or a list of them)");
   try {
     return it->get<T>();
   } catch (const nlohmann::json::exception&) {
