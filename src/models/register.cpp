@@ -2,26 +2,17 @@
 // factories, so that "ggx:alpha=0.2,f0=0.9" works everywhere a BRDF SPEC is accepted.
 #include "halfback/models/register.hpp"
 
+#include "colour_params.hpp"
 #include "halfback/models/analytic.hpp"
 #include "halfback/models/ngan_lobes.hpp"
+#include "halfback/models/ngan_microfacet.hpp"
 
 namespace halfback::models {
 
 namespace {
 
-// Colour parameters: a grey value plus per-channel overrides that default to it, because
-// registry parameters are scalars. Every channel has the grey value's range.
-std::vector<ModelParam> colour_params(const std::string& name, const std::string& what,
-                                      double default_value, double max) {
-  return {{name, what + " (grey)", default_value, 0, max},
-          defaults_to(name + "_r", what + ", red channel", name, 0, max),
-          defaults_to(name + "_g", what + ", green channel", name, 0, max),
-          defaults_to(name + "_b", what + ", blue channel", name, 0, max)};
-}
-
-Rgb colour(const ModelArgs& a, const std::string& name) {
-  return {a[name + "_r"], a[name + "_g"], a[name + "_b"]};
-}
+using detail::colour;
+using detail::colour_params;
 
 std::vector<ModelParam> concat(std::vector<ModelParam> a, const std::vector<ModelParam>& b) {
   a.insert(a.end(), b.begin(), b.end());
@@ -90,6 +81,7 @@ void register_analytic_models(ModelRegistry& registry) {
                   return std::make_shared<Sheen>(SheenParams{colour(a, "color"), a["alpha"]});
                 }});
   register_ngan_lobe_models(registry);
+  register_ngan_microfacet_models(registry);
 }
 
 }  // namespace halfback::models

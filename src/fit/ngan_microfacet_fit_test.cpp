@@ -1,0 +1,130 @@
+// Ngan et al. 2005's microfacet-style lobes (cook-torrance, ashikhmin-shirley) in the fitter:
+// parameters recovered from BRDFs they generate, and every published fit of BBM's files loads as
+// a spec (its values inside the registry's ranges) and evaluates finite and positive.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+
+#include "halfback/fit/fit.hpp"
+#include "halfback/fit/published.hpp"
+#include "halfback/loader/load.hpp"
+#include "support/test_support.hpp"
+
+namespace halfback::fit::ngan_microfacet_fit_test {  // (own namespace: one unity file)
+namespace {
+
+double value_in(const Model& m, std::size_t term, std::string_view name) {
+  for (const Param& p : m.params)
+    if (p.term == term && p.name == name) return p.value;
+  ADD_FAILURE() << "no parameter " << name;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// Fits `model` to the BRDF of `truth` from `start` (empty: the automatic starts), 2000 samples (as
+// `halfback fit --samples 2000`), and checks every fitted parameter to 1e-3 relative.
+void expect_recovered(const std::string& model, const std::string& truth,
+                      const std::string& start) {
+  SCOPED_TRACE(truth + " from " + start);
+  FitOptions o;
+  o.samples = 2000;
+  if (!start.empty()) o.starts = {start};
+  const FitResult r = fit(*load_brdf(truth), model, o);
+  const Model want = parse_model(truth);
+  int fitted = 0;
+  for (const Param& p : r.model.params) {
+    if (!p.fitted) continue;
+    ++fitted;
+    const double w = value_in(want, p.term, p.name);
+    EXPECT_NEAR(p.value, w, 1e-3 * std::abs(w)) << p.name << " of term " << p.term;
+  }
+  EXPECT_GT(fitted, 0);
+}
+
+TEST(NganMicrofacetFit, CookTorranceRecovered) {
+  expect_recovered("cook-torrance",
+                   "cook-torrance:albedo_r=0.6,albedo_g=0.35,albedo_b=0.1,eta=0.3,roughness=0.2",
+                   "cook-torrance:albedo_r=0.5,albedo_g=0.5,albedo_b=0.5,eta=0.1,roughness=0.5");
+}
+
+TEST(NganMicrofacetFit, AshikhminShirleyRecovered) {
+  expect_recovered("ashikhmin-shirley",
+                   "ashikhmin-shirley:albedo_r=0.6,albedo_g=0.35,albedo_b=0.1,f0=0.3,sharpness=60",
+                   "ashikhmin-shirley:albedo_r=0.5,albedo_g=0.5,albedo_b=0.5,f0=0.1,sharpness=20");
+}
+
+// As `halfback fit --brdf TRUTH --model MODEL --samples 2000`, from the automatic starts.
+TEST(NganMicrofacetFit, RecoveredFromTheAutomaticStarts) {
+  expect_recovered("cook-torrance",
+                   "cook-torrance:albedo_r=0.8,albedo_g=0.5,albedo_b=0.3,eta=0.6,roughness=0.05",
+                   "");
+  expect_recovered("ashikhmin-shirley",
+                   "ashikhmin-shirley:albedo_r=0.8,albedo_g=0.5,albedo_b=0.3,f0=0.6,sharpness=500",
+                   "");
+}
+
+TEST(NganMicrofacetFit, LambertPlusCookTorranceRecovered) {
+  expect_recovered("lambert+cook-torrance",
+                   "lambert:albedo_r=0.3,albedo_g=0.2,albedo_b=0.05+cook-torrance:albedo_r=0.5,"
+                   "albedo_g=0.4,albedo_b=0.3,eta=0.05,roughness=0.15",
+                   "lambert:albedo_r=0.5,albedo_g=0.5,albedo_b=0.5+cook-torrance:albedo_r=0.5,"
+                   "albedo_g=0.5,albedo_b=0.5,eta=0.2,roughness=0.3");
+}
+
+// The spec of a published line: BBM's names in lower case, fresnelReflectance as f0.
+std::string spec_of_published(const PublishedFit& f) {
+  static const std::map<std::string, std::string> models{
+      {"Lambertian", "lambert"},
+      {"NganCookTorrance", "cook-torrance"},
+      {"NganAshikhminShirley", "ashikhmin-shirley"}};
+  static const std::map<std::string, std::string> params{{"albedo", "albedo"},
+                                                         {"eta", "eta"},
+                                                         {"roughness", "roughness"},
+                                                         {"fresnelReflectance", "f0"},
+                                                         {"sharpness", "sharpness"}};
+  std::string spec;
+  for (const PublishedLobe& lobe : f.lobes) {
+    if (!spec.empty()) spec += '+';
+    spec += models.at(lobe.model);
+    char sep = ':';
+    for (const auto& [key, values] : lobe.params) {
+      const std::string name = params.at(key);
+      for (std::size_t c = 0; c < values.size(); ++c) {
+        char buf[80];
+        const char* channel = values.size() == 3 ? (c == 0 ? "_r" : c == 1 ? "_g" : "_b") : "";
+        std::snprintf(buf, sizeof buf, "%c%s%s=%.17g", sep, name.c_str(), channel, values[c]);
+        spec += buf;
+        sep = ',';
+      }
+    }
+  }
+  return spec;
+}
+
+TEST(NganMicrofacetFit, EveryPublishedLineLoadsAndEvaluates) {
+  HALFBACK_REQUIRE_SHARED(dir, "fits");
+  for (const char* file : {"ngan_cooktorrance.fit", "ngan_ashikhminshirley.fit"}) {
+    const auto fits = read_published_fits(dir / file);
+    EXPECT_EQ(fits.size(), 86u) << file;
+    for (const PublishedFit& f : fits) {
+      const std::string spec = spec_of_published(f);
+      SCOPED_TRACE(std::string(file) + ": " + f.material + " as " + spec);
+      BrdfPtr b;
+      ASSERT_NO_THROW(b = load_brdf(spec));
+      for (const DirPair<double>& p :
+           {DirPair<double>{{0, 0, 1}, {0, 0, 1}}, DirPair<double>{{0.6, 0, 0.8}, {-0.6, 0, 0.8}},
+            DirPair<double>{{0.6, 0, 0.8}, {0, 0.8, 0.6}}}) {
+        const Rgb v = b->eval(p);
+        for (double c : {v.r, v.g, v.b}) {
+          EXPECT_TRUE(std::isfinite(c));
+          EXPECT_GT(c, 0);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace halfback::fit::ngan_microfacet_fit_test
