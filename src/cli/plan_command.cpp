@@ -6,7 +6,9 @@
 
 #include <filesystem>
 #include <numbers>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "command.hpp"
 #include "halfback/study/acquisition.hpp"
@@ -16,57 +18,54 @@ namespace halfback::cli {
 namespace {
 
 struct PlanOptions {
-  std::string param = "hybrid", design = "regular", spacing = "own", output;
-  std::size_t budget = 10000;
-  bool full = false;
-  double max_theta = 90;
-  std::uint64_t seed = 1;
+  study::PlanSettings settings;
+  std::string output;
 };
 
 constexpr double kDeg = 180 / std::numbers::pi;
 
-study::GonioSetup setup_of(const PlanOptions& o) {
-  study::GonioSetup s;
-  const auto space = space_from_name(o.param);
-  if (!space || space->is_dirs())
-    throw UsageError(fmt::format("--param '{}': expected a parameterization: {}", o.param,
-                                 parameterization_names()));
-  s.space = *space;
-  const auto design = study::parse_design(o.design);
-  if (!design)
-    throw UsageError(fmt::format("--design '{}': expected regular or stratified", o.design));
-  s.design = *design;
-  const auto spacing = study::parse_spacing(o.spacing);
-  if (!spacing || *spacing == study::Spacing::learned)
-    throw UsageError(
-        fmt::format("--spacing '{}': expected own, angle or merl (a learned spacing "
-                    "needs the profiles of a study)",
-                    o.spacing));
-  s.spacing = *spacing;
-  s.isotropic = !o.full;
-  s.budget = o.budget;
-  s.max_theta_deg = o.max_theta;
-  s.seed = o.seed;
-  return s;
-}
-
+// The rows to measure: their index, the motors' angles in degrees and the directions.
 std::string plan_csv(const study::AcquisitionPlan& a) {
-  std::string out =
-      "row,light_theta_deg,light_phi_deg,detector_theta_deg,detector_phi_deg,"
-      "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n";
+  const std::vector<std::string> header{"row",
+                                        "light_theta_deg",
+                                        "light_phi_deg",
+                                        "detector_theta_deg",
+                                        "detector_phi_deg",
+                                        "wi_x",
+                                        "wi_y",
+                                        "wi_z",
+                                        "wo_x",
+                                        "wo_y",
+                                        "wo_z"};
+  std::vector<std::vector<double>> c(header.size(), std::vector<double>(a.measured.size()));
   for (std::size_t r = 0; r < a.measured.size(); ++r) {
     const study::GonioPosition& g = a.positions[r];
     const DirPair<double>& p = a.measured[r];
-    out += fmt::format(
-        "{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n", r,
-        g.light_theta * kDeg, g.light_phi * kDeg, g.detector_theta * kDeg, g.detector_phi * kDeg,
-        p.wi.x, p.wi.y, p.wi.z, p.wo.x, p.wo.y, p.wo.z);
+    const double row[] = {double(r),
+                          g.light_theta * kDeg,
+                          g.light_phi * kDeg,
+                          g.detector_theta * kDeg,
+                          g.detector_phi * kDeg,
+                          p.wi.x,
+                          p.wi.y,
+                          p.wi.z,
+                          p.wo.x,
+                          p.wo.y,
+                          p.wo.z};
+    for (std::size_t k = 0; k < header.size(); ++k) c[k][r] = row[k];
   }
-  return out;
+  const std::vector<std::span<const double>> columns(c.begin(), c.end());
+  return to_csv(header, columns);
 }
 
 int run_plan(const PlanOptions& o) {
-  const study::GonioSetup setup = setup_of(o);
+  const study::GonioSetup setup = [&] {
+    try {
+      return study::plan_setup(o.settings);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(fmt::format("--{}", e.what()));  // "--design 'x': expected ..."
+    }
+  }();
   const std::filesystem::path csv(o.output);
   if (csv.extension() != ".csv")
     throw UsageError(
@@ -98,24 +97,25 @@ Command register_plan(CLI::App& parent) {
   auto o = std::make_shared<PlanOptions>();
   CLI::App* app = parent.add_subcommand(
       "plan", "Measurement plan of a design for a real gonio-reflectometer (CSV + JSON sidecar)");
-  app->add_option("--param", o->param, "Parameterization whose cells are measured")
+  app->add_option("--param", o->settings.param, "Parameterization whose cells are measured")
       ->capture_default_str();
-  app->add_option("--design", o->design,
+  app->add_option("--design", o->settings.design,
                   "regular (cell centres) or stratified (a random point "
                   "in each cell)")
       ->capture_default_str();
-  app->add_option("--spacing", o->spacing,
+  app->add_option("--spacing", o->settings.spacing,
                   "Spacing of the cells: own, angle or merl "
                   "(docs/study.md, Designs)")
       ->capture_default_str();
-  app->add_option("--budget", o->budget, "Cells wanted inside the domain")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{10000000}))
+  app->add_option("--budget", o->settings.budget, "Cells wanted inside the domain")
+      ->check(CLI::Range(std::size_t{1}, study::kMaxSampleBudget))
       ->capture_default_str();
-  app->add_flag("--full", o->full, "Plan the full (4D) form, for anisotropic materials");
-  app->add_option("--max-theta", o->max_theta, "The instrument's reach: degrees from the normal")
+  app->add_flag("--full", o->settings.full, "Plan the full (4D) form, for anisotropic materials");
+  app->add_option("--max-theta", o->settings.max_theta,
+                  "The instrument's reach: degrees from the normal")
       ->check(CLI::Range(1.0, 90.0))
       ->capture_default_str();
-  app->add_option("--seed", o->seed, "Seed of the stratified design's points")
+  app->add_option("--seed", o->settings.seed, "Seed of the stratified design's points")
       ->capture_default_str();
   app->add_option("-o,--output", o->output, "Output: PLAN.csv (and PLAN.json beside it)")
       ->required()

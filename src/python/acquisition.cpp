@@ -20,33 +20,11 @@ namespace {
 
 constexpr double kDeg = 180 / std::numbers::pi;
 
-study::GonioSetup setup_of(const std::string& param, const std::string& design, std::size_t budget,
-                           const std::string& spacing, bool full, double max_theta,
-                           std::uint64_t seed) {
-  study::GonioSetup s;
-  const auto space = space_from_name(param);
-  if (!space || space->is_dirs())
-    throw py::value_error("param '" + param + "': expected one of " + parameterization_names());
-  const auto d = study::parse_design(design);
-  if (!d) throw py::value_error("design '" + design + "': expected regular or stratified");
-  const auto sp = study::parse_spacing(spacing);
-  if (!sp || *sp == study::Spacing::learned)
-    throw py::value_error("spacing '" + spacing + "': expected own, angle or merl");
-  if (budget < 1 || budget > 10000000) throw py::value_error("budget must be in [1, 10000000]");
-  if (!(max_theta >= 1 && max_theta <= 90)) throw py::value_error("max_theta must be in [1, 90]");
-  s.space = *space;
-  s.design = *d;
-  s.spacing = *sp;
-  s.budget = budget;
-  s.isotropic = !full;
-  s.max_theta_deg = max_theta;
-  s.seed = seed;
-  return s;
-}
-
 py::dict plan(const std::string& param, const std::string& design, std::size_t budget,
               const std::string& spacing, bool full, double max_theta, std::uint64_t seed) {
-  const study::GonioSetup s = setup_of(param, design, budget, spacing, full, max_theta, seed);
+  // plan_setup's std::invalid_argument reaches Python as a ValueError naming the setting.
+  const study::GonioSetup s =
+      study::plan_setup({param, design, spacing, budget, full, max_theta, seed});
   study::AcquisitionPlan a;
   {
     py::gil_scoped_release release;

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <type_traits>
 
+#include "halfback/core/parameterization.hpp"
 #include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 
@@ -23,30 +24,19 @@ constexpr double kRightAngle = std::numbers::pi / 2;
 // Configurations closer than this (radians, every angle) are the same measurement.
 constexpr double kSameAngle = 1e-9;
 
-double azimuth(const Vec3<double>& w) {
-  const double phi = std::atan2(w.y, w.x);
-  return phi < 0 ? phi + kFullTurn : phi;
-}
-
-double zenith(const Vec3<double>& w) {
-  return std::atan2(std::hypot(w.x, w.y), w.z);
-}
-
-Vec3<double> turned(const Vec3<double>& w, double angle) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  return {c * w.x - s * w.y, s * w.x + c * w.y, w.z};
-}
-
 // The pair turned about the normal so that the light's azimuth is 0 (the detector's, when the
 // light is at the normal).
 DirPair<double> light_at_azimuth_zero(const DirPair<double>& p) {
   const double r = std::hypot(p.wi.x, p.wi.y);
-  const double angle = -azimuth(r == 0 ? p.wo : p.wi);
-  DirPair<double> q{turned(p.wi, angle), turned(p.wo, angle)};
+  const Vec3<double>& turn = r == 0 ? p.wo : p.wi;  // the direction brought to azimuth 0
+  const double len = std::hypot(turn.x, turn.y);
+  if (len == 0) return p;                            // both at the normal
+  const double c = turn.x / len, s = -turn.y / len;  // the rotation by minus its azimuth
+  DirPair<double> q{detail::rotate_z(p.wi, c, s), detail::rotate_z(p.wo, c, s)};
   if (r > 0)
     q.wi = {r, 0, p.wi.z};  // exactly at azimuth 0, not a rounding away from it
   else
-    q.wo = {std::hypot(p.wo.x, p.wo.y), 0, p.wo.z};
+    q.wo = {len, 0, p.wo.z};
   return q;
 }
 
@@ -118,7 +108,39 @@ double path_travel(const std::vector<GonioPosition>& path) {
 }  // namespace
 
 GonioPosition position_of(const DirPair<double>& p) {
-  return {zenith(p.wi), azimuth(p.wi), zenith(p.wo), azimuth(p.wo)};
+  const Tuple4<double> q = Spherical::forward(p);  // (θi, φi, θo, φo), azimuths in [0, 2π)
+  return {q[0], q[1], q[2], q[3]};
+}
+
+GonioSetup plan_setup(const PlanSettings& o) {
+  GonioSetup s;
+  const auto space = space_from_name(o.param);
+  if (!space || space->is_dirs())
+    throw std::invalid_argument(fmt::format("param '{}': expected a parameterization: {}", o.param,
+                                            parameterization_names()));
+  const auto design = parse_design(o.design);
+  if (!design)
+    throw std::invalid_argument(
+        fmt::format("design '{}': expected regular or stratified", o.design));
+  const auto spacing = parse_spacing(o.spacing);
+  if (!spacing || *spacing == Spacing::learned)
+    throw std::invalid_argument(fmt::format(
+        "spacing '{}': expected own, angle or merl (a learned spacing needs the profiles of a "
+        "study)",
+        o.spacing));
+  if (o.budget < 1 || o.budget > kMaxSampleBudget)
+    throw std::invalid_argument(
+        fmt::format("budget {}: expected 1 to {}", o.budget, kMaxSampleBudget));
+  if (!(o.max_theta >= 1 && o.max_theta <= 90))
+    throw std::invalid_argument(fmt::format("max_theta {}: expected 1 to 90 degrees", o.max_theta));
+  s.space = *space;
+  s.design = *design;
+  s.spacing = *spacing;
+  s.budget = o.budget;
+  s.isotropic = !o.full;
+  s.max_theta_deg = o.max_theta;
+  s.seed = o.seed;
+  return s;
 }
 
 double travel(const GonioPosition& a, const GonioPosition& b) {
@@ -137,19 +159,21 @@ AcquisitionPlan acquisition_plan(const GonioSetup& setup) {
   // Each point's configuration, once: the first point of a configuration adds a row.
   std::map<std::array<long long, 4>, std::size_t> row_of_key;
   std::vector<DirPair<double>> rows;
-  std::vector<GonioPosition> cell_order;
+  std::vector<GonioPosition> positions, cell_order;  // of the rows; of the points
   out.row_of_point.resize(out.plan.points.size());
   for (std::size_t k = 0; k < out.plan.points.size(); ++k) {
     const DirPair<double>& pair = out.plan.points[k].pair;
     cell_order.push_back(position_of(pair));
     const DirPair<double> p =
         reciprocal_representative(iso ? light_at_azimuth_zero(pair) : pair, iso);
-    const auto [it, fresh] = row_of_key.try_emplace(key_of(position_of(p)), rows.size());
-    if (fresh) rows.push_back(p);
+    const GonioPosition g = position_of(p);
+    const auto [it, fresh] = row_of_key.try_emplace(key_of(g), rows.size());
+    if (fresh) {
+      rows.push_back(p);
+      positions.push_back(g);
+    }
     out.row_of_point[k] = it->second;
   }
-  std::vector<GonioPosition> positions(rows.size());
-  for (std::size_t r = 0; r < rows.size(); ++r) positions[r] = position_of(rows[r]);
   const std::vector<std::size_t> order = serpentine(positions, iso);
   std::vector<std::size_t> new_row(rows.size());
   for (std::size_t j = 0; j < order.size(); ++j) {
@@ -247,26 +271,17 @@ T field(const nlohmann::json& j, const char* key, const std::string& file) {
   }
 }
 
-GonioSetup setup_from(const nlohmann::json& j, const std::string& file, std::size_t max_budget) {
-  GonioSetup s;
-  const auto text = [&](const char* key) { return field<std::string>(j, key, file); };
-  const auto space = space_from_name(text("param"));
-  if (!space || space->is_dirs()) throw FormatError(file, "setup.param", "not a parameterization");
-  s.space = *space;
-  const auto design = parse_design(text("design"));
-  if (!design) throw FormatError(file, "setup.design", "not regular or stratified");
-  s.design = *design;
-  const auto spacing = parse_spacing(text("spacing"));
-  if (!spacing || *spacing == Spacing::learned)
-    throw FormatError(file, "setup.spacing", "not own, angle or merl");
-  s.spacing = *spacing;
-  s.isotropic = field<bool>(j, "isotropic", file);
-  s.budget = field<std::size_t>(j, "budget", file);
-  if (s.budget < 1 || s.budget > max_budget)
-    throw FormatError(file, "setup.budget", fmt::format("not in [1, {}]", max_budget));
-  s.seed = field<std::uint64_t>(j, "seed", file);
-  s.max_theta_deg = field<double>(j, "max_theta_deg", file);
-  return s;
+// The sidecar's "setup" as settings (plan_setup checks them).
+PlanSettings settings_from(const nlohmann::json& j, const std::string& file) {
+  PlanSettings o;
+  o.param = field<std::string>(j, "param", file);
+  o.design = field<std::string>(j, "design", file);
+  o.spacing = field<std::string>(j, "spacing", file);
+  o.full = !field<bool>(j, "isotropic", file);
+  o.budget = field<std::size_t>(j, "budget", file);
+  o.seed = field<std::uint64_t>(j, "seed", file);
+  o.max_theta = field<double>(j, "max_theta_deg", file);
+  return o;
 }
 
 AcquisitionPlan plan_of(const nlohmann::json& j, const std::string& file, std::size_t max_budget) {
@@ -276,10 +291,11 @@ AcquisitionPlan plan_of(const nlohmann::json& j, const std::string& file, std::s
     throw FormatError(file, "version", "a version this halfback does not read (1)");
   const auto setup = j.find("setup");
   if (setup == j.end() || !setup->is_object()) throw FormatError(file, "setup", "missing");
-  GonioSetup s;
   try {
-    s = setup_from(*setup, file, max_budget);
-    AcquisitionPlan a = acquisition_plan(s);
+    const PlanSettings settings = settings_from(*setup, file);
+    if (settings.budget > max_budget)
+      throw FormatError(file, "setup.budget", fmt::format("above {}", max_budget));
+    AcquisitionPlan a = acquisition_plan(plan_setup(settings));
     if (field<std::size_t>(j, "points", file) != a.plan.points.size() ||
         field<std::size_t>(j, "rows", file) != a.measured.size() ||
         field<std::vector<std::size_t>>(j, "row_of_point", file) != a.row_of_point)
@@ -287,7 +303,7 @@ AcquisitionPlan plan_of(const nlohmann::json& j, const std::string& file, std::s
                         "the setup, planned again, gives other points or rows (a plan of another "
                         "version of halfback, or edited)");
     return a;
-  } catch (const std::invalid_argument& e) {  // a budget of 0, a reach out of range
+  } catch (const std::invalid_argument& e) {  // plan_setup's: a bad name, budget or reach
     throw FormatError(file, "setup", e.what());
   }
 }

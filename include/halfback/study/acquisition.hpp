@@ -15,10 +15,25 @@
 #include <vector>
 
 #include "halfback/study/gonio.hpp"
+#include "halfback/study/study.hpp"
 
 namespace halfback::study {
 
-// An instrument's position, in radians.
+// A plan's settings as a user gives them (`halfback plan`, halfback.plan, a sidecar's "setup").
+struct PlanSettings {
+  std::string param = "hybrid", design = "regular", spacing = "own";
+  std::size_t budget = 10000;
+  bool full = false;  // the full (4D) form, for anisotropic materials
+  double max_theta = 90;
+  std::uint64_t seed = 1;
+};
+// The setup they describe. Throws std::invalid_argument naming the setting: a param that is no
+// parameterization, a design other than regular or stratified, a spacing other than own, angle
+// or merl (learned needs a study's profiles), a budget outside [1, kMaxSampleBudget], a reach
+// outside [1, 90] degrees.
+GonioSetup plan_setup(const PlanSettings& settings);
+
+// An instrument's position, in radians: the spherical coordinates (θi, φi, θo, φo) of the pair.
 struct GonioPosition {
   double light_theta = 0, light_phi = 0, detector_theta = 0, detector_phi = 0;
 };
@@ -63,7 +78,7 @@ AcquisitionPlan read_plan_sidecar(const std::filesystem::path& path);
 // The same from the sidecar's text (`source` names it in errors); a budget above `max_budget`
 // (planning it again is the planner's cost, not the reader's) is refused like a bad field.
 AcquisitionPlan parse_plan_sidecar(std::string_view text, const std::string& source,
-                                   std::size_t max_budget = 10000000);
+                                   std::size_t max_budget = kMaxSampleBudget);
 
 // The values measured at a plan's rows (row_values[r] at measured[r]; NaN where a row was not
 // measured), spread back to its points, reconstructed as the study does. Throws
