@@ -6,6 +6,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "colour_params.hpp"
+
 namespace halfback::models {
 
 namespace {
@@ -93,16 +95,13 @@ Rgb Lafortune::eval(const DirPair<double>& p) const {
 
 namespace {
 
+// The specular scale of every lobe: the published ones reach 1.7, so up to 10.
 std::vector<ModelParam> albedo_params() {
-  const double max = 10;  // a specular scale: the published ones reach 1.7
-  return {{"albedo", "specular scale (grey)", 0.05, 0, max},
-          defaults_to("albedo_r", "specular scale, red", "albedo", 0, max),
-          defaults_to("albedo_g", "specular scale, green", "albedo", 0, max),
-          defaults_to("albedo_b", "specular scale, blue", "albedo", 0, max)};
+  return detail::colour_params("albedo", "specular scale", 0.05, 10);
 }
 
 Rgb albedo_of(const ModelArgs& a) {
-  return {a["albedo_r"], a["albedo_g"], a["albedo_b"]};
+  return detail::colour(a, "albedo");
 }
 
 ModelInfo ward_info(bool duer) {
