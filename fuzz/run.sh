@@ -73,10 +73,7 @@ mkdir -p "$artifacts"
 status=0
 # Seeds of the plans' sidecars: small plans written by the planner itself, and broken ones.
 "$build/fuzz/make_plan_seeds" "$corpus/plan"
-# view_wire is built but not run here: its first CI-length run (2026-12-05) found an input that
-# keeps a connection past libFuzzer's 20 s timeout (artifact view_wire-timeout-*): to be fixed
-# (issue 35, class E) before it runs again.
-for target in merl rgl alta npy h5 envmap view plan; do
+for target in merl rgl alta npy h5 envmap view view_wire plan; do
   case "$target" in
     merl) max_len=4096 ;;     # full-size files are built inside the target
     rgl)  max_len=65536 ;;

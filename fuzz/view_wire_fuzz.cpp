@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
@@ -80,7 +81,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   send_pieces(fds[0], input);
   std::string answer;
   char buf[65536];
-  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) > 0;) answer.append(buf, std::size_t(n));
+  // Read to the end (a signal of libFuzzer's interrupting a read is no end: had the reading
+  // stopped there, the server would have dropped the connection only at its write deadline).
+  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) > 0 || (n < 0 && errno == EINTR);)
+    if (n > 0) answer.append(buf, std::size_t(n));
   serving.join();
   ::close(fds[0]);
   if (!begins_with_a_status(answer)) std::abort();

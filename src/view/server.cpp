@@ -129,12 +129,16 @@ int milliseconds_until(Clock::time_point t) {
 }
 
 // Whether `sock` has data (or an end) to read before `t` (a signal does not end the wait).
-bool readable_before(socket_t sock, Clock::time_point t) {
-  pollfd p{sock, POLLIN, 0};
+// Whether `sock` has `events` (POLLIN, POLLOUT) before `t`.
+bool ready_before(socket_t sock, short events, Clock::time_point t) {
+  pollfd p{sock, events, 0};
   int ready = 0;
   do ready = ::poll(&p, 1, milliseconds_until(t));
   while (ready < 0 && errno == EINTR);
   return ready > 0;
+}
+bool readable_before(socket_t sock, Clock::time_point t) {
+  return ready_before(sock, POLLIN, t);
 }
 
 // The numeric address and port of a socket's peer (`peer`) or its own end.
@@ -156,7 +160,9 @@ void socket_address(socket_t sock, bool peer, std::string& ip, int& port) {
 // until head_done()), every read ends at that deadline, however the bytes trickle: httplib's
 // own stream only bounds the wait of each read, which a client sending a line a second extends
 // forever. Past the deadline the stream swallows what httplib writes (its 400), and the server
-// answers 408 itself.
+// answers 408 itself. Likewise a response is written within kResponseWriteSeconds of its first
+// byte, without blocking on a full socket: a client that stops reading (or reads a byte now and
+// then) loses its connection instead of holding a worker in send() for ever.
 class ConnectionStream : public httplib::Stream {
  public:
   ConnectionStream(socket_t sock, std::chrono::microseconds read_timeout,
@@ -173,12 +179,13 @@ class ConnectionStream : public httplib::Stream {
   }
   void head_done() { in_head_ = false; }
   bool head_too_late() const { return too_late_; }
+  // The next write begins a response (its deadline starts then).
+  void response_done() { writing_ = false; }
 
   bool is_readable() const override { return offset_ < size_ || readable_before(sock_, limit()); }
   bool is_writable() const override {
-    pollfd p{sock_, POLLOUT, 0};
-    return ::poll(&p, 1,
-                  int(std::chrono::ceil<std::chrono::milliseconds>(write_timeout_).count())) > 0;
+    const Clock::time_point t = Clock::now() + write_timeout_;
+    return ready_before(sock_, POLLOUT, writing_ ? std::min(t, write_deadline_) : t);
   }
 
   ssize_t read(char* ptr, std::size_t size) override {
@@ -192,8 +199,17 @@ class ConnectionStream : public httplib::Stream {
 
   ssize_t write(const char* ptr, std::size_t size) override {
     if (too_late_) return ssize_t(size);  // the 408 replaces httplib's answer
+    if (!writing_) {
+      writing_ = true;
+      write_deadline_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(kResponseWriteSeconds));
+    }
     if (!is_writable()) return -1;
-    return ::send(sock_, ptr, size, MSG_NOSIGNAL);
+    // What the socket takes now (httplib writes the rest in further calls).
+    ssize_t n;
+    do n = ::send(sock_, ptr, size, MSG_NOSIGNAL | MSG_DONTWAIT);
+    while (n < 0 && errno == EINTR);
+    return n < 0 && errno == EAGAIN ? 0 : n;
   }
 
   void get_remote_ip_and_port(std::string& ip, int& port) const override {
@@ -228,8 +244,8 @@ class ConnectionStream : public httplib::Stream {
   std::chrono::microseconds read_timeout_, write_timeout_;
   std::array<char, 4096> buffer_{};
   std::size_t offset_ = 0, size_ = 0;
-  Clock::time_point head_deadline_{};
-  bool in_head_ = false, too_late_ = false;
+  Clock::time_point head_deadline_{}, write_deadline_{};
+  bool in_head_ = false, too_late_ = false, writing_ = false;
 };
 
 // Writes a whole response that closes the connection, with a JSON {"error": message} body (as the
@@ -343,6 +359,7 @@ class HttpServer : public httplib::Server {
       bool closed = false;
       ok = process_request(stream, k + 1 == keep_alive_max_count_, closed,
                            [&stream](httplib::Request&) { stream.head_done(); });
+      stream.response_done();
       if (stream.head_too_late()) {
         answer_and_close(sock, 408, "Request Timeout",
                          fmt::format("the request line and headers did not arrive within {} s",

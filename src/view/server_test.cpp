@@ -10,6 +10,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <stdexcept>
 #include <string>
@@ -196,6 +197,46 @@ TEST(ViewServer, ABurstOfConnectionsIsAnsweredAtOnce) {
     ::close(fd);
   }
   EXPECT_LT(seconds_since(t0), 0.9);
+}
+
+// A client that stops reading a large response loses its connection after the write timeout (5 s
+// without progress) or kResponseWriteSeconds after the response began, whatever the socket's own
+// options: on a socket pair (no SO_SNDTIMEO, as
+// the wire fuzzer serves), a send() of the whole response blocked the server's thread for as long
+// as the client did not read.
+TEST(ViewServer, AClientThatStopsReadingIsDropped) {
+  Api api(config());
+  Server server(api, 1);
+  const int port = server.bind("127.0.0.1", 0);
+  int fds[2];
+  ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, fds), 0);
+  std::atomic<bool> served{false};
+  std::thread serving([&] {
+    server.serve_connection(fds[1]);
+    served = true;
+  });
+  // Every form's slices of two BRDFs at n = 256: 8 forms × 2 × 3 channels × 256² floats.
+  const std::string request =
+      "GET /api/slices?token=" + kToken +
+      "&brdf=lambert&brdf=ggx:alpha=0.2&n=256 HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+      "\r\nConnection: close\r\n\r\n";
+  ASSERT_EQ(::write(fds[0], request.data(), request.size()), ssize_t(request.size()));
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!served && seconds_since(t0) < kResponseWriteSeconds + 3)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_TRUE(served) << "the server still writes to a client that stopped reading";
+  EXPECT_GT(seconds_since(t0), 1.0);  // the write timeout (5 s without progress), or the deadline
+  std::string answer;
+  char buf[65536];
+  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) > 0;) answer.append(buf, std::size_t(n));
+  serving.join();
+  ::close(fds[0]);
+  ASSERT_EQ(answer.rfind("HTTP/1.1 200 OK\r\n", 0), 0u) << answer.substr(0, 80);
+  const std::size_t at = answer.find("Content-Length: ");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t length = std::stoul(answer.substr(at + 16));
+  EXPECT_GT(length, std::size_t(4) << 20);
+  EXPECT_LT(answer.size() - answer.find("\r\n\r\n") - 4, length);  // cut short
 }
 
 // Two Host or two Origin headers on the wire are refused (httplib keeps both; the Api refuses).

@@ -14,6 +14,9 @@ namespace halfback::view {
 // waiting for it (the connection's opening, or the end of the previous response), however they
 // trickle in: after it, 408 and the connection closed;
 inline constexpr double kRequestHeadSeconds = 4;
+// a response is written within kResponseWriteSeconds of its first byte (the largest, 12 MB of
+// slices, takes milliseconds on loopback): a client that reads slower is dropped;
+inline constexpr double kResponseWriteSeconds = 10;
 // one client address holds at most kConnectionsPerClient connections at once: another is
 // answered 503 and closed at once.
 inline constexpr int kConnectionsPerClient = 32;
