@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "halfback/core/space.hpp"
+#include "halfback/formats/adaptive_param.hpp"
 #include "halfback/loader/load.hpp"
 
 namespace halfback::cli {
@@ -182,11 +183,42 @@ CLI::Validator non_negative_integer() {
                         "INT >= 0", "non-negative integer");
 }
 
+namespace {
+// ", or a family's member: dupuy-jakob:BRDF" when families are registered.
+std::string family_hint() {
+  std::string hint;
+  for (const std::string& f : parameterization_families())
+    (hint += hint.empty() ? ", or " : ", ") += f;
+  return hint;
+}
+// The space of a name, or the message saying why there is none (a family's member whose argument
+// is wrong: the family's own message).
+std::optional<Space> space_or_message(const std::string& name, std::string& message) {
+  try {
+    const auto s = space_from_name(name);
+    if (s && !s->is_dirs() && is_per_material_placeholder(s->param())) {
+      message = fmt::format(
+          "'{}' is each BRDF's own warp, for `halfback study --params` only: "
+          "here, name the BRDF (dupuy-jakob:BRDF)",
+          name);
+      return std::nullopt;
+    }
+    return s;
+  } catch (const std::exception& e) {
+    message = fmt::format("'{}': {}", name, e.what());
+    return std::nullopt;
+  }
+}
+}  // namespace
+
 CLI::Validator space_name_validator() {
   return CLI::Validator(
       [](std::string& name) -> std::string {
-        if (space_from_name(name)) return {};
-        return fmt::format("unknown coordinates '{}' (expected one of: {})", name, space_names());
+        std::string message;
+        if (space_or_message(name, message)) return {};
+        if (!message.empty()) return message;
+        return fmt::format("unknown coordinates '{}' (expected one of: {}{})", name, space_names(),
+                           family_hint());
       },
       "");
 }
@@ -194,10 +226,12 @@ CLI::Validator space_name_validator() {
 CLI::Validator parameterization_validator() {
   return CLI::Validator(
       [](std::string& name) -> std::string {
-        const auto s = space_from_name(name);
+        std::string message;
+        const auto s = space_or_message(name, message);
         if (s && !s->is_dirs()) return {};
-        return fmt::format("unknown parameterization '{}' (expected one of: {})", name,
-                           parameterization_names(", "));
+        if (!message.empty()) return message;
+        return fmt::format("unknown parameterization '{}' (expected one of: {}{})", name,
+                           parameterization_names(", "), family_hint());
       },
       "");
 }

@@ -12,6 +12,7 @@
 
 #include "command.hpp"
 #include "halfback/core/simd.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/util/signal_cleanup.hpp"
 
 #ifndef HALFBACK_VERSION
@@ -93,6 +94,7 @@ std::string version_text() {
 }
 
 int run(int argc, char** argv) {
+  register_brdf_parameterization_families();
   CLI::App app(kDescription, "halfback");
   app.set_version_flag("--version", version_text,
                        "Print the version and the SIMD instruction set in use, and exit");

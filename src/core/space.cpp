@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <map>
 #include <mutex>
 
 namespace halfback {
@@ -45,6 +46,16 @@ void ParamDescriptor::forward_rows(bool isotropic, const DirPair<double>* pairs,
       std::copy(q.begin(), q.end(), coords + 4 * i);
     }
   }
+}
+
+DirPair<double> mirror_pair(const DirPair<double>& p) {
+  const double hx = p.wi.x + p.wo.x, hy = p.wi.y + p.wo.y;
+  const double a = (hx == 0 && hy == 0) ? 0 : std::atan2(hy, hx);
+  const double c = std::cos(2 * a), s = std::sin(2 * a);
+  auto m = [&](const Vec3<double>& v) {
+    return Vec3<double>{c * v.x + s * v.y, s * v.x - c * v.y, v.z};
+  };
+  return {m(p.wi), m(p.wo)};
 }
 
 void wrap_azimuth_rows(std::span<const Axis> axes, double* coords, std::size_t m) {
@@ -152,12 +163,65 @@ std::string_view name_of(Space space) {
   return "unknown";
 }
 
-std::optional<Space> space_from_name(std::string_view name) {
-  if (name == "dirs") return Space::dirs;
+namespace {
+
+struct Family {
+  std::string usage;
+  ParamFactory make;
+};
+
+struct Families {
+  std::mutex mutex;  // also serializes the building of members (one registration per name)
+  std::map<std::string, Family, std::less<>> by_prefix;
+};
+
+Families& families() {
+  static Families f;
+  return f;
+}
+
+std::optional<Space> registered_space(std::string_view name) {
   const std::vector<Space> all = parameterizations();
   for (auto it = all.rbegin(); it != all.rend(); ++it)  // the newest of a registered name
     if (it->param().name() == name) return *it;
   return std::nullopt;
+}
+
+}  // namespace
+
+void register_parameterization_family(std::string prefix, std::string usage, ParamFactory make) {
+  if (prefix.empty() || prefix.find(':') != std::string::npos || !make)
+    throw std::invalid_argument(
+        "register_parameterization_family: a prefix without ':' and a "
+        "factory are needed");
+  Families& f = families();
+  std::lock_guard lock(f.mutex);
+  f.by_prefix[std::move(prefix)] = Family{std::move(usage), std::move(make)};
+}
+
+std::vector<std::string> parameterization_families() {
+  Families& f = families();
+  std::lock_guard lock(f.mutex);
+  std::vector<std::string> out;
+  for (const auto& [prefix, family] : f.by_prefix) out.push_back(prefix + ":" + family.usage);
+  return out;
+}
+
+std::optional<Space> space_from_name(std::string_view name) {
+  if (name == "dirs") return Space::dirs;
+  if (auto s = registered_space(name)) return s;
+  const std::size_t colon = name.find(':');
+  if (colon == std::string_view::npos) return std::nullopt;
+  Families& f = families();
+  std::lock_guard lock(f.mutex);
+  const auto it = f.by_prefix.find(name.substr(0, colon));
+  if (it == f.by_prefix.end()) return std::nullopt;
+  if (auto s = registered_space(name)) return s;  // built by another thread meanwhile
+  std::shared_ptr<const ParamDescriptor> member = it->second.make(name.substr(colon + 1));
+  if (!member || member->name() != name)
+    throw std::logic_error("the parameterization family '" + it->first +
+                           "' built a member not named '" + std::string(name) + "'");
+  return register_parameterization(std::move(member));
 }
 
 namespace {

@@ -25,6 +25,20 @@ std::string relative_azimuth_label(Space space) {
   return std::string(space.param().axes(true)[2].label);
 }
 
+double third_coordinate_at(Space space, double radians) {
+  const Axis& a = space.param().axes(true)[2];
+  if (a.kind == AxisKind::azimuth) return radians;
+  return a.lo + radians / (2 * std::numbers::pi) * (a.hi - a.lo);
+}
+
+std::string third_coordinate_title(Space space, double degrees) {
+  const Axis& a = space.param().axes(true)[2];
+  if (a.kind == AxisKind::azimuth)
+    return fmt::format("{} = {:g}°", relative_azimuth_label(space), degrees);
+  const double turn = std::fmod(std::fmod(degrees, 360.0) + 360.0, 360.0) / 360.0;
+  return fmt::format("{} = {:g}", a.label, a.lo + turn * (a.hi - a.lo));
+}
+
 std::string format_coordinate(const CoordinateInfo& c, double value) {
   if (c.angle) return fmt::format("{}°", std::lround(value * 180.0 / std::numbers::pi));
   const std::string s = fmt::format("{:.2f}", value);

@@ -241,7 +241,8 @@ void draw_marker_cross(Scene& scene, Point p) {
 
 // The colour key of a parameterization: the square of (first, second) coordinate values,
 // hatched where no pair has them (outside the isotropic domain at relative azimuth 90°, the
-// largest slice: docs/figures.md).
+// largest slice: docs/figures.md; for a third coordinate that is no azimuth, at any of 32 values
+// across its range).
 void draw_key(Scene& scene, Space space, const Rect& rect, double ppp) {
   const auto coords = iso_coordinates(space);
   PanelMap map{rect, 0, coords[0].max, 0, coords[1].max};
@@ -250,8 +251,14 @@ void draw_key(Scene& scene, Space space, const Rect& rect, double ppp) {
   a.valid.assign(g.size(), 0);
   b.valid.assign(g.size(), 0);
   const ParamDescriptor& param = space.param();
+  const Axis& third = param.axes(true)[2];
   auto inside = [&](double x, double y) {
-    return bool(param.inverse_iso(Tuple3<double>{x, y, 0.5 * kPi}).in_domain);
+    if (third.kind == AxisKind::azimuth)
+      return bool(param.inverse_iso(Tuple3<double>{x, y, 0.5 * kPi}).in_domain);
+    for (int k = 0; k < 32; ++k)
+      if (param.inverse_iso({x, y, third.lo + (k + 0.5) / 32 * (third.hi - third.lo)}).in_domain)
+        return true;
+    return false;
   };
   for (std::size_t j = 0; j < g.ny; ++j)
     for (std::size_t i = 0; i < g.nx; ++i) {

@@ -215,7 +215,7 @@ std::vector<SliceFigure::Panel> sample_panels(const SliceOptions& o, const Slice
                        coords[0].max,
                        0,
                        coords[1].max};
-      p.sample = sample_slice(p.param, core_azimuth(p.azimuth_deg),
+      p.sample = sample_slice(p.param, third_coordinate_at(p.param, core_azimuth(p.azimuth_deg)),
                               p.map.raster_grid(o.pixels_per_point), o.threads);
       panels.push_back(std::move(p));
     }
@@ -324,9 +324,9 @@ void draw_panel_isolines(Scene& sc, const SliceOptions& o, const SliceFigure& fi
 
 // The domain boundary, exactly (bisection on valid_iso).
 void draw_domain_boundary(Scene& sc, const SliceFigure::Panel& p) {
-  const double az = std::fmod(std::fmod(p.azimuth_deg, 360.0) + 360.0, 360.0) * kDeg;
+  const double third = third_coordinate_at(p.param, core_azimuth(p.azimuth_deg));
   auto inside = [&](double x, double y) {
-    return bool(p.param.param().inverse_iso({x, y, az < 2 * kPi ? az : 0.0}).in_domain);
+    return bool(p.param.param().inverse_iso({x, y, third}).in_domain);
   };
   draw_polylines(sc, p.map, region_boundary(p.sample.grid, p.sample.valid, inside),
                  Stroke{kBlack, 0.8});
@@ -343,8 +343,7 @@ void draw_panel_labels(Scene& sc, const SliceFigure::Panel& p, const SliceLayout
   for (double t : ay.ticks) ay.labels.push_back(format_coordinate(coords[1], t));
   draw_axes(sc, p.map, ax, ay, true, first_column, fs);
   sc.text({p.map.rect.x + 0.5 * l.panel, p.map.rect.y - 5},
-          fmt::format("{} = {:g}°", relative_azimuth_label(p.param), p.azimuth_deg), 9.5,
-          HAlign::centre, VAlign::bottom);
+          third_coordinate_title(p.param, p.azimuth_deg), 9.5, HAlign::centre, VAlign::bottom);
   if (first_column)
     sc.text({14, p.map.rect.y + 0.5 * l.panel}, std::string(name_of(p.param)), 11, HAlign::centre,
             VAlign::middle, kBlack, 90, true);

@@ -247,8 +247,8 @@ double table_at(const std::vector<double>& t, double u) {
   return t[i] + (x - double(i)) * (t[i + 1] - t[i]);
 }
 
-Geometry geometry_fields(const Brdf& brdf, const RglExportOptions& o, const std::string& desc) {
-  const RecoveredNdf ndf = recover_ndf(brdf, o.vndf_resolution, o.threads);
+Geometry geometry_fields(const RecoveredNdf& ndf, const RglExportOptions& o,
+                         const std::string& desc) {
   Geometry g;
   g.theta_i = incidence_grid(ndf.sigma, o.theta_i);
   g.ndf = rounded_to_float(ndf.ndf);
@@ -268,6 +268,21 @@ Geometry geometry_fields(const Brdf& brdf, const RglExportOptions& o, const std:
   g.fields.push_back(
       float_field("vndf", {1, g.theta_i.size(), n, n}, vndf_tables(ndf.ndf, g.theta_i)));
   return g;
+}
+
+// The material of geometry `g` with luminance and RGB tables of res × res ones: its warps are
+// the file's, its values the Jacobian factor alone.
+std::shared_ptr<const RglBrdf> geometry_material(const Geometry& g, std::size_t res,
+                                                 const std::string& label) {
+  const std::size_t slices = g.theta_i.size();
+  std::vector<TensorFieldData> fields = g.fields;
+  fields.push_back(float_field("luminance", {1, slices, res, res},
+                               std::vector<double>(slices * res * res, 1.0)));
+  fields.push_back(float_field("rgb", {1, slices, 3, res, res},
+                               std::vector<double>(slices * 3 * res * res, 1.0)));
+  fields.push_back({"jacobian", TensorDtype::uint8, {1}, {std::byte{1}}});
+  return std::make_shared<const RglBrdf>(parse_tensor_file(serialize_tensor_file(fields), label),
+                                         label, RglOptions{.clamp_negative = false});
 }
 
 // ρ cos θo · 4σ(ωi)/D(m) at the sample nodes of one incidence slice, through the VNDF warp of
@@ -352,6 +367,27 @@ std::vector<double> spectra_of_rgb(const std::vector<double>& rgb, std::size_t s
 
 }  // namespace
 
+std::shared_ptr<const RglBrdf> rgl_warp_material(const Brdf& brdf, const RglWarpOptions& o) {
+  if (!brdf.isotropic() && !o.allow_anisotropic)
+    throw std::invalid_argument(brdf.name() +
+                                " is anisotropic: the warp of its NDF is isotropic (one φi slice)");
+  if (!(o.ndf_floor >= 0 && o.ndf_floor < 1))
+    throw std::invalid_argument(fmt::format("ndf floor {}: must be in [0, 1)", o.ndf_floor));
+  RglExportOptions e;
+  e.theta_i = o.theta_i;
+  e.vndf_resolution = o.vndf_resolution;
+  e.threads = o.threads;
+  check_option("theta_i", e.theta_i, 2, 90);
+  check_option("vndf_resolution", e.vndf_resolution, 2, 1024);
+  RecoveredNdf ndf = recover_ndf(brdf, e.vndf_resolution, e.threads);
+  const double floor = o.ndf_floor * *std::max_element(ndf.ndf.begin(), ndf.ndf.end());
+  for (double& d : ndf.ndf) d = std::max(d, floor);
+  for (std::size_t k = 0; k < ndf.ndf.size(); ++k)
+    ndf.sigma[k] = projected_area(ndf.ndf, u_to_theta(node_u(k, ndf.ndf.size())));
+  const Geometry g = geometry_fields(ndf, e, brdf.name() + ": the VNDF warp of its NDF");
+  return geometry_material(g, 2, brdf.name());
+}
+
 std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions& o) {
   if (!brdf.isotropic())
     throw std::invalid_argument(brdf.name() +
@@ -370,23 +406,16 @@ std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions
                         brdf.description(),
                         o.variant == RglVariant::rgb ? "" : "; spectra upsampled from RGB")
           : o.description;
-  Geometry g = geometry_fields(brdf, o, desc);
+  Geometry g = geometry_fields(recover_ndf(brdf, o.vndf_resolution, o.threads), o, desc);
 
   const auto res = static_cast<std::size_t>(o.resolution);
   const std::size_t slices = g.theta_i.size();
-  std::vector<TensorFieldData> probe = g.fields;
-  probe.push_back(float_field("luminance", {1, slices, res, res},
-                              std::vector<double>(slices * res * res, 1.0)));
-  probe.push_back(float_field("rgb", {1, slices, 3, res, res},
-                              std::vector<double>(slices * 3 * res * res, 1.0)));
+  const std::shared_ptr<const RglBrdf> warp = geometry_material(g, res, "export");
   TensorFieldData jacobian{"jacobian", TensorDtype::uint8, {1}, {std::byte{1}}};
-  probe.push_back(jacobian);
-  const RglBrdf warp(parse_tensor_file(serialize_tensor_file(probe), "export"), "export",
-                     RglOptions{.clamp_negative = false});
 
   std::vector<double> rgb(slices * 3 * res * res), luminance(slices * res * res);
   for (std::size_t s = 0; s < slices; ++s) {
-    tabulate_slice(brdf, warp, g, s, res, o.threads, rgb.data() + s * 3 * res * res,
+    tabulate_slice(brdf, *warp, g, s, res, o.threads, rgb.data() + s * 3 * res * res,
                    luminance.data() + s * res * res);
     if (o.progress) o.progress(int(s + 1), int(slices));
   }

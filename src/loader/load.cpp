@@ -10,6 +10,8 @@
 
 #include "halfback/brdf/registry.hpp"
 #include "halfback/brdf/test_functions.hpp"
+#include "halfback/core/space.hpp"
+#include "halfback/formats/adaptive_param.hpp"
 #include "halfback/formats/alta.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/nbrdf.hpp"
@@ -247,4 +249,16 @@ BrdfPtr load_one(std::string_view spec) {
 }
 
 }  // namespace
+void register_brdf_parameterization_families() {
+  register_parameterization_family("dupuy-jakob", "BRDF", [](std::string_view spec) {
+    if (spec.empty())
+      throw std::invalid_argument(
+          "dupuy-jakob: a BRDF is needed after the colon (dupuy-jakob:BRDF, e.g. "
+          "dupuy-jakob:ggx:alpha=0.2 or dupuy-jakob:FILE.bsdf)");
+    if ("dupuy-jakob:" + std::string(spec) == kPerMaterialWarp) return per_material_placeholder();
+    const BrdfPtr brdf = load_brdf(spec);
+    return adaptive_parameterization(*brdf, "dupuy-jakob:" + std::string(spec));
+  });
+}
+
 }  // namespace halfback

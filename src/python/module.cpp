@@ -677,6 +677,7 @@ names, as before.)doc");
 PYBIND11_MODULE(_core, m) {
   m.attr("__version__") = HALFBACK_VERSION;
   m.doc() = "halfback: exact, fast changes of variables between BRDF parameterizations";
+  halfback::register_brdf_parameterization_families();
   bind_conversions(m);
   bind_brdf_class(m);
   bind_hemisphere(m);

@@ -156,14 +156,14 @@ class PyParam final : public ParamDescriptor {
     return forward(DirPair<double>{s.pair.wo, s.pair.wi});
   }
   Tuple4<double> mirror(const Tuple4<double>& q) const override {
-    return forward(mirrored(inverse(q).pair));
+    return forward(mirror_pair(inverse(q).pair));
   }
   Tuple3<double> reciprocal_iso(const Tuple3<double>& q) const override {
     const Solved<double> s = inverse_iso(q);
     return forward_iso(DirPair<double>{s.pair.wo, s.pair.wi});
   }
   Tuple3<double> mirror_iso(const Tuple3<double>& q) const override {
-    return forward_iso(mirrored(inverse_iso(q).pair));
+    return forward_iso(mirror_pair(inverse_iso(q).pair));
   }
 
  private:
@@ -321,17 +321,6 @@ class PyParam final : public ParamDescriptor {
     inverse_rows(iso, q, 1, &s.pair, &ok);
     s.in_domain = ok != 0;
     return s;
-  }
-
-  // Across the vertical plane of h̄ (the xz-plane when h̄ = 0).
-  static DirPair<double> mirrored(const DirPair<double>& p) {
-    const double hx = p.wi.x + p.wo.x, hy = p.wi.y + p.wo.y;
-    const double a = (hx == 0 && hy == 0) ? 0 : std::atan2(hy, hx);
-    const double c = std::cos(2 * a), s = std::sin(2 * a);
-    auto m = [&](const Vec3<double>& v) {
-      return Vec3<double>{c * v.x + s * v.y, s * v.x - c * v.y, v.z};
-    };
-    return {m(p.wi), m(p.wo)};
   }
 
   UserSpec s_;

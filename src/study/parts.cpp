@@ -15,6 +15,7 @@
 #include "halfback/study/metric_tables.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/csv.hpp"
+#include "material_spaces.hpp"
 
 namespace halfback::study {
 
@@ -255,7 +256,12 @@ bool wants_learned(const StudyConfig& c) {
 }
 
 LabeledProfile study_profile(const Brdf& brdf, const std::string& label, const StudyConfig& c) {
-  return {label, design_profile(brdf, c.params, c.profile_grid, c.space)};
+  // Computed in the BRDF's spaces, named by the parameterizations (a per-material warp's profile
+  // is kept under its placeholder, as its rows are).
+  DesignProfile p =
+      design_profile(brdf, material_spaces(brdf, label, c.params), c.profile_grid, c.space);
+  for (std::size_t k = 0; k < p.spaces.size(); ++k) p.spaces[k].space = c.params[k];
+  return {label, std::move(p)};
 }
 
 // The label, then per space its name and one line of numbers per axis.

@@ -15,6 +15,7 @@
 #include "halfback/render/sampling_metric.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metric_tables.hpp"
+#include "material_spaces.hpp"
 
 namespace halfback::study {
 
@@ -133,27 +134,31 @@ struct GonioRun {
   bool copy_of_own = false;
 };
 
-std::vector<GonioRun> gonio_runs(Space s, bool iso, const StudyConfig& config) {
+// s names the parameterization (config.params), w is the space worked in (material_spaces).
+std::vector<GonioRun> gonio_runs(Space s, Space w, bool iso, const StudyConfig& config) {
   const auto& budgets = iso ? config.budgets : config.budgets_4d;
   const auto learned = std::find_if(config.learned.begin(), config.learned.end(),
-                                    [&](const LearnedWarps& w) { return w.space == s; });
+                                    [&](const LearnedWarps& l) { return l.space == s; });
   const bool own = std::find(config.spacings.begin(), config.spacings.end(), Spacing::own) !=
                    config.spacings.end();
   std::vector<GonioRun> runs;
   auto add = [&](Spacing spacing, Design d) {
     if (spacing == Spacing::learned && learned == config.learned.end()) return;
-    const bool copy = own && spacing != Spacing::own && same_as_own(s, iso, spacing);
+    const bool copy = own && spacing != Spacing::own && same_as_own(w, iso, spacing);
     for (std::size_t budget : budgets) {
       GonioRun run;
       run.copy_of_own = copy;
-      run.setup.space = s;
+      run.setup.space = w;
       run.setup.isotropic = iso;
       run.setup.design = d;
       run.setup.budget = budget;
       run.setup.seed = config.seed;
       run.setup.max_theta_deg = config.max_theta_deg;
       run.setup.spacing = spacing;
-      if (spacing == Spacing::learned) run.setup.learned = *learned;
+      if (spacing == Spacing::learned) {
+        run.setup.learned = *learned;
+        run.setup.learned->space = w;  // learned under the name, applied in the BRDF's own space
+      }
       runs.push_back(std::move(run));
       if (copy) break;  // one marker copies every budget
     }
@@ -168,8 +173,10 @@ std::vector<GonioRun> gonio_runs(Space s, bool iso, const StudyConfig& config) {
 // Metric 5: the tabulated sampler in each parameterization's chart at each table size, measured
 // once per chart (parameterizations that share a chart share the sampler: their rows copy it),
 // against the cosine and the BRDF's own sampler.
+// `work`: the spaces the samplers are built in (material_spaces), the rows named by config.params.
 std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
-                                                             const StudyConfig& config) {
+                                                             const StudyConfig& config,
+                                                             std::span<const Space> work) {
   const render::SamplingMetricOptions o{.samples = config.sampler_samples, .seed = config.seed};
   const render::SamplingMeasure cosine =
       render::measure_sampling(brdf, *render::with_cosine_sampling(brdf), o);
@@ -177,8 +184,9 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
   if (brdf.has_importance_sampling()) own = render::measure_sampling(brdf, brdf, o);
   std::map<std::pair<std::string, std::size_t>, SamplingPoint> by_chart;
   std::vector<std::pair<Space, SamplingPoint>> rows;
-  for (const Space space : config.params)
+  for (std::size_t k = 0; k < work.size(); ++k)
     for (const std::size_t kib : config.sampler_kib) {
+      const Space space = work[k];
       const std::string chart(space.param().sampler_chart().name);
       auto it = by_chart.find({chart, kib});
       if (it == by_chart.end()) {
@@ -194,7 +202,7 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
                                         own ? render::relative_efficiency(m, *own) : 0})
                  .first;
       }
-      rows.emplace_back(space, it->second);
+      rows.emplace_back(config.params[k], it->second);
     }
   return rows;
 }
@@ -227,13 +235,14 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
       throw std::logic_error("study: no table " + std::string(name));
     }
   };
-  auto study_in = [&](Space s) {
+  // Rows are named by s, the work done in w (s but for the per-material warp: material_spaces).
+  auto study_in = [&](Space s, Space w) {
     Task t;
     t.space = s;
-    const IsoSamples x = sample_isotropic(brdf, s, config.grid, config.space);
+    const IsoSamples x = sample_isotropic(brdf, w, config.grid, config.space);
     const bool iso = brdf.isotropic();
     std::optional<FullSamples> f;
-    if (!iso) f = sample_full(brdf, s, config.full_grid, config.space);
+    if (!iso) f = sample_full(brdf, w, config.full_grid, config.space);
     add_azimuthal(t.table("azimuthal"), s, azimuthal_error(x), 3);
     if (f) add_azimuthal(t.table("azimuthal"), s, azimuthal_error(*f), 4);
     MetricTable& separability = t.table("separability");
@@ -242,7 +251,7 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
     if (f) add_separability(separability, s, config.ranks, separability_4d(*f, config.ranks), 4);
     if (gonio) {
       std::vector<GonioPoint> points;
-      for (const GonioRun& run : gonio_runs(s, iso, config)) {
+      for (const GonioRun& run : gonio_runs(s, w, iso, config)) {
         if (run.copy_of_own) {  // the same cells as own: the same numbers
           for (std::size_t k = 0, own = points.size(); k < own; ++k)
             if (points[k].spacing == Spacing::own && points[k].design == run.setup.design)
@@ -262,9 +271,10 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
     say(fmt::format("{} {}", gonio ? "gonio" : "metrics", name_of(s)));
     return t;
   };
+  const std::vector<Space> work = material_spaces(brdf, label, config.params);
   std::vector<Task> done(config.params.size());
   parallel_for(config.params.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) done[k] = study_in(config.params[k]);
+    for (std::size_t k = begin; k < end; ++k) done[k] = study_in(config.params[k], work[k]);
   });
 
   if (gonio && !config.environments.empty()) {
@@ -294,7 +304,7 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
     }
   }
   if (!config.sampler_kib.empty()) {
-    for (const auto& [space, point] : sampling_metric(brdf, config))
+    for (const auto& [space, point] : sampling_metric(brdf, config, work))
       for (Task& t : done)
         if (t.space == space) add_sampling(t.table("sampling"), space, point);
     say("sampling");

@@ -22,6 +22,7 @@
 #include <map>
 #include <numbers>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -254,18 +255,20 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
     std::string message;
   };
   const std::string hint = "Run 'halfback convert --help' for more information.\n";
+  // The parameterizations with a parameter, after the others (the CLI registers the family).
+  const std::string kFamilies = ", or dupuy-jakob:BRDF";
   const Case cases[] = {
       {{"convert", "--from", "hybird", "--to", "dirs"},
        "halfback convert: error: --from: unknown coordinates 'hybird' (expected one of: " +
-           space_names() + ")\n" + hint},
+           space_names() + kFamilies + ")\n" + hint},
       {{"render", "--brdf", "lambert", "--sampling-param", "polar", "-o", "never.png"},
        "halfback render: error: --sampling-param: unknown parameterization 'polar' (expected one "
        "of: " +
-           parameterization_names(", ") +
+           parameterization_names(", ") + kFamilies +
            ")\nRun 'halfback render --help' for more information.\n"},
       {{"convert", "--from", "dirs", "--to", "polar"},
        "halfback convert: error: --to: unknown coordinates 'polar' (expected one of: " +
-           space_names() + ")\n" + hint},
+           space_names() + kFamilies + ")\n" + hint},
       {{"convert", "--from", "dirs"}, "halfback convert: error: --to is required\n" + hint},
       {{"convert", "--from", "dirs", "--to", "hybrid", "--bogus"},
        "halfback convert: error: The following argument was not expected: --bogus\n" + hint},
@@ -567,10 +570,10 @@ TEST_F(CliTest, JacobianColumnMatchesTheLibraryAndTheSphericalFormula) {
 TEST_F(CliTest, OutOfDomainTuplesAreValidZeroRows) {
   const std::string in =
       "hbar,phi_h,k,phi_k\n"
-      "0.3,0,0.3,0\n"   // valid
-      "0.9,0,0.9,0\n"   // outside the domain
-      "0.3,1e9,0.3,0\n" // an azimuth beyond 65536 rad (7 is 7 − 2π: periodic)
-      "0.3,1,0.2,2\n";  // valid
+      "0.3,0,0.3,0\n"    // valid
+      "0.9,0,0.9,0\n"    // outside the domain
+      "0.3,1e9,0.3,0\n"  // an azimuth beyond 65536 rad (7 is 7 − 2π: periodic)
+      "0.3,1,0.2,2\n";   // valid
   const Result r = run({"convert", "--from", "hybrid", "--to", "dirs", "--jacobian"}, in);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err, "");  // not an error, not a warning
@@ -699,7 +702,7 @@ TEST_F(CliTest, PlanWritesPositionsAndItsSidecar) {
   ASSERT_GT(t.rows(), 100u);
   EXPECT_EQ(t.header[1], "light_theta_deg");
   for (std::size_t k = 0; k < t.rows(); ++k) {
-    EXPECT_EQ(t.columns[2][k], 0) << k;  // the light at azimuth 0: isotropy
+    EXPECT_EQ(t.columns[2][k], 0) << k;                       // the light at azimuth 0: isotropy
     EXPECT_LE(t.columns[1][k], t.columns[3][k] + 1e-7) << k;  // reciprocity: the lower light
     const double z = t.columns[7][k], theta = std::acos(z) * 180 / std::numbers::pi;
     EXPECT_NEAR(theta, t.columns[1][k], 1e-6) << k;
@@ -710,12 +713,12 @@ TEST_F(CliTest, PlanWritesPositionsAndItsSidecar) {
       << json.substr(0, 600);
   EXPECT_NE(json.find("\"row_of_point\":["), std::string::npos);
   EXPECT_NE(r.err.find("fewer by reciprocity"), std::string::npos) << r.err;
-  for (const auto& args : std::vector<std::vector<std::string>>{
-           {"plan", "--param", "dirs", "-o", "q.csv"},
-           {"plan", "--design", "sobol", "-o", "q.csv"},
-           {"plan", "--spacing", "learned", "-o", "q.csv"},
-           {"plan", "--max-theta", "0", "-o", "q.csv"},
-           {"plan", "-o", "q.txt"}}) {
+  for (const auto& args :
+       std::vector<std::vector<std::string>>{{"plan", "--param", "dirs", "-o", "q.csv"},
+                                             {"plan", "--design", "sobol", "-o", "q.csv"},
+                                             {"plan", "--spacing", "learned", "-o", "q.csv"},
+                                             {"plan", "--max-theta", "0", "-o", "q.csv"},
+                                             {"plan", "-o", "q.txt"}}) {
     r = run(args);
     EXPECT_EQ(r.status, 2) << args[1] << ": " << r.err;
   }
@@ -740,7 +743,8 @@ TEST_F(CliTest, ReconstructFromAPlansMeasurements) {
   r = run({"reconstruct", "--plan", "p.json", "--measurements", "lab.csv", "-o", "m.binary"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("rows measured"), std::string::npos) << r.err;
-  r = run({"eval", "--brdf", "m.binary"}, std::string(kDirsHeader) + "0.6,0,0.8,-0.3,0.2,0.9327379\n");
+  r = run({"eval", "--brdf", "m.binary"},
+          std::string(kDirsHeader) + "0.6,0,0.8,-0.3,0.2,0.9327379\n");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NEAR(std::stod(r.out.substr(r.out.find('\n') + 1)), rho, 1e-6) << r.out;
 
@@ -1739,6 +1743,54 @@ TEST_F(CliTest, StudyParamsChooseTheColumns) {
   r = run({"study", "--params", "hybrid,nope", "lambert"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("'nope' is not a parameterization"), std::string::npos) << r.err;
+}
+
+// Dupuy & Jakob's parameterization with a parameter: converted by name both ways (the ordered
+// pair back), refused with the family's message when its BRDF names nothing, the study's
+// per-material placeholder refused outside the study, and studied per material: every BRDF has a
+// row under the placeholder's name (an anisotropic one, and test:S, whose NDF cannot be recovered),
+// and --resume takes the parts back.
+TEST_F(CliTest, DupuyJakobByNameAndPerMaterialInTheStudy) {
+  const std::string pairs =
+      "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n0.3,0.1,0.9486832980505138,-0.2,0.4,0.8944271909999159\n";
+  Result r = run({"convert", "--from", "dirs", "--to", "dupuy-jakob:ggx:alpha=0.3"}, pairs);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("theta_i,phi_i,s1,s2\n", 0), 0u) << r.out;
+  const Result back =
+      run({"convert", "--from", "dupuy-jakob:ggx:alpha=0.3", "--to", "dirs"}, r.out);
+  ASSERT_EQ(back.status, 0) << back.err;
+  const std::vector<std::vector<std::string>> rows = csv_rows(back.out);
+  ASSERT_EQ(rows.size(), 2u);
+  const double expected[6] = {0.3, 0.1, 0.9486832980505138, -0.2, 0.4, 0.8944271909999159};
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(std::stod(rows[1][std::size_t(k)]), expected[k], 1e-9);
+  r = run({"convert", "--from", "dirs", "--to", "dupuy-jakob:nope"}, pairs);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("'dupuy-jakob:nope': 'nope' is neither"), std::string::npos) << r.err;
+  r = run({"convert", "--from", "dirs", "--to", "dupuy-jakob:per-material"}, pairs);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("for `halfback study --params` only"), std::string::npos) << r.err;
+
+  const std::vector<std::string> study = {"study",
+                                          "--quick",
+                                          "--no-images",
+                                          "--params",
+                                          "halfdiff,dupuy-jakob:per-material",
+                                          "-o",
+                                          "st",
+                                          "ggx:alpha=0.2",
+                                          "ggx:alpha_x=0.1,alpha_y=0.4",
+                                          "test:S"};
+  r = run(study);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<std::vector<std::string>> gonio = csv_rows(slurp(path("st") / "gonio.csv"));
+  std::set<std::string> studied;
+  for (const auto& row : gonio)
+    if (row.size() > 1 && row[1] == "dupuy-jakob:per-material") studied.insert(row[0]);
+  EXPECT_EQ(studied.size(), 3u);
+  std::vector<std::string> resume = study;
+  resume.insert(resume.begin() + 1, "--resume");
+  r = run(resume);
+  EXPECT_EQ(r.status, 0) << r.err;
 }
 
 TEST_F(CliTest, StudyBadInput) {

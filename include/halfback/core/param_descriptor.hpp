@@ -21,6 +21,10 @@ namespace halfback {
 // before a run-time parameterization's inverse_rows.
 void wrap_azimuth_rows(std::span<const Axis> axes, double* coords, std::size_t m);
 
+// The pair mirrored across the vertical plane of h̄ (the xz-plane when h̄ = 0): what a run-time
+// parameterization's mirror map does to the pair behind its coordinates.
+DirPair<double> mirror_pair(const DirPair<double>& p);
+
 // A parameterization at run time: its names and axes, and its maps in double precision, for code
 // that picks a parameterization from user input. For a C++ parameterization (CompiledParam) the
 // maps are the templates themselves, bit for bit; a run-time one (a Python user's) overrides them.

@@ -9,6 +9,7 @@
 #include <compare>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -75,6 +76,17 @@ std::vector<Space> parameterizations();
 // parameterization: register_parameterization<P>() (parameterization.hpp).
 Space register_parameterization(std::shared_ptr<const ParamDescriptor> descriptor);
 
+// A family of parameterizations with parameters (Dupuy & Jakob's per-material warp: the
+// parameter is a BRDF): the name "PREFIX:ARGS" denotes the parameterization that `make(ARGS)`
+// builds, registered under that whole name the first time space_from_name() meets it. `make`
+// throws std::invalid_argument (or another std::exception) naming what is wrong with ARGS. A
+// higher layer registers the family (the loader: loader/parameterization_families.hpp), so that
+// core stays below the BRDFs. Registering a prefix again replaces its factory.
+using ParamFactory = std::function<std::shared_ptr<const ParamDescriptor>(std::string_view args)>;
+void register_parameterization_family(std::string prefix, std::string usage, ParamFactory make);
+// "PREFIX:USAGE" of each family, e.g. "dupuy-jakob:BRDF", for help texts.
+std::vector<std::string> parameterization_families();
+
 // A space and whether its isotropic (3D, canonical-pose) form is meant. `dirs` has no isotropic
 // form: it is always the 6 Cartesian components (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z).
 struct Form {
@@ -84,6 +96,8 @@ struct Form {
 };
 
 std::string_view name_of(Space space);
+// The space of a name: "dirs", a parameterization's, or a family's "PREFIX:ARGS" (built and
+// registered on first use; the family's errors propagate). nullopt for an unknown name.
 std::optional<Space> space_from_name(std::string_view name);
 std::string space_names();  // "dirs, spherical, halfdiff, ortho, hybrid" (and registered)
 std::string parameterization_names(std::string_view last_separator = " or ");

@@ -24,6 +24,13 @@ std::array<CoordinateInfo, 2> iso_coordinates(Space space);
 // "φ_k − φ_h" (ortho, hybrid).
 std::string relative_azimuth_label(Space space);
 
+// The third isotropic coordinate of the slice at relative azimuth `radians` ∈ [0, 2π): that
+// azimuth when the coordinate is one (every built-in parameterization), else the same fraction of
+// its range (Dupuy & Jakob's s2, the half vector's relative azimuth through the warp's CDF).
+double third_coordinate_at(Space space, double radians);
+// The slice's title: "φ_d = 45°", or "s_2 = 0.125" for a third coordinate that is no azimuth.
+std::string third_coordinate_title(Space space, double degrees);
+
 // Formats a coordinate value for a tick label: "40°" for angles (value in radians), "0.5" else.
 std::string format_coordinate(const CoordinateInfo& c, double value);
 

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,23 @@ RecoveredNdf recover_ndf(const Brdf& brdf, int nodes, int threads = 0);
 
 // σ(θ) of an NDF table (nodes as above, linear in u), by the quadrature the power iteration uses.
 double projected_area(const std::vector<double>& ndf, double theta);
+
+// The warps of an RGL file of `brdf` alone: its NDF recovered as above (as Dupuy & Jakob measure
+// it, from the retro-reflection), each value raised to at least `ndf_floor` times the largest,
+// the VNDF tables and their warps of the writer, and luminance and RGB tables of ones (the
+// material's value is then the table map's Jacobian factor only). The floor keeps the VNDF
+// positive wherever ωi·m > 0, so that the warp is a bijection there (a measured NDF may be 0 at
+// grazing θm). Isotropic: one φi slice; an anisotropic BRDF is refused unless allow_anisotropic
+// (then its NDF is the one recovered along φ = 0). Throws as recover_ndf, or
+// std::invalid_argument for options out of range.
+struct RglWarpOptions {
+  int theta_i = 8;
+  int vndf_resolution = 128;
+  double ndf_floor = 1e-4;
+  int threads = 0;
+  bool allow_anisotropic = false;
+};
+std::shared_ptr<const RglBrdf> rgl_warp_material(const Brdf& brdf, const RglWarpOptions& options);
 
 // The fields of the RGL file of `brdf`, in the order of the published files: version,
 // description, phi_i, theta_i, sigma, ndf, vndf, luminance, rgb (variants rgb and both),

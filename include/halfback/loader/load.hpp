@@ -40,6 +40,13 @@ std::vector<std::filesystem::path> brdf_files_in(const std::filesystem::path& di
 // default figures need no file.
 BrdfPtr load_brdf(std::string_view spec);
 
+// Registers with core's registry the parameterization families whose parameter is a BRDF spec:
+// "dupuy-jakob:SPEC", Dupuy & Jakob 2018's half vector warped by the visible normals of SPEC's
+// recovered NDF (formats/adaptive_param.hpp). After it, every tool that takes a parameterization
+// by name takes these. The CLI and the Python module call it at start; calling it again is
+// harmless.
+void register_brdf_parameterization_families();
+
 // A spec that may be a sum "lambert:albedo=0.3+ggx:alpha=0.2" ('+' followed by a lowercase
 // letter separates terms), each term loaded by `load_term`: load_brdf() is load_sum(spec,
 // <a file or a model>); the explorer passes its own term loader, which confines files to its
