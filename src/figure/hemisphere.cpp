@@ -9,6 +9,7 @@
 
 #include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
+#include "halfback/figure/plot.hpp"
 #include "halfback/figure/render.hpp"
 
 namespace halfback::figure {
@@ -319,10 +320,32 @@ HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
   std::size_t longest = 0;
   for (Space s : o.params) longest = std::max(longest, utf8_length(name_of(s)));
   const double left = snap(std::max(92.0, 16 + 0.62 * 11 * double(longest)));
-  const double top = 64, key_gap = 62, key = snap(0.62 * D), right = 24, bottom = 64;
+  const double key_gap = 62, key = snap(0.62 * D), right = 24;
   const std::size_t rows = o.params.size(), cols = o.elevations_deg.size();
   Scene& sc = fig.scene;
   sc.width = snap(left + double(cols) * D + double(cols - 1) * gap + key_gap + key + right);
+  // The heading, subtitle and notes are wrapped to the width (a figure of one or two columns is
+  // narrower than their lines): the margins above and below grow with their lines.
+  const auto heading = wrap_text(
+      "Incoming directions ωi for a fixed ωo, coloured by the coordinates of (ωi, ωo)",
+      sc.width - left - 8, 12);
+  const auto subtitle = wrap_text(
+      "red: first coordinate / range, green: second / range; isolines every 10° or 0.1 "
+      "(white: first, black dashed: second)",
+      sc.width - left - 8, 9);
+  std::string legend = "ωo = (−sin θ_o, 0, cos θ_o).";
+  if (o.markers) legend += "  ○: mirror direction of ωo;  ×: ωo itself (the back direction).";
+  legend += "  Hatched: ωi below the horizon.";
+  std::vector<std::string> notes;
+  for (const std::string& note :
+       {capitalized(projection_title(o.projection)) + ", ψ the angle from the disk centre; " +
+            centre_title(o.centre) + ".",
+        legend,
+        std::string("Colour key: (first, second) coordinate → (red, green); hatched where no "
+                    "pair has these coordinates.")})
+    for (std::string& line : wrap_text(note, sc.width - 16, 9)) notes.push_back(std::move(line));
+  const double top = 64 + 15 * double(heading.size() - 1) + 12 * double(subtitle.size() - 1);
+  const double bottom = 64 + 13 * double(notes.size() - 3);
   sc.height = snap(top + double(rows) * D + double(rows - 1) * vgap + bottom);
   check_raster_size(sc.width, sc.height, o.pixels_per_point,
                     fmt::format("fewer elevations ({} given) or parameterizations ({} given), or "
@@ -330,13 +353,16 @@ HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
                                 cols, rows));
   sc.title = "Figure 1: the hemisphere of incoming directions for a fixed outgoing direction";
 
-  sc.text({left, 20},
-          "Incoming directions ωi for a fixed ωo, coloured by the coordinates of (ωi, ωo)", 12,
-          HAlign::left, VAlign::baseline, kBlack, 0, true);
-  sc.text({left, 36},
-          "red: first coordinate / range, green: second / range; isolines every 10° or 0.1 "
-          "(white: first, black dashed: second)",
-          9);
+  double line_y = 20;
+  for (const std::string& line : heading) {
+    sc.text({left, line_y}, line, 12, HAlign::left, VAlign::baseline, kBlack, 0, true);
+    line_y += 15;
+  }
+  line_y += 1;
+  for (const std::string& line : subtitle) {
+    sc.text({left, line_y}, line, 9);
+    line_y += 12;
+  }
   const std::size_t pixels = std::size_t(std::lround(D * o.pixels_per_point));
 
   for (std::size_t c = 0; c < cols; ++c) {
@@ -402,19 +428,11 @@ HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
     draw_key(sc, space, {key_x, y + 0.5 * (D - key), key, key}, o.pixels_per_point);
   }
 
-  const double fy = top + double(rows) * D + double(rows - 1) * vgap + 20;
-  sc.text({8, fy},
-          capitalized(projection_title(o.projection)) + ", ψ the angle from the disk centre; " +
-              centre_title(o.centre) + ".",
-          9);
-  std::string legend = "ωo = (−sin θ_o, 0, cos θ_o).";
-  if (o.markers) legend += "  ○: mirror direction of ωo;  ×: ωo itself (the back direction).";
-  legend += "  Hatched: ωi below the horizon.";
-  sc.text({8, fy + 13}, legend, 9);
-  sc.text({8, fy + 26},
-          "Colour key: (first, second) coordinate → (red, green); hatched where no pair has "
-          "these coordinates.",
-          9);
+  double fy = top + double(rows) * D + double(rows - 1) * vgap + 20;
+  for (const std::string& line : notes) {
+    sc.text({8, fy}, line, 9);
+    fy += 13;
+  }
   return fig;
 }
 

@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
 
+#include "halfback/figure/plot.hpp"
 #include "halfback/figure/render.hpp"
 
 namespace halfback::figure {
@@ -154,6 +156,29 @@ TEST(HemisphereFigure, NormalViewHasNoBelowHorizonAndColoursAreTheCoordinates) {
     const Tuple3<double> q = Ortho::forward_iso(DirPair<double>{*w, p.wo});
     EXPECT_EQ(p.sample.first.values[k], q[0]);
     EXPECT_EQ(p.sample.second.values[k], q[1]);
+  }
+}
+
+// Every text of the figure lies inside the page, by the layout's own width estimate: with one
+// column the heading, subtitle and notes are wider than the panels and were cut at the page's
+// right edge; they wrap now, and the page grows in height for their lines.
+TEST(HemisphereFigure, TextsFitThePageWhateverTheColumns) {
+  for (const std::vector<double>& elevations :
+       {std::vector<double>{30}, std::vector<double>{0, 60}, std::vector<double>{0, 40, 80}}) {
+    HemisphereOptions o;
+    o.params = {space_of<Hybrid>};
+    o.elevations_deg = elevations;
+    o.pixels_per_point = 0.2;
+    const auto fig = hemisphere_figure(o);
+    double lowest = 0;
+    for (const Item& item : fig.scene.items) {
+      const auto* t = std::get_if<TextItem>(&item);
+      if (!t || t->halign != HAlign::left || t->angle != 0) continue;
+      EXPECT_LE(t->at.x + approx_text_width(t->text, t->size), fig.scene.width)
+          << elevations.size() << " columns: " << t->text;
+      lowest = std::max(lowest, t->at.y);
+    }
+    EXPECT_LT(lowest, fig.scene.height) << elevations.size() << " columns";
   }
 }
 
