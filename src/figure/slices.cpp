@@ -349,23 +349,40 @@ void draw_panel_labels(Scene& sc, const SliceFigure::Panel& p, const SliceLayout
             VAlign::middle, kBlack, 90, true);
 }
 
-// Test-function mode: the legend on a dark strip (the white swatch needs it), item widths from
-// the label lengths.
-void draw_test_function_legend(Scene& sc, const SliceOptions& o, const SliceLayout& l, double ly) {
+// Test-function mode: the legend's items (label, width from its length), in rows that fit
+// `width` points.
+struct LegendRows {
   std::vector<std::string> labels;
   std::vector<double> widths;
-  double total = 0;
+  std::vector<std::vector<std::size_t>> rows;  // item indices, row by row
+};
+LegendRows test_function_legend(const SliceOptions& o, double width) {
+  LegendRows g;
+  double x = 0;
   for (TestFunction f : o.test_functions) {
-    labels.push_back(formula(f) + " (" + colour_name(f) + ")");
-    widths.push_back(40 + approx_text_width(labels.back(), 9));
-    total += widths.back();
+    g.labels.push_back(formula(f) + " (" + colour_name(f) + ")");
+    g.widths.push_back(40 + approx_text_width(g.labels.back(), 9));
+    if (g.rows.empty() || x + g.widths.back() > width) g.rows.emplace_back(), x = 0;
+    g.rows.back().push_back(g.labels.size() - 1);
+    x += g.widths.back();
   }
-  sc.rect(l.left - 8, ly - 9, total + 4, 18, kSliceBackground, std::nullopt);
-  double x = l.left;
-  for (std::size_t k = 0; k < o.test_functions.size(); ++k) {
-    draw_legend_line(sc, {x, ly}, Stroke{test_function_colour(o.test_functions[k]), 1.6}, labels[k],
-                     9, kWhite);
-    x += widths[k];
+  return g;
+}
+
+// The legend on a dark strip per row (the white swatch needs it).
+void draw_test_function_legend(Scene& sc, const SliceOptions& o, const SliceLayout& l,
+                               const LegendRows& g, double ly) {
+  for (const std::vector<std::size_t>& row : g.rows) {
+    double total = 0;
+    for (std::size_t k : row) total += g.widths[k];
+    sc.rect(l.left - 8, ly - 9, total + 4, 18, kSliceBackground, std::nullopt);
+    double x = l.left;
+    for (std::size_t k : row) {
+      draw_legend_line(sc, {x, ly}, Stroke{test_function_colour(o.test_functions[k]), 1.6},
+                       g.labels[k], 9, kWhite);
+      x += g.widths[k];
+    }
+    ly += 20;
   }
 }
 
@@ -393,8 +410,12 @@ void draw_luminance_colour_bar(Scene& sc, const SliceOptions& o, const SliceFigu
           return Color{t, t, t};
         },
         tick_t, labels, "luminance", o.pixels_per_point);
-  sc.text({l.left, ly},
-          "Luminance isolines at the levels marked on the colour bar (decades thicker).", 9);
+  for (const std::string& line :
+       wrap_text("Luminance isolines at the levels marked on the colour bar (decades thicker).",
+                 sc.width - l.left - 8, 9)) {
+    sc.text({l.left, ly}, line, 9);
+    ly += 12;
+  }
 }
 
 }  // namespace
@@ -413,8 +434,22 @@ SliceFigure slice_figure(const SliceOptions& o) {
 
   const SliceText text = generic ? brdf_slice_text(o) : test_function_slice_text(o);
   sc.title = text.title;
+  // Heading, subtitle and legend wrapped to the figure's width (one column is narrower than
+  // their lines): the margins grow with their lines.
+  const std::vector<std::string> heading = wrap_text(text.heading, sc.width - l.left - 8, 12);
   const std::vector<std::string> subtitle = wrap_text(text.subtitle, sc.width - l.left - 12, 9);
-  l.top = 58 + 12 * double(subtitle.size());
+  const double heading_extra = 15 * double(heading.size() - 1);
+  l.top = 58 + heading_extra + 12 * double(subtitle.size());
+  const LegendRows legend = test_function_legend(o, sc.width - l.left);
+  const double note_lines =
+      generic ? double(wrap_text("Luminance isolines at the levels marked on the colour bar "
+                                 "(decades thicker).",
+                                 sc.width - l.left - 8, 9)
+                           .size()) -
+                    1
+              : 0;
+  l.bottom +=
+      generic ? 12 * note_lines : 20 * double(std::max<std::size_t>(legend.rows.size(), 1) - 1);
   sc.height = snap(l.panels_bottom() + l.bottom);
   check_raster_size(sc.width, sc.height, o.pixels_per_point,
                     fmt::format("fewer azimuths ({} given) or parameterizations ({} given), or a "
@@ -424,10 +459,11 @@ SliceFigure slice_figure(const SliceOptions& o) {
   fig.panels = sample_panels(o, l);
   const PanelValues values = generic ? evaluate_panels(o, fig) : PanelValues{};
 
-  // Title and subtitle (wrapped to the figure's width).
-  sc.text({l.left, 20}, text.heading, 12, HAlign::left, VAlign::baseline, kBlack, 0, true);
+  for (std::size_t k = 0; k < heading.size(); ++k)
+    sc.text({l.left, 20 + 15 * double(k)}, heading[k], 12, HAlign::left, VAlign::baseline, kBlack,
+            0, true);
   for (std::size_t k = 0; k < subtitle.size(); ++k)
-    sc.text({l.left, 36 + 12 * double(k)}, subtitle[k], 9);
+    sc.text({l.left, 36 + heading_extra + 12 * double(k)}, subtitle[k], 9);
 
   for (std::size_t n = 0; n < fig.panels.size(); ++n) {
     const SliceFigure::Panel& p = fig.panels[n];
@@ -442,7 +478,7 @@ SliceFigure slice_figure(const SliceOptions& o) {
   if (generic)
     draw_luminance_colour_bar(sc, o, fig, l, ly);
   else
-    draw_test_function_legend(sc, o, l, ly);
+    draw_test_function_legend(sc, o, l, legend, ly);
   return fig;
 }
 

@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
+#include "halfback/figure/plot.hpp"
 #include "halfback/figure/render.hpp"
 
 namespace halfback::figure {
@@ -190,6 +192,39 @@ TEST(Slices, GenericBrdfMode) {
   // RGB mode renders too, on the same slices.
   o.colouring = SliceColouring::rgb;
   EXPECT_NO_THROW(slice_figure(o));
+}
+
+// Every left-aligned text lies inside the page by the layout's own width estimate, and the
+// legend's strips too, whatever the columns: with one column the heading and the test functions'
+// legend were cut at the page's right edge; they wrap into lines and rows now.
+TEST(Slices, TextsAndLegendFitThePageWhateverTheColumns) {
+  for (const bool generic : {false, true})
+    for (const std::vector<double>& azimuths :
+         {std::vector<double>{90}, std::vector<double>{0, 45, 90}}) {
+      SliceOptions o;
+      o.params = {space_of<Hybrid>};
+      o.azimuths_deg = azimuths;
+      if (generic) o.brdf = std::make_shared<TestFunctionBrdf>(TestFunction::grazing);
+      o.pixels_per_point = 0.2;
+      const auto fig = slice_figure(o);
+      const std::string where = (generic ? "generic, " : "test functions, ") +
+                                std::to_string(azimuths.size()) + " columns";
+      double lowest = 0;
+      for (const Item& item : fig.scene.items) {
+        if (const auto* t = std::get_if<TextItem>(&item);
+            t && t->halign == HAlign::left && t->angle == 0) {
+          EXPECT_LE(t->at.x + approx_text_width(t->text, t->size), fig.scene.width)
+              << where << ": " << t->text;
+          lowest = std::max(lowest, t->at.y);
+        }
+        if (const auto* p = std::get_if<PathItem>(&item); p && p->fill) {
+          for (const Point& q : p->points) {
+            EXPECT_LE(q.x, fig.scene.width + 1e-9) << where;
+          }
+        }
+      }
+      EXPECT_LT(lowest, fig.scene.height) << where;
+    }
 }
 
 TEST(Slices, LogLevels) {
