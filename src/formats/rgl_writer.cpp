@@ -371,8 +371,9 @@ std::shared_ptr<const RglBrdf> rgl_warp_material(const Brdf& brdf, const RglWarp
   if (!brdf.isotropic() && !o.allow_anisotropic)
     throw std::invalid_argument(brdf.name() +
                                 " is anisotropic: the warp of its NDF is isotropic (one φi slice)");
-  if (!(o.ndf_floor >= 0 && o.ndf_floor < 1))
-    throw std::invalid_argument(fmt::format("ndf floor {}: must be in [0, 1)", o.ndf_floor));
+  if (!(o.ndf_floor_share >= 0 && o.ndf_floor_share < 1))
+    throw std::invalid_argument(
+        fmt::format("ndf floor share {}: must be in [0, 1)", o.ndf_floor_share));
   RglExportOptions e;
   e.theta_i = o.theta_i;
   e.vndf_resolution = o.vndf_resolution;
@@ -380,7 +381,7 @@ std::shared_ptr<const RglBrdf> rgl_warp_material(const Brdf& brdf, const RglWarp
   check_option("theta_i", e.theta_i, 2, 90);
   check_option("vndf_resolution", e.vndf_resolution, 2, 1024);
   RecoveredNdf ndf = recover_ndf(brdf, e.vndf_resolution, e.threads);
-  const double floor = o.ndf_floor * *std::max_element(ndf.ndf.begin(), ndf.ndf.end());
+  const double floor = o.ndf_floor_share / kPi;  // a constant c holds π c of ∫ D cos θm dωm = 1
   for (double& d : ndf.ndf) d = std::max(d, floor);
   for (std::size_t k = 0; k < ndf.ndf.size(); ++k)
     ndf.sigma[k] = projected_area(ndf.ndf, u_to_theta(node_u(k, ndf.ndf.size())));

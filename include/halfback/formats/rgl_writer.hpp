@@ -56,17 +56,19 @@ RecoveredNdf recover_ndf(const Brdf& brdf, int nodes, int threads = 0);
 double projected_area(const std::vector<double>& ndf, double theta);
 
 // The warps of an RGL file of `brdf` alone: its NDF recovered as above (as Dupuy & Jakob measure
-// it, from the retro-reflection), each value raised to at least `ndf_floor` times the largest,
-// the VNDF tables and their warps of the writer, and luminance and RGB tables of ones (the
-// material's value is then the table map's Jacobian factor only). The floor keeps the VNDF
-// positive wherever ωi·m > 0, so that the warp is a bijection there (a measured NDF may be 0 at
-// grazing θm). Isotropic: one φi slice; an anisotropic BRDF is refused unless allow_anisotropic
-// (then its NDF is the one recovered along φ = 0). Throws as recover_ndf, or
-// std::invalid_argument for options out of range.
+// it, from the retro-reflection), raised to at least a constant NDF holding `ndf_floor_share` of
+// ∫ D cos θm dωm = 1 (the value share/π), the VNDF tables and their warps of the writer, and
+// luminance and RGB tables of ones (the material's value is then the table map's Jacobian factor
+// only). The floor keeps the VNDF positive wherever ωi·m > 0, so that the warp is a bijection
+// there (a measured NDF may be 0 at grazing θm), while taking at most that share of the samples
+// from the lobe (a floor relative to the peak took most of a near-mirror's: docs/study.md).
+// Isotropic: one φi slice; an anisotropic BRDF is refused unless allow_anisotropic (then its NDF
+// is the one recovered along φ = 0). Throws as recover_ndf, or std::invalid_argument for options
+// out of range.
 struct RglWarpOptions {
   int theta_i = 8;
   int vndf_resolution = 128;
-  double ndf_floor = 1e-4;
+  double ndf_floor_share = 1e-3;
   int threads = 0;
   bool allow_anisotropic = false;
 };
