@@ -45,7 +45,11 @@ Scene bar_chart(const BarChart& c, const BarChartLayout& l) {
 
   const std::size_t ns = c.series.size();
   const double group = double(ns) * l.bar_height + l.group_gap;
-  const double left = l.label_width, top = 48, legend = 18 * double(ns) + 10;
+  // The row labels are right-aligned before the bars: the margin widens for a longer label.
+  double left = l.label_width;
+  for (const std::string& row : c.rows)
+    left = std::max(left, snap(12 + approx_text_width(escape_markup(row), 8.5)));
+  const double top = 48, legend = 18 * double(ns) + 10;
   Scene sc;
   sc.title = c.title;
   sc.width = snap(left + l.plot_width + 40);

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "halfback/figure/plot.hpp"
 #include "halfback/figure/render.hpp"
 
 namespace halfback::figure {
@@ -32,6 +33,31 @@ TEST(BarChart, BarLengthsAreTheValuesOnTheAxis) {
     if (const auto* t = std::get_if<TextItem>(&item)) title |= plain_text(t->text) == "t_1";
   EXPECT_TRUE(title);
   EXPECT_FALSE(render(sc, Format::svg).empty());
+}
+
+// A row label longer than the layout's label width widens the margin: every right-aligned label
+// starts inside the page by the layout's width estimate (a study's "dupuy-jakob:per-material"
+// lost its first letter), and the bars start where the margin ends.
+TEST(BarChart, LongRowLabelsFitTheMargin) {
+  BarChart c;
+  c.title = "t";
+  c.x_label = "error";
+  c.rows = {"halfdiff", "dupuy-jakob:per-material, a long row label"};
+  c.series = {"x"};
+  c.values = {{0.1}, {0.2}};
+  BarChartLayout l;
+  l.label_width = 110;
+  const Scene sc = bar_chart(c, l);
+  double bars_start = -1;
+  for (const Item& item : sc.items) {
+    if (const auto* t = std::get_if<TextItem>(&item); t && t->halign == HAlign::right) {
+      EXPECT_GE(t->at.x - approx_text_width(t->text, t->size), 0.0) << t->text;
+    }
+    if (const auto* p = std::get_if<PathItem>(&item);
+        p && p->fill && p->points.size() == 4 && p->points[2].y - p->points[0].y == l.bar_height)
+      bars_start = p->points[0].x;
+  }
+  EXPECT_GT(bars_start, l.label_width);
 }
 
 TEST(BarChart, BadInput) {
