@@ -192,8 +192,7 @@ std::optional<Space> registered_space(std::string_view name) {
 void register_parameterization_family(std::string prefix, std::string usage, ParamFactory make) {
   if (prefix.empty() || prefix.find(':') != std::string::npos || !make)
     throw std::invalid_argument(
-        "register_parameterization_family: a prefix without ':' and a "
-        "factory are needed");
+        "register_parameterization_family: a prefix without ':' and a factory are needed");
   Families& f = families();
   std::lock_guard lock(f.mutex);
   f.by_prefix[std::move(prefix)] = Family{std::move(usage), std::move(make)};

@@ -80,7 +80,7 @@ Space register_parameterization(std::shared_ptr<const ParamDescriptor> descripto
 // parameter is a BRDF): the name "PREFIX:ARGS" denotes the parameterization that `make(ARGS)`
 // builds, registered under that whole name the first time space_from_name() meets it. `make`
 // throws std::invalid_argument (or another std::exception) naming what is wrong with ARGS. A
-// higher layer registers the family (the loader: loader/parameterization_families.hpp), so that
+// higher layer registers the family (the loader: register_brdf_parameterization_families), so that
 // core stays below the BRDFs. Registering a prefix again replaces its factory.
 using ParamFactory = std::function<std::shared_ptr<const ParamDescriptor>(std::string_view args)>;
 void register_parameterization_family(std::string prefix, std::string usage, ParamFactory make);
