@@ -9,16 +9,10 @@
 #include <limits>
 
 #include "halfback/loader/load.hpp"
+#include "recovery_test_support.hpp"
 
 namespace halfback::fit {
 namespace {
-
-double value_of(const Model& m, std::size_t term, std::string_view name) {
-  for (const Param& p : m.params)
-    if (p.term == term && p.name == name) return p.value;
-  ADD_FAILURE() << "no parameter " << name;
-  return std::numeric_limits<double>::quiet_NaN();
-}
 
 std::string with_alpha(const std::string& spec, double alpha) {
   char buf[64];
@@ -26,25 +20,11 @@ std::string with_alpha(const std::string& spec, double alpha) {
   return spec + buf;
 }
 
-// Fits `model` to the BRDF of `truth` (the same terms, every fitted parameter given) from `start`
-// and checks every fitted parameter to 1e-4 relative.
-void expect_recovered(const std::string& model, const std::string& truth, const std::string& start,
-                      Loss loss = Loss::ngan) {
-  SCOPED_TRACE(truth + " from " + start + " under " + std::string(name_of(loss)));
-  FitOptions o;
-  o.samples = 3000;
-  o.loss = loss;
-  o.starts = {start};
-  const FitResult r = fit(*load_brdf(truth), model, o);
-  const Model want = parse_model(truth);
-  for (const Param& p : r.model.params) {
-    if (!p.fitted) continue;
-    const double w = value_of(want, p.term, p.name);
-    EXPECT_NEAR(p.value, w, 1e-4 * std::abs(w)) << p.name << " of term " << p.term;
-  }
-  EXPECT_LT(r.loss_value, 1e-12);
-}
+using recovery_test::expect_recovered;
+using recovery_test::value_in;
 
+// Each from a start given (an empty start would be the automatic ones), 3000 samples, every
+// fitted parameter to 1e-4 relative, loss < 1e-12.
 TEST(FitRecovery, Lambert) {
   expect_recovered("lambert", "lambert:albedo_r=0.7,albedo_g=0.3,albedo_b=0.05",
                    "lambert:albedo_r=0.1,albedo_g=0.9,albedo_b=1");
@@ -60,7 +40,7 @@ TEST(FitRecovery, GgxFromStartsAcrossTheBounds) {
 TEST(FitRecovery, BeckmannUnderEachLoss) {
   for (Loss loss : kLosses)
     expect_recovered("beckmann", "beckmann:alpha=0.3,f0_r=0.5,f0_g=0.4,f0_b=0.2",
-                     "beckmann:alpha=0.05", loss);
+                     "beckmann:alpha=0.05", {.loss = loss});
 }
 
 TEST(FitRecovery, Sheen) {
@@ -135,12 +115,12 @@ TEST(FitMultistart, TwoMinimaOneStartFailsTheStartsSucceed) {
   o.starts.clear();
   const FitResult multi = fit(*target, model, o);
   EXPECT_GT(one.loss_value, 1.5 * multi.loss_value) << one.spec;
-  EXPECT_GT(value_of(one.model, 0, "alpha"), 0.2) << "the single start left the broad basin";
+  EXPECT_GT(value_in(one.model, 0, "alpha"), 0.2) << "the single start left the broad basin";
   EXPECT_LE(multi.loss_value, scan_best * (1 + 1e-9)) << multi.spec;
   // The value reported is the loss of the spec reported.
   EXPECT_NEAR(multi.loss_value, loss_value(t, *load_brdf(multi.spec), o.loss, s),
               1e-12 * multi.loss_value);
-  EXPECT_NEAR(value_of(multi.model, 0, "alpha"), scan_alpha, 0.02 * scan_alpha);
+  EXPECT_NEAR(value_in(multi.model, 0, "alpha"), scan_alpha, 0.02 * scan_alpha);
 }
 
 // A BRDF of given value everywhere (NaN, ∞, 0), isotropic or not.

@@ -11,36 +11,18 @@
 #include "halfback/fit/fit.hpp"
 #include "halfback/fit/published.hpp"
 #include "halfback/loader/load.hpp"
+#include "recovery_test_support.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::fit::ngan_microfacet_fit_test {  // (own namespace: one unity file)
 namespace {
 
-double value_in(const Model& m, std::size_t term, std::string_view name) {
-  for (const Param& p : m.params)
-    if (p.term == term && p.name == name) return p.value;
-  ADD_FAILURE() << "no parameter " << name;
-  return std::numeric_limits<double>::quiet_NaN();
-}
-
-// Fits `model` to the BRDF of `truth` from `start` (empty: the automatic starts), 2000 samples (as
-// `halfback fit --samples 2000`), and checks every fitted parameter to 1e-3 relative.
+// As `halfback fit --samples 2000`: every fitted parameter to 1e-3 relative (the loss not checked).
 void expect_recovered(const std::string& model, const std::string& truth,
                       const std::string& start) {
-  SCOPED_TRACE(truth + " from " + start);
-  FitOptions o;
-  o.samples = 2000;
-  if (!start.empty()) o.starts = {start};
-  const FitResult r = fit(*load_brdf(truth), model, o);
-  const Model want = parse_model(truth);
-  int fitted = 0;
-  for (const Param& p : r.model.params) {
-    if (!p.fitted) continue;
-    ++fitted;
-    const double w = value_in(want, p.term, p.name);
-    EXPECT_NEAR(p.value, w, 1e-3 * std::abs(w)) << p.name << " of term " << p.term;
-  }
-  EXPECT_GT(fitted, 0);
+  recovery_test::expect_recovered(
+      model, truth, start,
+      {.samples = 2000, .tolerance = 1e-3, .max_loss = std::numeric_limits<double>::infinity()});
 }
 
 TEST(NganMicrofacetFit, CookTorranceRecovered) {
