@@ -7,12 +7,18 @@
 
 #include "halfback/core/params/charts.hpp"
 #include "halfback/formats/rgl.hpp"
+#include "rgl_impl.hpp"
 
 namespace halfback {
 
 namespace adaptive_detail {  // named: the layer is a unity build
 
-constexpr double kPi = std::numbers::pi;
+using rgl_detail::azimuth_u;
+using rgl_detail::kPi;
+using rgl_detail::reflection_jacobian;
+using rgl_detail::theta_to_u;
+using rgl_detail::u_to_theta;
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 Vec3<double> direction(double theta, double phi) {
@@ -20,18 +26,13 @@ Vec3<double> direction(double theta, double phi) {
   return {s * std::cos(phi), s * std::sin(phi), std::cos(theta)};
 }
 
-// An angle onto [0, 1) of the unit square's second coordinate: (a + π) / 2π, wrapped.
-double azimuth_to_v(double a) {
-  const double v = a / (2 * kPi) + 0.5;
-  return v - std::floor(v);
-}
-
-// The half vector's angles of a point u of the unit square (relative to φi).
+// The half vector of a point u of the unit square (the warp's tables are isotropic: its azimuth is
+// relative to φi), as RglBrdf::sample takes it.
 struct HalfVector {
   double theta, phi;  // phi relative to φi
 };
 HalfVector half_vector_of(RglWarpPoint u) {
-  return {kPi / 2 * u.x * u.x, 2 * kPi * u.y - kPi};
+  return {u_to_theta(u.x), 2 * kPi * u.y - kPi};
 }
 
 class AdaptiveParam final : public ParamDescriptor {
@@ -48,7 +49,7 @@ class AdaptiveParam final : public ParamDescriptor {
     h = l > 0 ? Vec3<double>{h.x / l, h.y / l, h.z / l} : Vec3<double>{0, 0, 1};
     const double theta_m = detail::elevation(h.x, h.y, h.z);
     const double phi_m = (h.x == 0 && h.y == 0) ? phi_i : std::atan2(h.y, h.x);
-    const RglWarpPoint u{std::sqrt(theta_m * (2 / kPi)), azimuth_to_v(phi_m - phi_i)};
+    const RglWarpPoint u{theta_to_u(theta_m), azimuth_u(phi_m, phi_i, true)};
     const RglWarpPoint s = warp_->vndf_inverse(u, theta_i, phi_i);
     return {theta_i, phi_i, s.x, s.y};
   }
@@ -67,7 +68,8 @@ class AdaptiveParam final : public ParamDescriptor {
     return {{wi, wo}, true};
   }
 
-  // dωi dωo / dq = sin θi dθi dφi · 4 (ωi·ĥ) dωm, dωm = 2π² u1 sin θm du, du = ds / p_u(u).
+  // dωi dωo / dq = sin θi dθi dφi · 4 (ωi·ĥ) dωm, dωm = 2π² u1 sin θm du, du = ds / p_u(u)
+  // (docs/math-more-parameterizations.md §6).
   double jacobian(const Tuple4<double>& q) const override {
     const double theta_i = q[0], phi_i = detail::wrap_azimuth(q[1]);
     const RglWarpPoint u = warp_->vndf_forward({q[2], q[3]}, theta_i, phi_i);
@@ -76,7 +78,7 @@ class AdaptiveParam final : public ParamDescriptor {
     const HalfVector m = half_vector_of(u);
     const double c = std::sin(theta_i) * std::sin(m.theta) * std::cos(m.phi) +
                      std::cos(theta_i) * std::cos(m.theta);  // ωi·ĥ, ĥ's azimuth relative
-    return std::abs(std::sin(theta_i) * 8 * kPi * kPi * u.x * std::sin(m.theta) * c / density);
+    return std::abs(std::sin(theta_i) * reflection_jacobian(u, m.theta, c) / density);
   }
 
   // The isotropic form: (θi, s1, s2) in the canonical pose; the warp is the same at every φi.

@@ -20,8 +20,10 @@ using rgl_detail::Flips;
 using rgl_detail::flips_for;
 using rgl_detail::kPi;
 using rgl_detail::phi_to_u;
+using rgl_detail::reflection_jacobian;
 using rgl_detail::Slices;
 using rgl_detail::theta_to_u;
+using rgl_detail::u_to_theta;
 
 std::string RglBrdf::name() const {
   return "rgl:" + label_;
@@ -93,11 +95,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// dωm = sin θm dθm dφm = 2π² u sin θm du dv, and dω = 4 |ω·m| dωm (reflection about m).
-double reflection_jacobian(RglWarpPoint um, double theta_m, double cos_gm) {
-  return 2 * kPi * kPi * um.x * std::sin(theta_m) * 4 * std::abs(cos_gm);
-}
-
 }  // namespace
 
 BrdfSample RglBrdf::sample(const Vec3<double>& wo, double u1, double u2) const {
@@ -109,7 +106,7 @@ BrdfSample RglBrdf::sample(const Vec3<double>& wo, double u1, double u2) const {
   const double phi_g = std::atan2(g.y, g.x);
   const Slices s = m.slices(phi_g, theta_g);
   const auto [um, pdf_u] = m.vndf.draw(s, {u1, u2});
-  const double theta_m = um.x * um.x * (kPi / 2);
+  const double theta_m = u_to_theta(um.x);
   const double phi_m = (2 * um.y - 1) * kPi + (m.isotropic ? phi_g : 0.0);
   const Vec3<double> n{std::sin(theta_m) * std::cos(phi_m), std::sin(theta_m) * std::sin(phi_m),
                        std::cos(theta_m)};

@@ -31,6 +31,16 @@ inline double theta_to_u(double theta) {
 inline double phi_to_u(double phi) {
   return (phi + kPi) * (0.5 / kPi);
 }
+// The polar angle of u (the inverse of theta_to_u).
+inline double u_to_theta(double u) {
+  return u * u * (kPi / 2);
+}
+
+// dωm = sin θm dθm dφm = 2π² u sin θm du dv, and dω = 4 |ω·m| dωm (reflection about m): the
+// solid angle of a reflected direction per unit area of the unit square at um.
+inline double reflection_jacobian(RglWarpPoint um, double theta_m, double cos_gm) {
+  return 2 * kPi * kPi * um.x * std::sin(theta_m) * 4 * std::abs(cos_gm);
+}
 
 // floor(u) for |u| < 1e9 without a libm call (SSE2 has no rounding instruction), in a form that
 // loops vectorize; 0 for NaN and larger values (the conversion to int would be undefined), which
