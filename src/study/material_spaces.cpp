@@ -5,24 +5,15 @@
 #include <utility>
 
 #include "halfback/formats/adaptive_param.hpp"
+#include "halfback/models/analytic.hpp"
 
 namespace halfback::study {
 
 namespace {
 
-// A constant ρ: the BRDF whose recovered NDF is the warp of a BRDF that has none to recover.
-class ConstantBrdf final : public Brdf {
- public:
-  std::string name() const override { return "constant"; }
-  std::string description() const override { return "a constant BRDF"; }
-  bool isotropic() const override { return true; }
-  bool reciprocal() const override { return true; }
-  Rgb eval(const DirPair<double>&) const override { return Rgb{1.0, 1.0, 1.0}; }
-};
-
 // The warp of `brdf`'s NDF, or, when it has none to recover (a retro-reflection that is zero or
-// not finite somewhere, as an ALTA file's few incidences give), of a constant BRDF's: every BRDF
-// gets a row.
+// not finite somewhere, as an ALTA file's few incidences give), of a Lambertian surface's: every
+// BRDF gets a row.
 std::shared_ptr<const ParamDescriptor> own_warp(const Brdf& brdf, const std::string& name) {
   RglWarpOptions o;
   o.vndf_resolution = 64;
@@ -30,7 +21,7 @@ std::shared_ptr<const ParamDescriptor> own_warp(const Brdf& brdf, const std::str
   try {
     return adaptive_parameterization(brdf, name, o);
   } catch (const std::invalid_argument&) {
-    return adaptive_parameterization(ConstantBrdf(), name + " [constant NDF]", o);
+    return adaptive_parameterization(models::Lambert(Rgb{1, 1, 1}), name + " [Lambertian warp]", o);
   }
 }
 

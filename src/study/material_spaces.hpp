@@ -16,7 +16,7 @@ namespace halfback::study {
 // registered once per BRDF (by `label` and the BRDF's name) for the process's lifetime (about
 // 0.3 MB each: tables of 64 × 64 on 8 incidences); an anisotropic BRDF gets the warp of its NDF
 // along φ = 0, and a BRDF with no NDF to recover (its retro-reflection zero or not finite
-// somewhere) the warp of a constant BRDF's ("[constant NDF]" in the member's name).
+// somewhere) the warp of a Lambertian surface's ("[Lambertian warp]" in the member's name).
 std::vector<Space> material_spaces(const Brdf& brdf, const std::string& label,
                                    std::span<const Space> params);
 

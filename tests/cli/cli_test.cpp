@@ -1748,7 +1748,8 @@ TEST_F(CliTest, StudyParamsChooseTheColumns) {
 // Dupuy & Jakob's parameterization with a parameter: converted by name both ways (the ordered
 // pair back), refused with the family's message when its BRDF names nothing, the study's
 // per-material placeholder refused outside the study, and studied per material: every BRDF has a
-// row under the placeholder's name (an anisotropic one, and test:S, whose NDF cannot be recovered),
+// row under the placeholder's name (a glossy model, an anisotropic one and a test function; a BRDF
+// whose NDF cannot be recovered: MaterialSpaces.EveryBrdfGetsAWarp),
 // and --resume takes the parts back.
 TEST_F(CliTest, DupuyJakobByNameAndPerMaterialInTheStudy) {
   const std::string pairs =
