@@ -386,9 +386,15 @@ void draw_test_function_legend(Scene& sc, const SliceOptions& o, const SliceLayo
   }
 }
 
-// Generic mode: the colour bar of the shared scale, right of the panels, and a note below.
+// Generic mode: the note below the panels, wrapped to the figure's width.
+constexpr std::string_view kLuminanceNote =
+    "Luminance isolines at the levels marked on the colour bar (decades thicker).";
+
+// Generic mode: the colour bar of the shared scale, right of the panels, and the note's lines
+// below.
 void draw_luminance_colour_bar(Scene& sc, const SliceOptions& o, const SliceFigure& fig,
-                               const SliceLayout& l, double ly) {
+                               const SliceLayout& l, const std::vector<std::string>& note,
+                               double ly) {
   const double bar_x = l.panels_right() + 22;
   const Rect bar{bar_x, l.top + 10, 14, l.panels_height() - 20};
   std::vector<double> tick_t;
@@ -410,9 +416,7 @@ void draw_luminance_colour_bar(Scene& sc, const SliceOptions& o, const SliceFigu
           return Color{t, t, t};
         },
         tick_t, labels, "luminance", o.pixels_per_point);
-  for (const std::string& line :
-       wrap_text("Luminance isolines at the levels marked on the colour bar (decades thicker).",
-                 sc.width - l.left - 8, 9)) {
+  for (const std::string& line : note) {
     sc.text({l.left, ly}, line, 9);
     ly += 12;
   }
@@ -440,16 +444,11 @@ SliceFigure slice_figure(const SliceOptions& o) {
   const std::vector<std::string> subtitle = wrap_text(text.subtitle, sc.width - l.left - 12, 9);
   const double heading_extra = 15 * double(heading.size() - 1);
   l.top = 58 + heading_extra + 12 * double(subtitle.size());
-  const LegendRows legend = test_function_legend(o, sc.width - l.left);
-  const double note_lines =
-      generic ? double(wrap_text("Luminance isolines at the levels marked on the colour bar "
-                                 "(decades thicker).",
-                                 sc.width - l.left - 8, 9)
-                           .size()) -
-                    1
-              : 0;
-  l.bottom +=
-      generic ? 12 * note_lines : 20 * double(std::max<std::size_t>(legend.rows.size(), 1) - 1);
+  const LegendRows legend = generic ? LegendRows{} : test_function_legend(o, sc.width - l.left);
+  const std::vector<std::string> note =
+      generic ? wrap_text(kLuminanceNote, sc.width - l.left - 8, 9) : std::vector<std::string>{};
+  l.bottom += generic ? 12 * double(note.size() - 1)
+                      : 20 * double(std::max<std::size_t>(legend.rows.size(), 1) - 1);
   sc.height = snap(l.panels_bottom() + l.bottom);
   check_raster_size(sc.width, sc.height, o.pixels_per_point,
                     fmt::format("fewer azimuths ({} given) or parameterizations ({} given), or a "
@@ -476,7 +475,7 @@ SliceFigure slice_figure(const SliceOptions& o) {
   // Legend or colour bar.
   const double ly = l.panels_bottom() + 46;
   if (generic)
-    draw_luminance_colour_bar(sc, o, fig, l, ly);
+    draw_luminance_colour_bar(sc, o, fig, l, note, ly);
   else
     draw_test_function_legend(sc, o, l, legend, ly);
   return fig;
