@@ -191,8 +191,8 @@ std::string family_hint() {
     (hint += hint.empty() ? ", or " : ", ") += f;
   return hint;
 }
-// The space of a name, or the message saying why there is none (a family's member whose argument
-// is wrong: the family's own message).
+}  // namespace
+
 std::optional<Space> space_or_message(const std::string& name, std::string& message) {
   try {
     const auto s = space_from_name(name);
@@ -209,7 +209,6 @@ std::optional<Space> space_or_message(const std::string& name, std::string& mess
     return std::nullopt;
   }
 }
-}  // namespace
 
 CLI::Validator space_name_validator() {
   return CLI::Validator(

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
+#include "halfback/core/space.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/csv.hpp"
 
@@ -132,6 +133,12 @@ void harden_options(CLI::App& app);
 
 // For counts that may be 0 (--threads): "a whole number >= 0", with a readable message.
 CLI::Validator non_negative_integer();
+
+// The space of a name given on the command line (space_from_name), or nullopt with `message`
+// saying why when the name is known but cannot be used here: a family's member whose argument is
+// wrong (the family's own message), or the study's per-material placeholder outside the study.
+// An unknown name: nullopt and an empty message (each option says what it expects).
+std::optional<Space> space_or_message(const std::string& name, std::string& message);
 
 CLI::Validator space_name_validator();
 // The same for a parameterization (not "dirs").

@@ -88,7 +88,9 @@ struct MaterialArgs {
 std::vector<Space> parameterization_list(const std::string& list) {
   std::vector<Space> spaces;
   for (const std::string& n : split_list(list, "--param", "parameterization")) {
-    const auto s = space_from_name(n);
+    std::string problem;
+    const auto s = space_or_message(n, problem);
+    if (!problem.empty()) throw UsageError("--param " + problem);
     if (!s || *s == Space::dirs)
       throw UsageError(fmt::format("--param: unknown parameterization '{}' (expected {})", n,
                                    parameterization_names()));

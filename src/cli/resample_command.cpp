@@ -28,7 +28,9 @@ struct ResampleOptions {
 };
 
 int run_resample(const ResampleOptions& o) {
-  const auto space = space_from_name(o.param);
+  std::string problem;
+  const auto space = space_or_message(o.param, problem);
+  if (!problem.empty()) throw UsageError("--param " + problem);
   if (!space || *space == Space::dirs)
     throw UsageError(fmt::format("--param '{}': expected a parameterization: {}", o.param,
                                  parameterization_names()));

@@ -1767,9 +1767,19 @@ TEST_F(CliTest, DupuyJakobByNameAndPerMaterialInTheStudy) {
   r = run({"convert", "--from", "dirs", "--to", "dupuy-jakob:nope"}, pairs);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("'dupuy-jakob:nope': 'nope' is neither"), std::string::npos) << r.err;
-  r = run({"convert", "--from", "dirs", "--to", "dupuy-jakob:per-material"}, pairs);
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"convert", "--from", "dirs", "--to", "dupuy-jakob:per-material"},
+        {"resample", "--brdf", "lambert", "--param", "dupuy-jakob:per-material", "-o", "r.npy"},
+        {"figure", "slices", "--param", "dupuy-jakob:per-material", "--out", "s.png"}}) {
+    r = run(args, pairs);
+    EXPECT_EQ(r.status, 2) << args[0];
+    EXPECT_NE(r.err.find("for `halfback study --params` only"), std::string::npos) << r.err;
+  }
+  r = run({"resample", "--brdf", "lambert", "--param", "dupuy-jakob:nope", "-o", "r.npy"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("for `halfback study --params` only"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'dupuy-jakob:nope': 'nope' is neither"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("r.npy")));
+  EXPECT_FALSE(fs::exists(path("s.png")));
 
   const std::vector<std::string> study = {"study",
                                           "--quick",
