@@ -284,6 +284,8 @@ TEST(RglExport, BadInputWritesNothing) {
     EXPECT_EQ(files, 1u);  // no temporary left behind
   };
   expect_refused(*load_brdf("lambert:albedo=0"), "zero in every backscattering direction");
+  // 1 − cos θd: zero at backscattering up to rounding (1e-16), not a distribution to recover.
+  expect_refused(*load_brdf("test:F"), "zero in every backscattering direction");
   const test::FunctionBrdf nan_everywhere([](const DirPair<double>&) { return std::nan(""); });
   expect_refused(nan_everywhere, "not finite at ω =");
   // Finite at backscattering, NaN elsewhere: found while tabulating.
