@@ -110,47 +110,6 @@ figure::Scene gonio_chart(const std::vector<BrdfResult>& results, bool four_d,
   return figure::loglog_chart(c);
 }
 
-// The renderings of the BRDFs and of their regular-design reconstructions under the first
-// environment, side by side (the same tone mapping for a row), for the eye.
-figure::Scene examples_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
-  const std::vector<Space>& params = params_of(results);
-  const double cell = 66, gap = 4, label_w = 250, top = 78;
-  const std::size_t columns = params.size() + 1;  // the BRDF, then its reconstructions
-  std::size_t rows = 0;
-  for (const BrdfResult& b : results) rows += b.example_images.size() == columns;
-  if (rows == 0 || config.environments.empty()) return {};
-  figure::Scene sc;
-  sc.title = "Renderings of the reconstructions";
-  const std::string title = fmt::format(
-      "The BRDF and its reconstructions from {} measurements (regular design), under {}",
-      config.image_budget, config.environments.front().label);
-  const std::string note = fmt::format(
-      "{} environment samples per pixel, the same in every image: the noise is common to a row",
-      config.image_spp);
-  sc.width = figure::snap(std::max(label_w + double(columns) * (cell + gap) + 10,
-                                   24 + 13 * 0.62 * double(title.size())));
-  sc.height = figure::snap(top + 14 + double(rows) * (cell + gap) + 10);
-  sc.text({12, 24}, figure::escape_markup(title), 13, figure::HAlign::left,
-          figure::VAlign::baseline, figure::kBlack, 0, true);
-  sc.text({12, 42}, figure::escape_markup(note), 9.5);
-  std::vector<std::string> heads{"BRDF"};
-  for (const std::string& name : param_names(params)) heads.push_back(name);
-  for (std::size_t k = 0; k < heads.size(); ++k)
-    sc.text({label_w + double(k) * (cell + gap) + cell / 2, top - 8},
-            figure::escape_markup(heads[k]), 9, figure::HAlign::centre);
-  double y = top;
-  for (const BrdfResult& b : results) {
-    if (b.example_images.size() != columns) continue;
-    sc.text({label_w - 8, y + cell / 2}, figure::escape_markup(b.label), 8.5, figure::HAlign::right,
-            figure::VAlign::middle);
-    for (std::size_t k = 0; k < b.example_images.size(); ++k)
-      sc.add(
-          figure::rendering_item(b.example_images[k], label_w + double(k) * (cell + gap), y, cell));
-    y += cell + gap;
-  }
-  return sc;
-}
-
 // Each parameterization's median error per design (section 3b).
 figure::Scene designs_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
   const std::size_t ref = reference_budget(config);
@@ -203,6 +162,50 @@ void save_plot(const figure::Scene& sc, const std::filesystem::path& dir, const 
 }
 
 }  // namespace
+
+// The renderings of the BRDFs and of their regular-design reconstructions under the first
+// environment, side by side (the same tone mapping for a row), for the eye.
+figure::Scene examples_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const std::vector<Space>& params = params_of(results);
+  const double cell = 66, gap = 4, label_w = 250, top = 78;
+  const std::size_t columns = params.size() + 1;  // the BRDF, then its reconstructions
+  std::size_t rows = 0;
+  for (const BrdfResult& b : results) rows += b.example_images.size() == columns;
+  if (rows == 0 || config.environments.empty()) return {};
+  figure::Scene sc;
+  sc.title = "Renderings of the reconstructions";
+  const std::string title = fmt::format(
+      "The BRDF and its reconstructions from {} measurements (regular design), under {}",
+      config.image_budget, config.environments.front().label);
+  const std::string note = fmt::format(
+      "{} environment samples per pixel, the same in every image: the noise is common to a row",
+      config.image_spp);
+  std::vector<std::string> heads{"BRDF"};
+  for (const std::string& name : param_names(params)) heads.push_back(figure::escape_markup(name));
+  // The columns' pitch: a cell, or the widest head (a parameterization's name is wider than a
+  // cell: "rectified-hybrid", "dupuy-jakob:per-material").
+  double pitch = cell + gap;
+  for (const std::string& head : heads)
+    pitch = std::max(pitch, figure::snap(figure::approx_text_width(head, 9) + 8));
+  sc.width = figure::snap(
+      std::max(label_w + double(columns) * pitch + 10, 24 + 13 * 0.62 * double(title.size())));
+  sc.height = figure::snap(top + 14 + double(rows) * (cell + gap) + 10);
+  sc.text({12, 24}, figure::escape_markup(title), 13, figure::HAlign::left,
+          figure::VAlign::baseline, figure::kBlack, 0, true);
+  sc.text({12, 42}, figure::escape_markup(note), 9.5);
+  for (std::size_t k = 0; k < heads.size(); ++k)
+    sc.text({label_w + double(k) * pitch + cell / 2, top - 8}, heads[k], 9, figure::HAlign::centre);
+  double y = top;
+  for (const BrdfResult& b : results) {
+    if (b.example_images.size() != columns) continue;
+    sc.text({label_w - 8, y + cell / 2}, figure::escape_markup(b.label), 8.5, figure::HAlign::right,
+            figure::VAlign::middle);
+    for (std::size_t k = 0; k < b.example_images.size(); ++k)
+      sc.add(figure::rendering_item(b.example_images[k], label_w + double(k) * pitch, y, cell));
+    y += cell + gap;
+  }
+  return sc;
+}
 
 ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
                          const Contents& has, const std::vector<SummaryMetric>& summary) {

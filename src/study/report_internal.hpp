@@ -131,6 +131,9 @@ struct ReportPlots {
 };
 ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
                          const Contents& has, const std::vector<SummaryMetric>& summary);
+// The renderings of the BRDFs and of their regular-design reconstructions under the first
+// environment, a column per parameterization (empty when there are none).
+figure::Scene examples_chart(const std::vector<BrdfResult>& results, const StudyConfig& config);
 // Writes the plots that have something to draw as PNG and SVG, adding their names to `files`.
 void save_plots(const ReportPlots& plots, const std::filesystem::path& dir,
                 std::vector<std::string>& files);

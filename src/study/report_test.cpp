@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "fake_results.hpp"
+#include "halfback/figure/plot.hpp"
+#include "report_internal.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::study {
@@ -70,6 +72,41 @@ StudyConfig config_of_fakes() {
 BrdfResult network_of(const BrdfResult& file) {
   return to_result(fake_numbers("nbrdf:" + file.label.substr(file.label.find(':') + 1),
                                 file.isotropic, {4, 3, 2, 1}));
+}
+
+// The renderings' column heads are parameterization names, some wider than a rendering: the
+// columns are spaced so that no two heads overlap (by the layout's width estimate), and each
+// rendering sits under its head.
+TEST(Report, RenderingColumnsFitTheirHeads) {
+  FakeBrdf b;
+  b.label = "a";
+  b.isotropic = true;
+  for (Space s : {space_of<RectifiedHybrid>, space_of<StereoHalfDiff>, space_of<HalfDiff>}) {
+    FakeParam p;
+    p.space = s;
+    b.params.push_back(p);
+  }
+  BrdfResult r = to_result(b);
+  const render::Image grey{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
+  r.example_images.assign(r.params.size() + 1, grey);
+  const figure::Scene sc = report::examples_chart({r}, config_of_fakes());
+  std::vector<const figure::TextItem*> heads;
+  std::vector<double> images;
+  for (const figure::Item& item : sc.items) {
+    if (const auto* t = std::get_if<figure::TextItem>(&item);
+        t && t->halign == figure::HAlign::centre)
+      heads.push_back(t);
+    if (const auto* i = std::get_if<figure::ImageItem>(&item)) images.push_back(i->x);
+  }
+  ASSERT_EQ(heads.size(), 4u);  // BRDF, then the three parameterizations
+  ASSERT_EQ(images.size(), 4u);
+  for (std::size_t k = 0; k + 1 < heads.size(); ++k) {
+    const double half_widths = (figure::approx_text_width(heads[k]->text, heads[k]->size) +
+                                figure::approx_text_width(heads[k + 1]->text, heads[k + 1]->size)) /
+                               2;
+    EXPECT_GE(heads[k + 1]->at.x - heads[k]->at.x, half_widths) << heads[k + 1]->text;
+    EXPECT_GE(images[k + 1] - images[k], heads[k + 1]->at.x - heads[k]->at.x - 1e-9);
+  }
 }
 
 TEST(Report, FilesRepeatTheResults) {
