@@ -54,6 +54,10 @@ def fit_loss(brdf, model, loss="ngan", samples=20000, threads=0):
     return _core.fit_loss(brdf, model, loss, samples, threads)
 
 
+def fit_samples(n):
+    return _core.fit_samples(n)
+
+
 def published_fits(path):
     return _core.published_fits(str(path))
 
@@ -78,6 +82,7 @@ study_brdf.__doc__ = _core.study_brdf.__doc__
 fit.__doc__ = _core.fit.__doc__
 plan.__doc__ = _core.plan.__doc__
 fit_loss.__doc__ = _core.fit_loss.__doc__
+fit_samples.__doc__ = _core.fit_samples.__doc__
 published_fits.__doc__ = _core.published_fits.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
 study_profile.__doc__ = _core.study_profile.__doc__
@@ -88,6 +93,7 @@ __all__ = [
     "convert",
     "fit",
     "fit_loss",
+    "fit_samples",
     "hemisphere",
     "jacobian",
     "load",

@@ -1,5 +1,5 @@
 // The fitter: model parsing against the registry, the sample layout, the losses' residuals, the
-// Ceres problem (one parameter block per term, bound-aware central differences) and the starts.
+// Ceres problem (one parameter block per term, bound-aware forward differences) and the starts.
 #include "halfback/fit/fit.hpp"
 
 #include <ceres/ceres.h>
@@ -314,9 +314,56 @@ Blocks blocks_of(const Model& m) {
   return b;
 }
 
+// The channel a parameter drives alone (0, 1, 2 for NAME_r/_g/_b), or -1 for one that may drive
+// every channel. Contract of the registry's colour parameters (models/colour_params.hpp), checked
+// for every registered model by FitCost.ColourParametersDriveTheirChannelOnly.
+int channel_of(const Param& p) {
+  const std::size_t n = p.name.size();
+  if (n < 3 || p.name[n - 2] != '_') return -1;
+  switch (p.name[n - 1]) {
+    case 'r':
+      return 0;
+    case 'g':
+      return 1;
+    case 'b':
+      return 2;
+    default:
+      return -1;
+  }
+}
+
+// A block's fitted parameters in groups that one difference serves: the three channels of a colour
+// parameter change disjoint residuals, so one evaluation with all three shifted gives three
+// columns of the Jacobian.
+std::vector<std::vector<std::size_t>> difference_groups(const Model& m,
+                                                        const std::vector<std::size_t>& params) {
+  std::vector<std::vector<std::size_t>> groups;
+  std::vector<std::string> stems;  // of each group; empty for a parameter alone
+  const auto joins = [&](std::size_t g, const Param& p) {
+    return !stems[g].empty() && p.name.starts_with(stems[g]) &&
+           p.name.size() == stems[g].size() + 2 &&
+           std::none_of(groups[g].begin(), groups[g].end(), [&](std::size_t k) {
+             return channel_of(m.params[params[k]]) == channel_of(p);
+           });
+  };
+  for (std::size_t j = 0; j < params.size(); ++j) {
+    const Param& p = m.params[params[j]];
+    std::size_t g = 0;
+    while (g < groups.size() && !(channel_of(p) >= 0 && joins(g, p))) ++g;
+    if (g == groups.size()) {
+      groups.emplace_back();
+      stems.push_back(channel_of(p) >= 0 ? p.name.substr(0, p.name.size() - 2) : std::string());
+    }
+    groups[g].push_back(j);
+  }
+  return groups;
+}
+
 // Residuals of the loss at the block values, and their Jacobian by forward differences (backward
-// at the upper bound), each difference re-evaluating only the term the parameter belongs to.
-// Derivatives are numeric because the models are not templated (docs/fit.md).
+// at the upper bound), each difference re-evaluating only the term its parameters belong to, the
+// channels of a colour parameter in one difference. Derivatives are numeric because the models
+// are not templated (docs/fit.md). Evaluate() is called by one thread at a time (the solver runs
+// single-threaded; the evaluations use the project's parallel loop), so scratch is shared.
 class FitCost final : public ceres::CostFunction {
  public:
   FitCost(const Model& model, const Blocks& blocks, const Samples& samples,
@@ -327,9 +374,17 @@ class FitCost final : public ceres::CostFunction {
         target_(target),
         loss_(loss),
         threads_(threads),
-        fixed_(samples.pairs.size(), Rgb{0, 0, 0}) {
+        fixed_(samples.pairs.size(), Rgb{0, 0, 0}),
+        terms_(blocks.term.size(), std::vector<Rgb>(samples.pairs.size())),
+        sum_(samples.pairs.size()),
+        shifted_(samples.pairs.size()),
+        shifted_sum_(samples.pairs.size()),
+        shifted_r_(3 * samples.pairs.size()) {
     set_num_residuals(int(3 * samples.pairs.size()));
-    for (const auto& ps : blocks.params) mutable_parameter_block_sizes()->push_back(int(ps.size()));
+    for (const auto& ps : blocks.params) {
+      mutable_parameter_block_sizes()->push_back(int(ps.size()));
+      groups_.push_back(difference_groups(model, ps));
+    }
     // Terms without a fitted parameter are constant: their sum once.
     std::vector<Rgb> v(s_.pairs.size());
     for (std::size_t t = 0; t < model.terms.size(); ++t) {
@@ -348,57 +403,53 @@ class FitCost final : public ceres::CostFunction {
   }
 
  private:
-  // The term of block b at its block values (others' parameters as in model_).
-  std::vector<Rgb> term_values(std::size_t b, const double* v) const {
+  // The term of block b at block values v (others' parameters as in model_), into `out`.
+  void term_values(std::size_t b, const double* v, std::vector<Rgb>& out) const {
     Model m = model_;
     for (std::size_t j = 0; j < blocks_.params[b].size(); ++j)
       m.params[blocks_.params[b][j]].value = v[j];
-    std::vector<Rgb> out(s_.pairs.size());
     eval_all(*load_brdf(term_spec(m, blocks_.term[b])), s_, out, threads_);
-    return out;
   }
 
   bool evaluate(double const* const* values, double* r, double** jacobians) const {
     const std::size_t n = s_.pairs.size(), nb = blocks_.term.size();
-    std::vector<std::vector<Rgb>> terms(nb);
-    std::vector<Rgb> sum = fixed_;
+    sum_ = fixed_;
     for (std::size_t b = 0; b < nb; ++b) {
-      terms[b] = term_values(b, values[b]);
-      for (std::size_t i = 0; i < n; ++i) sum[i] = sum[i] + terms[b][i];
+      term_values(b, values[b], terms_[b]);
+      for (std::size_t i = 0; i < n; ++i) sum_[i] = sum_[i] + terms_[b][i];
     }
-    residuals(loss_, s_, target_, sum, r, threads_);
+    residuals(loss_, s_, target_, sum_, r, threads_);
     if (!jacobians) return true;
-    std::vector<double> rs(3 * n);
-    for (std::size_t b = 0; b < nb; ++b) {
-      if (!jacobians[b]) continue;
-      const std::size_t np = blocks_.params[b].size();
-      std::vector<double> v(values[b], values[b] + np);
-      for (std::size_t j = 0; j < np; ++j) {
-        const Param& p = model_.params[blocks_.params[b][j]];
-        const double x = v[j];
-        // Forward difference (one term evaluation), backward at the upper bound; the step is
-        // about sqrt(machine epsilon) relative, or of the range where x is near 0.
-        double h = 1e-7 * std::max(std::abs(x), 1e-3 * std::max(1.0, p.max - p.min));
-        if (x + h > p.max) h = -h;
-        shifted_residuals(b, v, j, x + h, sum, terms[b], rs);
-        for (std::size_t k = 0; k < 3 * n; ++k) jacobians[b][k * np + j] = (rs[k] - r[k]) / h;
-        v[j] = x;
-      }
-    }
+    for (std::size_t b = 0; b < nb; ++b)
+      if (jacobians[b])
+        for (const auto& group : groups_[b])
+          difference_columns(b, values[b], group, r, jacobians[b]);
     return true;
   }
 
-  // Residuals with parameter j of block b at x (the others at v).
-  void shifted_residuals(std::size_t b, std::vector<double>& v, std::size_t j, double x,
-                         std::span<const Rgb> sum, std::span<const Rgb> term,
-                         std::vector<double>& out) const {
-    const double keep = v[j];
-    v[j] = x;
-    const std::vector<Rgb> t = term_values(b, v.data());
-    v[j] = keep;
-    std::vector<Rgb> s(sum.begin(), sum.end());
-    for (std::size_t i = 0; i < s.size(); ++i) s[i] = s[i] - term[i] + t[i];
-    residuals(loss_, s_, target_, s, out.data(), threads_);
+  // The Jacobian's columns of the parameters `group` of block b (indices into the block), from
+  // one shifted evaluation of the term. A colour channel's column is zero off its channel.
+  void difference_columns(std::size_t b, const double* x, const std::vector<std::size_t>& group,
+                          const double* r, double* jac) const {
+    const std::size_t np = blocks_.params[b].size(), n = s_.pairs.size();
+    std::vector<double> v(x, x + np), h(np, 0.0);
+    for (std::size_t j : group) {
+      const Param& p = model_.params[blocks_.params[b][j]];
+      // Forward (backward at the upper bound); about sqrt(machine epsilon) relative, or of the
+      // range where x is near 0.
+      h[j] = 1e-7 * std::max(std::abs(x[j]), 1e-3 * std::max(1.0, p.max - p.min));
+      if (x[j] + h[j] > p.max) h[j] = -h[j];
+      v[j] = x[j] + h[j];
+    }
+    term_values(b, v.data(), shifted_);
+    for (std::size_t i = 0; i < n; ++i) shifted_sum_[i] = sum_[i] - terms_[b][i] + shifted_[i];
+    residuals(loss_, s_, target_, shifted_sum_, shifted_r_.data(), threads_);
+    for (std::size_t j : group) {
+      const int channel = group.size() > 1 ? channel_of(model_.params[blocks_.params[b][j]]) : -1;
+      for (std::size_t k = 0; k < 3 * n; ++k)
+        jac[k * np + j] =
+            channel < 0 || int(k % 3) == channel ? (shifted_r_[k] - r[k]) / h[j] : 0.0;
+    }
   }
 
   const Model& model_;
@@ -408,6 +459,10 @@ class FitCost final : public ceres::CostFunction {
   Loss loss_;
   int threads_;
   std::vector<Rgb> fixed_;
+  std::vector<std::vector<std::vector<std::size_t>>> groups_;  // per block
+  mutable std::vector<std::vector<Rgb>> terms_;                // scratch, per block
+  mutable std::vector<Rgb> sum_, shifted_, shifted_sum_;
+  mutable std::vector<double> shifted_r_;
 };
 
 struct Solved {
@@ -435,9 +490,9 @@ Solved solve_from(const Model& start, const Samples& s, std::span<const Rgb> tar
       problem.SetParameterUpperBound(x[b].data(), int(j), p.max);
     }
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = o.max_iterations;
-  options.function_tolerance = 1e-12;
+  options.function_tolerance = 1e-9;
   options.gradient_tolerance = 1e-12;
   options.parameter_tolerance = 1e-10;
   options.logging_type = ceres::SILENT;
@@ -523,6 +578,97 @@ Model start_from_spec(const Model& m, std::string_view spec) {
   return out;
 }
 
+// Many starts on many samples: each start runs on a prefix of the layout (kCoarseSamples; the
+// Halton layout's prefix is itself a layout), then the distinct coarse solutions within 5 % of
+// the best loss run again on all samples (docs/fit.md, "Starts"). Returns every run.
+constexpr std::size_t kCoarseSamples = 4096;
+
+Samples prefix_of(const Samples& s, std::size_t n) {
+  Samples p{{s.pairs.begin(), s.pairs.begin() + std::ptrdiff_t(n)},
+            {s.weight.begin(), s.weight.begin() + std::ptrdiff_t(n)},
+            {s.cos_i.begin(), s.cos_i.begin() + std::ptrdiff_t(n)}};
+  double total = 0;
+  for (double w : p.weight) total += w;
+  for (double& w : p.weight) w *= double(n) / total;
+  return p;
+}
+
+// Whether two solutions lie in one basin: every fitted parameter within 5 % (of its value, or of
+// 1e-3 of its range near zero). Coarse solutions of one basin differ by about 1 % where the loss
+// is flat; one of them is refined.
+bool same_basin(const Model& a, const Model& b) {
+  for (std::size_t i = 0; i < a.params.size(); ++i) {
+    const Param& p = a.params[i];
+    const double scale =
+        std::max({std::abs(p.value), std::abs(b.params[i].value), 1e-3 * (p.max - p.min)});
+    if (p.fitted && std::abs(p.value - b.params[i].value) > 0.05 * scale) return false;
+  }
+  return true;
+}
+
+bool at_bound(const Param& p) {
+  const double tol = 1e-12 * (p.max - p.min);
+  return p.value <= p.min + tol || p.value >= p.max - tol;
+}
+
+// The full solve from a coarse solution. Parameters the coarse solve left at a bound are held
+// there (Ceres's steps truncated at a bound shrink its trust region: dozens of iterations of
+// creeping otherwise); one whose inward move lowers the loss afterwards is freed and the solve
+// resumed (the bound's KKT condition, checked by a difference).
+Solved refine(const Model& coarse, const Samples& s, std::span<const Rgb> target,
+              const FitOptions& o) {
+  Model held = coarse;
+  std::vector<std::size_t> pinned;
+  for (std::size_t i = 0; i < held.params.size(); ++i)
+    if (held.params[i].fitted && at_bound(held.params[i]))
+      held.params[i].fitted = false, pinned.push_back(i);
+  const bool any_free =
+      std::any_of(held.params.begin(), held.params.end(), [](auto& p) { return p.fitted; });
+  Solved r = any_free ? solve_from(held, s, target, o) : Solved{held, 0, 0};
+  if (!any_free) r.loss = loss_value(target, *load_brdf(spec_of(held)), o.loss, s, o.threads);
+  bool freed = false;
+  for (std::size_t i : pinned) {
+    Param& p = r.model.params[i];
+    Model trial = r.model;
+    const double step = 1e-6 * (p.max - p.min);
+    trial.params[i].value = p.value <= p.min + step ? p.min + step : p.max - step;
+    if (loss_value(target, *load_brdf(spec_of(trial)), o.loss, s, o.threads) < r.loss)
+      p.fitted = true, freed = true;
+  }
+  if (freed) {
+    const Solved again = solve_from(r.model, s, target, o);
+    r = {again.model, again.loss, r.iterations + again.iterations};
+  }
+  for (std::size_t i : pinned) r.model.params[i].fitted = true;
+  return r;
+}
+
+std::vector<Solved> solve_starts(const std::vector<Model>& starts, const Samples& s,
+                                 std::span<const Rgb> target, const FitOptions& o) {
+  std::vector<Solved> out;
+  if (s.pairs.size() <= 2 * kCoarseSamples) {
+    for (const Model& start : starts) out.push_back(solve_from(start, s, target, o));
+    return out;
+  }
+  const Samples coarse = prefix_of(s, kCoarseSamples);
+  std::vector<Solved> rough;
+  for (const Model& start : starts)
+    rough.push_back(solve_from(start, coarse, target.first(kCoarseSamples), o));
+  std::sort(rough.begin(), rough.end(), [](auto& a, auto& b) { return a.loss < b.loss; });
+  std::vector<const Model*> refined;
+  for (const Solved& r : rough) {
+    if (!(r.loss <= 1.05 * rough.front().loss) && !refined.empty()) break;
+    if (std::any_of(refined.begin(), refined.end(),
+                    [&](const Model* m) { return same_basin(*m, r.model); }))
+      continue;
+    refined.push_back(&r.model);
+    out.push_back(refine(r.model, s, target, o));
+  }
+  for (Solved& r : rough)
+    out.push_back({r.model, std::numeric_limits<double>::infinity(), r.iterations});
+  return out;
+}
+
 // ---- The target ----------------------------------------------------------------------------
 
 std::string where(const DirPair<double>& p) {
@@ -579,18 +725,14 @@ FitResult fit(const Brdf& target, std::string_view model_spec, const FitOptions&
   if (starts.empty()) starts = automatic_starts(model, target);
 
   FitResult result;
-  double best = std::numeric_limits<double>::infinity();
-  for (const Model& start : starts) {
-    Solved solved = solve_from(start, s, t, o);
-    result.iterations += solved.iterations;
-    if (solved.loss < best || result.model.terms.empty()) {
-      best = solved.loss;
-      result.model = std::move(solved.model);
-    }
-  }
+  const std::vector<Solved> solved = solve_starts(starts, s, t, o);
+  for (const Solved& x : solved) result.iterations += x.iterations;
+  const Solved& best = *std::min_element(solved.begin(), solved.end(),
+                                         [](auto& a, auto& b) { return a.loss < b.loss; });
+  result.model = best.model;
   result.spec = spec_of(result.model);
   result.loss = o.loss;
-  result.loss_value = best;
+  result.loss_value = best.loss;
   result.samples = s.pairs.size();
   result.starts = starts.size();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

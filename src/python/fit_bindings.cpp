@@ -1,4 +1,5 @@
 // halfback.fit, fit_loss and published_fits (issue 37; docs/fit.md).
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -84,6 +85,26 @@ py::list published_fits(const std::string& path) {
   return out;
 }
 
+// fit()'s layout of n pairs as arrays (for baselines written in Python: bench/fit_scipy_bench.py).
+py::dict fit_samples(std::size_t n) {
+  const fit::Samples s = fit::halfdiff_samples(n);
+  const auto rows = py::ssize_t(s.pairs.size());
+  py::array_t<double> wi({rows, py::ssize_t(3)}), wo({rows, py::ssize_t(3)}), weight(rows),
+      cos_i(rows);
+  auto a = wi.mutable_unchecked<2>(), b = wo.mutable_unchecked<2>();
+  auto w = weight.mutable_unchecked<1>(), c = cos_i.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < rows; ++i) {
+    const auto& p = s.pairs[std::size_t(i)];
+    a(i, 0) = p.wi.x, a(i, 1) = p.wi.y, a(i, 2) = p.wi.z;
+    b(i, 0) = p.wo.x, b(i, 1) = p.wo.y, b(i, 2) = p.wo.z;
+    w(i) = s.weight[std::size_t(i)], c(i) = s.cos_i[std::size_t(i)];
+  }
+  py::dict out;
+  out["wi"] = wi, out["wo"] = wo, out["weight"] = weight, out["cos_i"] = cos_i;
+  out["layout"] = std::string(fit::kLayoutName);
+  return out;
+}
+
 }  // namespace
 
 void bind_fit(py::module_& m) {
@@ -102,6 +123,10 @@ anisotropic) raises RuntimeError.)doc");
 pairs, as fit() measures it: fit(b, m, loss, n)["loss_value"] is fit_loss(b, its spec, loss, n).
 The GIL is released while it runs. A bad loss raises ValueError; a target the fit cannot use,
 RuntimeError.)doc");
+  m.def("fit_samples", &fit_samples, py::arg("n"),
+        R"doc(fit()'s layout of n pairs (docs/fit.md, "Sample layout") as a dict of arrays: wi and
+wo (n, 3), weight (n,; mean 1) and cos_i (n,). A prefix of the layout of more pairs is the layout
+of fewer, up to the weights' normalisation. n = 0 raises ValueError.)doc");
   m.def(
       "published_fits", &published_fits, py::arg("path"),
       R"doc(The published fits of a BBM .fit file (Ngan et al. 2005; ../shared/data/fits/): a list of

@@ -55,6 +55,25 @@ def test_fit_loss_is_the_loss_fit_reports():
         halfback.fit_loss("lambert:albedo=0", target, samples=100)
 
 
+def test_fit_samples_are_the_layout_fit_loss_uses():
+    s = halfback.fit_samples(2000)
+    assert s["wi"].shape == (2000, 3) and s["wo"].shape == (2000, 3)
+    assert np.all(s["wi"][:, 2] > 0) and np.all(s["wo"][:, 2] > 0)
+    assert s["weight"].mean() == pytest.approx(1, abs=1e-12)
+    np.testing.assert_array_equal(s["cos_i"], s["wi"][:, 2])
+    # A prefix of a longer layout is the shorter one (fit's coarse starts rely on it).
+    longer = halfback.fit_samples(5000)
+    np.testing.assert_array_equal(longer["wi"][:2000], s["wi"])
+    # Ngan's loss written from the arrays is fit_loss's.
+    target, model = "lambert:albedo=0.3", "lambert:albedo=0.5"
+    t = halfback.load(target).eval(s["wi"], s["wo"])
+    m = halfback.load(model).eval(s["wi"], s["wo"])
+    r = (m - t) * (np.sqrt(s["weight"]) * s["cos_i"])[:, None]
+    assert np.mean(r**2) == pytest.approx(halfback.fit_loss(target, model, "ngan", 2000), rel=1e-12)
+    with pytest.raises(ValueError):
+        halfback.fit_samples(0)
+
+
 def test_published_fits_as_specs(tmp_path):
     f = tmp_path / "x.fit"
     f.write_text("# c\nm = Aggregate(Lambertian(albedo = [0.1, 0.2, 0.3]), "
