@@ -28,6 +28,12 @@ std::string_view name_of(Loss loss) {
       return "low-e2";
     case Loss::cube_root:
       return "cube-root";
+    case Loss::bieron_l2:
+      return "bieron-l2";
+    case Loss::bieron_log:
+      return "bieron-log";
+    case Loss::nielsen:
+      return "nielsen";
     case Loss::log:
       break;
   }
@@ -230,22 +236,33 @@ std::string spec_of(const Model& m) {
 
 namespace {
 
-// The residual of one channel of one sample (docs/fit.md): model value m, target t, cos θi c,
-// sqrt of the sample's weight sw.
-double residual(Loss loss, double m, double t, double c, double sw) {
+// The residual of one channel of one sample (docs/fit.md, "Losses"): model value m, target t,
+// cos θi ci, cos θo co, sqrt of the sample's solid-angle weight sw.
+double residual(Loss loss, double m, double t, double ci, double co, double sw) {
   switch (loss) {
     case Loss::ngan:
-      return sw * c * (m - t);
+      return sw * ci * (m - t);
     case Loss::low_e1:
-      return c * (m - t);
+      return ci * (m - t);
     case Loss::low_e2:
-      return std::log1p(c * std::max(m, 0.0)) - std::log1p(c * t);
+      return std::log1p(ci * std::max(m, 0.0)) - std::log1p(ci * t);
     case Loss::cube_root:
-      return sw * (std::cbrt(c * m) - std::cbrt(c * t));
+      return sw * (std::cbrt(ci * m) - std::cbrt(ci * t));
+    case Loss::bieron_l2:
+      return sw * std::sqrt(co) * ci * (m - t);
+    case Loss::bieron_log:
+      return sw * std::sqrt(co) * (std::log1p(ci * std::max(m, 0.0)) - std::log1p(ci * t));
+    case Loss::nielsen: {
+      // The study's error space (study/metrics.hpp): ln(1 + ρ c / ε), c = max(cos θi cos θo, 0.01).
+      constexpr double kEps = 1e-3;
+      const double c = std::max(ci * co, 0.01);
+      return sw * std::sqrt(ci * co) *
+             (std::log1p(c * std::max(m, 0.0) / kEps) - std::log1p(c * t / kEps));
+    }
     case Loss::log:
       break;
   }
-  return sw * (std::log1p(std::max(m, 0.0)) - std::log1p(t));
+  return sw * std::sqrt(ci * co) * (std::log1p(std::max(m, 0.0)) - std::log1p(t));
 }
 
 constexpr std::size_t kGrain = 2048;
@@ -266,10 +283,10 @@ void residuals(Loss loss, const Samples& s, std::span<const Rgb> target, std::sp
       s.pairs.size(), kGrain,
       [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
-          const double c = s.cos_i[i], sw = std::sqrt(s.weight[i]);
-          r[3 * i] = residual(loss, model[i].r, target[i].r, c, sw);
-          r[3 * i + 1] = residual(loss, model[i].g, target[i].g, c, sw);
-          r[3 * i + 2] = residual(loss, model[i].b, target[i].b, c, sw);
+          const double c = s.cos_i[i], co = s.pairs[i].wo.z, sw = std::sqrt(s.weight[i]);
+          r[3 * i] = residual(loss, model[i].r, target[i].r, c, co, sw);
+          r[3 * i + 1] = residual(loss, model[i].g, target[i].g, c, co, sw);
+          r[3 * i + 2] = residual(loss, model[i].b, target[i].b, c, co, sw);
         }
       },
       threads);

@@ -64,12 +64,24 @@ def test_fit_samples_are_the_layout_fit_loss_uses():
     # A prefix of a longer layout is the shorter one (fit's coarse starts rely on it).
     longer = halfback.fit_samples(5000)
     np.testing.assert_array_equal(longer["wi"][:2000], s["wi"])
-    # Ngan's loss written from the arrays is fit_loss's.
-    target, model = "lambert:albedo=0.3", "lambert:albedo=0.5"
+    # Each loss written from the arrays (docs/fit.md, "Losses") is fit_loss's.
+    target, model = "lambert:albedo=0.3+ggx:alpha=0.2", "lambert:albedo=0.5"
     t = halfback.load(target).eval(s["wi"], s["wo"])
     m = halfback.load(model).eval(s["wi"], s["wo"])
-    r = (m - t) * (np.sqrt(s["weight"]) * s["cos_i"])[:, None]
-    assert np.mean(r**2) == pytest.approx(halfback.fit_loss(target, model, "ngan", 2000), rel=1e-12)
+    w, c, co = (x[:, None] for x in (s["weight"], s["cos_i"], s["wo"][:, 2]))
+    k = np.maximum(c * co, 0.01)
+    residuals = {
+        "ngan": np.sqrt(w) * c * (m - t),
+        "low-e1": c * (m - t),
+        "low-e2": np.log1p(c * m) - np.log1p(c * t),
+        "cube-root": np.sqrt(w) * (np.cbrt(c * m) - np.cbrt(c * t)),
+        "bieron-l2": np.sqrt(w * co) * c * (m - t),
+        "bieron-log": np.sqrt(w * co) * (np.log1p(c * m) - np.log1p(c * t)),
+        "log": np.sqrt(w * c * co) * (np.log1p(m) - np.log1p(t)),
+        "nielsen": np.sqrt(w * c * co) * (np.log1p(k * m / 1e-3) - np.log1p(k * t / 1e-3)),
+    }
+    for loss, r in residuals.items():
+        assert np.mean(r**2) == pytest.approx(halfback.fit_loss(target, model, loss, 2000), rel=1e-9), loss
     with pytest.raises(ValueError):
         halfback.fit_samples(0)
 

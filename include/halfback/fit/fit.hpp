@@ -22,12 +22,12 @@ class FitDataError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Loss { ngan, low_e1, low_e2, cube_root, log };
-inline constexpr Loss kLosses[] = {Loss::ngan, Loss::low_e1, Loss::low_e2, Loss::cube_root,
-                                   Loss::log};
+enum class Loss { ngan, low_e1, low_e2, cube_root, bieron_l2, bieron_log, log, nielsen };
+inline constexpr Loss kLosses[] = {Loss::ngan,      Loss::low_e1,     Loss::low_e2, Loss::cube_root,
+                                   Loss::bieron_l2, Loss::bieron_log, Loss::log,    Loss::nielsen};
 std::string_view name_of(Loss loss);                    // "ngan", "low-e1", ...
 std::optional<Loss> parse_loss(std::string_view name);  // nullopt when unknown
-std::string loss_names();                               // "ngan, low-e1, low-e2, cube-root, log"
+std::string loss_names();                               // "ngan, low-e1, ..."
 
 // The sample layout: n pairs from a Halton sequence (bases 2, 3, 5) in the isotropic halfdiff
 // coordinates θh ∈ [0, π/2), θd ∈ [0, π/2), φd ∈ [0, π) at the canonical pose (φh = 0); points
