@@ -30,7 +30,7 @@ namespace {
 struct StudyOptions {
   std::vector<std::string> specs, merge;
   std::string out = "study";
-  std::string budgets, budgets_4d, environments, params, sampler_kib;
+  std::string budgets, budgets_4d, environments, params, sampler_kib, fit_budgets;
   std::string designs = "own,angle,merl,learned";
   study::StudySettings settings;
   bool resume = false;
@@ -46,6 +46,8 @@ study::StudyConfig make_config(const StudyOptions& o) {
   if (!o.environments.empty()) s.environments = split_list(o.environments, "--env", "environment");
   if (!o.sampler_kib.empty())
     s.sampler_kib = count_list(o.sampler_kib, "--sampler-kib", "table size");
+  if (!o.fit_budgets.empty())
+    s.fit_budgets = count_list(o.fit_budgets, "--fit-budgets", "sample budget");
   s.designs = split_list(o.designs, "--designs", "design");
   if (!o.params.empty()) s.params = split_list(o.params, "--params", "parameterization");
   try {
@@ -375,6 +377,15 @@ Command register_study(CLI::App& parent) {
                   "Samples per outgoing direction of the sampling metric (default 4096)")
       ->check(CLI::Range(std::size_t(2), study::kMaxSamplerSamples));
   app->add_flag("--no-sampling", o->settings.no_sampling, "No sampling metric");
+  app->add_option("--fit-model", o->settings.fit_model,
+                  "Model of the fit metric, fitted to each design's measurements and to the whole "
+                  "BRDF (default lambert+ggx; docs/study.md)");
+  app->add_option("--fit-loss", o->settings.fit_loss,
+                  "Loss of the fit metric (default ngan; `halfback fit --loss`)");
+  app->add_option("--fit-budgets", o->fit_budgets,
+                  "Measurement budgets of the fit metric, ascending, comma-separated (default "
+                  "1000,10000; --quick 1000)");
+  app->add_flag("--no-fit", o->settings.no_fit, "No fit metric");
   app->add_flag("-q,--quiet", o->quiet, "Nothing on stdout (the report is in the output folder)");
   app->add_flag("--full-report", o->full_report,
                 "The whole report on stdout (by default: its summary and where the files are)");

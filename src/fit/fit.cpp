@@ -10,6 +10,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
+#include <random>
 #include <set>
 
 #include "halfback/core/batch.hpp"
@@ -561,9 +563,11 @@ double at_quantile(const Param& p, double q) {
   return p.min + q * (p.max - p.min);
 }
 
-std::vector<Model> automatic_starts(const Model& m, const Brdf& target) {
+// The registry's defaults, α from the target's peak (when there is a target BRDF to look at),
+// and the grid.
+std::vector<Model> automatic_starts(const Model& m, const Brdf* target) {
   std::vector<Model> starts{m};  // the registry's defaults
-  if (const auto alpha = roughness_from_peak(target)) {
+  if (const auto alpha = target ? roughness_from_peak(*target) : std::nullopt) {
     Model guess = m;
     for (Param& p : guess.params)
       if (p.fitted && p.name == "alpha") p.value = std::clamp(*alpha, p.min, p.max);
@@ -595,19 +599,43 @@ Model start_from_spec(const Model& m, std::string_view spec) {
   return out;
 }
 
-// Many starts on many samples: each start runs on a prefix of the layout (kCoarseSamples; the
-// Halton layout's prefix is itself a layout), then the distinct coarse solutions within 5 % of
-// the best loss run again on all samples (docs/fit.md, "Starts"). Returns every run.
+// Many starts on many samples: each start runs on a subset of kCoarseSamples (for the Halton
+// layout its prefix, itself a layout; for a caller's samples a seeded random subset), then the
+// distinct coarse solutions within 5 % of the best loss run again on all samples (docs/fit.md,
+// "Starts"). Returns every run.
 constexpr std::size_t kCoarseSamples = 4096;
 
-Samples prefix_of(const Samples& s, std::size_t n) {
-  Samples p{{s.pairs.begin(), s.pairs.begin() + std::ptrdiff_t(n)},
-            {s.weight.begin(), s.weight.begin() + std::ptrdiff_t(n)},
-            {s.cos_i.begin(), s.cos_i.begin() + std::ptrdiff_t(n)}};
+struct Subset {
+  Samples samples;
+  std::vector<Rgb> target;
+};
+
+// The samples `keep` of `s` with their targets, weights renormalised to mean 1.
+Subset subset_of(const Samples& s, std::span<const Rgb> target, std::span<const std::size_t> keep) {
+  Subset out;
   double total = 0;
-  for (double w : p.weight) total += w;
-  for (double& w : p.weight) w *= double(n) / total;
-  return p;
+  for (std::size_t i : keep) {
+    out.samples.pairs.push_back(s.pairs[i]);
+    out.samples.weight.push_back(s.weight[i]);
+    out.samples.cos_i.push_back(s.cos_i[i]);
+    out.target.push_back(target[i]);
+    total += s.weight[i];
+  }
+  for (double& w : out.samples.weight) w *= double(keep.size()) / total;
+  return out;
+}
+
+Subset coarse_subset(const Samples& s, std::span<const Rgb> target, bool halton_prefix) {
+  std::vector<std::size_t> keep(s.pairs.size());
+  std::iota(keep.begin(), keep.end(), std::size_t{0});
+  if (!halton_prefix) {  // a partial Fisher–Yates shuffle, seeded: the same subset every run
+    std::mt19937_64 rng(20261205);
+    for (std::size_t i = 0; i < kCoarseSamples; ++i)
+      std::swap(keep[i], keep[i + std::size_t(rng() % (keep.size() - i))]);
+    std::sort(keep.begin(), keep.begin() + std::ptrdiff_t(kCoarseSamples));
+  }
+  keep.resize(kCoarseSamples);
+  return subset_of(s, target, keep);
 }
 
 // Whether two solutions lie in one basin: every fitted parameter within 5 % (of its value, or of
@@ -661,16 +689,17 @@ Solved refine(const Model& coarse, const Samples& s, std::span<const Rgb> target
 }
 
 std::vector<Solved> solve_starts(const std::vector<Model>& starts, const Samples& s,
-                                 std::span<const Rgb> target, const FitOptions& o) {
+                                 std::span<const Rgb> target, bool halton_prefix,
+                                 const FitOptions& o) {
   std::vector<Solved> out;
   if (s.pairs.size() <= 2 * kCoarseSamples) {
     for (const Model& start : starts) out.push_back(solve_from(start, s, target, o));
     return out;
   }
-  const Samples coarse = prefix_of(s, kCoarseSamples);
+  const Subset coarse = coarse_subset(s, target, halton_prefix);
   std::vector<Solved> rough;
   for (const Model& start : starts)
-    rough.push_back(solve_from(start, coarse, target.first(kCoarseSamples), o));
+    rough.push_back(solve_from(start, coarse.samples, coarse.target, o));
   std::sort(rough.begin(), rough.end(), [](auto& a, auto& b) { return a.loss < b.loss; });
   std::vector<const Model*> refined;
   for (const Solved& r : rough) {
@@ -722,13 +751,38 @@ double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t sam
   return loss_value(t, model, loss, s, threads);
 }
 
-FitResult fit(const Brdf& target, std::string_view model_spec, const FitOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const Model model = parse_model(model_spec);
+namespace {
+
+Model fittable_model(std::string_view model_spec) {
+  Model model = parse_model(model_spec);
   if (std::none_of(model.params.begin(), model.params.end(),
                    [](const Param& p) { return p.fitted; }))
     throw std::invalid_argument(
         fmt::format("model '{}': every parameter is given, nothing to fit", model_spec));
+  return model;
+}
+
+FitResult best_of(const std::vector<Solved>& solved, std::size_t samples, std::size_t starts,
+                  Loss loss, std::chrono::steady_clock::time_point t0) {
+  FitResult result;
+  for (const Solved& x : solved) result.iterations += x.iterations;
+  const Solved& best = *std::min_element(solved.begin(), solved.end(),
+                                         [](auto& a, auto& b) { return a.loss < b.loss; });
+  result.model = best.model;
+  result.spec = spec_of(result.model);
+  result.loss = loss;
+  result.loss_value = best.loss;
+  result.samples = samples;
+  result.starts = starts;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace
+
+FitResult fit(const Brdf& target, std::string_view model_spec, const FitOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Model model = fittable_model(model_spec);
   std::vector<Model> starts;
   for (const std::string& spec : o.starts) starts.push_back(start_from_spec(model, spec));
   if (!target.isotropic())
@@ -739,21 +793,24 @@ FitResult fit(const Brdf& target, std::string_view model_spec, const FitOptions&
   std::vector<Rgb> t(s.pairs.size());
   eval_all(target, s, t, o.threads);
   check_target(t, s);
-  if (starts.empty()) starts = automatic_starts(model, target);
+  if (starts.empty()) starts = automatic_starts(model, &target);
+  return best_of(solve_starts(starts, s, t, true, o), s.pairs.size(), starts.size(), o.loss, t0);
+}
 
-  FitResult result;
-  const std::vector<Solved> solved = solve_starts(starts, s, t, o);
-  for (const Solved& x : solved) result.iterations += x.iterations;
-  const Solved& best = *std::min_element(solved.begin(), solved.end(),
-                                         [](auto& a, auto& b) { return a.loss < b.loss; });
-  result.model = best.model;
-  result.spec = spec_of(result.model);
-  result.loss = o.loss;
-  result.loss_value = best.loss;
-  result.samples = s.pairs.size();
-  result.starts = starts.size();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return result;
+FitResult fit_at(const Samples& samples, std::span<const Rgb> values, std::string_view model_spec,
+                 const FitOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t n = samples.pairs.size();
+  if (n == 0 || values.size() != n || samples.weight.size() != n || samples.cos_i.size() != n)
+    throw std::invalid_argument(fmt::format(
+        "fit_at: {} pairs, {} weights, {} cosines and {} values: not one of each per pair", n,
+        samples.weight.size(), samples.cos_i.size(), values.size()));
+  const Model model = fittable_model(model_spec);
+  std::vector<Model> starts;
+  for (const std::string& spec : o.starts) starts.push_back(start_from_spec(model, spec));
+  check_target(values, samples);
+  if (starts.empty()) starts = automatic_starts(model, nullptr);
+  return best_of(solve_starts(starts, samples, values, false, o), n, starts.size(), o.loss, t0);
 }
 
 }  // namespace halfback::fit

@@ -69,6 +69,14 @@ void read_setting(PySettings& out, const std::string& key, const py::handle& v) 
     s.sampler_kib = setting<std::vector<std::size_t>>(v, key);
   else if (key == "sampler_samples")
     s.sampler_samples = setting<std::size_t>(v, key);
+  else if (key == "fit_model")
+    s.fit_model = setting<std::string>(v, key);
+  else if (key == "fit_loss")
+    s.fit_loss = setting<std::string>(v, key);
+  else if (key == "fit_budgets")
+    s.fit_budgets = setting<std::vector<std::size_t>>(v, key);
+  else if (key == "no_fit")
+    s.no_fit = setting<bool>(v, key);
   else if (key == "budgets")
     s.budgets = setting<std::vector<std::size_t>>(v, key);
   else if (key == "budgets_4d")
@@ -92,7 +100,8 @@ void read_setting(PySettings& out, const std::string& key, const py::handle& v) 
         "settings: unknown key '" + key +
         "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
         "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
-        "seed, no_gonio, no_images, sampler_kib, sampler_samples, no_sampling)");
+        "seed, no_gonio, no_images, sampler_kib, sampler_samples, no_sampling, fit_model, fit_loss, "
+        "fit_budgets, no_fit)");
 }
 
 PySettings study_settings(const py::object& settings) {
@@ -252,7 +261,8 @@ spec: a file or model spec, as for load(). settings: a dict of the options of `h
 with '-' spelled '_': params (a list of parameterization names; missing: all of them, spherical
 last), space (the error space), designs (a list), quick, budgets, budgets_4d,
 test_pairs, env (a list), image_budget, image_size, image_spp, max_theta, seed, no_gonio,
-no_images, sampler_kib (a list), sampler_samples, no_sampling (missing: the defaults), and, for the learned design (a default design), profiles: the
+no_images, sampler_kib (a list), sampler_samples, no_sampling, fit_model, fit_loss, fit_budgets (a
+list), no_fit (missing: the defaults), and, for the learned design (a default design), profiles: the
 study_profile() texts of every BRDF of the study, this one's included, in the study's order (the
 warps are learned from all but this one's; without them, a ValueError).
 Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image": one

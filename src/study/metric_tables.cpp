@@ -5,7 +5,7 @@ namespace halfback::study {
 std::span<const TableDef> study_tables() {
   static const TableDef kTables[] = {
       {azimuthal_table}, {separability_table}, {gonio_table}, {budget_table, derive_budget},
-      {image_table},     {sampling_table},
+      {image_table},     {sampling_table},     {fit_table},
   };
   return kTables;
 }

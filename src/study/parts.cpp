@@ -32,6 +32,8 @@ void apply_quick(StudyConfig& c) {
   c.image_spp = 8;
   c.sampler_kib = {64};
   c.sampler_samples = 1024;
+  c.fit_budgets = {1000};
+  c.fit_samples = 5000;
 }
 
 void check_ascending(const std::vector<std::size_t>& v, const char* option) {
@@ -104,6 +106,11 @@ StudyConfig make_config(const StudySettings& o) {
   if (!o.sampler_kib.empty()) c.sampler_kib = o.sampler_kib;
   if (o.sampler_samples) c.sampler_samples = o.sampler_samples;
   if (o.no_sampling) c.sampler_kib.clear();
+  check_ascending(o.fit_budgets, "--fit-budgets");
+  if (!o.fit_model.empty()) c.fit_model = o.fit_model;
+  if (!o.fit_loss.empty()) c.fit_loss = o.fit_loss;
+  if (!o.fit_budgets.empty()) c.fit_budgets = o.fit_budgets;
+  if (o.no_fit) c.fit_model.clear();
   c.seed = o.seed;
   c.max_theta_deg = o.max_theta;
   // The image budget: as asked, else 10^4 if it is a budget, else the middle budget.
@@ -135,13 +142,14 @@ std::string describe_config(const StudyConfig& c) {
       "{}\nbudgets_4d = {}\n"
       "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
       "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
-      "learned_from = {}\nsampler_kib = {}\nsampler_samples = {}\n",
+      "learned_from = {}\nsampler_kib = {}\nsampler_samples = {}\nfit_model = {}\nfit_loss = "
+      "{}\nfit_budgets = {}\nfit_samples = {}\n",
       joined(names_of(c.params)), name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
       joined(std::vector<std::size_t>(c.full_grid.begin(), c.full_grid.end())), joined(c.ranks),
       joined(c.budgets), joined(c.budgets_4d), c.test_pairs, format_csv_number(c.max_theta_deg),
       c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(names_of(c.spacings)),
       c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from, joined(c.sampler_kib),
-      c.sampler_samples);
+      c.sampler_samples, c.fit_model, c.fit_loss, joined(c.fit_budgets), c.fit_samples);
 }
 
 namespace {
@@ -227,6 +235,13 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
     c.sampler_kib = numbers_of<std::size_t>(get("sampler_kib"), where);
   if (kv.count("sampler_samples"))
     c.sampler_samples = number_of<std::size_t>(get("sampler_samples"), where);
+  // Parts written before the fit metric (issue 37) have none of its lines: no fit metric.
+  c.fit_model = kv.count("fit_model") ? get("fit_model") : std::string();
+  if (kv.count("fit_loss")) c.fit_loss = get("fit_loss");
+  c.fit_budgets.clear();
+  if (kv.count("fit_budgets") && !kv.at("fit_budgets").empty())
+    c.fit_budgets = numbers_of<std::size_t>(get("fit_budgets"), where);
+  if (kv.count("fit_samples")) c.fit_samples = number_of<std::size_t>(get("fit_samples"), where);
   return c;
 }
 

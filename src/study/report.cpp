@@ -50,6 +50,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
           designs_section(results, config, plots);
   if (has.images) md += image_section(results, config, plots);
   if (has.sampling) md += sampling_section(results, config);
+  if (has.fit) md += fit_section(results, config);
   md += files_and_networks_section(results, config);
   md += files_paragraph(out.files);
 

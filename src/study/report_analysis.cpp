@@ -40,6 +40,7 @@ Contents contents_of(const std::vector<BrdfResult>& results) {
     has.gonio |= !b.table("gonio").rows.empty();
     has.images |= has_images(b);
     has.sampling |= !b.table("sampling").rows.empty();
+    has.fit |= !b.table("fit").rows.empty();
   }
   return has;
 }

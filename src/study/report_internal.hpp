@@ -32,7 +32,7 @@ const std::vector<Space>& params_of(const std::vector<BrdfResult>& results);
 // What the results hold beyond the isotropic metrics 1-2, which decides the optional sections,
 // files and plots.
 struct Contents {
-  bool anisotropic = false, gonio = false, images = false, sampling = false;
+  bool anisotropic = false, gonio = false, images = false, sampling = false, fit = false;
 };
 Contents contents_of(const std::vector<BrdfResult>& results);
 
@@ -164,6 +164,9 @@ std::string best_design_table(const DesignComparison& c, std::size_t ref);
 std::string image_tables(const std::vector<BrdfResult>& results);
 std::string published_image_table(const std::vector<BrdfResult>& results);
 std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyConfig& config);
+// Per design and budget, each parameterization's median excess of the fit from its measurements
+// over the whole fit and median shape change, and which has the lowest excess per BRDF.
+std::string fit_tables(const std::vector<BrdfResult>& results, const StudyConfig& config);
 std::string file_network_winner_table(const std::vector<BrdfResult>& results, std::size_t ref);
 std::string file_network_gonio_table(const std::vector<BrdfResult>& results, std::size_t ref);
 std::string summary_table(const SummaryMetric& m, const std::vector<Space>& params,
@@ -185,6 +188,7 @@ std::string gonio_section(const std::vector<BrdfResult>& results, const StudyCon
 std::string designs_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
                             const ReportPlots& plots);
 std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config);
+std::string fit_section(const std::vector<BrdfResult>& results, const StudyConfig& config);
 std::string image_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
                           const ReportPlots& plots);
 std::string files_and_networks_section(const std::vector<BrdfResult>& results,

@@ -239,6 +239,22 @@ std::string sampling_section(const std::vector<BrdfResult>& results, const Study
   return md + sampling_tables(results, config);
 }
 
+// Fitting from measurements (issue 37): does the parameterization of a design change the fit?
+std::string fit_section(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  std::string md = fmt::format(
+      "## Fitting from measurements\n\n`{}` fitted under the `{}` loss (docs/fit.md) to the "
+      "measurements of each design of the isotropic gonio-reflectometer (own spacing, within "
+      "the reach), each measurement weighted 1 as a laboratory fits its data (uniform: the "
+      "design's density weights the loss) or by its cell's solid angle (so that the loss "
+      "estimates the whole fit's integral), and to the whole BRDF (fit()'s layout of {} pairs). "
+      "Each cell: the median over the BRDFs of the excess of "
+      "the measurements' fit over the whole fit, both measured on the whole BRDF (0 %: as good "
+      "as fitting the whole BRDF), then the median largest relative change of a shape "
+      "parameter (e.g. α) between the two fits; lower is better. fit.csv has every fit's spec.\n\n",
+      config.fit_model, config.fit_loss, config.fit_samples);
+  return md + fit_tables(results, config);
+}
+
 // 5. The same materials as measured files and as their neural fits, side by side: does the
 // network representation change which parameterization wins?
 std::string files_and_networks_section(const std::vector<BrdfResult>& results,

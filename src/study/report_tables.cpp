@@ -466,4 +466,40 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
   return md;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Metric 6: fitting from measurements
+// ---------------------------------------------------------------------------------------------
+
+std::string fit_tables(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const std::vector<Space>& params = params_of(results);
+  std::string md = table_header("weights | design | budget", params);
+  std::string wins_text;
+  for (FitWeights w : kFitWeights)
+    for (Design d : kDesigns)
+      for (const std::size_t budget : config.fit_budgets) {
+        std::vector<std::vector<double>> excess(params.size()), change(params.size());
+        Wins wins(params);
+        for (const BrdfResult& b : results) {
+          std::vector<double> row(params.size(), NAN);
+          for (std::size_t k = 0; k < params.size(); ++k)
+            for (const FitPoint& p : fit_points(b, params[k]))
+              if (p.weights == w && p.design == d && p.budget == budget) {
+                row[k] = p.layout_loss / p.whole_loss - 1;
+                excess[k].push_back(row[k]);
+                change[k].push_back(p.shape_change);
+              }
+          wins.add(row);
+        }
+        md += fmt::format("| {} | {} | {} |", name_of(w), name_of(d), budget);
+        for (std::size_t k = 0; k < params.size(); ++k)
+          md += excess[k].empty() ? std::string(" – |")
+                                  : fmt::format(" {:.3g} % / {:.2g} % |", 100 * median(excess[k]),
+                                                100 * median(change[k]));
+        md += "\n";
+        wins_text +=
+            fmt::format("- {}, {} at {}: {}\n", name_of(w), name_of(d), budget, wins.text());
+      }
+  return md + "\nLowest excess (BRDFs):\n\n" + wins_text + "\n";
+}
+
 }  // namespace halfback::study::report

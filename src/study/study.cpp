@@ -9,7 +9,9 @@
 #include <optional>
 #include <stdexcept>
 
+#include "fit_metric.hpp"
 #include "halfback/core/parallel.hpp"
+#include "halfback/fit/fit.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/render/sampling_metric.hpp"
@@ -99,6 +101,20 @@ void StudyConfig::validate() const {
         fmt::format("study: {} samples per direction for the sampling "
                     "metric: expected 2 to {}",
                     sampler_samples, kMaxSamplerSamples));
+  if (!fit_model.empty()) {
+    if (!fit::parse_loss(fit_loss))
+      throw std::invalid_argument(
+          fmt::format("study: the fit loss '{}': expected {}", fit_loss, fit::loss_names()));
+    (void)fit::parse_model(fit_model);  // std::invalid_argument naming the model's problem
+    for (std::size_t i = 0; i < fit_budgets.size(); ++i)
+      if (fit_budgets[i] < 1 || fit_budgets[i] > kMaxSampleBudget ||
+          (i && fit_budgets[i] <= fit_budgets[i - 1]))
+        throw std::invalid_argument(
+            fmt::format("study: fit budgets must be ascending, from 1 to {}", kMaxSampleBudget));
+    if (fit_samples < 100 || fit_samples > kMaxTestPairs)
+      throw std::invalid_argument(fmt::format(
+          "study: {} samples for the whole fit: expected 100 to {}", fit_samples, kMaxTestPairs));
+  }
   if (!environments.empty() && !budgets.empty()) {
     if (std::find(budgets.begin(), budgets.end(), image_budget) == budgets.end())
       throw std::invalid_argument(
@@ -309,6 +325,9 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
         if (t.space == space) add_sampling(t.table("sampling"), space, point);
     say("sampling");
   }
+  for (const auto& [space, point] : fit_metric(brdf, config, work, say))
+    for (Task& t : done)
+      if (t.space == space) add_fit(t.table("fit"), space, point);
   // Each table: the rows of the parameterizations one after the other.
   result.params = config.params;
   result.tables = stored_tables();

@@ -91,6 +91,14 @@ struct FitResult {
 // FitDataError for a target the fit cannot use.
 FitResult fit(const Brdf& target, std::string_view model, const FitOptions& options = {});
 
+// Fits `model` to values measured at the caller's pairs (e.g. a gonio-reflectometer's plan:
+// values[k] at samples.pairs[k], weighted by samples.weight[k], whose mean should be 1 for the
+// loss's value to compare with fit()'s), from the registry's defaults and the grid of starts (no
+// start from a peak: there is no BRDF to look at). Throws std::invalid_argument for mismatched
+// sizes, no pairs, or as fit() for the model; FitDataError for values the fit cannot use.
+FitResult fit_at(const Samples& samples, std::span<const Rgb> values, std::string_view model,
+                 const FitOptions& options = {});
+
 // The loss of `model` against target values `target_rgb` at `samples` (one per pair).
 double loss_value(std::span<const Rgb> target_rgb, const Brdf& model, Loss loss,
                   const Samples& samples, int threads = 0);

@@ -25,7 +25,7 @@ struct TableDef {
 };
 
 // Every table, in the order of the CSV files: azimuthal, separability, gonio, budget, image,
-// sampling.
+// sampling, fit.
 std::span<const TableDef> study_tables();
 // The stored tables (those of study_tables() that are not derived), without rows, in order.
 std::vector<MetricTable> stored_tables();
@@ -72,5 +72,12 @@ std::vector<ImagePoint> image_points(const BrdfResult& result, Space space);
 MetricTable sampling_table();
 void add_sampling(MetricTable& table, Space space, const SamplingPoint& point);
 std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space);
+
+// fit: a model fitted to the measurements of each design (isotropic form, own spacing) against
+// the same model fitted to the whole BRDF; excess = layout_loss / whole_loss − 1 (derived when
+// the row is added).
+MetricTable fit_table();
+void add_fit(MetricTable& table, Space space, const FitPoint& point);
+std::vector<FitPoint> fit_points(const BrdfResult& result, Space space);
 
 }  // namespace halfback::study

@@ -31,6 +31,11 @@ struct StudySettings {
   // --sampler-kib: the sampling metric's table sizes (KiB); empty: the default (64, 1024).
   std::vector<std::size_t> sampler_kib;
   std::size_t sampler_samples = 0;  // per outgoing direction; 0: the default
+  // The fit metric (StudyConfig::fit_model, ...): --fit-model (empty: the default), --fit-loss,
+  // --fit-budgets (empty: the default), --no-fit.
+  std::string fit_model, fit_loss;
+  std::vector<std::size_t> fit_budgets;
+  bool no_fit = false;
   std::vector<std::size_t> budgets, budgets_4d;
   std::size_t test_pairs = 0, image_budget = 0;
   int image_size = 0, image_spp = 0;

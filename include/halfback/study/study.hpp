@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -82,6 +83,14 @@ struct StudyConfig {
   // render::measure_sampling with `sampler_samples` samples per ωo.
   std::vector<std::size_t> sampler_kib{64, 1024};
   std::size_t sampler_samples = 4096;
+  // Metric 6 (issue 37): `fit_model` (empty: no fit metric) fitted under `fit_loss` (fit.hpp's
+  // names) to the measurements of the isotropic gonio-reflectometer's designs (own spacing) at
+  // each of `fit_budgets` (ascending), under both FitWeights, and to the whole BRDF on fit()'s
+  // layout of `fit_samples` pairs; isotropic BRDFs only.
+  std::string fit_model = "lambert+ggx";
+  std::string fit_loss = "ngan";
+  std::vector<std::size_t> fit_budgets{1000, 10000};
+  std::size_t fit_samples = 20000;
   // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.
   std::function<void(std::string_view stage)> progress;
 
@@ -117,6 +126,28 @@ struct SamplingPoint {
   double efficiency_vs_cosine = 0;
   std::string own_sampler = "none";
   double efficiency_vs_own = 0;
+};
+
+// A row of the fit table (metric 6, issue 37): `model` fitted under `loss` to the `samples`
+// measurements of a design at `budget`, and to the whole BRDF (fit()'s layout): both fits' losses
+// on the whole BRDF's layout, and the largest relative change of a shape parameter (not a colour
+// channel) between them.
+// How the fit weights a design's measurements: each 1 (as a laboratory fits its data; the design's
+// density then weights the loss), or by the solid angle dωi dωo of its cell (so that the loss
+// estimates the same integral as the whole fit's).
+enum class FitWeights { uniform, solid_angle };
+inline constexpr std::array<FitWeights, 2> kFitWeights{FitWeights::uniform,
+                                                       FitWeights::solid_angle};
+std::string_view name_of(FitWeights w);  // "uniform", "solid-angle"
+std::optional<FitWeights> parse_fit_weights(std::string_view name);
+
+struct FitPoint {
+  Design design = Design::regular;
+  std::size_t budget = 0, samples = 0;
+  FitWeights weights = FitWeights::uniform;
+  std::string model, loss;
+  double whole_loss = 0, layout_loss = 0, shape_change = 0;
+  std::string spec;  // the layout's fit
 };
 
 struct BrdfResult {
