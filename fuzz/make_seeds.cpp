@@ -1,4 +1,4 @@
-// Writes small valid inputs for the fuzzers into DIR/{merl,rgl,alta,npy,envmap}/ (see
+// Writes small valid inputs for the fuzzers into DIR/{merl,rgl,alta,npy,envmap,factored}/ (see
 // fuzz/run.sh): a synthetic RGL material with tiny grids (RGB and spectral), ALTA files, MERL
 // headers, .npy arrays, environment maps (Radiance and OpenEXR); and of each, a copy with trailing
 // data and one extended by zeros, as `truncate -s` extends a file (issue 35, class C: every reader
@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "halfback/formats/factored.hpp"
 #include "halfback/formats/rgl.hpp"
 #include "halfback/render/image.hpp"
 
@@ -83,8 +84,16 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path dir = argv[1];
-  for (const char* sub : {"merl", "rgl", "alta", "npy", "envmap"})
+  for (const char* sub : {"merl", "rgl", "alta", "npy", "envmap", "factored"})
     fs::create_directories(dir / sub);
+
+  // A factored BRDF of rank 2 on a small grid, each factor a ramp.
+  FactoredModel factored;
+  factored.counts = {3, 2, 4};
+  for (auto& terms : factored.channels)
+    for (int r = 0; r < 2; ++r)
+      terms.push_back({{0.1, 0.2 * r, 0.3}, {1.0, 0.5}, {0.2, 0.4, 0.6, 0.8 * r}});
+  write_factored(dir / "factored" / "small.json", factored);
 
   const auto iso = rgl_material(3, 4, 2, {0.0f});
   write(dir / "rgl" / "iso.bsdf", iso.data(), iso.size());

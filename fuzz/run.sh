@@ -11,7 +11,7 @@ build="${FUZZ_BUILD_DIR:-build/fuzz}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 
 cmake --preset fuzz -B "$build" >/dev/null
-cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz h5_fuzz envmap_fuzz \
+cmake --build "$build" -j "$jobs" --target merl_fuzz rgl_fuzz alta_fuzz npy_fuzz h5_fuzz factored_fuzz envmap_fuzz \
   view_fuzz view_wire_fuzz plan_fuzz make_fuzz_seeds make_plan_seeds
 
 corpus="$build/corpus"
@@ -73,13 +73,14 @@ mkdir -p "$artifacts"
 status=0
 # Seeds of the plans' sidecars: small plans written by the planner itself, and broken ones.
 "$build/fuzz/make_plan_seeds" "$corpus/plan"
-for target in merl rgl alta npy h5 envmap view view_wire plan; do
+for target in merl rgl alta npy h5 factored envmap view view_wire plan; do
   case "$target" in
     merl) max_len=4096 ;;     # full-size files are built inside the target
     rgl)  max_len=65536 ;;
     alta) max_len=65536 ;;
     npy)  max_len=4096 ;;
     h5)   max_len=32768 ;;
+    factored) max_len=16384 ;;
     envmap) max_len=32768 ;;
     view) max_len=2048 ;;
     view_wire) max_len=4096 ;;

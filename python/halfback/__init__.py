@@ -54,6 +54,10 @@ def fit_loss(brdf, model, loss="ngan", samples=20000, threads=0):
     return _core.fit_loss(brdf, model, loss, samples, threads)
 
 
+def factor(brdf, param="hybrid", rank=2, counts=(32, 32, 32), threads=0):
+    return _core.factor(brdf, param, rank, tuple(counts), threads)
+
+
 def fit_samples(n):
     return _core.fit_samples(n)
 
@@ -83,6 +87,7 @@ fit.__doc__ = _core.fit.__doc__
 plan.__doc__ = _core.plan.__doc__
 fit_loss.__doc__ = _core.fit_loss.__doc__
 fit_samples.__doc__ = _core.fit_samples.__doc__
+factor.__doc__ = _core.factor.__doc__
 published_fits.__doc__ = _core.published_fits.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
 study_profile.__doc__ = _core.study_profile.__doc__
@@ -91,6 +96,7 @@ __all__ = [
     "Brdf",
     "columns",
     "convert",
+    "factor",
     "fit",
     "fit_loss",
     "fit_samples",

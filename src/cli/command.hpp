@@ -70,6 +70,7 @@ Command register_view(CLI::App& parent);
 Command register_fit(CLI::App& parent);
 Command register_plan(CLI::App& parent);
 Command register_reconstruct(CLI::App& parent);
+Command register_factor(CLI::App& parent);
 
 // "halfback COMMAND: warning: MESSAGE" on stderr.
 void warn(std::string_view command, std::string_view message);

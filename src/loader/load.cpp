@@ -13,6 +13,7 @@
 #include "halfback/core/space.hpp"
 #include "halfback/formats/adaptive_param.hpp"
 #include "halfback/formats/alta.hpp"
+#include "halfback/formats/factored.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/nbrdf.hpp"
 #include "halfback/formats/rgl.hpp"
@@ -75,6 +76,7 @@ BrdfFileFormat detect_brdf_format(const std::filesystem::path& path) {
     return BrdfFileFormat::nbrdf_h5;
   if (head.compare(0, 6, "\x93NUMPY") == 0 && is_nbrdf_npy(path)) return BrdfFileFormat::nbrdf_npy;
   if (looks_like_alta(head)) return BrdfFileFormat::alta;
+  if (looks_like_factored(head)) return BrdfFileFormat::factored;
   return BrdfFileFormat::unknown;
 }
 
@@ -228,7 +230,8 @@ BrdfPtr load_one(std::string_view spec) {
         throw FormatError(path.string(), "format",
                           "not a MERL .binary (34992012 bytes, 90 90 180 header), RGL .bsdf "
                           "(\"tensor_file\" magic), ALTA text file (#DIM header), neural BRDF "
-                          "(HDF5 .h5, or NAME_fc1.npy)");
+                          "(HDF5 .h5, or NAME_fc1.npy), factored BRDF (JSON, \"format\": "
+                          "\"halfback-factored-brdf\")");
     }
     switch (format) {
       case BrdfFileFormat::merl:
@@ -241,6 +244,8 @@ BrdfPtr load_one(std::string_view spec) {
         return std::make_shared<NbrdfBrdf>(read_nbrdf_h5(path), path.stem().string());
       case BrdfFileFormat::nbrdf_npy:
         return load_nbrdf(path);
+      case BrdfFileFormat::factored:
+        return std::make_shared<FactoredBrdf>(read_factored(path));
       case BrdfFileFormat::unknown:
         break;
     }

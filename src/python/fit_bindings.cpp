@@ -3,8 +3,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <string>
 
+#include "halfback/fit/factor.hpp"
 #include "halfback/fit/fit.hpp"
 #include "halfback/fit/published.hpp"
 #include "py_brdf.hpp"
@@ -72,6 +74,26 @@ double fit_loss(const py::object& brdf, const py::object& model, const std::stri
   return fit::loss_of(*target, *m, *l, samples, threads);
 }
 
+// halfback.factor: fit/factor.hpp's model as a dict (the file's text under "text").
+py::dict factor(const py::object& brdf, const std::string& param, std::size_t rank,
+                const std::array<std::size_t, 3>& counts, int threads) {
+  const auto space = space_from_name(param);
+  if (!space || space->is_dirs())
+    throw py::value_error("param '" + param + "': not a parameterization");
+  const BrdfPtr target = brdf_of(brdf);
+  fit::FactorResult r;
+  {
+    py::gil_scoped_release release;
+    r = fit::factor_brdf(*target, *space, {.rank = rank, .counts = counts, .threads = threads});
+  }
+  py::dict d;
+  d["text"] = factored_text(r.model);
+  d["numbers"] = r.model.numbers();
+  d["relative_error"] = r.relative_error;
+  d["sweeps"] = r.sweeps;
+  return d;
+}
+
 py::list published_fits(const std::string& path) {
   py::list out;
   for (const fit::PublishedFit& f : fit::read_published_fits(path)) {
@@ -123,6 +145,13 @@ anisotropic) raises RuntimeError.)doc");
 pairs, as fit() measures it: fit(b, m, loss, n)["loss_value"] is fit_loss(b, its spec, loss, n).
 The GIL is released while it runs. A bad loss raises ValueError; a target the fit cannot use,
 RuntimeError.)doc");
+  m.def("factor", &factor, py::arg("brdf"), py::arg("param") = "hybrid", py::arg("rank") = 2,
+        py::arg("counts") = std::array<std::size_t, 3>{32, 32, 32}, py::arg("threads") = 0,
+        R"doc(A factored model of a BRDF (a spec or a Brdf) in a parameterization, as `halfback
+factor` (docs/fit.md, "Factored models"), the GIL released while it runs: a dict with text (the
+JSON file: write it to a .json file, which load() reads), numbers (its size), relative_error
+(μ-weighted, in log(1 + ρ), on its grid) and sweeps. A bad rank, counts or parameterization, or
+an anisotropic BRDF, raises ValueError; a BRDF not finite somewhere, RuntimeError.)doc");
   m.def("fit_samples", &fit_samples, py::arg("n"),
         R"doc(fit()'s layout of n pairs (docs/fit.md, "Sample layout") as a dict of arrays: wi and
 wo (n, 3), weight (n,; mean 1) and cos_i (n,). A prefix of the layout of more pairs is the layout

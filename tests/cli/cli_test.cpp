@@ -635,6 +635,10 @@ TEST_F(CliTest, ExitStatusesFollowOneRule) {
       {{"render", "--brdf", "lambert", "--spp", "-3", "-o", "x.png"}, 2},
       {{"fit", "--brdf", "lambert", "--model", "ggx", "--loss", "l2", "-o", "f.json"}, 2},
       {{"fit", "--brdf", "lambert", "--model", "nosuch", "-o", "f.json"}, 2},
+      {{"factor", "--brdf", "lambert", "--rank", "0", "-o", "f.json"}, 2},
+      {{"factor", "--brdf", "lambert", "--counts", "8,8", "-o", "f.json"}, 2},
+      {{"factor", "--brdf", "lambert", "--param", "dirs", "-o", "f.json"}, 2},
+      {{"factor", "--brdf", "ggx:alpha_x=0.1,alpha_y=0.3", "-o", "f.json"}, 2},
       // BRDF specs that name nothing or hold a bad value, for every command that takes one.
       {{"info", "ggx:alpha=-1"}, 2},
       {{"info", "nosuch"}, 2},
@@ -678,6 +682,8 @@ TEST_F(CliTest, ExitStatusesFollowOneRule) {
       {{"study", "junk.bsdf", "-o", "st"}, 1},
       {{"view", "junk.bsdf", "--port", "0"}, 1},
       {{"fit", "--brdf", "junk.bsdf", "--model", "ggx", "-o", "f.json"}, 1},
+      {{"factor", "--brdf", "junk.bsdf", "-o", "f.json"}, 1},
+      {{"factor", "--brdf", "lambert", "--counts", "4,4,4", "-o", no_dir + ".json"}, 1},
       {{"fit", "--brdf", "lambert", "--model", "ggx", "--samples", "100", "-o", no_dir + ".json"},
        1},
   };
@@ -691,6 +697,23 @@ TEST_F(CliTest, ExitStatusesFollowOneRule) {
       EXPECT_NE(r.err.find("--help' for more information"), std::string::npos) << line;
     }
   }
+}
+
+// `halfback factor` (issue 37): the factored model is a file that every command reads, written
+// only on success (an existing file is kept when the command fails).
+TEST_F(CliTest, FactorWritesABrdfThatCommandsRead) {
+  Result r = run({"factor", "--brdf", "lambert:albedo=0.5", "--param", "halfdiff", "--rank", "1",
+                  "--counts", "4,4,4", "-o", "l.json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("rank 1, 39 numbers"), std::string::npos) << r.out;
+  r = run({"eval", "--brdf", path("l.json").string()},
+          "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n0,0,1,0.6,0,0.8\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("0.1591549"), std::string::npos) << r.out;  // 0.5 / π
+  put(path("keep.json"), "kept\n");
+  r = run({"factor", "--brdf", "lambert", "--param", "dupuy-jakob:ggx", "-o", "keep.json"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(slurp(path("keep.json")), "kept\n");
 }
 
 // `halfback plan` (issue 33): the positions to measure, each configuration once, with a JSON

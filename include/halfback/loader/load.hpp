@@ -15,7 +15,7 @@
 
 namespace halfback {
 
-enum class BrdfFileFormat { unknown, merl, rgl, alta, nbrdf_h5, nbrdf_npy };
+enum class BrdfFileFormat { unknown, merl, rgl, alta, nbrdf_h5, nbrdf_npy, factored };
 
 // The format of a file from its content: MERL by its size and 90/90/180 header, RGL by the
 // "tensor_file\0" magic, ALTA by its `#` header lines (a #DIM line before the first data line),
