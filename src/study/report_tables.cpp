@@ -435,12 +435,12 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
   for (const std::size_t kib : config.sampler_kib) {
     std::string rows;
     Wins wins(params);
-    int beats_own = 0, with_own = 0;
+    int beats_own = 0, with_own = 0, beats_warp = 0, with_warp = 0;
     for (const BrdfResult& b : results) {
       if (b.table("sampling").rows.empty()) continue;
       std::vector<double> variance;
       rows += row_start(b.label);
-      bool better_than_own = false, has_own = false;
+      bool better_than_own = false, has_own = false, better_than_warp = false, has_warp = false;
       for (Space s : params) {
         double v = NAN;
         for (const SamplingPoint& p : sampling_points(b, s))
@@ -448,6 +448,8 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
             v = p.relative_variance;
             has_own = p.own_sampler != "none";
             better_than_own |= has_own && p.efficiency_vs_own > 1;
+            has_warp |= std::isfinite(p.efficiency_vs_vndf_warp);
+            better_than_warp |= p.efficiency_vs_vndf_warp > 1;
           }
         variance.push_back(v);
         rows += std::isfinite(v) ? fmt::format(" {:.3g} |", v) : " – |";
@@ -456,12 +458,16 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
       wins.add(variance);
       with_own += has_own;
       beats_own += better_than_own;
+      with_warp += has_warp;
+      beats_warp += better_than_warp;
     }
     md += fmt::format("Tables of {} KiB:\n\n", kib) + table_header("BRDF", params) + rows +
           fmt::format(
               "\nLowest variance (BRDFs): {}. BRDFs with a sampler of their own: {}, of "
-              "which some table here is more efficient than it for {}.\n\n",
-              wins.text(), with_own, beats_own);
+              "which some table here is more efficient than it for {}. BRDFs with Dupuy & "
+              "Jakob's warp in at most {} KiB: {}, of which some table here is more efficient "
+              "than it for {}.\n\n",
+              wins.text(), with_own, beats_own, kib, with_warp, beats_warp);
   }
   return md;
 }

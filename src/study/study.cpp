@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <initializer_list>
 #include <map>
 #include <optional>
@@ -12,6 +13,8 @@
 #include "fit_metric.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/fit/fit.hpp"
+#include "halfback/formats/rgl.hpp"
+#include "halfback/formats/rgl_writer.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/render/sampling_metric.hpp"
@@ -190,6 +193,33 @@ std::vector<GonioRun> gonio_runs(Space s, Space w, bool iso, const StudyConfig& 
 // once per chart (parameterizations that share a chart share the sampler: their rows copy it),
 // against the cosine and the BRDF's own sampler.
 // `work`: the spaces the samplers are built in (material_spaces), the rows named by config.params.
+// Dupuy & Jakob 2018's sampler of `brdf` in at most `kib` KiB: the RGL export's VNDF and
+// luminance warps (8 incidence slices), the largest of a ladder of resolutions whose sampling
+// fields fit (the RGB tables only evaluate: not counted). With the KiB taken; nullptr where the
+// BRDF is anisotropic, the export refuses it, or nothing fits.
+std::pair<std::shared_ptr<const Brdf>, double> vndf_warp_sampler(const Brdf& brdf,
+                                                                 std::size_t kib) {
+  if (!brdf.isotropic()) return {nullptr, NAN};
+  constexpr std::pair<int, int> kLadder[] = {{64, 256}, {48, 192}, {32, 128}, {24, 96},
+                                             {16, 64},  {12, 48},  {8, 32}};
+  for (const auto& [resolution, vndf] : kLadder) {
+    try {
+      RglExportOptions o;
+      o.theta_i = 8, o.resolution = resolution, o.vndf_resolution = vndf, o.threads = 1;
+      std::vector<TensorFieldData> fields = rgl_fields(brdf, o);
+      std::size_t bytes = 0;
+      for (const TensorFieldData& f : fields)
+        if (f.name != "rgb" && f.name != "spectra") bytes += f.data.size();
+      if (bytes > kib * 1024) continue;
+      TensorFile file = parse_tensor_file(serialize_tensor_file(fields), "vndf-warp");
+      return {std::make_shared<RglBrdf>(file, "vndf-warp"), double(bytes) / 1024};
+    } catch (const std::invalid_argument&) {
+      return {nullptr, NAN};  // the export refuses this BRDF
+    }
+  }
+  return {nullptr, NAN};
+}
+
 std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
                                                              const StudyConfig& config,
                                                              std::span<const Space> work) {
@@ -199,6 +229,11 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
   std::optional<render::SamplingMeasure> own;
   if (brdf.has_importance_sampling()) own = render::measure_sampling(brdf, brdf, o);
   std::map<std::pair<std::string, std::size_t>, SamplingPoint> by_chart;
+  std::map<std::size_t, std::pair<render::SamplingMeasure, double>> vndf_warp;  // by KiB
+  for (const std::size_t kib : config.sampler_kib) {
+    const auto [sampler, kib_taken] = vndf_warp_sampler(brdf, kib);
+    if (sampler) vndf_warp[kib] = {render::measure_sampling(brdf, *sampler, o), kib_taken};
+  }
   std::vector<std::pair<Space, SamplingPoint>> rows;
   for (std::size_t k = 0; k < work.size(); ++k)
     for (const std::size_t kib : config.sampler_kib) {
@@ -217,6 +252,12 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
                                         own ? brdf.describe_sampling() : "none",
                                         own ? render::relative_efficiency(m, *own) : 0})
                  .first;
+        if (const auto w = vndf_warp.find(kib); w != vndf_warp.end()) {
+          it->second.vndf_warp_kib = w->second.second;
+          it->second.efficiency_vs_vndf_warp = render::relative_efficiency(m, w->second.first);
+        } else {
+          it->second.vndf_warp_kib = it->second.efficiency_vs_vndf_warp = NAN;
+        }
       }
       rows.emplace_back(config.params[k], it->second);
     }

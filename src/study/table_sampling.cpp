@@ -9,14 +9,15 @@ MetricTable sampling_table() {
           {columns::parameterization(), columns::integer("table_kib"), columns::text("chart"),
            columns::real("relative_variance"), columns::real("relative_variance_error"),
            columns::real("ns_per_sample"), columns::real("efficiency_vs_cosine"),
-           columns::text("own_sampler"), columns::real("efficiency_vs_own")},
+           columns::text("own_sampler"), columns::real("efficiency_vs_own"),
+           columns::real("vndf_warp_kib"), columns::real("efficiency_vs_vndf_warp")},
           {}};
 }
 
 void add_sampling(MetricTable& table, Space space, const SamplingPoint& p) {
   table.add({std::string(name_of(space)), std::int64_t(p.kib), p.chart, p.relative_variance,
              p.relative_variance_error, p.ns_per_sample, p.efficiency_vs_cosine, p.own_sampler,
-             p.efficiency_vs_own});
+             p.efficiency_vs_own, p.vndf_warp_kib, p.efficiency_vs_vndf_warp});
 }
 
 std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space) {
@@ -26,7 +27,8 @@ std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space
     points.push_back({std::size_t(t.integer(*row, "table_kib")), t.text(*row, "chart"),
                       t.real(*row, "relative_variance"), t.real(*row, "relative_variance_error"),
                       t.real(*row, "ns_per_sample"), t.real(*row, "efficiency_vs_cosine"),
-                      t.text(*row, "own_sampler"), t.real(*row, "efficiency_vs_own")});
+                      t.text(*row, "own_sampler"), t.real(*row, "efficiency_vs_own"),
+                      t.real(*row, "vndf_warp_kib"), t.real(*row, "efficiency_vs_vndf_warp")});
   return points;
 }
 

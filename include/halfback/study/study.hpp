@@ -126,6 +126,10 @@ struct SamplingPoint {
   double efficiency_vs_cosine = 0;
   std::string own_sampler = "none";
   double efficiency_vs_own = 0;
+  // Dupuy & Jakob 2018's sampler (the VNDF and luminance warps of the BRDF's RGL export) in at
+  // most `kib` KiB of sampling tables: the KiB it took and this table's efficiency against it;
+  // NaN where there is none (an anisotropic BRDF, one the export refuses, or no size that fits).
+  double vndf_warp_kib = 0, efficiency_vs_vndf_warp = 0;
 };
 
 // A row of the fit table (metric 6, issue 37): `model` fitted under `loss` to the `samples`
