@@ -62,6 +62,10 @@ def fit_samples(n):
     return _core.fit_samples(n)
 
 
+def emit(spec, target, name="halfback_fit"):
+    return _core.emit(spec, target, name)
+
+
 def published_fits(path):
     return _core.published_fits(str(path))
 
@@ -88,6 +92,7 @@ plan.__doc__ = _core.plan.__doc__
 fit_loss.__doc__ = _core.fit_loss.__doc__
 fit_samples.__doc__ = _core.fit_samples.__doc__
 factor.__doc__ = _core.factor.__doc__
+emit.__doc__ = _core.emit.__doc__
 published_fits.__doc__ = _core.published_fits.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
 study_profile.__doc__ = _core.study_profile.__doc__
@@ -96,6 +101,7 @@ __all__ = [
     "Brdf",
     "columns",
     "convert",
+    "emit",
     "factor",
     "fit",
     "fit_loss",

@@ -6,6 +6,7 @@
 #include <array>
 #include <string>
 
+#include "halfback/fit/emit.hpp"
 #include "halfback/fit/factor.hpp"
 #include "halfback/fit/fit.hpp"
 #include "halfback/fit/published.hpp"
@@ -127,6 +128,15 @@ py::dict fit_samples(std::size_t n) {
   return out;
 }
 
+// A model spec as a renderer's material (fit/emit.hpp): unknown targets and models the renderer
+// lacks raise ValueError (std::invalid_argument).
+std::string emit(const std::string& spec, const std::string& target, const std::string& name) {
+  const auto renderer = fit::parse_renderer(target);
+  if (!renderer)
+    throw py::value_error("target '" + target + "': expected " + fit::renderer_names());
+  return fit::emit_material(fit::parse_model(spec), *renderer, name);
+}
+
 }  // namespace
 
 void bind_fit(py::module_& m) {
@@ -162,6 +172,13 @@ of fewer, up to the weights' normalisation. n = 0 raises ValueError.)doc");
 dicts material, line, spec (a halfback spec of the registry's restatements of BBM's models,
 load() reads it) and model (its terms, as fit() takes them: "lambert+ward"). A malformed file
 raises RuntimeError naming the line; a model halfback lacks, ValueError.)doc");
+  m.def("emit", &emit, py::arg("spec"), py::arg("target"), py::arg("name") = "halfback_fit",
+        R"doc(The model `spec` (fit()'s "spec", or any spec of lambert, ggx, beckmann, or lambert
+plus one of them) as a renderer's own material named `name`, the text `halfback fit --emit`
+writes (docs/fit.md, "Renderer-ready output"): target "mitsuba3" (a Mitsuba 3 scene file holding
+one <bsdf>) or "pbrt-v4" (a MakeNamedMaterial). A comment at the top says what the conversion
+loses. An unknown target, or a model the renderer has no material for (ward, abc, beckmann in
+pbrt-v4, ...), raises ValueError pointing to `halfback export-rgl`.)doc");
 }
 
 }  // namespace halfback::python

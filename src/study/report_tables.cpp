@@ -448,7 +448,7 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
             v = p.relative_variance;
             has_own = p.own_sampler != "none";
             better_than_own |= has_own && p.efficiency_vs_own > 1;
-            has_warp |= std::isfinite(p.efficiency_vs_vndf_warp);
+            has_warp |= p.vndf_warp_kib > 0;
             better_than_warp |= p.efficiency_vs_vndf_warp > 1;
           }
         variance.push_back(v);

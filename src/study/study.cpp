@@ -195,11 +195,11 @@ std::vector<GonioRun> gonio_runs(Space s, Space w, bool iso, const StudyConfig& 
 // `work`: the spaces the samplers are built in (material_spaces), the rows named by config.params.
 // Dupuy & Jakob 2018's sampler of `brdf` in at most `kib` KiB: the RGL export's VNDF and
 // luminance warps (8 incidence slices), the largest of a ladder of resolutions whose sampling
-// fields fit (the RGB tables only evaluate: not counted). With the KiB taken; nullptr where the
-// BRDF is anisotropic, the export refuses it, or nothing fits.
+// fields fit (the RGB tables only evaluate: not counted). With the KiB taken; nullptr (and 0)
+// where the BRDF is anisotropic, the export refuses it, or nothing fits.
 std::pair<std::shared_ptr<const Brdf>, double> vndf_warp_sampler(const Brdf& brdf,
                                                                  std::size_t kib) {
-  if (!brdf.isotropic()) return {nullptr, NAN};
+  if (!brdf.isotropic()) return {nullptr, 0.0};
   constexpr std::pair<int, int> kLadder[] = {{64, 256}, {48, 192}, {32, 128}, {24, 96},
                                              {16, 64},  {12, 48},  {8, 32}};
   for (const auto& [resolution, vndf] : kLadder) {
@@ -214,10 +214,10 @@ std::pair<std::shared_ptr<const Brdf>, double> vndf_warp_sampler(const Brdf& brd
       TensorFile file = parse_tensor_file(serialize_tensor_file(fields), "vndf-warp");
       return {std::make_shared<RglBrdf>(file, "vndf-warp"), double(bytes) / 1024};
     } catch (const std::invalid_argument&) {
-      return {nullptr, NAN};  // the export refuses this BRDF
+      return {nullptr, 0.0};  // the export refuses this BRDF
     }
   }
-  return {nullptr, NAN};
+  return {nullptr, 0.0};
 }
 
 std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
@@ -256,7 +256,7 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
           it->second.vndf_warp_kib = w->second.second;
           it->second.efficiency_vs_vndf_warp = render::relative_efficiency(m, w->second.first);
         } else {
-          it->second.vndf_warp_kib = it->second.efficiency_vs_vndf_warp = NAN;
+          it->second.vndf_warp_kib = it->second.efficiency_vs_vndf_warp = 0;  // none
         }
       }
       rows.emplace_back(config.params[k], it->second);

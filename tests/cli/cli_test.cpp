@@ -639,6 +639,8 @@ TEST_F(CliTest, ExitStatusesFollowOneRule) {
       {{"factor", "--brdf", "lambert", "--counts", "8,8", "-o", "f.json"}, 2},
       {{"factor", "--brdf", "lambert", "--param", "dirs", "-o", "f.json"}, 2},
       {{"factor", "--brdf", "ggx:alpha_x=0.1,alpha_y=0.3", "-o", "f.json"}, 2},
+      {{"fit", "--brdf", "lambert", "--model", "ward", "--emit", "pbrt-v4:f.pbrt", "-o", "f.json"},
+       2},
       // BRDF specs that name nothing or hold a bad value, for every command that takes one.
       {{"info", "ggx:alpha=-1"}, 2},
       {{"info", "nosuch"}, 2},
@@ -2253,6 +2255,86 @@ TEST_F(CliTest, FitBadInputLeavesNoOutput) {
   }
   EXPECT_EQ(entries(), std::vector<std::string>{"old.json"});
   EXPECT_EQ(slurp(path("old.json")), "old");
+}
+
+// `--emit TARGET:FILE`: the fit as the renderers' own materials, beside the JSON (docs/fit.md,
+// "Renderer-ready output"); the emitted values are the fitted spec's.
+TEST_F(CliTest, FitEmitWritesTheRenderersMaterials) {
+  Result r = run({"fit", "--brdf", "lambert:albedo_r=0.6,albedo_g=0.25,albedo_b=0.125", "--model",
+                  "lambert", "--samples", "500", "--threads", "1", "-o", "fit.json", "--emit",
+                  "mitsuba3:bsdf.xml", "--emit", "pbrt-v4:material.pbrt"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(entries(), (std::vector<std::string>{"bsdf.xml", "fit.json", "material.pbrt"}));
+  const std::string spec = r.out.substr(0, r.out.find('\n'));
+  const std::string xml = slurp(path("bsdf.xml")), pbrt = slurp(path("material.pbrt"));
+  EXPECT_NE(xml.find("halfback fit: " + spec + "\n"), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<bsdf id=\"halfback_fit\" type=\"diffuse\">"), std::string::npos) << xml;
+  EXPECT_NE(pbrt.find("MakeNamedMaterial \"halfback_fit\"\n    \"string type\" \"diffuse\""),
+            std::string::npos)
+      << pbrt;
+  EXPECT_NE(r.err.find("mitsuba3 material 'halfback_fit' written to bsdf.xml"), std::string::npos)
+      << r.err;
+  // The albedo fitted, as the spec prints it, is the reflectance written.
+  const std::size_t at = spec.find("albedo_r=") + 9;
+  const std::string red = spec.substr(at, spec.find(',', at) - at);
+  EXPECT_NE(xml.find("<rgb name=\"reflectance\" value=\"" + red + ", "), std::string::npos) << xml;
+  EXPECT_NE(pbrt.find("\"rgb reflectance\" [ " + red + " "), std::string::npos) << pbrt;
+
+  r = run({"fit", "--brdf", "ggx:alpha=0.2,f0=0.9", "--model", "ggx", "--samples", "500",
+           "--threads", "1", "-o", "ggx.json", "--emit", "pbrt-v4:ggx.pbrt"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(path("ggx.pbrt")).find("\"string type\" \"conductor\""), std::string::npos);
+}
+
+// A model the renderer has no material for, an unknown target or a malformed --emit: usage
+// errors (2) before the fit; a fitted value the renderer cannot take, a target the fit cannot use
+// or an unwritable destination: 1. Nothing is written, and existing files are kept.
+TEST_F(CliTest, FitEmitRefusesWhatTheRendererLacksAndLeavesNoFile) {
+  put(path("old.json"), "old");
+  put(path("old.xml"), "old xml");
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    std::string words;
+  };
+  const std::string brdf = "ggx:alpha=0.2,f0=0.9";
+  const std::vector<Case> cases{
+      {{"--brdf", brdf, "--model", "ward", "--emit", "pbrt-v4:E"}, 2, "halfback export-rgl"},
+      {{"--brdf", brdf, "--model", "lambert+ggx", "--emit", "pbrt-v4:E"}, 2, "no plain sum"},
+      {{"--brdf", brdf, "--model", "beckmann", "--emit", "pbrt-v4:E"}, 2, "Trowbridge-Reitz"},
+      {{"--brdf", brdf, "--model", "sheen", "--emit", "mitsuba3:E"}, 2, "no 'sheen' lobe"},
+      {{"--brdf", brdf, "--model", "ggx", "--emit", "blender:E"}, 2, "unknown target 'blender'"},
+      {{"--brdf", brdf, "--model", "ggx", "--emit", "mitsuba3"}, 2, "TARGET:FILE"},
+      {{"--brdf", brdf, "--model", "ggx", "--emit", "mitsuba3:-"}, 2, "writes to a file"},
+      {{"--brdf", brdf, "--model", "ggx", "--emit", "mitsuba3:J"}, 2, "the file of -o"},
+      {{"--brdf", brdf, "--model", "ggx", "--emit", "mitsuba3:E", "--emit", "pbrt-v4:E"},
+       2,
+       "another --emit"},
+      {{"--brdf", "lambert:albedo=0", "--model", "ggx", "--emit", "mitsuba3:E"}, 1, "zero at all"},
+      {{"--brdf", "lambert:albedo=1", "--model", "lambert:albedo=1+ggx", "--emit", "mitsuba3:E"},
+       1,
+       "an albedo of 1"},
+      {{"--brdf", brdf, "--model", "ggx", "--emit", "mitsuba3:no/such/dir/E"}, 1, "cannot"},
+  };
+  for (const Case& c : cases) {
+    for (const auto& [json, emitted] :
+         {std::pair{"new.json", "new.xml"}, {"old.json", "old.xml"}}) {
+      std::vector<std::string> args{"fit", "--samples", "200", "--threads", "1", "-o", json};
+      for (std::string a : c.args) {
+        for (const auto& [from, to] : {std::pair{"E", emitted}, {"J", json}})
+          if (const std::size_t at = a.rfind(from); at != std::string::npos && at + 1 == a.size())
+            a.replace(at, 1, to);
+        args.push_back(a);
+      }
+      const Result r = run(args);
+      EXPECT_EQ(r.status, c.status) << c.words << ": " << r.err;
+      EXPECT_NE(r.err.find(c.words), std::string::npos) << r.err;
+      EXPECT_TRUE(r.out.empty()) << r.out;
+    }
+  }
+  EXPECT_EQ(entries(), (std::vector<std::string>{"old.json", "old.xml"}));
+  EXPECT_EQ(slurp(path("old.json")), "old");
+  EXPECT_EQ(slurp(path("old.xml")), "old xml");
 }
 
 }  // namespace

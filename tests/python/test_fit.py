@@ -147,3 +147,32 @@ def test_published_fits_script_on_two_materials(tmp_path):
         assert 0 < float(row["published_loss"]) < 10 and 0 < float(row["halfback_loss"]) < 10
         halfback.load(row["published_spec"])
     assert "| lambert+ward | 2 |" in (tmp_path / "published-fits.md").read_text()
+
+
+def test_emit_writes_the_fitted_parameters_as_the_renderers_materials():
+    # halfback.emit: the text of `halfback fit --emit` (docs/fit.md, "Renderer-ready output").
+    import re
+    r = halfback.fit("ggx:alpha=0.2,eta=0.3,k=2.5", "ggx:eta=0.3,k=2.5", samples=1000, threads=1)
+    alpha = next(p["value"] for p in r["parameters"] if p["name"] == "alpha")
+    pbrt = halfback.emit(r["spec"], "pbrt-v4")
+    assert pbrt.startswith("# halfback fit: " + r["spec"] + "\n")
+    assert float(re.search(r'"float roughness" \[ (\S+) \]', pbrt).group(1)) == alpha
+    assert '"bool remaproughness" false' in pbrt
+    assert re.search(r'"rgb eta" \[ 0\.3 0\.3 0\.3 \]', pbrt) and re.search(r'"rgb k" \[ 2\.5 2\.5 2\.5 \]', pbrt)
+    xml = halfback.emit(r["spec"], "mitsuba3", name="metal")
+    assert '<bsdf id="metal" type="roughconductor">' in xml
+    assert float(re.search(r'<float name="alpha" value="(\S+)"/>', xml).group(1)) == alpha
+    # Lambert: pbrt-v4's diffuse R / pi is halfback's value at any pair.
+    spec = "lambert:albedo_r=0.6,albedo_g=0.25,albedo_b=0.125"
+    refl = [float(v) for v in re.search(r'"rgb reflectance" \[ (.*) \]', halfback.emit(spec, "pbrt-v4")).group(1).split()]
+    wi, wo = np.array([[0.6, 0.0, 0.8]]), np.array([[0.0, 0.28, 0.96]])
+    assert np.allclose(halfback.load(spec).eval(wi, wo)[0], np.array(refl) / np.pi, rtol=1e-12, atol=0)
+
+
+def test_emit_errors_point_to_export_rgl():
+    with pytest.raises(ValueError, match="export-rgl"):
+        halfback.emit("ward", "mitsuba3")
+    with pytest.raises(ValueError, match="Trowbridge-Reitz"):
+        halfback.emit("beckmann", "pbrt-v4")
+    with pytest.raises(ValueError, match="target 'blender'"):
+        halfback.emit("ggx", "blender")

@@ -128,7 +128,7 @@ struct SamplingPoint {
   double efficiency_vs_own = 0;
   // Dupuy & Jakob 2018's sampler (the VNDF and luminance warps of the BRDF's RGL export) in at
   // most `kib` KiB of sampling tables: the KiB it took and this table's efficiency against it;
-  // NaN where there is none (an anisotropic BRDF, one the export refuses, or no size that fits).
+  // both 0 where there is none (an anisotropic BRDF, one the export refuses, or no size that fits).
   double vndf_warp_kib = 0, efficiency_vs_vndf_warp = 0;
 };
 
