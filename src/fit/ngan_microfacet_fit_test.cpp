@@ -1,4 +1,4 @@
-// Ngan et al. 2005's microfacet-style lobes (cook-torrance, ashikhmin-shirley) in the fitter:
+// Ngan et al. 2005's microfacet-style lobes (cook-torrance, ashikhmin-shirley, he) in the fitter:
 // parameters recovered from BRDFs they generate, and every published fit of BBM's files loads as
 // a spec (its values inside the registry's ranges) and evaluates finite and positive.
 #include <gtest/gtest.h>
@@ -44,6 +44,10 @@ TEST(NganMicrofacetFit, RecoveredFromTheAutomaticStarts) {
                    "");
   expect_recovered("ashikhmin-shirley",
                    "ashikhmin-shirley:albedo_r=0.8,albedo_g=0.5,albedo_b=0.3,f0=0.6,sharpness=500",
+                   "");
+  expect_recovered("he",
+                   "he:albedo_r=0.8,albedo_g=0.5,albedo_b=0.3,autocorrelation=4,roughness=0.2,"
+                   "eta=1.8",
                    "");
 }
 
@@ -106,6 +110,45 @@ TEST(NganMicrofacetFit, EveryPublishedLineLoadsAndEvaluates) {
       }
     }
   }
+}
+
+// A broad lobe in the series' regime (g_red ≈ 8 at the normal), where σ0 and τ act apart: in the
+// rough limit (g_red > 19) only their ratio would be seen. η is seen through F's shape in θd.
+TEST(NganMicrofacetFit, HeRecovered) {
+  expect_recovered("he",
+                   "he:albedo_r=0.6,albedo_g=0.35,albedo_b=0.1,autocorrelation=2,roughness=0.15,"
+                   "eta=1.5",
+                   "he:albedo_r=0.5,albedo_g=0.5,albedo_b=0.5,autocorrelation=3,roughness=0.25,"
+                   "eta=2");
+}
+
+// He's lobe through halfback's own mapping of the published lines (fit::spec_of: NganHe -> he,
+// BBM's names in lower case). ≥ 0, not > 0: four lines have eta = 1.0, where Cook's F and so the
+// lobe vanish, and some Lambertian channels are 0.
+TEST(NganMicrofacetFit, EveryPublishedHeLineLoadsAndEvaluates) {
+  HALFBACK_REQUIRE_SHARED(dir, "fits");
+  const auto fits = read_published_fits(dir / "ngan_he.fit");
+  EXPECT_EQ(fits.size(), 86u);
+  int positive_at_mirror = 0;
+  for (const PublishedFit& f : fits) {
+    const std::string spec = spec_of(f);
+    SCOPED_TRACE("ngan_he.fit: " + f.material + " as " + spec);
+    BrdfPtr b;
+    ASSERT_NO_THROW(b = load_brdf(spec));
+    for (const DirPair<double>& p :
+         {DirPair<double>{{0, 0, 1}, {0, 0, 1}}, DirPair<double>{{0.6, 0, 0.8}, {-0.6, 0, 0.8}},
+          DirPair<double>{{0.6, 0, 0.8}, {0, 0.8, 0.6}},
+          DirPair<double>{{0.997, 0, 0.0707}, {-0.997, 0, 0.0707}}}) {
+      const Rgb v = b->eval(p);
+      for (double c : {v.r, v.g, v.b}) {
+        EXPECT_TRUE(std::isfinite(c));
+        EXPECT_GE(c, 0);
+      }
+    }
+    const BrdfPtr lobe = load_brdf(spec.substr(spec.find("+he:") + 1));
+    if (lobe->eval({{0.6, 0, 0.8}, {-0.6, 0, 0.8}}).g > 0) ++positive_at_mirror;
+  }
+  EXPECT_EQ(positive_at_mirror, 86 - 4);
 }
 
 }  // namespace
