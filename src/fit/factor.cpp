@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 #include "halfback/core/batch.hpp"
@@ -142,7 +143,7 @@ Factors start(const Sampled& s, std::size_t rank) {
     for (std::size_t r = 1; r < rank; ++r)
       for (std::size_t i = 0; i < s.n[axis]; ++i)
         f[axis](Eigen::Index(r), Eigen::Index(i)) =
-            0.1 * std::cos(double(r) * 3.14159265358979 * (double(i) + 0.5) / double(s.n[axis]) +
+            0.1 * std::cos(double(r) * std::numbers::pi * (double(i) + 0.5) / double(s.n[axis]) +
                            double(axis));
   }
   return f;

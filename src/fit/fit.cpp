@@ -311,6 +311,21 @@ double loss_value(std::span<const Rgb> target_rgb, const Brdf& model, Loss loss,
   return mean_square(r);
 }
 
+int channel_of(const Param& p) {
+  const std::size_t n = p.name.size();
+  if (n < 3 || p.name[n - 2] != '_') return -1;
+  switch (p.name[n - 1]) {
+    case 'r':
+      return 0;
+    case 'g':
+      return 1;
+    case 'b':
+      return 2;
+    default:
+      return -1;
+  }
+}
+
 // ---- The least-squares problem -------------------------------------------------------------
 
 namespace {
@@ -331,24 +346,6 @@ Blocks blocks_of(const Model& m) {
     if (!ps.empty()) b.term.push_back(t), b.params.push_back(std::move(ps));
   }
   return b;
-}
-
-// The channel a parameter drives alone (0, 1, 2 for NAME_r/_g/_b), or -1 for one that may drive
-// every channel. Contract of the registry's colour parameters (models/colour_params.hpp), checked
-// for every registered model by FitCost.ColourParametersDriveTheirChannelOnly.
-int channel_of(const Param& p) {
-  const std::size_t n = p.name.size();
-  if (n < 3 || p.name[n - 2] != '_') return -1;
-  switch (p.name[n - 1]) {
-    case 'r':
-      return 0;
-    case 'g':
-      return 1;
-    case 'b':
-      return 2;
-    default:
-      return -1;
-  }
 }
 
 // A block's fitted parameters in groups that one difference serves: the three channels of a colour
@@ -551,9 +548,7 @@ std::optional<double> roughness_from_peak(const Brdf& target) {
 
 // Whether a fitted parameter shapes the lobe (not a colour channel): the grid varies those.
 bool is_shape(const Param& p) {
-  const std::size_t n = p.name.size();
-  return !(n > 2 && p.name[n - 2] == '_' &&
-           (p.name[n - 1] == 'r' || p.name[n - 1] == 'g' || p.name[n - 1] == 'b'));
+  return channel_of(p) < 0;
 }
 
 // The value at fraction q of [min, max], geometric when the range spans decades.

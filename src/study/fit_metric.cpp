@@ -19,9 +19,7 @@ double shape_change(const fit::Model& layout, const fit::Model& whole) {
   double worst = 0;
   for (std::size_t i = 0; i < whole.params.size(); ++i) {
     const fit::Param& p = whole.params[i];
-    const std::size_t n = p.name.size();
-    const bool channel = n > 2 && p.name[n - 2] == '_';
-    if (!p.fitted || channel) continue;
+    if (!p.fitted || fit::channel_of(p) >= 0) continue;
     const double scale = std::max(std::abs(p.value), 1e-6 * (p.max - p.min));
     worst = std::max(worst, std::abs(layout.params[i].value - p.value) / scale);
   }

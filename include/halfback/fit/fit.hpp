@@ -59,6 +59,12 @@ struct Model {
 };
 Model parse_model(std::string_view model);
 
+// The channel a parameter drives alone (0, 1, 2 for NAME_r/_g/_b), or -1 for one that may drive
+// every channel (a shape parameter such as alpha). Contract of the registry's colour parameters
+// (models/colour_params.hpp), checked for every registered model by
+// FitModel.ColourChannelsDriveTheirChannelOnly.
+int channel_of(const Param& p);
+
 // The spec of the model at its parameters' values ("lambert:albedo_r=...+ggx:alpha=..."),
 // readable by load_brdf(), exact to the last bit (the shortest decimal that reads back as the same
 // double).
