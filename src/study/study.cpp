@@ -7,6 +7,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 
@@ -15,6 +16,7 @@
 #include "halfback/fit/fit.hpp"
 #include "halfback/formats/rgl.hpp"
 #include "halfback/formats/rgl_writer.hpp"
+#include "halfback/loader/load.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/render/sampling_metric.hpp"
@@ -193,25 +195,37 @@ std::vector<GonioRun> gonio_runs(Space s, Space w, bool iso, const StudyConfig& 
 // once per chart (parameterizations that share a chart share the sampler: their rows copy it),
 // against the cosine and the BRDF's own sampler.
 // `work`: the spaces the samplers are built in (material_spaces), the rows named by config.params.
+// The bytes of the sampling fields of an RGL export (NDF, σ, VNDF, luminance and their warps; not
+// the RGB tables, which only evaluate) at these resolutions: they depend on the options only, so
+// they are measured once per ladder step, on a Lambertian.
+std::size_t sampling_bytes(const RglExportOptions& o) {
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, std::size_t> known;
+  const std::lock_guard lock(mutex);
+  const auto key = std::pair{o.resolution, o.vndf_resolution};
+  if (const auto it = known.find(key); it != known.end()) return it->second;
+  std::size_t bytes = 0;
+  for (const TensorFieldData& f : rgl_fields(*load_brdf("lambert"), o))
+    if (f.name != "rgb" && f.name != "spectra") bytes += f.data.size();
+  return known[key] = bytes;
+}
+
 // Dupuy & Jakob 2018's sampler of `brdf` in at most `kib` KiB: the RGL export's VNDF and
-// luminance warps (8 incidence slices), the largest of a ladder of resolutions whose sampling
-// fields fit (the RGB tables only evaluate: not counted). With the KiB taken; nullptr (and 0)
-// where the BRDF is anisotropic, the export refuses it, or nothing fits.
+// luminance warps (8 incidence slices) at the largest of a ladder of resolutions whose sampling
+// fields fit. With the KiB taken; nullptr (and 0) where the BRDF is anisotropic, the export
+// refuses it, or nothing fits.
 std::pair<std::shared_ptr<const Brdf>, double> vndf_warp_sampler(const Brdf& brdf,
                                                                  std::size_t kib) {
   if (!brdf.isotropic()) return {nullptr, 0.0};
   constexpr std::pair<int, int> kLadder[] = {{64, 256}, {48, 192}, {32, 128}, {24, 96},
                                              {16, 64},  {12, 48},  {8, 32}};
   for (const auto& [resolution, vndf] : kLadder) {
+    RglExportOptions o;
+    o.theta_i = 8, o.resolution = resolution, o.vndf_resolution = vndf, o.threads = 1;
+    const std::size_t bytes = sampling_bytes(o);
+    if (bytes > kib * 1024) continue;
     try {
-      RglExportOptions o;
-      o.theta_i = 8, o.resolution = resolution, o.vndf_resolution = vndf, o.threads = 1;
-      std::vector<TensorFieldData> fields = rgl_fields(brdf, o);
-      std::size_t bytes = 0;
-      for (const TensorFieldData& f : fields)
-        if (f.name != "rgb" && f.name != "spectra") bytes += f.data.size();
-      if (bytes > kib * 1024) continue;
-      TensorFile file = parse_tensor_file(serialize_tensor_file(fields), "vndf-warp");
+      TensorFile file = parse_tensor_file(serialize_tensor_file(rgl_fields(brdf, o)), "vndf-warp");
       return {std::make_shared<RglBrdf>(file, "vndf-warp"), double(bytes) / 1024};
     } catch (const std::invalid_argument&) {
       return {nullptr, 0.0};  // the export refuses this BRDF
