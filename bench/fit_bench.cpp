@@ -50,9 +50,43 @@ void BM_ModelLossAtSamples(benchmark::State& state) {
   state.SetItemsProcessed(std::int64_t(state.iterations()) * state.range(0));
 }
 
+// He et al.'s lobe (the slowest model: a series of up to 64 terms per channel) at the samples, for
+// a smooth, a mid (a fit to gold-metallic-paint3) and a rough surface; beside GGX above.
+void BM_HeLossAtSamples(benchmark::State& state) {
+  static const char* const kHe[] = {"he:autocorrelation=3,roughness=0.05,eta=1.5",
+                                    "he:autocorrelation=31.6,roughness=0.3,eta=5.4",
+                                    "he:autocorrelation=2,roughness=1.5,eta=1.5"};
+  const BrdfPtr target = load_brdf(kTarget);
+  const BrdfPtr model = load_brdf(kHe[state.range(1)]);
+  const fit::Samples s = fit::halfdiff_samples(std::size_t(state.range(0)));
+  std::vector<Rgb> t(s.pairs.size());
+  for (std::size_t i = 0; i < t.size(); ++i) t[i] = target->eval(s.pairs[i]);
+  for (auto _ : state) benchmark::DoNotOptimize(fit::loss_value(t, *model, fit::Loss::ngan, s, 1));
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * state.range(0));
+}
+
+// A Lambert + He fit as the whole-database fit runs it (scripts/fit_database.py: 2·10⁴ samples,
+// the automatic starts, one thread).
+void BM_FitLambertHe(benchmark::State& state) {
+  const BrdfPtr target = load_brdf(kTarget);
+  fit::FitOptions o;
+  o.samples = std::size_t(state.range(0));
+  o.threads = 1;
+  fit::FitResult r;
+  for (auto _ : state) {
+    r = fit::fit(*target, "lambert+he", o);
+    benchmark::DoNotOptimize(r.spec.data());
+  }
+  state.counters["fit_loss"] = r.loss_value;
+  state.counters["fit_iterations"] = r.iterations;
+}
+
 BENCHMARK(BM_ModelLossAtSamples)->Arg(100000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitLambertGgxOneStart)->Arg(100000)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_FitLambertGgx)->Arg(100000)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_HeLossAtSamples)->Args({100000, 0})->Args({100000, 1})->Args({100000, 2})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitLambertHe)->Arg(20000)->Iterations(1)->Unit(benchmark::kSecond);
 
 }  // namespace
 

@@ -489,7 +489,7 @@ struct Solved {
 
 // One Levenberg–Marquardt run from `start` (its fitted values), within the registry's bounds.
 Solved solve_from(const Model& start, const Samples& s, std::span<const Rgb> target,
-                  const FitOptions& o) {
+                  const FitOptions& o, double function_tolerance = 1e-9) {
   const Blocks blocks = blocks_of(start);
   std::vector<std::vector<double>> x(blocks.term.size());
   for (std::size_t b = 0; b < x.size(); ++b)
@@ -508,7 +508,7 @@ Solved solve_from(const Model& start, const Samples& s, std::span<const Rgb> tar
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = o.max_iterations;
-  options.function_tolerance = 1e-9;
+  options.function_tolerance = function_tolerance;
   options.gradient_tolerance = 1e-12;
   options.parameter_tolerance = 1e-10;
   options.logging_type = ceres::SILENT;
@@ -574,7 +574,16 @@ std::vector<Model> automatic_starts(const Model& m, const Brdf* target) {
       if (p.fitted && is_shape(p)) p.value = at_quantile(p, q);
     starts.push_back(g);
   }
-  return starts;
+  // A start equal to an earlier one (the peak's guess of a model without α is its defaults) would
+  // only repeat that run.
+  std::vector<Model> distinct;
+  for (const Model& s : starts)
+    if (std::none_of(distinct.begin(), distinct.end(), [&](const Model& d) {
+          return std::equal(d.params.begin(), d.params.end(), s.params.begin(),
+                            [](const Param& a, const Param& b) { return a.value == b.value; });
+        }))
+      distinct.push_back(s);
+  return distinct;
 }
 
 Model start_from_spec(const Model& m, std::string_view spec) {
@@ -599,6 +608,13 @@ Model start_from_spec(const Model& m, std::string_view spec) {
 // distinct coarse solutions within 5 % of the best loss run again on all samples (docs/fit.md,
 // "Starts"). Returns every run.
 constexpr std::size_t kCoarseSamples = 4096;
+// At most this many basins are refined: on a valley (He's η against its albedo) the starts stop
+// in several "basins" a fraction of a percent apart, and each full run costs more than all the
+// coarse ones.
+constexpr std::size_t kMaxRefined = 2;
+// The coarse runs only pick the basins: they stop at a relative change of the loss of 1e-6 (the
+// fine run's is 1e-9).
+constexpr double kCoarseTolerance = 1e-6;
 
 struct Subset {
   Samples samples;
@@ -694,10 +710,11 @@ std::vector<Solved> solve_starts(const std::vector<Model>& starts, const Samples
   const Subset coarse = coarse_subset(s, target, halton_prefix);
   std::vector<Solved> rough;
   for (const Model& start : starts)
-    rough.push_back(solve_from(start, coarse.samples, coarse.target, o));
+    rough.push_back(solve_from(start, coarse.samples, coarse.target, o, kCoarseTolerance));
   std::sort(rough.begin(), rough.end(), [](auto& a, auto& b) { return a.loss < b.loss; });
   std::vector<const Model*> refined;
   for (const Solved& r : rough) {
+    if (refined.size() == kMaxRefined) break;
     if (!(r.loss <= 1.05 * rough.front().loss) && !refined.empty()) break;
     if (std::any_of(refined.begin(), refined.end(),
                     [&](const Model* m) { return same_basin(*m, r.model); }))

@@ -157,6 +157,17 @@ double effective_roughness(double tan_i, double tan_o, double sigma, double tau)
   return sigma / std::sqrt(1 + x * x);
 }
 
+// 1/m for the series' terms: products, not divisions, in its loop (it is the fit's hot spot).
+constexpr std::array<double, kTerms + 1> kInverse = [] {
+  std::array<double, kTerms + 1> inv{};
+  for (int m = 1; m <= kTerms; ++m) inv[m] = 1.0 / m;
+  return inv;
+}();
+
+// exp(x) underflows to exactly 0 below this (the smallest subnormal is e^−744.44): such terms are
+// skipped, not computed (glibc's underflow path is slow, and off the specular peak most are).
+constexpr double kExpZeroBelow = -746;
+
 // Σ_{m ≥ 1} e^(−g − b/m) g^m/(m!·m) per channel, as BBM sums it: at most 64 terms, all channels
 // stopped together after the first term at which the smallest channel's term is < ε and smaller
 // than the previous smallest one.
@@ -166,8 +177,9 @@ Channels taylor_sum(const Channels& g, const Channels& b) {
   for (int m = 1; m <= kTerms; ++m) {
     double term_min = std::numeric_limits<double>::infinity();
     for (int c = 0; c < 3; ++c) {
-      power[c] *= g[c] / m;
-      const double term = std::exp(-g[c] - b[c] / m) * power[c] / m;
+      power[c] *= g[c] * kInverse[m];
+      const double x = -g[c] - b[c] * kInverse[m];
+      const double term = x < kExpZeroBelow ? 0.0 : std::exp(x) * power[c] * kInverse[m];
       sum[c] += term;
       term_min = std::min(term_min, term);
     }
