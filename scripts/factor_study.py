@@ -7,7 +7,9 @@ model (halfback.factor, --counts cells) and its loss under --loss on fit()'s lay
 (halfback.fit_loss), beside the loss of halfback's fit of --model (default lambert+ggx). Writes
 OUT/factored.csv (a row per BRDF, parameterization and rank) and OUT/factored.md (per
 parameterization: the median loss at each rank over the BRDFs, and on how many BRDFs it is the
-smallest model that reaches the analytic fit's loss). Runs on Debian's /usr/bin/python3:
+smallest model that reaches the analytic fit's loss), and each model's image-space error under
+--env with the study's image protocol (halfback.image_error: relative RMSE and mean ΔE2000 of the
+rendered sphere against the BRDF's own). Runs on Debian's /usr/bin/python3:
 
   PYTHONPATH=build/release/python /usr/bin/python3 scripts/factor_study.py --out OUT BRDF...
 """
@@ -23,11 +25,14 @@ import time
 import halfback
 
 
-def factored_loss(brdf, param, rank, counts, loss, samples, tmp):
+def factored_loss(brdf, param, rank, counts, loss, samples, env, tmp):
+    """The factored model's size, its grid error, its loss and its image-space error."""
     r = halfback.factor(brdf, param, rank, counts)
     path = pathlib.Path(tmp) / "f.json"
     path.write_text(r["text"], encoding="utf-8")
-    return r["numbers"], r["relative_error"], halfback.fit_loss(brdf, str(path), loss, samples)
+    image = halfback.image_error(str(path), brdf, env)
+    return (r["numbers"], r["relative_error"], halfback.fit_loss(brdf, str(path), loss, samples),
+            image)
 
 
 def main():
@@ -40,6 +45,7 @@ def main():
     ap.add_argument("--model", default="lambert+ggx")
     ap.add_argument("--loss", default="ngan")
     ap.add_argument("--samples", type=int, default=20000)
+    ap.add_argument("--env", default="sky", help="environment of the image-space error")
     a = ap.parse_args()
     params = a.params.split(",")
     ranks = [int(r) for r in a.ranks.split(",")]
@@ -52,14 +58,19 @@ def main():
             brdf = halfback.load(spec)
             fitted = halfback.fit(brdf, a.model, a.loss, a.samples)
             n_fit = sum(p["fitted"] for p in fitted["parameters"])
+            fit_image = halfback.image_error(fitted["spec"], brdf, a.env)
             for param in params:
                 for rank in ranks:
-                    numbers, grid_error, value = factored_loss(brdf, param, rank, counts, a.loss,
-                                                               a.samples, tmp)
+                    numbers, grid_error, value, image = factored_loss(
+                        brdf, param, rank, counts, a.loss, a.samples, a.env, tmp)
                     rows.append({"brdf": spec, "parameterization": param, "rank": rank,
                                  "numbers": numbers, "grid_error": grid_error, "loss": value,
+                                 "image_relative_rmse": image["relative_rmse"],
+                                 "image_delta_e2000": image["mean_delta_e2000"],
                                  "model": a.model,
-                                 "model_numbers": n_fit, "model_loss": fitted["loss_value"]})
+                                 "model_numbers": n_fit, "model_loss": fitted["loss_value"],
+                                 "model_image_relative_rmse": fit_image["relative_rmse"],
+                                 "model_image_delta_e2000": fit_image["mean_delta_e2000"]})
             print(f"\r{k}/{len(a.brdfs)} BRDFs, {time.monotonic() - t0:.0f} s", end="",
                   file=sys.stderr)
     print(file=sys.stderr)
@@ -88,7 +99,22 @@ def main():
         md.append(f"| {p} | " + " | ".join(f"{m:.4g}" for m in med) + f" | {wins[p]} |")
     model_loss = statistics.median({r["brdf"]: r["model_loss"] for r in rows}.values())
     md += ["", f"Median loss of {a.model} ({rows[0]['model_numbers']} numbers): {model_loss:.4g}.",
-           "Numbers per factored model: 3 · rank · (sum of the counts)."]
+           "Numbers per factored model: 3 · rank · (sum of the counts).", "",
+           f"Image-space error under {a.env} (the study's protocol): median relative RMSE / mean "
+           "ΔE2000 of the sphere over the BRDFs.", "",
+           "| parameterization | " + " | ".join(f"rank {r}" for r in ranks) + " |",
+           "|---|" + "---|" * len(ranks)]
+    for p in params:
+        cells = []
+        for rank in ranks:
+            sel = [r for r in rows if r["parameterization"] == p and r["rank"] == rank]
+            cells.append(f"{statistics.median(r['image_relative_rmse'] for r in sel):.3g} / "
+                         f"{statistics.median(r['image_delta_e2000'] for r in sel):.3g}")
+        md.append(f"| {p} | " + " | ".join(cells) + " |")
+    per_brdf = {r["brdf"]: r for r in rows}.values()
+    md += ["", f"{a.model}: "
+           f"{statistics.median(r['model_image_relative_rmse'] for r in per_brdf):.3g} / "
+           f"{statistics.median(r['model_image_delta_e2000'] for r in per_brdf):.3g}."]
     (out / "factored.md").write_text("\n".join(md) + "\n", encoding="utf-8")
     print("\n".join(md))
 

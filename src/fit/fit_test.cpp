@@ -200,6 +200,16 @@ TEST(FitMultistart, TwoMinimaOneStartFailsTheStartsSucceed) {
   EXPECT_NEAR(value_in(multi.model, 0, "alpha"), scan_alpha, 0.02 * scan_alpha);
 }
 
+// The automatic starts run each distinct start once: the peak's guess sets α, so a model without
+// α (Ward's lobe names it roughness) has one start fewer, not the defaults twice.
+TEST(FitMultistart, EachDistinctStartRunsOnce) {
+  const BrdfPtr target = load_brdf("ggx:alpha=0.3");
+  FitOptions o;
+  o.samples = 1000;
+  EXPECT_EQ(fit(*target, "ggx", o).starts, 7u);  // defaults, the peak's α, a grid of 5
+  EXPECT_EQ(fit(*target, "ward", o).starts, 6u);  // defaults, a grid of 5
+}
+
 // A BRDF of given value everywhere (NaN, ∞, 0), isotropic or not.
 class ConstantBrdf final : public Brdf {
  public:

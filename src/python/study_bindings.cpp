@@ -12,6 +12,7 @@
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/parts.hpp"
 #include "halfback/study/report.hpp"
+#include "halfback/study/study.hpp"
 #include "halfback/util/output_dir.hpp"
 #include "py_brdf.hpp"
 
@@ -250,10 +251,39 @@ whole window is inside the image and where mask (same shape; default all) is non
 `halfback study`'s image-space error (docs/study.md).)doc");
 }
 
+// study::image_error of two BRDFs (docs/study.md, "Image-space error"), as a dict.
+py::dict image_error(const py::object& test, const py::object& reference, const std::string& env,
+                     const py::object& settings) {
+  const BrdfPtr t = brdf_of(test), r = brdf_of(reference);
+  const study::StudyConfig config = study::make_config(study_settings(settings).settings);
+  study::ImageError e;
+  {
+    py::gil_scoped_release release;
+    const render::Environment environment = render::load_environment(env);
+    e = study::image_error(*t, *r, *environment.map, config);
+  }
+  py::dict d;
+  d["relative_rmse"] = e.relative_rmse;
+  d["mean_delta_e2000"] = e.mean_delta_e;
+  d["p95_delta_e2000"] = e.p95_delta_e;
+  d["mae"] = e.mae;
+  d["rmse"] = e.rmse;
+  d["ssim"] = e.ssim;
+  d["pixels"] = e.pixels;
+  return d;
+}
+
 }  // namespace
 
 void bind_study(py::module_& m) {
   bind_image_metrics(m);
+  m.def("image_error", &image_error, py::arg("test"), py::arg("reference"), py::arg("env") = "sky",
+        py::arg("settings") = py::none(),
+        R"doc(The image-space error of `test` against `reference` (Brdf objects or specs) with the
+study's image protocol: both rendered on a sphere under env (a built-in name, a constant or an
+.exr/.hdr file) by environment sampling with the same random numbers, compared over the sphere's
+pixels. settings: study settings (image_size, image_spp, seed; default 96, 16, the study's seed).
+Returns a dict: relative_rmse, mean_delta_e2000, p95_delta_e2000, mae, rmse, ssim, pixels.)doc");
   m.def("study_brdf", &study_one_brdf, py::arg("spec"), py::arg("settings") = py::none(),
         R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
 

@@ -280,6 +280,18 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
 
 }  // namespace
 
+ImageError image_error(const Brdf& test, const Brdf& reference, const render::EnvMap& env,
+                       const StudyConfig& config) {
+  const render::RenderSettings settings = image_settings(config);
+  const render::RenderResult truth = render::render_sampled(reference, env, settings);
+  if (truth.nonfinite > 0)
+    throw std::invalid_argument(fmt::format(
+        "image error: the reference {} has no finite value at {} pixels", reference.name(),
+        truth.nonfinite));
+  const render::Image img = render::render_sampled(test, env, settings).image;
+  return compare_images(img, truth.image, sphere_mask(settings.width, settings.height));
+}
+
 BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyConfig& config) {
   config.validate();
   const auto t0 = std::chrono::steady_clock::now();

@@ -75,3 +75,23 @@ def test_ssim_refuses_bad_input():
         halfback.ssim(test[:8, :8], reference[:8, :8])
     with pytest.raises(ValueError, match="mask"):
         halfback.ssim(test, reference, np.ones((3, 3)))
+
+
+def test_image_error_is_the_brdf_error_not_noise():
+    # Environment sampling with the same random numbers: a Lambertian 10 % brighter is 10 % off
+    # at every pixel, whatever the noise of each rendering; a BRDF against itself is exact.
+    for env in ("sky", "studio"):
+        e = halfback.image_error("lambert:albedo=0.55", "lambert:albedo=0.5", env=env)
+        assert e["relative_rmse"] == pytest.approx(0.1, abs=1e-7)  # float pixels
+        assert e["pixels"] > 0
+    same = halfback.image_error("embedded:pink-felt", halfback.load("embedded:pink-felt"))
+    assert same["relative_rmse"] == 0 and same["mean_delta_e2000"] == 0 and same["ssim"] == 1
+    small = halfback.image_error("ggx:alpha=0.21", "ggx:alpha=0.2", settings={"image_size": 64})
+    assert 0 < small["relative_rmse"] < 0.2 and small["ssim"] < 1
+
+
+def test_image_error_refuses_bad_input():
+    with pytest.raises(ValueError, match="environment 'nope'"):
+        halfback.image_error("lambert", "lambert", env="nope")
+    with pytest.raises(ValueError, match=">= 8 pixels"):
+        halfback.image_error("lambert", "lambert", settings={"image_size": -3})

@@ -19,6 +19,7 @@
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/image.hpp"
 #include "halfback/study/gonio.hpp"
+#include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metrics.hpp"
 #include "halfback/study/table.hpp"
 
@@ -173,5 +174,13 @@ struct BrdfResult {
 // Every metric of `brdf` in every parameterization of config.params (one task each; the
 // renderings then use all cores). Throws what the metrics throw.
 BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyConfig& config);
+
+// The image-space error of `test` against `reference` under `env` with the study's image
+// protocol (config.image_size, image_spp and seed; environment sampling, so both are evaluated at
+// the same light directions): a model, a fit or a factored model scored as the reconstructions
+// are. Throws std::invalid_argument when the reference's rendering has a non-finite pixel, and
+// what compare_images throws.
+ImageError image_error(const Brdf& test, const Brdf& reference, const render::EnvMap& env,
+                       const StudyConfig& config);
 
 }  // namespace halfback::study
