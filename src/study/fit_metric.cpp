@@ -69,19 +69,26 @@ struct Job {
 
 }  // namespace
 
-std::vector<std::pair<Space, FitPoint>> fit_metric(const Brdf& brdf, const StudyConfig& config,
-                                                   std::span<const Space> work,
-                                                   const std::function<void(std::string)>& say) {
-  if (config.fit_model.empty() || config.fit_budgets.empty() || !brdf.isotropic()) return {};
-  const fit::Loss loss = fit::parse_loss(config.fit_loss).value();  // validate() checked it
-  fit::FitOptions o{.loss = loss, .samples = config.fit_samples};
-  fit::FitResult whole;
+std::optional<fit::FitResult> whole_fit(const Brdf& brdf, const StudyConfig& config,
+                                        const std::function<void(std::string)>& say) {
+  if (config.fit_model.empty() || !brdf.isotropic()) return std::nullopt;
+  const fit::FitOptions o{.loss = fit::parse_loss(config.fit_loss).value(),  // validate() checked
+                          .samples = config.fit_samples};
   try {
-    whole = fit::fit(brdf, config.fit_model, o);
+    return fit::fit(brdf, config.fit_model, o);
   } catch (const fit::FitDataError& e) {
     say(fmt::format("fit: skipped, {}", e.what()));
-    return {};
+    return std::nullopt;
   }
+}
+
+std::vector<std::pair<Space, FitPoint>> fit_metric(const Brdf& brdf, const StudyConfig& config,
+                                                   std::span<const Space> work,
+                                                   const std::optional<fit::FitResult>& whole_fit) {
+  if (!whole_fit || config.fit_budgets.empty()) return {};
+  const fit::FitResult& whole = *whole_fit;
+  const fit::Loss loss = fit::parse_loss(config.fit_loss).value();
+  fit::FitOptions o{.loss = loss, .samples = config.fit_samples};
   const fit::Samples layout = fit::halfdiff_samples(config.fit_samples);
   std::vector<Rgb> truth(layout.pairs.size());
   for (std::size_t i = 0; i < truth.size(); ++i) truth[i] = brdf.eval(layout.pairs[i]);
@@ -122,7 +129,6 @@ std::vector<std::pair<Space, FitPoint>> fit_metric(const Brdf& brdf, const Study
   std::vector<std::pair<Space, FitPoint>> out;
   for (std::size_t j = 0; j < jobs.size(); ++j)
     if (rows[j]) out.emplace_back(config.params[jobs[j].param], *rows[j]);
-  say("fit");
   return out;
 }
 

@@ -435,12 +435,13 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
   for (const std::size_t kib : config.sampler_kib) {
     std::string rows;
     Wins wins(params);
-    int beats_own = 0, with_own = 0, beats_warp = 0, with_warp = 0;
+    int beats_own = 0, with_own = 0, beats_warp = 0, with_warp = 0, beats_mix = 0, with_mix = 0;
     for (const BrdfResult& b : results) {
       if (b.table("sampling").rows.empty()) continue;
       std::vector<double> variance;
       rows += row_start(b.label);
-      bool better_than_own = false, has_own = false, better_than_warp = false, has_warp = false;
+      bool better_than_own = false, has_own = false, better_than_warp = false, has_warp = false,
+           better_than_mix = false, has_mix = false;
       for (Space s : params) {
         double v = NAN;
         for (const SamplingPoint& p : sampling_points(b, s))
@@ -450,6 +451,8 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
             better_than_own |= has_own && p.efficiency_vs_own > 1;
             has_warp |= p.vndf_warp_kib > 0;
             better_than_warp |= p.efficiency_vs_vndf_warp > 1;
+            has_mix |= p.efficiency_vs_fitted_mixture > 0;
+            better_than_mix |= p.efficiency_vs_fitted_mixture > 1;
           }
         variance.push_back(v);
         rows += std::isfinite(v) ? fmt::format(" {:.3g} |", v) : " – |";
@@ -460,14 +463,18 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
       beats_own += better_than_own;
       with_warp += has_warp;
       beats_warp += better_than_warp;
+      with_mix += has_mix;
+      beats_mix += better_than_mix;
     }
     md += fmt::format("Tables of {} KiB:\n\n", kib) + table_header("BRDF", params) + rows +
           fmt::format(
               "\nLowest variance (BRDFs): {}. BRDFs with a sampler of their own: {}, of "
               "which some table here is more efficient than it for {}. BRDFs with Dupuy & "
               "Jakob's warp in at most {} KiB: {}, of which some table here is more efficient "
-              "than it for {}.\n\n",
-              wins.text(), with_own, beats_own, kib, with_warp, beats_warp);
+              "than it for {}. BRDFs with a fitted mixture ({} sampled through its lobes' "
+              "samplers): {}, of which some table here is more efficient than it for {}.\n\n",
+              wins.text(), with_own, beats_own, kib, with_warp, beats_warp,
+              config.fit_model.empty() ? "no model" : config.fit_model, with_mix, beats_mix);
   }
   return md;
 }

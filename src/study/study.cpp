@@ -234,9 +234,9 @@ std::pair<std::shared_ptr<const Brdf>, double> vndf_warp_sampler(const Brdf& brd
   return {nullptr, 0.0};
 }
 
-std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
-                                                             const StudyConfig& config,
-                                                             std::span<const Space> work) {
+std::vector<std::pair<Space, SamplingPoint>> sampling_metric(
+    const Brdf& brdf, const StudyConfig& config, std::span<const Space> work,
+    const std::optional<fit::FitResult>& fitted) {
   const render::SamplingMetricOptions o{.samples = config.sampler_samples, .seed = config.seed};
   const render::SamplingMeasure cosine =
       render::measure_sampling(brdf, *render::with_cosine_sampling(brdf), o);
@@ -248,6 +248,8 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
     const auto [sampler, kib_taken] = vndf_warp_sampler(brdf, kib);
     if (sampler) vndf_warp[kib] = {render::measure_sampling(brdf, *sampler, o), kib_taken};
   }
+  std::optional<render::SamplingMeasure> mixture;
+  if (fitted) mixture = render::measure_sampling(brdf, *load_brdf(fitted->spec), o);
   std::vector<std::pair<Space, SamplingPoint>> rows;
   for (std::size_t k = 0; k < work.size(); ++k)
     for (const std::size_t kib : config.sampler_kib) {
@@ -272,6 +274,8 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(const Brdf& brdf,
         } else {
           it->second.vndf_warp_kib = it->second.efficiency_vs_vndf_warp = 0;  // none
         }
+        it->second.efficiency_vs_fitted_mixture =
+            mixture ? render::relative_efficiency(m, *mixture) : 0;
       }
       rows.emplace_back(config.params[k], it->second);
     }
@@ -386,15 +390,21 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
       say(fmt::format("images {}", env.label));
     }
   }
+  // One fit of the whole BRDF serves metric 5's fitted-mixture sampler and metric 6.
+  const std::optional<fit::FitResult> fitted =
+      config.sampler_kib.empty() && config.fit_budgets.empty() ? std::nullopt
+                                                               : whole_fit(brdf, config, say);
   if (!config.sampler_kib.empty()) {
-    for (const auto& [space, point] : sampling_metric(brdf, config, work))
+    for (const auto& [space, point] : sampling_metric(brdf, config, work, fitted))
       for (Task& t : done)
         if (t.space == space) add_sampling(t.table("sampling"), space, point);
     say("sampling");
   }
-  for (const auto& [space, point] : fit_metric(brdf, config, work, say))
+  const auto fit_rows = fit_metric(brdf, config, work, fitted);
+  for (const auto& [space, point] : fit_rows)
     for (Task& t : done)
       if (t.space == space) add_fit(t.table("fit"), space, point);
+  if (!fit_rows.empty()) say("fit");
   // Each table: the rows of the parameterizations one after the other.
   result.params = config.params;
   result.tables = stored_tables();

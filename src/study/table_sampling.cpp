@@ -10,14 +10,16 @@ MetricTable sampling_table() {
            columns::real("relative_variance"), columns::real("relative_variance_error"),
            columns::real("ns_per_sample"), columns::real("efficiency_vs_cosine"),
            columns::text("own_sampler"), columns::real("efficiency_vs_own"),
-           columns::real("vndf_warp_kib"), columns::real("efficiency_vs_vndf_warp")},
+           columns::real("vndf_warp_kib"), columns::real("efficiency_vs_vndf_warp"),
+           columns::real("efficiency_vs_fitted_mixture")},
           {}};
 }
 
 void add_sampling(MetricTable& table, Space space, const SamplingPoint& p) {
   table.add({std::string(name_of(space)), std::int64_t(p.kib), p.chart, p.relative_variance,
              p.relative_variance_error, p.ns_per_sample, p.efficiency_vs_cosine, p.own_sampler,
-             p.efficiency_vs_own, p.vndf_warp_kib, p.efficiency_vs_vndf_warp});
+             p.efficiency_vs_own, p.vndf_warp_kib, p.efficiency_vs_vndf_warp,
+             p.efficiency_vs_fitted_mixture});
 }
 
 std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space) {
@@ -28,7 +30,8 @@ std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space
                       t.real(*row, "relative_variance"), t.real(*row, "relative_variance_error"),
                       t.real(*row, "ns_per_sample"), t.real(*row, "efficiency_vs_cosine"),
                       t.text(*row, "own_sampler"), t.real(*row, "efficiency_vs_own"),
-                      t.real(*row, "vndf_warp_kib"), t.real(*row, "efficiency_vs_vndf_warp")});
+                      t.real(*row, "vndf_warp_kib"), t.real(*row, "efficiency_vs_vndf_warp"),
+                      t.real(*row, "efficiency_vs_fitted_mixture")});
   return points;
 }
 

@@ -131,6 +131,10 @@ struct SamplingPoint {
   // most `kib` KiB of sampling tables: the KiB it took and this table's efficiency against it;
   // both 0 where there is none (an anisotropic BRDF, one the export refuses, or no size that fits).
   double vndf_warp_kib = 0, efficiency_vs_vndf_warp = 0;
+  // The fitted-mixture sampler (Sztrajman et al. 2021 sample their neural BRDFs through fitted
+  // analytic lobes): config.fit_model fitted to the whole BRDF, sampled as the mixture of its
+  // lobes' own samplers; this table's efficiency against it, 0 where there is no fit.
+  double efficiency_vs_fitted_mixture = 0;
 };
 
 // A row of the fit table (metric 6, issue 37): `model` fitted under `loss` to the `samples`
