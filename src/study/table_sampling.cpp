@@ -11,7 +11,11 @@ MetricTable sampling_table() {
            columns::real("ns_per_sample"), columns::real("efficiency_vs_cosine"),
            columns::text("own_sampler"), columns::real("efficiency_vs_own"),
            columns::real("vndf_warp_kib"), columns::real("efficiency_vs_vndf_warp"),
-           columns::real("efficiency_vs_fitted_mixture")},
+           columns::real("efficiency_vs_fitted_mixture"),
+           columns::real("pixel_relative_variance_brdf"),
+           columns::real("pixel_relative_variance_mis"),
+           columns::real("pixel_efficiency_vs_cosine_brdf"),
+           columns::real("pixel_efficiency_vs_cosine_mis")},
           {}};
 }
 
@@ -19,7 +23,9 @@ void add_sampling(MetricTable& table, Space space, const SamplingPoint& p) {
   table.add({std::string(name_of(space)), std::int64_t(p.kib), p.chart, p.relative_variance,
              p.relative_variance_error, p.ns_per_sample, p.efficiency_vs_cosine, p.own_sampler,
              p.efficiency_vs_own, p.vndf_warp_kib, p.efficiency_vs_vndf_warp,
-             p.efficiency_vs_fitted_mixture});
+             p.efficiency_vs_fitted_mixture, p.pixel_relative_variance_brdf,
+             p.pixel_relative_variance_mis, p.pixel_efficiency_vs_cosine_brdf,
+             p.pixel_efficiency_vs_cosine_mis});
 }
 
 std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space) {
@@ -31,7 +37,11 @@ std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space
                       t.real(*row, "ns_per_sample"), t.real(*row, "efficiency_vs_cosine"),
                       t.text(*row, "own_sampler"), t.real(*row, "efficiency_vs_own"),
                       t.real(*row, "vndf_warp_kib"), t.real(*row, "efficiency_vs_vndf_warp"),
-                      t.real(*row, "efficiency_vs_fitted_mixture")});
+                      t.real(*row, "efficiency_vs_fitted_mixture"),
+                      t.real(*row, "pixel_relative_variance_brdf"),
+                      t.real(*row, "pixel_relative_variance_mis"),
+                      t.real(*row, "pixel_efficiency_vs_cosine_brdf"),
+                      t.real(*row, "pixel_efficiency_vs_cosine_mis")});
   return points;
 }
 

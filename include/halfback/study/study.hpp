@@ -135,6 +135,12 @@ struct SamplingPoint {
   // analytic lobes): config.fit_model fitted to the whole BRDF, sampled as the mixture of its
   // lobes' own samplers; this table's efficiency against it, 0 where there is no fit.
   double efficiency_vs_fitted_mixture = 0;
+  // A pixel of the sphere of the image protocol (under the study's first environment) rendered
+  // with this table's samples alone and with MIS (one environment and one table sample): the
+  // variance of one pixel sample relative to the pixel's mean², averaged over the sphere, and the
+  // efficiency against the same strategy with cosine sampling.
+  double pixel_relative_variance_brdf = 0, pixel_relative_variance_mis = 0;
+  double pixel_efficiency_vs_cosine_brdf = 0, pixel_efficiency_vs_cosine_mis = 0;
 };
 
 // A row of the fit table (metric 6, issue 37): `model` fitted under `loss` to the `samples`
