@@ -84,7 +84,10 @@ void BM_FitLambertHe(benchmark::State& state) {
 BENCHMARK(BM_ModelLossAtSamples)->Arg(100000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitLambertGgxOneStart)->Arg(100000)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_FitLambertGgx)->Arg(100000)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK(BM_HeLossAtSamples)->Args({100000, 0})->Args({100000, 1})->Args({100000, 2})
+BENCHMARK(BM_HeLossAtSamples)
+    ->Args({100000, 0})
+    ->Args({100000, 1})
+    ->Args({100000, 2})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitLambertHe)->Arg(20000)->Iterations(1)->Unit(benchmark::kSecond);
 

@@ -206,7 +206,7 @@ TEST(FitMultistart, EachDistinctStartRunsOnce) {
   const BrdfPtr target = load_brdf("ggx:alpha=0.3");
   FitOptions o;
   o.samples = 1000;
-  EXPECT_EQ(fit(*target, "ggx", o).starts, 7u);  // defaults, the peak's α, a grid of 5
+  EXPECT_EQ(fit(*target, "ggx", o).starts, 7u);   // defaults, the peak's α, a grid of 5
   EXPECT_EQ(fit(*target, "ward", o).starts, 6u);  // defaults, a grid of 5
 }
 

@@ -101,7 +101,8 @@ void read_setting(PySettings& out, const std::string& key, const py::handle& v) 
         "settings: unknown key '" + key +
         "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
         "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
-        "seed, no_gonio, no_images, sampler_kib, sampler_samples, no_sampling, fit_model, fit_loss, "
+        "seed, no_gonio, no_images, sampler_kib, sampler_samples, no_sampling, fit_model, "
+        "fit_loss, "
         "fit_budgets, no_fit)");
 }
 

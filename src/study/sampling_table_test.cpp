@@ -90,7 +90,8 @@ TEST(SamplingTable, PixelVarianceKnownCaseAndGlossy) {
   for (Space s : c.params)
     for (const SamplingPoint& p : sampling_points(b, s)) {
       EXPECT_LT(p.pixel_efficiency_vs_cosine_brdf, 1e-6) << name_of(s);
-      EXPECT_GT(p.pixel_relative_variance_mis, 0) << name_of(s);  // environment samples do not follow the cosine
+      // Environment samples do not follow the cosine.
+      EXPECT_GT(p.pixel_relative_variance_mis, 0) << name_of(s);
       EXPECT_EQ(p.efficiency_vs_fitted_mixture, 0);  // no fit model
     }
   c.environments = {render::load_environment("sky")};

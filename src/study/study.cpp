@@ -337,9 +337,9 @@ ImageError image_error(const Brdf& test, const Brdf& reference, const render::En
   const render::RenderSettings settings = image_settings(config);
   const render::RenderResult truth = render::render_sampled(reference, env, settings);
   if (truth.nonfinite > 0)
-    throw std::invalid_argument(fmt::format(
-        "image error: the reference {} has no finite value at {} pixels", reference.name(),
-        truth.nonfinite));
+    throw std::invalid_argument(
+        fmt::format("image error: the reference {} has no finite value at {} pixels",
+                    reference.name(), truth.nonfinite));
   const render::Image img = render::render_sampled(test, env, settings).image;
   return compare_images(img, truth.image, sphere_mask(settings.width, settings.height));
 }

@@ -5,18 +5,18 @@
 namespace halfback::study {
 
 MetricTable sampling_table() {
-  return {"sampling",
-          {columns::parameterization(), columns::integer("table_kib"), columns::text("chart"),
-           columns::real("relative_variance"), columns::real("relative_variance_error"),
-           columns::real("ns_per_sample"), columns::real("efficiency_vs_cosine"),
-           columns::text("own_sampler"), columns::real("efficiency_vs_own"),
-           columns::real("vndf_warp_kib"), columns::real("efficiency_vs_vndf_warp"),
-           columns::real("efficiency_vs_fitted_mixture"),
-           columns::real("pixel_relative_variance_brdf"),
-           columns::real("pixel_relative_variance_mis"),
-           columns::real("pixel_efficiency_vs_cosine_brdf"),
-           columns::real("pixel_efficiency_vs_cosine_mis")},
-          {}};
+  return {
+      "sampling",
+      {columns::parameterization(), columns::integer("table_kib"), columns::text("chart"),
+       columns::real("relative_variance"), columns::real("relative_variance_error"),
+       columns::real("ns_per_sample"), columns::real("efficiency_vs_cosine"),
+       columns::text("own_sampler"), columns::real("efficiency_vs_own"),
+       columns::real("vndf_warp_kib"), columns::real("efficiency_vs_vndf_warp"),
+       columns::real("efficiency_vs_fitted_mixture"), columns::real("pixel_relative_variance_brdf"),
+       columns::real("pixel_relative_variance_mis"),
+       columns::real("pixel_efficiency_vs_cosine_brdf"),
+       columns::real("pixel_efficiency_vs_cosine_mis")},
+      {}};
 }
 
 void add_sampling(MetricTable& table, Space space, const SamplingPoint& p) {
