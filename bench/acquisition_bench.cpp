@@ -1,0 +1,60 @@
+// `halfback plan` and `halfback reconstruct` at 10⁵ measurements (issue 33: each ≤ 2 s; docs/
+// acquisition.md, "Speed"): the plan of a design with its instrument order, and the reconstruction
+// from values at its rows, beside the unit of both measured in the same run, the design's points
+// alone (gonio_plan). Isotropic hybrid (the 3D gonio-reflectometer), regular and stratified.
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#include "halfback/loader/load.hpp"
+#include "halfback/study/acquisition.hpp"
+
+namespace {
+
+using namespace halfback;
+using namespace halfback::study;
+
+GonioSetup setup_of(const benchmark::State& state) {
+  PlanSettings p;
+  p.budget = std::size_t(state.range(0));
+  p.design = state.range(1) == 0 ? "regular" : "stratified";
+  return plan_setup(p);
+}
+
+// The design's points only: the baseline of the two below.
+void BM_DesignPoints(benchmark::State& state) {
+  const GonioSetup s = setup_of(state);
+  for (auto _ : state) benchmark::DoNotOptimize(gonio_plan(s).points.data());
+}
+
+// The plan: the points, each configuration once (isotropy, reciprocity), the instrument's order.
+void BM_Plan(benchmark::State& state) {
+  const GonioSetup s = setup_of(state);
+  AcquisitionPlan plan;
+  for (auto _ : state) {
+    plan = acquisition_plan(s);
+    benchmark::DoNotOptimize(plan.measured.data());
+  }
+  state.counters["rows"] = double(plan.measured.size());
+  state.counters["travel_vs_cell_order"] = plan.travel / plan.cell_order_travel;
+}
+
+// The reconstruction from the values measured at the rows (a GGX's, evaluated once outside).
+void BM_Reconstruct(benchmark::State& state) {
+  const AcquisitionPlan plan = acquisition_plan(setup_of(state));
+  const BrdfPtr truth = load_brdf("ggx:alpha=0.15");
+  std::vector<Rgb> values(plan.measured.size());
+  for (std::size_t r = 0; r < values.size(); ++r) values[r] = truth->eval(plan.measured[r]);
+  for (auto _ : state) {
+    GonioReconstruction rec = reconstruct(plan, values, "ggx");
+    benchmark::DoNotOptimize(rec.samples());
+  }
+}
+
+BENCHMARK(BM_DesignPoints)->Args({100000, 0})->Args({100000, 1})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Plan)->Args({100000, 0})->Args({100000, 1})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Reconstruct)->Args({100000, 0})->Args({100000, 1})->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
