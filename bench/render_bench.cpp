@@ -30,7 +30,7 @@
 //    1 MB and 16 MB of tables (--part 6; not in the default parts).
 // 7. The table's size (issue 36, the renderer's default): equal-time error of MIS with halfdiff's
 //    table at 64 KB, 1 MB and the default size, and with cosine sampling, for measured materials
-//    (RGL files and neural BRDFs) and a tabulated glossy model (--part 7; not in the default parts).
+//    (RGL files and neural BRDFs) and a tabulated glossy model (--part 7; not by default).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
