@@ -338,7 +338,8 @@ ImageError image_error(const Brdf& test, const Brdf& reference, const render::En
   const render::RenderResult truth = render::render_sampled(reference, env, settings);
   if (truth.nonfinite > 0)
     throw std::invalid_argument(
-        fmt::format("image error: the reference {} has no finite value at {} pixels",
+        fmt::format("image error: the reference {} gave {} values that are not finite in its "
+                    "rendering",
                     reference.name(), truth.nonfinite));
   const render::Image img = render::render_sampled(test, env, settings).image;
   return compare_images(img, truth.image, sphere_mask(settings.width, settings.height));

@@ -1,4 +1,8 @@
-"""The study's SSIM against a NumPy port of Wang et al. 2004 on a fixed pair of images."""
+"""The study's SSIM against a NumPy port of Wang et al. 2004 on a fixed pair of images, and
+halfback.image_error, the study's image-space error of one BRDF against another."""
+
+import os
+import pathlib
 
 import numpy as np
 import pytest
@@ -95,3 +99,14 @@ def test_image_error_refuses_bad_input():
         halfback.image_error("lambert", "lambert", env="nope")
     with pytest.raises(ValueError, match=">= 8 pixels"):
         halfback.image_error("lambert", "lambert", settings={"image_size": -3})
+
+
+def test_image_error_refuses_a_reference_without_values_somewhere():
+    # An ALTA file measured at a few incidence angles only has no value elsewhere: no truth to
+    # compare with (the study skips such images too).
+    alta = pathlib.Path(os.environ.get("HALFBACK_SHARED_DIR", "/nonexistent")) / "data" / "alta"
+    path = alta / "retro-3M-jaune.dat"
+    if not path.exists():
+        pytest.skip("../shared/data/alta not found (set HALFBACK_SHARED_DIR)")
+    with pytest.raises(ValueError, match="retro-3M-jaune gave [0-9]+ values that are not finite"):
+        halfback.image_error("lambert", str(path))

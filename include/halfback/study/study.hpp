@@ -188,8 +188,8 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
 // The image-space error of `test` against `reference` under `env` with the study's image
 // protocol (config.image_size, image_spp and seed; environment sampling, so both are evaluated at
 // the same light directions): a model, a fit or a factored model scored as the reconstructions
-// are. Throws std::invalid_argument when the reference's rendering has a non-finite pixel, and
-// what compare_images throws.
+// are. Throws std::invalid_argument when the reference gives a value that is not finite in its
+// rendering (an ALTA file without data somewhere), and what compare_images throws.
 ImageError image_error(const Brdf& test, const Brdf& reference, const render::EnvMap& env,
                        const StudyConfig& config);
 
