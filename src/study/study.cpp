@@ -236,14 +236,12 @@ std::pair<std::shared_ptr<const Brdf>, double> vndf_warp_sampler(const Brdf& brd
 
 // The sphere's pixels as estimators (the study's image protocol, under the first environment of
 // the study, the sky without one): `sampler` (a BRDF with the sampling to measure) rendered with
-// the BRDF's samples alone or with MIS; per pixel of the sphere whose mean is > 0, the variance of
-// one pixel sample relative to the mean² (luminance), averaged; and the time per pixel sample.
-struct PixelMeasure {
-  double relative_variance = 0, seconds_per_sample = 0;
-};
-
-PixelMeasure measure_pixels(const Brdf& sampler, const StudyConfig& config,
-                            render::Strategy strategy) {
+// the BRDF's samples alone or with MIS. As a SamplingMeasure, so that render::relative_efficiency
+// compares two: relative_variance is the variance of one pixel sample relative to the pixel's
+// mean² (luminance), averaged over the sphere's pixels whose mean is > 0; seconds_per_sample the
+// rendering's time per pixel sample; per_wo is empty.
+render::SamplingMeasure measure_pixels(const Brdf& sampler, const StudyConfig& config,
+                                       render::Strategy strategy) {
   render::RenderSettings settings = image_settings(config);
   settings.strategy = strategy;
   settings.variance = true;
@@ -261,16 +259,10 @@ PixelMeasure measure_pixels(const Brdf& sampler, const StudyConfig& config,
     sum += double(r.variance[p]) * r.spp / (mean * mean);  // the mean's variance × spp
     ++counted;
   }
-  return {counted ? sum / double(counted) : 0,
-          r.seconds / (double(settings.width) * settings.height * r.spp)};
-}
-
-// (relative variance × time) of b over a's, with relative_efficiency()'s floor for exact ones.
-double pixel_efficiency(const PixelMeasure& a, const PixelMeasure& b) {
-  constexpr double kFloor = 1e-20;
-  const double cost_a = std::max(a.relative_variance, kFloor) * a.seconds_per_sample;
-  const double cost_b = std::max(b.relative_variance, kFloor) * b.seconds_per_sample;
-  return std::isfinite(cost_a) && cost_a > 0 ? cost_b / cost_a : 0;
+  render::SamplingMeasure m;
+  m.relative_variance = counted ? sum / double(counted) : 0;
+  m.seconds_per_sample = r.seconds / (double(settings.width) * settings.height * r.spp);
+  return m;
 }
 
 std::vector<std::pair<Space, SamplingPoint>> sampling_metric(
@@ -290,8 +282,10 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(
   std::optional<render::SamplingMeasure> mixture;
   if (fitted) mixture = render::measure_sampling(brdf, *load_brdf(fitted->spec), o);
   const auto cosine_sampler = render::with_cosine_sampling(brdf);
-  const PixelMeasure cosine_brdf = measure_pixels(*cosine_sampler, config, render::Strategy::brdf);
-  const PixelMeasure cosine_mis = measure_pixels(*cosine_sampler, config, render::Strategy::mis);
+  const render::SamplingMeasure cosine_brdf =
+      measure_pixels(*cosine_sampler, config, render::Strategy::brdf);
+  const render::SamplingMeasure cosine_mis =
+      measure_pixels(*cosine_sampler, config, render::Strategy::mis);
   std::vector<std::pair<Space, SamplingPoint>> rows;
   for (std::size_t k = 0; k < work.size(); ++k)
     for (const std::size_t kib : config.sampler_kib) {
@@ -318,12 +312,13 @@ std::vector<std::pair<Space, SamplingPoint>> sampling_metric(
         }
         it->second.efficiency_vs_fitted_mixture =
             mixture ? render::relative_efficiency(m, *mixture) : 0;
-        const PixelMeasure alone = measure_pixels(table, config, render::Strategy::brdf);
-        const PixelMeasure mis = measure_pixels(table, config, render::Strategy::mis);
+        const render::SamplingMeasure alone = measure_pixels(table, config, render::Strategy::brdf);
+        const render::SamplingMeasure mis = measure_pixels(table, config, render::Strategy::mis);
         it->second.pixel_relative_variance_brdf = alone.relative_variance;
         it->second.pixel_relative_variance_mis = mis.relative_variance;
-        it->second.pixel_efficiency_vs_cosine_brdf = pixel_efficiency(alone, cosine_brdf);
-        it->second.pixel_efficiency_vs_cosine_mis = pixel_efficiency(mis, cosine_mis);
+        it->second.pixel_efficiency_vs_cosine_brdf =
+            render::relative_efficiency(alone, cosine_brdf);
+        it->second.pixel_efficiency_vs_cosine_mis = render::relative_efficiency(mis, cosine_mis);
       }
       rows.emplace_back(config.params[k], it->second);
     }
