@@ -276,13 +276,11 @@ void table_size_at_equal_time(bool quick) {
       {"neural gold-metallic-paint3", load_brdf("embedded:gold-metallic-paint3")},
       {"GGX α = 0.05, tabulated", load_brdf("ggx:alpha=0.05,f0=0.9")}};
   const render::TabulationOptions standard;  // the renderer's default
-  const std::size_t standard_kb =
-      std::size_t(standard.theta_slices) * standard.radial * standard.azimuthal * 20 / 1024;
   std::printf(
       "\n## Tabulated sampler: size of halfdiff's table (MIS, %.1f s, 128 × 128, built-in sky; "
-      "relative RMSE at equal time)\n\n| material | cosine | 64 KB | 1 MB | default (%zu KB) "
-      "|\n|---|---|---|---|---|\n",
-      budget, standard_kb);
+      "relative RMSE at equal time)\n\n| material | cosine | 64 KB | 1 MB | default (%d × %d × "
+      "%d cells) |\n|---|---|---|---|---|\n",
+      budget, standard.theta_slices, standard.radial, standard.azimuthal);
   for (const Material& m : measured) {
     const render::Image reference = reference_image(*m.brdf, sky, quick);
     std::printf("| %s |", m.label.c_str());

@@ -93,8 +93,9 @@ for target in merl rgl alta npy h5 factored envmap view view_wire plan; do
   [ -f "fuzz/$target.dict" ] && dict=("-dict=fuzz/$target.dict")
   # libhdf5 allocates a metadata entry's size as read from the file before reading it (H5C_protect):
   # a corrupt header asks for terabytes. In a release build malloc returns null there and HDF5
-  # reports a corrupt file (tested in tests/formats); the fuzzer must see the same, so for h5 a
-  # failed allocation returns null and the limit is on memory touched (-rss_limit_mb), not reserved.
+  # reports a corrupt file (NbrdfH5.AbsurdAddressInTheRootEntryIsAnError); the fuzzer must see the
+  # same, so for h5 a failed allocation returns null and the limit is on memory touched
+  # (-rss_limit_mb), not reserved.
   asan_options=""
   extra=()
   if [ "$target" = h5 ]; then
@@ -102,9 +103,9 @@ for target in merl rgl alta npy h5 factored envmap view view_wire plan; do
     extra=(-malloc_limit_mb=1048576)
   fi
   echo "== ${target}_fuzz: ${seconds}s"
-  if ! ASAN_OPTIONS="$asan_options" "$build/fuzz/${target}_fuzz" "$corpus/$target" "${dict[@]}" "${extra[@]}" -max_total_time="$seconds" \
-      -max_len="$max_len" -timeout=20 -rss_limit_mb=2560 -print_final_stats=1 \
-      -artifact_prefix="$artifacts/${target}-" 2>"$build/${target}_fuzz.log"; then
+  if ! ASAN_OPTIONS="$asan_options" "$build/fuzz/${target}_fuzz" "$corpus/$target" "${dict[@]}" \
+      "${extra[@]}" -max_total_time="$seconds" -max_len="$max_len" -timeout=20 \
+      -rss_limit_mb=2560 -print_final_stats=1 -artifact_prefix="$artifacts/${target}-" 2>"$build/${target}_fuzz.log"; then
     echo "${target}_fuzz FAILED; see $build/${target}_fuzz.log and $artifacts/" >&2
     tail -40 "$build/${target}_fuzz.log" >&2
     status=1
