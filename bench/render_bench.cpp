@@ -31,6 +31,12 @@
 // 7. The table's size (issue 36, the renderer's default): equal-time error of MIS with halfdiff's
 //    table at 64 KB, 1 MB and the default size, and with cosine sampling, for measured materials
 //    (RGL files and neural BRDFs) and a tabulated glossy model (--part 7; not by default).
+// 8. The automatic choice of the BRDF sampler (issue 36, docs/render.md "Choosing the BRDF
+//    sampler"): equal-time error of MIS with the table, the cosine and the pilot's choice
+//    (render() with each RenderSettings::brdf_sampling: set-up and pilot count in the time), for
+//    neural BRDFs of the MERL and RGL databases (from ../shared/data; the embedded two without it)
+//    and a tabulated glossy model, under the built-in sky and studio and two of the shared
+//    environments (--part 8; not by default).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
@@ -41,6 +47,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <thread>
@@ -130,12 +137,15 @@ std::uint64_t image_hash(const render::Image& image) {
   return bytes_hash(image.rgb);
 }
 
+std::string shared_data_dir() {
+  const char* shared = std::getenv("HALFBACK_SHARED_DIR");  // as for the tests
+  return (shared && *shared ? std::string(shared) : HALFBACK_SOURCE_DIR "/../shared") + "/data/";
+}
+
 // Part 4: one line per material and repetition: CPU seconds of the set-up and of the render,
 // and pixel samples per CPU second.
 void throughput(const ThroughputOptions& o) {
-  const char* shared = std::getenv("HALFBACK_SHARED_DIR");  // as for the tests
-  const std::string data =
-      (shared && *shared ? std::string(shared) : HALFBACK_SOURCE_DIR "/../shared") + "/data/";
+  const std::string data = shared_data_dir();
   const std::string env_file = data + "envmaps/uffizi.hdr";
   struct Timed {
     std::string key, spec;
@@ -174,10 +184,7 @@ void throughput(const ThroughputOptions& o) {
 // ωo (one pixel's samples): CPU ns per row of sample_batch, pdf_batch and eval_batch, over 2^16
 // rows at as many incidences, the numbers uniform (a fixed seed).
 void rgl_calls(const ThroughputOptions& o) {
-  const char* shared = std::getenv("HALFBACK_SHARED_DIR");
-  const std::string file =
-      (shared && *shared ? std::string(shared) : HALFBACK_SOURCE_DIR "/../shared") +
-      "/data/rgl/ilm_l3_37_metallic_rgb.bsdf";
+  const std::string file = shared_data_dir() + "rgl/ilm_l3_37_metallic_rgb.bsdf";
   const BrdfPtr brdf = load_brdf(file);
   constexpr std::size_t kPacket = 64, kRows = std::size_t(1) << 16;
   std::vector<Vec3<double>> wo(kRows);
@@ -298,6 +305,66 @@ void table_size_at_equal_time(bool quick) {
   }
 }
 
+// Hides a model's own sampler, as for measured data.
+class Opaque final : public Brdf {
+ public:
+  explicit Opaque(BrdfPtr b) : b_(std::move(b)) {}
+  std::string name() const override { return b_->name(); }
+  std::string description() const override { return b_->description(); }
+  bool isotropic() const override { return b_->isotropic(); }
+  bool reciprocal() const override { return b_->reciprocal(); }
+  Rgb eval(const DirPair<double>& p) const override { return b_->eval(p); }
+
+ private:
+  BrdfPtr b_;
+};
+
+// Part 8: table, cosine and the pilot's choice at equal time, per material and environment.
+void sampler_choice_at_equal_time(bool quick) {
+  const double budget = quick ? 0.2 : 1.5;
+  const std::string data = shared_data_dir();
+  const bool shared = std::filesystem::exists(data + "envmaps/grace.hdr");
+  std::vector<Material> materials{
+      {"neural pink-felt", load_brdf("embedded:pink-felt")},
+      {"neural gold-metallic-paint3", load_brdf("embedded:gold-metallic-paint3")},
+      {"GGX α = 0.05, tabulated", std::make_shared<Opaque>(load_brdf("ggx:alpha=0.05,f0=0.9"))}};
+  std::vector<std::pair<std::string, render::EnvMap>> envs;
+  envs.emplace_back("sky", render::EnvMap::default_sky());
+  envs.emplace_back("studio", render::EnvMap::from_spec("studio"));
+  if (shared) {
+    for (const char* name : {"blue-acrylic", "chrome", "beige-fabric", "nylon"})
+      materials.push_back(
+          {std::string("neural ") + name, load_brdf(data + "nbrdf/merl_nbrdf/" + name + ".h5")});
+    for (const char* name : {"acrylic_felt_green_rgb", "paper_white_rgb"})
+      materials.push_back({std::string("neural RGL ") + name,
+                           load_brdf(data + "nbrdf/rgl-isotropic_nbrdf/" + name + ".h5")});
+    for (const char* name : {"grace.hdr", "uffizi.hdr"})
+      envs.emplace_back(name, render::EnvMap::from_spec(data + "envmaps/" + name));
+  }
+  std::printf(
+      "\n## Choosing the BRDF sampler (MIS, %.1f s, 128 × 128; relative RMSE at equal time, "
+      "set-up and pilot included)\n\n| material | environment | table | cosine | auto | auto "
+      "chose |\n|---|---|---|---|---|---|\n",
+      budget);
+  for (const auto& [env_name, env] : envs)
+    for (const Material& m : materials) {
+      const render::Image reference = reference_image(*m.brdf, env, quick);
+      std::printf("| %s | %s |", m.label.c_str(), env_name.c_str());
+      std::string chose;
+      for (render::BrdfSampling choice : {render::BrdfSampling::table, render::BrdfSampling::cosine,
+                                          render::BrdfSampling::automatic}) {
+        render::RenderSettings s = budgeted(budget);
+        s.brdf_sampling = choice;
+        const render::RenderResult r = render::render(*m.brdf, env, s);
+        print_equal_time_error(r, reference, budget);
+        if (choice == render::BrdfSampling::automatic)
+          chose = r.sampler.find("cosine") == 0 ? "cosine" : "table";
+      }
+      std::printf(" %s |\n", chose.c_str());
+      std::fflush(stdout);
+    }
+}
+
 int main(int argc, char** argv) {
   bool quick = false;
   int only = 0;
@@ -327,6 +394,10 @@ int main(int argc, char** argv) {
   }
   if (only == 7) {
     table_size_at_equal_time(quick);
+    return 0;
+  }
+  if (only == 8) {
+    sampler_choice_at_equal_time(quick);
     return 0;
   }
   const unsigned all = std::max(1u, std::thread::hardware_concurrency());

@@ -44,7 +44,7 @@ foreach(rel IN LISTS files)
     continue()
   endif()
   set(is_test FALSE)
-  if(rel MATCHES "_test\\.cpp$" OR rel MATCHES "^(tests|bench|fuzz)/")
+  if(rel MATCHES "_test(_support)?\\.(cpp|hpp)$" OR rel MATCHES "^(tests|bench|fuzz)/")
     set(is_test TRUE)
   endif()
   # The files a line of the graph is for: the library's (support's own files count as its

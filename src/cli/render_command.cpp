@@ -17,7 +17,7 @@ namespace {
 
 struct RenderOptions {
   std::string brdf, env = "sky", output, strategy = "mis", heuristic = "power",
-                    sampling = "halfdiff";
+                    sampling = "halfdiff", brdf_sampling = "auto";
   int width = 512, height = 512, spp = 64, threads = 0;
   std::uint64_t seed = 1;
   double time_budget = 0, exposure = 0, env_rotation = 0, env_exposure = 0;
@@ -53,7 +53,8 @@ int run_render(const RenderOptions& o) {
   s.strategy = render::strategy_from_name(o.strategy).value();  // checked by the parser
   s.heuristic = o.heuristic == "balance" ? render::Heuristic::balance : render::Heuristic::power;
   s.tabulation.param = *space_from_name(o.sampling);  // checked by the parser
-  s.progress = !o.quiet;                              // drawn only when stderr is a terminal
+  s.brdf_sampling = render::brdf_sampling_from_name(o.brdf_sampling).value();  // checked too
+  s.progress = !o.quiet;  // drawn only when stderr is a terminal
 
   const BrdfPtr brdf = brdf_argument(o.brdf, "--brdf");
   const render::EnvMap env = [&] {
@@ -140,6 +141,12 @@ Command register_render(CLI::App& parent) {
                   "parameterization whose chart the tabulated sampler of measured BRDFs uses: " +
                       parameterization_names())
       ->check(parameterization_validator())
+      ->capture_default_str();
+  app->add_option("--brdf-sampling", o->brdf_sampling,
+                  "how a BRDF without a sampler of its own is sampled: table (the tabulated "
+                  "sampler), cosine, or auto (whichever has the lower variance in a small pilot "
+                  "rendering of the same scene)")
+      ->check(CLI::IsMember({"auto", "table", "cosine"}))
       ->capture_default_str();
   app->add_option("--threads", o->threads, "worker threads (0: all cores)")
       ->check(CLI::Range(0, 1024))

@@ -446,7 +446,7 @@ py::dict hemisphere_view(const std::string& param, double theta_o, std::size_t p
 
 py::array_t<float> render_brdf(const PyBrdf& b, const std::string& env, int width, int height,
                                int spp, std::uint64_t seed, const std::string& strategy,
-                               int threads) {
+                               int threads, const std::string& brdf_sampling) {
   render::RenderSettings s;
   s.width = width;
   s.height = height;
@@ -457,6 +457,11 @@ py::array_t<float> render_brdf(const PyBrdf& b, const std::string& env, int widt
   if (!parsed)
     throw py::value_error("strategy: expected 'mis', 'brdf' or 'env', got '" + strategy + "'");
   s.strategy = *parsed;
+  const auto sampling = render::brdf_sampling_from_name(brdf_sampling);
+  if (!sampling)
+    throw py::value_error("brdf_sampling: expected 'auto', 'table' or 'cosine', got '" +
+                          brdf_sampling + "'");
+  s.brdf_sampling = *sampling;
   const render::EnvMap map = render::EnvMap::from_spec(env);
   render::RenderResult r;
   {
@@ -597,10 +602,12 @@ Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape
 (sample positions), axis_names, metadata.)doc")
       .def("render", &render_brdf, py::arg("env") = "sky", py::arg("width") = 256,
            py::arg("height") = 256, py::arg("spp") = 64, py::arg("seed") = 1,
-           py::arg("strategy") = "mis", py::arg("threads") = 0,
+           py::arg("strategy") = "mis", py::arg("threads") = 0, py::arg("brdf_sampling") = "auto",
            R"doc(A unit sphere of the BRDF under an environment (as `halfback render`): an (H, W, 3)
 float32 array of linear radiance, row 0 at the top. env: "sky" (a sky with a sun; "default" is its older name), "studio", "sunset",
-"constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".)doc")
+"constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".
+brdf_sampling (a BRDF without a sampler of its own): "table", "cosine", or "auto" (the one with
+the lower variance in a small pilot rendering; `halfback render --brdf-sampling`).)doc")
       .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; })
       .def_property_readonly(
           "spec", [](const PyBrdf& b) { return b.spec; },

@@ -1,5 +1,6 @@
 #include "halfback/render/renderer.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -460,13 +461,69 @@ RenderResult render_passes(const Brdf& brdf, const EnvMap& env, const RenderSett
                            Clock::time_point start);
 }
 
+std::optional<BrdfSampling> brdf_sampling_from_name(std::string_view name) {
+  if (name == "auto") return BrdfSampling::automatic;
+  if (name == "table") return BrdfSampling::table;
+  if (name == "cosine") return BrdfSampling::cosine;
+  return std::nullopt;
+}
+
+double relative_pixel_variance(const RenderResult& r, std::span<const std::uint8_t> mask) {
+  if (r.variance.empty()) throw std::invalid_argument("relative_pixel_variance: no variance");
+  double variance = 0, square = 0;
+  for (std::size_t p = 0; p < r.variance.size(); ++p) {
+    if (!mask.empty() && !mask[p]) continue;
+    const float* rgb = &r.image.rgb[3 * p];
+    const double mean = Rgb{rgb[0], rgb[1], rgb[2]}.luminance();
+    variance += double(r.variance[p]) * r.spp;  // the mean's variance × spp: one sample's
+    square += mean * mean;
+  }
+  return square > 0 ? variance / square : 0;
+}
+
+namespace {
+
+// The pilot of BrdfSampling::automatic: `sampler` rendered as `s` asks, at most kPilotSide pixels
+// on a side and kPilotSpp samples, without a budget.
+double pilot_variance(const Brdf& sampler, const EnvMap& env, const RenderSettings& s) {
+  RenderSettings p = s;
+  const double scale = std::min(1.0, double(kPilotSide) / std::max(s.width, s.height));
+  p.width = std::max(1, int(std::lround(s.width * scale)));
+  p.height = std::max(1, int(std::lround(s.height * scale)));
+  p.spp = kPilotSpp;
+  p.variance = true;
+  p.time_budget = 0;
+  p.progress = false;
+  return relative_pixel_variance(render_passes(sampler, env, p, Clock::now()));
+}
+
+}  // namespace
+
+ChosenSampler choose_brdf_sampler(const Brdf& brdf, const EnvMap& env, const RenderSettings& s) {
+  TabulationOptions tab = s.tabulation;
+  if (tab.threads == 0) tab.threads = s.threads;
+  tab.time_budget = s.time_budget;  // the sampler's set-up counts against the budget
+  if (brdf.has_importance_sampling()) return {with_importance_sampling(brdf, tab), ""};
+  if (s.brdf_sampling == BrdfSampling::cosine) return {with_cosine_sampling(brdf), ""};
+  auto table = with_importance_sampling(brdf, tab);
+  const double pilot_samples = 2.0 * kPilotSide * kPilotSide * kPilotSpp;
+  const bool affordable =
+      s.time_budget > 0 || double(s.width) * s.height * s.spp >= kPilotShare * pilot_samples;
+  if (s.brdf_sampling == BrdfSampling::table || s.strategy == Strategy::env || !affordable)
+    return {table, ""};
+  auto cosine = with_cosine_sampling(brdf);
+  const double v_table = pilot_variance(*table, env, s), v_cosine = pilot_variance(*cosine, env, s);
+  const bool cosine_wins = v_cosine < kTableCost * v_table;
+  return {cosine_wins ? cosine : table,
+          fmt::format(" (chosen by a pilot: relative variance {:.3g} with the cosine, {:.3g} with "
+                      "the table, whose samples cost {:g} times as much)",
+                      v_cosine, v_table, kTableCost)};
+}
+
 RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings) {
   validate(settings);
   const auto start = Clock::now();
-  TabulationOptions tab = settings.tabulation;
-  if (tab.threads == 0) tab.threads = settings.threads;
-  tab.time_budget = settings.time_budget;  // the sampler's set-up counts against the budget
-  const auto sampled = with_importance_sampling(brdf, tab);
+  const auto [sampled, why] = choose_brdf_sampler(brdf, env, settings);
   const double build = std::chrono::duration<double>(Clock::now() - start).count();
   if (settings.time_budget > 0 && !(build < settings.time_budget))
     throw TimeBudgetExceeded("the time budget of " + format_seconds(settings.time_budget) +
@@ -474,6 +531,7 @@ RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& s
                              format_seconds(build) + ")");
   RenderResult r = render_passes(*sampled, env, settings, start);
   r.sampler_seconds = build;
+  r.sampler += why;
   return r;
 }
 

@@ -225,7 +225,8 @@ std::string image_section(const std::vector<BrdfResult>& results, const StudyCon
   return md;
 }
 
-// Importance sampling (issue 36): the tabulated sampler of each parameterization's chart.
+// Importance sampling (issue 36): the tabulated and factored samplers of each parameterization's
+// chart.
 std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config) {
   std::string md = fmt::format(
       "## Importance sampling\n\nThe BRDF sampled by a table of ρ cos θi in each "
@@ -234,8 +235,10 @@ std::string sampling_section(const std::vector<BrdfResult>& results, const Study
       "directional albedo, mean over 8 outgoing directions from the normal to 89° ({} samples "
       "each; lower is better; sampling.csv has its standard error, the time per sample and the "
       "efficiency against the cosine and the BRDF's own sampler). Parameterizations that share "
-      "a chart share the sampler.\n\n",
-      config.sampler_samples);
+      "a chart share the sampler. Below each table, the factored sampler (Lawrence et al. 2004's "
+      "manner: {} terms shared by every view, finer cells at the same memory) beside the "
+      "tabulated one.\n\n",
+      config.sampler_samples, kFactoredTerms);
   return md + sampling_tables(results, config);
 }
 

@@ -429,6 +429,47 @@ std::string summary_table(const SummaryMetric& m, const std::vector<Space>& para
 // Metric 5: importance sampling
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+// Per parameterization at one table size: the tabulated and the factored sampler's median
+// efficiencies against the cosine, on the albedo and on the pixels with MIS, and for how many
+// BRDFs the factored one is the more efficient on the albedo.
+std::string sampler_comparison(const std::vector<BrdfResult>& results,
+                               const std::vector<Space>& params, std::size_t kib) {
+  std::string md = fmt::format(
+      "Tabulated and factored ({} terms) samplers in {} KiB, median efficiency against "
+      "the cosine on the albedo and on the pixels (MIS):\n\n| parameterization | "
+      "albedo, tabulated | albedo, factored | pixels, tabulated | pixels, factored | "
+      "factored more efficient (BRDFs) |\n|---|---|---|---|---|---|\n",
+      kFactoredTerms, kib);
+  for (Space s : params) {
+    std::vector<double> albedo[2], pixels[2];
+    int wins = 0, compared = 0;
+    for (const BrdfResult& b : results) {
+      const SamplingPoint* found[2] = {nullptr, nullptr};
+      const std::vector<SamplingPoint> kinds[2] = {sampling_points(b, s, "tabulated"),
+                                                   sampling_points(b, s, "factored")};
+      for (int k = 0; k < 2; ++k)
+        for (const SamplingPoint& p : kinds[k])
+          if (p.kib == kib) found[k] = &p;
+      if (!found[0] || !found[1]) continue;
+      for (int k = 0; k < 2; ++k) {
+        albedo[k].push_back(found[k]->efficiency_vs_cosine);
+        pixels[k].push_back(found[k]->pixel_efficiency_vs_cosine_mis);
+      }
+      ++compared;
+      wins += found[1]->efficiency_vs_cosine > found[0]->efficiency_vs_cosine;
+    }
+    if (compared == 0) continue;
+    md += fmt::format("| {} | {:.3g} | {:.3g} | {:.3g} | {:.3g} | {} of {} |\n", name_of(s),
+                      median(albedo[0]), median(albedo[1]), median(pixels[0]), median(pixels[1]),
+                      wins, compared);
+  }
+  return md + "\n";
+}
+
+}  // namespace
+
 std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyConfig& config) {
   const std::vector<Space>& params = params_of(results);
   std::string md;
@@ -474,7 +515,8 @@ std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyC
               "than it for {}. BRDFs with a fitted mixture ({} sampled through its lobes' "
               "samplers): {}, of which some table here is more efficient than it for {}.\n\n",
               wins.text(), with_own, beats_own, kib, with_warp, beats_warp,
-              config.fit_model.empty() ? "no model" : config.fit_model, with_mix, beats_mix);
+              config.fit_model.empty() ? "no model" : config.fit_model, with_mix, beats_mix) +
+          sampler_comparison(results, params, kib);
   }
   return md;
 }

@@ -18,6 +18,7 @@
 #include "halfback/formats/rgl_writer.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/brdf_sampler.hpp"
+#include "halfback/render/factored_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/render/sampling_metric.hpp"
 #include "halfback/study/image_metrics.hpp"
@@ -237,9 +238,9 @@ std::pair<std::shared_ptr<const Brdf>, double> vndf_warp_sampler(const Brdf& brd
 // The sphere's pixels as estimators (the study's image protocol, under the first environment of
 // the study, the sky without one): `sampler` (a BRDF with the sampling to measure) rendered with
 // the BRDF's samples alone or with MIS. As a SamplingMeasure, so that render::relative_efficiency
-// compares two: relative_variance is the variance of one pixel sample relative to the pixel's
-// mean² (luminance), averaged over the sphere's pixels whose mean is > 0; seconds_per_sample the
-// rendering's time per pixel sample; per_wo is empty.
+// compares two: relative_variance is the image's relative variance per pixel sample over the
+// sphere (render::relative_pixel_variance); seconds_per_sample the rendering's time per pixel
+// sample; per_wo is empty.
 render::SamplingMeasure measure_pixels(const Brdf& sampler, const StudyConfig& config,
                                        render::Strategy strategy) {
   render::RenderSettings settings = image_settings(config);
@@ -249,78 +250,110 @@ render::SamplingMeasure measure_pixels(const Brdf& sampler, const StudyConfig& c
                                   ? *render::default_environments().front().map
                                   : *config.environments.front().map;
   const render::RenderResult r = render::render_sampled(sampler, env, settings);
-  const std::vector<std::uint8_t> mask = sphere_mask(settings.width, settings.height);
-  double sum = 0;
-  std::size_t counted = 0;
-  for (std::size_t p = 0; p < mask.size(); ++p) {
-    const float* rgb = &r.image.rgb[3 * p];
-    const double mean = Rgb{rgb[0], rgb[1], rgb[2]}.luminance();
-    if (!mask[p] || !(mean > 0)) continue;
-    sum += double(r.variance[p]) * r.spp / (mean * mean);  // the mean's variance × spp
-    ++counted;
-  }
   render::SamplingMeasure m;
-  m.relative_variance = counted ? sum / double(counted) : 0;
+  m.relative_variance =
+      render::relative_pixel_variance(r, sphere_mask(settings.width, settings.height));
   m.seconds_per_sample = r.seconds / (double(settings.width) * settings.height * r.spp);
   return m;
+}
+
+// What metric 5 compares each sampler with, measured once per BRDF.
+struct SamplingReferences {
+  render::SamplingMeasure cosine, cosine_pixels_brdf, cosine_pixels_mis;
+  std::optional<render::SamplingMeasure> own, mixture;
+  std::string own_description = "none";
+  std::map<std::size_t, std::pair<render::SamplingMeasure, double>> vndf_warp;  // by KiB asked
+};
+
+SamplingReferences sampling_references(const Brdf& brdf, const StudyConfig& config,
+                                       const render::SamplingMetricOptions& o,
+                                       const std::optional<fit::FitResult>& fitted) {
+  SamplingReferences r;
+  const auto cosine_sampler = render::with_cosine_sampling(brdf);
+  r.cosine = render::measure_sampling(brdf, *cosine_sampler, o);
+  r.cosine_pixels_brdf = measure_pixels(*cosine_sampler, config, render::Strategy::brdf);
+  r.cosine_pixels_mis = measure_pixels(*cosine_sampler, config, render::Strategy::mis);
+  if (brdf.has_importance_sampling()) {
+    r.own = render::measure_sampling(brdf, brdf, o);
+    r.own_description = brdf.describe_sampling();
+  }
+  if (fitted) r.mixture = render::measure_sampling(brdf, *load_brdf(fitted->spec), o);
+  for (const std::size_t kib : config.sampler_kib) {
+    const auto [sampler, kib_taken] = vndf_warp_sampler(brdf, kib);
+    if (sampler) r.vndf_warp[kib] = {render::measure_sampling(brdf, *sampler, o), kib_taken};
+  }
+  return r;
+}
+
+// A row of metric 5: `sampler` (of `kind`, in `chart`, taking `kib_taken` of the `kib` asked)
+// measured on the albedo and the pixels, against the references.
+SamplingPoint measure_sampler(const Brdf& brdf, const Brdf& sampler, const SamplingReferences& ref,
+                              const StudyConfig& config, const render::SamplingMetricOptions& o,
+                              std::string kind, std::size_t kib, double kib_taken,
+                              std::string chart) {
+  const render::SamplingMeasure m = render::measure_sampling(brdf, sampler, o);
+  SamplingPoint p;
+  p.kib = kib;
+  p.sampler = std::move(kind);
+  p.sampler_kib = kib_taken;
+  p.chart = std::move(chart);
+  p.relative_variance = m.relative_variance;
+  p.relative_variance_error = m.relative_variance_error;
+  p.ns_per_sample = 1e9 * m.seconds_per_sample;
+  p.efficiency_vs_cosine = render::relative_efficiency(m, ref.cosine);
+  p.own_sampler = ref.own_description;
+  p.efficiency_vs_own = ref.own ? render::relative_efficiency(m, *ref.own) : 0;
+  if (const auto w = ref.vndf_warp.find(kib); w != ref.vndf_warp.end()) {
+    p.vndf_warp_kib = w->second.second;
+    p.efficiency_vs_vndf_warp = render::relative_efficiency(m, w->second.first);
+  }
+  p.efficiency_vs_fitted_mixture = ref.mixture ? render::relative_efficiency(m, *ref.mixture) : 0;
+  const render::SamplingMeasure alone = measure_pixels(sampler, config, render::Strategy::brdf);
+  const render::SamplingMeasure mis = measure_pixels(sampler, config, render::Strategy::mis);
+  p.pixel_relative_variance_brdf = alone.relative_variance;
+  p.pixel_relative_variance_mis = mis.relative_variance;
+  p.pixel_efficiency_vs_cosine_brdf = render::relative_efficiency(alone, ref.cosine_pixels_brdf);
+  p.pixel_efficiency_vs_cosine_mis = render::relative_efficiency(mis, ref.cosine_pixels_mis);
+  return p;
+}
+
+// The factored sampler's tables are capped at this many radial cells (2·256² cells a term): its
+// build factors views × cells, which grows past what a study of many BRDFs can afford.
+constexpr int kMaxFactoredRadial = 256;
+
+// Metric 5's rows of one chart at one table size: the tabulated sampler and the factored one.
+std::vector<SamplingPoint> chart_samplers(const Brdf& brdf, Space space, std::size_t kib,
+                                          const SamplingReferences& ref, const StudyConfig& config,
+                                          const render::SamplingMetricOptions& o) {
+  const std::string chart(space.param().sampler_chart().name);
+  const render::TabulatedSampler table(brdf, render::tabulation_for_memory(space, kib * 1024));
+  render::FactorOptions fo = render::factoring_for_memory(space, kib * 1024, kFactoredTerms);
+  fo.radial = std::min(fo.radial, kMaxFactoredRadial);
+  fo.azimuthal = 2 * fo.radial;
+  const render::FactoredSampler factored(brdf, fo);
+  return {measure_sampler(brdf, table, ref, config, o, "tabulated", kib,
+                          double(table.cells()) * 20 / 1024, chart),
+          measure_sampler(brdf, factored, ref, config, o, "factored", kib,
+                          double(factored.bytes()) / 1024, chart)};
 }
 
 std::vector<std::pair<Space, SamplingPoint>> sampling_metric(
     const Brdf& brdf, const StudyConfig& config, std::span<const Space> work,
     const std::optional<fit::FitResult>& fitted) {
   const render::SamplingMetricOptions o{.samples = config.sampler_samples, .seed = config.seed};
-  const render::SamplingMeasure cosine =
-      render::measure_sampling(brdf, *render::with_cosine_sampling(brdf), o);
-  std::optional<render::SamplingMeasure> own;
-  if (brdf.has_importance_sampling()) own = render::measure_sampling(brdf, brdf, o);
-  std::map<std::pair<std::string, std::size_t>, SamplingPoint> by_chart;
-  std::map<std::size_t, std::pair<render::SamplingMeasure, double>> vndf_warp;  // by KiB
-  for (const std::size_t kib : config.sampler_kib) {
-    const auto [sampler, kib_taken] = vndf_warp_sampler(brdf, kib);
-    if (sampler) vndf_warp[kib] = {render::measure_sampling(brdf, *sampler, o), kib_taken};
-  }
-  std::optional<render::SamplingMeasure> mixture;
-  if (fitted) mixture = render::measure_sampling(brdf, *load_brdf(fitted->spec), o);
-  const auto cosine_sampler = render::with_cosine_sampling(brdf);
-  const render::SamplingMeasure cosine_brdf =
-      measure_pixels(*cosine_sampler, config, render::Strategy::brdf);
-  const render::SamplingMeasure cosine_mis =
-      measure_pixels(*cosine_sampler, config, render::Strategy::mis);
+  const SamplingReferences ref = sampling_references(brdf, config, o, fitted);
+  // Parameterizations that share a chart share its samplers: measured once.
+  std::map<std::pair<std::string, std::size_t>, std::vector<SamplingPoint>> by_chart;
   std::vector<std::pair<Space, SamplingPoint>> rows;
   for (std::size_t k = 0; k < work.size(); ++k)
     for (const std::size_t kib : config.sampler_kib) {
-      const Space space = work[k];
-      const std::string chart(space.param().sampler_chart().name);
+      const std::string chart(work[k].param().sampler_chart().name);
       auto it = by_chart.find({chart, kib});
-      if (it == by_chart.end()) {
-        const render::TabulatedSampler table(brdf,
-                                             render::tabulation_for_memory(space, kib * 1024));
-        const render::SamplingMeasure m = render::measure_sampling(brdf, table, o);
+      if (it == by_chart.end())
         it = by_chart
-                 .emplace(std::pair{chart, kib},
-                          SamplingPoint{kib, chart, m.relative_variance, m.relative_variance_error,
-                                        1e9 * m.seconds_per_sample,
-                                        render::relative_efficiency(m, cosine),
-                                        own ? brdf.describe_sampling() : "none",
-                                        own ? render::relative_efficiency(m, *own) : 0})
+                 .emplace(std::pair{chart, kib}, chart_samplers(brdf, work[k], kib, ref, config, o))
                  .first;
-        if (const auto w = vndf_warp.find(kib); w != vndf_warp.end()) {
-          it->second.vndf_warp_kib = w->second.second;
-          it->second.efficiency_vs_vndf_warp = render::relative_efficiency(m, w->second.first);
-        } else {
-          it->second.vndf_warp_kib = it->second.efficiency_vs_vndf_warp = 0;  // none
-        }
-        it->second.efficiency_vs_fitted_mixture =
-            mixture ? render::relative_efficiency(m, *mixture) : 0;
-        const render::SamplingMeasure alone = measure_pixels(table, config, render::Strategy::brdf);
-        const render::SamplingMeasure mis = measure_pixels(table, config, render::Strategy::mis);
-        it->second.pixel_relative_variance_brdf = alone.relative_variance;
-        it->second.pixel_relative_variance_mis = mis.relative_variance;
-        it->second.pixel_efficiency_vs_cosine_brdf =
-            render::relative_efficiency(alone, cosine_brdf);
-        it->second.pixel_efficiency_vs_cosine_mis = render::relative_efficiency(mis, cosine_mis);
-      }
-      rows.emplace_back(config.params[k], it->second);
+      for (const SamplingPoint& p : it->second) rows.emplace_back(config.params[k], p);
     }
   return rows;
 }

@@ -90,13 +90,8 @@ class TabulatedSampler final : public SamplingWrapper {
   double build_seconds() const { return build_seconds_; }
 
  private:
-  struct Blend {  // up to four slices and their weights
-    int index[4];
-    double weight[4];
-    int count;
-  };
-  Blend blend(const Vec3<double>& wo_canonical) const;
-  double table_pdf(const Vec3<double>& wo, const Vec3<double>& wi, const Blend& b) const;
+  // The table's density at ωi (both in the canonical pose), per unit solid angle.
+  double table_pdf(const Vec3<double>& wo, const Vec3<double>& wi) const;
 
   TabulationOptions options_;
   SamplerChart chart_;  // options_.param's, looked up once: sample() and pdf() are per path vertex

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -32,6 +33,20 @@ enum class Strategy { mis, brdf, env };
 // "mis", "brdf" or "env"; nullopt for another name.
 std::optional<Strategy> strategy_from_name(std::string_view name);
 enum class Heuristic { balance, power };
+// How render() samples a BRDF that has no sampler of its own (docs/render.md, "Choosing the BRDF
+// sampler"): its tabulated sampler (settings.tabulation), the cosine-weighted hemisphere, or
+// (automatic) the one of the two that renders the scene with less error at equal time: a pilot
+// renders it with each (kPilotSide² pixels at kPilotSpp samples, the render's seed) and the table
+// is kept unless the cosine's relative variance is below kTableCost times the table's (the table's
+// time per pixel sample over the cosine's, measured: docs/performance.md). The choice, like the
+// image, is a function of the settings. A render too small to afford the pilot (fewer than
+// kPilotShare times its samples, and no time budget) and the env strategy (which draws no BRDF
+// sample) keep the table.
+enum class BrdfSampling { automatic, table, cosine };
+// "auto", "table" or "cosine"; nullopt for another name.
+std::optional<BrdfSampling> brdf_sampling_from_name(std::string_view name);
+inline constexpr double kTableCost = 2;
+inline constexpr int kPilotSide = 48, kPilotSpp = 16, kPilotShare = 16;
 enum class Sequence { sobol, random };  // scrambled Sobol (0,2) points per pixel, or independent
 
 // The largest image: width × height pixels. Rendering keeps about 100 bytes per pixel (two
@@ -62,6 +77,7 @@ struct RenderSettings {
   bool progress = false;         // a progress bar on stderr, only when stderr is a terminal
   bool variance = false;         // also return the per-pixel variance of the mean (luminance)
   TabulationOptions tabulation;  // for BRDFs without a sampler of their own
+  BrdfSampling brdf_sampling = BrdfSampling::automatic;  // for the same
 };
 
 struct RenderResult {
@@ -69,15 +85,32 @@ struct RenderResult {
   std::vector<float> variance;  // width × height when settings.variance, else empty
   int spp = 0;                  // pixel samples taken (fewer than asked if the budget ran out)
   double seconds = 0;           // rendering time, without building the BRDF sampler
-  double sampler_seconds = 0;   // building the BRDF sampler (tabulation)
+  double sampler_seconds = 0;   // building the BRDF sampler (tabulation) and choosing it (pilot)
   bool budget_exhausted = false;
   std::uint64_t nonfinite = 0;  // sample values that were NaN or infinite, counted as 0
   // Pixels with a channel that is not finite in the float image: the mean radiance overflows
   // the float range (about 3.4e38), e.g. an environment scaled far too high. Such an image is
   // not a picture of anything; the CLI refuses to write it.
   std::uint64_t nonfinite_pixels = 0;
-  std::string sampler;  // which BRDF sampler was used
+  std::string sampler;  // which BRDF sampler was used (and why, when a pilot chose it)
 };
+
+// The BRDF as render() samples it under `settings` (brdf_sampling, tabulation, threads, the time
+// budget of the table's build): the BRDF itself when it has a sampler of its own, else its table
+// or the cosine; `why` is empty, or says what the pilot measured when it chose. The BRDF must
+// outlive the result. Throws TimeBudgetExceeded as render() does.
+struct ChosenSampler {
+  std::shared_ptr<const Brdf> brdf;
+  std::string why;
+};
+ChosenSampler choose_brdf_sampler(const Brdf& brdf, const EnvMap& env,
+                                  const RenderSettings& settings);
+
+// The image's relative variance per pixel sample, in luminance: Σ variance × spp / Σ mean² over
+// the pixels (those whose `mask` entry is not 0 when `mask` is not empty): the expected squared
+// relative RMSE of an image of one sample per pixel. 0 when the pixels are all black. Needs a
+// result rendered with settings.variance.
+double relative_pixel_variance(const RenderResult& result, std::span<const std::uint8_t> mask = {});
 
 // Throws std::invalid_argument for invalid settings (sizes, spp, fov), TimeBudgetExceeded when the
 // budget ends before every pixel has a sample.

@@ -68,10 +68,12 @@ MetricTable image_table();
 void add_image(MetricTable& table, Space space, const ImagePoint& point);
 std::vector<ImagePoint> image_points(const BrdfResult& result, Space space);
 
-// sampling: the tabulated importance sampler in the parameterization's chart, per table size.
+// sampling: the importance samplers in the parameterization's chart, per table size and sampler
+// ("tabulated", "factored"); sampling_points gives one sampler's rows, in the order of the sizes.
 MetricTable sampling_table();
 void add_sampling(MetricTable& table, Space space, const SamplingPoint& point);
-std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space);
+std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space,
+                                           std::string_view sampler = "tabulated");
 
 // fit: a model fitted to the measurements of each design (isotropic form, own spacing) against
 // the same model fitted to the whole BRDF; excess = layout_loss / whole_loss − 1 (derived when

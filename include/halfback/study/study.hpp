@@ -117,11 +117,15 @@ struct ImagePoint {
   double mae = 0, rmse = 0, ssim = 0;  // Sztrajman et al. 2021's protocol (ImageError)
 };
 
-// A row of the sampling table: the tabulated sampler in a parameterization's chart at a table
-// size, against the cosine and the BRDF's own sampler (`own_sampler` "none" and efficiency 0 when
-// it has none).
+// A row of the sampling table: a sampler in a parameterization's chart at a table size, against
+// the cosine and the BRDF's own sampler (`own_sampler` "none" and efficiency 0 when it has none).
+// The samplers: "tabulated" (render::TabulatedSampler) and "factored" (render::FactoredSampler,
+// kFactoredTerms terms; Lawrence et al. 2004's manner).
+inline constexpr int kFactoredTerms = 4;
 struct SamplingPoint {
-  std::size_t kib = 0;
+  std::size_t kib = 0;  // the memory asked
+  std::string sampler = "tabulated";
+  double sampler_kib = 0;  // the memory its tables take
   std::string chart;
   double relative_variance = 0, relative_variance_error = 0, ns_per_sample = 0;
   double efficiency_vs_cosine = 0;
@@ -135,10 +139,11 @@ struct SamplingPoint {
   // analytic lobes): config.fit_model fitted to the whole BRDF, sampled as the mixture of its
   // lobes' own samplers; this table's efficiency against it, 0 where there is no fit.
   double efficiency_vs_fitted_mixture = 0;
-  // A pixel of the sphere of the image protocol (under the study's first environment) rendered
-  // with this table's samples alone and with MIS (one environment and one table sample): the
-  // variance of one pixel sample relative to the pixel's mean², averaged over the sphere, and the
-  // efficiency against the same strategy with cosine sampling.
+  // The sphere of the image protocol (under the study's first environment) rendered with this
+  // sampler's samples alone and with MIS (one environment and one BRDF sample): the image's
+  // relative variance per pixel sample (render::relative_pixel_variance over the sphere: Σ
+  // variance / Σ mean², the squared relative RMSE of one sample per pixel), and the efficiency
+  // against the same strategy with cosine sampling.
   double pixel_relative_variance_brdf = 0, pixel_relative_variance_mis = 0;
   double pixel_efficiency_vs_cosine_brdf = 0, pixel_efficiency_vs_cosine_mis = 0;
 };

@@ -76,9 +76,10 @@ struct HalfVectorChart {
     const double l = std::sqrt(h.x * h.x + h.y * h.y + h.z * h.z);
     if (!(l > 0)) return false;
     h = {h.x / l, h.y / l, h.z / l};
-    r = std::atan2(std::sqrt(h.x * h.x + h.y * h.y), h.z);
+    const double sin_r = std::sqrt(h.x * h.x + h.y * h.y);
+    r = std::atan2(sin_r, h.z);
     phi = detail::chart_azimuth(h.y, h.x);
-    jac = 4 * (wo.x * h.x + wo.y * h.y + wo.z * h.z) * std::sin(r);
+    jac = 4 * (wo.x * h.x + wo.y * h.y + wo.z * h.z) * sin_r;
     return true;
   }
 };
