@@ -32,11 +32,15 @@
 //    table at 64 KB, 1 MB and the default size, and with cosine sampling, for measured materials
 //    (RGL files and neural BRDFs) and a tabulated glossy model (--part 7; not by default).
 // 8. The automatic choice of the BRDF sampler (issue 36, docs/render.md "Choosing the BRDF
-//    sampler"): equal-time error of MIS with the table, the cosine and the pilot's choice
-//    (render() with each RenderSettings::brdf_sampling: set-up and pilot count in the time), for
+//    sampler"): equal-time error of MIS with the table, the cosine and the automatic choice
+//    (render() with each RenderSettings::brdf_sampling: set-up and choice count in the time), and
+//    the albedo-variance ratio the choice is made by (cosine's ÷ table's), for
 //    neural BRDFs of the MERL and RGL databases (from ../shared/data; the embedded two without it)
 //    and a tabulated glossy model, under the built-in sky and studio and two of the shared
 //    environments (--part 8; not by default).
+// 9. The RGL files' own sampler (Dupuy & Jakob's VNDF warp, what render() uses for them) against
+//    the table, the cosine and the automatic choice of the same data with the warp hidden, at
+//    equal time (--part 9; not by default).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
@@ -319,7 +323,25 @@ class Opaque final : public Brdf {
   BrdfPtr b_;
 };
 
-// Part 8: table, cosine and the pilot's choice at equal time, per material and environment.
+// The cells "| table | cosine | auto | chose |" of a row: `brdf` rendered with each
+// RenderSettings::brdf_sampling at equal time, and what auto chose.
+void print_choices(const Brdf& brdf, const render::EnvMap& env, const render::Image& reference,
+                   double budget) {
+  std::string chose;
+  for (render::BrdfSampling choice : {render::BrdfSampling::table, render::BrdfSampling::cosine,
+                                      render::BrdfSampling::automatic}) {
+    render::RenderSettings s = budgeted(budget);
+    s.brdf_sampling = choice;
+    const render::RenderResult r = render::render(brdf, env, s);
+    print_equal_time_error(r, reference, budget);
+    if (choice == render::BrdfSampling::automatic)
+      chose = r.sampler.find("cosine") == 0 ? "cosine" : "table";
+  }
+  std::printf(" %s |\n", chose.c_str());
+  std::fflush(stdout);
+}
+
+// Part 8: table, cosine and the automatic choice at equal time, per material and environment.
 void sampler_choice_at_equal_time(bool quick) {
   const double budget = quick ? 0.2 : 1.5;
   const std::string data = shared_data_dir();
@@ -342,26 +364,58 @@ void sampler_choice_at_equal_time(bool quick) {
       envs.emplace_back(name, render::EnvMap::from_spec(data + "envmaps/" + name));
   }
   std::printf(
+      "\n## The albedo-variance ratio of the automatic choice (cosine's ÷ table's; the "
+      "table at ≥ %g)\n\n| material | ratio |\n|---|---|\n",
+      render::kPeakedRatio);
+  for (const Material& m : materials) {
+    const render::RenderSettings s = budgeted(budget);
+    const render::SamplingMetricOptions o{.samples = render::kChoiceSamples, .seed = s.seed};
+    const auto table = render::with_importance_sampling(*m.brdf, s.tabulation);
+    const double ratio =
+        render::measure_sampling(*m.brdf, *render::with_cosine_sampling(*m.brdf), o)
+            .relative_variance /
+        render::measure_sampling(*m.brdf, *table, o).relative_variance;
+    std::printf("| %s | %.3g |\n", m.label.c_str(), ratio);
+  }
+  std::printf(
       "\n## Choosing the BRDF sampler (MIS, %.1f s, 128 × 128; relative RMSE at equal time, "
-      "set-up and pilot included)\n\n| material | environment | table | cosine | auto | auto "
+      "set-up and choice included)\n\n| material | environment | table | cosine | auto | auto "
       "chose |\n|---|---|---|---|---|---|\n",
       budget);
   for (const auto& [env_name, env] : envs)
     for (const Material& m : materials) {
       const render::Image reference = reference_image(*m.brdf, env, quick);
       std::printf("| %s | %s |", m.label.c_str(), env_name.c_str());
-      std::string chose;
-      for (render::BrdfSampling choice : {render::BrdfSampling::table, render::BrdfSampling::cosine,
-                                          render::BrdfSampling::automatic}) {
-        render::RenderSettings s = budgeted(budget);
-        s.brdf_sampling = choice;
-        const render::RenderResult r = render::render(*m.brdf, env, s);
-        print_equal_time_error(r, reference, budget);
-        if (choice == render::BrdfSampling::automatic)
-          chose = r.sampler.find("cosine") == 0 ? "cosine" : "table";
-      }
-      std::printf(" %s |\n", chose.c_str());
-      std::fflush(stdout);
+      print_choices(*m.brdf, env, reference, budget);
+    }
+}
+
+// Part 9: the RGL files' own sampler (Dupuy & Jakob's VNDF warp) against the table, the cosine
+// and the automatic choice of the same data with the warp hidden.
+void rgl_warp_against_choice(bool quick) {
+  const double budget = quick ? 0.2 : 1.5;
+  const std::string data = shared_data_dir();
+  std::vector<Material> files{{"RGL metallic paint", load_brdf("embedded:ilm_l3_37_metallic")},
+                              {"RGL felt", load_brdf("embedded:acrylic_felt_green")}};
+  std::vector<std::pair<std::string, render::EnvMap>> envs;
+  envs.emplace_back("sky", render::EnvMap::default_sky());
+  envs.emplace_back("studio", render::EnvMap::from_spec("studio"));
+  if (std::filesystem::exists(data + "envmaps/uffizi.hdr")) {
+    for (const char* name : {"paper_white_rgb", "cc_ibiza_sunset_rgb", "irid_flake_paint2_rgb"})
+      files.push_back({std::string("RGL ") + name, load_brdf(data + "rgl/" + name + ".bsdf")});
+    envs.emplace_back("uffizi.hdr", render::EnvMap::from_spec(data + "envmaps/uffizi.hdr"));
+  }
+  std::printf(
+      "\n## RGL files: their VNDF warp against table, cosine and auto (MIS, %.1f s, 128 × 128; "
+      "relative RMSE at equal time)\n\n| material | environment | own warp | table | cosine | "
+      "auto | auto chose |\n|---|---|---|---|---|---|---|\n",
+      budget);
+  for (const auto& [env_name, env] : envs)
+    for (const Material& m : files) {
+      const render::Image reference = reference_image(*m.brdf, env, quick);
+      std::printf("| %s | %s |", m.label.c_str(), env_name.c_str());
+      print_equal_time_error(render::render(*m.brdf, env, budgeted(budget)), reference, budget);
+      print_choices(Opaque(m.brdf), env, reference, budget);
     }
 }
 
@@ -398,6 +452,10 @@ int main(int argc, char** argv) {
   }
   if (only == 8) {
     sampler_choice_at_equal_time(quick);
+    return 0;
+  }
+  if (only == 9) {
+    rgl_warp_against_choice(quick);
     return 0;
   }
   const unsigned all = std::max(1u, std::thread::hardware_concurrency());

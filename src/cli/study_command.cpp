@@ -371,7 +371,8 @@ Command register_study(CLI::App& parent) {
                 "Metrics 1-2 only (no gonio-reflectometer, no images)");
   app->add_flag("--no-images", o->settings.no_images, "No image-space error");
   app->add_option("--sampler-kib", o->sampler_kib,
-                  "Sizes of the tabulated samplers' tables compared by the sampling metric, KiB, "
+                  "Sizes of the samplers' tables (tabulated and factored) compared by the sampling "
+                  "metric, KiB, "
                   "comma-separated (default 64,1024; --quick 64)");
   app->add_option("--sampler-samples", o->settings.sampler_samples,
                   "Samples per outgoing direction of the sampling metric (default 4096)")

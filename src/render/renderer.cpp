@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "halfback/core/parallel.hpp"
+#include "halfback/render/sampling_metric.hpp"
 #include "sequence.hpp"
 
 namespace halfback::render {
@@ -481,49 +482,30 @@ double relative_pixel_variance(const RenderResult& r, std::span<const std::uint8
   return square > 0 ? variance / square : 0;
 }
 
-namespace {
-
-// The pilot of BrdfSampling::automatic: `sampler` rendered as `s` asks, at most kPilotSide pixels
-// on a side and kPilotSpp samples, without a budget.
-double pilot_variance(const Brdf& sampler, const EnvMap& env, const RenderSettings& s) {
-  RenderSettings p = s;
-  const double scale = std::min(1.0, double(kPilotSide) / std::max(s.width, s.height));
-  p.width = std::max(1, int(std::lround(s.width * scale)));
-  p.height = std::max(1, int(std::lround(s.height * scale)));
-  p.spp = kPilotSpp;
-  p.variance = true;
-  p.time_budget = 0;
-  p.progress = false;
-  return relative_pixel_variance(render_passes(sampler, env, p, Clock::now()));
-}
-
-}  // namespace
-
-ChosenSampler choose_brdf_sampler(const Brdf& brdf, const EnvMap& env, const RenderSettings& s) {
+ChosenSampler choose_brdf_sampler(const Brdf& brdf, const RenderSettings& s) {
   TabulationOptions tab = s.tabulation;
   if (tab.threads == 0) tab.threads = s.threads;
   tab.time_budget = s.time_budget;  // the sampler's set-up counts against the budget
   if (brdf.has_importance_sampling()) return {with_importance_sampling(brdf, tab), ""};
   if (s.brdf_sampling == BrdfSampling::cosine) return {with_cosine_sampling(brdf), ""};
   auto table = with_importance_sampling(brdf, tab);
-  const double pilot_samples = 2.0 * kPilotSide * kPilotSide * kPilotSpp;
-  const bool affordable =
-      s.time_budget > 0 || double(s.width) * s.height * s.spp >= kPilotShare * pilot_samples;
-  if (s.brdf_sampling == BrdfSampling::table || s.strategy == Strategy::env || !affordable)
-    return {table, ""};
+  if (s.brdf_sampling == BrdfSampling::table || s.strategy == Strategy::env) return {table, ""};
   auto cosine = with_cosine_sampling(brdf);
-  const double v_table = pilot_variance(*table, env, s), v_cosine = pilot_variance(*cosine, env, s);
-  const bool cosine_wins = v_cosine < kTableCost * v_table;
-  return {cosine_wins ? cosine : table,
-          fmt::format(" (chosen by a pilot: relative variance {:.3g} with the cosine, {:.3g} with "
-                      "the table, whose samples cost {:g} times as much)",
-                      v_cosine, v_table, kTableCost)};
+  const SamplingMetricOptions o{.samples = kChoiceSamples, .seed = s.seed};
+  const double v_table = measure_sampling(brdf, *table, o).relative_variance;
+  const double v_cosine = measure_sampling(brdf, *cosine, o).relative_variance;
+  const double ratio = v_table > 0 ? v_cosine / v_table : 0;
+  const bool peaked = ratio >= kPeakedRatio;
+  return {
+      peaked ? table : cosine,
+      fmt::format(" (chosen: the cosine's albedo variance is {:.3g} times the table's, {} {:g})",
+                  ratio, peaked ? "at least" : "below", kPeakedRatio)};
 }
 
 RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings) {
   validate(settings);
   const auto start = Clock::now();
-  const auto [sampled, why] = choose_brdf_sampler(brdf, env, settings);
+  const auto [sampled, why] = choose_brdf_sampler(brdf, settings);
   const double build = std::chrono::duration<double>(Clock::now() - start).count();
   if (settings.time_budget > 0 && !(build < settings.time_budget))
     throw TimeBudgetExceeded("the time budget of " + format_seconds(settings.time_budget) +

@@ -49,7 +49,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
     md += gonio_section(results, config, has.anisotropic, plots) +
           designs_section(results, config, plots);
   if (has.images) md += image_section(results, config, plots);
-  if (has.sampling) md += sampling_section(results, config);
+  if (has.sampling) md += sampling_section(results, config, plots);
   if (has.fit) md += fit_section(results, config);
   md += files_and_networks_section(results, config);
   md += files_paragraph(out.files);

@@ -110,6 +110,65 @@ figure::Scene gonio_chart(const std::vector<BrdfResult>& results, bool four_d,
   return figure::loglog_chart(c);
 }
 
+// Metric 5: each sampler's efficiency against the cosine, one panel per table size and measure
+// (the albedo estimator, the pixels with MIS), against the first parameterization's tabulated
+// albedo efficiency at that size (how peaked the BRDF is: broad on the left); per
+// parameterization the tabulated sampler solid and the factored one dashed, and the cosine's 1.
+figure::Scene sampling_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const std::vector<Space>& params = params_of(results);
+  std::vector<const BrdfResult*> sampled;
+  for (const BrdfResult& b : results)
+    if (!b.table("sampling").rows.empty()) sampled.push_back(&b);
+  if (sampled.empty() || params.empty()) return {};
+  figure::LogLogChart c;
+  c.title = "Importance sampling: efficiency against cosine sampling, by how peaked the BRDF is";
+  c.x_label =
+      fmt::format("{} table's albedo efficiency vs cosine (broad ← → peaked)", name_of(params[0]));
+  c.y_label = "efficiency vs cosine";
+  for (const std::size_t kib : config.sampler_kib) {
+    const auto efficiency = [&](const BrdfResult& b, Space s, std::string_view sampler,
+                                bool pixels) {
+      for (const SamplingPoint& p : sampling_points(b, s, sampler))
+        if (p.kib == kib) return pixels ? p.pixel_efficiency_vs_cosine_mis : p.efficiency_vs_cosine;
+      return 0.0;
+    };
+    std::vector<const BrdfResult*> order = sampled;
+    std::stable_sort(order.begin(), order.end(), [&](const BrdfResult* a, const BrdfResult* b) {
+      return efficiency(*a, params[0], "tabulated", false) <
+             efficiency(*b, params[0], "tabulated", false);
+    });
+    for (const bool pixels : {false, true}) {
+      figure::LogLogPanel panel{
+          fmt::format("{} KiB, {}", kib, pixels ? "pixels (MIS)" : "directional albedo"), {}};
+      for (std::size_t k = 0; k < params.size(); ++k)
+        for (const char* sampler : {"tabulated", "factored"}) {
+          figure::LineSeries line{fmt::format("{} {}", name_of(params[k]), sampler),
+                                  int(k),
+                                  std::string_view(sampler) == "factored",
+                                  {},
+                                  {}};
+          for (const BrdfResult* b : order) {
+            const double x = efficiency(*b, params[0], "tabulated", false);
+            const double e = efficiency(*b, params[k], sampler, pixels);
+            if (!(e > 0 && std::isfinite(e) && x > 0 && std::isfinite(x))) continue;
+            line.x.push_back(x);
+            line.y.push_back(e);
+          }
+          if (!line.x.empty()) panel.series.push_back(std::move(line));
+        }
+      if (panel.series.empty()) continue;
+      const double lo = panel.series.front().x.front(), hi = panel.series.front().x.back();
+      panel.series.push_back({"cosine", int(params.size()), false, {lo, hi}, {1, 1}});
+      c.panels.push_back(std::move(panel));
+    }
+  }
+  if (c.panels.empty()) return {};
+  c.columns = 2;
+  c.panel_width = 320;
+  c.panel_height = 200;
+  return figure::loglog_chart(c);
+}
+
 // Each parameterization's median error per design (section 3b).
 figure::Scene designs_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
   const std::size_t ref = reference_budget(config);
@@ -216,6 +275,7 @@ ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConf
   if (has.gonio) p.gonio = gonio_chart(results, false, config);
   if (has.gonio && has.anisotropic) p.gonio4d = gonio_chart(results, true, config);
   if (has.gonio) p.designs = designs_chart(results, config);
+  if (has.sampling) p.sampling = sampling_chart(results, config);
   if (has.images) {
     p.image = figure::bar_chart(image_chart(results, config));
     p.renderings = examples_chart(results, config);
@@ -232,6 +292,7 @@ void save_plots(const ReportPlots& p, const std::filesystem::path& dir,
   save_plot(p.gonio4d, dir, "gonio4d", files);
   save_plot(p.designs, dir, "designs", files);
   save_plot(p.image, dir, "image", files);
+  save_plot(p.sampling, dir, "sampling", files);
   save_plot(p.renderings, dir, "renderings", files);
 }
 

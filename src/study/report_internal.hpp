@@ -127,7 +127,8 @@ std::pair<std::vector<double>, std::size_t> medians(const SummaryMetric& m,
 // The plots, in the order they are written. Some may have nothing to draw (every curve exact, no
 // rendering): the report links only those that are written.
 struct ReportPlots {
-  figure::Scene summary, azimuthal, separability, gonio, gonio4d, designs, image, renderings;
+  figure::Scene summary, azimuthal, separability, gonio, gonio4d, designs, image, renderings,
+      sampling;
 };
 ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
                          const Contents& has, const std::vector<SummaryMetric>& summary);
@@ -187,7 +188,8 @@ std::string gonio_section(const std::vector<BrdfResult>& results, const StudyCon
                           bool any_aniso, const ReportPlots& plots);
 std::string designs_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
                             const ReportPlots& plots);
-std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config);
+std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                             const ReportPlots& plots);
 std::string fit_section(const std::vector<BrdfResult>& results, const StudyConfig& config);
 std::string image_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
                           const ReportPlots& plots);

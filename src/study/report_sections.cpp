@@ -227,7 +227,8 @@ std::string image_section(const std::vector<BrdfResult>& results, const StudyCon
 
 // Importance sampling (issue 36): the tabulated and factored samplers of each parameterization's
 // chart.
-std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
+                             const ReportPlots& plots) {
   std::string md = fmt::format(
       "## Importance sampling\n\nThe BRDF sampled by a table of ρ cos θi in each "
       "parameterization's sampler chart (the renderer's tabulated sampler, docs/render.md), "
@@ -239,7 +240,8 @@ std::string sampling_section(const std::vector<BrdfResult>& results, const Study
       "manner: {} terms shared by every view, finer cells at the same memory) beside the "
       "tabulated one.\n\n",
       config.sampler_samples, kFactoredTerms);
-  return md + sampling_tables(results, config);
+  return md + plot_link(plots.sampling, "Importance sampling", "sampling") +
+         sampling_tables(results, config);
 }
 
 // Fitting from measurements (issue 37): does the parameterization of a design change the fit?

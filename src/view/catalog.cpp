@@ -7,6 +7,7 @@
 
 #include "halfback/loader/load.hpp"
 #include "halfback/render/brdf_sampler.hpp"
+#include "halfback/render/renderer.hpp"
 #include "halfback/view/api.hpp"
 
 namespace halfback::view {
@@ -169,7 +170,8 @@ BrdfPtr Catalog::sampled_brdf(std::string_view spec) const {
   };
   auto owner = std::make_shared<Owner>();
   owner->base = base;
-  owner->sampler = render::with_importance_sampling(*base);
+  owner->sampler =
+      render::choose_brdf_sampler(*base, render::RenderSettings{}).brdf;  // as render()
   BrdfPtr sampled(owner, owner->sampler.get());
   std::lock_guard lock(mutex_);
   if (auto it = brdfs_.find(spec); it != brdfs_.end() && it->second.brdf == base)

@@ -319,6 +319,7 @@ TEST_F(CliTest, OptionValuesFollowOneRule) {
       {{"render", "--brdf", "lambert", "--seed", "99999999999999999999999", "-o", png},
        "--seed: '99999999999999999999999' is too large (at most 18446744073709551615)"},
       {{"render", "--brdf", "lambert", "--spp", "1e3", "-o", png}, "--spp: "},
+      {{"render", "--brdf", "lambert", "--brdf-sampling", "pilot", "-o", png}, "--brdf-sampling"},
       {{"render", "--brdf", "lambert", "--env", "", "-o", png}, "--env: an empty value"},
       {{"study", "--budgets", "", "lambert"}, "--budgets: an empty value"},
       {{"study", "--budgets-4d", "", "lambert"}, "--budgets-4d: an empty value"},

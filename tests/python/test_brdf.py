@@ -146,6 +146,19 @@ def test_render_furnace_and_errors():
         halfback.load("lambert").render(strategy="path")
     with pytest.raises(ValueError, match="missing.hdr"):  # a spec that names nothing
         halfback.load("lambert").render("missing.hdr")
+    with pytest.raises(ValueError, match="brdf_sampling"):
+        halfback.load("lambert").render(brdf_sampling="pilot")
+
+
+def test_render_brdf_sampling_choices_agree():
+    # A network has no sampler of its own: the table, the cosine and the automatic choice render
+    # the same sphere in expectation (a constant sky: the pixel is the directional albedo).
+    felt = halfback.load("embedded:pink-felt")
+    means = [
+        felt.render("constant:1", 16, 16, 256, brdf_sampling=s)[4:12, 4:12].mean()
+        for s in ("table", "cosine", "auto")
+    ]
+    assert max(means) / min(means) < 1.02
 
 
 def test_brdf_eval_from_several_threads():

@@ -35,18 +35,19 @@ std::optional<Strategy> strategy_from_name(std::string_view name);
 enum class Heuristic { balance, power };
 // How render() samples a BRDF that has no sampler of its own (docs/render.md, "Choosing the BRDF
 // sampler"): its tabulated sampler (settings.tabulation), the cosine-weighted hemisphere, or
-// (automatic) the one of the two that renders the scene with less error at equal time: a pilot
-// renders it with each (kPilotSide² pixels at kPilotSpp samples, the render's seed) and the table
-// is kept unless the cosine's relative variance is below kTableCost times the table's (the table's
-// time per pixel sample over the cosine's, measured: docs/performance.md). The choice, like the
-// image, is a function of the settings. A render too small to afford the pilot (fewer than
-// kPilotShare times its samples, and no time budget) and the env strategy (which draws no BRDF
-// sample) keep the table.
+// (automatic) the table for a peaked BRDF and the cosine for a broad one. Peaked: the cosine's
+// relative variance of the directional-albedo estimator (render::measure_sampling at 8 ωo,
+// kChoiceSamples each, the render's seed) is at least kPeakedRatio times the table's. Equal-time
+// renderings under four environments found the cosine better on broad lobes (its samples cost
+// half as much, and scrambled Sobol points stay stratified through its smooth map) and the
+// table on peaked ones (docs/performance.md). The choice depends on the BRDF and the settings
+// only, not on timings, so the image stays a function of the settings. The env strategy (which
+// draws no BRDF sample) keeps the table.
 enum class BrdfSampling { automatic, table, cosine };
 // "auto", "table" or "cosine"; nullopt for another name.
 std::optional<BrdfSampling> brdf_sampling_from_name(std::string_view name);
-inline constexpr double kTableCost = 2;
-inline constexpr int kPilotSide = 48, kPilotSpp = 16, kPilotShare = 16;
+inline constexpr double kPeakedRatio = 300;
+inline constexpr std::size_t kChoiceSamples = 2048;
 enum class Sequence { sobol, random };  // scrambled Sobol (0,2) points per pixel, or independent
 
 // The largest image: width × height pixels. Rendering keeps about 100 bytes per pixel (two
@@ -85,26 +86,25 @@ struct RenderResult {
   std::vector<float> variance;  // width × height when settings.variance, else empty
   int spp = 0;                  // pixel samples taken (fewer than asked if the budget ran out)
   double seconds = 0;           // rendering time, without building the BRDF sampler
-  double sampler_seconds = 0;   // building the BRDF sampler (tabulation) and choosing it (pilot)
+  double sampler_seconds = 0;   // building the BRDF sampler (tabulation) and choosing it
   bool budget_exhausted = false;
   std::uint64_t nonfinite = 0;  // sample values that were NaN or infinite, counted as 0
   // Pixels with a channel that is not finite in the float image: the mean radiance overflows
   // the float range (about 3.4e38), e.g. an environment scaled far too high. Such an image is
   // not a picture of anything; the CLI refuses to write it.
   std::uint64_t nonfinite_pixels = 0;
-  std::string sampler;  // which BRDF sampler was used (and why, when a pilot chose it)
+  std::string sampler;  // which BRDF sampler was used (and why, when render() chose it)
 };
 
 // The BRDF as render() samples it under `settings` (brdf_sampling, tabulation, threads, the time
 // budget of the table's build): the BRDF itself when it has a sampler of its own, else its table
-// or the cosine; `why` is empty, or says what the pilot measured when it chose. The BRDF must
-// outlive the result. Throws TimeBudgetExceeded as render() does.
+// or the cosine; `why` is empty, or says what was measured when the choice was automatic. The BRDF
+// must outlive the result. Throws TimeBudgetExceeded as render() does.
 struct ChosenSampler {
   std::shared_ptr<const Brdf> brdf;
   std::string why;
 };
-ChosenSampler choose_brdf_sampler(const Brdf& brdf, const EnvMap& env,
-                                  const RenderSettings& settings);
+ChosenSampler choose_brdf_sampler(const Brdf& brdf, const RenderSettings& settings);
 
 // The image's relative variance per pixel sample, in luminance: Σ variance × spp / Σ mean² over
 // the pixels (those whose `mask` entry is not 0 when `mask` is not empty): the expected squared
