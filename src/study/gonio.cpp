@@ -16,11 +16,19 @@
 namespace halfback::study {
 
 std::string_view name_of(Design d) {
-  return d == Design::regular ? "regular" : "stratified";
+  switch (d) {
+    case Design::regular:
+      return "regular";
+    case Design::stratified:
+      return "stratified";
+    case Design::dupuy_jakob:
+      return "dupuy-jakob";
+  }
+  return "?";
 }
 
 std::optional<Design> parse_design(std::string_view name) {
-  for (Design d : kDesigns)
+  for (Design d : kAllDesigns)
     if (name_of(d) == name) return d;
   return std::nullopt;
 }
@@ -91,6 +99,9 @@ GridSpec gonio_cells(const GonioSetup& s) {
   if (s.space == Space::dirs)
     throw std::invalid_argument("the gonio-reflectometer needs a parameterization, not dirs");
   if (s.budget == 0) throw std::invalid_argument("the gonio-reflectometer needs a budget >= 1");
+  if (s.design == Design::dupuy_jakob)
+    throw std::invalid_argument(
+        "the dupuy-jakob design is export-rgl's acquisition (dupuy_jakob_design.hpp), not a grid");
   if (!(s.max_theta_deg > 0 && s.max_theta_deg <= 90))
     throw std::invalid_argument("the gonio-reflectometer's reach must be in (0, 90] degrees");
   // A first guess from the fraction of the box inside the domain, then the nearest n.

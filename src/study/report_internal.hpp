@@ -165,6 +165,7 @@ std::string best_design_table(const DesignComparison& c, std::size_t ref);
 std::string image_tables(const std::vector<BrdfResult>& results);
 std::string published_image_table(const std::vector<BrdfResult>& results);
 std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyConfig& config);
+std::string dupuy_jakob_table(const std::vector<BrdfResult>& results, const StudyConfig& config);
 // Per design and budget, each parameterization's median excess of the fit from its measurements
 // over the whole fit and median shape change, and which has the lowest excess per BRDF.
 std::string fit_tables(const std::vector<BrdfResult>& results, const StudyConfig& config);

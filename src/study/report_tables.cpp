@@ -425,6 +425,53 @@ std::string summary_table(const SummaryMetric& m, const std::vector<Space>& para
   return md + "\n";
 }
 
+// Dupuy & Jakob's acquisition (the dupuy-jakob rows of the per-material parameterization) against
+// each parameterization's own regular grid, per budget: the medians over the BRDFs measured in all
+// of them and, per BRDF, which is lowest. Empty when no BRDF has such rows.
+std::string dupuy_jakob_table(const std::vector<BrdfResult>& results, const StudyConfig& config) {
+  const std::vector<Space>& params = params_of(results);
+  std::string rows;
+  for (const std::size_t budget : config.budgets) {
+    std::vector<std::vector<double>> errors(params.size() + 1);
+    std::vector<int> wins(params.size() + 1, 0);
+    std::size_t measured = 0, brdfs = 0;
+    for (const BrdfResult& b : results) {
+      std::vector<double> row(params.size() + 1, NAN);
+      for (Space s : params) {
+        const std::vector<GonioPoint> points = gonio_points(b, s, 3);
+        if (const GonioPoint* p = find_point(points, Design::dupuy_jakob, budget, Spacing::own)) {
+          row[0] = p->error;
+          measured = p->samples;
+        }
+      }
+      for (std::size_t k = 0; k < params.size(); ++k) {
+        const std::vector<GonioPoint> points = gonio_points(b, params[k], 3);
+        if (const GonioPoint* p = find_point(points, Design::regular, budget, Spacing::own))
+          row[k + 1] = p->error;
+      }
+      if (std::any_of(row.begin(), row.end(), [](double v) { return !std::isfinite(v); })) continue;
+      ++brdfs;
+      const double best = *std::min_element(row.begin(), row.end());
+      for (std::size_t k = 0; k < row.size(); ++k) {
+        errors[k].push_back(row[k]);
+        wins[k] += row[k] <= best;
+      }
+    }
+    if (brdfs == 0) continue;
+    rows += fmt::format("| {} | {} | {} |", budget, brdfs, measured);
+    for (std::size_t k = 0; k < errors.size(); ++k)
+      rows += fmt::format(" {:.4f} ({}) |", median(errors[k]), wins[k]);
+    rows += "\n";
+  }
+  if (rows.empty()) return {};
+  return "Dupuy & Jakob's acquisition (`dupuy-jakob`: the retro-reflection, then 8 incidence "
+         "slices through the VNDF warp, as `export-rgl` writes it; docs/acquisition.md) against "
+         "each parameterization's own regular grid at the same budget: median relative error "
+         "over the BRDFs measured in all (in parentheses: on how many each is the lowest), and "
+         "the measurements Dupuy & Jakob's layout takes, the retro-reflection included.\n\n" +
+         table_header("budget | BRDFs | its measurements | Dupuy & Jakob", params) + rows + "\n";
+}
+
 // ---------------------------------------------------------------------------------------------
 // Metric 5: importance sampling
 // ---------------------------------------------------------------------------------------------

@@ -14,6 +14,7 @@
 #include "fit_metric.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/fit/fit.hpp"
+#include "halfback/formats/adaptive_param.hpp"
 #include "halfback/formats/rgl.hpp"
 #include "halfback/formats/rgl_writer.hpp"
 #include "halfback/loader/load.hpp"
@@ -21,6 +22,7 @@
 #include "halfback/render/factored_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/render/sampling_metric.hpp"
+#include "halfback/study/dupuy_jakob_design.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metric_tables.hpp"
 #include "material_spaces.hpp"
@@ -189,7 +191,23 @@ std::vector<GonioRun> gonio_runs(Space s, Space w, bool iso, const StudyConfig& 
     for (Design d : kDesigns) add(Spacing::own, d);
   for (Spacing spacing : config.spacings)
     if (spacing != Spacing::own) add(spacing, Design::regular);
+  // Dupuy & Jakob's own acquisition, in their parameterization (isotropic BRDFs: the export's).
+  if (own && iso && is_per_material_placeholder(s.param())) add(Spacing::own, Design::dupuy_jakob);
   return runs;
+}
+
+// Dupuy & Jakob's acquisition of `brdf` at `budget` (dupuy_jakob_design.hpp) as a row of the
+// gonio table: the measurements it takes, the retro-reflection included. None when the budget is
+// below its smallest layout or the export refuses the BRDF (a value the format cannot hold).
+std::optional<GonioPoint> dupuy_jakob_point(const Brdf& brdf, std::size_t budget,
+                                            const TestPairs& test) {
+  try {
+    const DupuyJakobLayout layout = dupuy_jakob_layout(budget);
+    const double error = reconstruction_error(*dupuy_jakob_acquisition(brdf, layout, 1), test);
+    return GonioPoint{Design::dupuy_jakob, budget, layout.measurements(), error, Spacing::own};
+  } catch (const std::invalid_argument&) {
+    return std::nullopt;
+  }
 }
 
 // Metric 5: the tabulated sampler in each parameterization's chart at each table size, measured
@@ -421,6 +439,10 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
             if (points[k].spacing == Spacing::own && points[k].design == run.setup.design)
               points.push_back({points[k].design, points[k].budget, points[k].samples,
                                 points[k].error, run.setup.spacing});
+          continue;
+        }
+        if (run.setup.design == Design::dupuy_jakob) {
+          if (const auto p = dupuy_jakob_point(brdf, run.setup.budget, test)) points.push_back(*p);
           continue;
         }
         auto rec = std::make_unique<GonioReconstruction>(brdf, run.setup);

@@ -17,7 +17,7 @@ inline Column parameterization() {
 
 inline Column design() {
   std::vector<std::string> names;
-  for (Design d : kDesigns) names.emplace_back(name_of(d));
+  for (Design d : kAllDesigns) names.emplace_back(name_of(d));
   return {"design", ColumnKind::text, names};
 }
 

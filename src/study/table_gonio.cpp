@@ -57,7 +57,7 @@ namespace {
 void add_budget_rows(MetricTable& into, Space space, const std::vector<GonioPoint>& points,
                      int dims) {
   for (Spacing spacing : kSpacings)
-    for (Design d : kDesigns) {
+    for (Design d : kAllDesigns) {
       const GonioCurve c = gonio_curve(points, d, spacing);
       if (c.samples.empty()) continue;
       for (double target : kTargetErrors) {

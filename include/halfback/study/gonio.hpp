@@ -54,9 +54,16 @@
 
 namespace halfback::study {
 
-enum class Design { regular, stratified };
+// The grid layouts above (kDesigns), and Dupuy & Jakob 2018's acquisition (`dupuy_jakob`,
+// dupuy_jakob_design.hpp): a design of the study's "dupuy-jakob:per-material" parameterization
+// only (its rows are that parameterization's), reconstructed as an RGL file, not by
+// GonioReconstruction (which refuses it) and never planned for an instrument.
+enum class Design { regular, stratified, dupuy_jakob };
 inline constexpr std::array<Design, 2> kDesigns{Design::regular, Design::stratified};
+inline constexpr std::array<Design, 3> kAllDesigns{Design::regular, Design::stratified,
+                                                   Design::dupuy_jakob};
 std::string_view name_of(Design d);
+// "regular", "stratified" or "dupuy-jakob"; nullopt for anything else.
 std::optional<Design> parse_design(std::string_view name);
 
 struct GonioSetup {
