@@ -124,7 +124,7 @@ FactoredSampler::FactoredSampler(const Brdf& brdf, const FactorOptions& o)
       chart_(o.param.param().sampler_chart()),
       isotropic_(brdf.isotropic()) {
   const auto start = std::chrono::steady_clock::now();
-  if (o.terms < 1 || o.radial < 2 || o.azimuthal < 2 || o.theta_views < 1 ||
+  if (o.terms < 1 || o.terms > kMaxTerms || o.radial < 2 || o.azimuthal < 2 || o.theta_views < 1 ||
       o.aniso_theta_views < 1 || o.aniso_phi_views < 1 || o.supersample < 1 || o.iterations < 1 ||
       !(o.defensive >= 0 && o.defensive < 1))
     throw std::invalid_argument("FactoredSampler: invalid factorization options");
@@ -179,10 +179,10 @@ std::string FactoredSampler::describe_sampling() const {
          (isotropic_ ? "" : " x " + std::to_string(n_phi_)) + " views) of " + brdf_.name();
 }
 
-std::vector<double> FactoredSampler::term_weights(const Vec3<double>& wo) const {
+FactoredSampler::TermWeights FactoredSampler::term_weights(const Vec3<double>& wo) const {
   const SliceGrid::Blend b = SliceGrid{n_theta_, n_phi_}.blend(wo);
   const auto J = std::size_t(n_terms_);
-  std::vector<double> w(J, 0.0);
+  TermWeights w{};
   for (int i = 0; i < b.count; ++i)
     if (b.weight[i] > 0)
       for (std::size_t j = 0; j < J; ++j)
@@ -200,7 +200,7 @@ BrdfSample FactoredSampler::sample(const Vec3<double>& wo_in, double u1, double 
   }
   u1 = std::min((u1 - eps) / (1 - eps), kOneMinusEpsilon);
   const CanonicalPose pose = canonical_pose(wo_in, isotropic_);
-  const std::vector<double> w = term_weights(pose.wo);
+  const TermWeights w = term_weights(pose.wo);
   const int pick = pick_weighted(w.data(), n_terms_, u1);
   if (pick < 0) return {};
   const auto cell = tables_[std::size_t(pick)].sample(u1, u2);
@@ -213,7 +213,7 @@ BrdfSample FactoredSampler::sample(const Vec3<double>& wo_in, double u1, double 
   wi = rotate_z(wi, pose.c, pose.s);
   // pdf(ωo, ωi) from the cell, weights and Jacobian at hand.
   double table = 0, total = 0;
-  for (std::size_t j = 0; j < w.size(); ++j) {
+  for (std::size_t j = 0; j < tables_.size(); ++j) {
     table += w[j] * tables_[j].probability(cell.row, cell.col);
     total += w[j];
   }
@@ -231,9 +231,9 @@ double FactoredSampler::pdf(const Vec3<double>& wo_in, const Vec3<double>& wi_in
     const auto row = std::min(std::size_t(s * options_.radial), std::size_t(options_.radial - 1));
     const auto col =
         std::min(std::size_t(t * options_.azimuthal), std::size_t(options_.azimuthal - 1));
-    const std::vector<double> w = term_weights(pose.wo);
+    const TermWeights w = term_weights(pose.wo);
     double total = 0;
-    for (std::size_t j = 0; j < w.size(); ++j) {
+    for (std::size_t j = 0; j < tables_.size(); ++j) {
       table += w[j] * tables_[j].probability(row, col);
       total += w[j];
     }

@@ -145,9 +145,10 @@ TEST(FactoredSampler, BlackBrdfGivesNoSampleButCosineDefence) {
 TEST(FactoredSampler, InvalidOptionsAreRefused) {
   const Opaque diffuse(lambert());
   for (auto edit :
-       {+[](FactorOptions& o) { o.terms = 0; }, +[](FactorOptions& o) { o.radial = 1; },
-        +[](FactorOptions& o) { o.iterations = 0; }, +[](FactorOptions& o) { o.defensive = 1; },
-        +[](FactorOptions& o) { o.theta_views = 0; }}) {
+       {+[](FactorOptions& o) { o.terms = 0; },
+        +[](FactorOptions& o) { o.terms = FactoredSampler::kMaxTerms + 1; },
+        +[](FactorOptions& o) { o.radial = 1; }, +[](FactorOptions& o) { o.iterations = 0; },
+        +[](FactorOptions& o) { o.defensive = 1; }, +[](FactorOptions& o) { o.theta_views = 0; }}) {
     FactorOptions o = small(space_of<HalfDiff>);
     edit(o);
     EXPECT_THROW(FactoredSampler(diffuse, o), std::invalid_argument);

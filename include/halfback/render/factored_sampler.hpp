@@ -13,6 +13,7 @@
 // sampler's slices are) and a cell of its table. Immutable and thread-safe once built.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -23,7 +24,7 @@ namespace halfback::render {
 struct FactorOptions {
   Space param = space_of<HalfDiff>;  // whose sampler chart the tables live in
   bool warp = true;                  // r = r_max s² (TabulationOptions::warp)
-  int terms = 4;                     // J
+  int terms = 4;                     // J, 1 to FactoredSampler::kMaxTerms
   int radial = 64, azimuthal = 128;  // cells of each term's table
   // Views the factorization is fitted to: θo steps (isotropic BRDFs), θo × φo (anisotropic).
   int theta_views = 16;
@@ -36,8 +37,9 @@ struct FactorOptions {
 
 class FactoredSampler final : public SamplingWrapper {
  public:
-  // Throws std::invalid_argument for options out of range (terms, cells, views, iterations < 1,
-  // defensive outside [0, 1)).
+  static constexpr int kMaxTerms = 16;
+  // Throws std::invalid_argument for options out of range (terms outside [1, kMaxTerms]; cells,
+  // views, iterations < 1; defensive outside [0, 1)).
   FactoredSampler(const Brdf& brdf, const FactorOptions& options = {});
   BrdfSample sample(const Vec3<double>& wo, double u1, double u2) const override;
   double pdf(const Vec3<double>& wo, const Vec3<double>& wi) const override;
@@ -53,8 +55,9 @@ class FactoredSampler final : public SamplingWrapper {
   double build_seconds() const { return build_seconds_; }
 
  private:
-  // The terms' weights at ωo (canonical pose), summed over the views' blend.
-  std::vector<double> term_weights(const Vec3<double>& wo) const;
+  // The terms' weights at ωo (canonical pose), summed over the views' blend (n_terms_ of them).
+  using TermWeights = std::array<double, kMaxTerms>;
+  TermWeights term_weights(const Vec3<double>& wo) const;
 
   FactorOptions options_;
   SamplerChart chart_;
