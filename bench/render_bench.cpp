@@ -63,6 +63,7 @@
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/render/sampling_metric.hpp"
+#include "support/test_brdfs.hpp"
 
 namespace {
 
@@ -309,19 +310,21 @@ void table_size_at_equal_time(bool quick) {
   }
 }
 
-// Hides a model's own sampler, as for measured data.
-class Opaque final : public Brdf {
- public:
-  explicit Opaque(BrdfPtr b) : b_(std::move(b)) {}
-  std::string name() const override { return b_->name(); }
-  std::string description() const override { return b_->description(); }
-  bool isotropic() const override { return b_->isotropic(); }
-  bool reciprocal() const override { return b_->reciprocal(); }
-  Rgb eval(const DirPair<double>& p) const override { return b_->eval(p); }
+using test::Opaque;
 
- private:
-  BrdfPtr b_;
-};
+// The built-in sky and studio, and those of `shared` (files of ../shared/data/envmaps) when the
+// shared data are there.
+std::vector<std::pair<std::string, render::EnvMap>> environments(
+    std::initializer_list<const char*> shared) {
+  std::vector<std::pair<std::string, render::EnvMap>> envs;
+  envs.emplace_back("sky", render::EnvMap::default_sky());
+  envs.emplace_back("studio", render::EnvMap::from_spec("studio"));
+  const std::string dir = shared_data_dir() + "envmaps/";
+  for (const char* name : shared)
+    if (std::filesystem::exists(dir + name))
+      envs.emplace_back(name, render::EnvMap::from_spec(dir + name));
+  return envs;
+}
 
 // The cells "| table | cosine | auto | chose |" of a row: `brdf` rendered with each
 // RenderSettings::brdf_sampling at equal time, and what auto chose.
@@ -350,9 +353,7 @@ void sampler_choice_at_equal_time(bool quick) {
       {"neural pink-felt", load_brdf("embedded:pink-felt")},
       {"neural gold-metallic-paint3", load_brdf("embedded:gold-metallic-paint3")},
       {"GGX α = 0.05, tabulated", std::make_shared<Opaque>(load_brdf("ggx:alpha=0.05,f0=0.9"))}};
-  std::vector<std::pair<std::string, render::EnvMap>> envs;
-  envs.emplace_back("sky", render::EnvMap::default_sky());
-  envs.emplace_back("studio", render::EnvMap::from_spec("studio"));
+  const auto envs = environments({"grace.hdr", "uffizi.hdr"});
   if (shared) {
     for (const char* name : {"blue-acrylic", "chrome", "beige-fabric", "nylon"})
       materials.push_back(
@@ -360,23 +361,14 @@ void sampler_choice_at_equal_time(bool quick) {
     for (const char* name : {"acrylic_felt_green_rgb", "paper_white_rgb"})
       materials.push_back({std::string("neural RGL ") + name,
                            load_brdf(data + "nbrdf/rgl-isotropic_nbrdf/" + name + ".h5")});
-    for (const char* name : {"grace.hdr", "uffizi.hdr"})
-      envs.emplace_back(name, render::EnvMap::from_spec(data + "envmaps/" + name));
   }
   std::printf(
       "\n## The albedo-variance ratio of the automatic choice (cosine's ÷ table's; the "
       "table at ≥ %g)\n\n| material | ratio |\n|---|---|\n",
       render::kPeakedRatio);
-  for (const Material& m : materials) {
-    const render::RenderSettings s = budgeted(budget);
-    const render::SamplingMetricOptions o{.samples = render::kChoiceSamples, .seed = s.seed};
-    const auto table = render::with_importance_sampling(*m.brdf, s.tabulation);
-    const double ratio =
-        render::measure_sampling(*m.brdf, *render::with_cosine_sampling(*m.brdf), o)
-            .relative_variance /
-        render::measure_sampling(*m.brdf, *table, o).relative_variance;
-    std::printf("| %s | %.3g |\n", m.label.c_str(), ratio);
-  }
+  for (const Material& m : materials)
+    std::printf("| %s | %.3g |\n", m.label.c_str(),
+                render::choose_brdf_sampler(*m.brdf, budgeted(budget)).albedo_variance_ratio);
   std::printf(
       "\n## Choosing the BRDF sampler (MIS, %.1f s, 128 × 128; relative RMSE at equal time, "
       "set-up and choice included)\n\n| material | environment | table | cosine | auto | auto "
@@ -397,13 +389,10 @@ void rgl_warp_against_choice(bool quick) {
   const std::string data = shared_data_dir();
   std::vector<Material> files{{"RGL metallic paint", load_brdf("embedded:ilm_l3_37_metallic")},
                               {"RGL felt", load_brdf("embedded:acrylic_felt_green")}};
-  std::vector<std::pair<std::string, render::EnvMap>> envs;
-  envs.emplace_back("sky", render::EnvMap::default_sky());
-  envs.emplace_back("studio", render::EnvMap::from_spec("studio"));
-  if (std::filesystem::exists(data + "envmaps/uffizi.hdr")) {
+  const auto envs = environments({"uffizi.hdr"});
+  if (std::filesystem::exists(data + "rgl")) {
     for (const char* name : {"paper_white_rgb", "cc_ibiza_sunset_rgb", "irid_flake_paint2_rgb"})
       files.push_back({std::string("RGL ") + name, load_brdf(data + "rgl/" + name + ".bsdf")});
-    envs.emplace_back("uffizi.hdr", render::EnvMap::from_spec(data + "envmaps/uffizi.hdr"));
   }
   std::printf(
       "\n## RGL files: their VNDF warp against table, cosine and auto (MIS, %.1f s, 128 × 128; "

@@ -104,54 +104,29 @@ std::string TabulatedSampler::describe_sampling() const {
          brdf_.name();
 }
 
-BrdfSample TabulatedSampler::sample(const Vec3<double>& wo_in, double u1, double u2) const {
-  if (!(wo_in.z > 0)) return {};
-  const double eps = options_.defensive;
-  if (u1 < eps) {
-    const Vec3<double> wi = sample_cosine_hemisphere(u1 / eps, u2);
-    if (!(wi.z > 0)) return {};
-    return {wi, pdf(wo_in, wi)};
-  }
-  u1 = std::min((u1 - eps) / (1 - eps), kOneMinusEpsilon);
-  const CanonicalPose pose = canonical_pose(wo_in, isotropic_);
-  const SliceGrid::Blend b = SliceGrid{n_theta_, n_phi_}.blend(pose.wo);
-  const int pick = pick_weighted(b.weight, b.count, u1);
-  if (pick < 0) return {};
-  const auto cell = slices_[std::size_t(b.index[pick])].sample(u1, u2);
-  if (!(cell.probability > 0)) return {};
-  const double s = (double(cell.row) + cell.remapped_row) / n_radial_;
-  const double t = (double(cell.col) + cell.remapped_col) / n_azimuthal_;
-  Vec3<double> wi{0, 0, 0};
-  double jac = 0;
-  if (!ParamMap{chart_, options_.warp}.forward(pose.wo, s, t, wi, jac)) return {};
-  wi = rotate_z(wi, pose.c, pose.s);
-  // pdf(ωo, ωi) from the cell and Jacobian at hand (pdf() would map ωi back to them).
-  double p = 0;
-  for (int i = 0; i < b.count; ++i)
-    if (b.weight[i] > 0)
-      p += b.weight[i] * slices_[std::size_t(b.index[i])].probability(cell.row, cell.col);
-  const double table = p * double(n_radial_) * double(n_azimuthal_) / jac;
-  return {wi, (1 - eps) * table + eps * cosine_hemisphere_pdf(wi)};
+MixtureSampling TabulatedSampler::sampling() const {
+  return {{chart_, options_.warp}, n_radial_,  n_azimuthal_,
+          options_.defensive,      isotropic_, slices_};
 }
 
-double TabulatedSampler::table_pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
-  double s = 0, t = 0, jac = 0;
-  if (!ParamMap{chart_, options_.warp}.inverse(wo, wi, s, t, jac)) return 0;
-  const std::size_t row = std::min(std::size_t(s * n_radial_), std::size_t(n_radial_ - 1));
-  const std::size_t col = std::min(std::size_t(t * n_azimuthal_), std::size_t(n_azimuthal_ - 1));
+BrdfSample TabulatedSampler::sample(const Vec3<double>& wo, double u1, double u2) const {
+  return sampling().sample(wo, u1, u2, [this](const Vec3<double>& w) { return blended(w); });
+}
+
+double TabulatedSampler::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  return sampling().pdf(wo, wi, [this](const Vec3<double>& w) { return blended(w); });
+}
+
+// The slices around ωo (canonical) and their blend weights.
+CellMixture TabulatedSampler::blended(const Vec3<double>& wo) const {
   const SliceGrid::Blend b = SliceGrid{n_theta_, n_phi_}.blend(wo);
-  double p = 0;
-  for (int i = 0; i < b.count; ++i)
-    if (b.weight[i] > 0) p += b.weight[i] * slices_[std::size_t(b.index[i])].probability(row, col);
-  return p * double(n_radial_) * double(n_azimuthal_) / jac;
-}
-
-double TabulatedSampler::pdf(const Vec3<double>& wo_in, const Vec3<double>& wi_in) const {
-  if (!(wo_in.z > 0 && wi_in.z > 0)) return 0;
-  const CanonicalPose pose = canonical_pose(wo_in, isotropic_);
-  const Vec3<double> wi = rotate_z(wi_in, pose.c, -pose.s);
-  const double eps = options_.defensive;
-  return (1 - eps) * table_pdf(pose.wo, wi) + eps * cosine_hemisphere_pdf(wi_in);
+  CellMixture m;
+  m.count = b.count;
+  for (int i = 0; i < b.count; ++i) {
+    m.table[std::size_t(i)] = b.index[i];
+    m.weight[std::size_t(i)] = b.weight[i];
+  }
+  return m;
 }
 
 }  // namespace halfback::render

@@ -9,8 +9,12 @@
 #include <numbers>
 #include <vector>
 
+#include <array>
+
 #include "halfback/brdf/brdf.hpp"
+#include "halfback/brdf/sampling.hpp"
 #include "halfback/core/space.hpp"
+#include "halfback/render/distribution.hpp"
 
 namespace halfback::render::detail {
 
@@ -118,5 +122,78 @@ inline CanonicalPose canonical_pose(const Vec3<double>& wo, bool isotropic) {
   if (!(r > 0)) return {{0, 0, wo.z}, 1, 0};
   return {{r, 0, wo.z}, wo.x / r, wo.y / r};
 }
+
+// The weights of up to kMax of a sampler's tables at one ωo.
+struct CellMixture {
+  static constexpr int kMax = 16;
+  int count = 0;
+  std::array<int, kMax> table{};
+  std::array<double, kMax> weight{};
+};
+
+// What the tabulated (slices) and factored (terms) samplers share: ωi drawn from a mixture of 2D
+// distributions over the same radial × azimuthal cells of a chart, the weights a function of the
+// canonical ωo (`mixture_at`), with a defensive cosine share. The pdf is
+//   (1 − ε) Σ w_k P_k(cell) / Σ w_k · N_r N_a / |J(ωi)| + ε cos θi / π.
+struct MixtureSampling {
+  ParamMap map;
+  int radial = 0, azimuthal = 0;
+  double defensive = 0;
+  bool isotropic = true;
+  const std::vector<Distribution2D>& tables;
+
+  template <class MixtureAt>
+  BrdfSample sample(const Vec3<double>& wo_in, double u1, double u2, MixtureAt mixture_at) const {
+    if (!(wo_in.z > 0)) return {};
+    if (u1 < defensive) {
+      const Vec3<double> wi = sample_cosine_hemisphere(u1 / defensive, u2);
+      if (!(wi.z > 0)) return {};
+      return {wi, pdf(wo_in, wi, mixture_at)};
+    }
+    u1 = std::min((u1 - defensive) / (1 - defensive), kOneMinusEpsilon);
+    const CanonicalPose pose = canonical_pose(wo_in, isotropic);
+    const CellMixture m = mixture_at(pose.wo);
+    const int pick = pick_weighted(m.weight.data(), m.count, u1);
+    if (pick < 0) return {};
+    const auto cell = tables[std::size_t(m.table[std::size_t(pick)])].sample(u1, u2);
+    if (!(cell.probability > 0)) return {};
+    const double s = (double(cell.row) + cell.remapped_row) / radial;
+    const double t = (double(cell.col) + cell.remapped_col) / azimuthal;
+    Vec3<double> wi{0, 0, 0};
+    double jac = 0;
+    if (!map.forward(pose.wo, s, t, wi, jac)) return {};
+    wi = rotate_z(wi, pose.c, pose.s);
+    // The pdf from the cell and Jacobian at hand (pdf() would map ωi back to them).
+    return {wi, (1 - defensive) * density(m, cell.row, cell.col, jac) +
+                    defensive * cosine_hemisphere_pdf(wi)};
+  }
+
+  template <class MixtureAt>
+  double pdf(const Vec3<double>& wo_in, const Vec3<double>& wi_in, MixtureAt mixture_at) const {
+    if (!(wo_in.z > 0 && wi_in.z > 0)) return 0;
+    const CanonicalPose pose = canonical_pose(wo_in, isotropic);
+    const Vec3<double> wi = rotate_z(wi_in, pose.c, -pose.s);
+    double table = 0, s = 0, t = 0, jac = 0;
+    if (map.inverse(pose.wo, wi, s, t, jac)) {
+      const auto row = std::min(std::size_t(s * radial), std::size_t(radial - 1));
+      const auto col = std::min(std::size_t(t * azimuthal), std::size_t(azimuthal - 1));
+      table = density(mixture_at(pose.wo), row, col, jac);
+    }
+    return (1 - defensive) * table + defensive * cosine_hemisphere_pdf(wi_in);
+  }
+
+ private:
+  // The mixture's density per unit solid angle in a cell of Jacobian `jac`; 0 without weight.
+  double density(const CellMixture& m, std::size_t row, std::size_t col, double jac) const {
+    double p = 0, total = 0;
+    for (int k = 0; k < m.count; ++k)
+      if (m.weight[std::size_t(k)] > 0) {
+        p += m.weight[std::size_t(k)] *
+             tables[std::size_t(m.table[std::size_t(k)])].probability(row, col);
+        total += m.weight[std::size_t(k)];
+      }
+    return total > 0 ? p / total * double(radial) * double(azimuthal) / jac : 0;
+  }
+};
 
 }  // namespace halfback::render::detail

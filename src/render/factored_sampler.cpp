@@ -179,70 +179,32 @@ std::string FactoredSampler::describe_sampling() const {
          (isotropic_ ? "" : " x " + std::to_string(n_phi_)) + " views) of " + brdf_.name();
 }
 
-FactoredSampler::TermWeights FactoredSampler::term_weights(const Vec3<double>& wo) const {
+static_assert(FactoredSampler::kMaxTerms <= CellMixture::kMax);
+
+MixtureSampling FactoredSampler::sampling() const {
+  return {{chart_, options_.warp}, options_.radial, options_.azimuthal,
+          options_.defensive,      isotropic_,      tables_};
+}
+
+CellMixture FactoredSampler::term_weights(const Vec3<double>& wo) const {
   const SliceGrid::Blend b = SliceGrid{n_theta_, n_phi_}.blend(wo);
   const auto J = std::size_t(n_terms_);
-  TermWeights w{};
+  CellMixture m;
+  m.count = n_terms_;
+  for (std::size_t j = 0; j < J; ++j) m.table[j] = int(j);
   for (int i = 0; i < b.count; ++i)
     if (b.weight[i] > 0)
       for (std::size_t j = 0; j < J; ++j)
-        w[j] += b.weight[i] * weights_[std::size_t(b.index[i]) * J + j];
-  return w;
+        m.weight[j] += b.weight[i] * weights_[std::size_t(b.index[i]) * J + j];
+  return m;
 }
 
-BrdfSample FactoredSampler::sample(const Vec3<double>& wo_in, double u1, double u2) const {
-  if (!(wo_in.z > 0)) return {};
-  const double eps = options_.defensive;
-  if (u1 < eps) {
-    const Vec3<double> wi = sample_cosine_hemisphere(u1 / eps, u2);
-    if (!(wi.z > 0)) return {};
-    return {wi, pdf(wo_in, wi)};
-  }
-  u1 = std::min((u1 - eps) / (1 - eps), kOneMinusEpsilon);
-  const CanonicalPose pose = canonical_pose(wo_in, isotropic_);
-  const TermWeights w = term_weights(pose.wo);
-  const int pick = pick_weighted(w.data(), n_terms_, u1);
-  if (pick < 0) return {};
-  const auto cell = tables_[std::size_t(pick)].sample(u1, u2);
-  if (!(cell.probability > 0)) return {};
-  const double s = (double(cell.row) + cell.remapped_row) / options_.radial;
-  const double t = (double(cell.col) + cell.remapped_col) / options_.azimuthal;
-  Vec3<double> wi{0, 0, 0};
-  double jac = 0;
-  if (!ParamMap{chart_, options_.warp}.forward(pose.wo, s, t, wi, jac)) return {};
-  wi = rotate_z(wi, pose.c, pose.s);
-  // pdf(ωo, ωi) from the cell, weights and Jacobian at hand.
-  double table = 0, total = 0;
-  for (std::size_t j = 0; j < tables_.size(); ++j) {
-    table += w[j] * tables_[j].probability(cell.row, cell.col);
-    total += w[j];
-  }
-  table *= double(options_.radial) * double(options_.azimuthal) / (total * jac);
-  return {wi, (1 - eps) * table + eps * cosine_hemisphere_pdf(wi)};
+BrdfSample FactoredSampler::sample(const Vec3<double>& wo, double u1, double u2) const {
+  return sampling().sample(wo, u1, u2, [this](const Vec3<double>& w) { return term_weights(w); });
 }
 
-double FactoredSampler::pdf(const Vec3<double>& wo_in, const Vec3<double>& wi_in) const {
-  if (!(wo_in.z > 0 && wi_in.z > 0)) return 0;
-  const CanonicalPose pose = canonical_pose(wo_in, isotropic_);
-  const Vec3<double> wi = rotate_z(wi_in, pose.c, -pose.s);
-  const double eps = options_.defensive;
-  double table = 0, s = 0, t = 0, jac = 0;
-  if (ParamMap{chart_, options_.warp}.inverse(pose.wo, wi, s, t, jac)) {
-    const auto row = std::min(std::size_t(s * options_.radial), std::size_t(options_.radial - 1));
-    const auto col =
-        std::min(std::size_t(t * options_.azimuthal), std::size_t(options_.azimuthal - 1));
-    const TermWeights w = term_weights(pose.wo);
-    double total = 0;
-    for (std::size_t j = 0; j < tables_.size(); ++j) {
-      table += w[j] * tables_[j].probability(row, col);
-      total += w[j];
-    }
-    if (total > 0)
-      table *= double(options_.radial) * double(options_.azimuthal) / (total * jac);
-    else
-      table = 0;
-  }
-  return (1 - eps) * table + eps * cosine_hemisphere_pdf(wi_in);
+double FactoredSampler::pdf(const Vec3<double>& wo, const Vec3<double>& wi) const {
+  return sampling().pdf(wo, wi, [this](const Vec3<double>& w) { return term_weights(w); });
 }
 
 FactorOptions factoring_for_memory(Space param, std::size_t bytes, int terms) {

@@ -499,21 +499,22 @@ ChosenSampler choose_brdf_sampler(const Brdf& brdf, const RenderSettings& s) {
   return {
       peaked ? table : cosine,
       fmt::format(" (chosen: the cosine's albedo variance is {:.3g} times the table's, {} {:g})",
-                  ratio, peaked ? "at least" : "below", kPeakedRatio)};
+                  ratio, peaked ? "at least" : "below", kPeakedRatio),
+      ratio};
 }
 
 RenderResult render(const Brdf& brdf, const EnvMap& env, const RenderSettings& settings) {
   validate(settings);
   const auto start = Clock::now();
-  const auto [sampled, why] = choose_brdf_sampler(brdf, settings);
+  const ChosenSampler chosen = choose_brdf_sampler(brdf, settings);
   const double build = std::chrono::duration<double>(Clock::now() - start).count();
   if (settings.time_budget > 0 && !(build < settings.time_budget))
     throw TimeBudgetExceeded("the time budget of " + format_seconds(settings.time_budget) +
                              " ran out while building the BRDF's sampler (" +
                              format_seconds(build) + ")");
-  RenderResult r = render_passes(*sampled, env, settings, start);
+  RenderResult r = render_passes(*chosen.brdf, env, settings, start);
   r.sampler_seconds = build;
-  r.sampler += why;
+  r.sampler += chosen.why;
   return r;
 }
 

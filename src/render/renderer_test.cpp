@@ -21,6 +21,7 @@
 #include "halfback/loader/load.hpp"
 #include "halfback/models/analytic.hpp"
 #include "support/exr_offsets.hpp"
+#include "support/test_brdfs.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::render {
@@ -28,18 +29,7 @@ namespace {
 
 constexpr double kOrthoHalfHeight = 1.25;
 
-class Opaque final : public Brdf {  // hides the model's own sampler
- public:
-  explicit Opaque(BrdfPtr b) : b_(std::move(b)) {}
-  std::string name() const override { return "opaque"; }
-  std::string description() const override { return b_->description(); }
-  bool isotropic() const override { return b_->isotropic(); }
-  bool reciprocal() const override { return b_->reciprocal(); }
-  Rgb eval(const DirPair<double>& p) const override { return b_->eval(p); }
-
- private:
-  BrdfPtr b_;
-};
+using test::Opaque;  // hides the model's own sampler
 
 BrdfPtr ggx(double alpha, double f0 = 1) {
   models::MicrofacetParams p;

@@ -7,22 +7,11 @@
 #include <string>
 
 #include "halfback/models/analytic.hpp"
+#include "support/test_brdfs.hpp"
 
 namespace halfback::render::test_support {
 
-// Hides a model's own sampler, as for measured data.
-class Opaque final : public Brdf {
- public:
-  explicit Opaque(BrdfPtr b) : b_(std::move(b)) {}
-  std::string name() const override { return "opaque:" + b_->name(); }
-  std::string description() const override { return b_->description(); }
-  bool isotropic() const override { return b_->isotropic(); }
-  bool reciprocal() const override { return b_->reciprocal(); }
-  Rgb eval(const DirPair<double>& p) const override { return b_->eval(p); }
-
- private:
-  BrdfPtr b_;
-};
+using test::Opaque;  // a model's own sampler hidden, as for measured data
 
 inline Vec3<double> dir(double theta_deg, double phi_deg) {
   const double t = theta_deg * std::numbers::pi / 180, p = phi_deg * std::numbers::pi / 180;

@@ -48,4 +48,20 @@ class FunctionBrdf : public Brdf {
   Rgb tint_;
 };
 
+// A BRDF with another's ρ and no sampler of its own (the cosine default), as measured data: the
+// renderer tabulates it.
+class Opaque final : public Brdf {
+ public:
+  explicit Opaque(BrdfPtr b) : b_(std::move(b)) {}
+  std::string name() const override { return "opaque:" + b_->name(); }
+  std::string description() const override { return b_->description(); }
+  bool isotropic() const override { return b_->isotropic(); }
+  bool reciprocal() const override { return b_->reciprocal(); }
+  Rgb eval(const DirPair<double>& p) const override { return b_->eval(p); }
+  using Brdf::eval;
+
+ private:
+  BrdfPtr b_;
+};
+
 }  // namespace halfback::test

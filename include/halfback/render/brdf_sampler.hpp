@@ -19,6 +19,11 @@
 
 namespace halfback::render {
 
+namespace detail {  // src/render/chart_cells.hpp
+struct MixtureSampling;
+struct CellMixture;
+}  // namespace detail
+
 struct TabulationOptions {
   // The parameterization whose sampler chart (params/charts.hpp: the 2D chart of ωi, for a fixed
   // ωo, of its first two coordinates) the tabulated sampler's cells live in. halfdiff's
@@ -90,8 +95,8 @@ class TabulatedSampler final : public SamplingWrapper {
   double build_seconds() const { return build_seconds_; }
 
  private:
-  // The table's density at ωi (both in the canonical pose), per unit solid angle.
-  double table_pdf(const Vec3<double>& wo, const Vec3<double>& wi) const;
+  detail::MixtureSampling sampling() const;  // the slices as a mixture (chart_cells.hpp)
+  detail::CellMixture blended(const Vec3<double>& wo) const;  // the slices' weights at ωo
 
   TabulationOptions options_;
   SamplerChart chart_;  // options_.param's, looked up once: sample() and pdf() are per path vertex

@@ -13,7 +13,6 @@
 // sampler's slices are) and a cell of its table. Immutable and thread-safe once built.
 #pragma once
 
-#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -55,9 +54,9 @@ class FactoredSampler final : public SamplingWrapper {
   double build_seconds() const { return build_seconds_; }
 
  private:
-  // The terms' weights at ωo (canonical pose), summed over the views' blend (n_terms_ of them).
-  using TermWeights = std::array<double, kMaxTerms>;
-  TermWeights term_weights(const Vec3<double>& wo) const;
+  detail::MixtureSampling sampling() const;  // the terms as a mixture (chart_cells.hpp)
+  // The terms' weights at ωo (canonical pose), blended between the views.
+  detail::CellMixture term_weights(const Vec3<double>& wo) const;
 
   FactorOptions options_;
   SamplerChart chart_;

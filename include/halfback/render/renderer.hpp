@@ -11,6 +11,7 @@
 // towards the light and ωo towards the camera.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -103,6 +104,7 @@ struct RenderResult {
 struct ChosenSampler {
   std::shared_ptr<const Brdf> brdf;
   std::string why;
+  double albedo_variance_ratio = NAN;  // the cosine's ÷ the table's, when measured
 };
 ChosenSampler choose_brdf_sampler(const Brdf& brdf, const RenderSettings& settings);
 
