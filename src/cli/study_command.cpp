@@ -31,6 +31,8 @@ struct StudyOptions {
   std::vector<std::string> specs, merge;
   std::string out = "study";
   std::string budgets, budgets_4d, environments, params, sampler_kib, fit_budgets;
+  std::vector<std::string> nielsen_database;  // Nielsen et al.'s database: files, folders
+  std::string nielsen_counts;
   std::string designs = "own,angle,merl,learned";
   study::StudySettings settings;
   bool resume = false;
@@ -49,6 +51,8 @@ study::StudyConfig make_config(const StudyOptions& o) {
   if (!o.fit_budgets.empty())
     s.fit_budgets = count_list(o.fit_budgets, "--fit-budgets", "sample budget");
   s.designs = split_list(o.designs, "--designs", "design");
+  if (!o.nielsen_counts.empty())
+    s.nielsen_counts = count_list(o.nielsen_counts, "--nielsen-counts", "measurement count");
   if (!o.params.empty()) s.params = split_list(o.params, "--params", "parameterization");
   try {
     return study::make_config(s);
@@ -265,12 +269,40 @@ std::vector<study::LabeledProfile> profile_pass(const std::vector<std::string>& 
   return profiles;
 }
 
+// Nielsen's database (--nielsen-database): its members loaded, their values at the candidate
+// configurations and at the study's test pairs (the same for every BRDF) computed once.
+void set_nielsen_database(study::StudyConfig& config, const std::vector<std::string>& specs) {
+  if (std::find(config.params.begin(), config.params.end(), space_of<HalfDiff>) ==
+      config.params.end())
+    throw UsageError("--nielsen-database: its rows are halfdiff's; add halfdiff to --params");
+  if (config.budgets.empty())
+    throw UsageError("--nielsen-database: needs the gonio-reflectometer (not --no-gonio)");
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<BrdfPtr> members;
+  for (const std::string& spec : expand_specs(specs)) members.push_back(load_brdf(spec));
+  study::NielsenOptions options;
+  options.max_theta_deg = config.max_theta_deg;
+  options.seed = config.seed;
+  try {
+    config.nielsen = std::make_shared<study::NielsenDatabase>(
+        std::move(members), options,
+        study::test_pair_directions(config.test_pairs, config.seed, config.max_theta_deg));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--nielsen-database: ") + e.what());
+  }
+  config.nielsen_from = study::nielsen_fingerprint(*config.nielsen);
+  fmt::print(stderr, "halfback study: Nielsen's database of {} BRDFs ({} configurations) in {:.1f} s\n",
+             config.nielsen->members(), config.nielsen->configurations().size(),
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
 int run_study(StudyOptions& o) {
   if (o.specs.empty()) throw UsageError("no BRDF given (files, directories or model specs)");
   study::StudyConfig config = make_config(o);
   const std::vector<std::string> specs = expand_specs(o.specs);
   create_output_directory(o.out);
   check_writable((std::filesystem::path(o.out) / "report.md").string());
+  if (!o.nielsen_database.empty()) set_nielsen_database(config, o.nielsen_database);
   std::vector<study::LabeledProfile> profiles;
   if (study::wants_learned(config)) {
     profiles = profile_pass(specs, o.out, config, o.resume);
@@ -387,6 +419,15 @@ Command register_study(CLI::App& parent) {
                   "Measurement budgets of the fit metric, ascending, comma-separated (default "
                   "1000,10000; --quick 1000)");
   app->add_flag("--no-fit", o->settings.no_fit, "No fit metric");
+  app->add_option("--nielsen-database", o->nielsen_database,
+                  "Nielsen et al. 2015's minimal sampling: the database of its principal "
+                  "components (isotropic BRDF files or folders, e.g. the MERL networks); each "
+                  "BRDF of the study that is one of them is left out of its own basis. Rows of "
+                  "halfdiff's gonio table, design nielsen (docs/acquisition.md)")
+      ->expected(1, -1);
+  app->add_option("--nielsen-counts", o->nielsen_counts,
+                  "Measurement counts of Nielsen's design, ascending, comma-separated (default "
+                  "1,2,5,10,20,40,100)");
   app->add_flag("-q,--quiet", o->quiet, "Nothing on stdout (the report is in the output folder)");
   app->add_flag("--full-report", o->full_report,
                 "The whole report on stdout (by default: its summary and where the files are)");

@@ -119,7 +119,7 @@ GonioSetup plan_setup(const PlanSettings& o) {
     throw std::invalid_argument(fmt::format("param '{}': expected a parameterization: {}", o.param,
                                             parameterization_names()));
   const auto design = parse_design(o.design);
-  if (!design || *design == Design::dupuy_jakob)
+  if (!design || (*design != Design::regular && *design != Design::stratified))
     throw std::invalid_argument(
         fmt::format("design '{}': expected regular or stratified", o.design));
   const auto spacing = parse_spacing(o.spacing);

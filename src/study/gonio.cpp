@@ -23,6 +23,8 @@ std::string_view name_of(Design d) {
       return "stratified";
     case Design::dupuy_jakob:
       return "dupuy-jakob";
+    case Design::nielsen:
+      return "nielsen";
   }
   return "?";
 }
@@ -102,6 +104,9 @@ GridSpec gonio_cells(const GonioSetup& s) {
   if (s.design == Design::dupuy_jakob)
     throw std::invalid_argument(
         "the dupuy-jakob design is export-rgl's acquisition (dupuy_jakob_design.hpp), not a grid");
+  if (s.design == Design::nielsen)
+    throw std::invalid_argument(
+        "the nielsen design is a database's principal components (nielsen.hpp), not a grid");
   if (!(s.max_theta_deg > 0 && s.max_theta_deg <= 90))
     throw std::invalid_argument("the gonio-reflectometer's reach must be in (0, 90] degrees");
   // A first guess from the fraction of the box inside the domain, then the nearest n.
@@ -489,8 +494,8 @@ void GonioReconstruction::eval_batch(std::span<const DirPair<double>> pairs,
   }
 }
 
-TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es,
-                          double max_theta_deg) {
+std::vector<DirPair<double>> test_pair_directions(std::size_t count, std::uint64_t seed,
+                                                  double max_theta_deg) {
   if (!(max_theta_deg > 0 && max_theta_deg <= 90))
     throw std::invalid_argument("test pairs: the largest angle must be in (0, 90] degrees");
   // Independent cosine-weighted directions have the density cos θi cos θo / π² on pairs; with
@@ -503,6 +508,12 @@ TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t se
   };
   std::vector<DirPair<double>> all(count);
   for (std::size_t i = 0; i < count; ++i) all[i] = {cosine(i, 0), cosine(i, 1)};
+  return all;
+}
+
+TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es,
+                          double max_theta_deg) {
+  const std::vector<DirPair<double>> all = test_pair_directions(count, seed, max_theta_deg);
   std::vector<Rgb> rho(count);
   truth.eval_batch(all, rho);
   TestPairs t;

@@ -111,6 +111,8 @@ StudyConfig make_config(const StudySettings& o) {
   if (!o.fit_loss.empty()) c.fit_loss = o.fit_loss;
   if (!o.fit_budgets.empty()) c.fit_budgets = o.fit_budgets;
   if (o.no_fit) c.fit_model.clear();
+  check_ascending(o.nielsen_counts, "--nielsen-counts");
+  if (!o.nielsen_counts.empty()) c.nielsen_counts = o.nielsen_counts;
   c.seed = o.seed;
   c.max_theta_deg = o.max_theta;
   // The image budget: as asked, else 10^4 if it is a budget, else the middle budget.
@@ -137,19 +139,25 @@ std::string describe_config(const StudyConfig& c) {
     if (!envs.empty()) envs += ',';
     envs += csv_text_field(e.label);
   }
+  // Nielsen's lines only with a database: the settings of runs without one read as before.
+  const std::string nielsen =
+      c.nielsen_from.empty()
+          ? std::string()
+          : fmt::format("nielsen_from = {}\nnielsen_counts = {}\n", c.nielsen_from,
+                        joined(c.nielsen_counts));
   return fmt::format(
       "parameterizations = {}\nspace = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = "
       "{}\nbudgets_4d = {}\n"
       "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
       "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
       "learned_from = {}\nsampler_kib = {}\nsampler_samples = {}\nfit_model = {}\nfit_loss = "
-      "{}\nfit_budgets = {}\nfit_samples = {}\n",
+      "{}\nfit_budgets = {}\nfit_samples = {}\n{}",
       joined(names_of(c.params)), name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
       joined(std::vector<std::size_t>(c.full_grid.begin(), c.full_grid.end())), joined(c.ranks),
       joined(c.budgets), joined(c.budgets_4d), c.test_pairs, format_csv_number(c.max_theta_deg),
       c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(names_of(c.spacings)),
       c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from, joined(c.sampler_kib),
-      c.sampler_samples, c.fit_model, c.fit_loss, joined(c.fit_budgets), c.fit_samples);
+      c.sampler_samples, c.fit_model, c.fit_loss, joined(c.fit_budgets), c.fit_samples, nielsen);
 }
 
 namespace {
@@ -242,6 +250,10 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
   if (kv.count("fit_budgets") && !kv.at("fit_budgets").empty())
     c.fit_budgets = numbers_of<std::size_t>(get("fit_budgets"), where);
   if (kv.count("fit_samples")) c.fit_samples = number_of<std::size_t>(get("fit_samples"), where);
+  // Runs without Nielsen's database have neither line.
+  if (kv.count("nielsen_from")) c.nielsen_from = get("nielsen_from");
+  if (kv.count("nielsen_counts"))
+    c.nielsen_counts = numbers_of<std::size_t>(get("nielsen_counts"), where);
   return c;
 }
 

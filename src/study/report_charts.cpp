@@ -90,7 +90,7 @@ figure::Scene gonio_chart(const std::vector<BrdfResult>& results, bool four_d,
     figure::LogLogPanel panel{b.label, {}};
     for (std::size_t i = 0; i < b.params.size(); ++i) {
       const std::vector<GonioPoint> points = gonio_points(b, b.params[i], four_d ? 4 : 3);
-      for (Design d : kDesigns) {
+      for (Design d : {Design::regular, Design::stratified, Design::nielsen}) {
         GonioCurve curve = gonio_curve(points, d);
         bool positive = !curve.samples.empty(), exact = true;
         for (double v : curve.errors) {
@@ -98,7 +98,9 @@ figure::Scene gonio_chart(const std::vector<BrdfResult>& results, bool four_d,
           exact &= v < 1e-12;
         }
         if (!positive || exact) continue;  // an exact reconstruction has no place on a log axis
-        panel.series.push_back({fmt::format("{} {}", name_of(b.params[i]), name_of(d)), int(i),
+        // Nielsen's curve (halfdiff's, a database's components) in a colour of its own.
+        const int colour = d == Design::nielsen ? int(b.params.size()) : int(i);
+        panel.series.push_back({fmt::format("{} {}", name_of(b.params[i]), name_of(d)), colour,
                                 d == Design::stratified, std::move(curve.samples),
                                 std::move(curve.errors)});
       }

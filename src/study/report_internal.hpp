@@ -166,6 +166,9 @@ std::string image_tables(const std::vector<BrdfResult>& results);
 std::string published_image_table(const std::vector<BrdfResult>& results);
 std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyConfig& config);
 std::string dupuy_jakob_table(const std::vector<BrdfResult>& results, const StudyConfig& config);
+// Nielsen et al.'s minimal sampling (halfdiff's nielsen rows) per kind of BRDF and count, against
+// halfdiff's regular grid; empty when no BRDF has such rows.
+std::string nielsen_table(const std::vector<BrdfResult>& results, const StudyConfig& config);
 // Per design and budget, each parameterization's median excess of the fit from its measurements
 // over the whole fit and median shape change, and which has the lowest excess per BRDF.
 std::string fit_tables(const std::vector<BrdfResult>& results, const StudyConfig& config);

@@ -114,6 +114,7 @@ std::string gonio_section(const std::vector<BrdfResult>& results, const StudyCon
   md += samples_to_target_table(results, kTargetErrors[1]);
   md += matching_budget_table(results, reference_budget(config));
   md += dupuy_jakob_table(results, config);
+  md += nielsen_table(results, config);
   md += "\n" + plot_link(plots.gonio, "Virtual gonio-reflectometer", "gonio");
   if (any_aniso)
     md += gonio_4d_table(results, config) + "\n" +

@@ -123,6 +123,9 @@ void StudyConfig::validate() const {
       throw std::invalid_argument(fmt::format(
           "study: {} samples for the whole fit: expected 100 to {}", fit_samples, kMaxTestPairs));
   }
+  for (std::size_t i = 0; i < nielsen_counts.size(); ++i)
+    if (nielsen_counts[i] < 1 || (i && nielsen_counts[i] <= nielsen_counts[i - 1]))
+      throw std::invalid_argument("study: Nielsen's measurement counts must be ascending, >= 1");
   if (!environments.empty() && !budgets.empty()) {
     if (std::find(budgets.begin(), budgets.end(), image_budget) == budgets.end())
       throw std::invalid_argument(
@@ -208,6 +211,19 @@ std::optional<GonioPoint> dupuy_jakob_point(const Brdf& brdf, std::size_t budget
   } catch (const std::invalid_argument&) {
     return std::nullopt;
   }
+}
+
+// Nielsen et al.'s acquisition of `brdf` (nielsen.hpp) as rows of halfdiff's gonio table, one per
+// measurement count (the budget and the samples), on the study's test pairs (the database keeps
+// its members' values there: combinations are read, not evaluated).
+std::vector<GonioPoint> nielsen_points(const Brdf& brdf, const TestPairs& test,
+                                       const StudyConfig& config) {
+  const NielsenAcquisition a = nielsen_acquisition(config.nielsen, brdf, config.nielsen_counts);
+  std::vector<GonioPoint> points;
+  for (const auto& rec : a.reconstructions)
+    points.push_back(GonioPoint{Design::nielsen, rec->measurements(), rec->measurements(),
+                                reconstruction_error(*rec, test), Spacing::own});
+  return points;
 }
 
 // Metric 5: the tabulated sampler in each parameterization's chart at each table size, measured
@@ -452,6 +468,8 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
             !config.environments.empty())
           t.for_images.push_back(std::move(rec));
       }
+      if (config.nielsen && iso && s == space_of<HalfDiff>)
+        for (const GonioPoint& p : nielsen_points(brdf, test, config)) points.push_back(p);
       for (const GonioPoint& p : points) add_gonio(t.table("gonio"), s, p, iso ? 3 : 4);
     }
     say(fmt::format("{} {}", gonio ? "gonio" : "metrics", name_of(s)));

@@ -54,14 +54,16 @@
 
 namespace halfback::study {
 
-// The grid layouts above (kDesigns), and Dupuy & Jakob 2018's acquisition (`dupuy_jakob`,
-// dupuy_jakob_design.hpp): a design of the study's "dupuy-jakob:per-material" parameterization
-// only (its rows are that parameterization's), reconstructed as an RGL file, not by
-// GonioReconstruction (which refuses it) and never planned for an instrument.
-enum class Design { regular, stratified, dupuy_jakob };
+// The grid layouts above (kDesigns), and two of the literature's acquisitions, reconstructed their
+// own way, not by GonioReconstruction (which refuses them), and never planned for an instrument:
+// Dupuy & Jakob 2018's (`dupuy_jakob`, dupuy_jakob_design.hpp), a design of the study's
+// "dupuy-jakob:per-material" parameterization only (its rows are that parameterization's), and
+// Nielsen et al. 2015's minimal sampling (`nielsen`, nielsen.hpp), rows of halfdiff (their
+// candidate configurations are MERL's bins) whose budget is the number of measurements.
+enum class Design { regular, stratified, dupuy_jakob, nielsen };
 inline constexpr std::array<Design, 2> kDesigns{Design::regular, Design::stratified};
-inline constexpr std::array<Design, 3> kAllDesigns{Design::regular, Design::stratified,
-                                                   Design::dupuy_jakob};
+inline constexpr std::array<Design, 4> kAllDesigns{Design::regular, Design::stratified,
+                                                   Design::dupuy_jakob, Design::nielsen};
 std::string_view name_of(Design d);
 // "regular", "stratified" or "dupuy-jakob"; nullopt for anything else.
 std::optional<Design> parse_design(std::string_view name);
@@ -168,6 +170,10 @@ struct TestPairs {
 };
 TestPairs draw_test_pairs(const Brdf& truth, std::size_t count, std::uint64_t seed, ErrorSpace es,
                           double max_theta_deg = 90);
+// The pairs draw_test_pairs() draws, all of them (before the truth's non-finite ones are left
+// out). Throws std::invalid_argument for a largest angle outside (0, 90].
+std::vector<DirPair<double>> test_pair_directions(std::size_t count, std::uint64_t seed,
+                                                  double max_theta_deg = 90);
 
 // The relative error of a reconstruction over the test pairs (header comment).
 double reconstruction_error(const Brdf& reconstruction, const TestPairs& test);

@@ -36,6 +36,8 @@ struct StudySettings {
   std::string fit_model, fit_loss;
   std::vector<std::size_t> fit_budgets;
   bool no_fit = false;
+  // --nielsen-counts (empty: the default); the database itself is StudyConfig::nielsen.
+  std::vector<std::size_t> nielsen_counts;
   std::vector<std::size_t> budgets, budgets_4d;
   std::size_t test_pairs = 0, image_budget = 0;
   int image_size = 0, image_spp = 0;

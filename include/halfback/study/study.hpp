@@ -21,6 +21,7 @@
 #include "halfback/study/gonio.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metrics.hpp"
+#include "halfback/study/nielsen.hpp"
 #include "halfback/study/table.hpp"
 
 namespace halfback::study {
@@ -92,6 +93,14 @@ struct StudyConfig {
   std::string fit_loss = "ngan";
   std::vector<std::size_t> fit_budgets{1000, 10000};
   std::size_t fit_samples = 20000;
+  // Nielsen et al. 2015's minimal sampling (nielsen.hpp; issue 33), with a database (none: no
+  // rows): rows of halfdiff's gonio table, design nielsen, at each of `nielsen_counts`
+  // measurements (ascending), isotropic BRDFs only, from the basis without the database's member
+  // like the BRDF (leave-one-out). `nielsen_from` names the database (nielsen_fingerprint) in the
+  // settings of a run, so that parts from other databases are never resumed or merged with these.
+  std::shared_ptr<const NielsenDatabase> nielsen;
+  std::vector<std::size_t> nielsen_counts{1, 2, 5, 10, 20, 40, 100};
+  std::string nielsen_from;
   // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.
   std::function<void(std::string_view stage)> progress;
 
