@@ -31,8 +31,9 @@ struct StudyOptions {
   std::vector<std::string> specs, merge;
   std::string out = "study";
   std::string budgets, budgets_4d, environments, params, sampler_kib, fit_budgets;
-  std::vector<std::string> nielsen_database;  // Nielsen et al.'s database: files, folders
+  std::string nielsen_database;  // Nielsen et al.'s database: files, folders, comma-separated
   std::string nielsen_counts;
+  double nielsen_eta = study::NielsenOptions{}.eta;
   std::string designs = "own,angle,merl,learned";
   study::StudySettings settings;
   bool resume = false;
@@ -271,7 +272,8 @@ std::vector<study::LabeledProfile> profile_pass(const std::vector<std::string>& 
 
 // Nielsen's database (--nielsen-database): its members loaded, their values at the candidate
 // configurations and at the study's test pairs (the same for every BRDF) computed once.
-void set_nielsen_database(study::StudyConfig& config, const std::vector<std::string>& specs) {
+void set_nielsen_database(study::StudyConfig& config, const std::vector<std::string>& specs,
+                          double eta) {
   if (std::find(config.params.begin(), config.params.end(), space_of<HalfDiff>) ==
       config.params.end())
     throw UsageError("--nielsen-database: its rows are halfdiff's; add halfdiff to --params");
@@ -283,6 +285,7 @@ void set_nielsen_database(study::StudyConfig& config, const std::vector<std::str
   study::NielsenOptions options;
   options.max_theta_deg = config.max_theta_deg;
   options.seed = config.seed;
+  options.eta = eta;
   try {
     config.nielsen = std::make_shared<study::NielsenDatabase>(
         std::move(members), options,
@@ -302,7 +305,10 @@ int run_study(StudyOptions& o) {
   const std::vector<std::string> specs = expand_specs(o.specs);
   create_output_directory(o.out);
   check_writable((std::filesystem::path(o.out) / "report.md").string());
-  if (!o.nielsen_database.empty()) set_nielsen_database(config, o.nielsen_database);
+  if (!o.nielsen_database.empty())
+    set_nielsen_database(config,
+                         split_list(o.nielsen_database, "--nielsen-database", "BRDF or folder"),
+                         o.nielsen_eta);
   std::vector<study::LabeledProfile> profiles;
   if (study::wants_learned(config)) {
     profiles = profile_pass(specs, o.out, config, o.resume);
@@ -421,13 +427,16 @@ Command register_study(CLI::App& parent) {
   app->add_flag("--no-fit", o->settings.no_fit, "No fit metric");
   app->add_option("--nielsen-database", o->nielsen_database,
                   "Nielsen et al. 2015's minimal sampling: the database of its principal "
-                  "components (isotropic BRDF files or folders, e.g. the MERL networks); each "
-                  "BRDF of the study that is one of them is left out of its own basis. Rows of "
-                  "halfdiff's gonio table, design nielsen (docs/acquisition.md)")
-      ->expected(1, -1);
+                  "components: isotropic BRDF files or folders, comma-separated (e.g. the folder "
+                  "of the MERL networks); each BRDF of the study that is one of them is left out "
+                  "of its own basis. Rows of halfdiff's gonio table, design nielsen "
+                  "(docs/acquisition.md)");
   app->add_option("--nielsen-counts", o->nielsen_counts,
                   "Measurement counts of Nielsen's design, ascending, comma-separated (default "
                   "1,2,5,10,20,40,100)");
+  app->add_option("--nielsen-eta", o->nielsen_eta,
+                  "Tikhonov weight of Nielsen's reconstruction (their release's example: 40)")
+      ->capture_default_str();
   app->add_flag("-q,--quiet", o->quiet, "Nothing on stdout (the report is in the output folder)");
   app->add_flag("--full-report", o->full_report,
                 "The whole report on stdout (by default: its summary and where the files are)");

@@ -177,23 +177,33 @@ AxisDemand axis_demand(const IsoSamples& s) {
     std::vector<double>& out = d.demand[axis];
     out.assign(n[axis], 0.0);
     const bool periodic = axis == 2;
+    // The cell k steps from p along the axis (wrapping around an azimuth), if it holds a value.
+    auto along = [&](std::size_t p, long k) -> std::optional<std::size_t> {
+      const std::size_t here = p / stride[axis] % n[axis];
+      const long i = long(here) + k, m = long(n[axis]);
+      if (!periodic && (i < 0 || i >= m)) return std::nullopt;
+      const std::size_t q = p - here * stride[axis] + std::size_t(((i % m) + m) % m) * stride[axis];
+      if (s.weight[q] <= 0) return std::nullopt;
+      return q;
+    };
     for (std::size_t p = 0; p < s.value.size(); ++p) {
       const std::size_t i = p / stride[axis] % n[axis];
       if (s.weight[p] <= 0 || n[axis] < 3) continue;
-      std::size_t lo = p - stride[axis], hi = p + stride[axis];
-      if (i == 0 || i + 1 == n[axis]) {
-        if (!periodic) continue;  // no second difference at a magnitude's end
-        lo = i == 0 ? p + (n[axis] - 1) * stride[axis] : lo;
-        hi = i + 1 == n[axis] ? p - (n[axis] - 1) * stride[axis] : hi;
-      }
-      if (s.weight[lo] <= 0 || s.weight[hi] <= 0) continue;  // across the domain's edge
-      const double second = s.value[lo] - 2 * s.value[p] + s.value[hi];
+      // The centred second difference, or at an end of the values along the axis (a magnitude's
+      // end, the domain's edge, the instrument's reach) the one-sided one from the two cells
+      // inside: an edge has as much curvature as the cells next to it, not none.
+      const auto lo = along(p, -1), hi = along(p, 1);
+      std::optional<std::size_t> far;
+      double second;
+      if (lo && hi)
+        second = s.value[*lo] - 2 * s.value[p] + s.value[*hi];
+      else if (hi && (far = along(p, 2)))
+        second = s.value[p] - 2 * s.value[*hi] + s.value[*far];
+      else if (lo && (far = along(p, -2)))
+        second = s.value[p] - 2 * s.value[*lo] + s.value[*far];
+      else
+        continue;
       out[i] += s.weight[p] * second * second;
-    }
-    // The ends of a magnitude take their neighbour's demand (no second difference there).
-    if (!periodic && n[axis] >= 3) {
-      out.front() = out[1];
-      out.back() = out[n[axis] - 2];
     }
     if (norm > 0)
       for (double& v : out) v /= norm;
@@ -211,13 +221,14 @@ DesignProfile design_profile(const Brdf& brdf, std::span<const Space> spaces, co
 namespace {
 
 // A strictly increasing CDF (n + 1 nodes) of the density ∝ (1 − share) D^(1/5)/mean + share.
-std::vector<double> cdf_of_demand(const std::vector<double>& demand) {
+std::vector<double> cdf_of_demand(const std::vector<double>& demand,
+                                  double uniform_share = kUniformShare) {
   const std::size_t n = demand.size();
   std::vector<double> rho(n);
   double mean = 0;
   for (std::size_t i = 0; i < n; ++i) mean += (rho[i] = std::pow(std::max(demand[i], 0.0), 0.2));
   mean /= double(n);
-  for (double& r : rho) r = mean > 0 ? (1 - kUniformShare) * r / mean + kUniformShare : 1.0;
+  for (double& r : rho) r = mean > 0 ? (1 - uniform_share) * r / mean + uniform_share : 1.0;
   std::vector<double> cdf(n + 1, 0.0);
   for (std::size_t i = 0; i < n; ++i) cdf[i + 1] = cdf[i] + rho[i];
   for (double& c : cdf) c /= cdf.back();
@@ -226,6 +237,19 @@ std::vector<double> cdf_of_demand(const std::vector<double>& demand) {
 }
 
 }  // namespace
+
+LearnedWarps warps_for_demand(const AxisDemand& demand, double uniform_share) {
+  if (!(uniform_share >= 0 && uniform_share <= 1))
+    throw std::invalid_argument("warps_for_demand: the uniform share must be in [0, 1]");
+  LearnedWarps w;
+  w.space = demand.space;
+  const GridSpec g = default_grid(demand.space, GridKind::isotropic, {1});
+  for (std::size_t axis = 0; axis < 3; ++axis)
+    w.axes[axis] =
+        AxisWarp::from_cdf(g.axes[axis].lo, g.axes[axis].hi,
+                           cdf_of_demand(demand.demand[axis], uniform_share));
+  return w;
+}
 
 std::vector<LearnedWarps> learn_warps(std::span<const DesignProfile> profiles,
                                       std::size_t held_out) {

@@ -25,6 +25,8 @@ std::string_view name_of(Design d) {
       return "dupuy-jakob";
     case Design::nielsen:
       return "nielsen";
+    case Design::sequential:
+      return "sequential";
   }
   return "?";
 }
@@ -104,6 +106,9 @@ GridSpec gonio_cells(const GonioSetup& s) {
   if (s.design == Design::dupuy_jakob)
     throw std::invalid_argument(
         "the dupuy-jakob design is export-rgl's acquisition (dupuy_jakob_design.hpp), not a grid");
+  if (s.design == Design::sequential)
+    throw std::invalid_argument(
+        "the sequential design is two grids, a pilot and the main stage (sequential_design.hpp)");
   if (s.design == Design::nielsen)
     throw std::invalid_argument(
         "the nielsen design is a database's principal components (nielsen.hpp), not a grid");

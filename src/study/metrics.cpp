@@ -151,8 +151,10 @@ std::vector<double> rank_errors(const Eigen::MatrixXd& m, const Eigen::MatrixXd&
 
 // The BRDF at the cell centres of a grid: values in the error space and dμ weights (0 outside
 // the domain, where the Jacobian is not finite, or where ρ is not finite: no data there).
-void sample_grid(const Brdf& brdf, const GridSpec& g, ErrorSpace es, std::vector<double>& value,
-                 std::vector<double>& weight) {
+// The grid's cells with `rho` (one value per cell, or one per pair of the domain when `brdf` is
+// given, evaluated here) as values in the error space and weights of the measure.
+void sample_grid(const Brdf* brdf, std::span<const Rgb> per_cell, const GridSpec& g, ErrorSpace es,
+                 std::vector<double>& value, std::vector<double>& weight) {
   const std::size_t n = g.points();
   std::vector<DirPair<double>> all(n);
   std::vector<std::uint8_t> ok(n);
@@ -166,7 +168,10 @@ void sample_grid(const Brdf& brdf, const GridSpec& g, ErrorSpace es, std::vector
       where.push_back(p);
     }
   std::vector<Rgb> rho(pairs.size());
-  brdf.eval_batch(pairs, rho);
+  if (brdf)
+    brdf->eval_batch(pairs, rho);
+  else
+    for (std::size_t k = 0; k < pairs.size(); ++k) rho[k] = per_cell[where[k]];
   value.assign(n, 0.0);
   weight.assign(n, 0.0);
   double cell = 1;
@@ -223,8 +228,22 @@ IsoSamples sample_isotropic(const Brdf& brdf, Space space, const IsoGrid& grid, 
   IsoSamples s;
   s.space = space;
   s.grid = grid;
-  sample_grid(brdf, default_grid(space, GridKind::isotropic, {grid.a, grid.b, grid.phi}), es,
+  sample_grid(&brdf, {}, default_grid(space, GridKind::isotropic, {grid.a, grid.b, grid.phi}), es,
               s.value, s.weight);
+  return s;
+}
+
+IsoSamples isotropic_samples_of(std::span<const Rgb> values, Space space, const IsoGrid& grid,
+                                ErrorSpace es) {
+  if (grid.a == 0 || grid.b == 0 || grid.phi == 0)
+    throw std::invalid_argument("study grid: every axis needs at least one cell");
+  if (values.size() != grid.a * grid.b * grid.phi)
+    throw std::invalid_argument("study grid: one value per cell");
+  IsoSamples s;
+  s.space = space;
+  s.grid = grid;
+  sample_grid(nullptr, values, default_grid(space, GridKind::isotropic, {grid.a, grid.b, grid.phi}),
+              es, s.value, s.weight);
   return s;
 }
 
@@ -235,7 +254,7 @@ FullSamples sample_full(const Brdf& brdf, Space space, const std::array<std::siz
   FullSamples s;
   s.space = space;
   s.counts = counts;
-  sample_grid(brdf, default_grid(space, GridKind::full, {counts.begin(), counts.end()}), es,
+  sample_grid(&brdf, {}, default_grid(space, GridKind::full, {counts.begin(), counts.end()}), es,
               s.value, s.weight);
   return s;
 }

@@ -105,7 +105,7 @@ namespace {
 std::vector<DesignKey> designs_measured(const std::vector<BrdfResult>& results, std::size_t ref) {
   std::vector<DesignKey> keys;
   for (Spacing spacing : kSpacings)
-    for (Design d : kDesigns) {
+    for (Design d : kGridDesigns) {
       bool any = false;
       for (const BrdfResult& b : results)
         for (Space s : b.params) {

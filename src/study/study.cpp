@@ -23,6 +23,7 @@
 #include "halfback/render/renderer.hpp"
 #include "halfback/render/sampling_metric.hpp"
 #include "halfback/study/dupuy_jakob_design.hpp"
+#include "halfback/study/sequential_design.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metric_tables.hpp"
 #include "material_spaces.hpp"
@@ -192,6 +193,7 @@ std::vector<GonioRun> gonio_runs(Space s, Space w, bool iso, const StudyConfig& 
   };
   if (own)
     for (Design d : kDesigns) add(Spacing::own, d);
+  if (own && iso) add(Spacing::own, Design::sequential);
   for (Spacing spacing : config.spacings)
     if (spacing != Spacing::own) add(spacing, Design::regular);
   // Dupuy & Jakob's own acquisition, in their parameterization (isotropic BRDFs: the export's).
@@ -455,6 +457,12 @@ BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyCon
             if (points[k].spacing == Spacing::own && points[k].design == run.setup.design)
               points.push_back({points[k].design, points[k].budget, points[k].samples,
                                 points[k].error, run.setup.spacing});
+          continue;
+        }
+        if (run.setup.design == Design::sequential) {
+          const SequentialAcquisition a = sequential_acquisition(brdf, run.setup, config.space);
+          points.push_back({Design::sequential, run.setup.budget, a.samples,
+                            reconstruction_error(*a.reconstruction, test), Spacing::own});
           continue;
         }
         if (run.setup.design == Design::dupuy_jakob) {

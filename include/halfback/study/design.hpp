@@ -100,5 +100,8 @@ DesignProfile design_profile(const Brdf& brdf, std::span<const Space> spaces, co
 // With no other profile the warps are the identity. The held-out profile is never read.
 std::vector<LearnedWarps> learn_warps(std::span<const DesignProfile> profiles,
                                       std::size_t held_out);
+// The warps of one demand by the same rule with a floor of `uniform_share` of the uniform density
+// (the sequential design's, from its pilot; learn_warps's floor is 1/5).
+LearnedWarps warps_for_demand(const AxisDemand& demand, double uniform_share);
 
 }  // namespace halfback::study

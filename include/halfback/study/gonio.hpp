@@ -60,10 +60,16 @@ namespace halfback::study {
 // "dupuy-jakob:per-material" parameterization only (its rows are that parameterization's), and
 // Nielsen et al. 2015's minimal sampling (`nielsen`, nielsen.hpp), rows of halfdiff (their
 // candidate configurations are MERL's bins) whose budget is the number of measurements.
-enum class Design { regular, stratified, dupuy_jakob, nielsen };
+// Between them, the sequential design (sequential_design.hpp): a pilot grid, then a grid in the
+// warps its values ask for; of every parameterization, isotropic form only.
+enum class Design { regular, stratified, sequential, dupuy_jakob, nielsen };
 inline constexpr std::array<Design, 2> kDesigns{Design::regular, Design::stratified};
-inline constexpr std::array<Design, 4> kAllDesigns{Design::regular, Design::stratified,
-                                                   Design::dupuy_jakob, Design::nielsen};
+// The designs of every parameterization (the grids and the sequential design).
+inline constexpr std::array<Design, 3> kGridDesigns{Design::regular, Design::stratified,
+                                                    Design::sequential};
+inline constexpr std::array<Design, 5> kAllDesigns{Design::regular, Design::stratified,
+                                                   Design::sequential, Design::dupuy_jakob,
+                                                   Design::nielsen};
 std::string_view name_of(Design d);
 // "regular", "stratified" or "dupuy-jakob"; nullopt for anything else.
 std::optional<Design> parse_design(std::string_view name);

@@ -19,6 +19,7 @@
 #include <array>
 #include <cstddef>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -52,6 +53,11 @@ struct IsoSamples {
 
 // Throws std::invalid_argument for Space::dirs or an empty grid.
 IsoSamples sample_isotropic(const Brdf& brdf, Space space, const IsoGrid& grid, ErrorSpace es);
+// The same from values measured at the cells' centres (values[p] at cell p, in the grid's order, φ
+// fastest): a value that is not finite is no measurement (weight 0). Throws std::invalid_argument
+// for an empty grid or a count of values other than its cells'.
+IsoSamples isotropic_samples_of(std::span<const Rgb> values, Space space, const IsoGrid& grid,
+                                ErrorSpace es);
 
 // Azimuthal dependence: the relative error of replacing the BRDF by its μ-weighted average over
 // the relative azimuth φ of the parameterization, ρ̄(a, b) = ∫ρ dμ(φ | a, b):
