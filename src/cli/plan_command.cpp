@@ -12,6 +12,8 @@
 
 #include "command.hpp"
 #include "halfback/study/acquisition.hpp"
+#include "halfback/util/format_error.hpp"
+#include "measurements.hpp"
 
 namespace halfback::cli {
 
@@ -20,6 +22,8 @@ namespace {
 struct PlanOptions {
   study::PlanSettings settings;
   std::string output;
+  // The sequential design's main stage: the pilot's sidecar and the values measured at its rows.
+  std::string pilot, pilot_measurements;
 };
 
 constexpr double kDeg = 180 / std::numbers::pi;
@@ -58,7 +62,25 @@ std::string plan_csv(const study::AcquisitionPlan& a) {
   return to_csv(header, columns);
 }
 
-int run_plan(const PlanOptions& o) {
+// The plan asked for: of a grid design; a sequential design's pilot; or, with --pilot, its main
+// stage from the pilot's measurements.
+study::AcquisitionPlan plan_asked(const PlanOptions& o) {
+  if (o.pilot.empty() != o.pilot_measurements.empty())
+    throw UsageError("--pilot and --pilot-measurements go together (the sequential design's "
+                     "main stage)");
+  if (!o.pilot.empty()) {
+    const study::AcquisitionPlan pilot = study::read_plan_sidecar(o.pilot);
+    if (!pilot.sequential || pilot.sequential->main)
+      throw UsageError(fmt::format(
+          "--pilot '{}': not the pilot of a sequential design (plan it with --design sequential)",
+          o.pilot));
+    std::size_t measured = 0;
+    const std::vector<Rgb> values =
+        read_measurements(o.pilot_measurements, pilot.measured.size(), measured);
+    if (measured == 0)
+      throw FormatError(o.pilot_measurements, "rows", "no row of the pilot was measured");
+    return study::sequential_main_plan(pilot, values);
+  }
   const study::GonioSetup setup = [&] {
     try {
       return study::plan_setup(o.settings);
@@ -66,6 +88,11 @@ int run_plan(const PlanOptions& o) {
       throw UsageError(fmt::format("--{}", e.what()));  // "--design 'x': expected ..."
     }
   }();
+  return setup.design == study::Design::sequential ? study::sequential_pilot_plan(setup)
+                                                   : study::acquisition_plan(setup);
+}
+
+int run_plan(const PlanOptions& o) {
   const std::filesystem::path csv(o.output);
   if (csv.extension() != ".csv")
     throw UsageError(
@@ -74,17 +101,25 @@ int run_plan(const PlanOptions& o) {
                     o.output));
   const std::filesystem::path json = std::filesystem::path(csv).replace_extension(".json");
   Output csv_out(csv.string()), json_out(json.string());  // both writable before any work
-  const study::AcquisitionPlan a = study::acquisition_plan(setup);
+  const study::AcquisitionPlan a = plan_asked(o);
+  const study::GonioSetup& setup = a.plan.setup;
   csv_out.write(plan_csv(a));
   json_out.write(study::plan_sidecar(a, csv.filename().string()));
   csv_out.commit();
   json_out.commit();
+  const std::string stage =
+      !a.sequential ? std::string()
+      : a.sequential->main
+          ? fmt::format(" (the main stage of a sequential design of {})", a.sequential->budget)
+          : fmt::format(" (the pilot of a sequential design of {}: measure it, then plan the "
+                        "main stage with --pilot {} --pilot-measurements VALUES.csv)",
+                        a.sequential->budget, json.string());
   fmt::print(stderr,
              "halfback plan: {} positions to measure for the {} points of the {} design of {} "
-             "spaced {} ({} fewer by reciprocity{}); motor travel {:.0f}° in this order, {:.0f}° "
+             "spaced {}{} ({} fewer by reciprocity{}); motor travel {:.0f}° in this order, {:.0f}° "
              "in the cells' order; {} and {}\n",
              a.measured.size(), a.plan.points.size(), study::name_of(setup.design),
-             name_of(setup.space), study::name_of(setup.spacing),
+             name_of(setup.space), study::name_of(setup.spacing), stage,
              a.plan.points.size() - a.measured.size(),
              setup.isotropic ? ", the light at azimuth 0 by isotropy" : "", a.travel * kDeg,
              a.cell_order_travel * kDeg, csv.string(), json.string());
@@ -100,9 +135,18 @@ Command register_plan(CLI::App& parent) {
   app->add_option("--param", o->settings.param, "Parameterization whose cells are measured")
       ->capture_default_str();
   app->add_option("--design", o->settings.design,
-                  "regular (cell centres) or stratified (a random point "
-                  "in each cell)")
+                  "regular (cell centres), stratified (a random point in each cell) or "
+                  "sequential (a pilot grid, then a grid where the pilot's values ask: this "
+                  "plans the pilot, --pilot the rest)")
       ->capture_default_str();
+  app->add_option("--pilot", o->pilot,
+                  "The sequential design's main stage: the pilot's PLAN.json (its setup is "
+                  "taken from there)")
+      ->type_name("FILE");
+  app->add_option("--pilot-measurements", o->pilot_measurements,
+                  "The values measured at the pilot's rows (as `halfback reconstruct "
+                  "--measurements` reads them)")
+      ->type_name("FILE");
   app->add_option("--spacing", o->settings.spacing,
                   "Spacing of the cells: own, angle or merl "
                   "(docs/study.md, Designs)")
@@ -125,8 +169,10 @@ Command register_plan(CLI::App& parent) {
       "degrees, and the directions). An isotropic plan turns every pair so that the light is at\n"
       "azimuth 0 and measures a pair and its swap (wo, wi) once. See docs/acquisition.md.\n"
       "\n"
-      "Example:\n"
-      "  halfback plan --param hybrid --budget 2000 --max-theta 85 -o plan.csv");
+      "Examples:\n"
+      "  halfback plan --param hybrid --budget 2000 --max-theta 85 -o plan.csv\n"
+      "  halfback plan --param halfdiff --design sequential --budget 10000 -o pilot.csv\n"
+      "  halfback plan --pilot pilot.json --pilot-measurements pilot-values.csv -o main.csv");
   return {app, [o] { return run_plan(*o); }};
 }
 

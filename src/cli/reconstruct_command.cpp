@@ -11,6 +11,7 @@
 #include <string>
 
 #include "command.hpp"
+#include "measurements.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl_writer.hpp"
 #include "halfback/study/acquisition.hpp"
@@ -23,47 +24,6 @@ namespace {
 struct ReconstructOptions {
   std::string plan, measurements, name, output;
 };
-
-// The measurements: a CSV with `row` and `r`, `g`, `b` (or one channel, `value`), a line per
-// measured row in any order; a row measured twice or out of the plan is a data error, a row
-// missing or NaN is not measured. Read a block of rows at a time (open_csv_input), as every CSV
-// input: memory bounded by the plan's rows, not by the file.
-std::vector<Rgb> read_measurements(const std::string& path, std::size_t rows,
-                                   std::size_t& measured) {
-  const std::unique_ptr<CsvStreamReader> in = open_csv_input(path);
-  const auto column = [&](std::string_view name) -> std::optional<std::size_t> {
-    for (std::size_t c = 0; c < in->header().size(); ++c)
-      if (in->header()[c] == name) return c;
-    return std::nullopt;
-  };
-  const auto row = column("row"), r = column("r"), g = column("g"), b = column("b"),
-             v = column("value");
-  if (!row || !((r && g && b) || v))
-    throw FormatError(path, "header", "expected the columns row and r, g, b (or row and value)");
-  std::vector<Rgb> values(rows, Rgb{NAN, NAN, NAN});
-  std::vector<std::uint8_t> seen(rows, 0);
-  measured = 0;
-  CsvTable t;
-  while (in->read_block(t, kBlockRows, {.allow_non_finite = true})) {
-    for (std::size_t k = 0; k < t.rows(); ++k) {
-      const double x = t.columns[*row][k];
-      if (!(x >= 0 && x < double(rows) && x == std::floor(x)))
-        throw FormatError(path, fmt::format("line {}", t.lines[k]),
-                          fmt::format("row {} is not a row of the plan (0 … {})", x, rows - 1));
-      const auto i = std::size_t(x);
-      if (seen[i]++)
-        throw FormatError(path, fmt::format("line {}", t.lines[k]),
-                          fmt::format("row {} is given twice", i));
-      const Rgb c = v ? Rgb{t.columns[*v][k], t.columns[*v][k], t.columns[*v][k]}
-                      : Rgb{t.columns[*r][k], t.columns[*g][k], t.columns[*b][k]};
-      if (std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b)) {
-        values[i] = c;
-        ++measured;
-      }
-    }
-  }
-  return values;
-}
 
 int run_reconstruct(const ReconstructOptions& o) {
   const std::filesystem::path out(o.output);

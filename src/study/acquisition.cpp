@@ -12,6 +12,7 @@
 #include <type_traits>
 
 #include "halfback/core/parameterization.hpp"
+#include "halfback/study/sequential_design.hpp"
 #include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
 
@@ -119,14 +120,15 @@ GonioSetup plan_setup(const PlanSettings& o) {
     throw std::invalid_argument(fmt::format("param '{}': expected a parameterization: {}", o.param,
                                             parameterization_names()));
   const auto design = parse_design(o.design);
-  if (!design || (*design != Design::regular && *design != Design::stratified))
-    throw std::invalid_argument(
-        fmt::format("design '{}': expected regular or stratified", o.design));
-  const auto spacing = parse_spacing(o.spacing);
-  if (!spacing || *spacing == Spacing::learned)
+  if (!design || *design == Design::dupuy_jakob || *design == Design::nielsen ||
+      (*design == Design::sequential && o.full))
     throw std::invalid_argument(fmt::format(
-        "spacing '{}': expected own, angle or merl (a learned spacing needs the profiles of a "
-        "study)",
+        "design '{}': expected regular, stratified or sequential (isotropic)", o.design));
+  const auto spacing = parse_spacing(o.spacing);
+  if (!spacing || (*spacing == Spacing::learned && (!o.learned || o.learned->space != *space)))
+    throw std::invalid_argument(fmt::format(
+        "spacing '{}': expected own, angle or merl (a learned spacing needs its warps: the "
+        "profiles of a study, or a sequential plan's pilot)",
         o.spacing));
   if (o.budget < 1 || o.budget > kMaxSampleBudget)
     throw std::invalid_argument(
@@ -140,6 +142,7 @@ GonioSetup plan_setup(const PlanSettings& o) {
   s.isotropic = !o.full;
   s.max_theta_deg = o.max_theta;
   s.seed = o.seed;
+  if (s.spacing == Spacing::learned) s.learned = o.learned;
   return s;
 }
 
@@ -153,6 +156,9 @@ double travel(const GonioPosition& a, const GonioPosition& b) {
 }
 
 AcquisitionPlan acquisition_plan(const GonioSetup& setup) {
+  if (setup.design == Design::sequential)
+    throw std::invalid_argument(
+        "the sequential design is two plans: sequential_pilot_plan, then sequential_main_plan");
   AcquisitionPlan out;
   out.plan = gonio_plan(setup);
   const bool iso = setup.isotropic;
@@ -187,6 +193,36 @@ AcquisitionPlan acquisition_plan(const GonioSetup& setup) {
   return out;
 }
 
+AcquisitionPlan sequential_pilot_plan(const GonioSetup& setup) {
+  AcquisitionPlan a = acquisition_plan(sequential_pilot(setup));
+  a.sequential = AcquisitionPlan::SequentialStage{setup.budget, false};
+  return a;
+}
+
+AcquisitionPlan sequential_main_plan(const AcquisitionPlan& pilot,
+                                     std::span<const Rgb> row_values) {
+  if (!pilot.sequential || pilot.sequential->main)
+    throw std::invalid_argument("the plan is not the pilot of a sequential design");
+  if (row_values.size() != pilot.measured.size())
+    throw std::invalid_argument(fmt::format("{} values for the {} rows of the pilot",
+                                            row_values.size(), pilot.measured.size()));
+  // The pilot's measurements are counted as the study counts them: by points (a row that two
+  // reciprocal points share counts twice), so that the main stage's budget is the study's.
+  std::vector<Rgb> values(pilot.plan.points.size());
+  std::size_t measured = 0;
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    const Rgb& v = values[k] = row_values[pilot.row_of_point[k]];
+    measured += std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b);
+  }
+  GonioSetup setup = pilot.plan.setup;
+  setup.design = Design::sequential;
+  setup.budget = pilot.sequential->budget;
+  AcquisitionPlan a = acquisition_plan(
+      sequential_main(setup, pilot_samples(pilot.plan, values, ErrorSpace::log), measured));
+  a.sequential = AcquisitionPlan::SequentialStage{setup.budget, true};
+  return a;
+}
+
 namespace {
 
 std::string_view warp_name(AxisWarp::Kind k) {
@@ -211,10 +247,8 @@ constexpr double kDegree = 180 / std::numbers::pi;
 
 std::string plan_sidecar(const AcquisitionPlan& a, std::string_view measurements) {
   const GonioSetup& s = a.plan.setup;
-  if (s.spacing == Spacing::learned)
-    throw std::invalid_argument(
-        "a plan of a learned spacing cannot be planned again from its "
-        "sidecar: use own, angle or merl");
+  if (s.spacing == Spacing::learned && !s.learned)
+    throw std::invalid_argument("a plan of the learned spacing without its warps");
   nlohmann::ordered_json j;
   j["format"] = "halfback-plan";
   j["version"] = 1;
@@ -239,6 +273,15 @@ std::string plan_sidecar(const AcquisitionPlan& a, std::string_view measurements
                           {"count", ax.count},
                           {"warp", std::string(warp_name(a.plan.warps[k].kind()))}});
   }
+  // The learned spacing's warps (a sequential main stage's): enough to plan it again.
+  if (s.spacing == Spacing::learned) {
+    j["learned_warps"] = nlohmann::ordered_json::array();
+    for (const AxisWarp& w : s.learned->axes)
+      j["learned_warps"].push_back({{"lo", w.lo()}, {"hi", w.hi()}, {"cdf", w.cdf()}});
+  }
+  if (a.sequential)
+    j["sequential"] = {{"budget", a.sequential->budget},
+                       {"stage", a.sequential->main ? "main" : "pilot"}};
   j["points"] = a.plan.points.size();
   j["rows"] = a.measured.size();
   j["travel_deg"] = {{"serpentine", a.travel * kDegree},
@@ -284,6 +327,58 @@ PlanSettings settings_from(const nlohmann::json& j, const std::string& file) {
   return o;
 }
 
+// The learned spacing's warps of a sidecar ("learned_warps": per axis lo, hi and the CDF's nodes).
+LearnedWarps learned_warps_of(const nlohmann::json& j, const PlanSettings& settings,
+                              const std::string& file) {
+  const auto it = j.find("learned_warps");
+  if (it == j.end() || !it->is_array() || it->size() != 3)
+    throw FormatError(file, "learned_warps", "missing, or not three axes");
+  const auto space = space_from_name(settings.param);
+  if (!space || space->is_dirs()) throw FormatError(file, "setup.param", "not a parameterization");
+  LearnedWarps w;
+  w.space = *space;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const nlohmann::json& axis = (*it)[k];
+    if (!axis.is_object()) throw FormatError(file, "learned_warps", "an axis is not an object");
+    const auto cdf = field<std::vector<double>>(axis, "cdf", file);
+    if (cdf.size() < 2 || cdf.size() > 4097)
+      throw FormatError(file, "learned_warps.cdf", "2 to 4097 nodes expected");
+    w.axes[k] = AxisWarp::from_cdf(field<double>(axis, "lo", file), field<double>(axis, "hi", file),
+                                   cdf);  // std::invalid_argument: not increasing from 0 to 1
+  }
+  return w;
+}
+
+// A sequential stage's "sequential" field, checked against the plan's setup: a pilot is the
+// sequential pilot of the design's budget, a main stage is of the learned spacing.
+std::optional<AcquisitionPlan::SequentialStage> sequential_stage_of(const nlohmann::json& j,
+                                                                    const GonioSetup& setup,
+                                                                    const std::string& file,
+                                                                    std::size_t max_budget) {
+  const auto it = j.find("sequential");
+  if (it == j.end()) return std::nullopt;
+  if (!it->is_object()) throw FormatError(file, "sequential", "not an object");
+  AcquisitionPlan::SequentialStage stage;
+  stage.budget = field<std::size_t>(*it, "budget", file);
+  const auto name = field<std::string>(*it, "stage", file);
+  if (name != "pilot" && name != "main")
+    throw FormatError(file, "sequential.stage", "expected pilot or main");
+  stage.main = name == "main";
+  if (stage.budget < 1 || stage.budget > max_budget)
+    throw FormatError(file, "sequential.budget", fmt::format("expected 1 to {}", max_budget));
+  GonioSetup whole = setup;
+  whole.design = Design::sequential;
+  whole.budget = stage.budget;
+  const bool fits = stage.main ? setup.spacing == Spacing::learned
+                               : setup.spacing == Spacing::own &&
+                                     setup.design == Design::regular &&
+                                     sequential_pilot(whole).budget == setup.budget;
+  if (!fits)
+    throw FormatError(file, "sequential",
+                      "the setup is not this stage of a sequential design (edited?)");
+  return stage;
+}
+
 AcquisitionPlan plan_of(const nlohmann::json& j, const std::string& file, std::size_t max_budget) {
   if (!j.is_object() || j.value("format", "") != "halfback-plan")
     throw FormatError(file, "format", "not a halfback plan (no \"format\": \"halfback-plan\")");
@@ -292,10 +387,12 @@ AcquisitionPlan plan_of(const nlohmann::json& j, const std::string& file, std::s
   const auto setup = j.find("setup");
   if (setup == j.end() || !setup->is_object()) throw FormatError(file, "setup", "missing");
   try {
-    const PlanSettings settings = settings_from(*setup, file);
+    PlanSettings settings = settings_from(*setup, file);
     if (settings.budget > max_budget)
       throw FormatError(file, "setup.budget", fmt::format("above {}", max_budget));
+    if (settings.spacing == "learned") settings.learned = learned_warps_of(j, settings, file);
     AcquisitionPlan a = acquisition_plan(plan_setup(settings));
+    a.sequential = sequential_stage_of(j, a.plan.setup, file, max_budget);
     if (field<std::size_t>(j, "points", file) != a.plan.points.size() ||
         field<std::size_t>(j, "rows", file) != a.measured.size() ||
         field<std::vector<std::size_t>>(j, "row_of_point", file) != a.row_of_point)

@@ -10,6 +10,8 @@
 #include <random>
 
 #include "halfback/models/analytic.hpp"
+#include "halfback/study/sequential_design.hpp"
+#include "halfback/util/format_error.hpp"
 
 namespace halfback::study {
 namespace {
@@ -109,6 +111,66 @@ TEST(AcquisitionPlan, ReconstructionFromTheRowsIsTheVirtualOne) {
   EXPECT_EQ(missing.samples(), virtual_one.samples() - 1);
   EXPECT_THROW(GonioReconstruction(a.plan, std::span(values).first(3), "lab"),
                std::invalid_argument);
+}
+
+// The sequential design through the instrument's two plans: the pilot measured at its rows, the
+// main stage planned from those values, measured and reconstructed, is the study's sequential
+// design (sequential_acquisition) to 1e-9.
+TEST(AcquisitionPlan, SequentialPlansAreTheStudysSequentialDesign) {
+  GonioSetup s;
+  s.space = space_of<HalfDiff>;
+  s.design = Design::sequential;
+  s.budget = 6000;
+  s.max_theta_deg = 85;
+  EXPECT_THROW(acquisition_plan(s), std::invalid_argument);
+  auto measure = [](const AcquisitionPlan& a) {
+    std::vector<Rgb> rows(a.measured.size());
+    truth().eval_batch(a.measured, rows);
+    return rows;
+  };
+  const AcquisitionPlan pilot = sequential_pilot_plan(s);
+  ASSERT_TRUE(pilot.sequential && !pilot.sequential->main);
+  const AcquisitionPlan main = sequential_main_plan(pilot, measure(pilot));
+  ASSERT_TRUE(main.sequential && main.sequential->main);
+  const GonioReconstruction lab = reconstruct(main, measure(main), "lab");
+  const SequentialAcquisition virtual_one = sequential_acquisition(truth(), s, ErrorSpace::log);
+  // The same warps (the rows' values are the points' up to the rounding of the isotropic turn).
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    const auto& x = main.plan.setup.learned->axes[axis].cdf();
+    const auto& y = virtual_one.warps.axes[axis].cdf();
+    ASSERT_EQ(x.size(), y.size());
+    for (std::size_t i = 0; i < x.size(); ++i) EXPECT_NEAR(x[i], y[i], 1e-12);
+  }
+  const TestPairs test = draw_test_pairs(truth(), 20000, 2, ErrorSpace::log, 85);
+  const double a = reconstruction_error(lab, test), b = reconstruction_error(*virtual_one.reconstruction, test);
+  EXPECT_NEAR(a, b, 1e-9 * b);
+  EXPECT_EQ(pilot.plan.points.size() + main.plan.points.size(), virtual_one.samples);
+
+  // Both sidecars plan again to the same rows; the main one carries its warps.
+  for (const AcquisitionPlan* p : {&pilot, &main}) {
+    const AcquisitionPlan back = parse_plan_sidecar(plan_sidecar(*p, "x.csv"), "p.json");
+    EXPECT_EQ(back.row_of_point, p->row_of_point);
+    ASSERT_TRUE(back.sequential);
+    EXPECT_EQ(back.sequential->main, p->sequential->main);
+    EXPECT_EQ(back.sequential->budget, 6000u);
+  }
+  EXPECT_EQ(*parse_plan_sidecar(plan_sidecar(main, "x.csv"), "p.json").plan.setup.learned,
+            *main.plan.setup.learned);
+  // Edited: a CDF that decreases, a pilot claimed for another budget, a main stage's stage.
+  std::string text = plan_sidecar(main, "x.csv");
+  const std::size_t cdf = text.find("\"cdf\":[0.0,") + 13;
+  ASSERT_NE(cdf, std::string::npos + 13) << text.substr(0, 400);
+  text.insert(cdf, "0.9,");
+  EXPECT_THROW(parse_plan_sidecar(text, "p.json"), FormatError);
+  std::string other = plan_sidecar(pilot, "x.csv");
+  other.replace(other.find("\"budget\":6000"), 13, "\"budget\":7000");
+  EXPECT_THROW(parse_plan_sidecar(other, "p.json"), FormatError);
+  std::string stage = plan_sidecar(main, "x.csv");
+  stage.replace(stage.find("\"stage\":\"main\""), 14, "\"stage\":\"pilot\"");
+  EXPECT_THROW(parse_plan_sidecar(stage, "p.json"), FormatError);
+  // The main stage from anything but a pilot, or from the wrong count of values.
+  EXPECT_THROW(sequential_main_plan(main, measure(main)), std::invalid_argument);
+  EXPECT_THROW(sequential_main_plan(pilot, std::vector<Rgb>(3)), std::invalid_argument);
 }
 
 }  // namespace

@@ -807,6 +807,61 @@ TEST_F(CliTest, ReconstructFromAPlansMeasurements) {
   EXPECT_FALSE(std::filesystem::exists(path("n.binary")));
 }
 
+// The sequential design for an instrument: the pilot's plan, its measurements, the main stage's
+// plan (with the warps in its sidecar), its measurements, the reconstruction.
+TEST_F(CliTest, SequentialPlanThroughItsTwoStages) {
+  Result r = run({"plan", "--param", "halfdiff", "--design", "sequential", "--budget", "3000",
+                  "-o", "pilot.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("the pilot of a sequential design of 3000"), std::string::npos) << r.err;
+  const double rho = 0.3 / std::numbers::pi;  // Lambert, albedo 0.3
+  auto lab = [&](const std::string& plan, const std::string& out) {
+    std::string text = "row,value\n";
+    for (std::size_t k = 0; k < parse(slurp(path(plan))).rows(); ++k)
+      text += std::to_string(k) + "," + std::to_string(rho) + "\n";
+    put(path(out), text);
+  };
+  lab("pilot.csv", "pv.csv");
+  r = run({"plan", "--pilot", "pilot.json", "--pilot-measurements", "pv.csv", "-o", "main.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string sidecar = slurp(path("main.json"));
+  EXPECT_NE(sidecar.find("\"learned_warps\""), std::string::npos);
+  EXPECT_NE(sidecar.find("\"stage\":\"main\""), std::string::npos);
+  lab("main.csv", "mv.csv");
+  r = run({"reconstruct", "--plan", "main.json", "--measurements", "mv.csv", "-o", "m.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run({"eval", "--brdf", "m.binary"},
+          std::string(kDirsHeader) + "0.6,0,0.8,-0.3,0.2,0.9327379\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NEAR(std::stod(r.out.substr(r.out.find('\n') + 1)), rho, 1e-6) << r.out;
+
+  // A pilot without its measurements, a plan that is no pilot, the pilot's rows twice, nothing
+  // measured: refused, nothing written.
+  ASSERT_EQ(run({"plan", "--budget", "500", "-o", "grid.csv"}).status, 0);
+  put(path("twice.csv"), "row,value\n1,0.1\n1,0.2\n");
+  put(path("none.csv"), "row,value\n1,nan\n");
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    std::string words;
+  };
+  for (const Case& c : std::vector<Case>{
+           {{"--pilot", "pilot.json"}, 2, "go together"},
+           {{"--pilot", "grid.json", "--pilot-measurements", "pv.csv"}, 2, "not the pilot"},
+           {{"--pilot", "main.json", "--pilot-measurements", "pv.csv"}, 2, "not the pilot"},
+           {{"--pilot", "pilot.json", "--pilot-measurements", "twice.csv"}, 1, "given twice"},
+           {{"--pilot", "pilot.json", "--pilot-measurements", "none.csv"}, 1, "no row"},
+           {{"--design", "sequential", "--full"}, 2, "sequential (isotropic)"}}) {
+    std::vector<std::string> args{"plan", "-o", "bad.csv"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    r = run(args);
+    EXPECT_EQ(r.status, c.status) << c.words << ": " << r.err;
+    EXPECT_NE(r.err.find(c.words), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(path("bad.csv"))) << c.words;
+    EXPECT_FALSE(std::filesystem::exists(path("bad.json"))) << c.words;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input
 // ---------------------------------------------------------------------------------------------

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -26,11 +27,13 @@ struct PlanSettings {
   bool full = false;  // the full (4D) form, for anisotropic materials
   double max_theta = 90;
   std::uint64_t seed = 1;
+  // The learned spacing's warps (a sequential plan's main stage, from its pilot's values).
+  std::optional<LearnedWarps> learned;
 };
 // The setup they describe. Throws std::invalid_argument naming the setting: a param that is no
-// parameterization, a design other than regular or stratified, a spacing other than own, angle
-// or merl (learned needs a study's profiles), a budget outside [1, kMaxSampleBudget], a reach
-// outside [1, 90] degrees.
+// parameterization, a design other than regular, stratified or sequential (isotropic), a spacing
+// other than own, angle or merl, or learned without warps of that parameterization, a budget
+// outside [1, kMaxSampleBudget], a reach outside [1, 90] degrees.
 GonioSetup plan_setup(const PlanSettings& settings);
 
 // An instrument's position, in radians: the spherical coordinates (θi, φi, θo, φo) of the pair.
@@ -53,6 +56,13 @@ struct AcquisitionPlan {
   // The motors' travel through `measured` in this order, and through the plan's points in the
   // order of its cells (before reciprocity and the isotropic turn).
   double travel = 0, cell_order_travel = 0;
+  // A stage of the sequential design (sequential_design.hpp): the design's whole budget, and
+  // whether this is its main stage (else its pilot). The plan itself is a grid (`plan.setup`).
+  struct SequentialStage {
+    std::size_t budget = 0;
+    bool main = false;
+  };
+  std::optional<SequentialStage> sequential;
 };
 
 // The plan of a setup for the instrument:
@@ -62,8 +72,16 @@ struct AcquisitionPlan {
 //     once: the one whose light is nearer the normal;
 //   * the order is a serpentine: the light's zenith in bands, the detector's azimuth in strips
 //     within a band, its zenith along a strip, each band and strip run back and forth.
-// Throws what gonio_plan() throws.
+// Throws what gonio_plan() throws (the sequential design is two plans: below).
 AcquisitionPlan acquisition_plan(const GonioSetup& setup);
+
+// The sequential design's stages for the instrument (docs/acquisition.md, "The sequential
+// design"): the pilot's plan, then the main stage's from the values measured at the pilot's rows
+// (row_values[r] at pilot.measured[r]; NaN: not measured), in the warps their second differences
+// ask for (error space log, the study's default). Throws std::invalid_argument for a setup that
+// is not sequential, a pilot that is not a sequential pilot, counts that differ.
+AcquisitionPlan sequential_pilot_plan(const GonioSetup& setup);
+AcquisitionPlan sequential_main_plan(const AcquisitionPlan& pilot, std::span<const Rgb> row_values);
 
 // The plan's sidecar, PLAN.json beside PLAN.csv (docs/acquisition.md, "Files"): the setup, the
 // cells and warps, the counts, the travel, and row_of_point. `measurements` names the CSV file.
