@@ -72,8 +72,8 @@ def published_fits(path):
 
 
 def plan(param="hybrid", design="regular", budget=10000, spacing="own", full=False, max_theta=90.0,
-         seed=1):
-    return _core.plan(param, design, budget, spacing, full, max_theta, seed)
+         seed=1, instrument="light-detector"):
+    return _core.plan(param, design, budget, spacing, full, max_theta, seed, instrument)
 
 
 def reconstruct(plan, values, out, name="measured"):

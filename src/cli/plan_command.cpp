@@ -24,32 +24,26 @@ struct PlanOptions {
   std::string output;
   // The sequential design's main stage: the pilot's sidecar and the values measured at its rows.
   std::string pilot, pilot_measurements;
+  std::string instrument = "light-detector";
 };
 
 constexpr double kDeg = 180 / std::numbers::pi;
 
 // The rows to measure: their index, the motors' angles in degrees and the directions.
 std::string plan_csv(const study::AcquisitionPlan& a) {
-  const std::vector<std::string> header{"row",
-                                        "light_theta_deg",
-                                        "light_phi_deg",
-                                        "detector_theta_deg",
-                                        "detector_phi_deg",
-                                        "wi_x",
-                                        "wi_y",
-                                        "wi_z",
-                                        "wo_x",
-                                        "wo_y",
-                                        "wo_z"};
+  std::vector<std::string> header{"row"};
+  for (std::string_view motor : study::motor_names(a.instrument))
+    header.push_back(std::string(motor) + "_deg");
+  for (const char* c : {"wi_x", "wi_y", "wi_z", "wo_x", "wo_y", "wo_z"}) header.emplace_back(c);
   std::vector<std::vector<double>> c(header.size(), std::vector<double>(a.measured.size()));
   for (std::size_t r = 0; r < a.measured.size(); ++r) {
     const study::GonioPosition& g = a.positions[r];
     const DirPair<double>& p = a.measured[r];
     const double row[] = {double(r),
-                          g.light_theta * kDeg,
-                          g.light_phi * kDeg,
-                          g.detector_theta * kDeg,
-                          g.detector_phi * kDeg,
+                          g.angle[0] * kDeg,
+                          g.angle[1] * kDeg,
+                          g.angle[2] * kDeg,
+                          g.angle[3] * kDeg,
                           p.wi.x,
                           p.wi.y,
                           p.wi.z,
@@ -88,8 +82,13 @@ study::AcquisitionPlan plan_asked(const PlanOptions& o) {
       throw UsageError(fmt::format("--{}", e.what()));  // "--design 'x': expected ..."
     }
   }();
-  return setup.design == study::Design::sequential ? study::sequential_pilot_plan(setup)
-                                                   : study::acquisition_plan(setup);
+  const auto instrument = study::parse_instrument(o.instrument);
+  if (!instrument)
+    throw UsageError(fmt::format("--instrument '{}': expected light-detector or sample-turning",
+                                 o.instrument));
+  return setup.design == study::Design::sequential
+             ? study::sequential_pilot_plan(setup, *instrument)
+             : study::acquisition_plan(setup, *instrument);
 }
 
 int run_plan(const PlanOptions& o) {
@@ -138,6 +137,12 @@ Command register_plan(CLI::App& parent) {
                   "regular (cell centres), stratified (a random point in each cell) or "
                   "sequential (a pilot grid, then a grid where the pilot's values ask: this "
                   "plans the pilot, --pilot the rest)")
+      ->capture_default_str();
+  app->add_option("--instrument", o->instrument,
+                  "light-detector (the sample fixed, the light and the detector on arms) or "
+                  "sample-turning (the light fixed, the sample tilted and spun, the detector on "
+                  "an arm): the motors' angles in the CSV, the order and the travel "
+                  "(docs/acquisition.md)")
       ->capture_default_str();
   app->add_option("--pilot", o->pilot,
                   "The sequential design's main stage: the pilot's PLAN.json (its setup is "

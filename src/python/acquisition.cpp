@@ -21,14 +21,21 @@ namespace {
 constexpr double kDeg = 180 / std::numbers::pi;
 
 py::dict plan(const std::string& param, const std::string& design, std::size_t budget,
-              const std::string& spacing, bool full, double max_theta, std::uint64_t seed) {
+              const std::string& spacing, bool full, double max_theta, std::uint64_t seed,
+              const std::string& instrument_name) {
   // plan_setup's std::invalid_argument reaches Python as a ValueError naming the setting.
   const study::GonioSetup s =
-      study::plan_setup({param, design, spacing, budget, full, max_theta, seed});
+      study::plan_setup({param, design, spacing, budget, full, max_theta, seed, std::nullopt});
+  const auto instrument = study::parse_instrument(instrument_name);
+  if (!instrument)
+    throw py::value_error("instrument '" + instrument_name +
+                          "': expected light-detector or sample-turning");
   study::AcquisitionPlan a;
   {
     py::gil_scoped_release release;
-    a = study::acquisition_plan(s);
+    // A sequential design's plan is its pilot (the main stage needs the pilot's values).
+    a = s.design == study::Design::sequential ? study::sequential_pilot_plan(s, *instrument)
+                                              : study::acquisition_plan(s, *instrument);
   }
   const auto rows = py::ssize_t(a.measured.size());
   py::array_t<double> positions({rows, py::ssize_t(4)}), wi({rows, py::ssize_t(3)}),
@@ -39,15 +46,15 @@ py::dict plan(const std::string& param, const std::string& design, std::size_t b
   for (py::ssize_t r = 0; r < rows; ++r) {
     const study::GonioPosition& g = a.positions[std::size_t(r)];
     const DirPair<double>& d = a.measured[std::size_t(r)];
-    p(r, 0) = g.light_theta * kDeg;
-    p(r, 1) = g.light_phi * kDeg;
-    p(r, 2) = g.detector_theta * kDeg;
-    p(r, 3) = g.detector_phi * kDeg;
+    for (py::ssize_t m = 0; m < 4; ++m) p(r, m) = g.angle[std::size_t(m)] * kDeg;
     i(r, 0) = d.wi.x, i(r, 1) = d.wi.y, i(r, 2) = d.wi.z;
     o(r, 0) = d.wo.x, o(r, 1) = d.wo.y, o(r, 2) = d.wo.z;
   }
   py::dict out;
   out["positions_deg"] = positions;
+  py::list motors;
+  for (std::string_view name : study::motor_names(a.instrument)) motors.append(std::string(name));
+  out["motors"] = motors;
   out["wi"] = wi;
   out["wo"] = wo;
   out["row_of_point"] =
@@ -104,12 +111,14 @@ void bind_acquisition(py::module_& m) {
   m.def(
       "plan", &plan, py::arg("param") = "hybrid", py::arg("design") = "regular",
       py::arg("budget") = 10000, py::arg("spacing") = "own", py::arg("full") = false,
-      py::arg("max_theta") = 90.0, py::arg("seed") = 1,
-      R"doc(The measurement plan of a design for a four-axis gonio-reflectometer, as `halfback plan`
-(docs/acquisition.md): a dict of positions_deg (rows x 4: light zenith, light azimuth, detector
-zenith, detector azimuth, degrees), wi and wo (rows x 3), row_of_point (the row each point of the
-design takes), travel_deg and cell_order_travel_deg, and sidecar (the JSON text that
-reconstruct() reads; save it beside your measurements).)doc");
+      py::arg("max_theta") = 90.0, py::arg("seed") = 1, py::arg("instrument") = "light-detector",
+      R"doc(The measurement plan of a design for a gonio-reflectometer, as `halfback plan`
+(docs/acquisition.md): a dict of positions_deg (rows x 4, degrees: the motors named in motors,
+light zenith, light azimuth, detector zenith, detector azimuth for the light-detector instrument;
+sample tilt, sample spin, detector zenith and azimuth about the light for the sample-turning
+one), wi and wo (rows x 3), row_of_point (the row each point of the design takes), travel_deg and
+cell_order_travel_deg, and sidecar (the JSON text that reconstruct() reads; save it beside your
+measurements). The sequential design's plan is its pilot.)doc");
   m.def("_reconstruct", &reconstruct, py::arg("plan"), py::arg("values"), py::arg("out"),
         py::arg("name"));
 }

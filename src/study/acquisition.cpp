@@ -47,21 +47,23 @@ DirPair<double> light_at_azimuth_zero(const DirPair<double>& p) {
 DirPair<double> reciprocal_representative(const DirPair<double>& p, bool isotropic) {
   DirPair<double> swap{p.wo, p.wi};
   if (isotropic) swap = light_at_azimuth_zero(swap);
-  const GonioPosition a = position_of(p), b = position_of(swap);
-  if (std::abs(a.light_theta - b.light_theta) > kSameAngle)
-    return a.light_theta < b.light_theta ? p : swap;
-  if (std::abs(a.light_phi - b.light_phi) > kSameAngle) return a.light_phi < b.light_phi ? p : swap;
-  return a.detector_phi <= b.detector_phi ? p : swap;
+  const auto& a = position_of(p).angle;  // θi, φi, θo, φo
+  const auto& b = position_of(swap).angle;
+  if (std::abs(a[0] - b[0]) > kSameAngle) return a[0] < b[0] ? p : swap;
+  if (std::abs(a[1] - b[1]) > kSameAngle) return a[1] < b[1] ? p : swap;
+  return a[3] <= b[3] ? p : swap;
 }
 
 // The configuration's angles on a lattice of kSameAngle, to find repeats.
 std::array<long long, 4> key_of(const GonioPosition& g) {
   const auto q = [](double x) { return std::llround(x / kSameAngle); };
-  return {q(g.light_theta), q(g.light_phi), q(g.detector_theta), q(g.detector_phi)};
+  return {q(g.angle[0]), q(g.angle[1]), q(g.angle[2]), q(g.angle[3])};
 }
 
 // The serpentine order of positions: per level a bin (the last level's value itself), each level
-// run forwards or backwards by the parity of the bins above it.
+// run forwards or backwards by the parity of the bins above it. Levels: angle 0 (the light's
+// zenith, the tilt) in bands, angle 1 (the light's azimuth, the spin; not for an isotropic plan,
+// where it is constant), angle 3 (the detector's azimuth) in strips, angle 2 along a strip.
 std::vector<std::size_t> serpentine(const std::vector<GonioPosition>& positions, bool isotropic) {
   const std::size_t n = positions.size();
   const std::size_t levels = isotropic ? 3 : 4;
@@ -76,11 +78,11 @@ std::vector<std::size_t> serpentine(const std::vector<GonioPosition>& positions,
   };
   std::vector<Key> keys(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const GonioPosition& g = positions[k];
-    std::array<double, 4> v{g.light_theta, g.light_phi, g.detector_phi, g.detector_theta};
+    const auto& a = positions[k].angle;
+    std::array<double, 4> v{a[0], a[1], a[3], a[2]};
     std::array<double, 4> range{kRightAngle, kFullTurn, kFullTurn, kRightAngle};
-    if (isotropic) {  // no light azimuth: θl, φv, θv
-      v = {g.light_theta, g.detector_phi, g.detector_theta, 0};
+    if (isotropic) {  // angle 1 constant
+      v = {a[0], a[3], a[2], 0};
       range = {kRightAngle, kFullTurn, kRightAngle, 1};
     }
     std::size_t parity = 0;
@@ -108,9 +110,62 @@ double path_travel(const std::vector<GonioPosition>& path) {
 
 }  // namespace
 
-GonioPosition position_of(const DirPair<double>& p) {
+std::string_view name_of(Instrument instrument) {
+  return instrument == Instrument::sample_turning ? "sample-turning" : "light-detector";
+}
+
+std::optional<Instrument> parse_instrument(std::string_view name) {
+  for (Instrument i : {Instrument::light_detector, Instrument::sample_turning})
+    if (name_of(i) == name) return i;
+  return std::nullopt;
+}
+
+std::array<std::string_view, 4> motor_names(Instrument instrument) {
+  if (instrument == Instrument::sample_turning)
+    return {"sample_tilt", "sample_spin", "detector_zenith", "detector_azimuth"};
+  return {"light_theta", "light_phi", "detector_theta", "detector_phi"};
+}
+
+namespace {
+
+// The sample-turning instrument's stage (docs/acquisition.md, "The instrument"): sample → lab is
+// R = R_y(−tilt) R_z(spin); R ωi is the light, +z in the laboratory.
+Vec3<double> stage_to_lab(const Vec3<double>& v, double tilt, double spin) {
+  const Vec3<double> s = detail::rotate_z(v, std::cos(spin), std::sin(spin));
+  const double c = std::cos(tilt), n = std::sin(tilt);
+  return {s.x * c - s.z * n, s.y, s.x * n + s.z * c};
+}
+Vec3<double> lab_to_stage(const Vec3<double>& v, double tilt, double spin) {
+  const double c = std::cos(tilt), n = std::sin(tilt);
+  const Vec3<double> s{v.x * c + v.z * n, v.y, -v.x * n + v.z * c};
+  return detail::rotate_z(s, std::cos(spin), -std::sin(spin));
+}
+
+double wrapped(double phi) {  // into [0, 2π)
+  phi = std::fmod(phi, kFullTurn);
+  return phi < 0 ? phi + kFullTurn : phi;
+}
+
+}  // namespace
+
+GonioPosition position_of(const DirPair<double>& p, Instrument instrument) {
   const Tuple4<double> q = Spherical::forward(p);  // (θi, φi, θo, φo), azimuths in [0, 2π)
-  return {q[0], q[1], q[2], q[3]};
+  if (instrument == Instrument::light_detector) return {{q[0], q[1], q[2], q[3]}};
+  const double tilt = q[0], spin = p.wi.x == 0 && p.wi.y == 0 ? 0.0 : wrapped(-q[1]);
+  const Vec3<double> d = stage_to_lab(p.wo, tilt, spin);
+  const double zenith = std::atan2(std::hypot(d.x, d.y), d.z);
+  const double azimuth = d.x == 0 && d.y == 0 ? 0.0 : wrapped(std::atan2(d.y, d.x));
+  return {{tilt, spin, zenith, azimuth}};
+}
+
+DirPair<double> pair_at(const GonioPosition& g, Instrument instrument) {
+  const auto& a = g.angle;
+  auto dir = [](double theta, double phi) {
+    return Vec3<double>{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                        std::cos(theta)};
+  };
+  if (instrument == Instrument::light_detector) return {dir(a[0], a[1]), dir(a[2], a[3])};
+  return {lab_to_stage({0, 0, 1}, a[0], a[1]), lab_to_stage(dir(a[2], a[3]), a[0], a[1])};
 }
 
 GonioSetup plan_setup(const PlanSettings& o) {
@@ -151,15 +206,16 @@ double travel(const GonioPosition& a, const GonioPosition& b) {
     const double d = std::abs(x - y);
     return std::min(d, kFullTurn - d);
   };
-  return std::abs(a.light_theta - b.light_theta) + around(a.light_phi, b.light_phi) +
-         std::abs(a.detector_theta - b.detector_theta) + around(a.detector_phi, b.detector_phi);
+  return std::abs(a.angle[0] - b.angle[0]) + around(a.angle[1], b.angle[1]) +
+         std::abs(a.angle[2] - b.angle[2]) + around(a.angle[3], b.angle[3]);
 }
 
-AcquisitionPlan acquisition_plan(const GonioSetup& setup) {
+AcquisitionPlan acquisition_plan(const GonioSetup& setup, Instrument instrument) {
   if (setup.design == Design::sequential)
     throw std::invalid_argument(
         "the sequential design is two plans: sequential_pilot_plan, then sequential_main_plan");
   AcquisitionPlan out;
+  out.instrument = instrument;
   out.plan = gonio_plan(setup);
   const bool iso = setup.isotropic;
   // Each point's configuration, once: the first point of a configuration adds a row.
@@ -169,14 +225,14 @@ AcquisitionPlan acquisition_plan(const GonioSetup& setup) {
   out.row_of_point.resize(out.plan.points.size());
   for (std::size_t k = 0; k < out.plan.points.size(); ++k) {
     const DirPair<double>& pair = out.plan.points[k].pair;
-    cell_order.push_back(position_of(pair));
+    cell_order.push_back(position_of(pair, instrument));
     const DirPair<double> p =
         reciprocal_representative(iso ? light_at_azimuth_zero(pair) : pair, iso);
-    const GonioPosition g = position_of(p);
-    const auto [it, fresh] = row_of_key.try_emplace(key_of(g), rows.size());
+    // The configuration is the same whatever the instrument: repeats are found by (θi, φi, θo, φo).
+    const auto [it, fresh] = row_of_key.try_emplace(key_of(position_of(p)), rows.size());
     if (fresh) {
       rows.push_back(p);
-      positions.push_back(g);
+      positions.push_back(position_of(p, instrument));
     }
     out.row_of_point[k] = it->second;
   }
@@ -193,8 +249,8 @@ AcquisitionPlan acquisition_plan(const GonioSetup& setup) {
   return out;
 }
 
-AcquisitionPlan sequential_pilot_plan(const GonioSetup& setup) {
-  AcquisitionPlan a = acquisition_plan(sequential_pilot(setup));
+AcquisitionPlan sequential_pilot_plan(const GonioSetup& setup, Instrument instrument) {
+  AcquisitionPlan a = acquisition_plan(sequential_pilot(setup), instrument);
   a.sequential = AcquisitionPlan::SequentialStage{setup.budget, false};
   return a;
 }
@@ -218,7 +274,8 @@ AcquisitionPlan sequential_main_plan(const AcquisitionPlan& pilot,
   setup.design = Design::sequential;
   setup.budget = pilot.sequential->budget;
   AcquisitionPlan a = acquisition_plan(
-      sequential_main(setup, pilot_samples(pilot.plan, values, ErrorSpace::log), measured));
+      sequential_main(setup, pilot_samples(pilot.plan, values, ErrorSpace::log), measured),
+      pilot.instrument);
   a.sequential = AcquisitionPlan::SequentialStage{setup.budget, true};
   return a;
 }
@@ -253,10 +310,15 @@ std::string plan_sidecar(const AcquisitionPlan& a, std::string_view measurements
   j["format"] = "halfback-plan";
   j["version"] = 1;
   j["measurements"] = std::string(measurements);
-  j["instrument"] =
-      "four-axis light/detector gonio-reflectometer, the sample fixed: the light along wi at "
-      "(light_theta, light_phi), the detector along wo at (detector_theta, detector_phi), degrees "
-      "from the normal and about it";
+  j["instrument"] = std::string(name_of(a.instrument));
+  j["instrument_motors"] = a.instrument == Instrument::light_detector
+                               ? "the sample fixed: the light along wi at (light_theta, "
+                                 "light_phi), the detector along wo at (detector_theta, "
+                                 "detector_phi), degrees from the sample's normal and about it"
+                               : "the light fixed: the sample spun about its normal by "
+                                 "sample_spin, then tilted by sample_tilt so that wi points at "
+                                 "the light; the detector at detector_zenith from the light and "
+                                 "detector_azimuth about it (docs/acquisition.md)";
   j["setup"] = {{"param", std::string(name_of(s.space))},
                 {"isotropic", s.isotropic},
                 {"design", std::string(name_of(s.design))},
@@ -327,6 +389,15 @@ PlanSettings settings_from(const nlohmann::json& j, const std::string& file) {
   return o;
 }
 
+// The sidecar's instrument; plans written before there were two hold a description of the
+// light/detector one there.
+Instrument instrument_of(const nlohmann::json& j, const std::string& file) {
+  const auto name = field<std::string>(j, "instrument", file);
+  if (const auto i = parse_instrument(name)) return *i;
+  if (name.starts_with("four-axis light/detector")) return Instrument::light_detector;
+  throw FormatError(file, "instrument", "expected light-detector or sample-turning");
+}
+
 // The learned spacing's warps of a sidecar ("learned_warps": per axis lo, hi and the CDF's nodes).
 LearnedWarps learned_warps_of(const nlohmann::json& j, const PlanSettings& settings,
                               const std::string& file) {
@@ -391,7 +462,7 @@ AcquisitionPlan plan_of(const nlohmann::json& j, const std::string& file, std::s
     if (settings.budget > max_budget)
       throw FormatError(file, "setup.budget", fmt::format("above {}", max_budget));
     if (settings.spacing == "learned") settings.learned = learned_warps_of(j, settings, file);
-    AcquisitionPlan a = acquisition_plan(plan_setup(settings));
+    AcquisitionPlan a = acquisition_plan(plan_setup(settings), instrument_of(j, file));
     a.sequential = sequential_stage_of(j, a.plan.setup, file, max_budget);
     if (field<std::size_t>(j, "points", file) != a.plan.points.size() ||
         field<std::size_t>(j, "rows", file) != a.measured.size() ||

@@ -45,8 +45,8 @@ TEST(AcquisitionPlan, EveryPointIsItsRowsConfiguration) {
         // The same zeniths (or swapped) and the same angle between the directions.
         const double ti = std::acos(std::clamp(p.wi.z, -1.0, 1.0)),
                      to = std::acos(std::clamp(p.wo.z, -1.0, 1.0));
-        const double mi = a.positions[a.row_of_point[k]].light_theta,
-                     mo = a.positions[a.row_of_point[k]].detector_theta;
+        const double mi = a.positions[a.row_of_point[k]].angle[0],  // θl
+                     mo = a.positions[a.row_of_point[k]].angle[2];  // θv
         const bool same = std::abs(ti - mi) < 1e-7 && std::abs(to - mo) < 1e-7;
         const bool swapped = std::abs(ti - mo) < 1e-7 && std::abs(to - mi) < 1e-7;
         ASSERT_TRUE(same || swapped) << name_of(space) << " point " << k;
@@ -59,12 +59,55 @@ TEST(AcquisitionPlan, EveryPointIsItsRowsConfiguration) {
       }
       for (const GonioPosition& g : a.positions) {
         if (iso) {
-          EXPECT_EQ(g.light_phi, 0.0);  // a three-axis instrument suffices
+          EXPECT_EQ(g.angle[1], 0.0);  // φl = 0: a three-axis instrument suffices
         }
-        EXPECT_LE(g.light_theta, g.detector_theta + 1e-9);  // the swap nearer the normal
+        EXPECT_LE(g.angle[0], g.angle[2] + 1e-9);  // the swap nearer the normal
       }
     }
   }
+}
+
+// Both instruments' motor angles map back to the pair to 1e-12, on random pairs and on a plan's
+// rows; the sample-turning instrument's angles are what its geometry says.
+TEST(AcquisitionPlan, MotorAnglesMapBackToThePair) {
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto dir = [&] {
+    const double t = 1.5 * u(rng), f = 6.283185307179586 * u(rng);
+    return Vec3<double>{std::sin(t) * std::cos(f), std::sin(t) * std::sin(f), std::cos(t)};
+  };
+  auto expect_same = [](const DirPair<double>& a, const DirPair<double>& b, const char* what) {
+    const double d = std::abs(a.wi.x - b.wi.x) + std::abs(a.wi.y - b.wi.y) +
+                     std::abs(a.wi.z - b.wi.z) + std::abs(a.wo.x - b.wo.x) +
+                     std::abs(a.wo.y - b.wo.y) + std::abs(a.wo.z - b.wo.z);
+    EXPECT_LT(d, 1e-12) << what;
+  };
+  for (Instrument instrument : {Instrument::light_detector, Instrument::sample_turning}) {
+    for (int k = 0; k < 2000; ++k) {
+      const DirPair<double> p{dir(), dir()};
+      expect_same(pair_at(position_of(p, instrument), instrument), p, "random pair");
+    }
+    GonioSetup s;
+    s.space = space_of<Hybrid>;
+    s.budget = 3000;
+    const AcquisitionPlan a = acquisition_plan(s, instrument);
+    EXPECT_EQ(a.instrument, instrument);
+    for (std::size_t r = 0; r < a.measured.size(); ++r)
+      expect_same(pair_at(a.positions[r], instrument), a.measured[r], "a plan's row");
+    EXPECT_LT(a.travel, 0.6 * a.cell_order_travel) << name_of(instrument);
+  }
+  // The sample tilted by θi, its spin bringing ωi into the tilt's plane; the detector at the
+  // angle between the directions from the light; the mirror direction at 2θi, azimuth 180°.
+  const double t = 0.4, f = 1.1;
+  const Vec3<double> wi{std::sin(t) * std::cos(f), std::sin(t) * std::sin(f), std::cos(t)};
+  const Vec3<double> mirror{-wi.x, -wi.y, wi.z};
+  const auto g = position_of({wi, mirror}, Instrument::sample_turning).angle;
+  EXPECT_NEAR(g[0], t, 1e-12);
+  EXPECT_NEAR(g[1], 2 * 3.141592653589793 - f, 1e-12);
+  EXPECT_NEAR(g[2], 2 * t, 1e-12);
+  EXPECT_NEAR(g[3], 3.141592653589793, 1e-12);
+  EXPECT_EQ(parse_instrument("sample-turning"), Instrument::sample_turning);
+  EXPECT_EQ(parse_instrument("turntable"), std::nullopt);
 }
 
 // Reciprocity halves a halfdiff plan (φd and φd + π are each other's swap); the serpentine order

@@ -739,8 +739,22 @@ TEST_F(CliTest, PlanWritesPositionsAndItsSidecar) {
       << json.substr(0, 600);
   EXPECT_NE(json.find("\"row_of_point\":["), std::string::npos);
   EXPECT_NE(r.err.find("fewer by reciprocity"), std::string::npos) << r.err;
+  // The sample-turning instrument: its motors in the columns, the same rows; the tilt is θi.
+  r = run({"plan", "--param", "halfdiff", "--budget", "500", "--instrument", "sample-turning",
+           "-o", "s.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const CsvTable st = parse(slurp(path("s.csv")));
+  EXPECT_EQ(st.header[1], "sample_tilt_deg");
+  EXPECT_EQ(st.header[3], "detector_zenith_deg");
+  EXPECT_EQ(st.rows(), t.rows());
+  for (std::size_t k = 0; k < st.rows(); ++k)
+    EXPECT_NEAR(std::acos(st.columns[7][k]) * 180 / std::numbers::pi, st.columns[1][k], 1e-6);
+  EXPECT_NE(slurp(path("s.json")).find("\"instrument\":\"sample-turning\""), std::string::npos);
+  std::filesystem::remove(path("s.csv"));
+  std::filesystem::remove(path("s.json"));
   for (const auto& args :
        std::vector<std::vector<std::string>>{{"plan", "--param", "dirs", "-o", "q.csv"},
+                                             {"plan", "--instrument", "turntable", "-o", "q.csv"},
                                              {"plan", "--design", "sobol", "-o", "q.csv"},
                                              {"plan", "--spacing", "learned", "-o", "q.csv"},
                                              {"plan", "--max-theta", "0", "-o", "q.csv"},

@@ -120,6 +120,15 @@ def test_plan_and_reconstruct(tmp_path):
         halfback.reconstruct(p["sidecar"], values[:5], tmp_path / "x.binary")
     with pytest.raises(ValueError, match="design 'sobol'"):
         halfback.plan(design="sobol")
+    # The sample-turning instrument: the same rows, its motors; the tilt is θi.
+    s = halfback.plan("halfdiff", budget=400, max_theta=85, instrument="sample-turning")
+    assert s["motors"] == ["sample_tilt", "sample_spin", "detector_zenith", "detector_azimuth"]
+    assert s["positions_deg"].shape == p["positions_deg"].shape
+    assert np.allclose(s["positions_deg"][:, 0], np.degrees(np.arccos(s["wi"][:, 2])))
+    with pytest.raises(ValueError, match="instrument 'turntable'"):
+        halfback.plan(instrument="turntable")
+    # A sequential design's plan is its pilot: about a quarter of the budget.
+    assert len(halfback.plan("halfdiff", design="sequential", budget=4000)["row_of_point"]) < 1500
     with pytest.raises(RuntimeError, match="row_of_point"):
         halfback.reconstruct(p["sidecar"].replace('"param":"halfdiff"', '"param":"hybrid"'), values,
                              tmp_path / "y.binary")

@@ -7,6 +7,7 @@
 // (ωi, ωo) is the light along ωi and the detector along ωo.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -36,18 +37,40 @@ struct PlanSettings {
 // outside [1, kMaxSampleBudget], a reach outside [1, 90] degrees.
 GonioSetup plan_setup(const PlanSettings& settings);
 
-// An instrument's position, in radians: the spherical coordinates (θi, φi, θo, φo) of the pair.
+// The instruments a plan is written for: how a pair (ωi, ωo) becomes its four motors' angles.
+//   light_detector  the sample fixed; the light at zenith θl and azimuth φl about the sample's
+//                   normal, the detector at (θv, φv): (θi, φi, θo, φo).
+//   sample_turning  the light fixed in the laboratory; the sample on a two-axis stage, spun about
+//                   its normal (spin) then tilted about a laboratory axis perpendicular to the
+//                   light (tilt), so that ωi points at the light: spin = −φi, tilt = θi; the
+//                   detector on a two-axis arm about the sample, at a zenith from the light (the
+//                   angle between ωi and ωo, up to 180°) and an azimuth about it, 0 in the plane of
+//                   the tilt away from the normal's lean (the mirror direction is at zenith 2θi,
+//                   azimuth 180°).
+enum class Instrument { light_detector, sample_turning };
+std::string_view name_of(Instrument instrument);  // "light-detector", "sample-turning"
+std::optional<Instrument> parse_instrument(std::string_view name);
+// The motors in the order of GonioPosition::angle (the plan's CSV columns, in degrees).
+std::array<std::string_view, 4> motor_names(Instrument instrument);
+
+// An instrument's position: its motors' angles in radians, in the order of motor_names. Angles 1
+// and 3 (φl and φv; the spin and the detector's azimuth) turn all the way round, in [0, 2π).
 struct GonioPosition {
-  double light_theta = 0, light_phi = 0, detector_theta = 0, detector_phi = 0;
+  std::array<double, 4> angle{};
 };
-GonioPosition position_of(const DirPair<double>& pair);
+GonioPosition position_of(const DirPair<double>& pair,
+                          Instrument instrument = Instrument::light_detector);
+// The pair at a position (position_of's inverse, to rounding).
+DirPair<double> pair_at(const GonioPosition& position,
+                        Instrument instrument = Instrument::light_detector);
 
 // The motors' travel from one position to the next: the sum of the four axes' moves (radians),
-// each azimuth the short way round.
+// angles 1 and 3 the short way round.
 double travel(const GonioPosition& from, const GonioPosition& to);
 
 struct AcquisitionPlan {
   GonioPlan plan;
+  Instrument instrument = Instrument::light_detector;
   // The positions to measure, in the order to measure them.
   std::vector<DirPair<double>> measured;
   std::vector<GonioPosition> positions;  // the same, as the motors' angles
@@ -72,15 +95,18 @@ struct AcquisitionPlan {
 //     once: the one whose light is nearer the normal;
 //   * the order is a serpentine: the light's zenith in bands, the detector's azimuth in strips
 //     within a band, its zenith along a strip, each band and strip run back and forth.
-// Throws what gonio_plan() throws (the sequential design is two plans: below).
-AcquisitionPlan acquisition_plan(const GonioSetup& setup);
+// The order and the travel are the instrument's; which pairs are measured is not. Throws what
+// gonio_plan() throws (the sequential design is two plans: below).
+AcquisitionPlan acquisition_plan(const GonioSetup& setup,
+                                 Instrument instrument = Instrument::light_detector);
 
 // The sequential design's stages for the instrument (docs/acquisition.md, "The sequential
 // design"): the pilot's plan, then the main stage's from the values measured at the pilot's rows
 // (row_values[r] at pilot.measured[r]; NaN: not measured), in the warps their second differences
 // ask for (error space log, the study's default). Throws std::invalid_argument for a setup that
 // is not sequential, a pilot that is not a sequential pilot, counts that differ.
-AcquisitionPlan sequential_pilot_plan(const GonioSetup& setup);
+AcquisitionPlan sequential_pilot_plan(const GonioSetup& setup,
+                                      Instrument instrument = Instrument::light_detector);
 AcquisitionPlan sequential_main_plan(const AcquisitionPlan& pilot, std::span<const Rgb> row_values);
 
 // The plan's sidecar, PLAN.json beside PLAN.csv (docs/acquisition.md, "Files"): the setup, the
