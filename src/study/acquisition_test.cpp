@@ -216,5 +216,32 @@ TEST(AcquisitionPlan, SequentialPlansAreTheStudysSequentialDesign) {
   EXPECT_THROW(sequential_main_plan(pilot, std::vector<Rgb>(3)), std::invalid_argument);
 }
 
+// Measurement noise (multiplicative, relative standard deviation σ, as a photometer's): the
+// reconstruction's error grows with σ, and by no more than σ itself in quadrature (the error space
+// is ln(1 + Y): a relative error σ of Y moves it by at most σ, and interpolation only averages).
+TEST(AcquisitionPlan, NoiseRaisesTheErrorByAtMostItsOwnSize) {
+  GonioSetup s;
+  s.space = space_of<HalfDiff>;
+  s.budget = 5000;
+  s.max_theta_deg = 85;
+  const AcquisitionPlan a = acquisition_plan(s);
+  std::vector<Rgb> clean(a.measured.size());
+  truth().eval_batch(a.measured, clean);
+  const TestPairs test = draw_test_pairs(truth(), 20000, 4, ErrorSpace::log, 85);
+  std::vector<double> errors;
+  for (double sigma : {0.0, 0.01, 0.03, 0.1}) {
+    std::mt19937_64 rng(17);
+    std::normal_distribution<double> n(0, 1);
+    std::vector<Rgb> noisy = clean;
+    for (Rgb& v : noisy) {
+      const double f = std::max(0.0, 1 + sigma * n(rng));
+      v = Rgb{v.r * f, v.g * f, v.b * f};
+    }
+    errors.push_back(reconstruction_error(reconstruct(a, noisy, "noisy"), test));
+    EXPECT_LE(errors.back(), std::hypot(errors.front(), sigma) * 1.05) << sigma;
+  }
+  for (std::size_t k = 1; k < errors.size(); ++k) EXPECT_GT(errors[k], errors[k - 1]) << k;
+}
+
 }  // namespace
 }  // namespace halfback::study

@@ -51,9 +51,9 @@ def test_tables_of_one_brdf(local):
     assert felt["brdf"].splitlines()[1].startswith("embedded:acrylic_felt_green,1,")
     rows = felt["gonio"].splitlines()
     assert rows[0] == "brdf,parameterization,design,samples,error,dims,budget,spacing"
-    # 4 parameterizations x (own in 2 layouts, angle and merl in the regular one) x 2 budgets,
-    # numbers that parse as floats.
-    assert len(rows) == 1 + 4 * 4 * 2
+    # 4 parameterizations x (own in 2 layouts and the sequential design, angle and merl in the
+    # regular one) x 2 budgets, numbers that parse as floats.
+    assert len(rows) == 1 + 4 * 5 * 2
     assert sorted({r.split(",")[7] for r in rows[1:]}) == ["angle", "merl", "own"]
     errors = [float(r.split(",")[4]) for r in rows[1:]]
     assert all(0 < e < 1 for e in errors)
@@ -148,7 +148,7 @@ def test_study_brdf_releases_the_gil():
     # Python code: with the GIL held for the whole call, it could not run until the call returned.
     result, turns = main_thread_turns_during(
         lambda: halfback.study_brdf("embedded:acrylic_felt_green", SETTINGS))
-    assert result["gonio"].count("\n") == 33
+    assert result["gonio"].count("\n") == 41  # header + 4 params x 5 designs x 2 budgets
     assert turns >= 20, "the main thread did not run during study_brdf: the GIL was held"
 
 
