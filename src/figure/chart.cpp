@@ -120,14 +120,21 @@ Scene loglog_chart(const LogLogChart& c) {
   const double margin_left = 52, gap_x = 30, gap_y = 58, top = 44;
   const double cell_w = c.panel_width + gap_x, cell_h = c.panel_height + gap_y;
   const LogLogPanel& first = c.panels.front();
-  const double legend = 16 * double((first.series.size() + 3) / 4) + 10;
+  // Legend entries as wide as the longest name (~0.58 em a glyph at 8.5 pt, after the 28-pixel
+  // swatch), at least 150 pixels; as many a row as the panels' width holds, 1 to 4.
+  std::size_t longest = 0;
+  for (const LineSeries& s : first.series) longest = std::max(longest, plain_text(s.name).size());
+  const double entry_w = std::max(150.0, 28 + 8.5 * 0.58 * double(longest) + 14);
+  const double panels_w = double(std::min(cols, c.panels.size())) * cell_w;
+  const std::size_t per_row = std::clamp<std::size_t>(std::size_t(panels_w / entry_w), 1,
+                                                      std::min<std::size_t>(4, first.series.size()));
+  const double legend = 16 * double((first.series.size() + per_row - 1) / per_row) + 10;
   Scene sc;
   sc.title = c.title;
-  // Wide enough for the panels, the legend (4 entries a row) and the title (~0.62 em a glyph).
+  // Wide enough for the panels, the legend and the title (~0.62 em a glyph).
   const double title_w = 24 + 13 * 0.62 * double(plain_text(c.title).size());
-  const double legend_w = margin_left + 150 * double(std::min<std::size_t>(4, first.series.size()));
-  sc.width = snap(std::max({margin_left + double(std::min(cols, c.panels.size())) * cell_w + 10,
-                            legend_w + 10, title_w}));
+  const double legend_w = margin_left + entry_w * double(per_row);
+  sc.width = snap(std::max({margin_left + panels_w + 10, legend_w + 10, title_w}));
   sc.height = snap(top + double(rows) * cell_h + legend + 10);
   sc.text({12, 24}, escape_markup(c.title), 13, HAlign::left, VAlign::baseline, kBlack, 0, true);
   const Stroke grid{{0.88, 0.88, 0.88}, 0.5}, axis{kBlack, 0.7};
@@ -188,7 +195,7 @@ Scene loglog_chart(const LogLogChart& c) {
   const double ly = top + double(rows) * cell_h + 8;
   for (std::size_t s = 0; s < first.series.size(); ++s) {
     const LineSeries& ser = first.series[s];
-    const double x = margin_left + double(s % 4) * 150, y = ly + 16 * double(s / 4);
+    const double x = margin_left + double(s % per_row) * entry_w, y = ly + 16 * double(s / per_row);
     const Color col = kSeries[std::size_t(std::max(ser.colour, 0)) % std::size(kSeries)];
     Stroke line{col, 1.1};
     if (ser.dashed) line.dash = {3.5, 2};

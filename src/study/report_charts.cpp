@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <map>
+#include <optional>
 
 #include "halfback/figure/chart.hpp"
 #include "halfback/figure/material.hpp"
@@ -109,6 +111,70 @@ figure::Scene gonio_chart(const std::vector<BrdfResult>& results, bool four_d,
   }
   if (c.panels.empty()) return {};
   c.columns = int(std::min<std::size_t>(4, c.panels.size()));
+  return figure::loglog_chart(c);
+}
+
+namespace {
+
+// One strategy's curve over a set of BRDFs: per budget, the median measurements and the median
+// error of those that have the row (none: nothing to draw).
+std::optional<figure::LineSeries> median_curve(const std::vector<BrdfResult>& results,
+                                               const std::vector<std::size_t>& members, Space s,
+                                               Design d) {
+  std::map<std::size_t, std::pair<std::vector<double>, std::vector<double>>> at;  // by budget
+  for (const std::size_t j : members)
+    for (const GonioPoint& p : gonio_points(results[j], s, 3))
+      if (p.design == d && p.spacing == Spacing::own && p.error > 0 && std::isfinite(p.error)) {
+        at[p.budget].first.push_back(double(p.samples));
+        at[p.budget].second.push_back(p.error);
+      }
+  if (at.empty()) return std::nullopt;
+  figure::LineSeries line;
+  for (auto& [budget, v] : at) {
+    line.x.push_back(median(v.first));
+    line.y.push_back(median(v.second));
+  }
+  return line;
+}
+
+}  // namespace
+
+// Every acquisition strategy of the study, one panel per kind of BRDF: the median error against
+// the median measurements of each parameterization's regular (solid) and sequential (dashed)
+// designs, Dupuy & Jakob's layout and Nielsen et al.'s minimal sampling (colours of their own).
+// Empty without a sequential, Dupuy & Jakob or Nielsen row.
+figure::Scene strategies_chart(const std::vector<BrdfResult>& results) {
+  const std::vector<Space>& params = params_of(results);
+  figure::LogLogChart c;
+  c.title = "Acquisition strategies: median relative error against measurements, by kind";
+  c.x_label = "measurements";
+  c.y_label = "median relative error";
+  bool beyond_grids = false;
+  for (const auto& [kind, members] : kinds_of(results)) {
+    figure::LogLogPanel panel{fmt::format("{} ({})", kind, members.size()), {}};
+    for (std::size_t i = 0; i < params.size(); ++i)
+      for (Design d : {Design::regular, Design::sequential})
+        if (auto line = median_curve(results, members, params[i], d)) {
+          line->name = fmt::format("{} {}", name_of(params[i]), name_of(d));
+          line->colour = int(i);
+          line->dashed = d == Design::sequential;
+          beyond_grids |= d == Design::sequential;
+          panel.series.push_back(std::move(*line));
+        }
+    const std::pair<Design, const char*> literature[] = {
+        {Design::dupuy_jakob, "Dupuy & Jakob"}, {Design::nielsen, "Nielsen et al."}};
+    for (std::size_t k = 0; k < 2; ++k)
+      for (Space s : params)
+        if (auto line = median_curve(results, members, s, literature[k].first)) {
+          line->name = literature[k].second;
+          line->colour = int(params.size() + k);
+          beyond_grids = true;
+          panel.series.push_back(std::move(*line));
+        }
+    if (!panel.series.empty()) c.panels.push_back(std::move(panel));
+  }
+  if (c.panels.empty() || !beyond_grids) return {};
+  c.columns = int(std::min<std::size_t>(3, c.panels.size()));
   return figure::loglog_chart(c);
 }
 
@@ -277,6 +343,7 @@ ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConf
   if (has.gonio) p.gonio = gonio_chart(results, false, config);
   if (has.gonio && has.anisotropic) p.gonio4d = gonio_chart(results, true, config);
   if (has.gonio) p.designs = designs_chart(results, config);
+  if (has.gonio) p.strategies = strategies_chart(results);
   if (has.sampling) p.sampling = sampling_chart(results, config);
   if (has.images) {
     p.image = figure::bar_chart(image_chart(results, config));
@@ -293,6 +360,7 @@ void save_plots(const ReportPlots& p, const std::filesystem::path& dir,
   save_plot(p.gonio, dir, "gonio", files);
   save_plot(p.gonio4d, dir, "gonio4d", files);
   save_plot(p.designs, dir, "designs", files);
+  save_plot(p.strategies, dir, "strategies", files);
   save_plot(p.image, dir, "image", files);
   save_plot(p.sampling, dir, "sampling", files);
   save_plot(p.renderings, dir, "renderings", files);

@@ -128,7 +128,7 @@ std::pair<std::vector<double>, std::size_t> medians(const SummaryMetric& m,
 // rendering): the report links only those that are written.
 struct ReportPlots {
   figure::Scene summary, azimuthal, separability, gonio, gonio4d, designs, image, renderings,
-      sampling;
+      sampling, strategies;
 };
 ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
                          const Contents& has, const std::vector<SummaryMetric>& summary);

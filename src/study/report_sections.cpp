@@ -116,6 +116,7 @@ std::string gonio_section(const std::vector<BrdfResult>& results, const StudyCon
   md += dupuy_jakob_table(results, config);
   md += nielsen_table(results, config);
   md += "\n" + plot_link(plots.gonio, "Virtual gonio-reflectometer", "gonio");
+  md += plot_link(plots.strategies, "Acquisition strategies by kind", "strategies");
   if (any_aniso)
     md += gonio_4d_table(results, config) + "\n" +
           plot_link(plots.gonio4d, "Virtual gonio-reflectometer, 4D", "gonio4d");
