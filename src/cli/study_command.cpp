@@ -31,7 +31,7 @@ struct StudyOptions {
   std::vector<std::string> specs, merge;
   std::string out = "study";
   std::string budgets, budgets_4d, environments, params, sampler_kib, fit_budgets;
-  std::string nielsen_database;  // Nielsen et al.'s database: files, folders, comma-separated
+  std::vector<std::string> nielsen_database;  // Nielsen et al.'s database: files, folders, specs
   std::string nielsen_counts;
   double nielsen_eta = study::NielsenOptions{}.eta;
   std::string designs = "own,angle,merl,learned";
@@ -305,10 +305,7 @@ int run_study(StudyOptions& o) {
   const std::vector<std::string> specs = expand_specs(o.specs);
   create_output_directory(o.out);
   check_writable((std::filesystem::path(o.out) / "report.md").string());
-  if (!o.nielsen_database.empty())
-    set_nielsen_database(config,
-                         split_list(o.nielsen_database, "--nielsen-database", "BRDF or folder"),
-                         o.nielsen_eta);
+  if (!o.nielsen_database.empty()) set_nielsen_database(config, o.nielsen_database, o.nielsen_eta);
   std::vector<study::LabeledProfile> profiles;
   if (study::wants_learned(config)) {
     profiles = profile_pass(specs, o.out, config, o.resume);
@@ -427,10 +424,12 @@ Command register_study(CLI::App& parent) {
   app->add_flag("--no-fit", o->settings.no_fit, "No fit metric");
   app->add_option("--nielsen-database", o->nielsen_database,
                   "Nielsen et al. 2015's minimal sampling: the database of its principal "
-                  "components: isotropic BRDF files or folders, comma-separated (e.g. the folder "
-                  "of the MERL networks); each BRDF of the study that is one of them is left out "
-                  "of its own basis. Rows of halfdiff's gonio table, design nielsen "
-                  "(docs/acquisition.md)");
+                  "components, an isotropic BRDF file, folder or spec (repeat the option for "
+                  "more; e.g. the folder of the MERL networks); each BRDF of the study that is "
+                  "one of them is left out of its own basis. Rows of halfdiff's gonio table, "
+                  "design nielsen (docs/acquisition.md)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app->add_option("--nielsen-counts", o->nielsen_counts,
                   "Measurement counts of Nielsen's design, ascending, comma-separated (default "
                   "1,2,5,10,20,40,100)");

@@ -452,6 +452,8 @@ NielsenAcquisition nielsen_acquisition(std::shared_ptr<const NielsenDatabase> da
 }
 
 std::string nielsen_fingerprint(const NielsenDatabase& db) {
+  // The options, the members' names and their values (through the Gram matrix of their mapped
+  // values: two models of one name with other parameters differ there).
   const NielsenOptions& o = db.options();
   std::string text = fmt::format("{} {} {} {} {} {} {}", o.theta_h, o.theta_d, o.phi_d,
                                  o.max_theta_deg, o.eta, o.candidates_per_step, o.seed);
@@ -459,6 +461,11 @@ std::string nielsen_fingerprint(const NielsenDatabase& db) {
     text += '\n';  // appended apart: GCC 12 bug 105329 (CMakeLists.txt)
     text += db.member(m).name();
   }
+  for (std::size_t a = 0; a < db.observations(); ++a)
+    for (std::size_t b = 0; b < db.observations(); ++b) {
+      const double g = db.gram(a, b);
+      text.append(reinterpret_cast<const char*>(&g), sizeof g);
+    }
   const std::string hash = sha256_hex(std::as_bytes(std::span(text)));
   return fmt::format("{} members, {}", db.members(), hash.substr(0, 16));
 }

@@ -228,6 +228,36 @@ TEST(Report, OnlyWhatWasComputedIsWrittenAndLinked) {
   EXPECT_NE(out.markdown.find("](gonio4d.png)"), std::string::npos);
 }
 
+// Nielsen et al.'s rows give their table (the grid's measurements for the same error, from its
+// curve) and, with the sequential design's rows, the strategies chart; without them, neither.
+TEST(Report, NielsenTableAndStrategiesChart) {
+  const test::TempDir tmp;
+  StudyConfig c = config_of_fakes();
+  c.nielsen_counts = {1, 10, 100};
+  std::vector<BrdfResult> results;
+  for (const char* label : {"a", "b"}) {
+    FakeBrdf b = fake_numbers(label, true);
+    FakeParam& halfdiff = b.params[0];  // k = 1: the regular grid's error 0.5 (N / 1000)^(-2/3)
+    ASSERT_EQ(halfdiff.space, space_of<HalfDiff>);
+    for (std::size_t n : {1u, 10u, 100u})
+      halfdiff.gonio.push_back({Design::nielsen, n, n, n == 100 ? 0.1 : 0.5});
+    for (std::size_t n : {1000u, 1000000u})
+      halfdiff.gonio.push_back({Design::sequential, n, n, 0.25 * std::pow(n / 1000.0, -2.0 / 3)});
+    results.push_back(to_result(b));
+  }
+  const std::string md = write_study(tmp.path(), results, c, 1).markdown;
+  // 0.5 (N / 1000)^(-2/3) = 0.1 at N = 1000 · 5^(3/2) = 11180; 0.5 is the grid's at 1000.
+  EXPECT_NE(md.find("| models | 100 | 2 | 0.1000 | 11180 | 2 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| models | 1 | 2 | 0.5000 | < smallest | 0 |"), std::string::npos) << md;
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() / "strategies.png"));
+  EXPECT_NE(md.find("](strategies.png)"), std::string::npos);
+  const test::TempDir plain;
+  const std::string md2 =
+      write_study(plain.path(), {fake("a", true), fake("b", true)}, config_of_fakes(), 1).markdown;
+  EXPECT_FALSE(std::filesystem::exists(plain.path() / "strategies.png"));
+  EXPECT_EQ(md2.find("Nielsen"), std::string::npos);
+}
+
 TEST(Report, MarkdownToHtml) {
   const test::TempDir tmp;
   const std::filesystem::path& dir = tmp.path();

@@ -1899,6 +1899,48 @@ TEST_F(CliTest, DupuyJakobByNameAndPerMaterialInTheStudy) {
   EXPECT_EQ(r.status, 0) << r.err;
 }
 
+// Nielsen et al.'s design in a study: rows of halfdiff at each count, the BRDF that is a member
+// left out of its basis; its database in the settings (another database: --resume refused);
+// halfdiff required.
+TEST_F(CliTest, StudyWithNielsensDatabase) {
+  const std::vector<std::string> study = {
+      "study", "--quick", "--no-images", "--no-sampling", "--no-fit", "--params", "halfdiff",
+      "--designs", "own", "--nielsen-counts", "1,5", "--test-pairs", "5000",
+      "--nielsen-database", "lambert:albedo_r=0.8,albedo_g=0.5,albedo_b=0.2",
+      "--nielsen-database", "lambert:albedo=0.1+ggx:alpha=0.1,f0=0.9",
+      "--nielsen-database", "lambert:albedo_r=0.4,albedo_g=0.45,albedo_b=0.3+ggx:alpha=0.3",
+      "-o", "st", "lambert:albedo=0.1+ggx:alpha=0.1,f0=0.9", "ggx:alpha=0.2"};
+  Result r = run(study);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("Nielsen's database of 3 BRDFs"), std::string::npos) << r.err;
+  std::map<std::string, std::map<std::string, double>> nielsen;  // brdf -> n -> error
+  for (const auto& row : csv_rows(slurp(path("st") / "gonio.csv")))
+    if (row.size() == 8 && row[2] == "nielsen") nielsen[row[0]][row[6]] = std::stod(row[4]);
+  ASSERT_EQ(nielsen.size(), 2u);
+  for (const auto& [brdf, e] : nielsen) {
+    ASSERT_EQ(e.size(), 2u) << brdf;
+    EXPECT_GT(e.at("5"), 1e-3) << brdf;  // the member is left out: not exact
+  }
+  EXPECT_NE(slurp(path("st") / "parts" / "settings.txt").find("nielsen_from = 3 members, "),
+            std::string::npos);
+  EXPECT_NE(slurp(path("st") / "report.md").find("Nielsen et al. 2015's minimal sampling"),
+            std::string::npos);
+  std::vector<std::string> other = study;
+  other[14] = "lambert:albedo=0.7";  // another first member
+  other.insert(other.begin() + 1, "--resume");
+  r = run(other);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("other settings"), std::string::npos) << r.err;
+  r = run({"study", "--quick", "--params", "hybrid", "--nielsen-database", "lambert", "-o", "s2",
+           "lambert"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("add halfdiff to --params"), std::string::npos) << r.err;
+  r = run({"study", "--quick", "--params", "halfdiff", "--nielsen-database",
+           "ggx:alpha_x=0.1,alpha_y=0.4", "--nielsen-database", "lambert", "-o", "s3", "lambert"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("not isotropic"), std::string::npos) << r.err;
+}
+
 TEST_F(CliTest, StudyBadInput) {
   Result r = run({"study", "-o", "st", "nope"});
   EXPECT_EQ(r.status, 2);

@@ -165,7 +165,8 @@ struct NielsenAcquisition {
 NielsenAcquisition nielsen_acquisition(std::shared_ptr<const NielsenDatabase> database,
                                        const Brdf& brdf, std::span<const std::size_t> counts);
 
-// The database's identity in a study's settings: its members' names and the options, hashed.
+// The database's identity in a study's settings: the options, its members' names and values
+// (their Gram matrix), hashed.
 std::string nielsen_fingerprint(const NielsenDatabase& database);
 
 }  // namespace halfback::study
