@@ -60,8 +60,9 @@ std::string plan_csv(const study::AcquisitionPlan& a) {
 // stage from the pilot's measurements.
 study::AcquisitionPlan plan_asked(const PlanOptions& o) {
   if (o.pilot.empty() != o.pilot_measurements.empty())
-    throw UsageError("--pilot and --pilot-measurements go together (the sequential design's "
-                     "main stage)");
+    throw UsageError(
+        "--pilot and --pilot-measurements go together (the sequential design's "
+        "main stage)");
   if (!o.pilot.empty()) {
     const study::AcquisitionPlan pilot = study::read_plan_sidecar(o.pilot);
     if (!pilot.sequential || pilot.sequential->main)
@@ -84,8 +85,8 @@ study::AcquisitionPlan plan_asked(const PlanOptions& o) {
   }();
   const auto instrument = study::parse_instrument(o.instrument);
   if (!instrument)
-    throw UsageError(fmt::format("--instrument '{}': expected light-detector or sample-turning",
-                                 o.instrument));
+    throw UsageError(
+        fmt::format("--instrument '{}': expected light-detector or sample-turning", o.instrument));
   return setup.design == study::Design::sequential
              ? study::sequential_pilot_plan(setup, *instrument)
              : study::acquisition_plan(setup, *instrument);
@@ -110,9 +111,10 @@ int run_plan(const PlanOptions& o) {
       !a.sequential ? std::string()
       : a.sequential->main
           ? fmt::format(" (the main stage of a sequential design of {})", a.sequential->budget)
-          : fmt::format(" (the pilot of a sequential design of {}: measure it, then plan the "
-                        "main stage with --pilot {} --pilot-measurements VALUES.csv)",
-                        a.sequential->budget, json.string());
+          : fmt::format(
+                " (the pilot of a sequential design of {}: measure it, then plan the "
+                "main stage with --pilot {} --pilot-measurements VALUES.csv)",
+                a.sequential->budget, json.string());
   fmt::print(stderr,
              "halfback plan: {} positions to measure for the {} points of the {} design of {} "
              "spaced {}{} ({} fewer by reciprocity{}); motor travel {:.0f}° in this order, {:.0f}° "

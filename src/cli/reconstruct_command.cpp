@@ -11,11 +11,11 @@
 #include <string>
 
 #include "command.hpp"
-#include "measurements.hpp"
 #include "halfback/formats/merl.hpp"
 #include "halfback/formats/rgl_writer.hpp"
 #include "halfback/study/acquisition.hpp"
 #include "halfback/util/format_error.hpp"
+#include "measurements.hpp"
 
 namespace halfback::cli {
 

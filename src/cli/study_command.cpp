@@ -294,7 +294,8 @@ void set_nielsen_database(study::StudyConfig& config, const std::vector<std::str
     throw UsageError(std::string("--nielsen-database: ") + e.what());
   }
   config.nielsen_from = study::nielsen_fingerprint(*config.nielsen);
-  fmt::print(stderr, "halfback study: Nielsen's database of {} BRDFs ({} configurations) in {:.1f} s\n",
+  fmt::print(stderr,
+             "halfback study: Nielsen's database of {} BRDFs ({} configurations) in {:.1f} s\n",
              config.nielsen->members(), config.nielsen->configurations().size(),
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }

@@ -126,8 +126,8 @@ Scene loglog_chart(const LogLogChart& c) {
   for (const LineSeries& s : first.series) longest = std::max(longest, plain_text(s.name).size());
   const double entry_w = std::max(150.0, 28 + 8.5 * 0.58 * double(longest) + 14);
   const double panels_w = double(std::min(cols, c.panels.size())) * cell_w;
-  const std::size_t per_row = std::clamp<std::size_t>(std::size_t(panels_w / entry_w), 1,
-                                                      std::min<std::size_t>(4, first.series.size()));
+  const std::size_t per_row = std::clamp<std::size_t>(
+      std::size_t(panels_w / entry_w), 1, std::min<std::size_t>(4, first.series.size()));
   const double legend = 16 * double((first.series.size() + per_row - 1) / per_row) + 10;
   Scene sc;
   sc.title = c.title;

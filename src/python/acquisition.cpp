@@ -108,11 +108,10 @@ py::dict reconstruct(const std::string& sidecar, const py::object& values, const
 }  // namespace
 
 void bind_acquisition(py::module_& m) {
-  m.def(
-      "plan", &plan, py::arg("param") = "hybrid", py::arg("design") = "regular",
-      py::arg("budget") = 10000, py::arg("spacing") = "own", py::arg("full") = false,
-      py::arg("max_theta") = 90.0, py::arg("seed") = 1, py::arg("instrument") = "light-detector",
-      R"doc(The measurement plan of a design for a gonio-reflectometer, as `halfback plan`
+  m.def("plan", &plan, py::arg("param") = "hybrid", py::arg("design") = "regular",
+        py::arg("budget") = 10000, py::arg("spacing") = "own", py::arg("full") = false,
+        py::arg("max_theta") = 90.0, py::arg("seed") = 1, py::arg("instrument") = "light-detector",
+        R"doc(The measurement plan of a design for a gonio-reflectometer, as `halfback plan`
 (docs/acquisition.md): a dict of positions_deg (rows x 4, degrees: the motors named in motors,
 light zenith, light azimuth, detector zenith, detector azimuth for the light-detector instrument;
 sample tilt, sample spin, detector zenith and azimuth about the light for the sample-turning

@@ -441,8 +441,7 @@ std::optional<AcquisitionPlan::SequentialStage> sequential_stage_of(const nlohma
   whole.design = Design::sequential;
   whole.budget = stage.budget;
   const bool fits = stage.main ? setup.spacing == Spacing::learned
-                               : setup.spacing == Spacing::own &&
-                                     setup.design == Design::regular &&
+                               : setup.spacing == Spacing::own && setup.design == Design::regular &&
                                      sequential_pilot(whole).budget == setup.budget;
   if (!fits)
     throw FormatError(file, "sequential",

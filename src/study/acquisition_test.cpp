@@ -46,7 +46,7 @@ TEST(AcquisitionPlan, EveryPointIsItsRowsConfiguration) {
         const double ti = std::acos(std::clamp(p.wi.z, -1.0, 1.0)),
                      to = std::acos(std::clamp(p.wo.z, -1.0, 1.0));
         const double mi = a.positions[a.row_of_point[k]].angle[0],  // θl
-                     mo = a.positions[a.row_of_point[k]].angle[2];  // θv
+            mo = a.positions[a.row_of_point[k]].angle[2];           // θv
         const bool same = std::abs(ti - mi) < 1e-7 && std::abs(to - mo) < 1e-7;
         const bool swapped = std::abs(ti - mo) < 1e-7 && std::abs(to - mi) < 1e-7;
         ASSERT_TRUE(same || swapped) << name_of(space) << " point " << k;
@@ -185,7 +185,8 @@ TEST(AcquisitionPlan, SequentialPlansAreTheStudysSequentialDesign) {
     for (std::size_t i = 0; i < x.size(); ++i) EXPECT_NEAR(x[i], y[i], 1e-12);
   }
   const TestPairs test = draw_test_pairs(truth(), 20000, 2, ErrorSpace::log, 85);
-  const double a = reconstruction_error(lab, test), b = reconstruction_error(*virtual_one.reconstruction, test);
+  const double a = reconstruction_error(lab, test),
+               b = reconstruction_error(*virtual_one.reconstruction, test);
   EXPECT_NEAR(a, b, 1e-9 * b);
   EXPECT_EQ(pilot.plan.points.size() + main.plan.points.size(), virtual_one.samples);
 

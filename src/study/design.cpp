@@ -245,9 +245,8 @@ LearnedWarps warps_for_demand(const AxisDemand& demand, double uniform_share) {
   w.space = demand.space;
   const GridSpec g = default_grid(demand.space, GridKind::isotropic, {1});
   for (std::size_t axis = 0; axis < 3; ++axis)
-    w.axes[axis] =
-        AxisWarp::from_cdf(g.axes[axis].lo, g.axes[axis].hi,
-                           cdf_of_demand(demand.demand[axis], uniform_share));
+    w.axes[axis] = AxisWarp::from_cdf(g.axes[axis].lo, g.axes[axis].hi,
+                                      cdf_of_demand(demand.demand[axis], uniform_share));
   return w;
 }
 

@@ -267,9 +267,9 @@ std::vector<std::size_t> NielsenBasis::directions(std::size_t count,
   const NielsenDatabase& db = *database_;
   const std::size_t candidates = db.configurations().size();
   if (count > candidates)
-    throw std::invalid_argument(fmt::format(
-        "Nielsen: {} directions asked, the database has {} candidate configurations", count,
-        candidates));
+    throw std::invalid_argument(
+        fmt::format("Nielsen: {} directions asked, the database has {} candidate configurations",
+                    count, candidates));
   std::vector<std::size_t> chosen;
   if (count == 0) return chosen;
   // The first: the largest row of Z, ‖Z(x)‖ = ‖X(x)‖ over all components (U spans the centred
@@ -283,7 +283,8 @@ std::vector<std::size_t> NielsenBasis::directions(std::size_t count,
     for (std::size_t o : kept_) sq += (g[o] - mean) * (g[o] - mean);
     variance[k] = sq;
   }
-  chosen.push_back(std::size_t(std::max_element(variance.begin(), variance.end()) - variance.begin()));
+  chosen.push_back(
+      std::size_t(std::max_element(variance.begin(), variance.end()) - variance.begin()));
   std::vector<char> taken(candidates, 0);
   taken[chosen[0]] = 1;
   std::mt19937_64 rng(db.options().seed);
@@ -369,8 +370,7 @@ std::array<std::vector<double>, 3> NielsenBasis::solve(std::span<const std::size
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeThinU | Eigen::ComputeThinV);
     Eigen::VectorXd s = svd.singularValues();
     for (Eigen::Index j = 0; j < s.size(); ++j) s(j) = s(j) > 0 ? s(j) / (s(j) * s(j) + eta) : 0;
-    const Eigen::VectorXd x =
-        svd.matrixV() * s.asDiagonal() * (svd.matrixU().transpose() * rhs);
+    const Eigen::VectorXd x = svd.matrixV() * s.asDiagonal() * (svd.matrixU().transpose() * rhs);
     // ĝ = μ + Σ_j x_j Σ_o U_oj (g_o − μ) = Σ_o (w_o + (1 − Σ w) / n) g_o, w = U x.
     std::vector<double> w(n_kept, 0.0);
     for (std::size_t j = 0; j < p; ++j)

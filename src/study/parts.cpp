@@ -140,11 +140,10 @@ std::string describe_config(const StudyConfig& c) {
     envs += csv_text_field(e.label);
   }
   // Nielsen's lines only with a database: the settings of runs without one read as before.
-  const std::string nielsen =
-      c.nielsen_from.empty()
-          ? std::string()
-          : fmt::format("nielsen_from = {}\nnielsen_counts = {}\n", c.nielsen_from,
-                        joined(c.nielsen_counts));
+  const std::string nielsen = c.nielsen_from.empty()
+                                  ? std::string()
+                                  : fmt::format("nielsen_from = {}\nnielsen_counts = {}\n",
+                                                c.nielsen_from, joined(c.nielsen_counts));
   return fmt::format(
       "parameterizations = {}\nspace = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = "
       "{}\nbudgets_4d = {}\n"

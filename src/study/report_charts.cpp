@@ -161,8 +161,8 @@ figure::Scene strategies_chart(const std::vector<BrdfResult>& results) {
           beyond_grids |= d == Design::sequential;
           panel.series.push_back(std::move(*line));
         }
-    const std::pair<Design, const char*> literature[] = {
-        {Design::dupuy_jakob, "Dupuy & Jakob"}, {Design::nielsen, "Nielsen et al."}};
+    const std::pair<Design, const char*> literature[] = {{Design::dupuy_jakob, "Dupuy & Jakob"},
+                                                         {Design::nielsen, "Nielsen et al."}};
     for (std::size_t k = 0; k < 2; ++k)
       for (Space s : params)
         if (auto line = median_curve(results, members, s, literature[k].first)) {

@@ -500,22 +500,26 @@ std::string nielsen_table(const std::vector<BrdfResult>& results, const StudyCon
       }
       if (errors.empty()) continue;
       const double need = median(needs);
-      const std::string need_text = need == 0              ? "< smallest"
-                                    : std::isinf(need)     ? "> largest"
-                                                           : fmt::format("{:.0f}", need);
+      const std::string need_text = need == 0          ? "< smallest"
+                                    : std::isinf(need) ? "> largest"
+                                                       : fmt::format("{:.0f}", need);
       rows += fmt::format("| {} | {} | {} | {:.4f} | {} | {} |\n", kind, n, errors.size(),
                           median(errors), need_text, wins);
     }
   if (rows.empty()) return {};
   return fmt::format(
-      "Nielsen et al. 2015's minimal sampling (`nielsen`: n measurements at the directions that "
-      "condition a database's principal components best, the BRDF left out of its own basis; "
-      "docs/acquisition.md): median error per kind of BRDF, the measurements halfdiff's regular "
-      "grid needs for the same error (median over the BRDFs, interpolated on its curve over "
-      "the budgets {}), and on how many BRDFs the n measurements beat the grid's smallest "
-      "budget.\n\n| kind | n | BRDFs | Nielsen's error | the grid needs | better than the grid "
-      "at {} |\n|---|---|---|---|---|---|\n",
-      fmt::join(config.budgets, ", "), config.budgets.empty() ? 0 : config.budgets.front()) +
+             "Nielsen et al. 2015's minimal sampling (`nielsen`: n measurements at the directions "
+             "that "
+             "condition a database's principal components best, the BRDF left out of its own "
+             "basis; "
+             "docs/acquisition.md): median error per kind of BRDF, the measurements halfdiff's "
+             "regular "
+             "grid needs for the same error (median over the BRDFs, interpolated on its curve over "
+             "the budgets {}), and on how many BRDFs the n measurements beat the grid's smallest "
+             "budget.\n\n| kind | n | BRDFs | Nielsen's error | the grid needs | better than the "
+             "grid "
+             "at {} |\n|---|---|---|---|---|---|\n",
+             fmt::join(config.budgets, ", "), config.budgets.empty() ? 0 : config.budgets.front()) +
          rows + "\n";
 }
 

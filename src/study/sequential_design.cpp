@@ -21,7 +21,8 @@ GonioSetup sequential_pilot(const GonioSetup& setup, const SequentialOptions& op
   pilot.design = Design::regular;
   pilot.spacing = Spacing::own;
   pilot.learned.reset();
-  pilot.budget = std::max<std::size_t>(1, std::size_t(std::lround(double(setup.budget) * pilot_share)));
+  pilot.budget =
+      std::max<std::size_t>(1, std::size_t(std::lround(double(setup.budget) * pilot_share)));
   return pilot;
 }
 

@@ -29,8 +29,8 @@ TEST(SequentialDesign, PilotSamplesAreTheGridsSamplesWhereMeasured) {
     for (const PlannedPoint& p : pilot.points) values.push_back(brdf->eval(p.pair));
     const IsoSamples s = pilot_samples(pilot, values, ErrorSpace::log);
     const auto& axes = pilot.cells.axes;
-    const IsoSamples all = sample_isotropic(*brdf, space, {axes[0].count, axes[1].count,
-                                                           axes[2].count}, ErrorSpace::log);
+    const IsoSamples all = sample_isotropic(
+        *brdf, space, {axes[0].count, axes[1].count, axes[2].count}, ErrorSpace::log);
     ASSERT_EQ(s.value.size(), all.value.size());
     std::size_t measured = 0;
     for (std::size_t p = 0; p < s.value.size(); ++p) {

@@ -23,9 +23,9 @@
 #include "halfback/render/renderer.hpp"
 #include "halfback/render/sampling_metric.hpp"
 #include "halfback/study/dupuy_jakob_design.hpp"
-#include "halfback/study/sequential_design.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metric_tables.hpp"
+#include "halfback/study/sequential_design.hpp"
 #include "material_spaces.hpp"
 
 namespace halfback::study {

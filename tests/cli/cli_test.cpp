@@ -740,8 +740,8 @@ TEST_F(CliTest, PlanWritesPositionsAndItsSidecar) {
   EXPECT_NE(json.find("\"row_of_point\":["), std::string::npos);
   EXPECT_NE(r.err.find("fewer by reciprocity"), std::string::npos) << r.err;
   // The sample-turning instrument: its motors in the columns, the same rows; the tilt is θi.
-  r = run({"plan", "--param", "halfdiff", "--budget", "500", "--instrument", "sample-turning",
-           "-o", "s.csv"});
+  r = run({"plan", "--param", "halfdiff", "--budget", "500", "--instrument", "sample-turning", "-o",
+           "s.csv"});
   ASSERT_EQ(r.status, 0) << r.err;
   const CsvTable st = parse(slurp(path("s.csv")));
   EXPECT_EQ(st.header[1], "sample_tilt_deg");
@@ -824,8 +824,8 @@ TEST_F(CliTest, ReconstructFromAPlansMeasurements) {
 // The sequential design for an instrument: the pilot's plan, its measurements, the main stage's
 // plan (with the warps in its sidecar), its measurements, the reconstruction.
 TEST_F(CliTest, SequentialPlanThroughItsTwoStages) {
-  Result r = run({"plan", "--param", "halfdiff", "--design", "sequential", "--budget", "3000",
-                  "-o", "pilot.csv"});
+  Result r = run({"plan", "--param", "halfdiff", "--design", "sequential", "--budget", "3000", "-o",
+                  "pilot.csv"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("the pilot of a sequential design of 3000"), std::string::npos) << r.err;
   const double rho = 0.3 / std::numbers::pi;  // Lambert, albedo 0.3
@@ -1904,12 +1904,29 @@ TEST_F(CliTest, DupuyJakobByNameAndPerMaterialInTheStudy) {
 // halfdiff required.
 TEST_F(CliTest, StudyWithNielsensDatabase) {
   const std::vector<std::string> study = {
-      "study", "--quick", "--no-images", "--no-sampling", "--no-fit", "--params", "halfdiff",
-      "--designs", "own", "--nielsen-counts", "1,5", "--test-pairs", "5000",
-      "--nielsen-database", "lambert:albedo_r=0.8,albedo_g=0.5,albedo_b=0.2",
-      "--nielsen-database", "lambert:albedo=0.1+ggx:alpha=0.1,f0=0.9",
-      "--nielsen-database", "lambert:albedo_r=0.4,albedo_g=0.45,albedo_b=0.3+ggx:alpha=0.3",
-      "-o", "st", "lambert:albedo=0.1+ggx:alpha=0.1,f0=0.9", "ggx:alpha=0.2"};
+      "study",
+      "--quick",
+      "--no-images",
+      "--no-sampling",
+      "--no-fit",
+      "--params",
+      "halfdiff",
+      "--designs",
+      "own",
+      "--nielsen-counts",
+      "1,5",
+      "--test-pairs",
+      "5000",
+      "--nielsen-database",
+      "lambert:albedo_r=0.8,albedo_g=0.5,albedo_b=0.2",
+      "--nielsen-database",
+      "lambert:albedo=0.1+ggx:alpha=0.1,f0=0.9",
+      "--nielsen-database",
+      "lambert:albedo_r=0.4,albedo_g=0.45,albedo_b=0.3+ggx:alpha=0.3",
+      "-o",
+      "st",
+      "lambert:albedo=0.1+ggx:alpha=0.1,f0=0.9",
+      "ggx:alpha=0.2"};
   Result r = run(study);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("Nielsen's database of 3 BRDFs"), std::string::npos) << r.err;

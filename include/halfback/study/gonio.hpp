@@ -67,9 +67,8 @@ inline constexpr std::array<Design, 2> kDesigns{Design::regular, Design::stratif
 // The designs of every parameterization (the grids and the sequential design).
 inline constexpr std::array<Design, 3> kGridDesigns{Design::regular, Design::stratified,
                                                     Design::sequential};
-inline constexpr std::array<Design, 5> kAllDesigns{Design::regular, Design::stratified,
-                                                   Design::sequential, Design::dupuy_jakob,
-                                                   Design::nielsen};
+inline constexpr std::array<Design, 5> kAllDesigns{
+    Design::regular, Design::stratified, Design::sequential, Design::dupuy_jakob, Design::nielsen};
 std::string_view name_of(Design d);
 // "regular", "stratified" or "dupuy-jakob"; nullopt for anything else.
 std::optional<Design> parse_design(std::string_view name);

@@ -89,7 +89,7 @@ class NielsenDatabase {
   NielsenOptions options_;
   std::vector<DirPair<double>> configurations_;
   std::vector<double> mapped_;  // configurations × observations, row-major
-  std::vector<double> gram_;   // observations × observations
+  std::vector<double> gram_;    // observations × observations
   std::vector<DirPair<double>> cached_pairs_;
   // Cached pairs × observations, row-major; in single precision (only errors are computed there).
   std::vector<float> cached_;

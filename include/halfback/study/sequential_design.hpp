@@ -50,8 +50,8 @@ GonioSetup sequential_main(const GonioSetup& setup, const IsoSamples& pilot, std
 // measurements of both.
 struct SequentialAcquisition {
   std::unique_ptr<GonioReconstruction> reconstruction;
-  std::size_t samples = 0;  // pilot and main
-  LearnedWarps warps;       // the main stage's
+  std::size_t samples = 0;     // pilot and main
+  LearnedWarps warps;          // the main stage's
   double predicted_ratio = 1;  // predicted_error_ratio of the pilot's demand and the warps
 };
 // The error of interpolation the model behind the warps predicts for a grid in `warps` against a
