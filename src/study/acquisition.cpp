@@ -408,14 +408,18 @@ LearnedWarps learned_warps_of(const nlohmann::json& j, const PlanSettings& setti
   if (!space || space->is_dirs()) throw FormatError(file, "setup.param", "not a parameterization");
   LearnedWarps w;
   w.space = *space;
+  const GridSpec axes = default_grid(*space, GridKind::isotropic, {1});
   for (std::size_t k = 0; k < 3; ++k) {
     const nlohmann::json& axis = (*it)[k];
     if (!axis.is_object()) throw FormatError(file, "learned_warps", "an axis is not an object");
     const auto cdf = field<std::vector<double>>(axis, "cdf", file);
     if (cdf.size() < 2 || cdf.size() > 4097)
       throw FormatError(file, "learned_warps.cdf", "2 to 4097 nodes expected");
-    w.axes[k] = AxisWarp::from_cdf(field<double>(axis, "lo", file), field<double>(axis, "hi", file),
-                                   cdf);  // std::invalid_argument: not increasing from 0 to 1
+    const double lo = field<double>(axis, "lo", file), hi = field<double>(axis, "hi", file);
+    if (lo != axes.axes[k].lo || hi != axes.axes[k].hi)
+      throw FormatError(file, "learned_warps",
+                        fmt::format("axis {} does not span the parameterization's range", k));
+    w.axes[k] = AxisWarp::from_cdf(lo, hi, cdf);  // invalid_argument: not increasing from 0 to 1
   }
   return w;
 }
