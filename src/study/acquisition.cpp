@@ -262,20 +262,15 @@ AcquisitionPlan sequential_main_plan(const AcquisitionPlan& pilot,
   if (row_values.size() != pilot.measured.size())
     throw std::invalid_argument(fmt::format("{} values for the {} rows of the pilot",
                                             row_values.size(), pilot.measured.size()));
-  // The pilot's measurements are counted as the study counts them: by points (a row that two
-  // reciprocal points share counts twice), so that the main stage's budget is the study's.
+  // The rows' values spread back to the points: the pilot's measurements are counted by points
+  // (a row that two reciprocal points share counts twice), so that the budget is the study's.
   std::vector<Rgb> values(pilot.plan.points.size());
-  std::size_t measured = 0;
-  for (std::size_t k = 0; k < values.size(); ++k) {
-    const Rgb& v = values[k] = row_values[pilot.row_of_point[k]];
-    measured += std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b);
-  }
+  for (std::size_t k = 0; k < values.size(); ++k) values[k] = row_values[pilot.row_of_point[k]];
   GonioSetup setup = pilot.plan.setup;
   setup.design = Design::sequential;
   setup.budget = pilot.sequential->budget;
-  AcquisitionPlan a = acquisition_plan(
-      sequential_main(setup, pilot_samples(pilot.plan, values, ErrorSpace::log), measured),
-      pilot.instrument);
+  AcquisitionPlan a = acquisition_plan(sequential_main(setup, pilot.plan, values, ErrorSpace::log),
+                                       pilot.instrument);
   a.sequential = AcquisitionPlan::SequentialStage{setup.budget, true};
   return a;
 }

@@ -206,6 +206,10 @@ TEST(AcquisitionPlan, SequentialPlansAreTheStudysSequentialDesign) {
   ASSERT_NE(cdf, std::string::npos + 13) << text.substr(0, 400);
   text.insert(cdf, "0.9,");
   EXPECT_THROW(parse_plan_sidecar(text, "p.json"), FormatError);
+  // A warp's range that is not its axis's.
+  std::string range = plan_sidecar(main, "x.csv");
+  range.replace(range.find("\"lo\":0.0"), 9, "\"lo\":0.1");
+  EXPECT_THROW(parse_plan_sidecar(range, "p.json"), FormatError);
   std::string other = plan_sidecar(pilot, "x.csv");
   other.replace(other.find("\"budget\":6000"), 13, "\"budget\":7000");
   EXPECT_THROW(parse_plan_sidecar(other, "p.json"), FormatError);

@@ -54,8 +54,8 @@ TEST(FitMetric, TheWholeFitIsBestOnItsOwnLayout) {
     }
 }
 
-// A grey Lambert fitted to a broad lobe over Lambert: its best albedo is a weighted mean of ρ cos²θi
-// (Ngan's loss), so the fit from the measurements approaches the whole fit exactly when the
+// A grey Lambert fitted to a broad lobe over Lambert: its best albedo is a weighted mean of ρ
+// cos²θi (Ngan's loss), so the fit from the measurements approaches the whole fit exactly when the
 // measurements carry their cells' solid angle; weighted 1, each design's density biases it.
 TEST(FitMetric, SolidAngleWeightsEstimateTheWholeFitsIntegral) {
   StudyConfig c = fit_only();

@@ -107,6 +107,18 @@ std::pair<double, double> rank_one_extremes(const Eigen::VectorXd& lambda,
   return {smallest, root(lambda(p - 1), lambda(p - 1) + norm2)};
 }
 
+// The first p scaled components at each configuration: a row each.
+Eigen::MatrixXd scaled_rows(const NielsenBasis& basis, std::span<const std::size_t> configurations,
+                            std::size_t p) {
+  Eigen::MatrixXd a(Eigen::Index(configurations.size()), Eigen::Index(p));
+  std::vector<double> row(p);
+  for (std::size_t r = 0; r < configurations.size(); ++r) {
+    basis.scaled_row(configurations[r], p, row);
+    for (std::size_t j = 0; j < p; ++j) a(Eigen::Index(r), Eigen::Index(j)) = row[j];
+  }
+  return a;
+}
+
 }  // namespace
 
 double nielsen_map(double rho, const DirPair<double>& pair) {
@@ -237,12 +249,17 @@ NielsenBasis::NielsenBasis(std::shared_ptr<const NielsenDatabase> database,
   }
 }
 
-void NielsenBasis::scaled_row(std::size_t configuration, std::size_t p,
-                              std::span<double> out) const {
+double NielsenBasis::kept_mean(std::size_t configuration) const {
   const std::span<const double> g = database_->mapped_at(configuration);
   double mean = 0;
   for (std::size_t o : kept_) mean += g[o];
-  mean /= double(kept_.size());
+  return mean / double(kept_.size());
+}
+
+void NielsenBasis::scaled_row(std::size_t configuration, std::size_t p,
+                              std::span<double> out) const {
+  const std::span<const double> g = database_->mapped_at(configuration);
+  const double mean = kept_mean(configuration);
   const std::size_t n = kept_.size();
   for (std::size_t j = 0; j < p; ++j) {
     double z = 0;
@@ -252,14 +269,8 @@ void NielsenBasis::scaled_row(std::size_t configuration, std::size_t p,
 }
 
 double NielsenBasis::condition_number(std::span<const std::size_t> configurations) const {
-  const std::size_t p = std::min(configurations.size(), components());
-  Eigen::MatrixXd a(Eigen::Index(configurations.size()), Eigen::Index(p));
-  std::vector<double> row(p);
-  for (std::size_t r = 0; r < configurations.size(); ++r) {
-    scaled_row(configurations[r], p, row);
-    for (std::size_t j = 0; j < p; ++j) a(Eigen::Index(r), Eigen::Index(j)) = row[j];
-  }
-  return condition_of(a);
+  return condition_of(
+      scaled_rows(*this, configurations, std::min(configurations.size(), components())));
 }
 
 std::vector<std::size_t> NielsenBasis::directions(std::size_t count,
@@ -277,9 +288,8 @@ std::vector<std::size_t> NielsenBasis::directions(std::size_t count,
   std::vector<double> variance(candidates);
   for (std::size_t k = 0; k < candidates; ++k) {
     const std::span<const double> g = db.mapped_at(k);
-    double mean = 0, sq = 0;
-    for (std::size_t o : kept_) mean += g[o];
-    mean /= double(kept_.size());
+    const double mean = kept_mean(k);
+    double sq = 0;
     for (std::size_t o : kept_) sq += (g[o] - mean) * (g[o] - mean);
     variance[k] = sq;
   }
@@ -295,12 +305,7 @@ std::vector<std::size_t> NielsenBasis::directions(std::size_t count,
     // matrix [B; z], whose AᵀA = BᵀB + z zᵀ: with BᵀB = Q Λ Qᵀ once per step, each candidate's
     // extreme eigenvalues are those of Λ + w wᵀ, w = Qᵀ z (rank_one_extremes).
     const std::size_t p = std::min(chosen.size() + 1, components());
-    Eigen::MatrixXd b(Eigen::Index(chosen.size()), Eigen::Index(p));
-    std::vector<double> row(p);
-    for (std::size_t r = 0; r < chosen.size(); ++r) {
-      scaled_row(chosen[r], p, row);
-      for (std::size_t j = 0; j < p; ++j) b(Eigen::Index(r), Eigen::Index(j)) = row[j];
-    }
+    const Eigen::MatrixXd b = scaled_rows(*this, chosen, p);
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> btb(b.transpose() * b);
     // Random candidates not yet taken (all of them when fewer remain).
     std::vector<std::size_t> pool;
@@ -355,17 +360,9 @@ std::array<std::vector<double>, 3> NielsenBasis::solve(std::span<const std::size
     }
     if (at.empty()) throw std::runtime_error("Nielsen: no finite measurement");
     const std::size_t p = std::min(at.size(), components());
-    Eigen::MatrixXd a(Eigen::Index(at.size()), Eigen::Index(p));
+    const Eigen::MatrixXd a = scaled_rows(*this, at, p);
     Eigen::VectorXd rhs(Eigen::Index(at.size()));
-    std::vector<double> row(p);
-    for (std::size_t r = 0; r < at.size(); ++r) {
-      scaled_row(at[r], p, row);
-      for (std::size_t j = 0; j < p; ++j) a(Eigen::Index(r), Eigen::Index(j)) = row[j];
-      const std::span<const double> g = db.mapped_at(at[r]);
-      double mean = 0;
-      for (std::size_t o : kept_) mean += g[o];
-      rhs(Eigen::Index(r)) = b[r] - mean / double(n_kept);
-    }
+    for (std::size_t r = 0; r < at.size(); ++r) rhs(Eigen::Index(r)) = b[r] - kept_mean(at[r]);
     // x = V diag(s / (s² + η)) Uᵀ b (their ProjectToPCSpace).
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeThinU | Eigen::ComputeThinV);
     Eigen::VectorXd s = svd.singularValues();

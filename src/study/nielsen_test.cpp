@@ -8,6 +8,7 @@
 
 #include "halfback/loader/load.hpp"
 #include "halfback/study/gonio.hpp"
+#include "support/test_brdfs.hpp"
 
 namespace halfback::study {
 namespace {
@@ -200,6 +201,18 @@ TEST(Nielsen, RefusesWhatItCannotDo) {
   EXPECT_THROW(NielsenDatabase(family({"lambert"}), small_grid()), std::invalid_argument);
   EXPECT_THROW(NielsenDatabase(family({"lambert", "ggx:alpha_x=0.1,alpha_y=0.4"}), small_grid()),
                std::invalid_argument);
+  // A member with a value that is not finite somewhere: refused, naming it.
+  BrdfList with_nan = family({"lambert", "ggx:alpha=0.3"});
+  with_nan.push_back(std::make_shared<test::FunctionBrdf>(
+      [](const DirPair<double>& p) { return p.wo.z > 0.9 ? NAN : 0.2; }));
+  try {
+    NielsenDatabase(with_nan, small_grid());
+    ADD_FAILURE() << "a member with NaN values was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("function has a value that is not finite"),
+              std::string::npos)
+        << e.what();
+  }
   NielsenOptions bad = small_grid();
   bad.eta = -1;
   EXPECT_THROW(NielsenDatabase(family(kSpecs), bad), std::invalid_argument);

@@ -483,16 +483,20 @@ std::string dupuy_jakob_table(const std::vector<BrdfResult>& results, const Stud
 std::string nielsen_table(const std::vector<BrdfResult>& results, const StudyConfig& config) {
   const Space halfdiff = space_of<HalfDiff>;
   std::string rows;
+  // Each BRDF's halfdiff rows, read once.
+  std::vector<std::vector<GonioPoint>> points(results.size());
+  for (std::size_t j = 0; j < results.size(); ++j) {
+    const BrdfResult& b = results[j];
+    if (std::find(b.params.begin(), b.params.end(), halfdiff) != b.params.end())
+      points[j] = gonio_points(b, halfdiff, 3);
+  }
   for (const auto& [kind, members] : kinds_of(results))
     for (const std::size_t n : config.nielsen_counts) {
       std::vector<double> errors, needs;
       int wins = 0;
       for (const std::size_t j : members) {
-        const BrdfResult& b = results[j];
-        if (std::find(b.params.begin(), b.params.end(), halfdiff) == b.params.end()) continue;
-        const std::vector<GonioPoint> points = gonio_points(b, halfdiff, 3);
-        const GonioPoint* p = find_point(points, Design::nielsen, n);
-        const GonioCurve grid = gonio_curve(points, Design::regular);
+        const GonioPoint* p = find_point(points[j], Design::nielsen, n);
+        const GonioCurve grid = gonio_curve(points[j], Design::regular);
         if (!p || grid.samples.empty()) continue;
         errors.push_back(p->error);
         needs.push_back(samples_to_reach(grid.samples, grid.errors, p->error));

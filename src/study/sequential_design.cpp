@@ -50,20 +50,16 @@ GonioSetup sequential_main(const GonioSetup& setup, const IsoSamples& pilot, std
   return main;
 }
 
-double predicted_error_ratio(const AxisDemand& demand, const LearnedWarps& warps) {
-  double warped = 0, uniform = 0;
-  for (std::size_t axis = 0; axis < 3; ++axis) {
-    const std::vector<double>& d = demand.demand[axis];
-    const std::vector<double>& cdf = warps.axes[axis].cdf();
-    const std::size_t n = d.size();
-    if (cdf.size() != n + 1) throw std::invalid_argument("predicted_error_ratio: other grids");
-    for (std::size_t i = 0; i < n; ++i) {
-      const double rho = (cdf[i + 1] - cdf[i]) * double(n);  // density against the uniform's
-      warped += d[i] / (rho * rho * rho * rho);
-      uniform += d[i];
-    }
-  }
-  return uniform > 0 ? std::sqrt(warped / uniform) : 1.0;
+std::size_t finite_values(std::span<const Rgb> values) {
+  return std::size_t(std::count_if(values.begin(), values.end(), [](const Rgb& v) {
+    return std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b);
+  }));
+}
+
+GonioSetup sequential_main(const GonioSetup& setup, const GonioPlan& pilot,
+                           std::span<const Rgb> values, ErrorSpace es,
+                           const SequentialOptions& options) {
+  return sequential_main(setup, pilot_samples(pilot, values, es), finite_values(values), options);
 }
 
 SequentialAcquisition sequential_acquisition(const Brdf& truth, const GonioSetup& setup,
@@ -73,16 +69,11 @@ SequentialAcquisition sequential_acquisition(const Brdf& truth, const GonioSetup
   for (const PlannedPoint& p : pilot.points) pairs.push_back(p.pair);
   std::vector<Rgb> values(pairs.size());
   truth.eval_batch(pairs, values);
-  std::size_t measured = 0;
-  for (const Rgb& v : values)
-    measured += std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b);
-  const GonioSetup main =
-      sequential_main(setup, pilot_samples(pilot, values, es), measured, options);
+  const GonioSetup main = sequential_main(setup, pilot, values, es, options);
   SequentialAcquisition a;
   a.reconstruction = std::make_unique<GonioReconstruction>(truth, main);
-  a.samples = measured + a.reconstruction->samples();
+  a.samples = finite_values(values) + a.reconstruction->samples();
   a.warps = *main.learned;
-  a.predicted_ratio = predicted_error_ratio(axis_demand(pilot_samples(pilot, values, es)), a.warps);
   return a;
 }
 

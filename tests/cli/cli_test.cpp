@@ -1948,6 +1948,12 @@ TEST_F(CliTest, StudyWithNielsensDatabase) {
   r = run(other);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("other settings"), std::string::npos) << r.err;
+  for (const char* counts : {"5,1", "0,2", "x"}) {
+    r = run({"study", "--quick", "--params", "halfdiff", "--nielsen-database", "lambert",
+             "--nielsen-counts", counts, "-o", "s4", "lambert"});
+    EXPECT_EQ(r.status, 2) << counts << ": " << r.err;
+    EXPECT_NE(r.err.find("--nielsen-counts"), std::string::npos) << counts << ": " << r.err;
+  }
   r = run({"study", "--quick", "--params", "hybrid", "--nielsen-database", "lambert", "-o", "s2",
            "lambert"});
   EXPECT_EQ(r.status, 2) << r.err;

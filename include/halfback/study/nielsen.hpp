@@ -125,6 +125,8 @@ class NielsenBasis {
   std::shared_ptr<const NielsenDatabase> database_ptr() const { return database_; }
 
  private:
+  double kept_mean(std::size_t configuration) const;  // the kept observations' mean there
+
   std::shared_ptr<const NielsenDatabase> database_;
   std::optional<std::size_t> left_out_;
   std::vector<std::size_t> kept_;  // the observations in the basis

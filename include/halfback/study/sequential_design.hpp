@@ -45,19 +45,21 @@ IsoSamples pilot_samples(const GonioPlan& pilot, std::span<const Rgb> values, Er
 // asks for (spacing learned, from the pilot). `measured` is the pilot's count of measurements.
 GonioSetup sequential_main(const GonioSetup& setup, const IsoSamples& pilot, std::size_t measured,
                            const SequentialOptions& options = {});
+// The same from the values measured at the pilot's points (values[k] at pilot.points[k]; not
+// finite: not measured), counted as the study counts them: by points.
+GonioSetup sequential_main(const GonioSetup& setup, const GonioPlan& pilot,
+                           std::span<const Rgb> values, ErrorSpace es,
+                           const SequentialOptions& options = {});
+// How many of the values are finite (measurements taken).
+std::size_t finite_values(std::span<const Rgb> values);
 
 // The study's virtual instrument through both stages: the main stage's reconstruction and the
 // measurements of both.
 struct SequentialAcquisition {
   std::unique_ptr<GonioReconstruction> reconstruction;
-  std::size_t samples = 0;     // pilot and main
-  LearnedWarps warps;          // the main stage's
-  double predicted_ratio = 1;  // predicted_error_ratio of the pilot's demand and the warps
+  std::size_t samples = 0;  // pilot and main
+  LearnedWarps warps;       // the main stage's
 };
-// The error of interpolation the model behind the warps predicts for a grid in `warps` against a
-// uniform one of as many cells, ( Σ_axes ∫ D ρ⁻⁴ / Σ_axes ∫ D )^½ (ρ the warps' density against
-// the uniform one, on the demand's cells).
-double predicted_error_ratio(const AxisDemand& demand, const LearnedWarps& warps);
 SequentialAcquisition sequential_acquisition(const Brdf& truth, const GonioSetup& setup,
                                              ErrorSpace es, const SequentialOptions& options = {});
 
