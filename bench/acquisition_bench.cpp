@@ -1,4 +1,4 @@
-// `halfback plan` and `halfback reconstruct` at 10⁵ measurements (issue 33: each ≤ 2 s; docs/
+// `halfback plan` and `halfback reconstruct` at 10⁵ measurements (the target: each ≤ 2 s; docs/
 // acquisition.md, "Speed"): the plan of a design with its instrument order, and the reconstruction
 // from values at its rows, beside the unit of both measured in the same run, the design's points
 // alone (gonio_plan). Isotropic hybrid (the 3D gonio-reflectometer), regular and stratified; the
@@ -7,13 +7,13 @@
 
 #include <vector>
 
+#include "halfback/acquire/acquisition.hpp"
 #include "halfback/loader/load.hpp"
-#include "halfback/study/acquisition.hpp"
 
 namespace {
 
 using namespace halfback;
-using namespace halfback::study;
+using namespace halfback::acquire;
 
 GonioSetup setup_of(const benchmark::State& state) {
   PlanSettings p;

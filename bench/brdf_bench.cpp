@@ -115,11 +115,12 @@ void run_batch_one_core(benchmark::State& state, const Brdf& brdf) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * p.size()));
 }
 
-// Issue 35, class F: the directional albedo of GGX α = 0.05 at θi = 75°, n = 64, by cosine
-// sampling (the baseline) and with MIS. Counters: the standard error and SE² × seconds (the
-// variance at equal time: the ratio of the two rows is MIS's gain; the target is ≥ 100, i.e. an
-// SE 10× lower at equal time). The estimate is kept in a struct (GCC 12 + Benchmark 1.7's
-// DoNotOptimize(double) was seen to corrupt a value).
+// docs/reliability/numerics.md, "Directional albedo: bounded memory, and multiple importance
+// sampling": the directional albedo of GGX α = 0.05 at θi = 75°, n = 64, by cosine sampling (the
+// baseline) and with MIS. Counters: the standard error and SE² × seconds (the variance at equal
+// time: the ratio of the two rows is MIS's gain; the target is ≥ 100, i.e. an SE 10× lower at equal
+// time). The estimate is kept in a struct (GCC 12 + Benchmark 1.7's DoNotOptimize(double) was seen
+// to corrupt a value).
 void albedo_at_75(benchmark::State& state, AlbedoSampling sampling) {
   const BrdfPtr ggx = load_brdf("ggx:alpha=0.05,f0=0.9");
   const double t = 75 * std::numbers::pi / 180;

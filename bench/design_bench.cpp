@@ -7,14 +7,14 @@
 
 #include <vector>
 
+#include "halfback/acquire/design.hpp"
+#include "halfback/acquire/gonio.hpp"
 #include "halfback/loader/load.hpp"
-#include "halfback/study/design.hpp"
-#include "halfback/study/gonio.hpp"
 
 namespace {
 
 using namespace halfback;
-using namespace halfback::study;
+using namespace halfback::acquire;
 
 const Brdf& truth() {
   static const BrdfPtr b = model_registry().create("ggx:alpha=0.15");

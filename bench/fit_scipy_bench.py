@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """halfback's fit against the same fit written with SciPy's least_squares, measured in the same run
-(issue 37; docs/performance.md, "Fitting").
+(docs/performance.md, "Fitting").
 
     PYTHONPATH=build/release/python /usr/bin/python3 bench/fit_scipy_bench.py [--samples N]
 

@@ -24,23 +24,23 @@
 // 5. The RGL file's sampling-interface calls as the renderer makes them (packets of 64 rows
 //    sharing one ωo): CPU ns per row of sample_batch, pdf_batch and eval_batch (--repeat N;
 //    --hash prints a hash of each call's outputs, to check that two builds compute the same bits).
-// 6. Samplers compared (issue 36, render/sampling_metric.hpp): the relative variance of the
+// 6. Samplers compared (render/sampling_metric.hpp): the relative variance of the
 //    one-sample albedo estimator over ωo, time per sample and efficiency against the cosine, for
 //    each material's own sampler and the tabulated sampler in every parameterization at 64 KB,
 //    1 MB and 16 MB of tables (--part 6; not in the default parts).
-// 7. The table's size (issue 36, the renderer's default): equal-time error of MIS with halfdiff's
+// 7. The table's size (the renderer's default): equal-time error of MIS with halfdiff's
 //    table at 64 KB, 1 MB and the default size, and with cosine sampling, for measured materials
 //    (RGL files and neural BRDFs) and a tabulated glossy model (--part 7; not by default).
-// 8. The automatic choice of the BRDF sampler (issue 36, docs/render.md "Choosing the BRDF
-//    sampler"): equal-time error of MIS with the table, the cosine and the automatic choice
-//    (render() with each RenderSettings::brdf_sampling: set-up and choice count in the time), and
-//    the albedo-variance ratio the choice is made by (cosine's ÷ table's), for
-//    neural BRDFs of the MERL and RGL databases (from ../shared/data; the embedded two without it)
-//    and a tabulated glossy model, under the built-in sky and studio and two of the shared
+// 8. The automatic choice of the BRDF sampler (docs/render.md "Choosing the BRDF sampler"): the
+//    threshold per environment, the albedo-variance ratio the choice is made by (cosine's ÷
+//    table's), and the error of MIS with the table, the cosine and the automatic choice at an
+//    equal CPU time (set-up and choice counted; print_equal_cpu_time_error), for neural BRDFs of
+//    the MERL and RGL databases (from ../shared/data; the embedded two without it), tabulated
+//    GGX lobes and two near-delta lobes, under the built-in sky and studio and two of the shared
 //    environments (--part 8; not by default).
 // 9. The RGL files' own sampler (Dupuy & Jakob's VNDF warp, what render() uses for them) against
 //    the table, the cosine and the automatic choice of the same data with the warp hidden, at
-//    equal time (--part 9; not by default).
+//    an equal CPU time (--part 9; not by default).
 // --quick shrinks every part (for a smoke run); --part N runs part N only (parts 1-3 by default).
 #include <time.h>
 
@@ -326,66 +326,106 @@ std::vector<std::pair<std::string, render::EnvMap>> environments(
   return envs;
 }
 
-// The cells "| table | cosine | auto | chose |" of a row: `brdf` rendered with each
-// RenderSettings::brdf_sampling at equal time, and what auto chose.
+// Relative RMSE at an equal CPU time of `cpu_budget` seconds (the process's CPU clock, all
+// threads): the BRDF's sampler as render() takes it under `choice` (set-up and choice timed),
+// then `spp` pixel samples with it (timed); the error is scaled to the time the budget leaves
+// after the set-up, RMSE ∝ 1/√time. Unlike a wall-clock budget, neither other processes on the
+// machine nor the budget's whole passes (1, 2, 4, ... samples) move it. Printed as a table cell;
+// returns the error and the sampler used.
+std::pair<double, std::string> print_equal_cpu_time_error(const Brdf& brdf,
+                                                          const render::EnvMap& env,
+                                                          render::BrdfSampling choice,
+                                                          const render::Image& reference,
+                                                          double cpu_budget, int spp) {
+  render::RenderSettings s;
+  s.width = s.height = 128;
+  s.spp = spp;
+  s.brdf_sampling = choice;
+  double t0 = cpu_seconds();
+  const render::ChosenSampler chosen = render::choose_brdf_sampler(brdf, env, s);
+  const double setup = cpu_seconds() - t0;
+  t0 = cpu_seconds();
+  const render::RenderResult r = render::render_sampled(*chosen.brdf, env, s);
+  const double seconds = cpu_seconds() - t0;
+  const double e = relative_rmse(r.image, reference) *
+                   std::sqrt(seconds / std::max(cpu_budget - setup, 1e-3 * cpu_budget));
+  std::printf(" %.4f |", e);
+  return {e, chosen.brdf->describe_sampling()};
+}
+
+// The cells "| table | cosine | auto | chose | auto ÷ better |" of a row: `brdf` with each
+// RenderSettings::brdf_sampling at equal CPU time, what auto chose, and its error over the
+// better of table and cosine.
 void print_choices(const Brdf& brdf, const render::EnvMap& env, const render::Image& reference,
-                   double budget) {
-  std::string chose;
-  for (render::BrdfSampling choice : {render::BrdfSampling::table, render::BrdfSampling::cosine,
-                                      render::BrdfSampling::automatic}) {
-    render::RenderSettings s = budgeted(budget);
-    s.brdf_sampling = choice;
-    const render::RenderResult r = render::render(brdf, env, s);
-    print_equal_time_error(r, reference, budget);
-    if (choice == render::BrdfSampling::automatic)
-      chose = r.sampler.find("cosine") == 0 ? "cosine" : "table";
-  }
-  std::printf(" %s |\n", chose.c_str());
+                   double cpu_budget, int spp) {
+  using render::BrdfSampling;
+  const double table =
+      print_equal_cpu_time_error(brdf, env, BrdfSampling::table, reference, cpu_budget, spp).first;
+  const double cosine =
+      print_equal_cpu_time_error(brdf, env, BrdfSampling::cosine, reference, cpu_budget, spp).first;
+  const auto [automatic, sampler] =
+      print_equal_cpu_time_error(brdf, env, BrdfSampling::automatic, reference, cpu_budget, spp);
+  std::printf(" %s | %.2f |\n", sampler.find("cosine") == 0 ? "cosine" : "table",
+              automatic / std::min(table, cosine));
   std::fflush(stdout);
 }
 
 // Part 8: table, cosine and the automatic choice at equal time, per material and environment.
 void sampler_choice_at_equal_time(bool quick) {
-  const double budget = quick ? 0.2 : 1.5;
+  const double cpu_budget = quick ? 0.4 : 3.0;  // CPU seconds: 1.5 s on two cores
+  const int spp = quick ? 16 : 256;
   const std::string data = shared_data_dir();
   const bool shared = std::filesystem::exists(data + "envmaps/grace.hdr");
   std::vector<Material> materials{
       {"neural pink-felt", load_brdf("embedded:pink-felt")},
       {"neural gold-metallic-paint3", load_brdf("embedded:gold-metallic-paint3")},
-      {"GGX α = 0.05, tabulated", std::make_shared<Opaque>(load_brdf("ggx:alpha=0.05,f0=0.9"))}};
+      {"GGX α = 0.05, tabulated", std::make_shared<Opaque>(load_brdf("ggx:alpha=0.05,f0=0.9"))},
+      {"GGX α = 0.25, tabulated", std::make_shared<Opaque>(load_brdf("ggx:alpha=0.25,f0=0.9"))},
+      {"Ward α = 0.001 (near-delta)", load_brdf("ward:roughness=0.001,albedo=1")},
+      {"Blinn-Phong n = 10⁶ (near-delta)", load_brdf("blinn-phong:sharpness=1e6,albedo=1")}};
   const auto envs = environments({"grace.hdr", "uffizi.hdr"});
   if (shared) {
-    for (const char* name : {"blue-acrylic", "chrome", "beige-fabric", "nylon"})
+    // From broad to peaked; the middle ones (albedo ratios 330-1600) are where the environment
+    // decides.
+    for (const char* name :
+         {"beige-fabric", "red-plastic", "light-red-paint", "teflon", "black-soft-plastic", "nylon",
+          "dark-red-paint", "silver-paint", "white-acrylic", "blue-acrylic", "chrome"})
       materials.push_back(
           {std::string("neural ") + name, load_brdf(data + "nbrdf/merl_nbrdf/" + name + ".h5")});
-    for (const char* name : {"acrylic_felt_green_rgb", "paper_white_rgb"})
+    for (const char* name : {"acrylic_felt_green_rgb"})
       materials.push_back({std::string("neural RGL ") + name,
                            load_brdf(data + "nbrdf/rgl-isotropic_nbrdf/" + name + ".h5")});
   }
   std::printf(
-      "\n## The albedo-variance ratio of the automatic choice (cosine's ÷ table's; the "
-      "table at ≥ %g)\n\n| material | ratio |\n|---|---|\n",
-      render::kPeakedRatio);
+      "\n## The threshold of the automatic choice per environment\n\n| environment | "
+      "residual fraction | threshold |\n|---|---|---|\n");
+  for (const auto& [env_name, env] : envs)
+    std::printf("| %s | %.3f | %.0f |\n", env_name.c_str(), env.residual_fraction(),
+                render::peaked_ratio(env));
+  std::printf(
+      "\n## The albedo-variance ratio of the automatic choice (cosine's ÷ table's)\n\n| "
+      "material | ratio |\n|---|---|\n");
   for (const Material& m : materials)
     std::printf("| %s | %.3g |\n", m.label.c_str(),
-                render::choose_brdf_sampler(*m.brdf, budgeted(budget)).albedo_variance_ratio);
+                render::choose_brdf_sampler(*m.brdf, budgeted(1)).albedo_variance_ratio);
   std::printf(
-      "\n## Choosing the BRDF sampler (MIS, %.1f s, 128 × 128; relative RMSE at equal time, "
-      "set-up and choice included)\n\n| material | environment | table | cosine | auto | auto "
-      "chose |\n|---|---|---|---|---|---|\n",
-      budget);
+      "\n## Choosing the BRDF sampler (MIS, 128 × 128, %d spp; relative RMSE at an equal CPU "
+      "time of %.1f s, set-up and choice included)\n\n| material | environment | table | cosine "
+      "| auto | auto chose | auto ÷ better |\n|---|---|---|---|---|---|---|\n",
+      spp, cpu_budget);
   for (const auto& [env_name, env] : envs)
     for (const Material& m : materials) {
       const render::Image reference = reference_image(*m.brdf, env, quick);
       std::printf("| %s | %s |", m.label.c_str(), env_name.c_str());
-      print_choices(*m.brdf, env, reference, budget);
+      print_choices(*m.brdf, env, reference, cpu_budget, spp);
     }
 }
 
 // Part 9: the RGL files' own sampler (Dupuy & Jakob's VNDF warp) against the table, the cosine
 // and the automatic choice of the same data with the warp hidden.
 void rgl_warp_against_choice(bool quick) {
-  const double budget = quick ? 0.2 : 1.5;
+  const double cpu_budget = quick ? 0.4 : 3.0;  // CPU seconds: 1.5 s on two cores
+  const int spp = quick ? 16 : 256;
   const std::string data = shared_data_dir();
   std::vector<Material> files{{"RGL metallic paint", load_brdf("embedded:ilm_l3_37_metallic")},
                               {"RGL felt", load_brdf("embedded:acrylic_felt_green")}};
@@ -395,16 +435,17 @@ void rgl_warp_against_choice(bool quick) {
       files.push_back({std::string("RGL ") + name, load_brdf(data + "rgl/" + name + ".bsdf")});
   }
   std::printf(
-      "\n## RGL files: their VNDF warp against table, cosine and auto (MIS, %.1f s, 128 × 128; "
-      "relative RMSE at equal time)\n\n| material | environment | own warp | table | cosine | "
-      "auto | auto chose |\n|---|---|---|---|---|---|---|\n",
-      budget);
+      "\n## RGL files: their VNDF warp against table, cosine and auto (MIS, 128 × 128, %d spp; "
+      "relative RMSE at an equal CPU time of %.1f s)\n\n| material | environment | own warp | "
+      "table | cosine | auto | auto chose | auto ÷ better |\n|---|---|---|---|---|---|---|---|\n",
+      spp, cpu_budget);
   for (const auto& [env_name, env] : envs)
     for (const Material& m : files) {
       const render::Image reference = reference_image(*m.brdf, env, quick);
       std::printf("| %s | %s |", m.label.c_str(), env_name.c_str());
-      print_equal_time_error(render::render(*m.brdf, env, budgeted(budget)), reference, budget);
-      print_choices(Opaque(m.brdf), env, reference, budget);
+      print_equal_cpu_time_error(*m.brdf, env, render::BrdfSampling::automatic, reference,
+                                 cpu_budget, spp);
+      print_choices(Opaque(m.brdf), env, reference, cpu_budget, spp);
     }
 }
 

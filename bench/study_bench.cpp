@@ -54,8 +54,8 @@ void BM_Baseline_Eval1M(benchmark::State& state) {
 void BM_Stage_Metrics12(benchmark::State& state) {
   const study::StudyConfig c;
   on_one_core(state, [&] {
-    const study::IsoSamples x =
-        study::sample_isotropic(network(), space_of<Hybrid>, c.grid, c.space);
+    const acquire::IsoSamples x =
+        acquire::sample_isotropic(network(), space_of<Hybrid>, c.grid, c.space);
     benchmark::DoNotOptimize(study::azimuthal_error(x));
     benchmark::DoNotOptimize(study::separability_2d(x, c.ranks));
     benchmark::DoNotOptimize(study::separability_unfolded(x, c.ranks));
@@ -66,15 +66,15 @@ void BM_Stage_Metrics12(benchmark::State& state) {
 // checked at the default 2 x 10^5 test pairs.
 void BM_Stage_Gonio(benchmark::State& state) {
   const study::StudyConfig c;
-  const study::TestPairs test =
-      study::draw_test_pairs(network(), c.test_pairs, c.seed, c.space, c.max_theta_deg);
+  const acquire::TestPairs test =
+      acquire::draw_test_pairs(network(), c.test_pairs, c.seed, c.space, c.max_theta_deg);
   on_one_core(state, [&] {
-    for (study::Design d : study::kDesigns)
+    for (acquire::Design d : acquire::kDesigns)
       for (std::size_t budget : c.budgets) {
-        study::GonioSetup setup{space_of<Hybrid>, true, d, budget, c.seed};
+        acquire::GonioSetup setup{space_of<Hybrid>, true, d, budget, c.seed};
         setup.max_theta_deg = c.max_theta_deg;
-        const study::GonioReconstruction rec(network(), setup);
-        benchmark::DoNotOptimize(study::reconstruction_error(rec, test));
+        const acquire::GonioReconstruction rec(network(), setup);
+        benchmark::DoNotOptimize(acquire::reconstruction_error(rec, test));
       }
   });
 }

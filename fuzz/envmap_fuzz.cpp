@@ -1,7 +1,8 @@
 // libFuzzer target for the environment map readers, Radiance .hdr and OpenEXR (see fuzz/run.sh):
 // the input written to a file of the process's own (EnvMap::load reads paths: its size is checked
-// against what the header declares before the pixels are read, issue 35, class C), loaded, and
-// looked up in a direction taken from the input's last bytes.
+// against what the header declares before the pixels are read, class C of
+// docs/reliability/readers.md), loaded, and looked up in a direction taken from the input's
+// last bytes.
 #include <unistd.h>
 
 #include <cstdint>

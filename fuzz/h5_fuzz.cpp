@@ -1,7 +1,9 @@
 // libFuzzer target for the Keras .h5 reader of neural BRDFs (see fuzz/run.sh): the input as an
 // HDF5 file image (the embedded materials' path: HDF5's in-memory driver), its declared end checked
-// against its size (issue 35, class C), then the network validated (finite weights, the bound on
-// ρ: issue 35, class B) and evaluated at a pair taken from the input's last bytes.
+// against its size (docs/reliability/readers.md, "A reader reads what the file's header declares,
+// and nothing more"), then the network validated (finite weights, the bound on ρ:
+// docs/reliability/readers.md, "One bound on a BRDF's value" and evaluated at a pair taken from the
+// input's last bytes.
 #include <cstdint>
 #include <cstring>
 

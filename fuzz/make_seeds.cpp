@@ -1,8 +1,9 @@
 // Writes small valid inputs for the fuzzers into DIR/{merl,rgl,alta,npy,envmap,factored}/ (see
 // fuzz/run.sh): a synthetic RGL material with tiny grids (RGB and spectral), ALTA files, MERL
 // headers, .npy arrays, environment maps (Radiance and OpenEXR); and of each, a copy with trailing
-// data and one extended by zeros, as `truncate -s` extends a file (issue 35, class C: every reader
-// ends where its header says, and a text reader refuses a NUL byte).
+// data and one extended by zeros, as `truncate -s` extends a file (class C of
+// docs/reliability/readers.md: every reader ends where its header says, and a text reader
+// refuses a NUL byte).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -13,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "halfback/brdf/rho_bound.hpp"
 #include "halfback/formats/factored.hpp"
 #include "halfback/formats/rgl.hpp"
 #include "halfback/render/image.hpp"
@@ -94,6 +96,13 @@ int main(int argc, char** argv) {
     for (int r = 0; r < 2; ++r)
       terms.push_back({{0.1, 0.2 * r, 0.3}, {1.0, 0.5}, {0.2, 0.4, 0.6, 0.8 * r}});
   write_factored(dir / "factored" / "small.json", factored);
+  // At the bound on ρ: max_log = log(1 + kMaxRho) and products far above it (the reader refuses
+  // a max_log above; mutations of this one test it).
+  FactoredModel at_bound = factored;
+  at_bound.max_log = {std::log1p(kMaxRho), std::log1p(kMaxRho), 0};
+  for (auto& terms : at_bound.channels)
+    for (FactoredTerm& t : terms) t.a = {800, 800, 800};
+  write_factored(dir / "factored" / "at_bound.json", at_bound);
 
   const auto iso = rgl_material(3, 4, 2, {0.0f});
   write(dir / "rgl" / "iso.bsdf", iso.data(), iso.size());

@@ -45,12 +45,20 @@ for seed in "/api/info?token=t" "/?token=t" "/static/app.js?token=t" \
     $'/api/info\ncookie: halfback_token_8765=t\norigin: http://127.0.0.1:8765' \
     $'/api/info?token=t\nHost: 127.0.0.1:8765' \
     $'/api/info?token=t\norigin: http://127.0.0.1:8765\nOrigin: http://localhost:8765' \
-    $'/api/info\ncookie: halfback_token_8765=t\nCookie: halfback_token_8765=t'; do
+    $'/api/info\ncookie: halfback_token_8765=t\nCookie: halfback_token_8765=t' \
+    "/api/slices?token=t&brdf=lambert&forms=dupuy-jakob:ggx:alpha=0.2,halfdiff&n=4" \
+    "/api/hemisphere?token=t&colour=dupuy-jakob:arg:0&n=4" \
+    "/api/point?token=t&brdf=arg:0&form=dupuy-jakob:lambert&iso=1&coords=0.2,0.3,0.5" \
+    "/api/slices?token=t&brdf=arg:0&forms=dupuy-jakob:file:../x&n=2" \
+    "/api/render?token=t&brdf=arg:0&env=/etc/passwd" \
+    "/api/fit?token=t&brdf=arg:1&model=lambert%2Blambert%2Blambert%2Blambert%2Blambert&samples=20000" \
+    "/api/slices?token=t&brdf=arg:0&brdf=arg:1&n=512&values=rgb"; do
   printf '%s' "$seed" > "$corpus/view/seed$k"
   k=$((k + 1))
 done
 # Seeds of the view's socket side: a connection's bytes, cut at "~~\n" into pieces sent apart
-# (fuzz/view_wire_fuzz.cpp): pipelined, trickled, cut mid-line, repeated Host/Origin, unfinished.
+# (fuzz/view_wire_fuzz.cpp): pipelined, trickled, cut mid-line, repeated Host/Origin, unfinished,
+# a fit whose client closes its side at once (the computation's abandonment).
 mkdir -p "$corpus/view_wire"
 host=$'Host: 127.0.0.1:8765\r\n'
 k=0
@@ -63,7 +71,8 @@ for seed in $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'\r\n' \
     $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'X-Unfinished: ' \
     $'GET /api/info?token=t HTTP/1.0\r\n'"$host"$'\r\n' \
     $'POST /api/info?token=t HTTP/1.1\r\n'"$host"$'Content-Length: 5\r\n\r\nhello' \
-    $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'Expect: 100-continue\r\nRange: bytes=0-3\r\n\r\n'; do
+    $'GET /api/info?token=t HTTP/1.1\r\n'"$host"$'Expect: 100-continue\r\nRange: bytes=0-3\r\n\r\n' \
+    $'GET /api/fit?token=t&brdf=arg:1&model=ggx&samples=2000 HTTP/1.1\r\n'"$host"$'\r\n'; do
   printf '%s' "$seed" > "$corpus/view_wire/seed$k"
   k=$((k + 1))
 done

@@ -3,7 +3,8 @@
 // several requests in a row), cut into pieces at each "~~\n" that are written one at a time with a
 // pause between them (a client trickling its request, cut anywhere). The pieces go through a
 // socket pair to Server::serve_connection: httplib's parser, the stream with the request head's
-// deadline, and the Api. The client then closes its side, so no input waits for a deadline.
+// deadline, and the Api. The client then closes its side, so no input waits for a deadline (and a
+// computation sees its client leave: the abandonment is fuzzed too).
 // The server's answer must begin with a status line of a status in [100, 600), or be empty.
 #include <sys/socket.h>
 #include <unistd.h>

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Factored models against analytic fits, per parameterization (issue 37, item 7; docs/fit.md,
-"Factored models"): which parameterization gives the smallest data-driven model for a given error?
+"""Factored models against analytic fits, per parameterization (docs/fit.md, "Factored models"):
+which parameterization gives the smallest data-driven model for a given error?
 
 For every BRDF given, every parameterization of --params and every rank of --ranks: the factored
 model (halfback.factor, --counts cells) and its loss under --loss on fit()'s layout

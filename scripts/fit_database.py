@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Fits every neural BRDF of one or more folders with each of several models (issue 37: the
+"""Fits every neural BRDF of one or more folders with each of several models (the
 whole-database fit; docs/fit.md, "The whole database").
 
 For every NAME.h5 under each --nbrdf folder and every model of --models (default: Lambert plus

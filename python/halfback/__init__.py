@@ -11,6 +11,8 @@ the paper's Figure 1. study_brdf() studies one BRDF (any engine can map it over 
 database) and merge_study() writes the report of the results (docs/study.md).
 """
 
+import math
+
 from ._core import (
     Brdf,
     columns,
@@ -47,8 +49,9 @@ def study_profile(spec, settings=None):
     return _core.study_profile(spec, settings)
 
 
-def fit(brdf, model, loss="ngan", samples=20000, threads=0):
-    return _core.fit(brdf, model, loss, samples, threads)
+def fit(brdf, model, loss="ngan", samples=20000, threads=0, starts=(), max_iterations=200,
+        max_theta=math.pi / 2):
+    return _core.fit(brdf, model, loss, samples, threads, list(starts), max_iterations, max_theta)
 
 
 def fit_loss(brdf, model, loss="ngan", samples=20000, threads=0):
@@ -67,6 +70,13 @@ def emit(spec, target, name="halfback_fit"):
     return _core.emit(spec, target, name)
 
 
+def nbrdf_train(brdf, output, hidden=(21, 21), samples=640000, epochs=100, batch=512,
+                learning_rate=5e-4, seed=0, threads=0, param=""):
+    import os
+    return _core.nbrdf_train(brdf, os.fspath(output), list(hidden), samples, epochs, batch,
+                             learning_rate, seed, threads, param)
+
+
 def published_fits(path):
     return _core.published_fits(str(path))
 
@@ -74,6 +84,17 @@ def published_fits(path):
 def plan(param="hybrid", design="regular", budget=10000, spacing="own", full=False, max_theta=90.0,
          seed=1, instrument="light-detector"):
     return _core.plan(param, design, budget, spacing, full, max_theta, seed, instrument)
+
+
+def plan_main(pilot, values):
+    import os
+    return _core.plan_main(os.fspath(pilot) if not isinstance(pilot, str) else pilot, values)
+
+
+def plan_error(plan, values, truth, test_pairs=200000, seed=1, max_theta=85.0, space="log"):
+    import os
+    return _core.plan_error(os.fspath(plan) if not isinstance(plan, str) else plan, values, truth,
+                            test_pairs, seed, max_theta, space)
 
 
 def reconstruct(plan, values, out, name="measured"):
@@ -90,11 +111,14 @@ def reconstruct(plan, values, out, name="measured"):
 study_brdf.__doc__ = _core.study_brdf.__doc__
 fit.__doc__ = _core.fit.__doc__
 plan.__doc__ = _core.plan.__doc__
+plan_main.__doc__ = _core.plan_main.__doc__
+plan_error.__doc__ = _core.plan_error.__doc__
 fit_loss.__doc__ = _core.fit_loss.__doc__
 fit_samples.__doc__ = _core.fit_samples.__doc__
 factor.__doc__ = _core.factor.__doc__
 emit.__doc__ = _core.emit.__doc__
 published_fits.__doc__ = _core.published_fits.__doc__
+nbrdf_train.__doc__ = _core.nbrdf_train.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
 study_profile.__doc__ = _core.study_profile.__doc__
 
@@ -112,7 +136,10 @@ __all__ = [
     "jacobian",
     "load",
     "merge_study",
+    "nbrdf_train",
     "plan",
+    "plan_error",
+    "plan_main",
     "models",
     "published_fits",
     "reconstruct",

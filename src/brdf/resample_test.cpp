@@ -211,7 +211,8 @@ TEST(Resample, ThreadCountDoesNotChangeTheBits) {
   EXPECT_EQ(std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(double)), 0);
 }
 
-// Issue 12, class 8: one rule for azimuths everywhere, wrap any finite value into [0°, 360°).
+// docs/reliability/numerics.md, "Azimuths are periodic": one rule for azimuths everywhere, wrap any
+// finite value into [0°, 360°).
 TEST(Resample, AzimuthsWrapIntoZeroTo360Degrees) {
   const std::pair<double, double> cases[] = {
       {0, 0},       {-90, 270}, {360, 0},       {400, 40},   {-45, 315},

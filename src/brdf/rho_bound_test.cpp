@@ -1,4 +1,4 @@
-// Class B of issue 35 (docs/reliability-round3-readers.md): the one bound on a BRDF's value, its
+// docs/reliability/readers.md, "One bound on a BRDF's value": the one bound on a BRDF's value, its
 // message, and the probe set that finds a value above it.
 #include "halfback/brdf/rho_bound.hpp"
 

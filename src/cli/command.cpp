@@ -7,6 +7,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <new>
+#include <stdexcept>
 #include <system_error>
 
 #include <unistd.h>
@@ -51,6 +54,107 @@ void Output::commit() {
 void check_writable(const std::string& path) {
   AtomicFile probe(path);
   probe.discard();
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// An option's value as given on the command line: the option's name and the text.
+struct OptionValue {
+  std::string option, value;
+  bool folder = false;  // an output folder (an option of type DIR: study -o, figure paper --out)
+};
+
+bool is_output_option(const CLI::Option& o) {
+  const auto& l = o.get_lnames();
+  const auto& s = o.get_snames();
+  return std::ranges::find(l, "output") != l.end() || std::ranges::find(l, "out") != l.end() ||
+         std::ranges::find(l, "json") != l.end() || std::ranges::find(s, "o") != s.end();
+}
+
+bool is_emit_option(const CLI::Option& o) {
+  return std::ranges::find(o.get_lnames(), "emit") != o.get_lnames().end();
+}
+
+// The texts in a value that may name a file: the value, its items split at ',' and '+', and
+// what follows each ':' of an item.
+std::vector<std::string> possible_paths(const std::string& value) {
+  std::vector<std::string> paths{value};
+  std::size_t start = 0;
+  while (start <= value.size()) {
+    const std::size_t end = std::min(value.find_first_of(",+", start), value.size());
+    const std::string item = value.substr(start, end - start);
+    paths.push_back(item);
+    for (std::size_t colon = item.find(':'); colon != std::string::npos;
+         colon = item.find(':', colon + 1))
+      paths.push_back(item.substr(colon + 1));
+    start = end + 1;
+  }
+  return paths;
+}
+
+// Whether `file` is a regular file inside the folder `dir` (at any depth) of a kind the
+// commands write into their output folders.
+bool written_kind_inside(const fs::path& dir, const fs::path& file) {
+  static const char* const kinds[] = {".csv", ".md",  ".html", ".png",     ".svg",
+                                      ".pdf", ".exr", ".part", ".profile", ".txt"};
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) return false;
+  const std::string ext = file.extension().string();
+  if (std::ranges::none_of(kinds, [&](const char* k) { return ext == k; })) return false;
+  const fs::path d = fs::weakly_canonical(dir, ec), f = fs::weakly_canonical(file, ec);
+  if (ec) return false;
+  const auto [d_end, f_at] = std::mismatch(d.begin(), d.end(), f.begin(), f.end());
+  return d_end == d.end() && f_at != f.end();
+}
+
+// UsageError when `out` would replace (or, a folder, overwrite a file in) the input `in`.
+void refuse_output_over_input(const OptionValue& out, const OptionValue& in) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(out.value, ec);
+  for (const std::string& candidate : possible_paths(in.value)) {
+    if (candidate.empty() || candidate == "-") continue;
+    const bool same = fs::is_regular_file(st) && fs::equivalent(out.value, candidate, ec) && !ec;
+    if (same)
+      throw UsageError(fmt::format(
+          "{} '{}' is the file of {} '{}': an output never replaces an input of the same "
+          "command; write it elsewhere",
+          out.option, out.value, in.option, in.value));
+    if (out.folder && fs::is_directory(st) && written_kind_inside(out.value, candidate))
+      throw UsageError(fmt::format(
+          "{} '{}' is a folder that holds the input {} '{}', a file of a kind the command "
+          "writes there: an output never replaces an input of the same command; move the input "
+          "or write elsewhere",
+          out.option, out.value, in.option, candidate));
+  }
+}
+
+}  // namespace
+
+void refuse_outputs_over_inputs(const CLI::App& app, const std::vector<std::string>& more_outputs) {
+  std::vector<OptionValue> outputs, inputs;
+  for (const std::string& path : more_outputs) outputs.push_back({"the sidecar of -o", path});
+  for (const CLI::Option* o : app.get_options()) {
+    const std::string name = o->get_name();
+    if (is_output_option(*o)) {
+      const bool folder = o->get_type_name().starts_with("DIR");
+      if (o->count() > 0)
+        for (const std::string& v : o->results()) outputs.push_back({name, v, folder});
+      else if (!o->get_default_str().empty())
+        outputs.push_back({name, o->get_default_str(), folder});
+    } else if (is_emit_option(*o)) {
+      for (const std::string& v : o->results())
+        if (const std::size_t colon = v.find(':'); colon != std::string::npos)
+          outputs.push_back({name + " " + v.substr(0, colon), v.substr(colon + 1)});
+    } else if (o->count() > 0) {
+      for (const std::string& v : o->results()) inputs.push_back({name, v});
+    }
+  }
+  for (const OptionValue& out : outputs) {
+    if (out.value.empty() || out.value == "-") continue;
+    for (const OptionValue& in : inputs) refuse_output_over_input(out, in);
+  }
 }
 
 std::vector<std::string> split_list(const std::string& list, const char* option, const char* what) {
@@ -138,8 +242,10 @@ std::string finite_number_error(const std::string& value) {
   if (!text.empty() && text.front() == '+') text.remove_prefix(1);
   double v = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec == std::errc() && end == text.data() + text.size() && std::isfinite(v)) return "";
-  return fmt::format("'{}' is not a finite number", value);
+  const bool parsed = ec == std::errc() && end == text.data() + text.size();
+  if (parsed && std::isfinite(v)) return "";
+  if (parsed && std::isinf(v)) return fmt::format("'{}' is not a finite number", value);
+  return fmt::format("'{}' is not a number", value);
 }
 
 std::string whole_number_error(const std::string& value, bool allow_negative) {
@@ -164,8 +270,13 @@ std::string whole_number_error(const std::string& value, bool allow_negative) {
 
 void harden_options(CLI::App& app) {
   for (CLI::Option* option : app.get_options()) {
-    const std::string type = option->get_type_name();
-    option->check(CLI::Validator(
+    // The value's type, without the descriptions of the option's checks ("FLOAT:FLOAT in [0 -
+    // 1e+09]" for a CLI::Range), which hid the type from this rule.
+    const std::string full_type = option->get_type_name();
+    const std::string type = full_type.substr(0, full_type.find(':'));
+    // First of the option's checks (transform() puts it in front), so that "nan" is "not a
+    // number" rather than out of the option's range.
+    option->transform(CLI::Validator(
         [type](std::string& value) -> std::string {
           if (value.empty()) return "an empty value: give one, or leave the option out";
           if (type == "FLOAT") return finite_number_error(value);
@@ -204,9 +315,14 @@ std::optional<Space> space_or_message(const std::string& name, std::string& mess
       return std::nullopt;
     }
     return s;
-  } catch (const std::exception& e) {
+  } catch (const std::invalid_argument& e) {  // a name or a model's value: the command line's
     message = fmt::format("'{}': {}", name, e.what());
     return std::nullopt;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {  // a family member's file that cannot be read or holds bad
+    // data: a data error, propagated with the name it came from
+    throw std::runtime_error(fmt::format("'{}': {}", name, e.what()));
   }
 }
 

@@ -47,8 +47,15 @@ class UsageError : public std::runtime_error {
 // A registered subcommand: its CLI11 app, and what runs it after a successful parse (returns the
 // exit code, or throws).
 struct Command {
+  Command() = default;
+  Command(CLI::App* a, std::function<int()> r, std::function<std::vector<std::string>()> more = {})
+      : app(a), run(std::move(r)), more_outputs(std::move(more)) {}
+
   CLI::App* app = nullptr;
   std::function<int()> run;
+  // The files the command writes that no option names (plan: the sidecar beside -o), for the
+  // output rule (refuse_outputs_over_inputs); empty for most commands.
+  std::function<std::vector<std::string>()> more_outputs;
 };
 
 using RegisterCommand = Command (*)(CLI::App& parent);
@@ -71,6 +78,8 @@ Command register_fit(CLI::App& parent);
 Command register_plan(CLI::App& parent);
 Command register_reconstruct(CLI::App& parent);
 Command register_factor(CLI::App& parent);
+Command register_nbrdf(CLI::App& parent);
+Command register_compare(CLI::App& parent);
 
 // "halfback COMMAND: warning: MESSAGE" on stderr.
 void warn(std::string_view command, std::string_view message);
@@ -97,6 +106,19 @@ class Output {
  private:
   std::unique_ptr<AtomicFile> file_;
 };
+
+// The output rule (docs/reliability/cli.md, "Files and outputs"): an output never replaces an
+// input of the same command. Called by main.cpp on the parsed command (`app`, its deepest parsed
+// subcommand) before it runs. Outputs: the values of -o/--output/--out/--json (their defaults when
+// not given), the FILE of --emit TARGET:FILE, and `more_outputs`. Inputs: the values of every other
+// option and positional, each also split at ',' and '+' (lists, sums) and after a ':' (a
+// family's member, dupuy-jakob:FILE). UsageError (status 2) naming both options when an output
+// that exists is the same file as an input (std::filesystem::equivalent: links and hard links
+// included), or when an output declared a folder (type name DIR) is a folder and an input is a
+// file inside it of a kind the
+// commands write into folders (.csv, .md, .html, .png, .svg, .pdf, .exr, .part, .profile, .txt).
+// Devices, FIFOs and standard streams are not compared (nothing is replaced there).
+void refuse_outputs_over_inputs(const CLI::App& app, const std::vector<std::string>& more_outputs);
 
 // Fails (std::system_error, "cannot write 'PATH': ...") unless `path` can be written, creating
 // and removing a temporary file beside it: commands call it before any long work.
@@ -125,8 +147,8 @@ double parse_number(std::string_view text, const std::string& what);
 
 // A CLI11 validator for parameterization names ("dirs", "hybrid", ...), with a message listing
 // the names.
-// One rule for the values of every option of every command (docs/reliability-round3.md, class
-// G), added to the whole tree of apps after registration: a value given empty is refused (an
+// One rule for the values of every option of every command (docs/reliability/cli.md, "Option
+// values"), added to the whole tree of apps after registration: a value given empty is refused (an
 // empty --env or --budgets is not the default); a FLOAT option takes a finite number (no nan,
 // no inf); an INT or UINT option a whole number written as one and within 64 bits (no 1e3, no
 // −1 for a UINT, no 2⁶⁴ quietly saturated). Violations are usage errors (exit status 2).
@@ -138,7 +160,10 @@ CLI::Validator non_negative_integer();
 // The space of a name given on the command line (space_from_name), or nullopt with `message`
 // saying why when the name is known but cannot be used here: a family's member whose argument is
 // wrong (the family's own message), or the study's per-material placeholder outside the study.
-// An unknown name: nullopt and an empty message (each option says what it expects).
+// An unknown name: nullopt and an empty message (each option says what it expects). A file
+// that a family's member names and that cannot be read or holds bad data is not the command
+// line's fault: its error (FormatError, std::system_error) propagates, status 1, also out of the
+// validators below (main.cpp reports an error thrown while parsing as a data error).
 std::optional<Space> space_or_message(const std::string& name, std::string& message);
 
 CLI::Validator space_name_validator();

@@ -7,11 +7,12 @@
 namespace halfback::cli {
 
 namespace {
-constexpr std::array<RegisterCommand, 15> kCommands{
+constexpr std::array<RegisterCommand, 17> kCommands{
     &register_convert,     &register_info,        &register_eval,   &register_resample,
     &register_export_merl, &register_export_rgl,  &register_models, &register_render,
     &register_figure,      &register_study,       &register_view,   &register_fit,
-    &register_plan,        &register_reconstruct, &register_factor,
+    &register_plan,        &register_reconstruct, &register_factor, &register_nbrdf,
+    &register_compare,
 };
 }  // namespace
 

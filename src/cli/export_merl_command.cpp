@@ -25,7 +25,7 @@ int run_export_merl(const ExportMerlOptions& o) {
   write_merl(o.output, data);
   const auto missing = data.missing[0];
   fmt::print(stderr,
-             "halfback export-merl: {} written ({} of {} bins outside the hemisphere or "
+             "halfback export-merl: {} written ({} of {} bins that hold no valid pair or "
              "not finite, stored as -1)\n",
              o.output, missing, merl::kBins);
   return kExitOk;

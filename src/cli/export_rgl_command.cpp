@@ -18,7 +18,8 @@ namespace halfback::cli {
 namespace {
 
 struct ExportRglOptions {
-  std::string brdf, output, description, variant = "rgb";
+  std::string brdf, output, description, variant = "rgb", incidences = "albedo",
+                                         tabulation = "average";
   RglExportOptions table;
   bool quiet = false;
 };
@@ -26,8 +27,15 @@ struct ExportRglOptions {
 const std::map<std::string, RglVariant> kVariants{
     {"rgb", RglVariant::rgb}, {"spectral", RglVariant::spectral}, {"both", RglVariant::both}};
 
+const std::map<std::string, RglIncidences> kIncidences{{"albedo", RglIncidences::albedo},
+                                                       {"sigma", RglIncidences::sigma}};
+const std::map<std::string, RglTabulation> kTabulations{{"average", RglTabulation::hat_average},
+                                                        {"point", RglTabulation::point}};
+
 int run_export_rgl(ExportRglOptions& o) {
   o.table.variant = kVariants.at(o.variant);
+  o.table.incidences = kIncidences.at(o.incidences);
+  o.table.tabulation = kTabulations.at(o.tabulation);
   if (o.output == "-") throw UsageError("-o: export-rgl writes a file, not standard output");
   AtomicFile probe(o.output);  // an unwritable destination fails before the work
   probe.discard();
@@ -72,8 +80,19 @@ Command register_export_rgl(CLI::App& parent) {
       ->required()
       ->type_name("FILE");
   app->add_option("--theta-i", o->table.theta_i,
-                  "incident elevations from 0 to 90 degrees, evenly spaced in projected area")
+                  "incident elevations from 0 to 90 degrees, placed by --incidences")
       ->check(CLI::Range(2, 90))
+      ->capture_default_str();
+  app->add_option("--incidences", o->incidences,
+                  "albedo: half of the elevations evenly spaced in projected area, the others "
+                  "where the directional albedo needs them; sigma: all evenly spaced in projected "
+                  "area (the published files' layout)")
+      ->check(CLI::IsMember(kIncidences))
+      ->capture_default_str();
+  app->add_option("--tabulation", o->tabulation,
+                  "average: a table node holds the average over its bilinear hat function, which "
+                  "keeps the directional albedo; point: the value at the node (as measured)")
+      ->check(CLI::IsMember(kTabulations))
       ->capture_default_str();
   app->add_option("--resolution", o->table.resolution,
                   "RGB and luminance samples per side, per incident elevation")

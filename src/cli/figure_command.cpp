@@ -379,7 +379,9 @@ Command add_paper(CLI::App& figure) {
       "Figures 1 (three views), 2 and 3-5 (the paper's MERL materials as neural fits, then RGL "
       "measurements and analytic models) on their default settings, into a folder, and print "
       "where they are");
-  p->add_option("-o,--out", pa->out, "Output folder (created if missing)")->required();
+  p->add_option("-o,--out", pa->out, "Output folder (created if missing)")
+      ->type_name("DIR")
+      ->required();
   p->add_option("--formats", pa->formats, "Formats to write: png, svg, pdf")->capture_default_str();
   p->add_option("--material", pa->materials,
                 "A BRDF SPEC for Figures 3, 4, 5... (repeatable; replaces the default measured "

@@ -64,8 +64,18 @@ std::string missing_subcommand_message(const CLI::App& parent, int argc, char** 
   return fmt::format("a subcommand is required (one of: {})", names);
 }
 
+// The command's deepest parsed subcommand (figure's hemisphere, ...), or the command's own app.
+const CLI::App& parsed_app(const Command& command) {
+  const CLI::App* app = command.app;
+  while (!app->get_subcommands().empty()) app = app->get_subcommands().front();
+  return *app;
+}
+
 int run_command(const std::string& who, const Command& command) {
   try {
+    refuse_outputs_over_inputs(parsed_app(command), command.more_outputs
+                                                        ? command.more_outputs()
+                                                        : std::vector<std::string>{});
     return command.run();
   } catch (const UsageError& e) {
     report_error(who, e.what());
@@ -93,6 +103,16 @@ std::string version_text() {
   return text;
 }
 
+// "halfback COMMAND SUBCOMMAND" of the deepest subcommand parsed so far; `deepest` is set to it.
+std::string parsed_command_name(const CLI::App*& deepest) {
+  std::string who = "halfback";
+  while (!deepest->get_subcommands().empty()) {
+    deepest = deepest->get_subcommands().front();
+    who += " " + deepest->get_name();
+  }
+  return who;
+}
+
 int run(int argc, char** argv) {
   register_brdf_parameterization_families();
   CLI::App app(kDescription, "halfback");
@@ -112,12 +132,8 @@ int run(int argc, char** argv) {
   } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::string who = "halfback";
     const CLI::App* deepest = &app;
-    while (!deepest->get_subcommands().empty()) {
-      deepest = deepest->get_subcommands().front();
-      who += " " + deepest->get_name();
-    }
+    const std::string who = parsed_command_name(deepest);
     if (who == "halfback" && dynamic_cast<const CLI::ExtrasError*>(&e) && !app.remaining().empty())
       report_error(who, fmt::format("unknown command '{}' (the commands are: {})",
                                     app.remaining().front(), command_names(commands)));
@@ -128,6 +144,16 @@ int run(int argc, char** argv) {
       report_error(who, e.what());
     usage_hint(who);
     return kExitUsageError;
+  } catch (const std::bad_alloc&) {
+    const CLI::App* deepest = &app;
+    report_error(parsed_command_name(deepest), "out of memory");
+    return kExitDataError;
+  } catch (const std::exception& e) {
+    // Thrown by a validator reading a file an option names (dupuy-jakob:FILE): the file cannot
+    // be read or holds bad data, a data error as in every command that reads one.
+    const CLI::App* deepest = &app;
+    report_error(parsed_command_name(deepest), e.what());
+    return kExitDataError;
   }
   for (const Command& command : commands)
     if (command.app->parsed()) return run_command("halfback " + command.app->get_name(), command);
@@ -143,6 +169,8 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   // Ctrl-C, SIGTERM and SIGHUP remove the hidden temporaries beside the outputs before dying.
   halfback::install_temporary_cleanup_handlers();
+  // Past `ulimit -f`, a write fails with a message (and no temporary is left) instead of SIGXFSZ.
+  halfback::ignore_file_size_signal();
   try {
     return halfback::cli::run(argc, argv);
   } catch (const std::exception& e) {

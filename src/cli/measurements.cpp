@@ -40,6 +40,12 @@ std::vector<Rgb> read_measurements(const std::string& path, std::size_t rows,
                           fmt::format("row {} is given twice", i));
       const Rgb c = v ? Rgb{t.columns[*v][k], t.columns[*v][k], t.columns[*v][k]}
                       : Rgb{t.columns[*r][k], t.columns[*g][k], t.columns[*b][k]};
+      if (c.r < 0 || c.g < 0 || c.b < 0)  // NaN (not measured) passes
+        throw FormatError(path, fmt::format("line {}", t.lines[k]),
+                          fmt::format("row {}: the value is negative ({:g}, {:g}, {:g}): a "
+                                      "reflectance is not (clamp noise below 0 to 0, or leave "
+                                      "the row out)",
+                                      i, c.r, c.g, c.b));
       if (std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b)) {
         values[i] = c;
         ++measured;

@@ -123,7 +123,9 @@ Command register_render(CLI::App& parent) {
          "(0: no limit; an error if not one sample per pixel fits)")
       ->check(CLI::Range(0.0, 1e9))
       ->capture_default_str();
-  app->add_option("--exposure", o->exposure, "PNG exposure in stops")->capture_default_str();
+  app->add_option("--exposure", o->exposure, "PNG exposure in stops, in [-64, 64]")
+      ->check(CLI::Range(-64.0, 64.0))
+      ->capture_default_str();
   app->add_flag("--filmic", o->filmic, "PNG: ACES filmic tone curve instead of a plain clamp");
   app->add_flag("--perspective", o->perspective, "perspective camera (default: orthographic)");
   app->add_option("--env-rotation", o->env_rotation,
@@ -144,8 +146,10 @@ Command register_render(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--brdf-sampling", o->brdf_sampling,
                   "how a BRDF without a sampler of its own is sampled: table (the tabulated "
-                  "sampler), cosine, or auto (whichever has the lower variance in a small pilot "
-                  "rendering of the same scene)")
+                  "sampler), cosine, or auto (the table when the cosine's samples miss energy the "
+                  "table finds, or when the BRDF is peaked for this environment: the cosine's "
+                  "albedo variance at least a threshold times the table's, the threshold higher "
+                  "the less light the environment leaves to the BRDF sampler; else the cosine)")
       ->check(CLI::IsMember({"auto", "table", "cosine"}))
       ->capture_default_str();
   app->add_option("--threads", o->threads, "worker threads (0: all cores)")

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <set>
 #include <string>
@@ -16,6 +17,7 @@
 #include "command.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/loader/load.hpp"
+#include "halfback/study/metric.hpp"
 #include "halfback/study/parts.hpp"
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
@@ -30,10 +32,11 @@ namespace {
 struct StudyOptions {
   std::vector<std::string> specs, merge;
   std::string out = "study";
-  std::string budgets, budgets_4d, environments, params, sampler_kib, fit_budgets;
+  std::string budgets, budgets_4d, environments, params, metrics;
+  std::map<std::string, std::string> metric_options;  // by MetricOption::key, as given
   std::vector<std::string> nielsen_database;  // Nielsen et al.'s database: files, folders, specs
   std::string nielsen_counts;
-  double nielsen_eta = study::NielsenOptions{}.eta;
+  double nielsen_eta = acquire::NielsenOptions{}.eta;
   std::string designs = "own,angle,merl,learned";
   study::StudySettings settings;
   bool resume = false;
@@ -47,10 +50,9 @@ study::StudyConfig make_config(const StudyOptions& o) {
   if (!o.budgets_4d.empty())
     s.budgets_4d = count_list(o.budgets_4d, "--budgets-4d", "sample budget");
   if (!o.environments.empty()) s.environments = split_list(o.environments, "--env", "environment");
-  if (!o.sampler_kib.empty())
-    s.sampler_kib = count_list(o.sampler_kib, "--sampler-kib", "table size");
-  if (!o.fit_budgets.empty())
-    s.fit_budgets = count_list(o.fit_budgets, "--fit-budgets", "sample budget");
+  if (!o.metrics.empty()) s.metrics = split_list(o.metrics, "--metrics", "metric");
+  for (const auto& [key, value] : o.metric_options)
+    if (!value.empty()) s.options[key] = value;
   s.designs = split_list(o.designs, "--designs", "design");
   if (!o.nielsen_counts.empty())
     s.nielsen_counts = count_list(o.nielsen_counts, "--nielsen-counts", "measurement count");
@@ -232,7 +234,7 @@ std::vector<study::LabeledProfile> profile_pass(const std::vector<std::string>& 
                                                 const study::StudyConfig& config, bool resume) {
   // One directory per error space and grid: a profile depends on them, and --resume with other
   // settings (refused) must not leave profiles that a later --resume would take for these.
-  const study::IsoGrid& g = config.profile_grid;
+  const acquire::IsoGrid& g = config.profile_grid;
   const std::filesystem::path dir =
       study::profiles_dir(out) / fmt::format("{}-{}x{}x{}", name_of(config.space), g.a, g.b, g.phi);
   create_output_directory(dir);
@@ -280,28 +282,52 @@ void set_nielsen_database(study::StudyConfig& config, const std::vector<std::str
   if (config.budgets.empty())
     throw UsageError("--nielsen-database: needs the gonio-reflectometer (not --no-gonio)");
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<BrdfPtr> members;
-  for (const std::string& spec : expand_specs(specs)) members.push_back(load_brdf(spec));
-  study::NielsenOptions options;
+  acquire::NielsenOptions options;
   options.max_theta_deg = config.max_theta_deg;
   options.seed = config.seed;
-  options.eta = eta;
-  try {
-    config.nielsen = std::make_shared<study::NielsenDatabase>(
-        std::move(members), options,
-        study::test_pair_directions(config.test_pairs, config.seed, config.max_theta_deg));
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(std::string("--nielsen-database: ") + e.what());
+  options.eta = eta;  // (checked by check_nielsen_options)
+  std::vector<BrdfPtr> members;
+  for (const std::string& spec : expand_specs(specs)) {
+    members.push_back(load_brdf(spec));
+    if (!members.back()->isotropic())
+      throw UsageError(fmt::format(
+          "--nielsen-database '{}': {} is not isotropic (the basis is of isotropic BRDFs)", spec,
+          members.back()->name()));
   }
-  config.nielsen_from = study::nielsen_fingerprint(*config.nielsen);
+  if (members.size() < 2)
+    throw UsageError("--nielsen-database: at least two BRDFs are needed (repeat the option)");
+  // What the database refuses now is in its members' values (one that is not finite): bad data.
+  try {
+    config.nielsen = std::make_shared<acquire::NielsenDatabase>(
+        std::move(members), options,
+        acquire::test_pair_directions(config.test_pairs, config.seed, config.max_theta_deg));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("--nielsen-database: ") + e.what());
+  }
+  const std::size_t candidates = config.nielsen->configurations().size();
+  if (!config.nielsen_counts.empty() && config.nielsen_counts.back() > candidates)
+    throw UsageError(
+        fmt::format("--nielsen-counts: {} measurements asked, Nielsen's database has {} candidate "
+                    "configurations within --max-theta",
+                    config.nielsen_counts.back(), candidates));
+  config.nielsen_from = acquire::nielsen_fingerprint(*config.nielsen);
   fmt::print(stderr,
              "halfback study: Nielsen's database of {} BRDFs ({} configurations) in {:.1f} s\n",
              config.nielsen->members(), config.nielsen->configurations().size(),
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
+// --nielsen-eta is checked whether or not a database is given (it was ignored without one).
+void check_nielsen_options(const StudyOptions& o) {
+  if (!(o.nielsen_eta >= 0))
+    throw UsageError(fmt::format(
+        "--nielsen-eta {}: the Tikhonov weight of Nielsen's reconstruction must be >= 0",
+        o.nielsen_eta));
+}
+
 int run_study(StudyOptions& o) {
   if (o.specs.empty()) throw UsageError("no BRDF given (files, directories or model specs)");
+  check_nielsen_options(o);
   study::StudyConfig config = make_config(o);
   const std::vector<std::string> specs = expand_specs(o.specs);
   create_output_directory(o.out);
@@ -345,6 +371,38 @@ int run_merge(const StudyOptions& o) {
   return kExitOk;
 }
 
+// --metrics, and per metric of the list (study::study_metrics()) that can be turned off, --no-NAME,
+// and its options (--fit-model for the option fit_model).
+void add_metric_options(CLI::App& app, StudyOptions& o) {
+  std::string optional;
+  for (const study::Metric* m : study::study_metrics())
+    if (m->switchable())
+      optional += fmt::format("{}{}{}", optional.empty() ? "" : ", ", m->name(),
+                              m->on_by_default() ? "" : " (not by default)");
+  app.add_option("--metrics", o.metrics,
+                 "Metrics to run, comma-separated: " + optional +
+                     " (default: those run by default; azimuthal and the other metrics without a "
+                     "switch always run)");
+  for (const study::Metric* m : study::study_metrics()) {
+    if (m->switchable()) {
+      const std::string name(m->name());
+      app.add_flag_callback(
+          "--no-" + name, [&o, name] { o.settings.off.push_back(name); },
+          fmt::format("Not the {} metric{}", name,
+                      m->description().empty() ? "" : fmt::format(" ({})", m->description())));
+    }
+    for (const study::MetricOption& option : m->options()) {
+      std::string flag = "--" + option.key;
+      std::replace(flag.begin(), flag.end(), '_', '-');
+      using Kind = study::MetricOption::Kind;
+      app.add_option(flag, o.metric_options[option.key], option.help)
+          ->type_name(option.kind == Kind::count    ? "N"
+                      : option.kind == Kind::counts ? "N,..."
+                                                    : "TEXT");
+    }
+  }
+}
+
 }  // namespace
 
 Command register_study(CLI::App& parent) {
@@ -358,6 +416,7 @@ Command register_study(CLI::App& parent) {
                   "BRDFs: files (MERL, RGL, ALTA, neural BRDF .h5), directories of files, or model "
                   "specs");
   app->add_option("-o,--out", o->out, "Output directory (created if missing)")
+      ->type_name("DIR")
       ->capture_default_str();
   app->add_option("--params", o->params,
                   "Parameterizations compared, comma-separated, in the order of the tables: " +
@@ -403,26 +462,7 @@ Command register_study(CLI::App& parent) {
   app->add_option("--seed", o->settings.seed,
                   "Seed of the test pairs, stratified designs and renderings")
       ->capture_default_str();
-  app->add_flag("--no-gonio", o->settings.no_gonio,
-                "Metrics 1-2 only (no gonio-reflectometer, no images)");
-  app->add_flag("--no-images", o->settings.no_images, "No image-space error");
-  app->add_option("--sampler-kib", o->sampler_kib,
-                  "Sizes of the samplers' tables (tabulated and factored) compared by the sampling "
-                  "metric, KiB, "
-                  "comma-separated (default 64,1024; --quick 64)");
-  app->add_option("--sampler-samples", o->settings.sampler_samples,
-                  "Samples per outgoing direction of the sampling metric (default 4096)")
-      ->check(CLI::Range(std::size_t(2), study::kMaxSamplerSamples));
-  app->add_flag("--no-sampling", o->settings.no_sampling, "No sampling metric");
-  app->add_option("--fit-model", o->settings.fit_model,
-                  "Model of the fit metric, fitted to each design's measurements and to the whole "
-                  "BRDF (default lambert+ggx; docs/study.md)");
-  app->add_option("--fit-loss", o->settings.fit_loss,
-                  "Loss of the fit metric (default ngan; `halfback fit --loss`)");
-  app->add_option("--fit-budgets", o->fit_budgets,
-                  "Measurement budgets of the fit metric, ascending, comma-separated (default "
-                  "1000,10000; --quick 1000)");
-  app->add_flag("--no-fit", o->settings.no_fit, "No fit metric");
+  add_metric_options(*app, *o);
   app->add_option("--nielsen-database", o->nielsen_database,
                   "Nielsen et al. 2015's minimal sampling: the database of its principal "
                   "components, an isotropic BRDF file, folder or spec (repeat the option for "

@@ -8,6 +8,8 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <memory>
@@ -52,16 +54,25 @@ void open_browser(const std::string& url) {
   posix_spawnattr_destroy(&attributes);
 }
 
+// The server stops within this many seconds of a stop signal, whatever it computes.
+constexpr int kStopSeconds = 4;
+
 // Waits for SIGINT/SIGTERM/SIGHUP (blocked in every thread of the process) and stops the server,
-// or returns when `done` is set.
+// or returns when `done` is set. The stop ends every computation that polls its deadline at once;
+// if the server still runs kStopSeconds later (a computation that polls none), or another stop
+// signal comes, the process ends there (std::_Exit, status 0: the stop that was asked for).
 void wait_for_signal(const sigset_t& signals, view::Server& server, const std::atomic<bool>& done) {
   const timespec tick{0, 100'000'000};
   while (!done.load()) {
-    if (sigtimedwait(&signals, nullptr, &tick) > 0) {
-      fmt::print(stderr, "halfback view: stopping\n");
-      server.stop();
-      return;
-    }
+    if (sigtimedwait(&signals, nullptr, &tick) <= 0) continue;
+    fmt::print(stderr, "halfback view: stopping\n");
+    server.stop();
+    for (int k = 0; k < 10 * kStopSeconds && !done.load(); ++k)
+      if (sigtimedwait(&signals, nullptr, &tick) > 0) break;
+    if (done.load()) return;
+    fmt::print(stderr, "halfback view: a request is still being computed; exiting without it\n");
+    std::fflush(nullptr);
+    std::_Exit(kExitOk);
   }
 }
 

@@ -6,16 +6,10 @@
 // stride 1 are written in place, others scattered from scratch. A row-major (m, D) input or
 // output (NumPy's C order) is read or written by the first or last stage itself, transposed in
 // its vector loop, where the kernel table can (fused_rows), and else transposed in one pass. Tiles
-// are grouped into chunks run by oneTBB on up to BatchOptions::threads threads. Every row is
-// computed by the same vector code, in the same lane, whatever the chunking (tiles are whole
+// are grouped into chunks run by core's parallel_for on up to BatchOptions::threads threads. Every
+// row is computed by the same vector code, in the same lane, whatever the chunking (tiles are whole
 // multiples of every vector width), so the result does not depend on the thread count.
 #include "halfback/core/batch.hpp"
-
-#include <tbb/blocked_range.h>
-#include <tbb/info.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
-#include <tbb/task_arena.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -503,8 +497,6 @@ std::size_t aligning_head(std::span<const ConstColumn<T>> in, const ConvertOutpu
   return (kLine - offset) % kLine / sizeof(T);
 }
 
-// Threads available to this process (TBB reads the affinity mask); more would only oversubscribe.
-
 }  // namespace
 
 template <class T>
@@ -544,13 +536,7 @@ void convert(Form from, Form to, std::span<const ConstColumn<T>> in, std::size_t
   }
   // Several chunks per thread, so that a thread slowed down by other work is compensated.
   const std::size_t grain = std::max<std::size_t>(tiles / (threads * 8), 4);
-  tbb::task_arena arena(static_cast<int>(threads));
-  arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, tiles, grain),
-        [&](const tbb::blocked_range<std::size_t>& r) { run_tiles(r.begin(), r.end()); },
-        tbb::simple_partitioner());
-  });
+  parallel_for(tiles, grain, run_tiles, static_cast<int>(threads));
 }
 
 template <class T>

@@ -1,7 +1,8 @@
-// Class 9 of issue 12: every direction pair that the checks accept converts to coordinates that
-// convert back. Accepted directions may be off unit length by up to kUnitTolerance and below the
-// horizon by up to kDomainTolerance; the conversions put them onto the unit upper hemisphere and
-// clamp the magnitudes ‖h̄‖, ‖k̄‖, ‖k‖ into [0, 1] (docs/math.md §6, docs/reliability-bounds.md).
+// docs/reliability/numerics.md, "Every accepted direction pair round-trips": every direction pair
+// that the checks accept converts to coordinates that convert back. Accepted directions may be off
+// unit length by up to kUnitTolerance and below the horizon by up to kDomainTolerance; the
+// conversions put them onto the unit upper hemisphere and clamp the magnitudes ‖h̄‖, ‖k̄‖, ‖k‖ into
+// [0, 1] (docs/math.md §6, docs/reliability/numerics.md).
 #include <gtest/gtest.h>
 
 #include <algorithm>

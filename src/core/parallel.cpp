@@ -16,6 +16,8 @@ int thread_count(int threads) {
     throw std::invalid_argument(
         "threads: " + std::to_string(threads) +
         " is negative (0 = all cores, 1 = the calling thread, n = at most n)");
+  // The threads available to this process (TBB reads the affinity mask): more would only
+  // oversubscribe.
   const int hardware = std::max(1, tbb::info::default_concurrency());
   return threads == 0 ? hardware : std::min(threads, hardware);
 }

@@ -35,6 +35,15 @@ Color viridis(double t) {
   return {out[0], out[1], out[2], 1};
 }
 
+Color diverging(double t) {
+  if (std::isnan(t)) return {t, t, t, 1};
+  static constexpr Color kCool{0.230, 0.299, 0.754}, kWarm{0.706, 0.016, 0.150};
+  t = std::clamp(t, 0.0, 1.0);
+  const Color& end = t < 0.5 ? kCool : kWarm;
+  const double s = std::abs(2 * t - 1);  // 0 at the centre, 1 at either end
+  return {1 + s * (end.r - 1), 1 + s * (end.g - 1), 1 + s * (end.b - 1), 1};
+}
+
 Color coordinate_colour(double u, double v) {
   return {std::clamp(u, 0.0, 1.0), std::clamp(v, 0.0, 1.0), 0.0, 1.0};
 }

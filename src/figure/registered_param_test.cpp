@@ -1,7 +1,8 @@
 // A parameterization defined here, in a test, and registered at run time: it gets the batch
 // conversions, resampling, figure axes and slices, and a tabulated sampler without any other file
-// knowing it (issue 32). Its own maps are checked like the built-in ones: round trips, the
-// Jacobian (1 in these coordinates: dω = d(cos θ) dφ) and the domain.
+// knowing it (docs/architecture.md: a parameterization in a test). Its own maps are checked like
+// the built-in ones: round trips, the Jacobian (1 in these coordinates: dω = d(cos θ) dφ) and the
+// domain.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -64,6 +64,8 @@ double percentile(std::vector<double> v, double p) {
   return v[k];
 }
 
+}  // namespace
+
 std::string power_of_ten_label(double log10_value) {
   const long e = std::lround(std::floor(log10_value + 1e-9));
   const double m = std::pow(10.0, log10_value - double(e));
@@ -72,8 +74,6 @@ std::string power_of_ten_label(double log10_value) {
   if (mi == 1) return fmt::format("10^{{{}}}", exp);
   return fmt::format("{}·10^{{{}}}", mi, exp);
 }
-
-}  // namespace
 
 SliceSample sample_slice(Space space, double azimuth, const Grid& grid, int threads) {
   if (space == Space::dirs) throw std::invalid_argument("slice: dirs is not a parameterization");

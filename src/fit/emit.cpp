@@ -11,13 +11,39 @@
 #include <stdexcept>
 #include <vector>
 
+#include "emit_detail.hpp"
 #include "halfback/core/rgb.hpp"
 #include "halfback/loader/load.hpp"
+#include "halfback/util/text_encoding.hpp"
 
 namespace halfback::fit {
 
 std::string_view name_of(Renderer renderer) {
-  return renderer == Renderer::mitsuba3 ? "mitsuba3" : "pbrt-v4";
+  switch (renderer) {
+    case Renderer::mitsuba3:
+      return "mitsuba3";
+    case Renderer::pbrt_v4:
+      return "pbrt-v4";
+    case Renderer::blender:
+      return "blender";
+    case Renderer::materialx:
+      return "materialx";
+  }
+  return "?";
+}
+
+std::string_view display_name(Renderer renderer) {
+  switch (renderer) {
+    case Renderer::mitsuba3:
+      return "Mitsuba 3";
+    case Renderer::pbrt_v4:
+      return "pbrt-v4";
+    case Renderer::blender:
+      return "Blender (Cycles)";
+    case Renderer::materialx:
+      return "MaterialX";
+  }
+  return "?";
 }
 
 std::optional<Renderer> parse_renderer(std::string_view name) {
@@ -27,7 +53,9 @@ std::optional<Renderer> parse_renderer(std::string_view name) {
 }
 
 std::string renderer_names() {
-  return fmt::format("{}, {}", name_of(Renderer::mitsuba3), name_of(Renderer::pbrt_v4));
+  std::vector<std::string_view> names;
+  for (Renderer r : kRenderers) names.push_back(name_of(r));
+  return fmt::format("{}", fmt::join(names, ", "));
 }
 
 // ---- Schlick's f0 as a conductor --------------------------------------------------------------
@@ -96,7 +124,7 @@ ConductorIor conductor_for_schlick(double f0) {
 
 // ---- The model's terms ----------------------------------------------------------------------
 
-namespace {
+namespace detail {
 
 // A parameter's value in the model: its own when the model holds it, else what the registry
 // says a missing one takes (the parameter it defaults to, or its default).
@@ -121,6 +149,44 @@ Rgb colour_of(const Model& m, std::size_t term, const std::string& name) {
           value_of(m, term, name + "_b")};
 }
 
+std::string unsupported(const Model& m, Renderer r, const std::string& why) {
+  return fmt::format(
+      "--emit {}: '{}' has no {} material: {}. Write the BRDF as a table instead: `halfback "
+      "export-rgl --brdf SPEC -o FILE.bsdf` (read by Mitsuba 3's and pbrt-v4's `measured`; "
+      "docs/formats.md) or `halfback export-merl`",
+      name_of(r), fmt::join(m.terms, "+"), display_name(r), why);
+}
+
+std::string num(double v) {
+  return fmt::format("{}", v);  // the shortest decimal that reads back as the same double
+}
+
+std::string rgb_list(const Rgb& c, const char* sep) {
+  return fmt::format("{}{}{}{}{}", num(c.r), sep, num(c.g), sep, num(c.b));
+}
+
+double isotropic_alpha(const Model& m, std::size_t t, Renderer r) {
+  const bool given_x = holds(m, t, "alpha_x"), given_y = holds(m, t, "alpha_y");
+  const double ax = value_of(m, t, "alpha_x"), ay = value_of(m, t, "alpha_y");
+  if (given_x != given_y || ax != ay)
+    throw std::invalid_argument(unsupported(
+        m, r,
+        "an anisotropic lobe (alpha_x, alpha_y) is not emitted (the renderers orient it by the "
+        "mesh's texture coordinates)"));
+  return ax;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::colour_of;
+using detail::holds;
+using detail::num;
+using detail::rgb_list;
+using detail::unsupported;
+using detail::value_of;
+
 // A microfacet term (ggx or beckmann) at its values.
 struct Lobe {
   bool ggx = true;
@@ -130,25 +196,10 @@ struct Lobe {
   double eta = 0, k = 0;
 };
 
-std::string unsupported(const Model& m, Renderer r, const std::string& why) {
-  return fmt::format(
-      "--emit {}: '{}' has no {} material: {}. Write the BRDF as a table instead: `halfback "
-      "export-rgl --brdf SPEC -o FILE.bsdf` (read by Mitsuba 3's and pbrt-v4's `measured`; "
-      "docs/formats.md) or `halfback export-merl`",
-      name_of(r), fmt::join(m.terms, "+"), r == Renderer::mitsuba3 ? "Mitsuba 3" : "pbrt-v4", why);
-}
-
 Lobe lobe_of(const Model& m, std::size_t t, Renderer r) {
   Lobe lobe;
   lobe.ggx = m.terms[t] == "ggx";
-  const bool given_x = holds(m, t, "alpha_x"), given_y = holds(m, t, "alpha_y");
-  const double ax = value_of(m, t, "alpha_x"), ay = value_of(m, t, "alpha_y");
-  if (given_x != given_y || ax != ay)
-    throw std::invalid_argument(unsupported(
-        m, r,
-        "an anisotropic lobe (alpha_x, alpha_y) is not emitted (the renderers orient it by the "
-        "mesh's texture coordinates)"));
-  lobe.alpha = ax;
+  lobe.alpha = detail::isotropic_alpha(m, t, r);
   lobe.eta = value_of(m, t, "eta");
   lobe.k = value_of(m, t, "k");
   if (lobe.eta == 0 && lobe.k > 0)
@@ -189,14 +240,6 @@ Terms terms_of(const Model& m, Renderer r) {
 }
 
 // ---- Text -----------------------------------------------------------------------------------
-
-std::string num(double v) {
-  return fmt::format("{}", v);  // the shortest decimal that reads back as the same double
-}
-
-std::string rgb_list(const Rgb& c, const char* sep) {
-  return fmt::format("{}{}{}{}{}", num(c.r), sep, num(c.g), sep, num(c.b));
-}
 
 // What one lobe's conversion loses, for the file's comment.
 struct LobeText {
@@ -284,8 +327,21 @@ std::string xml_comment(const Model& m, const std::string& form,
   return "<!-- " + s + "     docs/fit.md, \"Renderer-ready output\" -->\n";
 }
 
+// The name as an XML attribute value: & < > " ' as character references (util's escape_xml, and
+// the apostrophe, which it leaves).
+std::string xml_attribute(std::string_view name) {
+  std::string out;
+  for (const char c : escape_xml(name)) {
+    if (c == '\'')
+      out += "&apos;";
+    else
+      out += c;
+  }
+  return out;
+}
+
 std::string emit_mitsuba(const Model& m, const Terms& t, std::string_view name) {
-  const std::string id = fmt::format("id=\"{}\"", name);
+  const std::string id = fmt::format("id=\"{}\"", xml_attribute(name));
   std::string body, form;
   std::vector<std::string> notes;
   const std::string pad = "        ";
@@ -356,12 +412,40 @@ std::string emit_pbrt(const Model& m, const Terms& t, std::string_view name) {
 
 void check_emittable(const Model& model, Renderer renderer) {
   if (model.terms.empty()) throw std::invalid_argument("--emit: the model has no terms");
+  if (renderer == Renderer::blender || renderer == Renderer::materialx) {
+    detail::check_node_emittable(model, renderer);
+    return;
+  }
   const Terms t = terms_of(model, renderer);
   if (t.lobe) (void)lobe_of(model, *t.lobe, renderer);
 }
 
+void check_material_name(std::string_view name, Renderer renderer) {
+  if (name.empty()) throw std::invalid_argument("material name: empty");
+  if (renderer == Renderer::materialx) {
+    detail::check_materialx_name(name);
+    return;
+  }
+  for (const char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f)
+      throw std::invalid_argument(fmt::format(
+          "material name '{}': a control character (byte {:#04x}; a line break would end the "
+          "{} statement) is not allowed",
+          name.substr(0, 64), u, renderer == Renderer::mitsuba3 ? "XML" : "pbrt-v4"));
+    if (renderer == Renderer::pbrt_v4 && (c == '"' || c == '\\'))
+      throw std::invalid_argument(fmt::format(
+          "material name '{}': '{}' is not allowed in a pbrt-v4 string (it would end or escape "
+          "the quoted name)",
+          name.substr(0, 64), c));
+  }
+}
+
 std::string emit_material(const Model& model, Renderer renderer, std::string_view name) {
+  check_material_name(name, renderer);
   check_emittable(model, renderer);
+  if (renderer == Renderer::blender) return detail::emit_blender(model, name);
+  if (renderer == Renderer::materialx) return detail::emit_materialx(model, name);
   const Terms t = terms_of(model, renderer);
   return renderer == Renderer::mitsuba3 ? emit_mitsuba(model, t, name) : emit_pbrt(model, t, name);
 }

@@ -298,8 +298,8 @@ void record(const std::string& what, double value) {
 
 // ---- Checks -------------------------------------------------------------------------------------
 
-std::string emit(const std::string& spec, Renderer r) {
-  return emit_material(parse_model(spec), r);
+std::string emit(const std::string& spec, Renderer r, std::string_view name = "halfback_fit") {
+  return emit_material(parse_model(spec), r, name);
 }
 
 // Mitsuba's / halfback's ρ where the two lobes differ only in Smith's G: 1 − (1 − G1i)(1 − G1o)
@@ -542,6 +542,17 @@ TEST(Emit, ModelsWithoutARendererMaterialAreRefusedNamingExportRgl) {
       {"ggx+ggx", Renderer::mitsuba3, "single lobe"},
       {"ggx:alpha_x=0.1,alpha_y=0.3", Renderer::mitsuba3, "anisotropic"},
       {"ggx:alpha_x=0.1", Renderer::pbrt_v4, "anisotropic"},
+      {"disney", Renderer::mitsuba3, "no 'disney' lobe"},
+      {"oren-nayar", Renderer::pbrt_v4, "no 'oren-nayar' lobe"},
+      {"ward", Renderer::blender, "no 'ward' lobe"},
+      {"lambert+sheen", Renderer::materialx, "no 'sheen' lobe"},
+      {"beckmann", Renderer::blender, "GGX distribution only"},
+      {"beckmann", Renderer::materialx, "GGX distribution only"},
+      {"ggx:eta=1.5", Renderer::blender, "exact Fresnel"},
+      {"ggx:alpha=2", Renderer::blender, "at most 1"},
+      {"ggx:alpha_x=0.1", Renderer::materialx, "anisotropic"},
+      {"disney:anisotropic=0.5", Renderer::blender, "anisotropic"},
+      {"lambert+disney", Renderer::materialx, "surface shader"},
   };
   for (const Case& c : cases) {
     const Model m = parse_model(c.model);
@@ -563,13 +574,31 @@ TEST(Emit, ModelsWithoutARendererMaterialAreRefusedNamingExportRgl) {
     EXPECT_NO_THROW(check_emittable(parse_model(ok), Renderer::mitsuba3)) << ok;
   for (const char* ok : {"lambert", "ggx", "ggx:alpha_x=0.2,alpha_y=0.2"})
     EXPECT_NO_THROW(check_emittable(parse_model(ok), Renderer::pbrt_v4)) << ok;
+  for (const char* ok : {"lambert", "oren-nayar+ggx+ggx", "disney", "lambert+disney+ggx"})
+    EXPECT_NO_THROW(check_emittable(parse_model(ok), Renderer::blender)) << ok;
+  for (const char* ok : {"lambert+oren-nayar+ggx", "ggx:eta=1.5", "ggx:eta=0.2,k=3", "disney"})
+    EXPECT_NO_THROW(check_emittable(parse_model(ok), Renderer::materialx)) << ok;
+}
+
+// A MaterialX name is an element name; Blender's is a Python string literal, escaped.
+TEST(Emit, NodeGraphNames) {
+  EXPECT_THROW(emit("lambert", Renderer::materialx, "1st"), std::invalid_argument);
+  EXPECT_THROW(emit("lambert", Renderer::materialx, "a-b"), std::invalid_argument);
+  EXPECT_THROW(emit("lambert", Renderer::materialx, "x\"/><evil"), std::invalid_argument);
+  EXPECT_NE(emit("lambert", Renderer::materialx, "_ok9").find("<surfacematerial name=\"_ok9\""),
+            std::string::npos);
+  const std::string py = emit("lambert", Renderer::blender, "a\"b\\c');import os#");
+  EXPECT_NE(py.find("NAME = \"a\\\"b\\\\c');import os#\"\n"), std::string::npos) << py;
+  EXPECT_THROW(emit("lambert", Renderer::blender, "a\nb"), std::invalid_argument);
 }
 
 TEST(Emit, RendererNames) {
   EXPECT_EQ(parse_renderer("mitsuba3"), Renderer::mitsuba3);
   EXPECT_EQ(parse_renderer("pbrt-v4"), Renderer::pbrt_v4);
   EXPECT_EQ(parse_renderer("pbrt"), std::nullopt);
-  EXPECT_EQ(renderer_names(), "mitsuba3, pbrt-v4");
+  EXPECT_EQ(renderer_names(), "mitsuba3, pbrt-v4, blender, materialx");
+  EXPECT_EQ(parse_renderer("blender"), Renderer::blender);
+  EXPECT_EQ(parse_renderer("materialx"), Renderer::materialx);
 }
 
 // The file's comment says where it came from and what is lost.
@@ -581,6 +610,47 @@ TEST(Emit, TheCommentGivesTheSpecAndWhatIsLost) {
   const std::string pbrt = emit("ggx:alpha=0.3,f0=0.5", Renderer::pbrt_v4);
   EXPECT_NE(pbrt.find("|F - F_Schlick| <= "), std::string::npos) << pbrt;
   EXPECT_NE(pbrt.find("\"bool remaproughness\" false"), std::string::npos) << pbrt;
+}
+
+}  // namespace
+}  // namespace halfback::fit
+
+namespace halfback::fit {
+namespace {
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// A material's name cannot add markup or statements: Mitsuba's id is XML-escaped (the file holds
+// the same elements as with a plain name), pbrt's name refuses what would end its quotes or line.
+TEST(Emit, AMaterialNameCannotInjectMarkupOrStatements) {
+  const Model m = parse_model("ggx:alpha=0.3,f0=0.5");
+  const std::string plain = emit_material(m, Renderer::mitsuba3, "metal");
+  const std::string hostile = emit_material(m, Renderer::mitsuba3, "x\"/><bsdf type=\"evil");
+  EXPECT_EQ(count_of(hostile, "<bsdf"), count_of(plain, "<bsdf")) << hostile;
+  EXPECT_EQ(count_of(hostile, "<"), count_of(plain, "<")) << hostile;
+  EXPECT_NE(hostile.find("id=\"x&quot;/&gt;&lt;bsdf type=&quot;evil\""), std::string::npos)
+      << hostile;
+  EXPECT_NE(emit_material(m, Renderer::mitsuba3, "a&b'c").find("id=\"a&amp;b&apos;c\""),
+            std::string::npos);
+  for (const Renderer r : kRenderers) {
+    for (const char* bad : {"x\nAttributeBegin", "x\r", "tab\there", ""})
+      EXPECT_THROW(emit_material(m, r, bad), std::invalid_argument) << name_of(r) << ' ' << bad;
+  }
+  for (const char* bad : {"x\" \"string type\" \"evil", "back\\slash"}) {
+    try {
+      emit_material(m, Renderer::pbrt_v4, bad);
+      ADD_FAILURE() << "pbrt-v4 accepted the name " << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("not allowed in a pbrt-v4 string"), std::string::npos)
+          << e.what();
+    }
+  }
+  const std::string pbrt = emit_material(m, Renderer::pbrt_v4, "my metal <1>");
+  EXPECT_NE(pbrt.find("MakeNamedMaterial \"my metal <1>\"\n"), std::string::npos) << pbrt;
 }
 
 }  // namespace

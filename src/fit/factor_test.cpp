@@ -8,6 +8,8 @@
 #include <cmath>
 #include <fstream>
 
+#include "halfback/brdf/rho_bound.hpp"
+
 #include "halfback/loader/load.hpp"
 #include "halfback/util/format_error.hpp"
 #include "support/test_support.hpp"
@@ -147,6 +149,53 @@ TEST(Factor, BadInputIsRefusedByName) {
   refused(replaced("\"max_log\": [", "\"max_log\": [-1, "), "max_log");
   refused(replaced("\"a\": [", "\"a\": [1, "), "factors.r[0].a");
   refused(replaced("\"phi\": [", "\"phi\": [\"x\", "), "factors.r[0].phi");
+}
+
+// The bound on ρ (brdf/rho_bound.hpp) holds for factored files: ρ_c ≤ exp(M_c) − 1, so a file
+// whose max_log can exceed kMaxRho is refused naming the field (1000 made ρ infinite, 30 made it
+// 1.07e13); a max_log at the bound is accepted and its values stay within it.
+TEST(FactoredFile, MaxLogAboveTheRhoBoundIsRefusedNamingTheField) {
+  FactoredModel m;
+  m.counts = {2, 2, 2};
+  for (auto& terms : m.channels) terms.push_back({{800, 800}, {1, 1}, {1, 1}});
+  const double at_bound = std::log1p(kMaxRho);
+  m.max_log = {at_bound, at_bound, at_bound};
+  const std::string good = factored_text(m);
+  const FactoredBrdf f(parse_factored(good, "good.json"));
+  const Rgb v = f.eval({{0.3, 0.1, std::sqrt(0.9)}, {-0.2, 0.4, std::sqrt(0.8)}});
+  EXPECT_TRUE(std::isfinite(v.r) && v.r <= kMaxRho * (1 + 1e-12)) << v.r;
+  for (const char* max_log : {"30", "1000", "1e300"}) {
+    std::string text = good;  // the first channel's max_log replaced
+    const auto open = text.find('[', text.find("\"max_log\""));
+    ASSERT_NE(open, std::string::npos);
+    text.replace(open + 1, text.find(',', open) - open - 1, max_log);
+    try {
+      (void)parse_factored(text, "big.json");
+      ADD_FAILURE() << "accepted max_log " << max_log;
+    } catch (const FormatError& e) {
+      EXPECT_EQ(e.field(), "max_log[0]") << e.what();
+      EXPECT_NE(e.problem().find("above the bound"), std::string::npos) << e.what();
+    }
+  }
+  m.max_log[1] = 30;
+  EXPECT_THROW((void)factored_text(m), std::invalid_argument);  // nor is one written
+}
+
+// The largest counts a factored file may have (4096 an axis) load: a factored BRDF makes no grid
+// of its cells (4096³ points would be above a resampled grid's limit, which made the file a
+// usage error blamed on the command line).
+TEST(FactoredFile, LargestCountsLoad) {
+  FactoredModel m;
+  m.counts = {4096, 4096, 4096};
+  for (auto& terms : m.channels)
+    terms.push_back({std::vector<double>(4096, 0.5), std::vector<double>(4096, 1.0),
+                     std::vector<double>(4096, 1.0)});
+  m.max_log = {1, 1, 1};
+  const test::TempDir dir;
+  write_factored(dir.path() / "big.json", m);
+  const BrdfPtr b = load_brdf((dir.path() / "big.json").string());
+  const Rgb v = b->eval({{0, 0, 1}, {0, 0, 1}});
+  EXPECT_NEAR(v.r, std::expm1(0.5), 1e-12);
 }
 
 // A BRDF that is NaN somewhere inside the domain: refused, naming the point.

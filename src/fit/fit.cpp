@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <numeric>
@@ -16,6 +17,7 @@
 
 #include "halfback/core/batch.hpp"
 #include "halfback/core/parallel.hpp"
+#include "halfback/fit/sample_limit.hpp"
 #include "halfback/loader/load.hpp"
 
 namespace halfback::fit {
@@ -36,10 +38,36 @@ std::string_view name_of(Loss loss) {
       return "bieron-log";
     case Loss::nielsen:
       return "nielsen";
+    case Loss::bbm_ngan:
+      return "bbm-ngan";
+    case Loss::bbm_low_e1:
+      return "bbm-low-e1";
+    case Loss::bbm_low_e2:
+      return "bbm-low-e2";
+    case Loss::bbm_bieron_l2:
+      return "bbm-bieron-l2";
+    case Loss::bbm_bieron_log:
+      return "bbm-bieron-log";
+    case Loss::bbm_standard_log:
+      return "bbm-standard-log";
     case Loss::log:
       break;
   }
   return "log";
+}
+
+bool is_bbm(Loss loss) {
+  switch (loss) {
+    case Loss::bbm_ngan:
+    case Loss::bbm_low_e1:
+    case Loss::bbm_low_e2:
+    case Loss::bbm_bieron_l2:
+    case Loss::bbm_bieron_log:
+    case Loss::bbm_standard_log:
+      return true;
+    default:
+      return false;
+  }
 }
 
 std::optional<Loss> parse_loss(std::string_view name) {
@@ -69,7 +97,20 @@ double radical_inverse(std::size_t i, std::size_t base) {
 
 }  // namespace
 
-Samples halfdiff_samples(std::size_t n) {
+std::string_view layout_name(Azimuths azimuths) {
+  return azimuths == Azimuths::turned ? kTurnedLayoutName : kLayoutName;
+}
+
+namespace {
+
+// v turned about the normal (z) by the angle whose cosine and sine are c and s.
+Vec3<double> turned(const Vec3<double>& v, double c, double s) {
+  return {c * v.x - s * v.y, s * v.x + c * v.y, v.z};
+}
+
+}  // namespace
+
+Samples halfdiff_samples(std::size_t n, Azimuths azimuths) {
   if (n == 0) throw std::invalid_argument("the number of samples must be positive");
   const Form iso{*space_from_name("halfdiff"), true}, dirs{Space::dirs, false};
   Samples s;
@@ -83,7 +124,13 @@ Samples halfdiff_samples(std::size_t n) {
     double d[6], jac = 0;
     if (!convert_one<double>(iso, dirs, q, d, &jac)) continue;
     if (!(d[2] > 0 && d[5] > 0 && std::isfinite(jac) && jac > 0)) continue;
-    s.pairs.push_back({{d[0], d[1], d[2]}, {d[3], d[4], d[5]}});
+    DirPair<double> pair{{d[0], d[1], d[2]}, {d[3], d[4], d[5]}};
+    if (azimuths == Azimuths::turned) {
+      const double phi = 2 * std::numbers::pi * radical_inverse(i, 7);
+      pair = {turned(pair.wi, std::cos(phi), std::sin(phi)),
+              turned(pair.wo, std::cos(phi), std::sin(phi))};
+    }
+    s.pairs.push_back(pair);
     s.weight.push_back(jac);
     s.cos_i.push_back(d[2]);
     total += jac;
@@ -93,24 +140,105 @@ Samples halfdiff_samples(std::size_t n) {
   return s;
 }
 
+// ---- BBM's grid ----------------------------------------------------------------------------
+
+namespace {
+
+bool is_low(Loss loss) {
+  return loss == Loss::bbm_low_e1 || loss == Loss::bbm_low_e2;
+}
+
+// A grid point (φ, θ) as BBM's spherical::convert makes it, with components of magnitude below
+// the machine epsilon set to 0 (BBM's guard against round-off near zero).
+Vec3<double> grid_direction(double phi, double theta) {
+  const auto snap = [](double x) {
+    return std::abs(x) < std::numeric_limits<double>::epsilon() ? 0.0 : x;
+  };
+  return {snap(std::cos(phi) * std::sin(theta)), snap(std::sin(phi) * std::sin(theta)),
+          snap(std::cos(theta))};
+}
+
+// The elevations 0, step, ..., π/2 of `n` points (BBM divides by max(n − 1, 1)).
+double grid_theta(std::size_t j, std::size_t n) {
+  return double(j) * (std::numbers::pi / 2) / double(std::max<std::size_t>(n, 2) - 1);
+}
+
+double sin_of(const Vec3<double>& v) {
+  return std::sqrt(std::max(1 - v.z * v.z, 0.0));
+}
+
+}  // namespace
+
+BbmGrid default_grid(Loss loss) {
+  if (is_low(loss)) return {36, 17, 1, 17};
+  return {18, 10, 18, 10};
+}
+
+Samples bbm_grid_samples(Loss loss, const BbmGrid& g) {
+  if (!is_bbm(loss))
+    throw std::invalid_argument(
+        fmt::format("loss '{}' is not measured on BBM's grid", name_of(loss)));
+  if (g.in_phi == 0 || g.in_theta == 0 || g.out_phi == 0 || g.out_theta == 0)
+    throw std::invalid_argument("every count of BBM's grid must be positive");
+  if (is_low(loss) && g.out_phi != 1)
+    throw std::invalid_argument(fmt::format(
+        "loss '{}' does not sample the outgoing azimuth: out_phi must be 1", name_of(loss)));
+  // The product in floating point first: counts from outside must not wrap around.
+  const double pairs =
+      double(g.in_phi) * double(g.in_theta) * double(g.out_phi) * double(g.out_theta);
+  check_fit_samples(pairs > double(kMaxFitSamples) ? kMaxFitSamples + 1 : std::size_t(pairs),
+                    "BBM grid pairs");
+  const std::size_t n = std::size_t(pairs);
+  Samples s;
+  s.pairs.reserve(n);
+  s.weight.reserve(n);
+  s.cos_i.reserve(n);
+  const double two_pi = 2 * std::numbers::pi;
+  for (std::size_t a = 0; a < g.in_phi; ++a)
+    for (std::size_t b = 0; b < g.in_theta; ++b) {
+      const Vec3<double> wi =
+          grid_direction(double(a) * two_pi / double(g.in_phi), grid_theta(b, g.in_theta));
+      for (std::size_t c = 0; c < g.out_phi; ++c)
+        for (std::size_t d = 0; d < g.out_theta; ++d) {
+          const Vec3<double> wo =
+              grid_direction(double(c) * two_pi / double(g.out_phi), grid_theta(d, g.out_theta));
+          s.pairs.push_back({wi, wo});
+          s.weight.push_back(is_low(loss) ? sin_of(wi) : sin_of(wi) * sin_of(wo));
+          s.cos_i.push_back(std::max(wi.z, 0.0));
+        }
+    }
+  return s;
+}
+
 // ---- Models --------------------------------------------------------------------------------
 
 namespace {
 
 // Parameters that switch a model's form rather than tune it: held at their default (Schlick
 // Fresnel on the microfacet models) unless the model spec gives them (docs/fit.md).
+// Bagher et al.'s normalisation and shadowing constants are held too (BBM marks them dependent:
+// the paper derives them from α and p by its own fitted approximations, not restated here).
 bool held_by_rule(std::string_view model, std::string_view param) {
+  if (model == "bagher-sgd")
+    for (std::string_view dependent : {"kscale", "lambda", "c", "k", "theta0"})
+      if (param == dependent || (param.size() == dependent.size() + 2 &&
+                                 param.starts_with(dependent) && param[dependent.size()] == '_'))
+        return true;
   return (model == "ggx" || model == "beckmann") && (param == "eta" || param == "k");
 }
 
-// Whether `p` is a grey value whose channels (p_r, p_g, p_b, defaulting to it) the model has.
+// Whether `p` is a grey value whose channels (p_r, p_g, p_b, defaulting to it) the model has;
+// or p_red, p_green, p_blue: channels that may drive every channel of ρ (disney's base colour,
+// through its tints), which channel_of() does not count as colour channels.
 bool has_channels(const ModelInfo& info, const ModelParam& p) {
-  int n = 0;
-  for (const ModelParam& q : info.params)
-    if (q.default_from == p.name &&
-        (q.name == p.name + "_r" || q.name == p.name + "_g" || q.name == p.name + "_b"))
-      ++n;
-  return n == 3;
+  int n = 0, long_names = 0;
+  for (const ModelParam& q : info.params) {
+    if (q.default_from != p.name) continue;
+    n += q.name == p.name + "_r" || q.name == p.name + "_g" || q.name == p.name + "_b";
+    long_names +=
+        q.name == p.name + "_red" || q.name == p.name + "_green" || q.name == p.name + "_blue";
+  }
+  return n == 3 || long_names == 3;
 }
 
 const ModelParam* find_param(const ModelInfo& info, std::string_view name) {
@@ -191,8 +319,9 @@ Model parse_model(std::string_view text) {
         continue;
       }
       // Fitted: numeric parameters that are neither a grey value with channels, nor one that
-      // follows another (alpha_x after alpha: the fitted models are isotropic), nor held by rule.
-      // A channel whose grey value is given follows it (held, not written).
+      // follows another (alpha_x after alpha: a lobe is isotropic unless alpha_x or alpha_y is
+      // given), nor held by rule. A channel whose grey value is given follows it (held, not
+      // written). Parameters without effect are held later, on the fit's samples.
       const ModelParam* source =
           p.default_from.empty() ? nullptr : find_param(info, p.default_from);
       const bool channel = source && has_channels(info, *source);
@@ -238,8 +367,13 @@ std::string spec_of(const Model& m) {
 
 namespace {
 
+// BBM sums its error over the channels and averages over the samples; halfback's loss value is
+// the mean over samples and channels: √3 in a bbm_* residual makes the two the same number.
+const double kSqrt3 = std::sqrt(3.0);
+
 // The residual of one channel of one sample (docs/fit.md, "Losses"): model value m, target t,
-// cos θi ci, cos θo co, sqrt of the sample's solid-angle weight sw.
+// cos θi ci, cos θo co, sqrt of the sample's weight sw (solid-angle weight on halfback's layout,
+// the loss's sine factors on BBM's grid). BBM's log losses do not clamp m at 0: neither do they.
 double residual(Loss loss, double m, double t, double ci, double co, double sw) {
   switch (loss) {
     case Loss::ngan:
@@ -261,6 +395,16 @@ double residual(Loss loss, double m, double t, double ci, double co, double sw) 
       return sw * std::sqrt(ci * co) *
              (std::log1p(c * std::max(m, 0.0) / kEps) - std::log1p(c * t / kEps));
     }
+    case Loss::bbm_ngan:
+    case Loss::bbm_low_e1:
+      return kSqrt3 * sw * ci * (m - t);
+    case Loss::bbm_low_e2:
+    case Loss::bbm_standard_log:
+      return kSqrt3 * sw * (std::log1p(ci * m) - std::log1p(ci * t));
+    case Loss::bbm_bieron_l2:
+      return kSqrt3 * sw * std::sqrt(std::max(co, 0.0)) * ci * (m - t);
+    case Loss::bbm_bieron_log:
+      return kSqrt3 * sw * std::sqrt(std::max(co, 0.0)) * (std::log1p(ci * m) - std::log1p(ci * t));
     case Loss::log:
       break;
   }
@@ -383,13 +527,15 @@ std::vector<std::vector<std::size_t>> difference_groups(const Model& m,
 class FitCost final : public ceres::CostFunction {
  public:
   FitCost(const Model& model, const Blocks& blocks, const Samples& samples,
-          std::span<const Rgb> target, Loss loss, int threads)
+          std::span<const Rgb> target, Loss loss, int threads,
+          const std::function<bool()>& cancelled)
       : model_(model),
         blocks_(blocks),
         s_(samples),
         target_(target),
         loss_(loss),
         threads_(threads),
+        cancelled_(cancelled),
         fixed_(samples.pairs.size(), Rgb{0, 0, 0}),
         terms_(blocks.term.size(), std::vector<Rgb>(samples.pairs.size())),
         sum_(samples.pairs.size()),
@@ -427,19 +573,27 @@ class FitCost final : public ceres::CostFunction {
     eval_all(*load_brdf(term_spec(m, blocks_.term[b])), s_, out, threads_);
   }
 
+  bool stop() const { return cancelled_ && cancelled_(); }
+
+  // False (a failed evaluation, which ends the solve with the callback below) once cancelled.
   bool evaluate(double const* const* values, double* r, double** jacobians) const {
     const std::size_t n = s_.pairs.size(), nb = blocks_.term.size();
     sum_ = fixed_;
     for (std::size_t b = 0; b < nb; ++b) {
+      if (stop()) return false;
       term_values(b, values[b], terms_[b]);
       for (std::size_t i = 0; i < n; ++i) sum_[i] = sum_[i] + terms_[b][i];
     }
     residuals(loss_, s_, target_, sum_, r, threads_);
+    // Residuals that are not finite: a failed evaluation (Ceres shrinks its step).
+    if (!std::all_of(r, r + 3 * n, [](double x) { return std::isfinite(x); })) return false;
     if (!jacobians) return true;
     for (std::size_t b = 0; b < nb; ++b)
       if (jacobians[b])
-        for (const auto& group : groups_[b])
+        for (const auto& group : groups_[b]) {
+          if (stop()) return false;
           difference_columns(b, values[b], group, r, jacobians[b]);
+        }
     return true;
   }
 
@@ -474,11 +628,28 @@ class FitCost final : public ceres::CostFunction {
   std::span<const Rgb> target_;
   Loss loss_;
   int threads_;
+  const std::function<bool()>& cancelled_;  // FitOptions::cancelled: no more evaluations
   std::vector<Rgb> fixed_;
   std::vector<std::vector<std::vector<std::size_t>>> groups_;  // per block
   mutable std::vector<std::vector<Rgb>> terms_;                // scratch, per block
   mutable std::vector<Rgb> sum_, shifted_, shifted_sum_;
   mutable std::vector<double> shifted_r_;
+};
+
+void throw_if_cancelled(const FitOptions& o) {
+  if (o.cancelled && o.cancelled()) throw FitCancelled("the fit was cancelled");
+}
+
+// Ends a solve at the end of an iteration once FitOptions::cancelled says so.
+class CancelCallback final : public ceres::IterationCallback {
+ public:
+  explicit CancelCallback(const std::function<bool()>& cancelled) : cancelled_(cancelled) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return cancelled_ && cancelled_() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::function<bool()>& cancelled_;
 };
 
 struct Solved {
@@ -498,7 +669,9 @@ Solved solve_from(const Model& start, const Samples& s, std::span<const Rgb> tar
   ceres::Problem problem;
   std::vector<double*> ptrs;
   for (auto& v : x) ptrs.push_back(v.data());
-  problem.AddResidualBlock(new FitCost(start, blocks, s, target, o.loss, o.threads), nullptr, ptrs);
+  throw_if_cancelled(o);
+  problem.AddResidualBlock(new FitCost(start, blocks, s, target, o.loss, o.threads, o.cancelled),
+                           nullptr, ptrs);
   for (std::size_t b = 0; b < x.size(); ++b)
     for (std::size_t j = 0; j < x[b].size(); ++j) {
       const Param& p = start.params[blocks.params[b][j]];
@@ -513,13 +686,19 @@ Solved solve_from(const Model& start, const Samples& s, std::span<const Rgb> tar
   options.parameter_tolerance = 1e-10;
   options.logging_type = ceres::SILENT;
   options.num_threads = 1;  // the residuals run on the project's parallel loop
+  CancelCallback cancel(o.cancelled);
+  options.callbacks.push_back(&cancel);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
+  throw_if_cancelled(o);
   Solved out{start, 0, int(summary.iterations.size())};
   for (std::size_t b = 0; b < x.size(); ++b)
     for (std::size_t j = 0; j < x[b].size(); ++j)
       out.model.params[blocks.params[b][j]].value = x[b][j];
   out.loss = loss_value(target, *load_brdf(spec_of(out.model)), o.loss, s, o.threads);
+  // A solution whose loss is not a number (a log loss of a model below −1/cos θi, an overflow)
+  // loses to every other.
+  if (std::isnan(out.loss)) out.loss = std::numeric_limits<double>::infinity();
   return out;
 }
 
@@ -753,25 +932,189 @@ void check_target(std::span<const Rgb> v, const Samples& s) {
     throw FitDataError(fmt::format("the target BRDF is zero at all {} samples", v.size()));
 }
 
+// The samples a fit uses: within reach (θi and θo ≤ max_theta) and measured (no NaN channel),
+// their weights scaled back to mean 1; and how many were left out of each kind. Infinite and
+// negative values stay, for check_target() to refuse: they are not a missing measurement.
+struct Usable {
+  Samples samples;
+  std::vector<Rgb> target;
+  std::size_t missing = 0, out_of_reach = 0;
+};
+
+Usable usable_samples(const Samples& s, std::span<const Rgb> t, double max_theta) {
+  if (!(max_theta > 0 && max_theta <= std::numbers::pi / 2))
+    throw std::invalid_argument(
+        fmt::format("max_theta = {} rad: the reach must be in (0, pi/2]", max_theta));
+  // cos θ ≥ cos(max_theta), with π/2 keeping every pair (cos(π/2) is 6e-17, not 0).
+  const double min_cos = max_theta >= std::numbers::pi / 2 ? 0.0 : std::cos(max_theta);
+  Usable u;
+  double total = 0;
+  for (std::size_t i = 0; i < s.pairs.size(); ++i) {
+    const DirPair<double>& p = s.pairs[i];
+    if (p.wi.z < min_cos || p.wo.z < min_cos) {
+      ++u.out_of_reach;
+      continue;
+    }
+    if (std::isnan(t[i].r) || std::isnan(t[i].g) || std::isnan(t[i].b)) {
+      ++u.missing;
+      continue;
+    }
+    u.samples.pairs.push_back(p);
+    u.samples.weight.push_back(s.weight[i]);
+    u.samples.cos_i.push_back(s.cos_i[i]);
+    u.target.push_back(t[i]);
+    total += s.weight[i];
+  }
+  if (u.target.empty())
+    throw FitDataError(fmt::format(
+        "no sample left to fit: of {}, {} are out of reach (max_theta = {:.4g} deg) and {} "
+        "missing (NaN)",
+        s.pairs.size(), u.out_of_reach, max_theta * 180 / std::numbers::pi, u.missing));
+  if (u.missing || u.out_of_reach) {
+    const double scale = double(u.target.size()) / total;
+    for (double& w : u.samples.weight) w *= scale;
+  }
+  return u;
+}
+
 }  // namespace
 
-double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t samples, int threads) {
-  const Samples s = halfdiff_samples(samples);
+double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t samples, int threads,
+               std::optional<BbmGrid> grid) {
+  const Samples s = is_bbm(loss) ? bbm_grid_samples(loss, grid.value_or(default_grid(loss)))
+                                 : halfdiff_samples(samples, model.isotropic() ? Azimuths::canonical
+                                                                               : Azimuths::turned);
   std::vector<Rgb> t(s.pairs.size());
   eval_all(target, s, t, threads);
   check_target(t, s);
   return loss_value(t, model, loss, s, threads);
 }
 
+// ---- What the model can do: anisotropy, parameters without effect, dead lobes ---------------
+
 namespace {
+
+// Term t of `m` as a BRDF; null when the model refuses the values.
+BrdfPtr term_brdf(const Model& m, std::size_t t) {
+  try {
+    return load_brdf(term_spec(m, t));
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+// `m` with parameter i at `value`.
+Model moved(const Model& m, std::size_t i, double value) {
+  Model out = m;
+  out.params[i].value = value;
+  return out;
+}
+
+// The values of term t of `m` at `pairs`; empty when the model refuses the values.
+std::vector<Rgb> term_values_at(const Model& m, std::size_t t,
+                                std::span<const DirPair<double>> pairs) {
+  const BrdfPtr b = term_brdf(m, t);
+  std::vector<Rgb> v;
+  if (!b) return v;
+  v.reserve(pairs.size());
+  for (const DirPair<double>& p : pairs) v.push_back(b->eval(p));
+  return v;
+}
+
+// Whether moving parameter i to 25 % or 75 % of its range changes its term at `probe` (a value
+// the model refuses counts as a change: the parameter matters).
+bool has_effect(const Model& m, std::size_t i, std::span<const DirPair<double>> probe) {
+  const Param& p = m.params[i];
+  const std::vector<Rgb> base = term_values_at(m, p.term, probe);
+  for (double q : {0.25, 0.75}) {
+    const std::vector<Rgb> v =
+        term_values_at(moved(m, i, p.min + q * (p.max - p.min)), p.term, probe);
+    if (base.empty() || v != base) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool can_be_anisotropic(const Model& model) {
+  const auto anisotropic = [](const Model& m, std::size_t t) {
+    const BrdfPtr b = term_brdf(m, t);
+    return b && !b->isotropic();
+  };
+  for (std::size_t t = 0; t < model.terms.size(); ++t)
+    if (anisotropic(model, t)) return true;
+  for (std::size_t i = 0; i < model.params.size(); ++i) {
+    const Param& p = model.params[i];
+    if (p.fitted && (anisotropic(moved(model, i, at_quantile(p, 0.1)), p.term) ||
+                     anisotropic(moved(model, i, at_quantile(p, 0.9)), p.term)))
+      return true;
+  }
+  return false;
+}
+
+Model hold_parameters_without_effect(Model model, const Samples& samples) {
+  // 512 pairs spread over the samples (every k-th): a prefix of BBM's grid, ordered by ωi's
+  // azimuth, holds no mirror pair, where a sharp lobe is all it is.
+  const std::size_t stride = std::max<std::size_t>(samples.pairs.size() / 512, 1);
+  std::vector<DirPair<double>> probe;
+  for (std::size_t i = 0; i < samples.pairs.size() && probe.size() < 512; i += stride)
+    probe.push_back(samples.pairs[i]);
+  for (std::size_t i = 0; i < model.params.size(); ++i)
+    if (model.params[i].fitted && !has_effect(model, i, probe)) model.params[i].fitted = false;
+  return model;
+}
+
+namespace {
+
+// Each term's share of the sum's albedo (Σ w cos θi ρ̄ over `s`, ρ̄ the mean of the channels; a
+// sum that is 0 everywhere: every share 0), the loss of the sum without it, and whether it is a
+// dead lobe (FitResult::dead). Each term is evaluated twice: nothing per term is kept.
+void report_terms(FitResult& r, const Samples& s, std::span<const Rgb> target, int threads) {
+  const std::size_t n = s.pairs.size(), terms = r.model.terms.size();
+  std::vector<double> integral(terms, 0.0);
+  std::vector<Rgb> v(n), sum(n, Rgb{0, 0, 0}), others(n);
+  for (std::size_t t = 0; t < terms; ++t) {
+    eval_all(*load_brdf(term_spec(r.model, t)), s, v, threads);
+    for (std::size_t i = 0; i < n; ++i) {
+      integral[t] += s.weight[i] * s.cos_i[i] * (v[i].r + v[i].g + v[i].b) / 3;
+      sum[i] = sum[i] + v[i];
+    }
+  }
+  const double total = std::accumulate(integral.begin(), integral.end(), 0.0);
+  std::vector<double> res(3 * n);
+  for (std::size_t t = 0; t < terms; ++t) {
+    eval_all(*load_brdf(term_spec(r.model, t)), s, v, threads);
+    for (std::size_t i = 0; i < n; ++i) others[i] = sum[i] - v[i];
+    residuals(r.loss, s, target, others, res.data(), threads);
+    r.albedo_share.push_back(total > 0 ? integral[t] / total : 0.0);
+    r.loss_without.push_back(mean_square(res));
+    r.dead.push_back(r.albedo_share.back() < kDeadLobeShare ||
+                     r.loss_without.back() <= (1 + kDeadLobeLoss) * r.loss_value);
+  }
+}
+
+bool any_fitted(const Model& model) {
+  return std::any_of(model.params.begin(), model.params.end(),
+                     [](const Param& p) { return p.fitted; });
+}
 
 Model fittable_model(std::string_view model_spec) {
   Model model = parse_model(model_spec);
-  if (std::none_of(model.params.begin(), model.params.end(),
-                   [](const Param& p) { return p.fitted; }))
+  if (!any_fitted(model))
     throw std::invalid_argument(
         fmt::format("model '{}': every parameter is given, nothing to fit", model_spec));
   return model;
+}
+
+// `model` with its parameters without effect at `s` held; std::invalid_argument when none is left.
+Model effective_model(const Model& model, const Samples& s, std::string_view model_spec) {
+  Model out = hold_parameters_without_effect(model, s);
+  if (!any_fitted(out))
+    throw std::invalid_argument(fmt::format(
+        "model '{}': no parameter left to fit (the others are given, held by rule or have no "
+        "effect, docs/fit.md)",
+        model_spec));
+  return out;
 }
 
 FitResult best_of(const std::vector<Solved>& solved, std::size_t samples, std::size_t starts,
@@ -794,19 +1137,33 @@ FitResult best_of(const std::vector<Solved>& solved, std::size_t samples, std::s
 
 FitResult fit(const Brdf& target, std::string_view model_spec, const FitOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
-  const Model model = fittable_model(model_spec);
+  check_fit_samples(o.samples, "samples");  // every caller's bound, not only the CLI's
+  const Model parsed = fittable_model(model_spec);
+  const Azimuths azimuths = can_be_anisotropic(parsed) ? Azimuths::turned : Azimuths::canonical;
+  const Samples s = is_bbm(o.loss) ? bbm_grid_samples(o.loss, o.grid.value_or(default_grid(o.loss)))
+                                   : halfdiff_samples(o.samples, azimuths);
+  const Model model = effective_model(parsed, s, model_spec);
   std::vector<Model> starts;
   for (const std::string& spec : o.starts) starts.push_back(start_from_spec(model, spec));
   if (!target.isotropic())
     throw FitDataError(
-        "the target BRDF is anisotropic: the fit samples the isotropic coordinates at one pose "
-        "and fits isotropic models (alpha_x = alpha_y), so it refuses anisotropic targets");
-  const Samples s = halfdiff_samples(o.samples);
-  std::vector<Rgb> t(s.pairs.size());
-  eval_all(target, s, t, o.threads);
-  check_target(t, s);
+        "the target BRDF is anisotropic: the fit samples the isotropic coordinates and fits "
+        "models whose roughness is isotropic unless given, so it refuses anisotropic targets");
+  std::vector<Rgb> all(s.pairs.size());
+  eval_all(target, s, all, o.threads);
+  const Usable u = usable_samples(s, all, o.max_theta);
+  check_target(u.target, u.samples);
+  throw_if_cancelled(o);
   if (starts.empty()) starts = automatic_starts(model, &target);
-  return best_of(solve_starts(starts, s, t, true, o), s.pairs.size(), starts.size(), o.loss, t0);
+  // The kept samples in the layout's order: a prefix of them is still spread as the layout's.
+  // BBM's grid is ordered by ωi's azimuth: its prefix is not a layout, a random subset is.
+  FitResult r = best_of(solve_starts(starts, u.samples, u.target, !is_bbm(o.loss), o),
+                        u.target.size(), starts.size(), o.loss, t0);
+  r.layout = is_bbm(o.loss) ? kBbmGridLayoutName : layout_name(azimuths);
+  r.missing = u.missing;
+  r.out_of_reach = u.out_of_reach;
+  report_terms(r, u.samples, u.target, o.threads);
+  return r;
 }
 
 FitResult fit_at(const Samples& samples, std::span<const Rgb> values, std::string_view model_spec,
@@ -817,12 +1174,19 @@ FitResult fit_at(const Samples& samples, std::span<const Rgb> values, std::strin
     throw std::invalid_argument(fmt::format(
         "fit_at: {} pairs, {} weights, {} cosines and {} values: not one of each per pair", n,
         samples.weight.size(), samples.cos_i.size(), values.size()));
-  const Model model = fittable_model(model_spec);
+  const Model model = effective_model(fittable_model(model_spec), samples, model_spec);
   std::vector<Model> starts;
   for (const std::string& spec : o.starts) starts.push_back(start_from_spec(model, spec));
-  check_target(values, samples);
+  const Usable u = usable_samples(samples, values, o.max_theta);
+  check_target(u.target, u.samples);
   if (starts.empty()) starts = automatic_starts(model, nullptr);
-  return best_of(solve_starts(starts, samples, values, false, o), n, starts.size(), o.loss, t0);
+  FitResult r = best_of(solve_starts(starts, u.samples, u.target, false, o), u.target.size(),
+                        starts.size(), o.loss, t0);
+  r.layout = "given";
+  r.missing = u.missing;
+  r.out_of_reach = u.out_of_reach;
+  report_terms(r, u.samples, u.target, o.threads);
+  return r;
 }
 
 }  // namespace halfback::fit

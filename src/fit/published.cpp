@@ -11,6 +11,7 @@
 
 #include "halfback/util/bounded_read.hpp"
 #include "halfback/util/format_error.hpp"
+#include "halfback/util/text_encoding.hpp"
 
 namespace halfback::fit {
 
@@ -39,8 +40,18 @@ class LineReader {
   }
   void expect(char c) {
     if (!accept(c))
-      fail(pos_ < text_.size() ? fmt::format("expected '{}', found '{}'", c, text_[pos_])
+      fail(pos_ < text_.size() ? fmt::format("expected '{}', found {}", c, found())
                                : fmt::format("expected '{}' at the end of the line", c));
+  }
+  // The character at the cursor, quoted and whole (all the bytes of a UTF-8 sequence, not its
+  // first: a message must be UTF-8, or Python shows the exception without its text; invalid
+  // bytes as U+FFFD).
+  std::string found() const {
+    std::size_t end = pos_ + 1;
+    while (end < text_.size() && (static_cast<unsigned char>(text_[end]) & 0xC0) == 0x80) ++end;
+    const std::string c = "'" + valid_utf8(text_.substr(pos_, end - pos_)) + "'";
+    if (static_cast<unsigned char>(text_[pos_]) < 0x80) return c;
+    return c + " (names are of ASCII letters, digits, '_' and '-')";
   }
   // A name: letters, digits, '_', '-' (material names such as "blue-acrylic").
   std::string name(const char* what) {
@@ -61,8 +72,30 @@ class LineReader {
     pos_ += std::size_t(end - first);
     return v;
   }
+  // A number, a list [a, b, ...], or a list of lists of one length ([[a, b], [c, d]]: Bagher et
+  // al.'s complex indices), read row by row into one list.
   std::vector<double> value() {
     if (!accept('[')) return {number()};
+    skip_space();
+    if (pos_ < text_.size() && text_[pos_] == '[') {
+      std::vector<double> v = row();
+      const std::size_t width = v.size();
+      while (accept(',')) {
+        const std::vector<double> r = row();
+        if (r.size() != width)
+          fail(fmt::format("a row of {} numbers where the first had {}", r.size(), width));
+        v.insert(v.end(), r.begin(), r.end());
+      }
+      expect(']');
+      return v;
+    }
+    std::vector<double> v{number()};
+    while (accept(',')) v.push_back(number());
+    expect(']');
+    return v;
+  }
+  std::vector<double> row() {
+    expect('[');
     std::vector<double> v{number()};
     while (accept(',')) v.push_back(number());
     expect(']');
@@ -154,6 +187,12 @@ std::string_view registry_name_of(std::string_view bbm_model) {
       {"NganCookTorrance", "cook-torrance"},
       {"NganAshikhminShirley", "ashikhmin-shirley"},
       {"NganHe", "he"},
+      // Löw et al. 2012's and Bagher et al. 2012's (models/published_lobes.hpp).
+      {"LowCookTorrance", "low-cook-torrance"},
+      {"LowAshikhminShirley", "low-ashikhmin-shirley"},
+      {"LowSmooth", "low-smooth"},
+      {"LowMicrofacetFit", "low-microfacet"},
+      {"Bagher", "bagher-sgd"},
   };
   for (const auto& [bbm, ours] : kNames)
     if (bbm == bbm_model) return ours;
@@ -162,8 +201,11 @@ std::string_view registry_name_of(std::string_view bbm_model) {
 
 namespace {
 
-std::string parameter_name(std::string_view bbm) {
-  if (bbm == "fresnelReflectance") return "f0";
+// The registry's name of BBM's parameter `bbm` of `model` (a registry name).
+std::string parameter_name(std::string_view model, std::string_view bbm) {
+  // Löw's Ashikhmin–Shirley gives its index of refraction the name of Ngan's Schlick F0.
+  if (bbm == "fresnelReflectance") return model == "low-ashikhmin-shirley" ? "eta" : "f0";
+  if (model == "bagher-sgd" && bbm == "K") return "kscale";  // "k" is another parameter
   std::string name(bbm);
   for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
   return name;
@@ -181,8 +223,16 @@ std::string term_spec(const PublishedLobe& lobe, const PublishedFit& fit) {
     separator = ',';
   };
   for (const auto& [key, values] : lobe.params) {
-    const std::string name = parameter_name(key);
-    if (values.size() == 1) {
+    const std::string name = parameter_name(model, key);
+    if (model == "bagher-sgd" && key == "eta" && values.size() == 6) {
+      // Bagher et al.'s Fresnel pair [[F0 r, g, b], [F1 r, g, b]] (BBM's vec2d of spectra).
+      const char* rows[] = {"f0", "f1"};
+      for (int row = 0; row < 2; ++row) {
+        add(std::string(rows[row]) + "_r", values[3 * row]);
+        add(std::string(rows[row]) + "_g", values[3 * row + 1]);
+        add(std::string(rows[row]) + "_b", values[3 * row + 2]);
+      }
+    } else if (values.size() == 1) {
       add(name, values[0]);
     } else if (values.size() == 3) {
       add(name + "_r", values[0]);

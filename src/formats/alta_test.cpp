@@ -197,9 +197,9 @@ TEST(AltaEval, OutsideTheDataAndCoordinates) {
   EXPECT_TRUE(std::isnan(b.eval({{0, 0, std::nan("")}, {0, 0, 1}}).r));
 }
 
-// Class 6 of docs/reliability-readers.md: a negative sample is a measurement of 0 with noise; it
-// is read as 0, counted, and no evaluation (at it or between samples) is negative. Where there is
-// no sample, ρ is missing (NaN), as above.
+// docs/reliability/readers.md, "Missing and negative measurements": a negative sample is a
+// measurement of 0 with noise; it is read as 0, counted, and no evaluation (at it or between
+// samples) is negative. Where there is no sample, ρ is missing (NaN), as above.
 double dips_below_zero(double, double px, double) {
   return px > 0.2 ? -0.003 : 0.5;
 }
@@ -332,8 +332,9 @@ TEST(AltaPublished, CosineFactorEvidence) {
   EXPECT_GT(r87, 0.4 * r81);  // ρ itself does not collapse
 }
 
-// Class 4 of docs/reliability-readers.md: ALTA text declares no sizes, so what the reader holds
-// grows with the lines it has read; a real file costs a small multiple of its size.
+// docs/reliability/readers.md, "Nothing is allocated from a size a file declares before the file is
+// checked to hold it": ALTA text declares no sizes, so what the reader holds grows with the lines
+// it has read; a real file costs a small multiple of its size.
 TEST(AltaAllocation, BoundedByTheFile) {
   HALFBACK_REQUIRE_SHARED(dir, "alta");
   const auto real = dir / "retro-orange-tape-dense.dat";
@@ -347,7 +348,7 @@ TEST(AltaAllocation, BoundedByTheFile) {
   EXPECT_LT(small.growth(), 64 * text.size() + 4096) << small.growth();
 }
 
-// Class B of issue 35 (docs/reliability-round3-readers.md): a sample whose ρ is above the bound
+// docs/reliability/readers.md, "One bound on a BRDF's value": a sample whose ρ is above the bound
 // on a BRDF's value (a value of 1e308 gave "max ρ: inf" and then vanished from the albedo as
 // unmeasured) is refused, naming the line; with the cosine factor, on ρ = value / cos θv.
 TEST(AltaBound, SampleAboveTheBoundIsRefused) {
@@ -366,9 +367,9 @@ TEST(AltaBound, SampleAboveTheBoundIsRefused) {
                       "above the bound of 1e+10");
 }
 
-// Class C of issue 35: a text file is read line by line; the zeros of a file extended past its
-// end (truncate -s) are binary data, refused at the first line that holds one, without reading
-// the rest.
+// docs/reliability/readers.md, "A reader reads what the file's header declares, and nothing more":
+// a text file is read line by line; the zeros of a file extended past its end (truncate -s) are
+// binary data, refused at the first line that holds one, without reading the rest.
 TEST(AltaTrailingData, NulBytesAreRefusedWithoutReadingTheRest) {
   test::TempDir tmp;
   const std::string text =

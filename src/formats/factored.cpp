@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "halfback/brdf/rho_bound.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/format_error.hpp"
@@ -22,16 +23,29 @@ constexpr std::size_t kMaxCells = 4096, kMaxRank = 64;
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t(64) << 20;
 constexpr const char* kChannels[3] = {"r", "g", "b"};
 
+// The largest M_c: ρ_c ≤ exp(M_c) − 1, so a file whose M_c is above log(1 + kMaxRho) can hold
+// values above the bound on a BRDF's value (brdf/rho_bound.hpp).
+const double kMaxLog = std::log1p(kMaxRho);
+
+// The bound's message for a channel's M_c above kMaxLog ("" when within).
+std::string max_log_problem(double max_log) {
+  if (!(max_log > kMaxLog)) return {};
+  return rho_above_bound(std::expm1(max_log), "its largest, exp(max_log) − 1");
+}
+
 void check_model(const FactoredModel& m) {
   if (m.space.is_dirs()) throw std::invalid_argument("factored BRDF: dirs is no parameterization");
   for (std::size_t n : m.counts)
     if (n < 1 || n > kMaxCells)
       throw std::invalid_argument(
           fmt::format("factored BRDF: {} cells on an axis: expected 1 to {}", n, kMaxCells));
-  for (double x : m.max_log)
+  for (double x : m.max_log) {
     if (!(std::isfinite(x) && x >= 0))
       throw std::invalid_argument(
           "factored BRDF: a channel's largest log value is not finite and >= 0");
+    if (const std::string problem = max_log_problem(x); !problem.empty())
+      throw std::invalid_argument("factored BRDF: max_log: " + problem);
+  }
   if (m.rank() < 1 || m.rank() > kMaxRank)
     throw std::invalid_argument(
         fmt::format("factored BRDF: rank {}: expected 1 to {}", m.rank(), kMaxRank));
@@ -61,7 +75,10 @@ GridSpec FactoredModel::grid() const {
 
 FactoredBrdf::FactoredBrdf(FactoredModel model) : model_(std::move(model)) {
   check_model(model_);
-  grid_ = model_.grid();
+  // Only the axes' ranges and counts are used (no grid point is made): a grid of one point
+  // given the file's counts, which may make more points than a resampled grid may hold.
+  grid_ = default_grid(model_.space, GridKind::isotropic, {1, 1, 1});
+  for (std::size_t axis = 0; axis < 3; ++axis) grid_.axes[axis].count = model_.counts[axis];
 }
 
 std::string FactoredBrdf::description() const {
@@ -187,6 +204,8 @@ FactoredModel parse_factored(std::string_view text, const std::string& source) {
   const std::vector<double> max_log = factor_values(j, "max_log", 3, source, "");
   for (std::size_t c = 0; c < 3; ++c) {
     if (max_log[c] < 0) throw FormatError(source, "max_log", "negative");
+    if (const std::string problem = max_log_problem(max_log[c]); !problem.empty())
+      throw FormatError(source, fmt::format("max_log[{}]", c), problem);
     m.max_log[c] = max_log[c];
   }
   const nlohmann::json& factors = field(j, "factors", source);

@@ -327,9 +327,47 @@ std::shared_ptr<const MerlBrdf> load_merl(const std::filesystem::path& path, Mer
 // Writer
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+std::optional<DirPair<double>> valid_pair(const std::array<double, 3>& q) {
+  const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{q[0], 0.0, q[1], q[2]});
+  if (!s.in_domain) return std::nullopt;
+  return s.pair;
+}
+
+}  // namespace
+
+// The pair a bin's value is tabulated at: its centre where that is a valid configuration (both
+// directions above the horizon); else, where some of the bin is valid, the point of its valid
+// part midway between the bin's most valid corner and the horizon on the segment from that corner
+// to the centre. Both directions are above the horizon where cos θh cos θd > sin θh sin θd
+// |cos φd| (φh = 0), which is largest at the bin's smallest θh and θd and its φd nearest π/2: the
+// bin holds valid pairs iff that corner is valid, and a valid pair of the bin is looked up in it.
+// Bins with no valid pair give nullopt.
+std::optional<DirPair<double>> merl_bin_pair(int th, int td, int pd) {
+  const std::array<double, 3> centre = merl::bin_centre(th, td, pd);
+  if (auto pair = valid_pair(centre)) return pair;
+  const double u = double(th) / merl::kThetaH;
+  const double phi_lo = double(pd) / merl::kPhiD * kPi, phi_hi = double(pd + 1) / merl::kPhiD * kPi;
+  const std::array<double, 3> corner = {u * u * (kPi / 2), double(td) / merl::kThetaD * (kPi / 2),
+                                        std::clamp(kPi / 2, phi_lo, phi_hi)};
+  if (!valid_pair(corner)) return std::nullopt;
+  auto at = [&](double t) {
+    std::array<double, 3> q;
+    for (int k = 0; k < 3; ++k) q[k] = corner[k] + t * (centre[k] - corner[k]);
+    return q;
+  };
+  double valid = 0, invalid = 1;  // bisection for the horizon on the segment
+  for (int i = 0; i < 48; ++i) {
+    const double mid = 0.5 * (valid + invalid);
+    (valid_pair(at(mid)) ? valid : invalid) = mid;
+  }
+  return valid_pair(at(0.5 * valid));
+}
+
 MerlData tabulate_merl(const Brdf& brdf) {
   // The φh = 0 slice of an anisotropic BRDF would be read back as the whole BRDF: refuse, as the
-  // RGL writer does (issue 35, class L).
+  // RGL writer does (docs/reliability/readers.md, "Missing and negative measurements").
   if (!brdf.isotropic())
     throw std::invalid_argument(brdf.name() +
                                 " is anisotropic: a MERL file holds an isotropic BRDF only (its "
@@ -347,10 +385,9 @@ MerlData tabulate_merl(const Brdf& brdf) {
     where.clear();
     for (int td = 0; td < merl::kThetaD; ++td) {
       for (int pd = 0; pd < merl::kPhiD; ++pd) {
-        const auto c = merl::bin_centre(th, td, pd);
-        const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{c[0], 0.0, c[1], c[2]});
-        if (!s.in_domain) continue;  // a direction below the horizon: left unmeasured (-1)
-        pairs.push_back(s.pair);
+        const std::optional<DirPair<double>> pair = merl_bin_pair(th, td, pd);
+        if (!pair) continue;  // no valid pair is looked up in this bin: left unmeasured (-1)
+        pairs.push_back(*pair);
         where.push_back(merl::bin(th, td, pd));
       }
     }

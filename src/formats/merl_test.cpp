@@ -848,13 +848,21 @@ TEST(MerlWriter, RoundTripAtBinCentres) {
         const auto c = merl::bin_centre(th, td, pd);
         const Solved<double> s = inverse<HalfDiff>(Tuple4<double>{c[0], 0.0, c[1], c[2]});
         const std::size_t i = merl::bin(th, td, pd);
-        if (!s.in_domain) {
+        const std::optional<DirPair<double>> at = merl_bin_pair(th, td, pd);
+        if (s.in_domain) {
+          ASSERT_TRUE(at.has_value());
+          EXPECT_EQ(at->wi.x, s.pair.wi.x);  // a valid centre is where the bin is tabulated
+          EXPECT_EQ(at->wo.z, s.pair.wo.z);
+        }
+        if (!at) {
           ++invalid;
-          EXPECT_EQ(back.values[i], -1.0);  // unmeasurable configuration: written as missing
+          EXPECT_EQ(back.values[i], -1.0);  // no valid pair in the bin: written as missing
           continue;
         }
         ++valid;
-        const Rgb want = model.eval(s.pair), got = brdf.eval(s.pair);
+        const merl::BinIndex b = merl::bin_of(*at);  // the pair is looked up in its own bin
+        EXPECT_EQ(merl::bin(b.theta_h, b.theta_d, b.phi_d), i) << th << " " << td << " " << pd;
+        const Rgb want = model.eval(*at), got = brdf.eval(*at);
         EXPECT_NEAR(got.r, want.r, 1e-14 * want.r) << th << " " << td << " " << pd;
         EXPECT_NEAR(got.g, want.g, 1e-14 * want.g);
         EXPECT_NEAR(got.b, want.b, 1e-14 * want.b);
@@ -867,16 +875,52 @@ TEST(MerlWriter, RoundTripAtBinCentres) {
   EXPECT_EQ(table.values, back.values);
 }
 
-// Class 6 of docs/reliability-readers.md: an exported model read back gives, at a configuration
-// whose bin centre is below the horizon (θi = 89.9°, θo = 80°, Δφ = 90°), a missing value (NaN),
-// not the -1 mark times the scale (-0.000667); and no lookup anywhere gives a negative ρ.
-TEST(MerlMissing, UnmeasuredBinsAreNaNNeverNegative) {
+// A written file has no holes: every valid pair, grazing ones included, finds a value (nearest
+// and trilinear). The bins whose centre is below the horizon but which hold valid pairs were
+// written as -1: 4-6 of 100 000 cosine-distributed pairs, and (θi = 89.9°, θo = 80°, Δφ = 90°),
+// were NaN.
+TEST(MerlWriter, EveryValidPairFindsAValue) {
   const MerlData table = tabulate_merl(TestLobe{});
+  const double deg = kPi / 180;
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto direction = [](double theta, double phi) {
+    return Vec3<double>{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                        std::cos(theta)};
+  };
+  for (const MerlLookup lookup : {MerlLookup::nearest, MerlLookup::trilinear}) {
+    const MerlBrdf brdf(table, {lookup});
+    EXPECT_TRUE(brdf.eval({direction(89.9 * deg, 0), direction(80 * deg, 90 * deg)}).finite());
+    std::size_t missing = 0;
+    for (int n = 0; n < 200000; ++n) {
+      // Half cosine-distributed, half with both directions within 5° of the horizon.
+      const bool grazing = n % 2;
+      const double ti = grazing ? (85 + 5 * u(rng)) * deg : std::acos(std::sqrt(u(rng)));
+      const double to = grazing ? (85 + 5 * u(rng)) * deg : std::acos(std::sqrt(u(rng)));
+      const DirPair<double> pair{direction(ti, 0), direction(to, 2 * kPi * u(rng))};
+      if (!(pair.wi.z > 0 && pair.wo.z > 0)) continue;
+      missing += !brdf.eval(pair).finite();
+    }
+    EXPECT_EQ(missing, 0u) << (lookup == MerlLookup::nearest ? "nearest" : "trilinear");
+  }
+}
+
+// docs/reliability/readers.md, "Missing and negative measurements": a file with unmeasured bins
+// (here every bin of θd ≥ 80°, as an instrument without grazing reach, and the bin of a grazing
+// pair) gives, at a pair looked up there, a missing value (NaN), not the -1 mark times the scale
+// (-0.000667); and no lookup anywhere gives a negative ρ.
+TEST(MerlMissing, UnmeasuredBinsAreNaNNeverNegative) {
+  MerlData table = tabulate_merl(TestLobe{});
+  for (int th = 0; th < merl::kThetaH; ++th)
+    for (int td = 80; td < merl::kThetaD; ++td)
+      for (int pd = 0; pd < merl::kPhiD; ++pd)
+        for (int c = 0; c < 3; ++c) table.values[c * merl::kBins + merl::bin(th, td, pd)] = -1;
   const double deg = kPi / 180;
   const DirPair<double> grazing{{std::sin(89.9 * deg), 0, std::cos(89.9 * deg)},
                                 {0, std::sin(80 * deg), std::cos(80 * deg)}};
   const merl::BinIndex b = merl::bin_of(grazing);
-  ASSERT_LT(table.values[merl::bin(b.theta_h, b.theta_d, b.phi_d)], 0) << "not an unmeasured bin";
+  for (int c = 0; c < 3; ++c)
+    table.values[c * merl::kBins + merl::bin(b.theta_h, b.theta_d, b.phi_d)] = -1;
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> u(0, 1);
   for (const MerlLookup lookup : {MerlLookup::nearest, MerlLookup::trilinear}) {
@@ -933,9 +977,10 @@ TEST(MerlWriter, AtomicReplaceAndErrors) {
   EXPECT_THROW(MerlBrdf{wrong}, std::invalid_argument);
 }
 
-// Class 4 of docs/reliability-readers.md: the reader allocates from the sizes a file declares only
-// after checking them against the file: a short file costs nothing, a whole one its own size plus
-// the declared output (3 x 90 x 90 x 180 doubles).
+// docs/reliability/readers.md, "Nothing is allocated from a size a file declares before the file is
+// checked to hold it": the reader allocates from the sizes a file declares only after checking them
+// against the file: a short file costs nothing, a whole one its own size plus the declared output
+// (3 x 90 x 90 x 180 doubles).
 TEST(MerlAllocation, BoundedByTheFileAndTheTable) {
   TempDir tmp;
   std::string head(12, '\0');

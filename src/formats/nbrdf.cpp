@@ -93,24 +93,46 @@ NbrdfLayer npy_layer(const std::filesystem::path& kernel_path,
   return {kernel.shape[0], kernel.shape[1], std::move(kernel.values), std::move(bias.values)};
 }
 
+}  // namespace
+
 // ---------------------------------------------------------------------------------------------
 // Validation
 // ---------------------------------------------------------------------------------------------
-void validate(const NbrdfNetwork& net) {
+std::optional<Space> nbrdf::input_space(const std::string& input, const std::string& source) {
+  if (input.empty() || input == kSztrajmanInput) return std::nullopt;
+  auto refuse = [&](const std::string& why) -> std::optional<Space> {
+    throw FormatError(source, kInputAttribute,
+                      "'" + input + "': " + why +
+                          "; this reader evaluates Sztrajman et al.'s input (" +
+                          std::string(kSztrajmanInput) + ") and the isotropic coordinates of " +
+                          parameterization_names());
+  };
+  if (input.find(':') != std::string::npos) return refuse("a family's member");
+  const std::optional<Space> space = space_from_name(input);
+  if (!space || space->is_dirs()) return refuse("not a parameterization");
+  if (space->id() > kBuiltinParamCount) return refuse("not a built-in parameterization");
+  return space;
+}
+
+void check_nbrdf_network(const NbrdfNetwork& net) {
   auto fail = [&](const std::string& field, const std::string& problem) {
     throw FormatError(net.source, field, problem);
   };
+  const bool sztrajman = !nbrdf::input_space(net.input, net.source);
+  const std::size_t inputs = sztrajman ? nbrdf::kInputs : 3;
   if (net.layers.empty() || net.layers.size() > nbrdf::kMaxLayers)
     fail("layers", std::to_string(net.layers.size()) + " dense layers, expected 1 to " +
                        std::to_string(nbrdf::kMaxLayers));
   for (std::size_t l = 0; l < net.layers.size(); ++l) {
     const NbrdfLayer& layer = net.layers[l];
     const std::string field = "layer " + std::to_string(l + 1);
-    const std::size_t expected_in = l == 0 ? nbrdf::kInputs : net.layers[l - 1].outputs;
+    const std::size_t expected_in = l == 0 ? inputs : net.layers[l - 1].outputs;
     if (layer.inputs != expected_in)
       fail(field, std::to_string(layer.inputs) + " inputs, expected " +
                       std::to_string(expected_in) +
-                      (l == 0 ? " (the encoded pair)" : " (the previous layer's outputs)"));
+                      (l > 0       ? " (the previous layer's outputs)"
+                       : sztrajman ? " (the encoded pair)"
+                                   : " (the isotropic coordinates of " + net.input + ")"));
     if (layer.outputs == 0 || layer.outputs > nbrdf::kMaxWidth)
       fail(field, std::to_string(layer.outputs) + " outputs, expected 1 to " +
                       std::to_string(nbrdf::kMaxWidth));
@@ -125,6 +147,8 @@ void validate(const NbrdfNetwork& net) {
       fail(field, "bias has a NaN or infinite value");
   }
 }
+
+namespace {
 
 // An upper bound of ρ over every input the encoding can give, by interval arithmetic through the
 // layers from the box sin θh, cos θh ∈ [0, 1], 0, d ∈ [−1, 1]³: each output's interval is the
@@ -205,7 +229,8 @@ std::shared_ptr<const NbrdfBrdf> load_nbrdf(const std::filesystem::path& path) {
 // ---------------------------------------------------------------------------------------------
 NbrdfBrdf::NbrdfBrdf(NbrdfNetwork network, std::string label)
     : network_(std::move(network)), label_(std::move(label)) {
-  validate(network_);
+  check_nbrdf_network(network_);
+  input_space_ = nbrdf::input_space(network_.input, network_.source);
   check_rho_bound();
 }
 
@@ -214,7 +239,9 @@ NbrdfBrdf::NbrdfBrdf(NbrdfNetwork network, std::string label)
 // ρ = e¹⁰⁰) is refused. Between the probe's pairs the writers and the renderer check the values
 // they use.
 void NbrdfBrdf::check_rho_bound() {
-  const double proven = interval_rho_bound(network_);
+  // The interval bound's box is that of Sztrajman's input.
+  const double proven =
+      input_space_ ? std::numeric_limits<double>::infinity() : interval_rho_bound(network_);
   if (rho_within_bound(proven)) {
     rho_bound_ =
         fmt::format("ρ ≤ {:.4g} sr⁻¹ everywhere (interval arithmetic through the layers)", proven);
@@ -240,6 +267,15 @@ std::string NbrdfBrdf::description() const {
   return "neural BRDF " + label_ + " (Sztrajman et al. 2021), a " + architecture() + " network";
 }
 
+std::string NbrdfBrdf::input_columns() const {
+  std::string s;
+  for (const std::string_view c : input_space_->param().columns(true)) {
+    if (!s.empty()) s += ", ";
+    s += c;
+  }
+  return s;
+}
+
 std::string NbrdfBrdf::architecture() const {
   std::string s = fmt::format("{}", network_.layers.front().inputs);
   for (const NbrdfLayer& layer : network_.layers) s += fmt::format("-{}", layer.outputs);
@@ -257,7 +293,11 @@ std::vector<Brdf::Fact> NbrdfBrdf::facts() const {
           {"source", network_.source},
           {"architecture", architecture() + " (ReLU hidden layers, linear output, exp(y) - 1)"},
           {"parameters", std::to_string(parameter_count()) + " float32"},
-          {"input", "(sin θh, 0, cos θh, d): d = ωo (the view direction) in the half-vector frame"},
+          {"input",
+           input_space_
+               ? "the isotropic coordinates of " + network_.input + " (" + input_columns() + ")"
+               : "(sin θh, 0, cos θh, d): d = ωo (the view direction) in the half-vector "
+                 "frame"},
           {"ρ bound", rho_bound_}};
 }
 
@@ -267,9 +307,14 @@ Rgb NbrdfBrdf::eval(const DirPair<double>& pair) const {
     return {nan, nan, nan};
   }
   if (below_horizon(pair)) return {0, 0, 0};
-  const auto x = nbrdf::encode(pair);
-  std::array<float, nbrdf::kInputs> input;
-  for (std::size_t i = 0; i < nbrdf::kInputs; ++i) input[i] = float(x[i]);
+  std::array<float, nbrdf::kInputs> input{};
+  if (input_space_) {
+    const auto q = input_space_->param().forward_iso(pair);
+    for (std::size_t i = 0; i < 3; ++i) input[i] = float(q[i]);
+  } else {
+    const auto x = nbrdf::encode(pair);
+    for (std::size_t i = 0; i < nbrdf::kInputs; ++i) input[i] = float(x[i]);
+  }
   const auto rho = nbrdf_detail::evaluate_one(network_, input);
   return {rho[0], rho[1], rho[2]};
 }
@@ -277,6 +322,12 @@ Rgb NbrdfBrdf::eval(const DirPair<double>& pair) const {
 void NbrdfBrdf::eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const {
   if (out.size() != pairs.size())
     throw std::invalid_argument("NbrdfBrdf::eval_batch: output size differs from the pairs'");
+  if (input_space_) {  // a parameterization's coordinates: one pair at a time
+    parallel_for(pairs.size(), 4096, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) out[i] = eval(pairs[i]);
+    });
+    return;
+  }
   using nbrdf_detail::kBlock;
   parallel_for(pairs.size(), 16 * kBlock, [&](std::size_t begin, std::size_t end) {
     alignas(64) double block[6 * kBlock];

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -60,6 +61,7 @@ class KerasReader {
     NbrdfNetwork network;
     network.source = name_;
     network.form = "Keras HDF5";
+    network.input = input_name();
     for (std::size_t i = 0; i < layers.size(); ++i) {
       Handle group(H5Gopen2(file_, layers[i].c_str(), H5P_DEFAULT), H5Gclose);
       if (!group.valid()) fail(layers[i], "layer group listed in layer_names is missing");
@@ -78,6 +80,15 @@ class KerasReader {
  private:
   [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
     throw FormatError(name_, field, problem);
+  }
+
+  // A file written by halfback names its input (nbrdf::kInputAttribute); the authors' files do not
+  // and have Sztrajman et al.'s. NbrdfBrdf refuses a name it cannot evaluate.
+  std::string input_name() const {
+    if (H5Aexists(file_, nbrdf::kInputAttribute) <= 0) return std::string(nbrdf::kSztrajmanInput);
+    const auto input = string_attribute(file_, "/", nbrdf::kInputAttribute);
+    if (input.size() != 1) fail(nbrdf::kInputAttribute, "not one string");
+    return input.front();
   }
 
   // A 0-D or 1-D attribute of fixed-length strings (NUL-padded or NUL-terminated).
@@ -209,7 +220,118 @@ void silence_hdf5_errors() {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Writing: Keras 2's layout (what read() reads), in an in-memory file whose image is returned
+// ---------------------------------------------------------------------------------------------
+[[noreturn]] void write_failed(const std::string& what) {
+  throw std::runtime_error("writing the HDF5 image of a neural BRDF: " + what + " failed");
+}
+
+// A 1-D attribute of fixed-length, NUL-padded strings (h5py's form of a NumPy 'S' array); an
+// empty list is an empty float array, as Keras writes it.
+void write_strings(hid_t loc, const char* name, const std::vector<std::string>& items) {
+  const hsize_t n = items.size();
+  Handle space(H5Screate_simple(1, &n, nullptr), H5Sclose);
+  if (items.empty()) {
+    Handle attr(H5Acreate2(loc, name, H5T_IEEE_F32LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+                H5Aclose);
+    if (!attr.valid()) write_failed(std::string("attribute ") + name);
+    return;
+  }
+  std::size_t width = 1;
+  for (const auto& s : items) width = std::max(width, s.size());
+  std::string buffer(items.size() * width, '\0');
+  for (std::size_t i = 0; i < items.size(); ++i)
+    buffer.replace(i * width, items[i].size(), items[i]);
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  if (!type.valid() || H5Tset_size(type.get(), width) < 0 ||
+      H5Tset_strpad(type.get(), H5T_STR_NULLPAD) < 0)
+    write_failed("a string type");
+  Handle attr(H5Acreate2(loc, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid() || H5Awrite(attr.get(), type.get(), buffer.data()) < 0)
+    write_failed(std::string("attribute ") + name);
+}
+
+// A scalar fixed-length string attribute (h5py's form of a NumPy bytes scalar, which Keras's
+// load_weights decodes from keras_version and backend).
+void write_string(hid_t loc, const char* name, const std::string& value) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  if (!type.valid() || H5Tset_size(type.get(), std::max<std::size_t>(value.size(), 1)) < 0 ||
+      H5Tset_strpad(type.get(), H5T_STR_NULLPAD) < 0)
+    write_failed("a string type");
+  std::string buffer = value.empty() ? std::string(1, '\0') : value;
+  Handle attr(H5Acreate2(loc, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid() || H5Awrite(attr.get(), type.get(), buffer.data()) < 0)
+    write_failed(std::string("attribute ") + name);
+}
+
+// A float32 dataset at `path` below `group` (intermediate groups created).
+void write_floats(hid_t group, const std::string& path, const std::vector<hsize_t>& dims,
+                  const std::vector<float>& values) {
+  Handle lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+  H5Pset_create_intermediate_group(lcpl.get(), 1);
+  // No modification times in the object headers: the same network gives the same bytes.
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_obj_track_times(dcpl.get(), false);
+  Handle space(H5Screate_simple(int(dims.size()), dims.data(), nullptr), H5Sclose);
+  Handle data(H5Dcreate2(group, path.c_str(), H5T_IEEE_F32LE, space.get(), lcpl.get(), dcpl.get(),
+                         H5P_DEFAULT),
+              H5Dclose);
+  if (!data.valid() ||
+      H5Dwrite(data.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)
+    write_failed("dataset " + path);
+}
+
+void write_keras_layers(hid_t file, const NbrdfNetwork& network) {
+  std::vector<std::string> names;
+  for (std::size_t l = 0; l < network.layers.size(); ++l)
+    names.push_back("dense_" + std::to_string(l + 1));
+  names.push_back("lambda_1");  // the output exp(y) - 1, without weights
+  write_strings(file, "layer_names", names);
+  for (std::size_t l = 0; l < names.size(); ++l) {
+    Handle gcpl(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
+    H5Pset_obj_track_times(gcpl.get(), false);
+    Handle group(H5Gcreate2(file, names[l].c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT),
+                 H5Gclose);
+    if (!group.valid()) write_failed("group " + names[l]);
+    if (l == network.layers.size()) {
+      write_strings(group.get(), "weight_names", {});
+      continue;
+    }
+    const NbrdfLayer& layer = network.layers[l];
+    const std::string kernel = names[l] + "/kernel:0", bias = names[l] + "/bias:0";
+    write_strings(group.get(), "weight_names", {kernel, bias});
+    write_floats(group.get(), kernel, {layer.inputs, layer.outputs}, layer.kernel);
+    write_floats(group.get(), bias, {layer.outputs}, layer.bias);
+  }
+}
+
 }  // namespace
+
+std::string nbrdf_h5_image(const NbrdfNetwork& network) {
+  check_nbrdf_network(network);
+  std::lock_guard lock(hdf5_mutex());
+  silence_hdf5_errors();
+  // The core driver without a backing store: the file lives in memory only.
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!fapl.valid() || H5Pset_fapl_core(fapl.get(), 1 << 16, false) < 0)
+    write_failed("setting up an in-memory file");
+  Handle file(H5Fcreate("nbrdf-image.h5", H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
+  if (!file.valid()) write_failed("creating an in-memory file");
+  write_keras_layers(file.get(), network);
+  write_string(file.get(), "backend", "tensorflow");
+  write_string(file.get(), "keras_version", "2.2.4");
+  write_string(file.get(), nbrdf::kInputAttribute,
+               network.input.empty() ? std::string(nbrdf::kSztrajmanInput) : network.input);
+  if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) write_failed("flushing the in-memory file");
+  const ssize_t size = H5Fget_file_image(file.get(), nullptr, 0);
+  if (size <= 0) write_failed("sizing the file image");
+  std::string image(std::size_t(size), '\0');
+  if (H5Fget_file_image(file.get(), image.data(), image.size()) != size)
+    write_failed("copying the file image");
+  return image;
+}
 
 NbrdfNetwork read_nbrdf_h5(const std::filesystem::path& path) {
   const std::string name = path.string();

@@ -461,9 +461,10 @@ TEST(NbrdfH5, AbsurdAddressInTheRootEntryIsAnError) {
       "mem");
 }
 
-// Class C of issue 35 (docs/reliability-round3-readers.md): an HDF5 file ends at the end of file
-// address of its superblock, a .npy file after the data its header declares; anything after is
-// refused with both byte counts, unread (a file extended to a gigabyte by truncate -s).
+// docs/reliability/readers.md, "A reader reads what the file's header declares, and nothing more":
+// an HDF5 file ends at the end of file address of its superblock, a .npy file after the data its
+// header declares; anything after is refused with both byte counts, unread (a file extended to a
+// gigabyte by truncate -s).
 TEST(NbrdfTrailingData, RefusedWithBothCounts) {
   TempDir tmp;
   write_keras_h5(tmp / "t.h5", tiny_network());
@@ -485,9 +486,10 @@ TEST(NbrdfTrailingData, RefusedWithBothCounts) {
                       "has 1073741824 bytes", "trailing data");
 }
 
-// Class B of issue 35: a network whose outputs are absurd (a last bias of 100: ρ = e¹⁰⁰ − 1,
-// 1.65e38 sr⁻¹ in float, everywhere) is refused at load, naming the file; its ρ is checked on the
-// probe set when interval arithmetic through the layers cannot prove it bounded everywhere.
+// docs/reliability/readers.md, "One bound on a BRDF's value": a network whose outputs are absurd (a
+// last bias of 100: ρ = e¹⁰⁰ − 1, 1.65e38 sr⁻¹ in float, everywhere) is refused at load, naming the
+// file; its ρ is checked on the probe set when interval arithmetic through the layers cannot prove
+// it bounded everywhere.
 TEST(NbrdfBound, DivergingNetworkIsRefusedAtLoad) {
   TempDir tmp;
   NbrdfNetwork net = tiny_network();
@@ -585,6 +587,103 @@ TEST(NbrdfShared, DirectionConventionAgreesWithTheRglReader) {
     total_right += right, total_swapped += swap;
   }
   EXPECT_GT(total_swapped, 1.5 * total_right);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The writer: the authors' pair of files, read back by this reader
+// ---------------------------------------------------------------------------------------------
+TEST(NbrdfWrite, WritesWhatTheReaderReadsBack) {
+  TempDir tmp;
+  write_nbrdf(tmp / "w.h5", tiny_network(), {{"trained_from", "a test"}});
+  const auto brdf = load_nbrdf(tmp / "w.h5");
+  EXPECT_EQ(brdf->name(), "nbrdf:w");
+  ASSERT_EQ(brdf->network().layers.size(), 2u);
+  for (std::size_t l = 0; l < 2; ++l) {
+    EXPECT_EQ(brdf->network().layers[l].kernel, tiny_network().layers[l].kernel);
+    EXPECT_EQ(brdf->network().layers[l].bias, tiny_network().layers[l].bias);
+  }
+  const std::string json = test::read_file(tmp / "w.json");
+  for (const char* part : {R"("class_name":"Sequential")", R"("units":2,"activation":"relu")",
+                           R"("units":3,"activation":"linear")", R"("function":"exp_minus_one")",
+                           R"("input":"sztrajman-halfdiff","trained_from":"a test")"})
+    EXPECT_NE(json.find(part), std::string::npos) << part << " not in " << json;
+  // Written again over both: replaced, nothing else left in the folder.
+  write_nbrdf(tmp / "w.h5", tiny_network());
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(tmp.path())) ++files;
+  EXPECT_EQ(files, 2u);
+}
+
+// A network of three inputs, the isotropic coordinates of a parameterization named in the file.
+NbrdfNetwork tiny_param_network(const std::string& input) {
+  NbrdfNetwork net = tiny_network();
+  net.input = input;
+  net.layers[0].inputs = 3;
+  net.layers[0].kernel.resize(3 * 2);  // rows x0, x1, x2 of tiny_network's kernel
+  return net;
+}
+
+TEST(NbrdfWrite, NetworkOfAParameterizationsCoordinatesReadsBack) {
+  TempDir tmp;
+  write_nbrdf(tmp / "h.h5", tiny_param_network("halfdiff"));
+  const auto brdf = load_nbrdf(tmp / "h.h5");
+  EXPECT_EQ(brdf->network().input, "halfdiff");
+  EXPECT_EQ(brdf->architecture(), "3-2-3");
+  // tiny_network on x = (θh, θd, φd): hidden h0 = relu(x0 − 0.5), h1 = relu(0.25 − x2), then
+  // y = (h0 + 2 h1, 0.5 h0 + 0.1, −h0 + h1 + 0.2) (its kernel's first three rows).
+  const DirPair<double> pair{{0.3, 0.1, std::sqrt(1 - 0.1)}, {-0.2, 0.4, std::sqrt(1 - 0.2)}};
+  const auto q = space_from_name("halfdiff")->param().forward_iso(pair);
+  const double h0 = std::max(double(float(q[0])) - 0.5, 0.0);
+  const double h1 = std::max(0.25 - double(float(q[2])), 0.0);
+  expect_rgb_near(
+      brdf->eval(pair),
+      {std::max(std::expm1(h0 + 2 * h1), 0.0), std::max(std::expm1(0.5 * h0 + 0.1), 0.0),
+       std::max(std::expm1(-h0 + h1 + 0.2), 0.0)},
+      1e-6);
+  std::vector<Rgb> batch(1);
+  brdf->eval_batch(std::span(&pair, 1), batch);
+  EXPECT_EQ(batch[0], brdf->eval(pair));
+  const auto facts = brdf->facts();
+  EXPECT_NE(facts[4].value.find("isotropic coordinates of halfdiff (theta_h, theta_d, phi_d)"),
+            std::string::npos)
+      << facts[4].value;
+}
+
+TEST(NbrdfWrite, ReaderRefusesAnInputItCannotEvaluate) {
+  TempDir tmp;
+  // Names that are no built-in parameterization: write_nbrdf refuses them as the reader does.
+  for (const std::string input : {"nonesuch", "dupuy-jakob:ggx", "dirs"})
+    EXPECT_FORMAT_ERROR(write_nbrdf(tmp / "n.h5", tiny_param_network(input)),
+                        std::string("halfback_input"), "'" + input + "'");
+  // A file whose attribute names another input (rewritten with the HDF5 C API): the reader
+  // refuses it.
+  write_nbrdf(tmp / "r.h5", tiny_param_network("halfdiff"));
+  {
+    const hid_t file = H5Fopen((tmp / "r.h5").c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    H5Adelete(file, "halfback_input");
+    write_string_attribute(file, "halfback_input", {"nonesuch"});
+    H5Fclose(file);
+  }
+  EXPECT_FORMAT_ERROR(load_nbrdf(tmp / "r.h5"), "r.h5", "halfback_input", "'nonesuch'",
+                      "this reader evaluates Sztrajman et al.'s input");
+  std::filesystem::remove(tmp / "r.h5");
+  std::filesystem::remove(tmp / "r.json");
+  // A parameterization's name on a network of Sztrajman's 6 inputs.
+  NbrdfNetwork six = tiny_network();
+  six.input = "hybrid";
+  EXPECT_FORMAT_ERROR(write_nbrdf(tmp / "s.h5", six), "layer 1",
+                      "expected 3 (the isotropic coordinates of hybrid)");
+  EXPECT_TRUE(std::filesystem::is_empty(tmp.path()));
+}
+
+TEST(NbrdfWrite, RefusesWhatItCannotWriteAndWritesNothing) {
+  TempDir tmp;
+  NbrdfNetwork nan = tiny_network();
+  nan.layers[1].bias[0] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(write_nbrdf(tmp / "n.h5", nan), FormatError);
+  EXPECT_THROW(write_nbrdf(tmp / "j.json", tiny_network()), std::invalid_argument);
+  EXPECT_TRUE(std::filesystem::is_empty(tmp.path()));
 }
 
 }  // namespace

@@ -351,10 +351,10 @@ TEST(RglEval, NonFiniteInputIsSafe) {
   EXPECT_FALSE(b.pdf({inf, inf, 1}, {0, 0, 1}) > 0);
 }
 
-// Class 1 of docs/reliability-readers.md: a real file (ilm_solo_m_68_rgb) has sixteen luminance
-// values between -4e-10 and -7e-11, which the reference loader reads; so must this reader, in every
-// density field, while a negative value beyond the noise tolerance is refused with a readable
-// number (never "-0.000000").
+// docs/reliability/readers.md, "Measurement noise is not an error": a real file (ilm_solo_m_68_rgb)
+// has sixteen luminance values between -4e-10 and -7e-11, which the reference loader reads; so must
+// this reader, in every density field, while a negative value beyond the noise tolerance is refused
+// with a readable number (never "-0.000000").
 TEST(RglNoise, TinyNegativeDensitiesLoadAsZero) {
   Synthetic s;
   s.luminance = [](std::size_t slice, std::size_t y, std::size_t x) {
@@ -972,9 +972,10 @@ TEST(RglSampling, BatchSamplerChiSquare) {
     expect_sampler_follows_pdf(*load_rgl(dir / (std::string(m) + "_rgb.bsdf")), m);
 }
 
-// Class 4 of docs/reliability-readers.md: a tensor file declaring a field far larger than itself is
-// refused before anything is allocated from that shape; a real file costs a small multiple of its
-// size (the bytes, and the float tables as doubles).
+// docs/reliability/readers.md, "Nothing is allocated from a size a file declares before the file is
+// checked to hold it": a tensor file declaring a field far larger than itself is refused before
+// anything is allocated from that shape; a real file costs a small multiple of its size (the bytes,
+// and the float tables as doubles).
 TEST(RglAllocation, BoundedByTheFile) {
   test::TempDir tmp;
   auto fields = Synthetic{}.fields();
@@ -993,10 +994,10 @@ TEST(RglAllocation, BoundedByTheFile) {
   EXPECT_LT(probe.growth(), 8 * std::filesystem::file_size(real)) << probe.growth();
 }
 
-// Class C of issue 35 (docs/reliability-round3-readers.md): a tensor file ends where its last
-// field does (the writers' zero padding to 8 bytes aside). Trailing data is refused with both byte
-// counts, and a small file extended to a gigabyte (sparse, as `truncate -s` makes it) is refused
-// without reading the extension.
+// docs/reliability/readers.md, "A reader reads what the file's header declares, and nothing more":
+// a tensor file ends where its last field does (the writers' zero padding to 8 bytes aside).
+// Trailing data is refused with both byte counts, and a small file extended to a gigabyte (sparse,
+// as `truncate -s` makes it) is refused without reading the extension.
 TEST(RglTrailingData, RefusedUnreadWithBothCounts) {
   test::TempDir tmp;
   std::vector<std::byte> bytes = Synthetic{}.bytes();
@@ -1024,9 +1025,10 @@ TEST(RglTrailingData, RefusedUnreadWithBothCounts) {
   EXPECT_LT(probe.growth(), 4 * end + 64 * 1024) << probe.growth();
 }
 
-// Class B of issue 35: ρ·cos θo = rgb · ndf / (4 sigma) can reach at most the largest |rgb| times
-// the largest ndf over 4 times the smallest sigma: a file where that exceeds the bound on ρ is
-// refused, naming the fields and their extremes (an ndf value of 1e30 gave ρ = 1e31).
+// docs/reliability/readers.md, "One bound on a BRDF's value": ρ·cos θo = rgb · ndf / (4 sigma) can
+// reach at most the largest |rgb| times the largest ndf over 4 times the smallest sigma: a file
+// where that exceeds the bound on ρ is refused, naming the fields and their extremes (an ndf value
+// of 1e30 gave ρ = 1e31).
 TEST(RglBound, TablesAboveTheBoundAreRefused) {
   Synthetic s;
   s.jacobian = 1;

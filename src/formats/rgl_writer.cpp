@@ -1,5 +1,6 @@
 // The RGL writer (docs/formats.md, "RGL writer"): power iteration for the NDF, σ, the VNDF
-// tables, and ρ sampled through the VNDF warp of halfback's own reader.
+// tables, the incident elevations, and ρ averaged over the tables' hat functions (or sampled at
+// their nodes) through the VNDF warp of halfback's own reader.
 #include "halfback/formats/rgl_writer.hpp"
 
 #include <fmt/format.h>
@@ -251,13 +252,13 @@ double table_at(const std::vector<double>& t, double u) {
   return t[i] + (x - double(i)) * (t[i + 1] - t[i]);
 }
 
-Geometry geometry_fields(const RecoveredNdf& ndf, const RglExportOptions& o,
+Geometry geometry_fields(const RecoveredNdf& ndf, std::vector<double> theta_i,
                          const std::string& desc) {
   Geometry g;
-  g.theta_i = incidence_grid(ndf.sigma, o.theta_i);
+  g.theta_i = std::move(theta_i);
   g.ndf = rounded_to_float(ndf.ndf);
   g.sigma = rounded_to_float(ndf.sigma);
-  const auto n = static_cast<std::uint64_t>(o.vndf_resolution);
+  const auto n = static_cast<std::uint64_t>(ndf.ndf.size());
   std::vector<double> two_rows(ndf.ndf), sigma_rows(ndf.sigma);
   two_rows.insert(two_rows.end(), ndf.ndf.begin(), ndf.ndf.end());
   sigma_rows.insert(sigma_rows.end(), ndf.sigma.begin(), ndf.sigma.end());
@@ -289,43 +290,98 @@ std::shared_ptr<const RglBrdf> geometry_material(const Geometry& g, std::size_t 
                                          label, RglOptions{.clamp_negative = false});
 }
 
-// ρ cos θo · 4σ(ωi)/D(m) at the sample nodes of one incidence slice, through the VNDF warp of
-// `warp` (the file being written, read by halfback's reader), with D and σ interpolated from the
-// stored tables as every reader does.
-void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, std::size_t slice,
-                    std::size_t res, int threads, double* rgb, double* luminance) {
-  const double theta_i = g.theta_i[slice];
+// The stored quantity f = ρ cos θo · 4σ(ωi)/D(m) at the point `s` of the warped square of one
+// incidence slice, through the VNDF warp of `warp` (the file being written, read by halfback's
+// reader), with D and σ interpolated from the stored tables as every reader does; 0 where ωo is
+// below the horizon.
+Rgb stored_value(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, double theta_i,
+                 double sigma, RglWarpPoint s) {
   const Vec3<double> wi = direction(theta_i, 0);
+  const RglWarpPoint um = warp.vndf_forward(s, theta_i, 0.0);
+  const Vec3<double> m = direction(u_to_theta(um.x), (2 * um.y - 1) * kPi);
+  const double c = wi.x * m.x + wi.y * m.y + wi.z * m.z;
+  const Vec3<double> wo{2 * c * m.x - wi.x, 2 * c * m.y - wi.y, 2 * c * m.z - wi.z};
+  if (!(c > 0 && wo.z > 0)) return {};
+  const Rgb rho = brdf.eval({wi, wo});
+  if (!rho.finite())
+    throw std::invalid_argument(
+        fmt::format("{}: ρ is not finite at ωi = {}, ωo = {}: cannot "
+                    "tabulate it",
+                    brdf.name(), format_dir(wi), format_dir(wo)));
+  // What the file stores is ρ·cos θo (ρ itself grows without bound at grazing ωo).
+  if (!rho_within_bound(rho * wo.z))
+    throw std::invalid_argument(fmt::format(
+        "{}: {}: an RGL file cannot hold it", brdf.name(),
+        rho_above_bound((rho * wo.z).max_channel(), describe_halfdiff({wi, wo}), "ρ·cos θo")));
+  const double scale = table_at(g.ndf, um.x) / (4 * sigma);
+  return scale > 0 ? rho * (wo.z / scale) : Rgb{};
+}
+
+// The tables of one incidence slice: each node holds the average of f over its hat function
+// (the bilinear interpolant's basis function on the res × res grid of the warped square), by the
+// midpoint rule on `kSubsamples`² points per cell. The readers interpolate the table bilinearly,
+// and the slice's directional albedo is ∫∫ f ds (the warp's Jacobian is the VNDF, which cancels
+// D/(4σ) and the 4 (ωi·m) of the reflection: docs/formats.md, "Energy"); the hat averages keep
+// that integral exactly, where point samples of a lobe narrower than a cell created or lost
+// energy in proportion to the cell's size (a near-mirror's tail, a grazing Fresnel peak).
+constexpr std::size_t kSubsamples = 12;
+
+void store_node(Rgb value, std::size_t node, std::size_t res, double* rgb, double* luminance) {
+  rgb[node] = value.r;
+  rgb[res * res + node] = value.g;
+  rgb[2 * res * res + node] = value.b;
+  luminance[node] = std::max(value.luminance(), 0.0);
+}
+
+void tabulate_slice(const Brdf& brdf, const RglBrdf& warp, const Geometry& g, std::size_t slice,
+                    std::size_t res, RglTabulation tabulation, int threads, double* rgb,
+                    double* luminance) {
+  const double theta_i = g.theta_i[slice];
   const double sigma = table_at(g.sigma, std::sqrt(theta_i * (2 / kPi)));
+  if (tabulation == RglTabulation::point) {
+    parallel_for(
+        res * res, 16,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t node = begin; node < end; ++node)
+            store_node(stored_value(brdf, warp, g, theta_i, sigma,
+                                    {node_u(node % res, res), node_u(node / res, res)}),
+                       node, res, rgb, luminance);
+        },
+        threads);
+    return;
+  }
+  const std::size_t cells = res - 1, fine = cells * kSubsamples;
+  const double h = 1.0 / double(fine);
+  // One row of the fine grid a task: the values at its points and their cell coordinates.
+  std::vector<Rgb> values(fine * fine);
+  parallel_for(
+      fine, 4,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t y = begin; y < end; ++y)
+          for (std::size_t x = 0; x < fine; ++x)
+            values[y * fine + x] =
+                stored_value(brdf, warp, g, theta_i, sigma, {(x + 0.5) * h, (y + 0.5) * h});
+      },
+      threads);
+  // Node (i, j) gathers the fine points of its (up to four) cells, weighted by its hat.
   parallel_for(
       res * res, 16,
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t node = begin; node < end; ++node) {
           const std::size_t i = node % res, j = node / res;
-          const RglWarpPoint um = warp.vndf_forward({node_u(i, res), node_u(j, res)}, theta_i, 0.0);
-          const Vec3<double> m = direction(u_to_theta(um.x), (2 * um.y - 1) * kPi);
-          const double c = wi.x * m.x + wi.y * m.y + wi.z * m.z;
-          const Vec3<double> wo{2 * c * m.x - wi.x, 2 * c * m.y - wi.y, 2 * c * m.z - wi.z};
-          Rgb value;
-          if (c > 0 && wo.z > 0) {
-            const Rgb rho = brdf.eval({wi, wo});
-            if (!rho.finite())
-              throw std::invalid_argument(
-                  fmt::format("{}: ρ is not finite at ωi = {}, ωo = {}: cannot tabulate it",
-                              brdf.name(), format_dir(wi), format_dir(wo)));
-            // What the file stores is ρ·cos θo (ρ itself grows without bound at grazing ωo).
-            if (!rho_within_bound(rho * wo.z))
-              throw std::invalid_argument(
-                  fmt::format("{}: {}: an RGL file cannot hold it", brdf.name(),
-                              rho_above_bound((rho * wo.z).max_channel(),
-                                              describe_halfdiff({wi, wo}), "ρ·cos θo")));
-            const double scale = table_at(g.ndf, um.x) / (4 * sigma);
-            if (scale > 0) value = rho * (wo.z / scale);
+          Rgb sum;
+          double weight = 0;
+          for (std::size_t y = j > 0 ? (j - 1) * kSubsamples : 0;
+               y < std::min(fine, (j + 1) * kSubsamples); ++y) {
+            const double wy = 1 - std::abs((y + 0.5) / kSubsamples - double(j));
+            for (std::size_t x = i > 0 ? (i - 1) * kSubsamples : 0;
+                 x < std::min(fine, (i + 1) * kSubsamples); ++x) {
+              const double w = wy * (1 - std::abs((x + 0.5) / kSubsamples - double(i)));
+              sum += values[y * fine + x] * w;
+              weight += w;
+            }
           }
-          rgb[node] = value.r;
-          rgb[res * res + node] = value.g;
-          rgb[2 * res * res + node] = value.b;
-          luminance[node] = std::max(value.luminance(), 0.0);
+          store_node(sum * (1 / weight), node, res, rgb, luminance);
         }
       },
       threads);
@@ -369,6 +425,84 @@ std::vector<double> spectra_of_rgb(const std::vector<double>& rgb, std::size_t s
   return out;
 }
 
+// The directional albedo (luminance) of the BRDF at every slice of geometry `g`: the mean of f
+// over a midpoint grid of the warped square (∫∫ f ds, as tabulate_slice keeps it).
+std::vector<double> slice_albedos(const Brdf& brdf, const Geometry& g, int threads) {
+  constexpr std::size_t kGrid = 48;
+  const std::shared_ptr<const RglBrdf> warp = geometry_material(g, 2, "incidences");
+  std::vector<double> rows(g.theta_i.size() * kGrid);
+  parallel_for(
+      rows.size(), 4,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t r = begin; r < end; ++r) {
+          const double theta_i = g.theta_i[r / kGrid];
+          const double sigma = table_at(g.sigma, std::sqrt(theta_i * (2 / kPi)));
+          const double y = (double(r % kGrid) + 0.5) / kGrid;
+          double sum = 0;
+          for (std::size_t x = 0; x < kGrid; ++x)
+            sum += stored_value(brdf, *warp, g, theta_i, sigma, {(double(x) + 0.5) / kGrid, y})
+                       .luminance();
+          rows[r] = sum / double(kGrid * kGrid);
+        }
+      },
+      threads);
+  std::vector<double> albedo(g.theta_i.size(), 0.0);
+  for (std::size_t r = 0; r < rows.size(); ++r) albedo[r / kGrid] += rows[r];
+  return albedo;
+}
+
+// The incident elevations of the file: half of them (rounded up) evenly spaced in σ as in the
+// published files (incidence_grid), the others, one at a time, where the directional albedo is
+// worst predicted by linear interpolation between the elevations chosen so far (the readers
+// interpolate every table linearly in θi), among candidates 1° apart. The albedo of many
+// materials turns sharply at grazing (a Fresnel peak between 70° and 85°, where σ-spaced
+// elevations are 8–10° apart): there, evenly spaced σ alone missed a tenth of the energy.
+std::vector<double> chosen_incidences(const Brdf& brdf, const RecoveredNdf& ndf,
+                                      const RglExportOptions& o) {
+  if (o.incidences == RglIncidences::sigma) return incidence_grid(ndf.sigma, o.theta_i);
+  const int base_count = std::max(2, (o.theta_i + 1) / 2);
+  std::vector<double> chosen = incidence_grid(ndf.sigma, base_count);
+  if (base_count >= o.theta_i) return chosen;
+  std::vector<double> candidates = chosen;
+  for (int d = 1; d < 90; ++d) {
+    const double t = d * kPi / 180;
+    const bool near = std::any_of(chosen.begin(), chosen.end(),
+                                  [&](double c) { return std::abs(c - t) < 0.25 * kPi / 180; });
+    if (!near) candidates.push_back(t);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  const std::vector<double> albedo =
+      slice_albedos(brdf, geometry_fields(ndf, candidates, ""), o.threads);
+  const double largest = *std::max_element(albedo.begin(), albedo.end());
+  std::vector<bool> in(candidates.size(), false);
+  for (double c : chosen)
+    in[std::size_t(std::find(candidates.begin(), candidates.end(), c) - candidates.begin())] = true;
+  for (int added = base_count; added < o.theta_i; ++added) {
+    std::size_t best = 0;
+    double worst = -1;
+    std::size_t left = 0;
+    for (std::size_t k = 1; k < candidates.size(); ++k) {
+      if (in[k]) {
+        left = k;
+        continue;
+      }
+      std::size_t right = k + 1;
+      while (!in[right]) ++right;  // the last candidate (90°) is always in
+      const double t = (candidates[k] - candidates[left]) / (candidates[right] - candidates[left]);
+      const double predicted = albedo[left] + t * (albedo[right] - albedo[left]);
+      const double error =
+          std::abs(albedo[k] - predicted) / std::max(albedo[k], 0.1 * largest + 1e-300);
+      if (error > worst) worst = error, best = k;
+    }
+    if (worst <= 0) break;
+    in[best] = true;
+  }
+  std::vector<double> out;
+  for (std::size_t k = 0; k < candidates.size(); ++k)
+    if (in[k]) out.push_back(candidates[k]);
+  return out;
+}
+
 }  // namespace
 
 std::shared_ptr<const RglBrdf> rgl_warp_material(const Brdf& brdf, const RglWarpOptions& o) {
@@ -389,7 +523,8 @@ std::shared_ptr<const RglBrdf> rgl_warp_material(const Brdf& brdf, const RglWarp
   for (double& d : ndf.ndf) d = std::max(d, floor);
   for (std::size_t k = 0; k < ndf.ndf.size(); ++k)
     ndf.sigma[k] = projected_area(ndf.ndf, u_to_theta(node_u(k, ndf.ndf.size())));
-  const Geometry g = geometry_fields(ndf, e, brdf.name() + ": the VNDF warp of its NDF");
+  const Geometry g = geometry_fields(ndf, incidence_grid(ndf.sigma, e.theta_i),
+                                     brdf.name() + ": the VNDF warp of its NDF");
   return geometry_material(g, 2, brdf.name());
 }
 
@@ -411,7 +546,8 @@ std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions
                         brdf.description(),
                         o.variant == RglVariant::rgb ? "" : "; spectra upsampled from RGB")
           : o.description;
-  Geometry g = geometry_fields(recover_ndf(brdf, o.vndf_resolution, o.threads), o, desc);
+  const RecoveredNdf ndf = recover_ndf(brdf, o.vndf_resolution, o.threads);
+  Geometry g = geometry_fields(ndf, chosen_incidences(brdf, ndf, o), desc);
 
   const auto res = static_cast<std::size_t>(o.resolution);
   const std::size_t slices = g.theta_i.size();
@@ -420,7 +556,7 @@ std::vector<TensorFieldData> rgl_fields(const Brdf& brdf, const RglExportOptions
 
   std::vector<double> rgb(slices * 3 * res * res), luminance(slices * res * res);
   for (std::size_t s = 0; s < slices; ++s) {
-    tabulate_slice(brdf, *warp, g, s, res, o.threads, rgb.data() + s * 3 * res * res,
+    tabulate_slice(brdf, *warp, g, s, res, o.tabulation, o.threads, rgb.data() + s * 3 * res * res,
                    luminance.data() + s * res * res);
     if (o.progress) o.progress(int(s + 1), int(slices));
   }

@@ -200,57 +200,84 @@ BrdfPtr load_embedded(std::string_view name) {
                               "': no such embedded material (embedded: " + known + ")");
 }
 
+// The BRDF of an existing file (or folder: a neural BRDF's NumPy form).
+BrdfPtr load_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  // A folder is a BRDF only as the NumPy form of a neural BRDF (its reader says what is
+  // missing).
+  if (std::filesystem::is_directory(path, ec)) return load_nbrdf(path);
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw FormatError(path.string(), "file", "not a regular file");
+  BrdfFileFormat format = detect_brdf_format(path);
+  if (format == BrdfFileFormat::unknown) {
+    // The content matches no format: let the reader the extension names say what is wrong.
+    const std::string ext = path.extension().string();
+    if (ext == ".binary")
+      format = BrdfFileFormat::merl;
+    else if (ext == ".bsdf")
+      format = BrdfFileFormat::rgl;
+    else if (ext == ".dat" || ext == ".alta")
+      format = BrdfFileFormat::alta;
+    else if (ext == ".h5")
+      format = BrdfFileFormat::nbrdf_h5;
+    else if (ext == ".npy")
+      format = BrdfFileFormat::nbrdf_npy;
+    else
+      throw FormatError(path.string(), "format",
+                        "not a MERL .binary (34992012 bytes, 90 90 180 header), RGL .bsdf "
+                        "(\"tensor_file\" magic), ALTA text file (#DIM header), neural BRDF "
+                        "(HDF5 .h5, or NAME_fc1.npy), factored BRDF (JSON, \"format\": "
+                        "\"halfback-factored-brdf\")");
+  }
+  switch (format) {
+    case BrdfFileFormat::merl:
+      return load_merl(path);
+    case BrdfFileFormat::rgl:
+      return load_rgl(path);
+    case BrdfFileFormat::alta:
+      return load_alta(path);
+    case BrdfFileFormat::nbrdf_h5:
+      return std::make_shared<NbrdfBrdf>(read_nbrdf_h5(path), path.stem().string());
+    case BrdfFileFormat::nbrdf_npy:
+      return load_nbrdf(path);
+    case BrdfFileFormat::factored:
+      return std::make_shared<FactoredBrdf>(read_factored(path));
+    case BrdfFileFormat::unknown:
+      break;
+  }
+  throw FormatError(path.string(), "format", "unknown");  // (every format returns above)
+}
+
+// "merl-trilinear:PATH": a MERL file read with trilinear interpolation between bin centres instead
+// of the reference reader's nearest bin (docs/formats.md, "Lookups").
+BrdfPtr load_merl_trilinear(std::string_view path_text) {
+  const std::filesystem::path path{std::string(path_text)};
+  std::error_code ec;
+  if (path_text.empty() || !std::filesystem::is_regular_file(path, ec))
+    throw std::invalid_argument("'merl-trilinear:" + std::string(path_text) +
+                                "': not an existing file (merl-trilinear:FILE.binary)");
+  if (detect_brdf_format(path) != BrdfFileFormat::merl)
+    throw FormatError(path.string(), "format",
+                      "not a MERL .binary (merl-trilinear: reads MERL files only)");
+  return load_merl(path, {.lookup = MerlLookup::trilinear});
+}
+
 BrdfPtr load_one(std::string_view spec) {
-  constexpr std::string_view embedded = "embedded:";
+  constexpr std::string_view embedded = "embedded:", trilinear = "merl-trilinear:";
   if (spec.substr(0, embedded.size()) == embedded)
     return load_embedded(spec.substr(embedded.size()));
+  if (spec.substr(0, trilinear.size()) == trilinear)
+    return load_merl_trilinear(spec.substr(trilinear.size()));
   const std::filesystem::path path{std::string(spec)};
   std::error_code ec;
-  if (!spec.empty() && std::filesystem::exists(path, ec)) {
-    // A folder is a BRDF only as the NumPy form of a neural BRDF (its reader says what is
-    // missing).
-    if (std::filesystem::is_directory(path, ec)) return load_nbrdf(path);
-    if (!std::filesystem::is_regular_file(path, ec))
-      throw FormatError(path.string(), "file", "not a regular file");
-    BrdfFileFormat format = detect_brdf_format(path);
-    if (format == BrdfFileFormat::unknown) {
-      // The content matches no format: let the reader the extension names say what is wrong.
-      const std::string ext = path.extension().string();
-      if (ext == ".binary")
-        format = BrdfFileFormat::merl;
-      else if (ext == ".bsdf")
-        format = BrdfFileFormat::rgl;
-      else if (ext == ".dat" || ext == ".alta")
-        format = BrdfFileFormat::alta;
-      else if (ext == ".h5")
-        format = BrdfFileFormat::nbrdf_h5;
-      else if (ext == ".npy")
-        format = BrdfFileFormat::nbrdf_npy;
-      else
-        throw FormatError(path.string(), "format",
-                          "not a MERL .binary (34992012 bytes, 90 90 180 header), RGL .bsdf "
-                          "(\"tensor_file\" magic), ALTA text file (#DIM header), neural BRDF "
-                          "(HDF5 .h5, or NAME_fc1.npy), factored BRDF (JSON, \"format\": "
-                          "\"halfback-factored-brdf\")");
-    }
-    switch (format) {
-      case BrdfFileFormat::merl:
-        return load_merl(path);
-      case BrdfFileFormat::rgl:
-        return load_rgl(path);
-      case BrdfFileFormat::alta:
-        return load_alta(path);
-      case BrdfFileFormat::nbrdf_h5:
-        return std::make_shared<NbrdfBrdf>(read_nbrdf_h5(path), path.stem().string());
-      case BrdfFileFormat::nbrdf_npy:
-        return load_nbrdf(path);
-      case BrdfFileFormat::factored:
-        return std::make_shared<FactoredBrdf>(read_factored(path));
-      case BrdfFileFormat::unknown:
-        break;
-    }
+  if (spec.empty() || !std::filesystem::exists(path, ec)) return model_registry().create(spec);
+  // What a file holds is data, never the command line's fault: a value that a BRDF's constructor
+  // refuses (std::invalid_argument) is a FormatError naming the file, like the readers' own.
+  try {
+    return load_file(path);
+  } catch (const std::invalid_argument& e) {
+    throw FormatError(path.string(), "data", e.what());
   }
-  return model_registry().create(spec);
 }
 
 }  // namespace
@@ -262,7 +289,14 @@ void register_brdf_parameterization_families() {
           "dupuy-jakob:ggx:alpha=0.2 or dupuy-jakob:FILE.bsdf)");
     if ("dupuy-jakob:" + std::string(spec) == kPerMaterialWarp) return per_material_placeholder();
     const BrdfPtr brdf = load_brdf(spec);
-    return adaptive_parameterization(*brdf, "dupuy-jakob:" + std::string(spec));
+    if (!path_exists(spec))
+      return adaptive_parameterization(*brdf, "dupuy-jakob:" + std::string(spec));
+    // A file's BRDF that no warp can be made of (NaN everywhere, ...) is bad data.
+    try {
+      return adaptive_parameterization(*brdf, "dupuy-jakob:" + std::string(spec));
+    } catch (const std::invalid_argument& e) {
+      throw FormatError(std::string(spec), "data", e.what());
+    }
   });
 }
 

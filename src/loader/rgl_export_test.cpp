@@ -32,6 +32,18 @@ std::shared_ptr<const RglBrdf> read_back(const std::vector<TensorFieldData>& fie
       parse_tensor_file(serialize_tensor_file(fields), "exported"), "exported");
 }
 
+// Export options with `theta_i` elevations, the rest the defaults (or the published layout:
+// σ-spaced elevations, point samples).
+RglExportOptions with_elevations(int theta_i, bool published = false) {
+  RglExportOptions o;
+  o.theta_i = theta_i;
+  if (published) {
+    o.incidences = RglIncidences::sigma;
+    o.tabulation = RglTabulation::point;
+  }
+  return o;
+}
+
 std::shared_ptr<const RglBrdf> exported(const Brdf& brdf, RglExportOptions o = {}) {
   return read_back(rgl_fields(brdf, o));
 }
@@ -74,9 +86,15 @@ constexpr double k80 = 80 * kPi / 180;
 // 85°, 1.6–3.6%. Over the whole hemisphere the estimate has no stable value (printed for two
 // seeds): the format stores ρ cos θo, which the reader divides by cos θo, so an absolute error at
 // the horizon becomes a relative error whose square, under cos θo, is not integrable there.
+// Under AddressSanitizer, a narrow and a broad lobe only (an export evaluates 2.4 million warps).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kAlphas[] = {0.05, 0.4};
+#else
+constexpr double kAlphas[] = {0.05, 0.1, 0.2, 0.4, 0.8};
+#endif
 TEST(RglExport, MicrofacetModelsAgreeWithTheirExport) {
   for (const char* dist : {"ggx", "beckmann"}) {
-    for (double alpha : {0.05, 0.1, 0.2, 0.4, 0.8}) {
+    for (double alpha : kAlphas) {
       const BrdfPtr model =
           load_brdf(fmt::format("{}:alpha={},f0_r=0.9,f0_g=0.6,f0_b=0.3", dist, alpha));
       const auto file = exported(*model);
@@ -157,10 +175,11 @@ TEST(RglExport, LambertAgreesToItsTabulation) {
   const double whole = relative_l2(*lambert, *file, 200000, 7);
   std::printf("lambert: relative L2 %.4f (θ ≤ 80°), %.4f (hemisphere)\n", err, whole);
   EXPECT_LT(err, 0.025);
-  // At the nodes of the tables the value is exact up to float rounding: normal incidence.
+  // A node holds the average of ρ cos θo 4σ/D over its hat function, not the point value: at
+  // normal incidence within 1% of ρ for Lambert (0.57% measured), where a point sample was exact.
   const Rgb at = file->eval({{0, 0, 1}, {0, 0, 1}});
-  EXPECT_NEAR(at.r, 0.8 / kPi, 1e-5);
-  EXPECT_NEAR(at.b, 0.2 / kPi, 1e-5);
+  EXPECT_NEAR(at.r, 0.8 / kPi, 0.01 * 0.8 / kPi);
+  EXPECT_NEAR(at.b, 0.2 / kPi, 0.01 * 0.2 / kPi);
 }
 
 // An RGL file, read by halfback and exported again, agrees with the original.
@@ -174,14 +193,19 @@ TEST(RglExport, RglFileExportedAgainAgrees) {
   }
 }
 
-// The θi grid is evenly spaced in σ as in the published files: re-exporting a published file
-// gives nearly its grid (the NDFs differ: theirs is measured, ours recovered from its ρ).
-TEST(RglExport, IncidenceGridLikeThePublishedFiles) {
+// Half of the θi grid (rounded up) is evenly spaced in σ as in the published files: re-exporting
+// a published file of 8 elevations with 15 gives nearly its grid among them (the NDFs differ:
+// theirs is measured, ours recovered from its ρ), and 7 more where the albedo needs them.
+TEST(RglExport, IncidenceGridHoldsThePublishedFilesGrid) {
   const auto original = load_rgl(HALFBACK_SOURCE_DIR "/data/rgl/ilm_l3_37_metallic_rgb.bsdf");
-  const auto again = exported(*original);
-  ASSERT_EQ(again->theta_i().size(), original->theta_i().size());
-  for (std::size_t k = 0; k < again->theta_i().size(); ++k)
-    EXPECT_NEAR(again->theta_i()[k], original->theta_i()[k], 0.05) << k;
+  const auto again = exported(*original, with_elevations(15));
+  ASSERT_EQ(again->theta_i().size(), 15u);
+  ASSERT_EQ(original->theta_i().size(), 8u);
+  for (double published : original->theta_i()) {
+    double nearest = kPi;
+    for (double t : again->theta_i()) nearest = std::min(nearest, std::abs(t - published));
+    EXPECT_LT(nearest, 0.05) << published;
+  }
 }
 
 // The fields, dtypes and shapes of a published file (its `valid` mask aside, which no reader
@@ -190,7 +214,8 @@ TEST(RglExport, FieldsLikeThePublishedFiles) {
   const TensorFile published =
       read_tensor_file(HALFBACK_SOURCE_DIR "/data/rgl/ilm_l3_37_metallic_rgb.bsdf");
   const BrdfPtr ggx = load_brdf("ggx:alpha=0.3");
-  const TensorFile mine = parse_tensor_file(serialize_tensor_file(rgl_fields(*ggx)), "mine");
+  const TensorFile mine =
+      parse_tensor_file(serialize_tensor_file(rgl_fields(*ggx, with_elevations(8))), "mine");
   std::vector<std::string> names;
   for (const TensorField& f : published.fields) {
     if (f.name == "valid") continue;
@@ -231,29 +256,85 @@ TEST(RglExport, StoredValuesAreNonNegative) {
   }
 }
 
-// Energy: the directional albedo of the file agrees with the source's. Exact up to the tables'
-// resolution at the incidence slices (θi = 0 is one); between slices, the tables are
-// interpolated linearly in θi, which for fast-varying Fresnel factors errs by a few percent at
-// the default 8 slices and less with more (docs: the table of measurements).
+// The directional albedo (luminance) of `f` at `wi` and its standard error, by Monte Carlo with
+// ωo drawn half from the cosine and half from `sampler`'s own sampling (balance heuristic): with
+// the export as the sampler, the peaks of a near-mirror's source are sampled as well as its own.
+std::pair<double, double> albedo_sampled_by(const Brdf& f, const Brdf& sampler,
+                                            const Vec3<double>& wi, int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0, 1);
+  double sum = 0, sum2 = 0;
+  for (int s = 0; s < n; ++s) {
+    Vec3<double> wo;
+    if (s % 2 == 0) {
+      const double r = std::sqrt(uni(rng)), phi = 2 * kPi * uni(rng);
+      wo = {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1 - r * r))};
+    } else {
+      wo = sampler.sample(wi, uni(rng), uni(rng)).wi;
+    }
+    double v = 0;
+    if (wo.z > 0) {
+      const double pdf = 0.5 * wo.z / kPi + 0.5 * sampler.pdf(wi, wo);
+      if (pdf > 0) v = f.eval({wi, wo}).luminance() * wo.z / pdf;
+    }
+    sum += v;
+    sum2 += v * v;
+  }
+  const double mean = sum / n;
+  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
+}
+
+// Near-mirrors and grazing Fresnel peaks keep their energy: the directional albedo of the export
+// is within 10% (plus three standard errors) of the source's at θi = 0, 30, 60, 80°, and never
+// above 1. Point samples of the tables gave chrome-steel 3× its albedo at 30° and 60° (ρ/D grows
+// by orders of magnitude across one cell of its tail), and white-paint 1.47 at 80° (a grazing
+// peak narrower than a cell); the hat averages keep each slice's energy, and the elevations
+// chosen by the albedo keep it between slices.
+TEST(RglExport, NearMirrorsAndGrazingPeaksKeepTheirEnergy) {
+  HALFBACK_REQUIRE_SHARED(dir, "nbrdf/merl_nbrdf");
+#if defined(__SANITIZE_ADDRESS__)
+  const char* const names[] = {"chrome-steel"};  // three neural exports take a minute under ASan
+#else
+  const char* const names[] = {"chrome-steel", "white-paint", "chrome"};
+#endif
+  for (const char* name : names) {
+    const BrdfPtr source = load_brdf((dir / (std::string(name) + ".h5")).string());
+    const auto file = exported(*source);
+    for (double deg : {0.0, 30.0, 60.0, 80.0}) {
+      const double t = deg * kPi / 180;
+      const Vec3<double> wi{std::sin(t), 0, std::cos(t)};
+      const auto [a, ea] = albedo_sampled_by(*source, *file, wi, 100000, 3);
+      const auto [b, eb] = albedo_sampled_by(*file, *file, wi, 100000, 5);
+      std::printf("%s θi = %2.0f°: albedo %.4f ± %.4f, exported %.4f ± %.4f (%+.1f%%)\n", name, deg,
+                  a, ea, b, eb, 100 * (b / a - 1));
+      EXPECT_NEAR(b, a, 0.1 * a + 3 * std::hypot(ea, eb)) << name << " θi = " << deg;
+      EXPECT_LE(b, 1.0) << name << " θi = " << deg;
+    }
+  }
+}
+
+// Energy: the directional albedo of the file agrees with the source's: exact up to the midpoint
+// rule at the incidence slices (θi = 0 is one), and between slices within 3% with the elevations
+// placed by the albedo. The published layout (8 σ-spaced elevations, point samples) errs by up to
+// 7% between slices where a Fresnel factor grows fast (docs/formats.md, "Energy").
 TEST(RglExport, DirectionalAlbedoAgrees) {
   for (const char* spec :
        {"ggx:alpha=0.3,f0_r=0.9,f0_g=0.6,f0_b=0.3", "beckmann:alpha=0.1", "lambert:albedo=0.7",
         "embedded:acrylic_felt_green", "embedded:pink-felt"}) {
     const BrdfPtr source = load_brdf(spec);
-    RglExportOptions fine;
-    fine.theta_i = 16;
-    const auto file = exported(*source), file16 = exported(*source, fine);
+    const auto file = exported(*source);
+    const auto published = exported(*source, with_elevations(8, true));
     for (double deg : {0.0, 30.0, 60.0, 75.0}) {
       const double t = deg * kPi / 180;
       const Vec3<double> wi{std::sin(t), 0, std::cos(t)};
       const double a = directional_albedo(*source, wi, 128).mean.luminance();
       const double b = directional_albedo(*file, wi, 128).mean.luminance();
-      const double b16 = directional_albedo(*file16, wi, 128).mean.luminance();
+      const double p8 = directional_albedo(*published, wi, 128).mean.luminance();
       std::printf(
-          "%s θi = %2.0f°: albedo %.4f, exported %.4f (%+.2f%%), 16 slices %.4f (%+.2f%%)\n", spec,
-          deg, a, b, 100 * (b / a - 1), b16, 100 * (b16 / a - 1));
-      EXPECT_NEAR(b, a, (deg == 0 ? 0.005 : 0.08) * a) << spec << " θi = " << deg;
-      EXPECT_NEAR(b16, a, (deg == 0 ? 0.005 : 0.03) * a) << spec << " θi = " << deg;
+          "%s θi = %2.0f°: albedo %.4f, exported %.4f (%+.2f%%), published layout %.4f (%+.2f%%)\n",
+          spec, deg, a, b, 100 * (b / a - 1), p8, 100 * (p8 / a - 1));
+      EXPECT_NEAR(b, a, (deg == 0 ? 0.005 : 0.03) * a) << spec << " θi = " << deg;
+      EXPECT_NEAR(p8, a, (deg == 0 ? 0.005 : 0.08) * a) << spec << " θi = " << deg;
     }
   }
 }
@@ -305,8 +386,9 @@ TEST(RglExport, BadInputWritesNothing) {
   bad = {};
   bad.variant = RglVariant::spectral;
   expect_refused(nan_off_specular, "ρ is not finite at ωi =", bad);
-  // Issue 35, class B: a value above the bound on ρ (what the file stores, ρ·cos θo) is refused,
-  // naming the BRDF, before a file its reader would refuse is written.
+  // docs/reliability/readers.md, "One bound on a BRDF's value": a value above the bound on ρ (what
+  // the file stores, ρ·cos θo) is refused, naming the BRDF, before a file its reader would refuse
+  // is written.
   const test::FunctionBrdf hot([](const DirPair<double>& p) { return p.wo.y > 0.3 ? 1e12 : 0.3; });
   expect_refused(hot, "function: ρ·cos θo = ");
   expect_refused(hot,

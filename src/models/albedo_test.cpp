@@ -55,8 +55,9 @@ TEST(AlbedoMis, StandardErrorIsHonest) {
   EXPECT_GT(spread, 0.1 * se);
 }
 
-// Issue 35, class F: on GGX α = 0.05 at 75°, n = 64, MIS's standard error is more than 10×
-// below the cosine estimator's (the benchmark measures it at equal time).
+// docs/reliability/numerics.md, "Directional albedo: bounded memory, and multiple importance
+// sampling": on GGX α = 0.05 at 75°, n = 64, MIS's standard error is more than 10× below the cosine
+// estimator's (the benchmark measures it at equal time).
 TEST(AlbedoMis, FarLessNoiseOnAGlossyLobe) {
   const models::Microfacet ggx = glossy(0.05);
   const AlbedoEstimate cos = directional_albedo(ggx, kAt75, 64, 1, AlbedoSampling::cosine);

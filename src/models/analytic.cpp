@@ -166,7 +166,7 @@ Abc::Abc(const AbcParams& p) : params_(p) {
   require_range("abc", "a", p.a, 0, 1e6);
   require_range("abc", "b", p.b, 0, 1e9);
   require_range("abc", "c", p.c, 0, 100);
-  require_range("abc", "eta", p.eta, 1e-3, 100);
+  require_range("abc", "eta", p.eta, 1, 100);  // from air into the dielectric
   require_rgb("abc", "kd", p.kd, 0, 1);
 }
 

@@ -4,8 +4,10 @@
 
 #include "colour_params.hpp"
 #include "halfback/models/analytic.hpp"
+#include "halfback/models/artist.hpp"
 #include "halfback/models/ngan_lobes.hpp"
 #include "halfback/models/ngan_microfacet.hpp"
+#include "halfback/models/published_lobes.hpp"
 
 namespace halfback::models {
 
@@ -62,7 +64,8 @@ void register_analytic_models(ModelRegistry& registry) {
                 {{"a", "A: specular scale", 1, 0, 1e6},
                  {"b", "B: inverse squared width in f = 2|h_bar|", 400, 0, 1e9},
                  {"c", "C: fall-off exponent", 1.5, 0, 100},
-                 {"eta", "index of refraction of the dielectric Fresnel factor", 1.5, 1e-3, 100},
+                 {"eta", "index of refraction of the dielectric Fresnel factor (from air: >= 1)",
+                  1.5, 1, 100},
                  {"kd", "diffuse albedo", 0, 0, 1}},
                 [](const ModelArgs& a) {
                   AbcParams p;
@@ -82,6 +85,11 @@ void register_analytic_models(ModelRegistry& registry) {
                 }});
   register_ngan_lobe_models(registry);
   register_ngan_microfacet_models(registry);
+  register_artist_models(registry);
+
+  // The lobes of Löw et al. 2012's and Bagher et al. 2012's published fits
+  // (models/published_lobes).
+  register_published_lobe_models(registry);
 }
 
 }  // namespace halfback::models

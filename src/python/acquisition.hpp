@@ -1,4 +1,4 @@
-// Measurement plans and reconstructions (issue 33, docs/acquisition.md): halfback.plan and the
+// Measurement plans and reconstructions (docs/acquisition.md): halfback.plan and the
 // core of halfback.reconstruct (acquisition.cpp).
 #pragma once
 

@@ -1,15 +1,17 @@
-// halfback.fit, fit_loss and published_fits (issue 37; docs/fit.md).
+// halfback.fit, fit_loss and published_fits (docs/fit.md).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <array>
+#include <numbers>
 #include <string>
 
 #include "halfback/fit/emit.hpp"
 #include "halfback/fit/factor.hpp"
 #include "halfback/fit/fit.hpp"
 #include "halfback/fit/published.hpp"
+#include "halfback/fit/sample_limit.hpp"
 #include "py_brdf.hpp"
 
 namespace py = pybind11;
@@ -19,7 +21,7 @@ namespace halfback::python {
 namespace {
 
 // ---------------------------------------------------------------------------------------------
-// Fitting (issue 37): halfback.fit, the GIL released while it runs
+// Fitting (docs/fit.md): halfback.fit, the GIL released while it runs
 // ---------------------------------------------------------------------------------------------
 
 py::dict fit_result_dict(const fit::FitResult& r) {
@@ -39,9 +41,21 @@ py::dict fit_result_dict(const fit::FitResult& r) {
   out["spec"] = r.spec;
   out["loss"] = std::string(fit::name_of(r.loss));
   out["loss_value"] = r.loss_value;
-  out["layout"] = std::string(fit::kLayoutName);
+  py::list terms;  // each term's albedo share and whether it is a dead lobe (docs/fit.md)
+  for (std::size_t t = 0; t < r.model.terms.size() && t < r.albedo_share.size(); ++t) {
+    py::dict d;
+    d["model"] = r.model.terms[t];
+    d["albedo_share"] = r.albedo_share[t];
+    d["loss_without"] = r.loss_without[t];
+    d["dead"] = bool(r.dead[t]);
+    terms.append(d);
+  }
+  out["layout"] = r.layout;
   out["samples"] = r.samples;
+  out["missing"] = r.missing;
+  out["out_of_reach"] = r.out_of_reach;
   out["parameters"] = params;
+  out["terms"] = terms;
   out["starts"] = r.starts;
   out["iterations"] = r.iterations;
   out["seconds"] = r.seconds;
@@ -49,11 +63,20 @@ py::dict fit_result_dict(const fit::FitResult& r) {
 }
 
 py::dict fit_brdf(const py::object& brdf, const std::string& model, const std::string& loss,
-                  std::size_t samples, int threads) {
+                  std::size_t samples, int threads, const std::vector<std::string>& starts,
+                  int max_iterations, double max_theta) {
   fit::FitOptions o;
+  o.starts = starts;
+  if (max_iterations < 1) throw py::value_error("max_iterations must be at least 1");
+  o.max_iterations = max_iterations;
+  if (!(max_theta > 0 && max_theta <= std::numbers::pi / 2))
+    throw py::value_error("max_theta = " + std::to_string(max_theta) +
+                          " rad: the reach must be in (0, pi/2] (radians)");
+  o.max_theta = max_theta;
   const auto l = fit::parse_loss(loss);
   if (!l) throw py::value_error("loss '" + loss + "': expected " + fit::loss_names());
   o.loss = *l;
+  fit::check_fit_samples(samples, "samples");  // ValueError above the CLI's bound
   o.samples = samples;
   o.threads = threads;
   const BrdfPtr target = brdf_of(brdf);
@@ -69,7 +92,7 @@ double fit_loss(const py::object& brdf, const py::object& model, const std::stri
                 std::size_t samples, int threads) {
   const auto l = fit::parse_loss(loss);
   if (!l) throw py::value_error("loss '" + loss + "': expected " + fit::loss_names());
-  if (samples < 1) throw py::value_error("samples must be at least 1");
+  fit::check_fit_samples(samples, "samples");
   const BrdfPtr target = brdf_of(brdf), m = brdf_of(model);
   py::gil_scoped_release release;
   return fit::loss_of(*target, *m, *l, samples, threads);
@@ -110,6 +133,7 @@ py::list published_fits(const std::string& path) {
 
 // fit()'s layout of n pairs as arrays (for baselines written in Python: bench/fit_scipy_bench.py).
 py::dict fit_samples(std::size_t n) {
+  fit::check_fit_samples(n, "n");
   const fit::Samples s = fit::halfdiff_samples(n);
   const auto rows = py::ssize_t(s.pairs.size());
   py::array_t<double> wi({rows, py::ssize_t(3)}), wo({rows, py::ssize_t(3)}), weight(rows),
@@ -142,17 +166,29 @@ std::string emit(const std::string& spec, const std::string& target, const std::
 void bind_fit(py::module_& m) {
   m.def("fit", &fit_brdf, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
         py::arg("samples") = 20000, py::arg("threads") = 0,
+        py::arg("starts") = std::vector<std::string>{}, py::arg("max_iterations") = 200,
+        py::arg("max_theta") = std::numbers::pi / 2,
         R"doc(Fits an analytic model or a sum of lobes ("lambert+ggx"; values given, as in
 "ggx:f0=0.9", are held) to a BRDF (a spec, as for load(), or a Brdf), as `halfback fit`
-(docs/fit.md), the GIL released while it runs. loss: ngan, low-e1, low-e2, cube-root or log.
-Returns a dict: spec (load() reads it), loss, loss_value, layout, samples, parameters (a list of
-dicts: term, model, name, value, fitted, min, max), starts, iterations, seconds. A bad model or
+(docs/fit.md), the GIL released while it runs. loss: one of halfback.fit's losses (ngan, low-e1,
+..., and the published bbm-* ones, measured on BBM's grid; samples then unused). starts: when
+not empty, the only starts (specs of the same terms whose values set the fitted parameters).
+max_iterations: of each Levenberg-Marquardt run.
+Returns a dict: spec (load() reads it), loss, loss_value, layout ("halfdiff-halton", or
+"halfdiff-halton-turned" for a model that can be anisotropic), samples (those fitted), missing
+(left out: NaN values) and out_of_reach (left out: θi or θo above max_theta, radians), parameters (a list of
+dicts: term, model, name, value, fitted, min, max; a parameter without effect is not fitted),
+terms (a list of dicts: model, albedo_share, loss_without, dead: a dead lobe has a share below
+1e-4 or a loss_without within 0.1 % of loss_value), starts,
+iterations, seconds. A bad model or
 loss raises ValueError; a target the fit cannot use (not finite, negative or zero where sampled,
 anisotropic) raises RuntimeError.)doc");
   m.def("fit_loss", &fit_loss, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
         py::arg("samples") = 20000, py::arg("threads") = 0,
         R"doc(The loss of `model` (a spec or a Brdf) against `brdf` on fit()'s layout of `samples`
-pairs, as fit() measures it: fit(b, m, loss, n)["loss_value"] is fit_loss(b, its spec, loss, n).
+pairs (turned when `model` is anisotropic), as fit() measures it: fit(b, m, loss,
+n)["loss_value"] is fit_loss(b, its spec, loss, n). A published bbm-* loss is measured on
+BBM's default grid (samples unused; docs/fit.md, "Published losses").
 The GIL is released while it runs. A bad loss raises ValueError; a target the fit cannot use,
 RuntimeError.)doc");
   m.def("factor", &factor, py::arg("brdf"), py::arg("param") = "hybrid", py::arg("rank") = 2,
@@ -173,12 +209,15 @@ dicts material, line, spec (a halfback spec of the registry's restatements of BB
 load() reads it) and model (its terms, as fit() takes them: "lambert+ward"). A malformed file
 raises RuntimeError naming the line; a model halfback lacks, ValueError.)doc");
   m.def("emit", &emit, py::arg("spec"), py::arg("target"), py::arg("name") = "halfback_fit",
-        R"doc(The model `spec` (fit()'s "spec", or any spec of lambert, ggx, beckmann, or lambert
-plus one of them) as a renderer's own material named `name`, the text `halfback fit --emit`
-writes (docs/fit.md, "Renderer-ready output"): target "mitsuba3" (a Mitsuba 3 scene file holding
-one <bsdf>) or "pbrt-v4" (a MakeNamedMaterial). A comment at the top says what the conversion
-loses. An unknown target, or a model the renderer has no material for (ward, abc, beckmann in
-pbrt-v4, ...), raises ValueError pointing to `halfback export-rgl`.)doc");
+        R"doc(The model `spec` (fit()'s "spec", or any spec of the models a target has) as a
+renderer's own material named `name`, the text `halfback fit --emit` writes (docs/fit.md,
+"Renderer-ready output"): target "mitsuba3" (a Mitsuba 3 scene file holding one <bsdf>: lambert,
+ggx, beckmann, lambert plus one of them), "pbrt-v4" (a MakeNamedMaterial: lambert, ggx),
+"blender" (a Python script that builds the material in Blender's Cycles: sums of lambert,
+oren-nayar, ggx and disney) or "materialx" (a MaterialX 1.38 document: sums of lambert,
+oren-nayar and ggx, or disney alone). A comment at the top says what the conversion loses. An
+unknown target, or a model the renderer has no material for (ward, abc, beckmann in pbrt-v4,
+...), raises ValueError pointing to `halfback export-rgl`.)doc");
 }
 
 }  // namespace halfback::python

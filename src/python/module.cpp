@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <filesystem>
 #include <limits>
 #include <numbers>
@@ -29,6 +30,8 @@
 #include "halfback/loader/load.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/renderer.hpp"
+#include "halfback/util/format_error.hpp"
+#include "halfback/util/text_encoding.hpp"
 #include "py_brdf.hpp"
 #include "user_param.hpp"
 
@@ -147,7 +150,8 @@ std::pair<const char*, const char*> byte_span(const py::array& a) {
 
 // Whether `out` shares memory with x other than as x itself (same start, shape and strides: the
 // engine then reads each row before writing it). A row of out written before a later row of x
-// is read gave wrong answers (issue 35, class D: errors up to 6): x is then copied first.
+// is read gave wrong answers (docs/reliability/python.md, "A row with a NaN or an infinity is
+// answered NaN"): x is then copied first.
 bool overlaps_unsafely(const py::array& x, const py::array& out) {
   const auto [a0, a1] = byte_span(x);
   const auto [b0, b1] = byte_span(out);
@@ -606,8 +610,11 @@ Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape
            R"doc(A unit sphere of the BRDF under an environment (as `halfback render`): an (H, W, 3)
 float32 array of linear radiance, row 0 at the top. env: "sky" (a sky with a sun; "default" is its older name), "studio", "sunset",
 "constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".
-brdf_sampling (a BRDF without a sampler of its own): "table", "cosine", or "auto" (the one with
-the lower variance in a small pilot rendering; `halfback render --brdf-sampling`).)doc")
+brdf_sampling (a BRDF without a sampler of its own): "table", "cosine", or "auto" (the table when
+the cosine's samples miss energy that the table finds, or when the BRDF is peaked for this
+environment, its albedo variance under the cosine at least a threshold times the table's that
+rises as the environment leaves less of its light to the BRDF sampler; else the cosine; as
+`halfback render --brdf-sampling`, docs/render.md).)doc")
       .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; })
       .def_property_readonly(
           "spec", [](const PyBrdf& b) { return b.spec; },
@@ -685,12 +692,22 @@ PYBIND11_MODULE(_core, m) {
   m.attr("__version__") = HALFBACK_VERSION;
   m.doc() = "halfback: exact, fast changes of variables between BRDF parameterizations";
   halfback::register_brdf_parameterization_families();
+  // A reader's message may quote bytes of its file that are not UTF-8: pybind11 would then raise
+  // the exception without its text. FormatError stays a RuntimeError, its text made valid UTF-8.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const halfback::FormatError& e) {
+      PyErr_SetString(PyExc_RuntimeError, halfback::valid_utf8(e.what()).c_str());
+    }
+  });
   bind_conversions(m);
   bind_brdf_class(m);
   bind_hemisphere(m);
   bind_loading(m);
   halfback::python::bind_study(m);
   halfback::python::bind_fit(m);
+  halfback::python::bind_nbrdf(m);
   halfback::python::bind_user_parameterizations(m);
   halfback::python::bind_acquisition(m);
 }

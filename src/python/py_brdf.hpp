@@ -25,5 +25,6 @@ BrdfPtr brdf_of(const pybind11::object& brdf);
 
 void bind_fit(pybind11::module_& m);    // fit_bindings.cpp
 void bind_study(pybind11::module_& m);  // study_bindings.cpp (and the SSIM)
+void bind_nbrdf(pybind11::module_& m);  // nbrdf_bindings.cpp
 
 }  // namespace halfback::python

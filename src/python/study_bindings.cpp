@@ -1,5 +1,5 @@
-// The study in Python (issue 14): halfback.study_brdf, study_profile, merge_study, and the SSIM
-// of its image-space error (docs/study.md).
+// The study in Python (docs/study.md, "Running on whole databases"): halfback.study_brdf,
+// study_profile, merge_study, and the SSIM of its image-space error (docs/study.md).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -10,6 +10,7 @@
 
 #include "halfback/loader/load.hpp"
 #include "halfback/study/image_metrics.hpp"
+#include "halfback/study/metric.hpp"
 #include "halfback/study/parts.hpp"
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
@@ -23,7 +24,8 @@ namespace halfback::python {
 namespace {
 
 // ---------------------------------------------------------------------------------------------
-// The study (issue 14): one BRDF at a time, for engines such as Dask, and the merge
+// The study (docs/study.md, "Running on whole databases"): one BRDF at a time, for engines such as
+// Dask, and the merge
 // ---------------------------------------------------------------------------------------------
 
 template <class T>
@@ -45,6 +47,44 @@ struct PySettings {
   bool designs_given = false;
 };
 
+// The keys of the metrics in the settings dict (study::study_metrics()): no_NAME for each metric
+// that can be turned off, and each option's key.
+std::string metric_setting_keys() {
+  std::string keys;
+  for (const study::Metric* m : study::study_metrics()) {
+    if (m->switchable()) keys += (keys.empty() ? "no_" : ", no_") + std::string(m->name());
+    for (const study::MetricOption& o : m->options()) keys += (keys.empty() ? "" : ", ") + o.key;
+  }
+  return keys;
+}
+
+// A metric's key of the settings dict (no_NAME, or an option: text, an integer or a list of
+// integers as its kind says); false when `key` is none of them.
+bool read_metric_setting(study::StudySettings& s, const std::string& key, const py::handle& v) {
+  for (const study::Metric* m : study::study_metrics()) {
+    if (m->switchable() && key == "no_" + std::string(m->name())) {
+      if (setting<bool>(v, key)) s.off.emplace_back(m->name());
+      return true;
+    }
+    for (const study::MetricOption& o : m->options()) {
+      if (key != o.key) continue;
+      using Kind = study::MetricOption::Kind;
+      if (o.kind == Kind::text) {
+        s.options[key] = setting<std::string>(v, key);
+      } else if (o.kind == Kind::count) {
+        s.options[key] = std::to_string(setting<std::size_t>(v, key));
+      } else {
+        std::string text;
+        for (const std::size_t n : setting<std::vector<std::size_t>>(v, key))
+          text += (text.empty() ? "" : ",") + std::to_string(n);
+        s.options[key] = text;
+      }
+      return true;
+    }
+  }
+  return false;
+}
+
 // One key of the settings dict.
 void read_setting(PySettings& out, const std::string& key, const py::handle& v) {
   study::StudySettings& s = out.settings;
@@ -60,24 +100,10 @@ void read_setting(PySettings& out, const std::string& key, const py::handle& v) 
     out.has_profiles = true;
   } else if (key == "quick")
     s.quick = setting<bool>(v, key);
-  else if (key == "no_gonio")
-    s.no_gonio = setting<bool>(v, key);
-  else if (key == "no_images")
-    s.no_images = setting<bool>(v, key);
-  else if (key == "no_sampling")
-    s.no_sampling = setting<bool>(v, key);
-  else if (key == "sampler_kib")
-    s.sampler_kib = setting<std::vector<std::size_t>>(v, key);
-  else if (key == "sampler_samples")
-    s.sampler_samples = setting<std::size_t>(v, key);
-  else if (key == "fit_model")
-    s.fit_model = setting<std::string>(v, key);
-  else if (key == "fit_loss")
-    s.fit_loss = setting<std::string>(v, key);
-  else if (key == "fit_budgets")
-    s.fit_budgets = setting<std::vector<std::size_t>>(v, key);
-  else if (key == "no_fit")
-    s.no_fit = setting<bool>(v, key);
+  else if (key == "metrics")
+    s.metrics = setting<std::vector<std::string>>(v, key);
+  else if (read_metric_setting(s, key, v))
+    return;
   else if (key == "budgets")
     s.budgets = setting<std::vector<std::size_t>>(v, key);
   else if (key == "budgets_4d")
@@ -97,13 +123,11 @@ void read_setting(PySettings& out, const std::string& key, const py::handle& v) 
   else if (key == "env")
     s.environments = setting<std::vector<std::string>>(v, key);
   else
-    throw py::value_error(
-        "settings: unknown key '" + key +
-        "' (accepted: params, space, designs, profiles, quick, budgets, budgets_4d, "
-        "test_pairs, env, image_budget, image_size, image_spp, max_theta, "
-        "seed, no_gonio, no_images, sampler_kib, sampler_samples, no_sampling, fit_model, "
-        "fit_loss, "
-        "fit_budgets, no_fit)");
+    throw py::value_error("settings: unknown key '" + key +
+                          "' (accepted: params, space, designs, profiles, quick, budgets, "
+                          "budgets_4d, test_pairs, env, image_budget, image_size, image_spp, "
+                          "max_theta, seed, metrics, " +
+                          metric_setting_keys() + ")");
 }
 
 PySettings study_settings(const py::object& settings) {
@@ -111,9 +135,9 @@ PySettings study_settings(const py::object& settings) {
   study::StudySettings& s = out.settings;
   if (!settings.is_none())
     for (const auto& [k, v] : settings.cast<py::dict>()) read_setting(out, py::str(k), v);
-  // The defaults work alone (issue 35): without profiles, the default designs leave out the
-  // learned one, which needs the profiles of the study's other BRDFs; asked for by name, it
-  // still needs them.
+  // The defaults work alone (a new user's first call, docs/reliability/python.md): without
+  // profiles, the default designs leave out the learned one, which needs the profiles of the
+  // study's other BRDFs; asked for by name, it still needs them.
   if (!out.has_profiles && !out.designs_given) std::erase(s.designs, std::string("learned"));
   return out;
 }
@@ -291,9 +315,10 @@ Returns a dict: relative_rmse, mean_delta_e2000, p95_delta_e2000, mae, rmse, ssi
 spec: a file or model spec, as for load(). settings: a dict of the options of `halfback study`
 with '-' spelled '_': params (a list of parameterization names; missing: all of them, spherical
 last), space (the error space), designs (a list), quick, budgets, budgets_4d,
-test_pairs, env (a list), image_budget, image_size, image_spp, max_theta, seed, no_gonio,
-no_images, sampler_kib (a list), sampler_samples, no_sampling, fit_model, fit_loss, fit_budgets (a
-list), no_fit (missing: the defaults), and, for the learned design (a default design), profiles: the
+test_pairs, env (a list), image_budget, image_size, image_spp, max_theta, seed, metrics (a list
+of the metrics to run), and per metric of the study's list no_NAME (no_gonio, no_images,
+no_sampling, no_fit) and its options (sampler_kib (a list), sampler_samples, fit_model, fit_loss,
+fit_budgets (a list), fit_samples) (missing: the defaults), and, for the learned design (a default design), profiles: the
 study_profile() texts of every BRDF of the study, this one's included, in the study's order (the
 warps are learned from all but this one's; without them, a ValueError).
 Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image": one

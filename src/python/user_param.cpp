@@ -1,6 +1,9 @@
 // A parameterization written by a Python user: vectorized NumPy callables behind a ParamDescriptor,
 // checked (core/param_check.hpp) before it is registered, then taken by name by every function of
-// the module (convert, resample, hemisphere, study_brdf, ...).
+// the module (convert, resample, hemisphere, study_brdf, ...). After registration its results are
+// checked at every call (a map may go wrong later, or where the checks did not sample): forward's
+// coordinates finite for a valid pair, inverse's pair valid (unit directions, above the horizon)
+// inside the axes' ranges; otherwise a ValueError naming the parameterization and the values.
 //
 // The user gives forward (wi, wo) -> q and inverse q -> (wi, wo) on (N, 3) and (N, 4) float64
 // arrays, the four axes, and optionally the Jacobian and the reciprocity map. The rest is derived:
@@ -17,6 +20,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -84,6 +88,21 @@ class PyParam final : public ParamDescriptor {
   }
 
   bool concurrent() const override { return false; }
+
+  // While one lives, the results of the user's maps are not checked at each call: for the
+  // registration's checks (core/param_check.hpp), which find and name the same faults (a
+  // round trip off by 1e-3, ...) in their own words. Not reentrant (one thread: concurrent() is
+  // false).
+  class ResultChecksOff {
+   public:
+    explicit ResultChecksOff(const PyParam& p) : p_(p) { p_.check_results_ = false; }
+    ~ResultChecksOff() { p_.check_results_ = true; }
+    ResultChecksOff(const ResultChecksOff&) = delete;
+    ResultChecksOff& operator=(const ResultChecksOff&) = delete;
+
+   private:
+    const PyParam& p_;
+  };
 
   // --- rows: one call of the user's code per block --------------------------------------------
   void forward_rows(bool iso, const DirPair<double>* pairs, std::size_t m,
@@ -200,6 +219,46 @@ class PyParam final : public ParamDescriptor {
     const Array q =
         checked(s_.forward(rows_of(wi.data(), m, 3), rows_of(wo.data(), m, 3)), m, 4, "forward");
     std::copy(q.data(), q.data() + 4 * m, coords);
+    for (std::size_t i = 0; i < m && check_results_; ++i)
+      if (check_pair(pairs[i]) == PairStatus::ok &&
+          !std::all_of(coords + 4 * i, coords + 4 * i + 4,
+                       [](double x) { return std::isfinite(x); }))
+        throw py::value_error(s_.name + ": forward returned coordinates that are not finite, (" +
+                              numbers(coords + 4 * i, 4) + "), for the valid pair wi = (" +
+                              vec_text(pairs[i].wi) + "), wo = (" + vec_text(pairs[i].wo) + ")");
+  }
+
+  // "a, b, c" of n numbers, %.17g.
+  static std::string numbers(const double* x, std::size_t n) {
+    std::string s;
+    for (std::size_t k = 0; k < n; ++k) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.17g", x[k]);
+      (s += k ? ", " : "") += b;
+    }
+    return s;
+  }
+
+  static std::string vec_text(const Vec3<double>& w) {
+    const double x[3] = {w.x, w.y, w.z};
+    return numbers(x, 3);
+  }
+
+  // A ValueError unless the pair the user's inverse gave for `q` (inside the axes' ranges, both
+  // directions finite) is valid: unit directions (to kUnitTolerance) above the horizon (to its
+  // tolerance), as every built-in inverse returns and everything downstream assumes.
+  void require_valid_inverse(const double* q, const DirPair<double>& p) const {
+    const PairStatus status = check_pair(p);
+    if (status == PairStatus::ok) return;
+    const auto length = [](const Vec3<double>& w) { return std::sqrt(detail::dot(w, w)); };
+    char lengths[96];
+    std::snprintf(lengths, sizeof lengths, "|wi| = %.9g, |wo| = %.9g", length(p.wi), length(p.wo));
+    throw py::value_error(s_.name + ": inverse returned a pair that is not valid (" +
+                          std::string(describe(status)) + "; " + lengths + ": wi = (" +
+                          vec_text(p.wi) + "), wo = (" + vec_text(p.wo) + ")) for q = (" +
+                          numbers(q, 4) +
+                          ") inside the axes' ranges: it must return unit directions above the "
+                          "horizon, or NaN outside the domain");
   }
 
   // The user's inverse, then the declared ranges; valid pairs onto the hemisphere (as the built-in
@@ -210,6 +269,7 @@ class PyParam final : public ParamDescriptor {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (std::size_t i = 0; i < m; ++i) {
       in_domain[i] = in_domain[i] && in_ranges(coords + 4 * i);
+      if (in_domain[i] && check_results_) require_valid_inverse(coords + 4 * i, pairs[i]);
       if (in_domain[i]) {
         pairs[i].wi.z = std::max(pairs[i].wi.z, 0.0);
         pairs[i].wo.z = std::max(pairs[i].wo.z, 0.0);
@@ -324,6 +384,7 @@ class PyParam final : public ParamDescriptor {
   }
 
   UserSpec s_;
+  mutable bool check_results_ = true;  // see ResultChecksOff
 };
 
 // The isotropic form's coordinates: the 4D ones but `drop`, the remaining azimuth last.
@@ -406,10 +467,11 @@ py::dict report_dict(const ParamCheckReport& r) {
 
 // The checks; a map that raises (a Python error, or a result of the wrong shape) fails them as
 // not vectorized, with its error.
-ParamCheckReport run_checks(const ParamDescriptor& p, std::size_t pairs, std::size_t box_samples) {
+ParamCheckReport run_checks(const PyParam& p, std::size_t pairs, std::size_t box_samples) {
   ParamCheckOptions o;
   o.pairs = pairs;
   o.box_samples = box_samples;
+  const PyParam::ResultChecksOff off(p);  // the checks name what is wrong themselves
   try {
     py::gil_scoped_release release;  // the maps take it back for each call
     return check_parameterization(p, o);

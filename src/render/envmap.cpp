@@ -477,6 +477,8 @@ EnvMap::EnvMap(int width, int height, std::vector<float> rgb, std::string name, 
   }
   compensated_ = total > 0 ? Distribution2D(std::size_t(height), std::size_t(width), compensated)
                            : distribution_;
+  const double power = mean * 4 * kPi;
+  residual_ = power > 0 ? std::clamp(1 - total / power, 0.0, 1.0) : 1.0;
 }
 
 EnvMap EnvMap::constant(const Rgb& radiance, EnvOptions options) {
@@ -532,7 +534,7 @@ EnvMap EnvMap::load(const std::filesystem::path& path, EnvOptions options) {
     throw FormatError(file, "file", "is a directory, not an image");
   if (!std::filesystem::exists(path, ec))
     throw FormatError(file, "file", std::string("cannot open: ") + std::strerror(ENOENT));
-  BoundedFile in(path);  // read as far as the header declares (class C of issue 35)
+  BoundedFile in(path);  // read as far as the header declares: a padded file is not read whole
   Bytes head = in.head(kHeadBytes);
   if (head.empty()) throw FormatError(file, "file", "empty file, not an HDR image");
   Loaded img;

@@ -204,7 +204,7 @@ TEST(EnvMap, BuiltInStudioAndSunset) {
   EXPECT_THROW(EnvMap::from_spec("studio2"), std::exception);
 }
 
-// Issue 35: one name for the default environment everywhere ("sky": the CLI and Python said
+// One name for the default environment everywhere, "sky" (the CLI and Python used to say
 // "default", the explorer "sky"); "default" is still taken, and is the same map.
 TEST(EnvMap, TheSkyHasOneName) {
   EXPECT_EQ(EnvMap::builtin_names(), (std::vector<std::string>{"sky", "studio", "sunset"}));
@@ -267,11 +267,11 @@ void expect_error(const std::filesystem::path& p, const std::string& words) {
   }
 }
 
-// Class 4 of docs/reliability-readers.md: a small file whose header declares a huge image must be
-// refused before the pixels are allocated: the reader may allocate a small multiple of the file's
-// size, not what the header claims.
-// The bytes of an EXR file whose dataWindow claims 16384 x 8192 pixels (1.6 GB of floats), the
-// rest of the file unchanged: the reproduction of class 4.
+// docs/reliability/readers.md, "Nothing is allocated from a size a file declares before the file is
+// checked to hold it": a small file whose header declares a huge image must be refused before the
+// pixels are allocated: the reader may allocate a small multiple of the file's size, not what the
+// header claims. The bytes of an EXR file whose dataWindow claims 16384 x 8192 pixels (1.6 GB of
+// floats), the rest of the file unchanged: the reproduction of class 4.
 std::string with_huge_data_window(const std::filesystem::path& exr) {
   std::string bytes = test::read_file(exr);
   const std::string key("dataWindow\0box2i\0", 17);
@@ -380,9 +380,10 @@ TEST(EnvMap, TinyNegativeRadianceIsNoise) {
   expect_error(p, "-0.001");
 }
 
-// Class C of issue 35 (docs/reliability-round3-readers.md): a map's file ends where its pixel
-// data does: trailing data is refused with both byte counts, and a small map extended to a
-// gigabyte (truncate -s) is refused without reading the extension (it was read whole: 2.1 GB).
+// No whole-file read without a bound (docs/reliability/readers.md, "A reader reads what the file's
+// header declares, and nothing more"): a map's file ends where its pixel data does: trailing data
+// is refused with both byte counts, and a small map extended to a gigabyte (truncate -s) is refused
+// without reading the extension (it was read whole: 2.1 GB).
 void expect_refused_unread(const std::filesystem::path& p, const std::string& words) {
   test::AllocationProbe probe;
   expect_error(p, words);

@@ -1,8 +1,9 @@
-// The study's fit metric (metric 6, issue 37): a row per parameterization, design and budget; a
+// The study's fit metric (metric 6): a row per parameterization, design and budget; a
 // model recovered from the measurements of every design when the BRDF is one of its members; the
 // whole BRDF's fit never beaten on its own layout; no rows where the metric does not apply.
 #include <gtest/gtest.h>
 
+#include "fit_metric.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/study/metric_tables.hpp"
 #include "halfback/study/study.hpp"
@@ -10,16 +11,19 @@
 namespace halfback::study {
 namespace {
 
+using acquire::Design;
+using acquire::Spacing;
+
 StudyConfig fit_only() {
   StudyConfig c;
   c.params = {space_of<HalfDiff>, space_of<Hybrid>, space_of<Spherical>};
   c.grid = {8, 8, 8};
   c.budgets.clear();  // no gonio-reflectometer error, no images
-  c.sampler_kib.clear();
+  find_metric("sampling")->switch_off(c);
   c.spacings = {Spacing::own};
-  c.fit_model = "lambert+ggx";
-  c.fit_budgets = {300, 3000};
-  c.fit_samples = 4000;
+  c.options["fit_model"] = "lambert+ggx";
+  c.options["fit_budgets"] = "300,3000";
+  c.options["fit_samples"] = "4000";
   return c;
 }
 
@@ -27,7 +31,7 @@ TEST(FitMetric, AMemberOfTheModelIsRecoveredFromEveryDesign) {
   const StudyConfig c = fit_only();
   const BrdfResult r =
       study_brdf(*load_brdf("lambert:albedo=0.3+ggx:alpha=0.3,f0=0.6"), "member", c);
-  ASSERT_EQ(r.table("fit").rows.size(), c.params.size() * 2 * c.fit_budgets.size() * 2);
+  ASSERT_EQ(r.table("fit").rows.size(), c.params.size() * 2 * 2 * 2);
   for (Space s : c.params)
     for (const FitPoint& p : fit_points(r, s)) {
       SCOPED_TRACE(std::string(name_of(s)) + " " + std::string(name_of(p.design)) + " " +
@@ -59,8 +63,8 @@ TEST(FitMetric, TheWholeFitIsBestOnItsOwnLayout) {
 // measurements carry their cells' solid angle; weighted 1, each design's density biases it.
 TEST(FitMetric, SolidAngleWeightsEstimateTheWholeFitsIntegral) {
   StudyConfig c = fit_only();
-  c.fit_model = "lambert:albedo_r=0.5,albedo_g=0.5+lambert";  // one fitted albedo, the blue one
-  c.fit_budgets = {3000};
+  c.options["fit_model"] = "lambert:albedo_r=0.5,albedo_g=0.5+lambert";  // the blue albedo fitted
+  c.options["fit_budgets"] = "3000";
   const BrdfResult r =
       study_brdf(*load_brdf("lambert:albedo=0.2+ggx:alpha=0.6,f0=0.5"), "broad", c);
   for (Space s : c.params) {
@@ -81,16 +85,16 @@ TEST(FitMetric, NoRowsWhereItDoesNotApply) {
   EXPECT_TRUE(study_brdf(*load_brdf("ggx:alpha_x=0.1,alpha_y=0.4"), "aniso", c)
                   .table("fit")
                   .rows.empty());  // the fit takes isotropic BRDFs
-  c.fit_model.clear();
+  find_metric("fit")->switch_off(c);
   EXPECT_TRUE(study_brdf(*load_brdf("lambert"), "off", c).table("fit").rows.empty());
-  c.fit_model = "lambert+ggx";
-  c.fit_loss = "l2";
+  c.options["fit_model"] = "lambert+ggx";
+  c.options["fit_loss"] = "l2";
   EXPECT_THROW(c.validate(), std::invalid_argument);
-  c.fit_loss = "ngan";
-  c.fit_budgets = {3000, 300};
+  c.options["fit_loss"] = "ngan";
+  c.options["fit_budgets"] = "3000,300";
   EXPECT_THROW(c.validate(), std::invalid_argument);
-  c.fit_budgets = {300};
-  c.fit_model = "lambert+nosuchmodel";
+  c.options["fit_budgets"] = "300";
+  c.options["fit_model"] = "lambert+nosuchmodel";
   EXPECT_THROW(c.validate(), std::invalid_argument);
 }
 

@@ -1,13 +1,14 @@
 #include "halfback/study/metric_tables.hpp"
 
+#include "halfback/study/metric.hpp"
+
 namespace halfback::study {
 
-std::span<const TableDef> study_tables() {
-  static const TableDef kTables[] = {
-      {azimuthal_table}, {separability_table}, {gonio_table}, {budget_table, derive_budget},
-      {image_table},     {sampling_table},     {fit_table},
-  };
-  return kTables;
+std::vector<TableDef> study_tables() {
+  std::vector<TableDef> tables;
+  for (const Metric* m : study_metrics())
+    for (const TableDef& def : m->tables()) tables.push_back(def);
+  return tables;
 }
 
 std::vector<MetricTable> stored_tables() {

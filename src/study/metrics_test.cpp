@@ -13,6 +13,14 @@
 namespace halfback::study {
 namespace {
 
+using acquire::ErrorSpace;
+using acquire::IsoGrid;
+using acquire::IsoSamples;
+using acquire::kErrorSpaces;
+using acquire::parse_error_space;
+using acquire::sample_isotropic;
+using acquire::to_error_space;
+
 using Fn = test::FunctionBrdf;
 
 double hbar_of(const DirPair<double>& p) {

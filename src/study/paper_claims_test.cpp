@@ -12,6 +12,10 @@
 namespace halfback::study {
 namespace {
 
+using acquire::ErrorSpace;
+using acquire::IsoGrid;
+using acquire::sample_isotropic;
+
 double azimuthal(const Brdf& b, Space s, std::size_t cells) {
   return azimuthal_error(sample_isotropic(b, s, IsoGrid{cells, cells, cells}, ErrorSpace::linear));
 }

@@ -12,12 +12,21 @@
 #include <type_traits>
 
 #include "halfback/render/image.hpp"
+#include "halfback/study/metric.hpp"
 #include "halfback/study/metric_tables.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "halfback/util/csv.hpp"
 #include "material_spaces.hpp"
 
 namespace halfback::study {
+
+using acquire::AxisDemand;
+using acquire::design_profile;
+using acquire::DesignProfile;
+using acquire::learn_warps;
+using acquire::parse_error_space;
+using acquire::parse_spacing;
+using acquire::Spacing;
 
 namespace {
 
@@ -30,10 +39,58 @@ void apply_quick(StudyConfig& c) {
   c.test_pairs = 20000;
   c.image_size = 48;
   c.image_spp = 8;
-  c.sampler_kib = {64};
-  c.sampler_samples = 1024;
-  c.fit_budgets = {1000};
-  c.fit_samples = 5000;
+  for (const Metric* m : study_metrics())
+    for (const MetricOption& o : m->options())
+      if (!o.quick_value.empty() && !c.option(o.key).empty()) c.options[o.key] = o.quick_value;
+}
+
+bool named(const std::vector<std::string>& names, std::string_view name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+// The names of --metrics and --no-NAME are metrics; std::invalid_argument otherwise.
+void check_metric_names(const StudySettings& o) {
+  for (const auto* list : {&o.metrics, &o.off})
+    for (const std::string& name : *list)
+      if (!find_metric(name))
+        throw std::invalid_argument(
+            fmt::format("--metrics: '{}' is not a metric ({})", name, metric_names()));
+  for (const auto& [key, value] : o.options) {
+    const bool known =
+        std::any_of(study_metrics().begin(), study_metrics().end(), [&](const Metric* m) {
+          const auto own = m->options();
+          return std::any_of(own.begin(), own.end(),
+                             [&](const MetricOption& x) { return x.key == key; });
+        });
+    if (!known) throw std::invalid_argument(fmt::format("'{}' is not an option of a metric", key));
+  }
+}
+
+// Whether the settings run `m`.
+bool runs(const StudySettings& o, const Metric& m) {
+  if (!m.switchable()) return true;
+  const bool asked = o.metrics.empty() ? m.on_by_default() : named(o.metrics, m.name());
+  return asked && !named(o.off, m.name());
+}
+
+// The given options of the metrics (their kinds checked, as the CLI's flags name them), and the
+// default of the first option of a metric that runs though it is not on by default.
+void apply_options(const StudySettings& o, StudyConfig& c) {
+  for (const Metric* m : study_metrics()) {
+    const std::vector<MetricOption> own = m->options();
+    for (std::size_t i = 0; i < own.size(); ++i) {
+      std::string flag = "--" + own[i].key;
+      std::replace(flag.begin(), flag.end(), '_', '-');
+      if (const auto it = o.options.find(own[i].key);
+          it != o.options.end() && !it->second.empty()) {
+        check_option_text(own[i], it->second, flag);
+        c.options[own[i].key] = it->second;
+      } else if (i == 0 && !m->on_by_default() && runs(o, *m)) {
+        c.options[own[i].key] =
+            o.quick && !own[i].quick_value.empty() ? own[i].quick_value : own[i].default_value;
+      }
+    }
+  }
 }
 
 void check_ascending(const std::vector<std::size_t>& v, const char* option) {
@@ -103,14 +160,8 @@ StudyConfig make_config(const StudySettings& o) {
   if (o.test_pairs) c.test_pairs = o.test_pairs;
   if (o.image_size) c.image_size = o.image_size;
   if (o.image_spp) c.image_spp = o.image_spp;
-  if (!o.sampler_kib.empty()) c.sampler_kib = o.sampler_kib;
-  if (o.sampler_samples) c.sampler_samples = o.sampler_samples;
-  if (o.no_sampling) c.sampler_kib.clear();
-  check_ascending(o.fit_budgets, "--fit-budgets");
-  if (!o.fit_model.empty()) c.fit_model = o.fit_model;
-  if (!o.fit_loss.empty()) c.fit_loss = o.fit_loss;
-  if (!o.fit_budgets.empty()) c.fit_budgets = o.fit_budgets;
-  if (o.no_fit) c.fit_model.clear();
+  check_metric_names(o);
+  apply_options(o, c);
   check_ascending(o.nielsen_counts, "--nielsen-counts");
   if (!o.nielsen_counts.empty()) c.nielsen_counts = o.nielsen_counts;
   c.seed = o.seed;
@@ -121,14 +172,16 @@ StudyConfig make_config(const StudySettings& o) {
   else if (!c.budgets.empty() &&
            std::find(c.budgets.begin(), c.budgets.end(), c.image_budget) == c.budgets.end())
     c.image_budget = c.budgets[c.budgets.size() / 2];
-  if (o.no_gonio) c.budgets.clear();
-  if (!o.no_gonio && !o.no_images) {
+  const bool gonio = runs(o, *find_metric("gonio"));
+  if (gonio && runs(o, *find_metric("images"))) {  // the environments are loaded only for these
     if (o.environments.empty())
       c.environments = render::default_environments();
     else
       for (const std::string& spec : o.environments)
         c.environments.push_back(render::load_environment(spec));
   }
+  for (const Metric* m : study_metrics())
+    if (!runs(o, *m)) m->switch_off(c);
   c.validate();
   return c;
 }
@@ -139,6 +192,11 @@ std::string describe_config(const StudyConfig& c) {
     if (!envs.empty()) envs += ',';
     envs += csv_text_field(e.label);
   }
+  // The metrics' options, in the order of the list.
+  std::string metric_lines;
+  for (const Metric* m : study_metrics())
+    for (const MetricOption& o : m->options())
+      metric_lines += fmt::format("{} = {}\n", o.key, c.option(o.key));
   // Nielsen's lines only with a database: the settings of runs without one read as before.
   const std::string nielsen = c.nielsen_from.empty()
                                   ? std::string()
@@ -149,14 +207,13 @@ std::string describe_config(const StudyConfig& c) {
       "{}\nbudgets_4d = {}\n"
       "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
       "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
-      "learned_from = {}\nsampler_kib = {}\nsampler_samples = {}\nfit_model = {}\nfit_loss = "
-      "{}\nfit_budgets = {}\nfit_samples = {}\n{}",
+      "learned_from = {}\n{}{}",
       joined(names_of(c.params)), name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
       joined(std::vector<std::size_t>(c.full_grid.begin(), c.full_grid.end())), joined(c.ranks),
       joined(c.budgets), joined(c.budgets_4d), c.test_pairs, format_csv_number(c.max_theta_deg),
       c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(names_of(c.spacings)),
-      c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from, joined(c.sampler_kib),
-      c.sampler_samples, c.fit_model, c.fit_loss, joined(c.fit_budgets), c.fit_samples, nielsen);
+      c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from, metric_lines,
+      nielsen);
 }
 
 namespace {
@@ -236,19 +293,24 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
     throw std::runtime_error(fmt::format("{}: a grid has the wrong number of axes", source));
   c.profile_grid = {profile_grid[0], profile_grid[1], profile_grid[2]};
   c.learned_from = get("learned_from");
-  // Parts written before the sampling metric (issue 36) have neither line: no sampling metric.
-  c.sampler_kib.clear();
-  if (kv.count("sampler_kib") && !kv.at("sampler_kib").empty())
-    c.sampler_kib = numbers_of<std::size_t>(get("sampler_kib"), where);
-  if (kv.count("sampler_samples"))
-    c.sampler_samples = number_of<std::size_t>(get("sampler_samples"), where);
-  // Parts written before the fit metric (issue 37) have none of its lines: no fit metric.
-  c.fit_model = kv.count("fit_model") ? get("fit_model") : std::string();
-  if (kv.count("fit_loss")) c.fit_loss = get("fit_loss");
-  c.fit_budgets.clear();
-  if (kv.count("fit_budgets") && !kv.at("fit_budgets").empty())
-    c.fit_budgets = numbers_of<std::size_t>(get("fit_budgets"), where);
-  if (kv.count("fit_samples")) c.fit_samples = number_of<std::size_t>(get("fit_samples"), where);
+  // The metrics' options. A run's settings without a metric's lines (written before it was
+  // added): the metric off, its other options at their defaults.
+  for (const Metric* m : study_metrics()) {
+    const std::vector<MetricOption> own = m->options();
+    for (std::size_t i = 0; i < own.size(); ++i) {
+      const auto it = kv.find(own[i].key);
+      if (it == kv.end()) {
+        if (i == 0) c.options[own[i].key].clear();
+        continue;
+      }
+      try {
+        if (!it->second.empty()) check_option_text(own[i], it->second, own[i].key);
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(fmt::format("{}: {}", source, e.what()));
+      }
+      c.options[own[i].key] = it->second;
+    }
+  }
   // Runs without Nielsen's database have neither line.
   if (kv.count("nielsen_from")) c.nielsen_from = get("nielsen_from");
   if (kv.count("nielsen_counts"))

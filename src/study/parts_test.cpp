@@ -15,6 +15,13 @@
 namespace halfback::study {
 namespace {
 
+using acquire::Design;
+using acquire::DesignProfile;
+using acquire::ErrorSpace;
+using acquire::kDesigns;
+using acquire::learn_warps;
+using acquire::Spacing;
+
 using fakes::FakeParam;
 
 // A made-up result with numbers that "%.6g" would round (so a lossy round trip shows).

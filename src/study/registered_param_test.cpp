@@ -17,6 +17,8 @@
 namespace halfback::study {
 namespace {
 
+using acquire::Spacing;
+
 // Hybrid under another name: the same maps, so the same numbers as hybrid's.
 struct ToyHybrid : Hybrid {
   static constexpr std::string_view name = "toy-hybrid";
@@ -99,7 +101,7 @@ TEST(StudyRegistered, ARegisteredParameterizationIsStudiedAndReported) {
 
 TEST(StudyRegistered, ParameterizationsAreChosenByName) {
   StudySettings s;
-  s.no_gonio = true;
+  s.off = {"gonio"};
   s.params = {"hybrid", "halfdiff"};
   EXPECT_EQ(make_config(s).params, (std::vector<Space>{space_of<Hybrid>, space_of<HalfDiff>}));
   s.params = {"hybrid", "hybrid"};

@@ -1,8 +1,9 @@
-// The files of a study (report.hpp): the CSV files of the tables of metric_tables.hpp, the
-// figures, report.md and report.html. The report's pieces are in report_*.cpp
-// (report_internal.hpp), the HTML step in markdown_html.cpp.
+// The files of a study (report.hpp): the CSV files of the metrics' tables, the figures,
+// report.md (a section per metric of study_metrics()) and report.html. The report's pieces are in
+// report_*.cpp (report_internal.hpp), the HTML step in markdown_html.cpp.
 #include "halfback/study/report.hpp"
 
+#include "halfback/study/metric.hpp"
 #include "halfback/util/atomic_file.hpp"
 #include "report_internal.hpp"
 
@@ -42,15 +43,8 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
   const std::vector<SummaryMetric> summary = summary_metrics(results, config, has);
   const ReportPlots plots = report_plots(results, config, has, summary);
   std::string md = report_header(results, config, has.anisotropic, seconds) +
-                   summary_section(results, summary, plots) +
-                   azimuthal_section(results, has.anisotropic) +
-                   separability_section(results, config, has.anisotropic);
-  if (has.gonio)
-    md += gonio_section(results, config, has.anisotropic, plots) +
-          designs_section(results, config, plots);
-  if (has.images) md += image_section(results, config, plots);
-  if (has.sampling) md += sampling_section(results, config, plots);
-  if (has.fit) md += fit_section(results, config);
+                   summary_section(results, summary, plots);
+  for (const Metric* m : study_metrics()) md += m->report_section(results, config, plots);
   md += files_and_networks_section(results, config);
   md += files_paragraph(out.files);
 

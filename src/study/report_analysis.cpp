@@ -10,6 +10,11 @@
 
 namespace halfback::study::report {
 
+using acquire::Design;
+using acquire::kGridDesigns;
+using acquire::kSpacings;
+using acquire::Spacing;
+
 namespace {
 
 std::string names(const std::vector<Space>& params) {
@@ -40,7 +45,6 @@ Contents contents_of(const std::vector<BrdfResult>& results) {
     has.gonio |= !b.table("gonio").rows.empty();
     has.images |= has_images(b);
     has.sampling |= !b.table("sampling").rows.empty();
-    has.fit |= !b.table("fit").rows.empty();
   }
   return has;
 }

@@ -11,9 +11,13 @@
 #include "halfback/figure/material.hpp"
 #include "halfback/figure/plot.hpp"
 #include "halfback/figure/render.hpp"
+#include "halfback/study/metric.hpp"
 #include "report_internal.hpp"
 
 namespace halfback::study::report {
+
+using acquire::Design;
+using acquire::Spacing;
 
 namespace {
 
@@ -193,7 +197,7 @@ figure::Scene sampling_chart(const std::vector<BrdfResult>& results, const Study
   c.x_label =
       fmt::format("{} table's albedo efficiency vs cosine (broad ← → peaked)", name_of(params[0]));
   c.y_label = "efficiency vs cosine";
-  for (const std::size_t kib : config.sampler_kib) {
+  for (const std::size_t kib : option_counts(config, "sampler_kib")) {
     const auto efficiency = [&](const BrdfResult& b, Space s, std::string_view sampler,
                                 bool pixels) {
       for (const SamplingPoint& p : sampling_points(b, s, sampler))

@@ -32,17 +32,18 @@ const std::vector<Space>& params_of(const std::vector<BrdfResult>& results);
 // What the results hold beyond the isotropic metrics 1-2, which decides the optional sections,
 // files and plots.
 struct Contents {
-  bool anisotropic = false, gonio = false, images = false, sampling = false, fit = false;
+  bool anisotropic = false, gonio = false, images = false, sampling = false;
 };
 Contents contents_of(const std::vector<BrdfResult>& results);
 
 // The point of a design at a budget; without a spacing, the own one (the tables of section 3 are
 // those of the own design). Null when not measured.
-const GonioPoint* find_point(const std::vector<GonioPoint>& points, Design layout,
-                             std::size_t budget, Spacing spacing = Spacing::own);
+const GonioPoint* find_point(const std::vector<GonioPoint>& points, acquire::Design layout,
+                             std::size_t budget, acquire::Spacing spacing = acquire::Spacing::own);
 // The result points into `points`: never into a temporary (gonio_points() returns one).
-const GonioPoint* find_point(std::vector<GonioPoint>&& points, Design layout, std::size_t budget,
-                             Spacing spacing = Spacing::own) = delete;
+const GonioPoint* find_point(std::vector<GonioPoint>&& points, acquire::Design layout,
+                             std::size_t budget,
+                             acquire::Spacing spacing = acquire::Spacing::own) = delete;
 
 // The reference budget of the comparisons: the image budget when it is one of the budgets,
 // else the middle one.
@@ -57,14 +58,14 @@ struct MeanImageError {
   int count = 0;
   double mae = INFINITY, rmse = INFINITY, ssim = 0;  // Sztrajman et al. 2021's protocol
 };
-MeanImageError mean_image_error(const std::vector<ImagePoint>& images, Design layout);
+MeanImageError mean_image_error(const std::vector<ImagePoint>& images, acquire::Design layout);
 bool has_images(const BrdfResult& b);
 
 // Section 3b. A design: a spacing in a layout (the own spacing in both layouts, the others in
 // the regular one; study.hpp).
 struct DesignKey {
-  Spacing spacing = Spacing::own;
-  Design layout = Design::regular;
+  acquire::Spacing spacing = acquire::Spacing::own;
+  acquire::Design layout = acquire::Design::regular;
 };
 std::string design_name(const DesignKey& k);
 // The error of one parameterization of a BRDF in a design at budget `ref` (INFINITY: not measured).
@@ -82,7 +83,7 @@ struct DesignComparison {
 };
 DesignComparison compare_designs(const std::vector<BrdfResult>& results, std::size_t ref);
 // The index in c.keys of a design, or c.keys.size() when it was not measured.
-std::size_t key_index(const DesignComparison& c, Spacing spacing, Design layout);
+std::size_t key_index(const DesignComparison& c, acquire::Spacing spacing, acquire::Design layout);
 // Which parameterization has the lowest error for each BRDF of c, each parameterization i in
 // design c.keys[design[i]].
 std::vector<std::size_t> winners(const DesignComparison& c, std::size_t ref,
@@ -145,7 +146,25 @@ std::string plot_link(const figure::Scene& plot, const char* alt, const char* st
 // Markdown tables (report_tables.cpp): each a table and the line that counts its winners
 // ---------------------------------------------------------------------------------------------
 
+// The parameterization with the lowest value in each row, counted over the rows.
+class Wins {
+ public:
+  explicit Wins(const std::vector<Space>& params) : params_(params), count_(params.size()) {}
+  // Ties (within 10^-9 relative) count for each of the tied parameterizations; a row without a
+  // finite value counts for none.
+  void add(const std::vector<double>& v);
+  int count(std::size_t i) const { return count_[i]; }
+  // "halfdiff 2, ortho 0, ..."
+  std::string text() const;
+
+ private:
+  std::vector<Space> params_;
+  std::vector<int> count_;
+};
+
 std::string md_cell(const std::string& s);
+// "| label |", the first cell of a BRDF's row.
+std::string row_start(const std::string& label);
 // "| first | halfdiff | ... |" and its rule; `first` may be several cells ("kind | BRDFs").
 std::string table_header(const std::string& first, const std::vector<Space>& params);
 
@@ -164,14 +183,10 @@ std::string best_design_table(const DesignComparison& c, std::size_t ref);
 // The image-space tables of section 4: the regular design's, then the stratified one's.
 std::string image_tables(const std::vector<BrdfResult>& results);
 std::string published_image_table(const std::vector<BrdfResult>& results);
-std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyConfig& config);
 std::string dupuy_jakob_table(const std::vector<BrdfResult>& results, const StudyConfig& config);
 // Nielsen et al.'s minimal sampling (halfdiff's nielsen rows) per kind of BRDF and count, against
 // halfdiff's regular grid; empty when no BRDF has such rows.
 std::string nielsen_table(const std::vector<BrdfResult>& results, const StudyConfig& config);
-// Per design and budget, each parameterization's median excess of the fit from its measurements
-// over the whole fit and median shape change, and which has the lowest excess per BRDF.
-std::string fit_tables(const std::vector<BrdfResult>& results, const StudyConfig& config);
 std::string file_network_winner_table(const std::vector<BrdfResult>& results, std::size_t ref);
 std::string file_network_gonio_table(const std::vector<BrdfResult>& results, std::size_t ref);
 std::string summary_table(const SummaryMetric& m, const std::vector<Space>& params,
@@ -192,9 +207,6 @@ std::string gonio_section(const std::vector<BrdfResult>& results, const StudyCon
                           bool any_aniso, const ReportPlots& plots);
 std::string designs_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
                             const ReportPlots& plots);
-std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
-                             const ReportPlots& plots);
-std::string fit_section(const std::vector<BrdfResult>& results, const StudyConfig& config);
 std::string image_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
                           const ReportPlots& plots);
 std::string files_and_networks_section(const std::vector<BrdfResult>& results,

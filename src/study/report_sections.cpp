@@ -4,9 +4,14 @@
 
 #include <algorithm>
 
+#include "halfback/study/metric.hpp"
 #include "report_internal.hpp"
 
 namespace halfback::study::report {
+
+using acquire::Design;
+using acquire::same_as_own;
+using acquire::Spacing;
 
 namespace {
 // The parameterizations that exist but were not compared, and how to compare them.
@@ -226,41 +231,6 @@ std::string image_section(const std::vector<BrdfResult>& results, const StudyCon
     md += "Not rendered (the BRDF has no value somewhere, so there is no ground-truth image): " +
           no_images + ".\n\n";
   return md;
-}
-
-// Importance sampling (issue 36): the tabulated and factored samplers of each parameterization's
-// chart.
-std::string sampling_section(const std::vector<BrdfResult>& results, const StudyConfig& config,
-                             const ReportPlots& plots) {
-  std::string md = fmt::format(
-      "## Importance sampling\n\nThe BRDF sampled by a table of ρ cos θi in each "
-      "parameterization's sampler chart (the renderer's tabulated sampler, docs/render.md), "
-      "tables of equal memory: the relative variance of the one-sample estimator of the "
-      "directional albedo, mean over 8 outgoing directions from the normal to 89° ({} samples "
-      "each; lower is better; sampling.csv has its standard error, the time per sample and the "
-      "efficiency against the cosine and the BRDF's own sampler). Parameterizations that share "
-      "a chart share the sampler. Below each table, the factored sampler (Lawrence et al. 2004's "
-      "manner: {} terms shared by every view, finer cells at the same memory) beside the "
-      "tabulated one.\n\n",
-      config.sampler_samples, kFactoredTerms);
-  return md + plot_link(plots.sampling, "Importance sampling", "sampling") +
-         sampling_tables(results, config);
-}
-
-// Fitting from measurements (issue 37): does the parameterization of a design change the fit?
-std::string fit_section(const std::vector<BrdfResult>& results, const StudyConfig& config) {
-  std::string md = fmt::format(
-      "## Fitting from measurements\n\n`{}` fitted under the `{}` loss (docs/fit.md) to the "
-      "measurements of each design of the isotropic gonio-reflectometer (own spacing, within "
-      "the reach), each measurement weighted 1 as a laboratory fits its data (uniform: the "
-      "design's density weights the loss) or by its cell's solid angle (so that the loss "
-      "estimates the whole fit's integral), and to the whole BRDF (fit()'s layout of {} pairs). "
-      "Each cell: the median over the BRDFs of the excess of "
-      "the measurements' fit over the whole fit, both measured on the whole BRDF (0 %: as good "
-      "as fitting the whole BRDF), then the median largest relative change of a shape "
-      "parameter (e.g. α) between the two fits; lower is better. fit.csv has every fit's spec.\n\n",
-      config.fit_model, config.fit_loss, config.fit_samples);
-  return md + fit_tables(results, config);
 }
 
 // 5. The same materials as measured files and as their neural fits, side by side: does the

@@ -5,42 +5,35 @@
 #include <algorithm>
 #include <array>
 
+#include "halfback/study/metric.hpp"
 #include "report_internal.hpp"
 
 namespace halfback::study::report {
 
-namespace {
+using acquire::Design;
+using acquire::kDesigns;
+using acquire::samples_to_reach;
+using acquire::Spacing;
 
-// The parameterization with the lowest value in each row, counted over the rows.
-class Wins {
- public:
-  explicit Wins(const std::vector<Space>& params) : params_(params), count_(params.size()) {}
-  // Ties (within 10^-9 relative) count for each of the tied parameterizations; a row without a
-  // finite value counts for none.
-  void add(const std::vector<double>& v) {
-    const double best = *std::min_element(v.begin(), v.end());
-    if (!std::isfinite(best)) return;
-    for (std::size_t i = 0; i < v.size(); ++i)
-      if (v[i] <= best + 1e-9 * std::abs(best) + 1e-15) ++count_[i];
-  }
-  int count(std::size_t i) const { return count_[i]; }
-  // "halfdiff 2, ortho 0, ..."
-  std::string text() const {
-    std::string s;
-    for (std::size_t i = 0; i < params_.size(); ++i)
-      s += fmt::format("{}{} {}", i ? ", " : "", name_of(params_[i]), count_[i]);
-    return s;
-  }
+void Wins::add(const std::vector<double>& v) {
+  const double best = *std::min_element(v.begin(), v.end());
+  if (!std::isfinite(best)) return;
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (v[i] <= best + 1e-9 * std::abs(best) + 1e-15) ++count_[i];
+}
 
- private:
-  std::vector<Space> params_;
-  std::vector<int> count_;
-};
+std::string Wins::text() const {
+  std::string s;
+  for (std::size_t i = 0; i < params_.size(); ++i)
+    s += fmt::format("{}{} {}", i ? ", " : "", name_of(params_[i]), count_[i]);
+  return s;
+}
 
-// "| label |", the first cell of a BRDF's row.
 std::string row_start(const std::string& label) {
   return "| " + md_cell(label) + " |";
 }
+
+namespace {
 
 // " regular / stratified |": the own design's errors in both layouts at a budget ("–" where
 // not measured).
@@ -525,138 +518,6 @@ std::string nielsen_table(const std::vector<BrdfResult>& results, const StudyCon
              "at {} |\n|---|---|---|---|---|---|\n",
              fmt::join(config.budgets, ", "), config.budgets.empty() ? 0 : config.budgets.front()) +
          rows + "\n";
-}
-
-// ---------------------------------------------------------------------------------------------
-// Metric 5: importance sampling
-// ---------------------------------------------------------------------------------------------
-
-namespace {
-
-// Per parameterization at one table size: the tabulated and the factored sampler's median
-// efficiencies against the cosine, on the albedo and on the pixels with MIS, and for how many
-// BRDFs the factored one is the more efficient on the albedo.
-std::string sampler_comparison(const std::vector<BrdfResult>& results,
-                               const std::vector<Space>& params, std::size_t kib) {
-  std::string md = fmt::format(
-      "Tabulated and factored ({} terms) samplers in {} KiB, median efficiency against "
-      "the cosine on the albedo and on the pixels (MIS):\n\n| parameterization | "
-      "albedo, tabulated | albedo, factored | pixels, tabulated | pixels, factored | "
-      "factored more efficient (BRDFs) |\n|---|---|---|---|---|---|\n",
-      kFactoredTerms, kib);
-  for (Space s : params) {
-    std::vector<double> albedo[2], pixels[2];
-    int wins = 0, compared = 0;
-    for (const BrdfResult& b : results) {
-      const SamplingPoint* found[2] = {nullptr, nullptr};
-      const std::vector<SamplingPoint> kinds[2] = {sampling_points(b, s, "tabulated"),
-                                                   sampling_points(b, s, "factored")};
-      for (int k = 0; k < 2; ++k)
-        for (const SamplingPoint& p : kinds[k])
-          if (p.kib == kib) found[k] = &p;
-      if (!found[0] || !found[1]) continue;
-      for (int k = 0; k < 2; ++k) {
-        albedo[k].push_back(found[k]->efficiency_vs_cosine);
-        pixels[k].push_back(found[k]->pixel_efficiency_vs_cosine_mis);
-      }
-      ++compared;
-      wins += found[1]->efficiency_vs_cosine > found[0]->efficiency_vs_cosine;
-    }
-    if (compared == 0) continue;
-    md += fmt::format("| {} | {:.3g} | {:.3g} | {:.3g} | {:.3g} | {} of {} |\n", name_of(s),
-                      median(albedo[0]), median(albedo[1]), median(pixels[0]), median(pixels[1]),
-                      wins, compared);
-  }
-  return md + "\n";
-}
-
-}  // namespace
-
-std::string sampling_tables(const std::vector<BrdfResult>& results, const StudyConfig& config) {
-  const std::vector<Space>& params = params_of(results);
-  std::string md;
-  for (const std::size_t kib : config.sampler_kib) {
-    std::string rows;
-    Wins wins(params);
-    int beats_own = 0, with_own = 0, beats_warp = 0, with_warp = 0, beats_mix = 0, with_mix = 0;
-    for (const BrdfResult& b : results) {
-      if (b.table("sampling").rows.empty()) continue;
-      std::vector<double> variance;
-      rows += row_start(b.label);
-      bool better_than_own = false, has_own = false, better_than_warp = false, has_warp = false,
-           better_than_mix = false, has_mix = false;
-      for (Space s : params) {
-        double v = NAN;
-        for (const SamplingPoint& p : sampling_points(b, s))
-          if (p.kib == kib) {
-            v = p.relative_variance;
-            has_own = p.own_sampler != "none";
-            better_than_own |= has_own && p.efficiency_vs_own > 1;
-            has_warp |= p.vndf_warp_kib > 0;
-            better_than_warp |= p.efficiency_vs_vndf_warp > 1;
-            has_mix |= p.efficiency_vs_fitted_mixture > 0;
-            better_than_mix |= p.efficiency_vs_fitted_mixture > 1;
-          }
-        variance.push_back(v);
-        rows += std::isfinite(v) ? fmt::format(" {:.3g} |", v) : " – |";
-      }
-      rows += "\n";
-      wins.add(variance);
-      with_own += has_own;
-      beats_own += better_than_own;
-      with_warp += has_warp;
-      beats_warp += better_than_warp;
-      with_mix += has_mix;
-      beats_mix += better_than_mix;
-    }
-    md += fmt::format("Tables of {} KiB:\n\n", kib) + table_header("BRDF", params) + rows +
-          fmt::format(
-              "\nLowest variance (BRDFs): {}. BRDFs with a sampler of their own: {}, of "
-              "which some table here is more efficient than it for {}. BRDFs with Dupuy & "
-              "Jakob's warp in at most {} KiB: {}, of which some table here is more efficient "
-              "than it for {}. BRDFs with a fitted mixture ({} sampled through its lobes' "
-              "samplers): {}, of which some table here is more efficient than it for {}.\n\n",
-              wins.text(), with_own, beats_own, kib, with_warp, beats_warp,
-              config.fit_model.empty() ? "no model" : config.fit_model, with_mix, beats_mix) +
-          sampler_comparison(results, params, kib);
-  }
-  return md;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Metric 6: fitting from measurements
-// ---------------------------------------------------------------------------------------------
-
-std::string fit_tables(const std::vector<BrdfResult>& results, const StudyConfig& config) {
-  const std::vector<Space>& params = params_of(results);
-  std::string md = table_header("weights | design | budget", params);
-  std::string wins_text;
-  for (FitWeights w : kFitWeights)
-    for (Design d : kDesigns)
-      for (const std::size_t budget : config.fit_budgets) {
-        std::vector<std::vector<double>> excess(params.size()), change(params.size());
-        Wins wins(params);
-        for (const BrdfResult& b : results) {
-          std::vector<double> row(params.size(), NAN);
-          for (std::size_t k = 0; k < params.size(); ++k)
-            for (const FitPoint& p : fit_points(b, params[k]))
-              if (p.weights == w && p.design == d && p.budget == budget) {
-                row[k] = p.layout_loss / p.whole_loss - 1;
-                excess[k].push_back(row[k]);
-                change[k].push_back(p.shape_change);
-              }
-          wins.add(row);
-        }
-        md += fmt::format("| {} | {} | {} |", name_of(w), name_of(d), budget);
-        for (std::size_t k = 0; k < params.size(); ++k)
-          md += excess[k].empty() ? std::string(" – |")
-                                  : fmt::format(" {:.3g} % / {:.2g} % |", 100 * median(excess[k]),
-                                                100 * median(change[k]));
-        md += "\n";
-        wins_text +=
-            fmt::format("- {}, {} at {}: {}\n", name_of(w), name_of(d), budget, wins.text());
-      }
-  return md + "\nLowest excess (BRDFs):\n\n" + wins_text + "\n";
 }
 
 }  // namespace halfback::study::report

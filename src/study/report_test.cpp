@@ -15,6 +15,9 @@
 namespace halfback::study {
 namespace {
 
+using acquire::Design;
+using acquire::Spacing;
+
 std::string slurp(const std::filesystem::path& p) {
   std::ifstream f(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};

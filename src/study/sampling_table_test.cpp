@@ -1,22 +1,28 @@
-// The study's sampling metric (metric 5, issue 36): a row per parameterization, table size and
+// The study's sampling metric (metric 5): a row per parameterization, table size and
 // sampler (tabulated, factored), parameterizations sharing a chart sharing the numbers, and the
 // charts ranked as they should be on a broad and a glossy lobe; the report's section.
 #include <gtest/gtest.h>
 
 #include "halfback/models/analytic.hpp"
+#include "halfback/render/brdf_sampler.hpp"
+#include "halfback/render/renderer.hpp"
+#include "halfback/study/image_metrics.hpp"
+#include "halfback/study/metric.hpp"
 #include "halfback/study/metric_tables.hpp"
 #include "halfback/study/study.hpp"
 
 namespace halfback::study {
 namespace {
 
+using acquire::Spacing;
+
 StudyConfig sampling_only() {
   StudyConfig c;
   c.params = {space_of<HalfDiff>, space_of<Hybrid>, space_of<Ortho>, space_of<Spherical>};
   c.grid = {8, 8, 8};
   c.budgets.clear();  // no gonio-reflectometer, no images
-  c.sampler_kib = {64, 1024};
-  c.sampler_samples = 2048;
+  c.options["sampler_kib"] = "64,1024";
+  c.options["sampler_samples"] = "2048";
   c.spacings = {Spacing::own};
   return c;
 }
@@ -30,7 +36,7 @@ TEST(SamplingTable, ChartsRankedAndSharedCharts) {
   const BrdfResult b = study_brdf(broad, "broad", c), g = study_brdf(glossy, "glossy", c);
   for (const BrdfResult* r : {&b, &g}) {
     // The tabulated and the factored sampler of each parameterization and size.
-    ASSERT_EQ(r->table("sampling").rows.size(), 2 * c.params.size() * c.sampler_kib.size());
+    ASSERT_EQ(r->table("sampling").rows.size(), 2 * c.params.size() * 2);
     const auto hybrid = sampling_points(*r, space_of<Hybrid>);
     const auto ortho = sampling_points(*r, space_of<Ortho>);
     ASSERT_EQ(hybrid.size(), 2u);
@@ -81,32 +87,51 @@ TEST(SamplingTable, ChartsRankedAndSharedCharts) {
   // The fitted mixture (config.fit_model, lambert+ggx, fitted to each): on the Lambertian the fit
   // is nearly a Lambertian (a faint GGX term left), its mixture nearly the cosine, more efficient
   // than every table (7 to 500 times here); on the glossy lobe the fit is that lobe, sampled by
-  // its own sampler.
+  // its own sampler: the same variance, so the ratio of the two efficiencies is the ratio of their
+  // times per sample, about 5 on an idle machine and up to 16 measured under load (2 cores, load
+  // 9-18); a mixture that sampled another lobe would have far more variance.
   for (Space s : c.params) {
     for (const SamplingPoint& p : sampling_points(b, s))
       EXPECT_LT(p.efficiency_vs_fitted_mixture, 1) << name_of(s);
     for (const SamplingPoint& p : sampling_points(g, s)) {
       EXPECT_GT(p.efficiency_vs_fitted_mixture, 0.1 * p.efficiency_vs_own) << name_of(s);
-      EXPECT_LT(p.efficiency_vs_fitted_mixture, 10 * p.efficiency_vs_own) << name_of(s);
+      EXPECT_LT(p.efficiency_vs_fitted_mixture, 40 * p.efficiency_vs_own) << name_of(s);
     }
   }
 }
 
+// The image's relative variance per pixel sample with the cosine sampler, rendered as the study
+// renders the pixel columns' reference (config.image_size, image_spp and seed; the sphere's
+// pixels): the variance the pixel efficiencies compare with, without the time per sample.
+double cosine_pixel_variance(const Brdf& brdf, const StudyConfig& c, render::Strategy strategy) {
+  render::RenderSettings s;
+  s.width = s.height = c.image_size;
+  s.spp = c.image_spp;
+  s.seed = c.seed;
+  s.strategy = strategy;
+  s.variance = true;
+  const render::RenderResult r =
+      render::render_sampled(*render::with_cosine_sampling(brdf), *c.environments.front().map, s);
+  return render::relative_pixel_variance(r, sphere_mask(s.width, s.height));
+}
+
 // The pixel columns: a Lambertian under a constant sky is rendered without variance by cosine
-// samples alone (each weighs albedo × radiance), so no table is as efficient there; on a glossy
-// lobe the half-vector table beats the cosine by far, alone and with MIS, under uniform light, and
-// with MIS under the sky.
+// samples alone (each weighs albedo × radiance), so no table does as well there; on a glossy lobe
+// the half-vector table has far less variance than the cosine, alone and with MIS, under uniform
+// light, and with MIS under the sky. Variances only (fixed seeds and sample counts): the
+// efficiencies also hold the time per sample, which a loaded machine changes.
 TEST(SamplingTable, PixelVarianceKnownCaseAndGlossy) {
   StudyConfig c = sampling_only();
   c.params = {space_of<HalfDiff>, space_of<Spherical>};
-  c.fit_model.clear();
+  c.options["fit_model"].clear();
   c.image_size = 48;
   c.environments = {render::load_environment("constant:1")};
   const models::Lambert broad(Rgb{0.5, 0.5, 0.5});
   const BrdfResult b = study_brdf(broad, "broad", c);
+  const double cosine_broad = cosine_pixel_variance(broad, c, render::Strategy::brdf);  // 0
   for (Space s : c.params)
     for (const SamplingPoint& p : sampling_points(b, s)) {
-      EXPECT_LT(p.pixel_efficiency_vs_cosine_brdf, 1e-6) << name_of(s);
+      EXPECT_LT(cosine_broad, 1e-6 * p.pixel_relative_variance_brdf) << name_of(s);  // 0.002-0.02
       // Environment samples do not follow the cosine.
       EXPECT_GT(p.pixel_relative_variance_mis, 0) << name_of(s);
       EXPECT_EQ(p.efficiency_vs_fitted_mixture, 0);  // no fit model
@@ -116,35 +141,43 @@ TEST(SamplingTable, PixelVarianceKnownCaseAndGlossy) {
   gp.alpha_x = gp.alpha_y = 0.08;
   for (const char* env : {"constant:1", "sky"}) {
     c.environments = {render::load_environment(env)};
-    const BrdfResult g = study_brdf(models::Microfacet(gp), "glossy", c);
+    const models::Microfacet glossy(gp);
+    const BrdfResult g = study_brdf(glossy, "glossy", c);
     const auto half = sampling_points(g, space_of<HalfDiff>);
     ASSERT_EQ(half.size(), 2u);
     const bool uniform = std::string(env) == "constant:1";
+    const double cosine_alone = cosine_pixel_variance(glossy, c, render::Strategy::brdf);
+    const double cosine_mis = cosine_pixel_variance(glossy, c, render::Strategy::mis);
     for (const SamplingPoint& p : half) {
-      // Uniform light: 78 and 180 alone, 32 and 67 with MIS in a release build.
+      // The cosine's variance over the table's, at 64 and 1024 KiB: uniform light, 206 and 391
+      // alone, 82 and 127 with MIS; the sky, 9.5 and 9.6 with MIS.
       if (uniform) {
-        EXPECT_GT(p.pixel_efficiency_vs_cosine_brdf, 10) << p.kib;
+        EXPECT_GT(cosine_alone / p.pixel_relative_variance_brdf, 100) << p.kib;
       }
-      EXPECT_GT(p.pixel_efficiency_vs_cosine_mis, uniform ? 10 : 3) << p.kib;  // sky: 5.7, 6.7
+      EXPECT_GT(cosine_mis / p.pixel_relative_variance_mis, uniform ? 30 : 5) << p.kib;
     }
-    // (Not asserted under the sky: the brdf strategy alone, 0.45 and 0.49. Its image variance is
+    // (Not asserted under the sky: the brdf strategy alone, 0.68 and 0.67. Its image variance is
     // the sun's: a 1.5° sun found by BRDF samples alone, in the few pixels that reflect it, whose
     // 16 samples rarely see it; that noise dominates the image's variance whichever the sampler.)
     if (uniform) {
-      EXPECT_GT(half[1].pixel_efficiency_vs_cosine_brdf, half[0].pixel_efficiency_vs_cosine_brdf);
+      EXPECT_LT(half[1].pixel_relative_variance_brdf, half[0].pixel_relative_variance_brdf);
     }
   }
 }
 
 TEST(SamplingTable, SettingsAreChecked) {
   StudyConfig c = sampling_only();
-  c.sampler_kib = {0};
+  c.options["sampler_kib"] = "0";
   EXPECT_THROW(c.validate(), std::invalid_argument);
-  c.sampler_kib = {kMaxSamplerKib + 1};
+  c.options["sampler_kib"] = std::to_string(kMaxSamplerKib + 1);
   EXPECT_THROW(c.validate(), std::invalid_argument);
-  c.sampler_kib = {64};
-  c.sampler_samples = 1;
+  c.options["sampler_kib"] = "64,32";
   EXPECT_THROW(c.validate(), std::invalid_argument);
+  c.options["sampler_kib"] = "64";
+  c.options["sampler_samples"] = "1";
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c.options["sampler_samples"] = "2";
+  EXPECT_NO_THROW(c.validate());
 }
 
 }  // namespace

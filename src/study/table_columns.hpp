@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "halfback/study/design.hpp"
-#include "halfback/study/gonio.hpp"
+#include "halfback/acquire/design.hpp"
+#include "halfback/acquire/gonio.hpp"
 #include "halfback/study/table.hpp"
 
 namespace halfback::study::columns {
@@ -17,13 +17,13 @@ inline Column parameterization() {
 
 inline Column design() {
   std::vector<std::string> names;
-  for (Design d : kAllDesigns) names.emplace_back(name_of(d));
+  for (acquire::Design d : acquire::kAllDesigns) names.emplace_back(name_of(d));
   return {"design", ColumnKind::text, names};
 }
 
 inline Column spacing() {
   std::vector<std::string> names;
-  for (Spacing s : kSpacings) names.emplace_back(name_of(s));
+  for (acquire::Spacing s : acquire::kSpacings) names.emplace_back(name_of(s));
   return {"spacing", ColumnKind::text, names};
 }
 
@@ -39,12 +39,12 @@ inline Column text(std::string name) {
   return {std::move(name), ColumnKind::text, {}};
 }
 
-inline Design design_of(const MetricTable& t, const Row& row) {
-  return parse_design(t.text(row, "design")).value();
+inline acquire::Design design_of(const MetricTable& t, const Row& row) {
+  return acquire::parse_design(t.text(row, "design")).value();
 }
 
-inline Spacing spacing_of(const MetricTable& t, const Row& row) {
-  return parse_spacing(t.text(row, "spacing")).value();
+inline acquire::Spacing spacing_of(const MetricTable& t, const Row& row) {
+  return acquire::parse_spacing(t.text(row, "spacing")).value();
 }
 
 }  // namespace halfback::study::columns

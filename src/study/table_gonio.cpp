@@ -9,6 +9,12 @@
 
 namespace halfback::study {
 
+using acquire::Design;
+using acquire::kAllDesigns;
+using acquire::kSpacings;
+using acquire::samples_to_reach;
+using acquire::Spacing;
+
 MetricTable gonio_table() {
   return {"gonio",
           {columns::parameterization(), columns::design(), columns::integer("samples"),

@@ -21,7 +21,10 @@ namespace fs = std::filesystem;
 namespace {
 
 [[noreturn]] void fail(int err, const fs::path& target) {
-  throw std::system_error(err, std::generic_category(), "cannot write '" + target.string() + "'");
+  std::string what = "cannot write '" + target.string() + "'";
+  if (err == EFBIG) what += " (above the file size limit of this process, ulimit -f)";
+  if (err == ENOSPC) what += " (the file system is full)";
+  throw std::system_error(err, std::generic_category(), what);
 }
 
 // The process's umask, read without changing it (umask(2) can only be read by setting it, which

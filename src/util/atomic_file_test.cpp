@@ -191,9 +191,9 @@ TEST_F(AtomicFileTest, SymbolicLinkIsKept) {
   EXPECT_EQ(entries(), (std::vector<std::string>{"link.csv", "real.csv"}));
 }
 
-// Issue 35, class K: a destination in a loop of symbolic links is refused (ELOOP, naming it)
-// and the links stay links (it was replaced by a regular file, status 0); an output directory
-// in a loop too.
+// docs/reliability/cli.md, "Files and outputs": a destination in a loop of symbolic links is
+// refused (ELOOP, naming it) and the links stay links (it was replaced by a regular file, status
+// 0); an output directory in a loop too.
 TEST_F(AtomicFileTest, SymbolicLinkLoopIsRefusedAndKept) {
   const fs::path a = dir_ / "a.csv", b = dir_ / "b.csv", self = dir_ / "self.csv";
   fs::create_symlink("b.csv", a);
@@ -226,9 +226,9 @@ TEST_F(AtomicFileTest, RelativePathInTheCurrentDirectory) {
 
 using test::FifoReader;
 
-// Outputs that are not regular files (issue 12, class 2). A FIFO is written directly to its
-// reader, and a probe (constructed, then discarded) does not open it: opening the writer end
-// twice would give the reader an early end of file.
+// Outputs that are not regular files (docs/reliability/cli.md, "Files and outputs"). A FIFO is
+// written directly to its reader, and a probe (constructed, then discarded) does not open it:
+// opening the writer end twice would give the reader an early end of file.
 TEST_F(AtomicFileTest, FifoIsWrittenDirectlyAndKept) {
   const fs::path fifo = dir_ / "pipe";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);

@@ -1,5 +1,6 @@
-// Class C of issue 35 (docs/reliability-round3-readers.md): reads bounded by what a file declares;
-// the size check's message; text read line by line, a NUL byte or an overlong line refused.
+// docs/reliability/readers.md, "A reader reads what the file's header declares, and nothing more":
+// reads bounded by what a file declares; the size check's message; text read line by line, a NUL
+// byte or an overlong line refused.
 #include "halfback/util/bounded_read.hpp"
 
 #include <gtest/gtest.h>

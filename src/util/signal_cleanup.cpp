@@ -53,6 +53,10 @@ void install_temporary_cleanup_handlers() {
   });
 }
 
+void ignore_file_size_signal() {
+  ::signal(SIGXFSZ, SIG_IGN);
+}
+
 int register_temporary(const std::filesystem::path& path) noexcept {
   std::string text;
   try {

@@ -86,6 +86,7 @@ struct Api::State {
   ApiConfig config;
   Catalog catalog;
   std::atomic<int> fits_running = 0;
+  std::atomic<bool> stopping = false;
   explicit State(ApiConfig c) : config(std::move(c)), catalog(config.specs, config.roots) {}
 };
 
@@ -95,6 +96,10 @@ Api::~Api() = default;
 void Api::set_port(int port) {
   state_->config.port = port;
 }
+void Api::stop() {
+  state_->stopping = true;
+}
+
 const ApiConfig& Api::config() const {
   return state_->config;
 }
@@ -116,9 +121,9 @@ namespace {
 Response error(int status, std::string_view message) {
   Response r;
   r.status = status;
-  JsonWriter w;
-  w.begin_object().field("error", message).end_object();
-  r.body = w.str();
+  Json body;
+  body["error"] = message;
+  r.body = json_text(std::move(body));
   return r;
 }
 
@@ -227,8 +232,9 @@ std::optional<Response> asset(std::string_view name) {
 }
 
 Response route(const Catalog& catalog, const Request& r, const ApiConfig& c,
-               std::atomic<int>& fits_running) {
+               std::atomic<int>& fits_running, const std::atomic<bool>& stopping) {
   const std::string& p = r.path;
+  const Budget budget(c.compute_seconds, r.abandoned, stopping);
   if (p == "/" || p == "/index.html") {
     Response res = *asset("index.html");
     if (r.param("token"))  // later loads (the modules, a reload) carry the cookie instead
@@ -240,14 +246,14 @@ Response route(const Catalog& catalog, const Request& r, const ApiConfig& c,
     if (auto a = asset(std::string_view(p).substr(8))) return *a;
   if (p == "/api/info") return info_response(catalog);
   if (p == "/api/brdf") return brdf_response(catalog, r);
-  if (p == "/api/slices") return slices_response(catalog, r, c.threads);
+  if (p == "/api/slices") return slices_response(catalog, r, c.threads, budget);
   if (p == "/api/hemisphere") return hemisphere_response(catalog, r, c.threads);
   if (p == "/api/polar") return polar_response(catalog, r);
-  if (p == "/api/albedo") return albedo_response(catalog, r, c.threads);
+  if (p == "/api/albedo") return albedo_response(catalog, r, c.threads, budget);
   if (p == "/api/point") return point_response(catalog, r);
-  if (p == "/api/render") return render_response(catalog, r, c.threads);
+  if (p == "/api/render") return render_response(catalog, r, c.threads, budget);
   if (p == "/api/pointlight") return point_light_response(catalog, r, c.threads);
-  if (p == "/api/fit") return fit_response(catalog, r, c.threads, fits_running);
+  if (p == "/api/fit") return fit_response(catalog, r, c.threads, fits_running, budget);
   return error(404, fmt::format("no such resource '{}'", p.substr(0, 128)));
 }
 
@@ -263,8 +269,10 @@ Response Api::handle(const Request& request) const {
       res = error(414, fmt::format("request target longer than {} bytes", kMaxTargetBytes));
     else if (auto refused = refusal(request, c))
       res = std::move(*refused);
+    else if (state_->stopping)
+      res = error(503, "the server is stopping");
     else
-      res = route(state_->catalog, request, c, state_->fits_running);
+      res = route(state_->catalog, request, c, state_->fits_running, state_->stopping);
   } catch (const RequestError& e) {
     res = error(e.status(), e.what());
   } catch (const FormatError& e) {
@@ -288,10 +296,11 @@ Response Api::handle(const Request& request) const {
   return res;
 }
 
-Response Api::handle_target(std::string method, std::string_view target,
-                            const RawHeaders& headers) const {
+Response Api::handle_target(std::string method, std::string_view target, const RawHeaders& headers,
+                            std::function<bool()> abandoned) const {
   Request request;
   request.method = std::move(method);
+  request.abandoned = std::move(abandoned);
   for (const auto& [name, value] : headers) {
     std::string lower = name;
     std::ranges::transform(lower, lower.begin(),

@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
+#include <unistd.h>
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -20,6 +23,7 @@
 #include "halfback/fit/fit.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/renderer.hpp"
+#include "halfback/util/text_encoding.hpp"
 #include "json.hpp"
 #include "support/test_support.hpp"
 
@@ -185,8 +189,9 @@ TEST(ViewApi, MalformedAndOversizedTargets) {
   EXPECT_EQ(api.handle(get("/no/such")).status, 404);
 }
 
-// Issue 35, class J: a Host, Origin or Cookie header given twice is refused (a repeated header
-// kept its first value, and the second was never checked); other headers may repeat.
+// docs/reliability/server.md, "An empty host, file names that are not UTF-8, repeated security
+// headers": a Host, Origin or Cookie header given twice is refused (a repeated header kept its
+// first value, and the second was never checked); other headers may repeat.
 TEST(ViewApi, RepeatedSecurityHeadersAreRefused) {
   Api api(config());
   const std::string own = fmt::format("127.0.0.1:{}", kPort), target = "/api/info?token=" + kToken;
@@ -237,8 +242,8 @@ TEST(ViewApi, BrdfEndpointAndSpecKinds) {
   EXPECT_TRUE(has_error(api.handle(get("/api/brdf")), 400, "missing query parameter 'brdf'"));
   EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", std::string(kMaxSpecBytes + 1, 'a')}})).status,
             413);
-  // A model spec is never a file, even when a file of that name exists.
-  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "/etc/passwd"}})).status, 400);
+  // A spec is never a bare path, even when a file of that name exists: 403, as outside the roots.
+  EXPECT_TRUE(has_error(api.handle(get("/api/brdf", {{"brdf", "/etc/passwd"}})), 403, "a path"));
 }
 
 // Sums as everywhere else (load_brdf): the value of each term is its own, and a term is loaded
@@ -257,7 +262,7 @@ TEST(ViewApi, SumsOfTermsAsEverywhere) {
   EXPECT_TRUE(has_error(brdf("lambert+"), 400, "empty term"));
   EXPECT_TRUE(has_error(brdf("lambert+ggx:alpha=-1"), 400, "alpha"));
   EXPECT_TRUE(has_error(brdf("lambert+file:../secret.hdr"), 403, ".."));
-  EXPECT_EQ(brdf("lambert+" + (outside.path() / "secret.hdr").string()).status, 400);
+  EXPECT_EQ(brdf("lambert+" + (outside.path() / "secret.hdr").string()).status, 403);
 
   // Its ρ is the sum of its terms' (the point endpoint, against Brdf::eval of each term).
   const auto rho = [&](const std::string& spec) {
@@ -351,11 +356,12 @@ TEST(ViewApi, AlbedoCurveIsTheLibrarysEstimate) {
   ASSERT_EQ(r.status, 200) << r.body;
   const double t = 89.0 / 3 * (std::numbers::pi / 180);  // the second angle, as the server
   const AlbedoEstimate e = directional_albedo(*load_brdf(kSpec), {std::sin(t), 0, std::cos(t)}, 16);
-  EXPECT_NE(r.body.find("\"theta_deg\":[0,29.666666666666668,59.333333333333336,89]"),
-            std::string::npos)
+  const Json body = Json::parse(r.body);
+  EXPECT_EQ(body["theta_deg"].get<std::vector<double>>(),
+            (std::vector<double>{0, 29.666666666666668, 59.333333333333336, 89}))
       << r.body;
-  EXPECT_NE(r.body.find(fmt::format("[{:.17g},{:.17g},{:.17g}]", e.mean.r, e.mean.g, e.mean.b)),
-            std::string::npos)
+  EXPECT_EQ(body["albedo"][1].get<std::vector<double>>(),
+            (std::vector<double>{e.mean.r, e.mean.g, e.mean.b}))
       << r.body;
   const Response lambert = albedo({{"brdf", "lambert:albedo=0.3"}, {"angles", "2"}});
   const std::size_t at = lambert.body.find("\"albedo\":[[");
@@ -382,8 +388,9 @@ TEST(ViewApi, FitIsTheLibrarysFit) {
   o.samples = 500;
   o.threads = 1;
   const fit::FitResult direct = fit::fit(*load_brdf(kSpec), "ggx", o);
-  EXPECT_NE(r.body.find(fmt::format("\"spec\":\"{}\"", direct.spec)), std::string::npos) << r.body;
-  EXPECT_NE(r.body.find("\"loss\":{\"name\":\"low-e2\""), std::string::npos) << r.body;
+  const Json body = Json::parse(r.body);
+  EXPECT_EQ(body["spec"], direct.spec) << r.body;
+  EXPECT_EQ(body["loss"]["name"], "low-e2") << r.body;
   EXPECT_NEAR(direct.model.params[0].value, 0.3, 1e-4);  // alpha of ggx:alpha=0.3,f0=0.9
   EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", direct.spec}})).status, 200);
 
@@ -402,6 +409,32 @@ TEST(ViewApi, FitIsTheLibrarysFit) {
       has_error(fit(with("samples", std::to_string(kMaxFitSamples + 1))), 400, "'samples'"));
   EXPECT_TRUE(has_error(fit(with("brdf", "lambert:albedo=0")), 422, "cannot be fitted"));
   EXPECT_TRUE(has_error(fit({{"brdf", "arg:0"}}), 400, "'model'"));
+}
+
+// A fit's size is bounded by terms × samples (a 400 naming the bound, before any work), and a fit
+// past its deadline is stopped (503).
+TEST(ViewApi, FitsAreBoundedInSizeAndTime) {
+  Api api(config());
+  const auto fit = [&](const std::string& model, const std::string& samples) {
+    return api.handle(get("/api/fit", {{"brdf", "arg:0"}, {"model", model}, {"samples", samples}}));
+  };
+  const std::string five = "lambert+lambert+lambert+lambert+lambert";
+  const Response big = fit(five, "20000");
+  EXPECT_TRUE(has_error(big, 400, "above the limit of 80000")) << big.body;
+  EXPECT_NE(big.body.find("samples <= 16000"), std::string::npos) << big.body;
+  EXPECT_EQ(fit("he+he+he+he+he+he+he+he+he+he+he+he+he+he+he+he+he+he+he+he", "5000").status, 400);
+  ApiConfig c = config();
+  c.compute_seconds = 0.3;
+  Api quick(c);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Response late = quick.handle(
+      get("/api/fit", {{"brdf", "arg:0"}, {"model", "he+he+he+he"}, {"samples", "20000"}}));
+  EXPECT_TRUE(has_error(late, 503, "did not end within 0.3 s")) << late.body;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+  // Abandoned by its client: stopped as well.
+  Request gone = get("/api/fit", {{"brdf", "arg:0"}, {"model", "he+he"}, {"samples", "20000"}});
+  gone.abandoned = [] { return true; };
+  EXPECT_TRUE(has_error(api.handle(gone), 503, "the client left"));
 }
 
 // One fit at a time: while a long fit runs, another request is answered 503 at once (a quick
@@ -633,16 +666,20 @@ TEST(ViewApi, PointListsEveryParameterizationAndRho) {
            {"wo", fmt::format("{:.17g},{:.17g},{:.17g}", pair.wo.x, pair.wo.y, pair.wo.z)}}));
   ASSERT_EQ(r.status, 200);
   EXPECT_NE(r.body.find("\"valid\":true"), std::string::npos);
+  const Json body = Json::parse(r.body);
   Rgb rho{};
   load_brdf(kSpec)->eval_batch({&pair, 1}, {&rho, 1});
-  EXPECT_NE(r.body.find(fmt::format("{:.17g}", rho.r)), std::string::npos) << r.body;
+  EXPECT_EQ(body["rho"][0]["rgb"][0].get<double>(), rho.r) << r.body;  // to the last bit
   const double d[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
   double q[4], jacobian = 0;
   ASSERT_TRUE(convert_one<double>(Form{Space::dirs, false}, Form{space_of<Hybrid>, false}, d, q,
                                   &jacobian));
-  EXPECT_NE(r.body.find(fmt::format("{:.17g},{:.17g},{:.17g},{:.17g}", q[0], q[1], q[2], q[3])),
-            std::string::npos);
-  EXPECT_NE(r.body.find(fmt::format("\"jacobian\":{:.17g}", jacobian)), std::string::npos);
+  const auto hybrid = std::find_if(body["forms"].begin(), body["forms"].end(),
+                                   [](const Json& f) { return f["space"] == "hybrid"; });
+  ASSERT_NE(hybrid, body["forms"].end()) << r.body;
+  EXPECT_EQ((*hybrid)["coords"].get<std::vector<double>>(),
+            (std::vector<double>{q[0], q[1], q[2], q[3]}));
+  EXPECT_EQ((*hybrid)["jacobian"].get<double>(), jacobian);
 }
 
 TEST(ViewApi, PointFromIsotropicCoordinatesAndItsErrors) {
@@ -656,7 +693,8 @@ TEST(ViewApi, PointFromIsotropicCoordinatesAndItsErrors) {
       "/api/point", {{"brdf", "arg:0"}, {"form", "ortho"}, {"iso", "1"}, {"coords", "0.9,0.9,0"}}));
   ASSERT_EQ(out.status, 200);  // outside the domain: an answer, not an error
   EXPECT_NE(out.body.find("\"valid\":false"), std::string::npos);
-  // A relative azimuth is periodic (issue 35, class I): φd = -π/2 is 3π/2, the same pair.
+  // A relative azimuth is periodic (docs/reliability/numerics.md, "Azimuths are periodic"): φd =
+  // -π/2 is 3π/2, the same pair.
   const auto wi_of = [&](const std::string& coords) {
     const Response r = api.handle(get(
         "/api/point", {{"brdf", "arg:0"}, {"form", "halfdiff"}, {"iso", "1"}, {"coords", coords}}));
@@ -693,8 +731,8 @@ TEST(ViewApi, RenderPassesAreSeededAndLimited) {
   EXPECT_NE(a.body, c.body);
   EXPECT_EQ(render("0", "513").status, 400);
   EXPECT_EQ(render("0", "16", "nowhere").status, 400);
-  EXPECT_EQ(render("0", "16", "/etc/passwd").status, 400);
-  EXPECT_EQ(render("0", "16", "file:x.hdr").status, 403);  // no root
+  EXPECT_EQ(render("0", "16", "/etc/passwd").status, 403);  // a bare path
+  EXPECT_EQ(render("0", "16", "file:x.hdr").status, 403);   // no root
   EXPECT_EQ(api.handle(get("/api/render", {{"brdf", "arg:0"}, {"spp", "65"}})).status, 400);
 }
 
@@ -723,8 +761,221 @@ TEST(ViewApi, FilesOnlyUnderTheRoots) {
   EXPECT_THROW(Api(config({outside.path() / "none"})), std::invalid_argument);
 }
 
-// Issue 35, class J: a file name that is not UTF-8 is listed in /api/info as valid JSON text
-// (U+FFFD for its bad byte), not as the raw byte.
+void replace_all(std::string& s, const std::string& from, const std::string& to) {
+  for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size()))
+    s.replace(at, from.size(), to);
+}
+
+// Every parameter of every endpoint, given a path outside the roots in every shape a spec can
+// hold it (dupuy-jakob:PATH, dupuy-jakob:file:PATH, file:PATH, the bare PATH, a sum's term;
+// absolute or with `..`): a parameter that carries a spec answers 403, and no parameter answers
+// differently for a file that exists and one that does not (no existence or format oracle).
+TEST(ViewApi, EverySpecParameterIsConfinedToTheRoots) {
+  register_brdf_parameterization_families();  // as `halfback view` has them
+  test::TempDir root, outside;
+  { std::ofstream(outside.path() / "g.bsdf") << "not a BRDF"; }
+  Api api(config({root.path()}));
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  const auto shapes = [&](const std::filesystem::path& file) {
+    const std::string abs = file.string(), rel = file.lexically_relative(cwd).string();
+    const std::string up = "../" + file.filename().string();  // from the root: its parent
+    return std::vector<std::string>{"dupuy-jakob:" + abs,
+                                    "dupuy-jakob:" + rel,
+                                    "dupuy-jakob:file:" + abs,
+                                    "dupuy-jakob:file:" + up,
+                                    "dupuy-jakob:ggx+file:" + up,
+                                    "file:" + abs,
+                                    "file:" + up,
+                                    abs,
+                                    rel,
+                                    "ggx+" + abs,
+                                    "lambert+file:" + up};
+  };
+  const auto existing = shapes(outside.path() / "g.bsdf");
+  const auto missing = shapes(outside.path() / "h.bsdf");  // the same length, one letter apart
+  const std::string outside_h = outside.path().filename().string() + "/h";
+  using Query = std::vector<std::pair<std::string, std::string>>;
+  struct Endpoint {
+    std::string path;
+    Query query;                     // a good request
+    std::vector<std::string> specs;  // its parameters that carry a spec
+  };
+  const std::vector<Endpoint> endpoints = {
+      {"/api/brdf", {{"brdf", "lambert"}}, {"brdf"}},
+      {"/api/slices",
+       {{"brdf", "lambert"},
+        {"forms", "halfdiff"},
+        {"azimuth", "10"},
+        {"pose", "0"},
+        {"n", "4"},
+        {"values", "rgb"}},
+       {"brdf", "forms"}},
+      {"/api/hemisphere",
+       {{"brdf", "lambert"},
+        {"colour", "halfdiff"},
+        {"theta_o", "10"},
+        {"phi_o", "0"},
+        {"n", "4"},
+        {"values", "rgb"}},
+       {"brdf", "colour"}},
+      {"/api/polar",
+       {{"brdf", "lambert"}, {"theta_o", "10"}, {"phi_o", "0"}, {"n", "5"}},
+       {"brdf"}},
+      {"/api/albedo", {{"brdf", "lambert"}, {"angles", "2"}, {"n", "2"}}, {"brdf"}},
+      {"/api/point",
+       {{"brdf", "lambert"}, {"form", "halfdiff"}, {"iso", "1"}, {"coords", "0.1,0.2,0.3"}},
+       {"brdf", "form"}},
+      {"/api/render",
+       {{"brdf", "lambert"}, {"env", "sky"}, {"size", "8"}, {"spp", "1"}, {"pass", "0"}},
+       {"brdf", "env"}},
+      {"/api/pointlight",
+       {{"brdf", "lambert"}, {"theta_l", "10"}, {"phi_l", "0"}, {"size", "8"}, {"spp", "1"}},
+       {"brdf"}},
+      {"/api/fit",
+       {{"brdf", "lambert"}, {"model", "lambert"}, {"loss", "ngan"}, {"samples", "100"}},
+       {"brdf", "model"}},
+  };
+  // The hemisphere's brdf= is read with colour=rho only.
+  const auto adjust = [](const Endpoint& e, const std::string& key, Query q) {
+    if (e.path == "/api/hemisphere" && key == "brdf")
+      for (auto& [k, v] : q)
+        if (k == "colour") v = "rho";
+    return q;
+  };
+  const auto with = [](Query q, const std::string& key, const std::string& value) {
+    for (auto& [k, v] : q)
+      if (k == key) v = value;
+    return q;
+  };
+  std::size_t checked = 0;
+  for (const Endpoint& e : endpoints) {
+    ASSERT_EQ(api.handle(get(e.path, e.query)).status, 200) << e.path;
+    for (const auto& [key, unused] : e.query) {
+      const bool spec = std::find(e.specs.begin(), e.specs.end(), key) != e.specs.end();
+      for (std::size_t k = 0; k < existing.size(); ++k) {
+        const Query base = adjust(e, key, e.query);
+        const Response a = api.handle(get(e.path, with(base, key, existing[k])));
+        const Response b = api.handle(get(e.path, with(base, key, missing[k])));
+        const std::string where = e.path + " " + key + "=" + existing[k] + ": " + a.body;
+        if (spec) {
+          EXPECT_EQ(a.status, 403) << where;
+        }
+        EXPECT_EQ(a.status, b.status) << where << " / " << b.body;
+        // The same words, but for the name given (whole, or cut where a message cuts it).
+        std::string a_body = a.body;
+        replace_all(a_body, outside.path().filename().string() + "/g", outside_h);
+        replace_all(a_body, "../g", "../h");
+        EXPECT_EQ(a_body, b.body) << where;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 300u);
+}
+
+// Proc's resident set of this process, in bytes.
+std::size_t resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  std::size_t pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * std::size_t(sysconf(_SC_PAGESIZE));
+}
+
+// Distinct dupuy-jakob:BRDF forms in requests, more than the registry could ever hold: each is
+// answered, none is registered (/api/info lists the same forms), and the memory they take stays
+// bounded (the parameterizations built for requests are a small cache).
+TEST(ViewApi, RequestsDoNotGrowProcessWideState) {
+  register_brdf_parameterization_families();  // as `halfback view` has them
+  Api api(config());
+  const Response before = api.handle(get("/api/info"));
+  const std::size_t registered = parameterizations().size();
+#if defined(__SANITIZE_ADDRESS__)
+  constexpr int kRequests = 150;  // memory safety only: each builds a warp, slow under ASan
+#else
+  constexpr int kRequests = 1200;  // above the registry's 1023
+#endif
+  std::size_t rss_early = 0;
+  for (int k = 0; k < kRequests; ++k) {
+    const std::string form = fmt::format("dupuy-jakob:ggx:alpha={:.6f}", 0.1 + 1e-4 * k);
+    const std::string key = k % 2 ? "forms" : "colour";
+    const Response r =
+        k % 2 ? api.handle(get("/api/slices", {{"brdf", "lambert"}, {"forms", form}, {"n", "4"}}))
+              : api.handle(get("/api/hemisphere", {{"colour", form}, {"n", "4"}}));
+    ASSERT_EQ(r.status, 200) << k << " " << key << "=" << form << ": " << r.body;
+    if (k == 100) rss_early = resident_bytes();
+  }
+  EXPECT_EQ(parameterizations().size(), registered);
+  EXPECT_EQ(api.handle(get("/api/info")).body, before.body);
+  const std::size_t rss_late = resident_bytes();  // read once: it may change between reads
+  const std::size_t growth = rss_late - std::min(rss_late, rss_early);
+  EXPECT_LT(growth, std::size_t(64) << 20) << "resident set grew by " << growth << " bytes";
+}
+
+// A parameterization built for a request is the registry's member of the same name, value for
+// value (its slices, the hemisphere's coordinates, a point from its coordinates), and a request
+// names at most kMaxCachedForms of them.
+TEST(ViewApi, ARequestsDupuyJakobFormIsTheRegisteredOnes) {
+  register_brdf_parameterization_families();  // as `halfback view` has them
+  Api api(config());
+  const std::string name = "dupuy-jakob:ggx:alpha=0.25";
+  const Response slice =
+      api.handle(get("/api/slices", {{"brdf", "arg:0"}, {"forms", name}, {"n", "8"}}));
+  ASSERT_EQ(slice.status, 200) << slice.body;
+  EXPECT_EQ(header_of(slice, "X-Halfback-Forms"), name);
+  const Response hemi =
+      api.handle(get("/api/hemisphere", {{"colour", name}, {"n", "8"}, {"phi_o", "0"}}));
+  ASSERT_EQ(hemi.status, 200) << hemi.body;
+  const Response point =
+      api.handle(get("/api/point", {{"form", name}, {"iso", "1"}, {"coords", "0.5,0.3,0.7"}}));
+  ASSERT_EQ(point.status, 200) << point.body;
+  // The same through the registry (this test's process registers the member).
+  const Space space = *space_from_name(name);
+  const auto bytes = [](const std::vector<float>& v) {  // NaN where NaN, bit for bit
+    return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(float));
+  };
+  EXPECT_EQ(slice.body, bytes(slice_field(*load_brdf(kSpec), space, 0, 8, 1)));
+  const double theta = 45 * (std::numbers::pi / 180.0);  // the default theta_o
+  EXPECT_EQ(hemi.body,
+            bytes(hemisphere_field(nullptr, space, {std::sin(theta), 0, std::cos(theta)}, 8, 1)));
+  const double q[3] = {0.5, 0.3, 0.7};
+  double d[6];
+  ASSERT_TRUE(convert_one<double>(Form{space, true}, Form{Space::dirs, false}, q, d));
+  const std::size_t at = point.body.find("\"wi\":[");
+  ASSERT_NE(at, std::string::npos) << point.body;
+  const char* p = point.body.c_str() + at + 6;
+  for (int c = 0; c < 3; ++c) {
+    char* end = nullptr;
+    EXPECT_NEAR(std::strtod(p, &end), d[c], 1e-12) << point.body;
+    p = end + 1;
+  }
+  std::string many;
+  for (std::size_t k = 0; k <= kMaxCachedForms; ++k)
+    many += fmt::format("{}dupuy-jakob:ggx:alpha=0.{}", k ? "," : "", k + 1);
+  EXPECT_TRUE(
+      has_error(api.handle(get("/api/slices", {{"brdf", "lambert"}, {"forms", many}, {"n", "2"}})),
+                413, "dupuy-jakob"));
+}
+
+// A slices answer is at most kMaxSlicesBytes (docs/view.md): BRDFs × forms × n² × channels above
+// it is refused with a message naming the bound; the page's largest request (two BRDFs, every
+// form, n = 512, luminance) is within it.
+TEST(ViewApi, SlicesAnswersStayWithinTheirBound) {
+  Api api(config());
+  const Response big = api.handle(get(
+      "/api/slices", {{"brdf", "arg:0"}, {"brdf", "lambert"}, {"n", "512"}, {"values", "rgb"}}));
+  EXPECT_TRUE(has_error(big, 400, "above the limit")) << big.status << big.body.substr(0, 200);
+  EXPECT_LE(big.body.size(), kMaxSlicesBytes);
+  const Response page = api.handle(
+      get("/api/slices",
+          {{"brdf", "arg:0"}, {"brdf", "lambert"}, {"n", "512"}, {"values", "luminance"}}));
+  ASSERT_EQ(page.status, 200) << page.body;
+  EXPECT_LE(page.body.size(), kMaxSlicesBytes);
+  EXPECT_EQ(page.body.size(), 2 * parameterizations().size() * 512 * 512 * sizeof(float));
+}
+
+// docs/reliability/server.md, "An empty host, file names that are not UTF-8, repeated security
+// headers": a file name that is not UTF-8 is listed in /api/info as valid JSON text (U+FFFD for its
+// bad byte), not as the raw byte.
 TEST(ViewApi, InfoListsFileNamesAsValidUtf8) {
   test::TempDir root;
   { std::ofstream(root.path() / "bad\xFFname.bsdf") << "x"; }
@@ -748,11 +999,27 @@ TEST(ViewApi, LoadsAFileUnderARoot) {
   EXPECT_EQ(s.status, 200);
 }
 
-TEST(ViewJson, EscapesAndNulls) {
-  JsonWriter w;
-  w.begin_object().field("s", std::string_view("a\"b\\c\n\x01")).field("x", NAN).key("a");
-  w.begin_array().value(1.5).value(2).end_array().end_object();
-  EXPECT_EQ(w.str(), "{\"s\":\"a\\\"b\\\\c\\u000a\\u0001\",\"x\":null,\"a\":[1.5,2]}");
+// A response's JSON: keys in the order set, strings escaped, NaN and infinities as null, and
+// text that is not UTF-8 made so as valid_utf8 does (one U+FFFD per byte of a cut sequence).
+TEST(ViewJson, EscapesNullsAndMakesUtf8) {
+  Json j;
+  j["s"] = "a\"b\\c\n\x01";
+  j["x"] = NAN;
+  j["inf"] = -INFINITY;
+  j["a"] = {1.5, 2};
+  j["bad"] = {"bad\xFFname", "x\xE2\x82"};
+  EXPECT_EQ(json_text(j),
+            "{\"s\":\"a\\\"b\\\\c\\n\\u0001\",\"x\":null,\"inf\":null,\"a\":[1.5,2],"
+            "\"bad\":[\"bad\xEF\xBF\xBDname\",\"x\xEF\xBF\xBD\xEF\xBF\xBD\"]}");
+}
+
+// Numbers keep their full precision: the text reads back as the same double.
+TEST(ViewJson, NumbersReadBackToTheLastBit) {
+  for (const double x : {0.1, 1.0 / 3, -2.5e-300, 4.9406564584124654e-324, 1.7976931348623157e308,
+                         29.666666666666668, 0.040000000000000001}) {
+    const std::string text = json_text(Json::array({x}));
+    EXPECT_EQ(Json::parse(text)[0].get<double>(), x) << text;
+  }
 }
 
 TEST(ViewApi, ErrorsAreJson) {

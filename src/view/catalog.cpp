@@ -5,9 +5,11 @@
 #include <cctype>
 #include <system_error>
 
+#include "halfback/formats/adaptive_param.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
+#include "halfback/util/format_error.hpp"
 #include "halfback/view/api.hpp"
 
 namespace halfback::view {
@@ -62,7 +64,10 @@ Catalog::Catalog(std::vector<std::string> specs, const std::vector<fs::path>& ro
   }
 }
 
-fs::path Catalog::resolve(std::string_view relative) const {
+namespace {
+
+// The lexical checks of a root-relative path (refuse_paths, resolve).
+void check_relative(std::string_view relative) {
   if (relative.empty()) throw RequestError(400, "empty file path");
   if (relative.find('\0') != std::string_view::npos)
     throw RequestError(400, "file path with a NUL byte");
@@ -70,10 +75,28 @@ fs::path Catalog::resolve(std::string_view relative) const {
   if (rel.is_absolute() || rel.has_root_directory() || rel.has_root_name())
     throw RequestError(403, fmt::format("'{}': absolute paths are refused; give a path relative "
                                         "to a --root directory",
-                                        relative));
+                                        relative.substr(0, 256)));
   for (const fs::path& part : rel)
     if (part == "..")
-      throw RequestError(403, fmt::format("'{}': '..' is refused in file paths", relative));
+      throw RequestError(
+          403, fmt::format("'{}': '..' is refused in file paths", relative.substr(0, 256)));
+}
+
+constexpr std::string_view kDupuyJakob = "dupuy-jakob:";
+
+}  // namespace
+
+void refuse_paths(std::string_view spec) {
+  if (starts_with(spec, "file:")) return check_relative(spec.substr(5));
+  if (spec.find_first_of("/\\") != std::string_view::npos || spec == "..")
+    throw RequestError(403, fmt::format("'{}': a path; files are named file:PATH, with PATH "
+                                        "relative to a --root directory",
+                                        spec.substr(0, 256)));
+}
+
+fs::path Catalog::resolve(std::string_view relative) const {
+  check_relative(relative);
+  const fs::path rel{std::string(relative)};
   if (roots_.empty())
     throw RequestError(403, "no --root directory was given: files cannot be loaded");
   for (const fs::path& root : roots_) {
@@ -100,10 +123,18 @@ BrdfPtr Catalog::load(std::string_view spec) const {
       if (e.status() != 404) throw;
     }
   }
+  // Every term passes the confinement rule before any is loaded: a path in a sum is a 403
+  // whatever its other terms are.
+  static const BrdfPtr checked = model_registry().create("lambert");
+  (void)load_sum(spec, [](std::string_view term) {
+    refuse_paths(term);
+    return checked;
+  });
   return load_sum(spec, [this](std::string_view term) { return load_term(term); });
 }
 
 BrdfPtr Catalog::load_term(std::string_view spec) const {
+  refuse_paths(spec);
   if (starts_with(spec, "arg:")) {
     const std::string_view n = spec.substr(4);
     std::size_t index = 0;
@@ -119,7 +150,36 @@ BrdfPtr Catalog::load_term(std::string_view spec) const {
                                           spec, specs_.size()));
     return load_brdf(specs_[index]);
   }
-  if (starts_with(spec, "file:")) return load_brdf(resolve(spec.substr(5)).string());
+  if (starts_with(spec, "file:")) {
+    // A reader's message names the file by its resolved path: the page sees the root-relative one
+    // (where the roots are is not the page's business).
+    const std::string_view relative = spec.substr(5);
+    const std::string path = resolve(relative).string();
+    const auto hidden = [&](const std::exception& e) {
+      std::string message = e.what();
+      for (std::size_t at; (at = message.find(path)) != std::string::npos;)
+        message.replace(at, path.size(), relative);
+      for (const fs::path& root : roots_)
+        for (std::size_t at; (at = message.find(root.string())) != std::string::npos;)
+          message.replace(at, root.string().size(), "<root>");
+      return message;
+    };
+    try {
+      return load_brdf(path);
+    } catch (const RequestError&) {
+      throw;
+    } catch (const std::bad_alloc&) {
+      throw;
+    } catch (const FormatError& e) {
+      throw RequestError(400, hidden(e));
+    } catch (const std::invalid_argument& e) {
+      throw RequestError(400, hidden(e));
+    } catch (const std::out_of_range& e) {
+      throw RequestError(400, hidden(e));
+    } catch (const std::exception& e) {
+      throw RequestError(500, hidden(e));
+    }
+  }
   if (starts_with(spec, "embedded:")) {
     const auto names = embedded_material_names();
     if (std::find(names.begin(), names.end(), spec.substr(9)) == names.end())
@@ -179,9 +239,44 @@ BrdfPtr Catalog::sampled_brdf(std::string_view spec) const {
   return sampled;
 }
 
+std::optional<ViewForm> Catalog::form(std::string_view name) const {
+  if (name.size() > kMaxSpecBytes)
+    throw RequestError(413,
+                       fmt::format("parameterization name longer than {} bytes", kMaxSpecBytes));
+  if (!starts_with(name, kDupuyJakob)) {
+    refuse_paths(name);
+    for (const Space s : parameterizations())  // the registry's names only: nothing is built
+      if (name_of(s) == name) return ViewForm(s);
+    return std::nullopt;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (auto it = forms_.find(name); it != forms_.end()) {
+      it->second.used = ++clock_;
+      return ViewForm(it->second.param);
+    }
+  }
+  const std::string_view spec = name.substr(kDupuyJakob.size());
+  if (spec.empty())
+    throw RequestError(400, "dupuy-jakob: a BRDF is needed after the colon (dupuy-jakob:BRDF)");
+  const BrdfPtr brdf = this->brdf(spec);  // confined as any BRDF of a request
+  auto param = adaptive_parameterization(*brdf, std::string(name));
+  std::lock_guard lock(mutex_);
+  FormEntry& e = forms_[std::string(name)];
+  if (!e.param) e.param = std::move(param);
+  e.used = ++clock_;
+  ViewForm result(e.param);
+  while (forms_.size() > kMaxCachedForms)
+    forms_.erase(std::min_element(forms_.begin(), forms_.end(), [](const auto& a, const auto& b) {
+      return a.second.used < b.second.used;
+    }));
+  return result;
+}
+
 std::shared_ptr<const render::EnvMap> Catalog::environment(std::string_view spec) const {
   if (spec.size() > kMaxSpecBytes)
     throw RequestError(413, fmt::format("environment spec longer than {} bytes", kMaxSpecBytes));
+  refuse_paths(spec);
   {
     std::lock_guard lock(mutex_);
     if (auto it = envs_.find(spec); it != envs_.end()) return it->second;

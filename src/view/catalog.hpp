@@ -8,7 +8,14 @@
 // An environment spec is a built-in name (sky, default, studio, sunset), "constant:V" or
 // "constant:R,G,B", or file:PATH (a .hdr or .exr under a root).
 //
-// Paths: an absolute PATH, or one with a `..` component, is refused; the path is resolved with
+// A parameterization name (forms=, colour=, form=) is one of the registry's, or
+// "dupuy-jakob:BRDF" with BRDF a BRDF spec as above: that member is built for the view from
+// brdf(BRDF) and never registered (see form()).
+//
+// Paths, the one rule of every spec a request carries (refuse_paths): a file is named file:PATH
+// alone; an absolute PATH, or one with a `..` component, is refused, and so is a path anywhere
+// else (a BRDF term, an environment, a parameterization or model name holding '/' or '\\', or a
+// `..`), whether or not the file exists. The path is resolved with
 // std::filesystem::weakly_canonical (symbolic links followed) and must stay inside the canonical
 // root. Problems are RequestErrors carrying the HTTP status.
 #pragma once
@@ -19,11 +26,13 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "fields.hpp"
 #include "halfback/brdf/brdf.hpp"
 #include "halfback/render/envmap.hpp"
 
@@ -40,6 +49,13 @@ class RequestError : public std::runtime_error {
   int status_;
 };
 
+// The confinement rule above for one spec (a BRDF term, an environment, a parameterization or
+// model name), lexically: for file:PATH the checks of PATH (400 empty or with a NUL byte, 403
+// absolute or with `..`), for any other spec 403 if it holds a '/', a '\\' or is `..`. Whether
+// PATH stays inside a root is resolve()'s. Every spec a request carries passes here before it
+// is read or named in an answer.
+void refuse_paths(std::string_view spec);
+
 class Catalog {
  public:
   Catalog(std::vector<std::string> specs, const std::vector<std::filesystem::path>& roots);
@@ -50,6 +66,11 @@ class Catalog {
   BrdfPtr brdf(std::string_view spec) const;
   // The same BRDF as the renderer samples it (render::with_importance_sampling), cached with it.
   BrdfPtr sampled_brdf(std::string_view spec) const;
+  // The parameterization a request names (see above): a registered one, or a dupuy-jakob member
+  // built from brdf(BRDF) for the view alone, cached (kMaxCachedForms, least recently used out)
+  // and never registered, so that requests do not grow the process's registry. nullopt for a
+  // name that is neither (after refuse_paths: a name holding a path is a 403).
+  std::optional<ViewForm> form(std::string_view name) const;
   // The environment of a request spec; cached.
   std::shared_ptr<const render::EnvMap> environment(std::string_view spec) const;
 
@@ -66,6 +87,10 @@ class Catalog {
   Listing list_files(std::size_t limit) const;
 
  private:
+  struct FormEntry {
+    std::shared_ptr<const ParamDescriptor> param;
+    std::uint64_t used = 0;
+  };
   struct Entry {
     BrdfPtr brdf;
     BrdfPtr sampled;  // built on first use
@@ -82,6 +107,7 @@ class Catalog {
   mutable std::mutex mutex_;
   mutable std::map<std::string, Entry, std::less<>> brdfs_;
   mutable std::map<std::string, std::shared_ptr<const render::EnvMap>, std::less<>> envs_;
+  mutable std::map<std::string, FormEntry, std::less<>> forms_;
   mutable std::uint64_t clock_ = 0;
 };
 

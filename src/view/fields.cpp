@@ -1,5 +1,6 @@
 #include "fields.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -54,33 +55,75 @@ void mirror_azimuth(const Vec3<double>& wo, double& cx, double& cy) {
   cy = r > 0 ? -wo.y / r : 0.0;
 }
 
+// The isotropic coordinates of the pairs whose flag is set in a request's parameterization
+// (its own forward map on the pairs as accept_pair() puts them, as the engine does), NaN
+// elsewhere; float, 3 per pair.
+std::vector<float> own_coordinates(const ParamDescriptor& p, std::vector<DirPair<double>> pairs,
+                                   const std::vector<std::uint8_t>& inside) {
+  for (DirPair<double>& pair : pairs) accept_pair(pair);
+  std::vector<double> q(3 * pairs.size());
+  p.forward_rows(true, pairs.data(), pairs.size(), q.data());
+  std::vector<float> field(q.size());
+  for (std::size_t k = 0; k < q.size(); ++k) field[k] = inside[k / 3] ? float(q[k]) : kNanF;
+  return field;
+}
+
 }  // namespace
 
-std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, std::size_t n,
-                               int threads, RhoValues values, double pose) {
+void form_to_pairs(const ViewForm& form, bool isotropic, std::vector<double>& q,
+                   std::vector<DirPair<double>>& pairs, std::vector<std::uint8_t>& valid,
+                   int threads) {
+  const std::size_t d = isotropic ? 3 : 4, n = q.size() / d;
+  pairs.assign(n, DirPair<double>{});
+  valid.assign(n, 0);
+  if (!form.own) {  // the core's batch engine (SIMD, with the domain mask)
+    std::vector<ConstColumn<double>> in;
+    for (std::size_t c = 0; c < d; ++c) in.push_back({q.data() + c, std::ptrdiff_t(d)});
+    double* base = &pairs.data()->wi.x;  // DirPair<double> is six packed doubles
+    static_assert(sizeof(DirPair<double>) == 6 * sizeof(double));
+    const Column<double> out_cols[6] = {{base, 6},     {base + 1, 6}, {base + 2, 6},
+                                        {base + 3, 6}, {base + 4, 6}, {base + 5, 6}};
+    ConvertOutput<double> out{out_cols};
+    out.valid = valid.data();
+    BatchOptions options;
+    options.threads = threads;
+    convert<double>(Form{form.space, isotropic}, Form{Space::dirs, false}, in, n, out, options);
+    return;
+  }
+  // A request's parameterization: its own checked inverse, in blocks (as the engine runs a
+  // registered parameterization outside its kernels).
+  const ParamDescriptor& p = *form.own;
+  constexpr std::size_t kBlock = 4096;
+  parallel_for((n + kBlock - 1) / kBlock, 1,
+               [&](std::size_t b0, std::size_t b1) {
+                 for (std::size_t b = b0; b < b1; ++b) {
+                   const std::size_t r0 = b * kBlock, m = std::min(kBlock, n - r0);
+                   wrap_azimuth_rows(p.axes(isotropic), q.data() + r0 * d, m);
+                   p.inverse_rows(isotropic, q.data() + r0 * d, m, pairs.data() + r0,
+                                  valid.data() + r0);
+                 }
+               },
+               p.concurrent() ? threads : 1);
+}
+
+std::vector<float> slice_field(const Brdf& brdf, const ViewForm& form, double azimuth,
+                               std::size_t n, int threads, RhoValues values, double pose) {
   // The grid of figure/slices.hpp (pixel centres), converted to direction pairs by the core's
   // batch engine (SIMD, with the domain mask): the same pairs as figure::sample_slice, which
   // converts one tuple at a time and costs several times more (docs/performance.md, "Viewer").
-  const auto coords = figure::iso_coordinates(space);
-  const figure::Grid grid = figure::Grid::pixel_centres(n, n, 0, coords[0].max, 0, coords[1].max);
-  std::vector<double> x(grid.size()), y(grid.size()), az(grid.size(), azimuth);
+  const auto axes = form.param().axes(true);
+  const figure::Grid grid = figure::Grid::pixel_centres(n, n, 0, axes[0].hi, 0, axes[1].hi);
+  std::vector<double> q(3 * grid.size());
   for (std::size_t j = 0; j < n; ++j)
     for (std::size_t i = 0; i < n; ++i) {
-      x[grid.index(i, j)] = grid.x(i);
-      y[grid.index(i, j)] = grid.y(j);
+      const std::size_t k = grid.index(i, j);
+      q[3 * k] = grid.x(i);
+      q[3 * k + 1] = grid.y(j);
+      q[3 * k + 2] = azimuth;
     }
-  std::vector<DirPair<double>> pairs(grid.size());
-  std::vector<std::uint8_t> valid(grid.size());
-  double* base = &pairs.data()->wi.x;  // DirPair<double> is six packed doubles
-  static_assert(sizeof(DirPair<double>) == 6 * sizeof(double));
-  const ConstColumn<double> in[3] = {{x.data()}, {y.data()}, {az.data()}};
-  const Column<double> out_cols[6] = {{base, 6},     {base + 1, 6}, {base + 2, 6},
-                                      {base + 3, 6}, {base + 4, 6}, {base + 5, 6}};
-  ConvertOutput<double> out{out_cols};
-  out.valid = valid.data();
-  BatchOptions options;
-  options.threads = threads;
-  convert<double>(Form{space, true}, Form{Space::dirs, false}, in, grid.size(), out, options);
+  std::vector<DirPair<double>> pairs;
+  std::vector<std::uint8_t> valid;
+  form_to_pairs(form, true, q, pairs, valid, threads);
   if (pose != 0) {
     const double c = std::cos(pose), s = std::sin(pose);
     const auto turn = [&](Vec3<double>& w) { w = {c * w.x - s * w.y, s * w.x + c * w.y, w.z}; };
@@ -92,7 +135,7 @@ std::vector<float> slice_field(const Brdf& brdf, Space space, double azimuth, st
   return eval_where(brdf, pairs, valid, values);
 }
 
-std::vector<float> hemisphere_field(const Brdf* brdf, Space space, const Vec3<double>& wo,
+std::vector<float> hemisphere_field(const Brdf* brdf, const ViewForm& space, const Vec3<double>& wo,
                                     std::size_t n, int threads, RhoValues values) {
   const auto view = figure::HemisphereView::around({0, 0, 1}, figure::Projection::equal_area);
   const figure::Grid grid = figure::Grid::pixel_centres(n, n, -1, 1, -1, 1);
@@ -111,7 +154,8 @@ std::vector<float> hemisphere_field(const Brdf* brdf, Space space, const Vec3<do
           }
       },
       threads);
-  if (space == Space::dirs) return eval_where(*brdf, pairs, inside, values);
+  if (space.is_dirs()) return eval_where(*brdf, pairs, inside, values);
+  if (space.own) return own_coordinates(*space.own, pairs, inside);
   // The coordinates, through the batch engine (the numbers `halfback convert` gives).
   std::vector<double> wi_x(grid.size()), wi_y(grid.size()), wi_z(grid.size());
   for (std::size_t k = 0; k < grid.size(); ++k) {
@@ -129,7 +173,7 @@ std::vector<float> hemisphere_field(const Brdf* brdf, Space space, const Vec3<do
   ConvertOutput<double> out{out_cols};
   BatchOptions options;
   options.threads = threads;
-  convert<double>(Form{Space::dirs, false}, Form{space, true}, in, grid.size(), out, options);
+  convert<double>(Form{Space::dirs, false}, Form{space.space, true}, in, grid.size(), out, options);
   std::vector<float> field(q.size());
   for (std::size_t k = 0; k < q.size(); ++k) field[k] = inside[k / 3] ? float(q[k]) : kNanF;
   return field;

@@ -10,17 +10,47 @@
 #include <span>
 
 #include "fields.hpp"
-#include "fit_json.hpp"
+#include "fit/fit_json.hpp"
 #include "halfback/brdf/albedo.hpp"
 #include "halfback/core/batch.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/figure/coordinates.hpp"
 #include "halfback/fit/fit.hpp"
 #include "halfback/loader/load.hpp"
+#include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "json.hpp"
 
 namespace halfback::view {
+
+Budget::Budget(double seconds, const std::function<bool()>& abandoned,
+               const std::atomic<bool>& stopping)
+    : seconds_(seconds),
+      deadline_(std::chrono::steady_clock::now() +
+                std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                    std::chrono::duration<double>(seconds))),
+      abandoned_(abandoned),
+      stopping_(stopping) {}
+
+bool Budget::expired() const {
+  return stopping_ || std::chrono::steady_clock::now() >= deadline_ || (abandoned_ && abandoned_());
+}
+
+double Budget::seconds_left() const {
+  const auto left = deadline_ - std::chrono::steady_clock::now();
+  return std::max(0.0, std::chrono::duration<double>(left).count());
+}
+
+void Budget::check(std::string_view what) const {
+  if (stopping_) throw RequestError(503, fmt::format("{} was stopped: the server stops", what));
+  if (abandoned_ && abandoned_())
+    throw RequestError(503, fmt::format("{} was stopped: the client left", what));
+  if (std::chrono::steady_clock::now() >= deadline_)
+    throw RequestError(503, fmt::format("{} did not end within {} s, the limit of a request's "
+                                        "computation: ask for less (fewer samples, terms or "
+                                        "pixels)",
+                                        what, seconds_));
+}
 
 namespace {
 
@@ -59,14 +89,25 @@ std::size_t whole(const Request& r, std::string_view key, std::size_t fallback, 
   return std::size_t(x);
 }
 
-Space space_param(const Request& r, std::string_view key, bool allow_dirs) {
-  const std::string& name = required(r, key);
-  const auto s = space_from_name(name);
-  if (!s || (*s == Space::dirs && !allow_dirs))
-    throw RequestError(
-        400, fmt::format("parameter '{}': '{}' is not one of {}", key, name.substr(0, 64),
-                         allow_dirs ? "rho, " + space_names() : parameterization_names(", ")));
-  return *s;
+// The names a form parameter accepts, for its error message.
+std::string form_names(bool allow_dirs) {
+  return fmt::format("{}{}, or dupuy-jakob:BRDF", allow_dirs ? "rho, dirs, " : "",
+                     parameterization_names(", "));
+}
+
+// The parameterization a request names (Catalog::form: confined, never registered).
+ViewForm form_of(const Catalog& catalog, std::string_view key, std::string_view name,
+                 bool allow_dirs) {
+  const auto f = name == "dirs" ? std::optional<ViewForm>(ViewForm()) : catalog.form(name);
+  if (!f || (f->is_dirs() && !allow_dirs))
+    throw RequestError(400, fmt::format("parameter '{}': '{}' is not one of {}", key,
+                                        name.substr(0, 64), form_names(allow_dirs)));
+  return *f;
+}
+
+ViewForm space_param(const Catalog& catalog, const Request& r, std::string_view key,
+                     bool allow_dirs) {
+  return form_of(catalog, key, required(r, key), allow_dirs);
 }
 
 std::vector<double> number_list(std::string_view text, std::string_view what, std::size_t count) {
@@ -95,9 +136,20 @@ Vec3<double> outgoing(const Request& r) {
   return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
 }
 
-Response json(const JsonWriter& w) {
+// [r, g, b], as the page reads a colour.
+Json rgb_json(const Rgb& x) {
+  return Json::array({x.r, x.g, x.b});
+}
+
+Json rgb_list(const std::vector<Rgb>& v) {
+  Json list = Json::array();
+  for (const Rgb& x : v) list.push_back(rgb_json(x));
+  return list;
+}
+
+Response json(const Json& j) {
   Response res;
-  res.body = w.str();
+  res.body = json_text(j);
   return res;
 }
 
@@ -142,115 +194,133 @@ RhoValues values_param(const Request& r) {
       400, fmt::format("parameter 'values': '{}' is not rgb or luminance", v->substr(0, 64)));
 }
 
-// The isotropic forms of `forms=` (comma-separated, each at most once); all by default.
-std::vector<Space> forms_param(const Request& r) {
+// The isotropic forms of `forms=` (comma-separated, each at most once, at most
+// kMaxCachedForms built for the request); all the registered ones by default.
+std::vector<ViewForm> forms_param(const Catalog& catalog, const Request& r) {
   const std::string* text = r.param("forms");
-  if (!text) return parameterizations();
-  std::vector<Space> forms;
-  std::string_view rest = *text;
-  while (true) {
+  std::vector<ViewForm> forms;
+  if (!text) {
+    for (const Space s : parameterizations()) forms.emplace_back(s);
+    return forms;
+  }
+  std::vector<std::string_view> names;
+  std::size_t built = 0;
+  for (std::string_view rest = *text;;) {
     const std::size_t comma = rest.find(',');
     const std::string_view name = rest.substr(0, comma);
-    const auto s = space_from_name(name);
-    if (!s || *s == Space::dirs)
-      throw RequestError(400, fmt::format("parameter 'forms': '{}' is not one of {} "
-                                          "(comma-separated)",
-                                          name.substr(0, 64), parameterization_names(", ")));
-    if (std::find(forms.begin(), forms.end(), *s) != forms.end())
-      throw RequestError(400, fmt::format("parameter 'forms': '{}' is named twice", name));
-    forms.push_back(*s);
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      throw RequestError(400,
+                         fmt::format("parameter 'forms': '{}' is named twice", name.substr(0, 64)));
+    names.push_back(name);
+    forms.push_back(form_of(catalog, "forms", name, false));
+    if (forms.back().own && ++built > kMaxCachedForms)
+      throw RequestError(413, fmt::format("parameter 'forms': at most {} dupuy-jakob:BRDF per "
+                                          "request",
+                                          kMaxCachedForms));
     if (comma == std::string_view::npos) return forms;
     rest = rest.substr(comma + 1);
   }
 }
 
-void write_models(JsonWriter& w) {
-  w.key("models").begin_array();
+Json models_json() {
+  Json models = Json::array();
   for (const std::string& name : model_registry().names()) {
     const ModelInfo* m = model_registry().find(name);
     if (!m) continue;
-    w.begin_object().field("name", m->name).field("description", m->description);
-    w.key("params").begin_array();
+    Json params = Json::array();
     for (const ModelParam& p : m->params) {
-      w.begin_object().field("name", p.name).field("description", p.description);
-      w.field("default", p.default_value).field("min", p.min).field("max", p.max);
-      w.field("default_from", p.default_from).key("choices").begin_array();
-      for (const std::string& c : p.choices) w.value(c);
-      w.end_array().end_object();
+      Json param;
+      param["name"] = p.name;
+      param["description"] = p.description;
+      param["default"] = p.default_value;
+      param["min"] = p.min;
+      param["max"] = p.max;
+      param["default_from"] = p.default_from;
+      param["choices"] = p.choices;
+      params.push_back(std::move(param));
     }
-    w.end_array().end_object();
+    Json model;
+    model["name"] = m->name;
+    model["description"] = m->description;
+    model["params"] = std::move(params);
+    models.push_back(std::move(model));
   }
-  w.end_array();
+  return models;
 }
 
-void write_forms(JsonWriter& w) {
-  w.key("forms").begin_array();
+Json forms_json() {
+  Json forms = Json::array();
   for (const Space s : parameterizations()) {
-    const auto coords = figure::iso_coordinates(s);
-    w.begin_object().field("space", name_of(s)).field("summary", s.param().summary());
-    w.field("azimuth_label", figure::relative_azimuth_label(s)).key("axes").begin_array();
-    for (const auto& c : coords)
-      w.begin_object()
-          .field("label", c.label)
-          .field("max", c.max)
-          .field("angle", c.angle)
-          .end_object();
-    w.end_array().key("columns").begin_array();
-    for (const auto c : column_names(Form{s, false})) w.value(c);
-    w.end_array().key("iso_columns").begin_array();
-    for (const auto c : column_names(Form{s, true})) w.value(c);
-    w.end_array().key("units").begin_array();  // of the columns: "rad" or "" (a length)
-    for (const Axis& a : s.param().axes(false)) w.value(a.unit());
-    w.end_array().key("iso_units").begin_array();
-    for (const Axis& a : s.param().axes(true)) w.value(a.unit());
-    w.end_array().end_object();
+    Json form;
+    form["space"] = name_of(s);
+    form["summary"] = s.param().summary();
+    form["azimuth_label"] = figure::relative_azimuth_label(s);
+    form["axes"] = Json::array();
+    for (const auto& c : figure::iso_coordinates(s)) {
+      Json axis;
+      axis["label"] = c.label;
+      axis["max"] = c.max;
+      axis["angle"] = c.angle;
+      form["axes"].push_back(std::move(axis));
+    }
+    for (const bool iso : {false, true}) {
+      Json& columns = form[iso ? "iso_columns" : "columns"] = Json::array();
+      for (const auto c : column_names(Form{s, iso})) columns.push_back(c);
+    }
+    for (const bool iso : {false, true}) {  // of the columns: "rad" or "" (a length)
+      Json& units = form[iso ? "iso_units" : "units"] = Json::array();
+      for (const Axis& a : s.param().axes(iso)) units.push_back(a.unit());
+    }
+    forms.push_back(std::move(form));
   }
-  w.end_array();
+  return forms;
 }
 
 }  // namespace
 
 Response info_response(const Catalog& catalog) {
-  JsonWriter w;
-  w.begin_object().key("specs").begin_array();
-  for (const std::string& s : catalog.specs()) w.value(s);
-  w.end_array();
-  write_models(w);
-  write_forms(w);
-  w.key("embedded").begin_array();
-  for (const std::string& name : embedded_material_names()) w.value(name);
-  w.end_array();
+  Json j;
+  j["specs"] = catalog.specs();
+  j["models"] = models_json();
+  j["forms"] = forms_json();
+  j["embedded"] = embedded_material_names();
   const Catalog::Listing files = catalog.list_files(1000);
-  w.key("files").begin_array();
-  for (const std::string& f : files.brdfs) w.value(f);
-  w.end_array().key("environments").begin_array();
-  for (const char* e : {"sky", "studio", "sunset"}) w.value(e);
-  for (const std::string& f : files.environments) w.value("file:" + f);
-  w.end_array().key("limits").begin_object();
-  w.field("grid", kMaxGridSide).field("polar", kMaxPolarSamples);
-  w.field("render", kMaxRenderSide).field("spp", kMaxRenderSpp);
-  w.field("fit_samples", kMaxFitSamples).end_object();
-  w.key("losses").begin_array();
-  for (const fit::Loss l : fit::kLosses) w.value(fit::name_of(l));
-  w.end_array().end_object();
-  return json(w);
+  j["files"] = files.brdfs;
+  Json& environments = j["environments"] = Json::array({"sky", "studio", "sunset"});
+  for (const std::string& f : files.environments) environments.push_back("file:" + f);
+  Json& limits = j["limits"];
+  limits["grid"] = kMaxGridSide;
+  limits["polar"] = kMaxPolarSamples;
+  limits["render"] = kMaxRenderSide;
+  limits["spp"] = kMaxRenderSpp;
+  limits["fit_samples"] = kMaxFitSamples;
+  Json& losses = j["losses"] = Json::array();
+  for (const fit::Loss l : fit::kLosses) losses.push_back(fit::name_of(l));
+  return json(j);
 }
 
 Response brdf_response(const Catalog& catalog, const Request& request) {
   const std::string& spec = required(request, "brdf");
   const BrdfPtr brdf = catalog.brdf(spec);
-  JsonWriter w;
-  w.begin_object().field("spec", spec).field("name", brdf->name());
-  w.field("description", brdf->description()).field("isotropic", brdf->isotropic());
-  w.field("reciprocal", brdf->reciprocal()).key("facts").begin_array();
-  for (const Brdf::Fact& f : brdf->facts())
-    w.begin_object().field("label", f.label).field("value", f.value).end_object();
-  w.end_array().end_object();
-  return json(w);
+  Json j;
+  j["spec"] = spec;
+  j["name"] = brdf->name();
+  j["description"] = brdf->description();
+  j["isotropic"] = brdf->isotropic();
+  j["reciprocal"] = brdf->reciprocal();
+  Json& facts = j["facts"] = Json::array();
+  for (const Brdf::Fact& f : brdf->facts()) {
+    Json fact;
+    fact["label"] = f.label;
+    fact["value"] = f.value;
+    facts.push_back(std::move(fact));
+  }
+  return json(j);
 }
 
-Response slices_response(const Catalog& catalog, const Request& request, int threads) {
-  const std::vector<Space> forms = forms_param(request);
+Response slices_response(const Catalog& catalog, const Request& request, int threads,
+                         const Budget& budget) {
+  const std::vector<ViewForm> forms = forms_param(catalog, request);
   double azimuth = std::fmod(number(request, "azimuth", 0, -360, 720), 360.0);
   if (azimuth < 0) azimuth += 360.0;
   double radians = azimuth * kDegree;
@@ -264,6 +334,14 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
   if (specs.size() > kMaxBrdfsPerSlices)
     throw RequestError(413, fmt::format("at most {} brdf= per /api/slices request (got {})",
                                         kMaxBrdfsPerSlices, specs.size()));
+  const std::size_t bytes = specs.size() * forms.size() * n * n * channels_of(values) * 4;
+  if (bytes > kMaxSlicesBytes)
+    throw RequestError(
+        400,
+        fmt::format("/api/slices: {} BRDF(s) x {} form(s) x {}² pixels x {} channel(s) is {} "
+                    "bytes, above the limit of {} (ask fewer forms, a smaller n, or "
+                    "values=luminance)",
+                    specs.size(), forms.size(), n, channels_of(values), bytes, kMaxSlicesBytes));
   std::vector<BrdfPtr> brdfs;
   for (const std::string* s : specs) brdfs.push_back(catalog.brdf(*s));
   // One field per (BRDF, form), computed in parallel: a slider update is one request.
@@ -271,16 +349,17 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
   parallel_for(
       fields.size(), 1,
       [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k)
+        for (std::size_t k = begin; k < end && !budget.expired(); ++k)
           fields[k] = slice_field(*brdfs[k / forms.size()], forms[k % forms.size()], radians, n,
                                   threads, values, pose);
       },
       threads);
+  budget.check("the slices");
   Response res = floats(fields, n, n, channels_of(values));
   std::string names;
-  for (const Space s : forms) {
+  for (const ViewForm& f : forms) {
     if (!names.empty()) names += ',';
-    names += name_of(s);
+    names += f.name();
   }
   res.headers.emplace_back("X-Halfback-Forms", names);
   res.headers.emplace_back("X-Halfback-Brdfs", std::to_string(brdfs.size()));
@@ -289,13 +368,13 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
 
 Response hemisphere_response(const Catalog& catalog, const Request& request, int threads) {
   const std::string* colour = request.param("colour");
-  Space space = Space::dirs;
-  if (colour && *colour != "rho") space = space_param(request, "colour", true);
+  ViewForm space;
+  if (colour && *colour != "rho") space = space_param(catalog, request, "colour", true);
   const std::size_t n = whole(request, "n", 128, 2, kMaxGridSide);
   const Vec3<double> wo = outgoing(request);
-  const RhoValues values = space == Space::dirs ? values_param(request) : RhoValues::rgb;
+  const RhoValues values = space.is_dirs() ? values_param(request) : RhoValues::rgb;
   BrdfPtr brdf;
-  if (space == Space::dirs) brdf = catalog.brdf(required(request, "brdf"));
+  if (space.is_dirs()) brdf = catalog.brdf(required(request, "brdf"));
   return floats(hemisphere_field(brdf.get(), space, wo, n, threads, values), n, n,
                 channels_of(values));
 }
@@ -305,22 +384,15 @@ Response polar_response(const Catalog& catalog, const Request& request) {
   const Vec3<double> wo = outgoing(request);
   const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
   const PolarCurves c = polar_curves(*brdf, wo, n);
-  JsonWriter w;
-  w.begin_object().key("angles_deg").begin_array();
-  for (const double a : c.angles_deg) w.value(a);
-  w.end_array();
-  const auto curve = [&](std::string_view name, const std::vector<Rgb>& v) {
-    w.key(name).begin_array();
-    for (const Rgb& x : v) w.begin_array().value(x.r).value(x.g).value(x.b).end_array();
-    w.end_array();
-  };
-  curve("in_plane", c.in_plane);
-  curve("across", c.across);
-  w.end_object();
-  return json(w);
+  Json j;
+  j["angles_deg"] = c.angles_deg;
+  j["in_plane"] = rgb_list(c.in_plane);
+  j["across"] = rgb_list(c.across);
+  return json(j);
 }
 
-Response albedo_response(const Catalog& catalog, const Request& request, int threads) {
+Response albedo_response(const Catalog& catalog, const Request& request, int threads,
+                         const Budget& budget) {
   const std::size_t angles = whole(request, "angles", 90, 2, kMaxAlbedoAngles);  // 0°, 1°, …, 89°
   const int n = int(whole(request, "n", 64, 1, kMaxAlbedoSamples));
   const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
@@ -332,37 +404,33 @@ Response albedo_response(const Catalog& catalog, const Request& request, int thr
   parallel_for(
       angles, 1,
       [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) {
+        for (std::size_t k = begin; k < end && !budget.expired(); ++k) {
           const double t = theta[k] * kDegree;
           a[k] = directional_albedo(*brdf, {std::sin(t), 0, std::cos(t)}, n);
         }
       },
       threads);
-  JsonWriter w;
-  w.begin_object().field("brdf", brdf->name()).field("samples", n * n);
-  w.key("theta_deg").begin_array();
-  for (const double t : theta) w.value(t);
-  w.end_array();
-  const auto rgbs = [&](std::string_view name, auto member) {
-    w.key(name).begin_array();
-    for (const AlbedoEstimate& e : a) {
-      const Rgb& x = e.*member;
-      w.begin_array().value(x.r).value(x.g).value(x.b).end_array();
-    }
-    w.end_array();
+  budget.check("the albedo curve");
+  Json j;
+  j["brdf"] = brdf->name();
+  j["samples"] = n * n;
+  j["theta_deg"] = theta;
+  const auto rgbs = [&a](Rgb AlbedoEstimate::*member) {
+    Json list = Json::array();
+    for (const AlbedoEstimate& e : a) list.push_back(rgb_json(e.*member));
+    return list;
   };
-  rgbs("albedo", &AlbedoEstimate::mean);
-  rgbs("standard_error", &AlbedoEstimate::standard_error);
-  w.key("measured").begin_array();
-  for (const AlbedoEstimate& e : a) w.value(e.measured);
-  w.end_array().end_object();
-  return json(w);
+  j["albedo"] = rgbs(&AlbedoEstimate::mean);
+  j["standard_error"] = rgbs(&AlbedoEstimate::standard_error);
+  Json& measured = j["measured"] = Json::array();
+  for (const AlbedoEstimate& e : a) measured.push_back(e.measured);
+  return json(j);
 }
 
 namespace {
 
 // The pair a /api/point request names: wi and wo, or form (+ iso) and coords.
-bool point_pair(const Request& request, DirPair<double>& pair) {
+bool point_pair(const Catalog& catalog, const Request& request, DirPair<double>& pair) {
   if (request.param("wi") || request.param("wo")) {
     pair = {direction_param(request, "wi"), direction_param(request, "wo")};
     const PairStatus status = accept_pair(pair);
@@ -371,35 +439,42 @@ bool point_pair(const Request& request, DirPair<double>& pair) {
       throw RequestError(400, std::string(describe(status)));
     return true;
   }
-  const Space space = space_param(request, "form", false);
+  const ViewForm form = space_param(catalog, request, "form", false);
   const std::string* iso_text = request.param("iso");
   const bool iso = iso_text && *iso_text == "1";
-  const Form from{space, iso};
-  const std::vector<double> q =
-      number_list(required(request, "coords"), "parameter 'coords'", dimension(from));
+  std::vector<double> q =
+      number_list(required(request, "coords"), "parameter 'coords'", iso ? 3 : 4);
+  if (form.own) {  // a request's parameterization: its own checked inverse
+    std::vector<DirPair<double>> pairs;
+    std::vector<std::uint8_t> valid;
+    form_to_pairs(form, iso, q, pairs, valid, 1);
+    pair = pairs[0];
+    return valid[0] != 0;
+  }
+  const Form from{form.space, iso};
   double d[6];
   const bool ok = convert_one<double>(from, Form{Space::dirs, false}, q, d);
   pair = {{d[0], d[1], d[2]}, {d[3], d[4], d[5]}};
   return ok;
 }
 
-void write_coordinates(JsonWriter& w, const DirPair<double>& pair, bool valid) {
+Json coordinates_json(const DirPair<double>& pair, bool valid) {
   const double d[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
-  w.key("forms").begin_array();
+  Json forms = Json::array();
   for (const Space s : parameterizations()) {
-    w.begin_object().field("space", name_of(s));
+    Json form;
+    form["space"] = name_of(s);
     for (const bool iso : {false, true}) {
       const Form to{s, iso};
       double q[4] = {NAN, NAN, NAN, NAN}, jacobian = NAN;
       if (valid)
         convert_one<double>(Form{Space::dirs, false}, to, d, {q, dimension(to)}, &jacobian);
-      w.key(iso ? "iso" : "coords").begin_array();
-      for (std::size_t k = 0; k < dimension(to); ++k) w.value(q[k]);
-      w.end_array().field(iso ? "iso_jacobian" : "jacobian", jacobian);
+      form[iso ? "iso" : "coords"] = std::vector<double>(q, q + dimension(to));
+      form[iso ? "iso_jacobian" : "jacobian"] = jacobian;
     }
-    w.end_object();
+    forms.push_back(std::move(form));
   }
-  w.end_array();
+  return forms;
 }
 
 }  // namespace
@@ -411,24 +486,26 @@ Response point_response(const Catalog& catalog, const Request& request) {
     throw RequestError(413, fmt::format("at most {} brdf= per request", kMaxBrdfsPerRequest));
   for (const std::string* s : specs) brdfs.push_back(catalog.brdf(*s));
   DirPair<double> pair{};
-  const bool valid = point_pair(request, pair);
-  JsonWriter w;
-  w.begin_object().field("valid", valid);
-  w.key("wi").begin_array().value(pair.wi.x).value(pair.wi.y).value(pair.wi.z).end_array();
-  w.key("wo").begin_array().value(pair.wo.x).value(pair.wo.y).value(pair.wo.z).end_array();
-  write_coordinates(w, pair, valid);
-  w.key("rho").begin_array();
+  const bool valid = point_pair(catalog, request, pair);
+  Json j;
+  j["valid"] = valid;
+  j["wi"] = {pair.wi.x, pair.wi.y, pair.wi.z};
+  j["wo"] = {pair.wo.x, pair.wo.y, pair.wo.z};
+  j["forms"] = coordinates_json(pair, valid);
+  Json& rho_list = j["rho"] = Json::array();
   for (std::size_t b = 0; b < brdfs.size(); ++b) {
     Rgb rho{NAN, NAN, NAN};
     if (valid) brdfs[b]->eval_batch({&pair, 1}, {&rho, 1});  // as `halfback eval` does
-    w.begin_object().field("brdf", *specs[b]).key("rgb").begin_array();
-    w.value(rho.r).value(rho.g).value(rho.b).end_array().end_object();
+    Json entry;
+    entry["brdf"] = *specs[b];
+    entry["rgb"] = rgb_json(rho);
+    rho_list.push_back(std::move(entry));
   }
-  w.end_array().end_object();
-  return json(w);
+  return json(j);
 }
 
-Response render_response(const Catalog& catalog, const Request& request, int threads) {
+Response render_response(const Catalog& catalog, const Request& request, int threads,
+                         const Budget& budget) {
   render::RenderSettings s;
   s.width = s.height = int(whole(request, "size", 128, 8, std::size_t(kMaxRenderSide)));
   s.spp = int(whole(request, "spp", 4, 1, std::size_t(kMaxRenderSpp)));
@@ -437,7 +514,15 @@ Response render_response(const Catalog& catalog, const Request& request, int thr
   const std::string* env_spec = request.param("env");
   const auto env = catalog.environment(env_spec ? std::string_view(*env_spec) : "sky");
   const BrdfPtr brdf = catalog.sampled_brdf(required(request, "brdf"));
-  const render::RenderResult result = render::render_sampled(*brdf, *env, s);
+  budget.check("the render");
+  s.time_budget = std::max(budget.seconds_left(), 1e-3);  // fewer samples (X-Halfback-Spp) past it
+  render::RenderResult result;
+  try {
+    result = render::render_sampled(*brdf, *env, s);
+  } catch (const render::TimeBudgetExceeded&) {
+    budget.check("the render");
+    throw RequestError(503, "the render did not take one sample per pixel within its time");
+  }
   Response res = floats(result.image.rgb, std::size_t(s.width), std::size_t(s.height), 3);
   res.headers.emplace_back("X-Halfback-Spp", std::to_string(result.spp));
   return res;
@@ -485,11 +570,12 @@ class FitSlot {
 // The model of `model=` (a sum of lobes of the registry) fitted to `brdf=` under `loss=`, with
 // `samples=` pairs (docs/fit.md); the answer is the JSON `halfback fit` writes.
 Response fit_response(const Catalog& catalog, const Request& request, int threads,
-                      std::atomic<int>& running) {
+                      std::atomic<int>& running, const Budget& budget) {
   const std::string& spec = required(request, "brdf");
   const std::string& model = required(request, "model");
   if (model.size() > kMaxSpecBytes)
     throw RequestError(413, fmt::format("model longer than {} bytes", kMaxSpecBytes));
+  refuse_paths(model);  // a model never names a file
   fit::FitOptions options;
   const std::string* loss = request.param("loss");
   if (loss) {
@@ -501,19 +587,27 @@ Response fit_response(const Catalog& catalog, const Request& request, int thread
   }
   options.samples = whole(request, "samples", 5000, 100, kMaxFitSamples);
   options.threads = threads;
-  (void)fit::parse_model(model);  // a bad model is a 400 before the BRDF is loaded
+  options.cancelled = [&budget] { return budget.expired(); };
+  // A bad model is a 400 before the BRDF is loaded, and so is one too large to fit in time.
+  const std::size_t terms = fit::parse_model(model).terms.size();
+  if (terms * options.samples > kMaxFitTermSamples)
+    throw RequestError(400, fmt::format("a fit of {} term(s) at {} samples is {} term-samples, "
+                                        "above the limit of {}: fewer terms, or samples <= {}",
+                                        terms, options.samples, terms * options.samples,
+                                        kMaxFitTermSamples, kMaxFitTermSamples / terms));
   const BrdfPtr target = catalog.brdf(spec);
   const FitSlot slot(running);
   fit::FitResult result;
   try {
     result = fit::fit(*target, model, options);
+  } catch (const fit::FitCancelled&) {
+    budget.check("the fit");
+    throw RequestError(503, "the fit was stopped");
   } catch (const fit::FitDataError& e) {
     throw RequestError(422,
                        fmt::format("'{}' cannot be fitted: {}", spec.substr(0, 128), e.what()));
   }
-  JsonWriter w;
-  write_fit(w, result, spec, model);
-  return json(w);
+  return json(fit::fit_json(result, spec, model));
 }
 
 }  // namespace halfback::view

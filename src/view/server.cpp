@@ -32,18 +32,18 @@ namespace halfback::view {
 
 namespace {
 
-// A thread for each connection, up to kMaxConnections at once (more wait their turn): a client
+// A thread for each connection, up to kMaxThreads at once (more wait their turn): a client
 // that trickles its request's header lines holds only its own connection's thread, where with a
 // pool of --workers threads twenty such clients stalled every request for 30 s; and it holds it
 // for kRequestHeadSeconds at most (HttpServer::serve). The work of the requests is bounded apart
 // (Server::Impl::handling: --workers at once).
 class ConnectionQueue : public httplib::TaskQueue {
  public:
-  static constexpr std::size_t kMaxConnections = 256;
+  static constexpr std::size_t kMaxThreads = 256;
 
   void enqueue(std::function<void()> fn) override {
     std::lock_guard lock(mutex_);
-    if (active_ < kMaxConnections)
+    if (active_ < kMaxThreads)
       start_locked(std::move(fn));
     else
       waiting_.push_back(std::move(fn));
@@ -252,9 +252,9 @@ class ConnectionStream : public httplib::Stream {
 // Api's), then waits briefly for the client's end so that the unread rest of its request does
 // not turn the close into a reset that would lose the response.
 void answer_and_close(socket_t sock, int status, const char* reason, std::string_view message) {
-  JsonWriter w;
-  w.begin_object().field("error", message).end_object();
-  const std::string body = w.str();
+  Json error;
+  error["error"] = message;
+  const std::string body = json_text(std::move(error));
   const std::string response = fmt::format(
       "HTTP/1.1 {} {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n"
       "Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n{}",
@@ -276,39 +276,95 @@ void answer_and_close(socket_t sock, int status, const char* reason, std::string
   }
 }
 
-// The open connections of each client address, each held by a Slot; at most
-// kConnectionsPerClient per address.
-class ClientConnections {
+// The open connections, each held by a Slot: at most kMaxConnections at once, keyed by connection
+// (every local process shares the address 127.0.0.1, so a bound per address let one of them
+// starve the page). A new connection at the bound makes room by closing the one that has waited
+// longest for a request head (idle between requests, or trickling one in: it holds a thread and
+// no work); when every connection is being answered, the new one is refused. close_all() shuts
+// every connection down (their reads and writes end at once) and refuses new ones.
+class Connections {
  public:
   class Slot {
    public:
-    Slot(ClientConnections& owner, std::string address)
-        : owner_(owner), address_(std::move(address)) {
-      std::lock_guard lock(owner_.mutex_);
-      int& open = owner_.open_[address_];
-      taken_ = open < kConnectionsPerClient;
-      if (taken_) ++open;
+    Slot(Connections& owner, socket_t sock) : owner_(owner), sock_(sock) {
+      taken_ = owner_.open(sock);
     }
     ~Slot() {
-      if (!taken_) return;
-      std::lock_guard lock(owner_.mutex_);
-      const auto it = owner_.open_.find(address_);
-      if (--it->second == 0) owner_.open_.erase(it);
+      if (taken_) owner_.close(sock_);
     }
     Slot(const Slot&) = delete;
     Slot& operator=(const Slot&) = delete;
     bool taken() const { return taken_; }
+    // The connection waits for a request head from now (true), or is being answered (false).
+    void waiting(bool w) { owner_.set_waiting(sock_, w); }
 
    private:
-    ClientConnections& owner_;
-    std::string address_;
+    Connections& owner_;
+    socket_t sock_;
     bool taken_ = false;
   };
 
+  void close_all() {
+    std::lock_guard lock(mutex_);
+    closing_ = true;
+    for (auto& [sock, c] : open_) {
+      ::shutdown(sock, SHUT_RDWR);
+      c.closed = true;
+    }
+  }
+
  private:
+  struct Open {
+    bool waiting = true;  // for a request head, since `since`
+    Clock::time_point since = Clock::now();
+    bool closed = false;  // shut down to make room (its Slot ends soon)
+  };
+
+  bool open(socket_t sock) {
+    std::lock_guard lock(mutex_);
+    if (closing_) return false;
+    const auto live =
+        std::count_if(open_.begin(), open_.end(), [](const auto& o) { return !o.second.closed; });
+    if (std::size_t(live) >= kMaxConnections) {
+      auto oldest = open_.end();
+      for (auto it = open_.begin(); it != open_.end(); ++it)
+        if (it->second.waiting && !it->second.closed &&
+            (oldest == open_.end() || it->second.since < oldest->second.since))
+          oldest = it;
+      if (oldest == open_.end()) return false;
+      ::shutdown(oldest->first, SHUT_RDWR);
+      oldest->second.closed = true;
+    }
+    open_[sock] = Open{};
+    return true;
+  }
+  void close(socket_t sock) {
+    std::lock_guard lock(mutex_);
+    open_.erase(sock);
+  }
+  void set_waiting(socket_t sock, bool w) {
+    std::lock_guard lock(mutex_);
+    if (const auto it = open_.find(sock); it != open_.end()) {
+      it->second.waiting = w;
+      it->second.since = Clock::now();
+    }
+  }
+
   std::mutex mutex_;
-  std::map<std::string, int> open_;
+  std::map<socket_t, Open> open_;
+  bool closing_ = false;
 };
+
+// The connection the calling thread serves (each connection has a thread of its own), for the
+// requests' Request::abandoned.
+thread_local socket_t serving_socket = INVALID_SOCKET;
+
+// Whether the peer of `sock` has closed its side (or the connection is gone): its answer is no
+// longer wanted. A client that closes only its sending side is taken to have left as well.
+bool peer_left(socket_t sock) {
+  pollfd p{sock, POLLRDHUP, 0};
+  return ::poll(&p, 1, 0) > 0 && (p.revents & (POLLRDHUP | POLLHUP | POLLERR | POLLNVAL)) != 0;
+}
 
 // httplib's server with its connection handling replaced (process_and_close_socket, a virtual
 // function of httplib::Server that may be overridden although private): the bound on
@@ -320,22 +376,21 @@ class HttpServer : public httplib::Server {
   // takes a second listen() for that): a burst of more, such as a page's requests with a few
   // other clients, otherwise saw connections dropped by the kernel and set up again 1 to 3 s
   // later.
-  void widen_backlog() { ::listen(svr_sock_, ConnectionQueue::kMaxConnections); }
+  void widen_backlog() { ::listen(svr_sock_, ConnectionQueue::kMaxThreads); }
   // Serves a connected socket as an accepted one (Server::serve_connection).
   void serve_accepted(socket_t sock) { process_and_close_socket(sock); }
+  // Shuts every connection down and refuses new ones (Server::stop).
+  void close_connections() { connections_.close_all(); }
 
  private:
   bool process_and_close_socket(socket_t sock) override {
-    std::string address;
-    int port = 0;
-    socket_address(sock, true, address, port);
     bool ok = false;
-    if (const ClientConnections::Slot slot(clients_, address); slot.taken())
-      ok = serve(sock);
+    if (Connections::Slot slot(connections_, sock); slot.taken())
+      ok = serve(sock, slot);
     else
       answer_and_close(sock, 503, "Service Unavailable",
-                       fmt::format("too many connections from {} (at most {} at once)", address,
-                                   kConnectionsPerClient));
+                       fmt::format("every one of the {} connections is being answered: try again",
+                                   kMaxConnections));
     ::shutdown(sock, SHUT_RDWR);
     ::close(sock);
     return ok;
@@ -343,8 +398,9 @@ class HttpServer : public httplib::Server {
 
   // The requests of one connection, up to httplib's keep-alive count: each must begin within
   // the keep-alive timeout and have its head read within kRequestHeadSeconds of the wait's start.
-  bool serve(socket_t sock) {
+  bool serve(socket_t sock, Connections::Slot& slot) {
     using std::chrono::microseconds, std::chrono::seconds;
+    serving_socket = sock;
     ConnectionStream stream(sock, seconds(read_timeout_sec_) + microseconds(read_timeout_usec_),
                             seconds(write_timeout_sec_) + microseconds(write_timeout_usec_));
     const auto head_time = std::chrono::duration_cast<Clock::duration>(
@@ -358,8 +414,12 @@ class HttpServer : public httplib::Server {
       stream.set_head_deadline(deadline);
       bool closed = false;
       ok = process_request(stream, k + 1 == keep_alive_max_count_, closed,
-                           [&stream](httplib::Request&) { stream.head_done(); });
+                           [&stream, &slot](httplib::Request&) {
+                             stream.head_done();
+                             slot.waiting(false);
+                           });
       stream.response_done();
+      slot.waiting(true);
       if (stream.head_too_late()) {
         answer_and_close(sock, 408, "Request Timeout",
                          fmt::format("the request line and headers did not arrive within {} s",
@@ -371,7 +431,7 @@ class HttpServer : public httplib::Server {
     return ok;
   }
 
-  ClientConnections clients_;
+  Connections connections_;
 };
 
 }  // namespace http_detail
@@ -403,8 +463,10 @@ Server::Server(Api& api, int workers) : impl_(std::make_unique<Impl>(api, std::m
         std::counting_semaphore<>& s;
         ~Release() { s.release(); }
       } release{impl_->handling};
+      const socket_t sock = http_detail::serving_socket;
       return impl_->api.handle_target(req.method, req.target,
-                                      Api::RawHeaders(req.headers.begin(), req.headers.end()));
+                                      Api::RawHeaders(req.headers.begin(), req.headers.end()),
+                                      [sock] { return http_detail::peer_left(sock); });
     }();
     res.status = r.status;
     for (const auto& [name, value] : r.headers) res.set_header(name.c_str(), value);
@@ -429,6 +491,8 @@ bool Server::run() {
 }
 
 void Server::stop() {
+  impl_->api.stop();  // computations in progress give up
+  impl_->http.close_connections();
   impl_->http.stop();
 }
 

@@ -1,6 +1,7 @@
 // The server on real sockets (127.0.0.1 only, every wait bounded): a port is not shared with a
-// second server, and clients that trickle their header lines do not stall the others (issue 35,
-// class E).
+// second server, clients that trickle their header lines or hold many connections do not stall
+// the others, and a computation ends when its client leaves, its deadline passes or the server
+// stops.
 #include "halfback/view/server.hpp"
 
 #include <arpa/inet.h>
@@ -12,6 +13,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -154,38 +156,141 @@ TEST(ViewServer, ARequestHeadHasADeadlineThatTricklingCannotExtend) {
   EXPECT_LT(seconds, kRequestHeadSeconds + 1.0);
 }
 
-// One client address holds at most kConnectionsPerClient connections: one more is refused at
-// once (503, closed), and a request gets through again when the others close.
-TEST(ViewServer, ConnectionsOfOneClientAreBounded) {
+// One local process that holds many connections trickling their request heads (twice the 32
+// that once bounded every loopback client together) does not starve the page's requests: each
+// is answered 200 at once.
+TEST(ViewServer, TricklingConnectionsOfOneProcessDoNotStarveThePage) {
+  Running s;
+  std::vector<int> slow;
+  for (int k = 0; k < 64; ++k) {
+    const int fd = connect_to(s.port);
+    ASSERT_GE(fd, 0);
+    (void)!::write(fd, "GET /api/info HTTP/1.1\r\n", 24);
+    slow.push_back(fd);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // every connection counted
+  int answered = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int batch = 0; batch < 10; ++batch) {  // 59 requests, 6 at a time, as a page loads
+    for (const int fd : slow) (void)!::send(fd, "X-A: b\r\n", 8, MSG_NOSIGNAL);
+    std::vector<int> page;
+    for (int k = 0; k < 6 && batch * 6 + k < 59; ++k) {
+      const int fd = connect_to(s.port);
+      ASSERT_GE(fd, 0);
+      const std::string request = info_request(s.port);
+      (void)!::write(fd, request.data(), request.size());
+      page.push_back(fd);
+    }
+    for (const int fd : page) {
+      answered += status_line(fd, 2) == "HTTP/1.1 200 OK";
+      ::close(fd);
+    }
+  }
+  EXPECT_EQ(answered, 59);
+  EXPECT_LT(seconds_since(t0), 3.0);
+  for (const int fd : slow) ::close(fd);
+}
+
+// At kMaxConnections open connections, a new one is answered: the connection that has waited
+// longest for its request head is closed to make room.
+TEST(ViewServer, AtTheBoundTheLongestWaitingConnectionMakesRoom) {
   Running s;
   std::vector<int> held;
-  for (int k = 0; k < kConnectionsPerClient; ++k) {
+  for (std::size_t k = 0; k < kMaxConnections; ++k) {
     const int fd = connect_to(s.port);
     ASSERT_GE(fd, 0);
     (void)!::write(fd, "GET /api/info", 13);  // a request begun, not finished
     held.push_back(fd);
+    if (k == 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the oldest
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // every connection counted
-  auto t0 = std::chrono::steady_clock::now();
-  EXPECT_EQ(get_info(s.port, 2), "HTTP/1.1 503 Service Unavailable");
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(get_info(s.port, 2), "HTTP/1.1 200 OK");
   EXPECT_LT(seconds_since(t0), 1.0);
+  pollfd p{held.front(), POLLIN, 0};  // the oldest was closed (its read ends)
+  ASSERT_EQ(::poll(&p, 1, 1000), 1);
+  char c;
+  EXPECT_EQ(::read(held.front(), &c, 1), 0);
   for (const int fd : held) ::close(fd);
-  t0 = std::chrono::steady_clock::now();
-  std::string status;
-  while (status != "HTTP/1.1 200 OK" && seconds_since(t0) < 2) {
-    status = get_info(s.port, 2);
-    if (status != "HTTP/1.1 200 OK") std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  EXPECT_EQ(status, "HTTP/1.1 200 OK");
 }
 
-// A burst of connections (as many as one client may hold) is answered at once: none waits for
+// Sends a GET of `target` (with the token and Host) on a new connection; returns the socket.
+int send_get(int port, const std::string& target) {
+  const int fd = connect_to(port);
+  const std::string request = "GET " + target + "&token=" + kToken +
+                              " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+                              "\r\nConnection: close\r\n\r\n";
+  if (fd >= 0) (void)!::write(fd, request.data(), request.size());
+  return fd;
+}
+
+// A fit that takes long (four He lobes at the largest size: minutes without a bound).
+const std::string kLongFit =
+    "/api/fit?brdf=lambert:albedo=0.3%2Bggx:alpha=0.2&model=he%2Bhe%2Bhe%2Bhe&samples=20000";
+
+// A fit whose client leaves is cancelled: the next fit is not refused as "another fit is
+// running".
+TEST(ViewServer, AFitWhoseClientLeavesIsCancelled) {
+  Running s;
+  const int fd = send_get(s.port, kLongFit);
+  ASSERT_GE(fd, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ::close(fd);  // the client leaves
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string status;
+  while (seconds_since(t0) < 5) {
+    const int quick = send_get(s.port, "/api/fit?brdf=lambert&model=lambert&samples=100");
+    status = status_line(quick, 5);
+    ::close(quick);
+    if (status == "HTTP/1.1 200 OK") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_EQ(status, "HTTP/1.1 200 OK");
+  EXPECT_LT(seconds_since(t0), 2.0);
+}
+
+// A fit past its deadline is answered 503, saying so.
+TEST(ViewServer, AFitPastItsDeadlineIsAnswered503) {
+  ApiConfig c = config();
+  c.compute_seconds = 0.5;
+  Api api(c);
+  Server server(api, 2);
+  const int port = server.bind("127.0.0.1", 0);
+  std::thread thread([&] { server.run(); });
+  const auto t0 = std::chrono::steady_clock::now();
+  const int fd = send_get(port, kLongFit);
+  ASSERT_GE(fd, 0);
+  EXPECT_EQ(status_line(fd, 5), "HTTP/1.1 503 Service Unavailable");
+  EXPECT_LT(seconds_since(t0), 2.0);
+  ::close(fd);
+  server.stop();
+  thread.join();
+}
+
+// stop() ends a server whatever it computes: the fit gives up, the connections close, run()
+// returns at once.
+TEST(ViewServer, StopEndsALongFitAtOnce) {
+  auto s = std::make_unique<Running>();
+  const int fd = send_get(s->port, kLongFit);
+  ASSERT_GE(fd, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto t0 = std::chrono::steady_clock::now();
+  s.reset();  // stop() and join the serving thread
+  EXPECT_LT(seconds_since(t0), 2.0);
+  char buf[256];
+  pollfd p{fd, POLLIN, 0};
+  EXPECT_EQ(::poll(&p, 1, 1000), 1);  // the connection ended
+  (void)!::read(fd, buf, sizeof buf);
+  ::close(fd);
+}
+
+// A burst of connections (as many as a few pages open) is answered at once: none waits for
 // the kernel to set it up again after dropping it from a full queue of unaccepted connections.
 TEST(ViewServer, ABurstOfConnectionsIsAnsweredAtOnce) {
   Running s;
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<int> burst;
-  for (int k = 0; k < kConnectionsPerClient - 2; ++k) {
+  for (int k = 0; k < 30; ++k) {
     const int fd = connect_to(s.port);
     ASSERT_GE(fd, 0);
     const std::string request = info_request(s.port);
@@ -222,7 +327,9 @@ TEST(ViewServer, AClientThatStopsReadingIsDropped) {
       "\r\nConnection: close\r\n\r\n";
   ASSERT_EQ(::write(fds[0], request.data(), request.size()), ssize_t(request.size()));
   const auto t0 = std::chrono::steady_clock::now();
-  while (!served && seconds_since(t0) < kResponseWriteSeconds + 3)
+  // The slices take seconds to compute under ASan on a loaded machine: wait for the write
+  // timeout after them, not from the request.
+  while (!served && seconds_since(t0) < kResponseWriteSeconds + 60)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_TRUE(served) << "the server still writes to a client that stopped reading";
   EXPECT_GT(seconds_since(t0), 1.0);  // the write timeout (5 s without progress), or the deadline

@@ -216,7 +216,7 @@ def test_bad_grids_and_render_settings_raise():
         halfback.hemisphere("hybrid", 0.1, pixels=1)
 
 
-# Issue 12, classes 8 and 10: the same rules as the command line.
+# docs/reliability/python.md: the same rules as the command line.
 
 def test_albedo_of_a_non_finite_angle_raises():
     b = halfback.load("lambert:albedo=0.25")
@@ -242,7 +242,7 @@ def test_isotropic_needs_a_parameterization_on_one_side():
 
 
 def test_slice_azimuths_wrap_into_0_2pi_and_nan_raises():
-    # Radians, as every angle of the Python API (issue 35, class D).
+    # Radians, as every angle of the Python API (docs/reliability/python.md).
     b = halfback.load("ggx:alpha=0.3")
     ref = b.resample("hybrid", "slice", 12, azimuth=1.5 * np.pi)
     assert ref["valid"].any()
@@ -264,8 +264,9 @@ def test_an_all_invalid_table_warns():
 
 
 def test_eval_normalizes_near_unit_directions_as_convert_does():
-    # Issue 35, class A: the CLI's rule (accept_pair) in Python: a grazing mirror pair with
-    # |wi| = 1 + 4e-7 gives the unit pair's rho (GGX alpha = 0.001: the mirror peak, 2.4e8).
+    # docs/reliability/numerics.md: the CLI's rule (accept_pair) in Python: a grazing
+    # mirror pair with |wi| = 1 + 4e-7 gives the unit pair's rho (GGX alpha = 0.001: the mirror
+    # peak, 2.4e8).
     t = np.radians(89.0)
     wi = np.array([[np.sin(t), 0.0, np.cos(t)]])
     wo = np.array([[-np.sin(t), 0.0, np.cos(t)]])
@@ -277,7 +278,8 @@ def test_eval_normalizes_near_unit_directions_as_convert_does():
 
 
 def test_all_nan_rows_evaluate_to_nan():
-    # Issue 35, class D: a row of NaN is answered NaN, as a row with one NaN (not 0, 0, 0).
+    # docs/reliability/python.md: a row of NaN is answered NaN, as a row with one NaN
+    # (not 0, 0, 0).
     b = halfback.load("ggx:alpha=0.2")
     pairs = np.array([[np.nan] * 6, [0, 0, 1, 0, 0, 1], [np.inf, 0, 0, 0, 0, 1]])
     rho = b.eval(pairs)
@@ -285,8 +287,9 @@ def test_all_nan_rows_evaluate_to_nan():
 
 
 def test_albedo_takes_radians_in_its_range():
-    # Issue 35, class D: albedo(30.0), degrees by mistake, and negative angles gave plausible
-    # numbers; every angle of the Python API is in radians, checked against its range.
+    # docs/reliability/python.md: albedo(30.0), degrees by mistake, and negative angles
+    # gave plausible numbers; every angle of the Python API is in radians, checked against its
+    # range.
     b = halfback.load("lambert:albedo=0.5")
     (mean, _) = b.albedo(np.radians(30.0), 16)
     assert mean[0] == pytest.approx(0.5, rel=1e-12)
@@ -296,8 +299,8 @@ def test_albedo_takes_radians_in_its_range():
 
 
 def test_a_new_users_conveniences():
-    # Issue 35: __version__; models() with parameters; a Brdf pickles (Dask ships objects) and
-    # compares by its spec, a file by its absolute path.
+    # A new user's rough edges (docs/reliability/python.md): __version__; models() with parameters;
+    # a Brdf pickles (Dask ships objects) and compares by its spec, a file by its absolute path.
     assert halfback.__version__.count(".") == 2
     ggx = halfback.models()["ggx"]
     alpha = next(p for p in ggx["params"] if p["name"] == "alpha")

@@ -227,8 +227,8 @@ def test_parameterizations_describe_every_space_and_the_stubs_name_them():
 
 
 def test_out_overlapping_the_input_gives_the_separate_result():
-    # Issue 35, class D: out sharing x's memory (one row ahead, strides swapped) gave errors up
-    # to 6; x is copied first, so every layout gives the result of a separate out.
+    # docs/reliability/python.md: out sharing x's memory (one row ahead, strides swapped)
+    # gave errors up to 6; x is copied first, so every layout gives the result of a separate out.
     from numpy.lib.stride_tricks import as_strided
 
     rng = np.random.default_rng(7)

@@ -24,6 +24,23 @@ def test_fit_recovers_a_lambert_plus_ggx_sum_and_its_spec_loads():
     assert halfback.fit(halfback.load("ggx:alpha=0.3"), "ggx", samples=500)["spec"].startswith("ggx:")
 
 
+def test_fit_reports_dead_lobes_inert_parameters_and_the_turned_layout():
+    # A Lambert term fitted to a GGX lobe ends at albedo 0: a dead lobe (docs/fit.md, "Dead lobes").
+    r = halfback.fit("ggx:alpha=0.2,f0=0.5", "lambert+ggx", samples=1000, threads=1)
+    assert [t["model"] for t in r["terms"]] == ["lambert", "ggx"]
+    assert [t["dead"] for t in r["terms"]] == [True, False]
+    assert sum(t["albedo_share"] for t in r["terms"]) == pytest.approx(1, abs=1e-12)
+    assert r["terms"][1]["loss_without"] > r["loss_value"]
+    # f0 has no effect under the exact Fresnel factor: not fitted.
+    r = halfback.fit("ggx:alpha=0.2,f0=0.5", "ggx:eta=1.5", samples=500)
+    assert not any(p["fitted"] for p in r["parameters"] if p["name"].startswith("f0"))
+    # A lobe that can be anisotropic: the turned layout, and fit_loss measures it there too.
+    r = halfback.fit("ggx:alpha=0.2,f0=0.5", "ggx:alpha_x=0.1", samples=500)
+    assert r["layout"] == "halfdiff-halton-turned"
+    assert halfback.fit_loss("ggx:alpha=0.2,f0=0.5", r["spec"], samples=500) == pytest.approx(
+        r["loss_value"], rel=1e-12)
+
+
 def test_fit_errors():
     with pytest.raises(ValueError, match="phong"):
         halfback.fit("ggx", "phong", samples=500)
@@ -101,6 +118,24 @@ def test_published_fits_as_specs(tmp_path):
         halfback.published_fits(f)
 
 
+def test_published_fits_name_a_character_that_is_not_ascii(tmp_path):
+    # The message quoted the first byte of "é" alone: not UTF-8, so the RuntimeError had no text.
+    f = tmp_path / "x.fit"
+    f.write_text("matériau = NganWard(albedo = 0.1)\n", encoding="utf-8")
+    with pytest.raises(RuntimeError, match="line 1, column 4: expected '=', found 'é'"):
+        halfback.published_fits(f)
+
+
+def test_fit_samples_have_the_cli_bound():
+    # One bound (fit/sample_limit.hpp) for the CLI's --samples and every Python entry point: above
+    # it, ValueError before any work (10**8 pairs would need some 50 GB).
+    for call in (lambda: halfback.fit("lambert", "lambert", samples=10**8),
+                 lambda: halfback.fit_loss("lambert", "lambert", samples=10**8),
+                 lambda: halfback.fit_samples(10**8)):
+        with pytest.raises(ValueError, match="expected 1 to 10000000 sample pairs"):
+            call()
+
+
 def test_plan_and_reconstruct(tmp_path):
     p = halfback.plan("halfdiff", budget=400, max_theta=85)
     rows = p["positions_deg"].shape[0]
@@ -118,6 +153,11 @@ def test_plan_and_reconstruct(tmp_path):
     assert halfback.reconstruct(tmp_path / "p.json", values[:, 1], tmp_path / "g.bsdf").spec.endswith("g.bsdf")
     with pytest.raises(ValueError, match="expected"):
         halfback.reconstruct(p["sidecar"], values[:5], tmp_path / "x.binary")
+    negative = values.copy()
+    negative[3] = [0.1, -0.5, 0.1]  # a reflectance is not negative: refused, naming the row
+    with pytest.raises(ValueError, match="row 3"):
+        halfback.reconstruct(p["sidecar"], negative, tmp_path / "n.binary")
+    assert not (tmp_path / "n.binary").exists()
     with pytest.raises(ValueError, match="design 'sobol'"):
         halfback.plan(design="sobol")
     # The sample-turning instrument: the same rows, its motors; the tilt is θi.
@@ -183,5 +223,31 @@ def test_emit_errors_point_to_export_rgl():
         halfback.emit("ward", "mitsuba3")
     with pytest.raises(ValueError, match="Trowbridge-Reitz"):
         halfback.emit("beckmann", "pbrt-v4")
-    with pytest.raises(ValueError, match="target 'blender'"):
-        halfback.emit("ggx", "blender")
+    with pytest.raises(ValueError, match="target 'cycles'"):
+        halfback.emit("ggx", "cycles")
+
+
+def test_missing_and_out_of_reach_samples_are_left_out_and_counted():
+    import math
+    truth = "lambert:albedo=0.3+ggx:alpha=0.2,f0=0.6"
+    r = halfback.fit(truth, "lambert+ggx", samples=3000, max_theta=math.radians(60))
+    assert r["out_of_reach"] > 500 and r["missing"] == 0
+    assert r["samples"] + r["out_of_reach"] == 3000
+    alpha = [p["value"] for p in r["parameters"] if p["name"] == "alpha"][0]
+    assert abs(alpha - 0.2) < 1e-4
+    with pytest.raises(ValueError, match="max_theta"):
+        halfback.fit(truth, "ggx", max_theta=60)  # degrees by mistake: radians expected
+
+
+def test_fit_under_a_published_loss_from_given_starts():
+    # A published loss (docs/fit.md, "Published losses") is measured on BBM's grid; starts given
+    # are the only starts.
+    target = "lambert:albedo=0.2+beckmann:alpha=0.3,f0=0.5"
+    r = halfback.fit(target, "lambert+beckmann", "bbm-low-e2",
+                     starts=["lambert+beckmann:alpha=0.15"], max_iterations=50)
+    assert r["layout"] == "bbm-grid" and r["starts"] == 1
+    assert r["loss_value"] < 1e-8  # the target is in the model
+    assert r["loss_value"] == pytest.approx(halfback.fit_loss(target, r["spec"], "bbm-low-e2"),
+                                            rel=1e-9, abs=1e-15)
+    with pytest.raises(ValueError, match="max_iterations"):
+        halfback.fit(target, "lambert", max_iterations=0)

@@ -89,6 +89,20 @@ def test_params_choose_the_parameterizations():
         halfback.study_brdf("lambert", {"params": ["nope"]})
 
 
+def test_metrics_and_their_options_are_settings_keys():
+    # The keys of the metrics come from the study's list of metrics: "metrics", no_NAME and each
+    # metric's options, typed by its kind.
+    d = halfback.study_brdf("lambert", {"params": ["halfdiff"], "quick": True, "metrics": ["fit"],
+                                        "fit_samples": 1000, "fit_budgets": [300]})
+    assert len(d["fit"].splitlines()) == 1 + 2 * 2  # two designs, two weightings
+    assert len(d["sampling"].splitlines()) == 1  # the header only: not run
+    assert "\nfit_budgets = 300\nfit_samples = 1000\n" in d["settings"]
+    with pytest.raises(ValueError, match="unknown key 'no_metric'.*no_sampling.*fit_budgets"):
+        halfback.study_brdf("lambert", {"no_metric": True})
+    with pytest.raises(ValueError, match=r"settings\['fit_budgets'\]"):
+        halfback.study_brdf("lambert", {"fit_budgets": "many"})
+
+
 def test_functions_travel_to_other_processes():
     # Engines pickle the task's function to send it to worker processes (a real cluster): by
     # name, so these are the same functions on arrival (a pybind11 built-in does not pickle).
@@ -180,8 +194,9 @@ def test_learned_design_on_dask_equals_the_cli_run(tmp_path):
 
 
 def test_study_brdf_defaults_work_alone():
-    # Issue 35 (a new user's first call): without profiles the default designs leave out the
-    # learned one (it needs the other BRDFs' profiles); asked for by name, it still needs them.
+    # A new user's first call (docs/reliability/python.md): without profiles the default designs
+    # leave out the learned one (it needs the other BRDFs' profiles); asked for by name, it still
+    # needs them.
     r = halfback.study_brdf("ggx:alpha=0.2", {"quick": True, "no_images": True})
     assert "designs = own,angle,merl" in r["settings"]
     with pytest.raises(ValueError, match="learned design needs"):

@@ -175,3 +175,38 @@ def test_the_study_gives_the_numbers_of_the_same_map_in_cpp(py_hybrid):
     for table in ("azimuthal", "gonio"):
         t = rows(table)
         assert np.allclose(t["py-hybrid"], t["hybrid"], rtol=1e-6), (table, t)
+
+
+def test_results_are_checked_at_every_call_after_registration():
+    # A map that passes the checks at registration and goes wrong later (state, or a region the
+    # checks did not sample) is refused at the call that shows it: an inverse returning |wi| = 1.5
+    # was reported valid (and resampled through), a forward returning inf passed through convert.
+    wrong = {"on": False}
+
+    def forward(wi, wo):
+        q = hybrid_forward(wi, wo)
+        if wrong["on"]:
+            q[:, 0] = np.inf
+        return q
+
+    def inverse(q):
+        wi, wo = hybrid_inverse(q)
+        return (1.5 * wi, wo) if wrong["on"] else (wi, wo)
+
+    p = halfback.Parameterization("py-goes-wrong", forward, inverse, AXES,
+                                  jacobian=hybrid_jacobian)
+    halfback.register_parameterization(p, pairs=3000, box_samples=50000)
+    x = random_dirs(100)
+    q = halfback.convert(x, "dirs", "py-goes-wrong")
+    assert np.isfinite(q).all()
+    wrong["on"] = True
+    with pytest.raises(ValueError, match="py-goes-wrong: inverse returned a pair that is not valid"
+                       r".*\|wi\| = 1\.5"):
+        halfback.convert(q, "py-goes-wrong", "dirs")
+    with pytest.raises(ValueError, match="py-goes-wrong: forward returned coordinates that are "
+                       "not finite, \\(inf"):
+        halfback.convert(x, "dirs", "py-goes-wrong")
+    with pytest.raises(ValueError, match="py-goes-wrong: inverse returned"):
+        halfback.load("ggx:alpha=0.3").resample("py-goes-wrong", kind="isotropic", size=4)
+    wrong["on"] = False
+    assert np.allclose(halfback.convert(q, "py-goes-wrong", "dirs")[:, :6], x, atol=1e-9)

@@ -1,5 +1,5 @@
 // Peak heap allocation through operator new, for the tests that a reader validates a file before
-// allocating from the sizes it declares (docs/reliability-readers.md, class 4). Only the test
+// allocating from the sizes it declares (docs/reliability/readers.md). Only the test
 // binaries that compile tests/support/allocation_probe.cpp (which replaces the global operator
 // new and delete) may include this header.
 #pragma once

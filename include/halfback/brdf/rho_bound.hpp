@@ -1,4 +1,4 @@
-// The one bound on a BRDF's value (docs/reliability-round3-readers.md, class B).
+// The one bound on a BRDF's value (docs/reliability/readers.md, "One bound on a BRDF's value").
 //
 // ρ above kMaxRho is a corrupt file or a diverging network, never a measurement: a perfect mirror
 // averaged over MERL's smallest bin is about 2·10⁶ sr⁻¹, and the sharpest published RGL material

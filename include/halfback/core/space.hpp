@@ -125,10 +125,10 @@ std::string_view describe(PairStatus status);
 
 // The one rule for a pair a user gives (eval, convert, Python, the explorer): check_pair()'s
 // status, and an accepted pair (ok) put onto the unit upper hemisphere as the conversions do
-// (docs/reliability-bounds.md, class 9): a direction unit to rounding is kept bit for bit, one
-// within kUnitTolerance of unit length is divided by its norm (a z below the horizon within
-// tolerance put onto it first). A pair with another status is left as it is: the caller refuses
-// it (not finite, not unit) or answers it (below the horizon: ρ = 0).
+// (docs/reliability/numerics.md, "Every accepted direction pair round-trips"): a direction unit to
+// rounding is kept bit for bit, one within kUnitTolerance of unit length is divided by its norm (a
+// z below the horizon within tolerance put onto it first). A pair with another status is left as it
+// is: the caller refuses it (not finite, not unit) or answers it (below the horizon: ρ = 0).
 PairStatus accept_pair(DirPair<double>& pair);
 
 }  // namespace halfback

@@ -24,6 +24,12 @@ std::uint8_t to_byte(double v);
 // (checked once against matplotlib's table; render_test.cpp checks five anchors).
 Color viridis(double t);
 
+// A diverging map for signed values, t in [0, 1] (clamped; NaN gives NaN components): blue at 0,
+// white at 0.5, red at 1, the display values interpolated linearly on each half. The end colours
+// are those of Moreland's cool-warm map (2009), without its interpolation in Msh space: a map of
+// ours, for residuals (figure/compare.hpp), where 0.5 is "no difference".
+Color diverging(double t);
+
 // The paper's colouring of a pair of coordinates: u (the first, normalized to [0, 1]) in red,
 // v (the second) in green, no blue. Values outside [0, 1] are clamped.
 Color coordinate_colour(double u, double v);

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
@@ -76,5 +77,8 @@ SliceFigure slice_figure(const SliceOptions& options);
 // Log-spaced isoline levels (log10 values) in (lo, hi): decades, or 1-2-5 steps, or 1-…-9 steps,
 // whichever gives the most levels not above max_count.
 std::vector<double> log_levels(double lo, double hi, std::size_t max_count);
+
+// A tick label of a log10 value: "10^{−2}", or "2·10^{−2}" off the decades (scene markup).
+std::string power_of_ten_label(double log10_value);
 
 }  // namespace halfback::figure

@@ -1,4 +1,4 @@
-// A data-driven factored model of a BRDF in a parameterization (issue 37, item 7; docs/fit.md,
+// A data-driven factored model of a BRDF in a parameterization (docs/fit.md,
 // "Factored models"): the FactoredModel (formats/factored.hpp) of `rank` separable terms in
 // log(1 + ρ) that is closest to the BRDF in the μ-weighted L² norm on the cell centres of the
 // parameterization's isotropic grid, dμ = cos θi cos θo dωi dωo (the study's measure).

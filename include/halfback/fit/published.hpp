@@ -15,7 +15,8 @@ namespace halfback::fit {
 
 struct PublishedLobe {
   std::string model;  // "Lambertian", "NganCookTorrance", ...
-  // Each value: one number, or several ("[r, g, b]").
+  // Each value: one number, or several ("[r, g, b]"; a list of lists, "[[r, g, b], [r, g, b]]",
+  // row by row).
   std::vector<std::pair<std::string, std::vector<double>>> params;
 };
 

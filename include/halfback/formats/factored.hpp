@@ -1,4 +1,4 @@
-// A data-driven factored BRDF (issue 37, item 7; docs/fit.md, "Factored models"): on the
+// A data-driven factored BRDF (docs/fit.md, "Factored models"): on the
 // isotropic coordinates (a, b, φ) of a parameterization, each colour channel is
 //   ρ_c(a, b, φ) = exp( clamp(Σ_r f_cr(a) g_cr(b) h_cr(φ), 0, M_c) ) − 1,
 // a sum of `rank` separable terms in log(1 + ρ) space, each factor tabulated at the cell centres

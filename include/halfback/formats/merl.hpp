@@ -157,13 +157,18 @@ class MerlBrdf final : public Brdf {
 std::shared_ptr<const MerlBrdf> load_merl(const std::filesystem::path& path,
                                           MerlOptions options = {});
 
-// Tabulates any BRDF at the bin centres (merl::bin_centre, at φh = 0: the canonical pose of the
-// isotropic halfdiff form) and writes a MERL file: value / scale per channel, so that reading it
-// back gives ρ at every bin centre up to the rounding of the division. Bins whose centre is not a
-// valid configuration (a direction below the horizon) and non-finite values of ρ are written as
-// -1 (unmeasured). Writes to a temporary file in the same directory and renames it into place, so
-// that no partial file is left on error. Throws FormatError on I/O errors, std::invalid_argument
-// for an anisotropic BRDF (a MERL file is isotropic; its φh = 0 slice would pass for the whole).
+// Where a bin's value is tabulated (at φh = 0: the canonical pose of the isotropic halfdiff
+// form): its centre (merl::bin_centre) when that is a valid configuration; else a valid point of
+// the bin (merl.cpp says which), so that every bin a valid pair can be looked up in has a value;
+// nullopt for a bin that holds no valid pair.
+std::optional<DirPair<double>> merl_bin_pair(int theta_h, int theta_d, int phi_d);
+
+// Tabulates any BRDF at merl_bin_pair of every bin and writes a MERL file: value / scale per
+// channel, so that reading it back gives ρ at those pairs up to the rounding of the division.
+// Bins that hold no valid pair and non-finite values of ρ are written as -1 (unmeasured). Writes to
+// a temporary file in the same directory and renames it into place, so that no partial file is left
+// on error. Throws FormatError on I/O errors, std::invalid_argument for an anisotropic BRDF (a MERL
+// file is isotropic; its φh = 0 slice would pass for the whole).
 void write_merl(const std::filesystem::path& path, const Brdf& brdf);
 // The same, tabulated in memory (the file's content as MerlData, without sha256).
 MerlData tabulate_merl(const Brdf& brdf);

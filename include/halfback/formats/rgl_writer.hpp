@@ -4,8 +4,8 @@
 // material and Mitsuba 3's spectral variants, or both in one file). The microfacet distribution is
 // recovered from the BRDF's backscattering by power iteration (Dupuy, Heitz, Iehl, Poulin &
 // Ostromoukhov 2015); the visible-normal distributions and their warps follow from it, and the RGB
-// and luminance tables are ρ sampled through the warps. docs/formats.md ("RGL writer") derives
-// every field.
+// and luminance tables are ρ averaged (or sampled) through the warps. docs/formats.md ("RGL
+// writer") derives every field.
 #pragma once
 
 #include <cstddef>
@@ -26,12 +26,25 @@ namespace halfback {
 // take a file with `wavelengths` for a spectral one).
 enum class RglVariant { rgb, spectral, both };
 
+// Where the incident elevations are: `sigma`, evenly spaced in σ from 0 to 90° (the published
+// files' layout, and Dupuy & Jakob's acquisition); `albedo`, half of them (rounded up) so and the
+// others, one at a time, where linear interpolation in θi predicts the BRDF's directional albedo
+// worst (docs/formats.md, "Energy").
+enum class RglIncidences { albedo, sigma };
+// What a node of the colour and luminance tables holds: `hat_average`, the average of the stored
+// quantity over the node's bilinear hat function in the warped square, which keeps each slice's
+// directional albedo exactly (up to the midpoint rule on 12 × 12 points a cell); `point`, its value
+// at the node, as an instrument measures it (the study's acquisition, its samplers).
+enum class RglTabulation { hat_average, point };
+
 struct RglExportOptions {
-  int theta_i = 8;            // incident elevations, 0 to 90°, evenly spaced in σ (as published)
+  int theta_i = 16;           // incident elevations, 0 to 90°, placed by `incidences`
   int resolution = 32;        // luminance and RGB tables: resolution × resolution samples
   int vndf_resolution = 128;  // the VNDF tables (N × N) and the NDF and σ tables (2 × N)
   std::string description;    // the `description` field; empty: says what the source was
   RglVariant variant = RglVariant::rgb;
+  RglIncidences incidences = RglIncidences::albedo;
+  RglTabulation tabulation = RglTabulation::hat_average;
   int threads = 0;  // parallel_for's convention: 0 all cores, 1 the calling thread
   // Called after each incidence slice is tabulated (from the calling thread), e.g. for a
   // progress display.

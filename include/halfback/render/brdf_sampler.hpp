@@ -28,7 +28,7 @@ struct TabulationOptions {
   // The parameterization whose sampler chart (params/charts.hpp: the 2D chart of ωi, for a fixed
   // ωo, of its first two coordinates) the tabulated sampler's cells live in. halfdiff's
   // half-vector chart: the lowest variance per byte of table on every material measured
-  // (docs/render.md, "Comparing samplers"; issue 36).
+  // (docs/render.md, "Comparing samplers").
   Space param = space_of<HalfDiff>;
   // The radial coordinate (θi, θh or ‖h̄‖) as r = r_max s², s uniform over the cells: cells are
   // finer near the lobe's peak (the normal for spherical, the mirror direction for the others).

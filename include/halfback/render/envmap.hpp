@@ -101,6 +101,12 @@ class EnvMap {
   // lookup() of each direction, equal to it (throws std::invalid_argument when the sizes differ).
   void lookup(std::span<const Vec3<double>> dirs, bool compensated, std::span<Lookup> out) const;
 
+  // The share of the map's power (luminance × solid angle) that compensated sampling leaves to
+  // the BRDF sampler: Σ min(L, L̄) ω / Σ L ω, L̄ the solid-angle mean of the luminance. 1 for a
+  // constant (or black) map, small for a dark map with bright lights (the exposure does not
+  // change it).
+  double residual_fraction() const { return residual_; }
+
   int width() const { return width_; }
   int height() const { return height_; }
   const std::string& name() const { return name_; }
@@ -146,6 +152,7 @@ class EnvMap {
   void column_sincos(std::size_t col, double t, double& sin_phi, double& cos_phi) const;
   Distribution2D distribution_, compensated_;
   std::size_t noise_clamped_ = 0;
+  double residual_ = 1;
 };
 
 // An environment as figures and reports use it: a map shared by the renderings that light with

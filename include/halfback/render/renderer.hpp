@@ -36,18 +36,27 @@ std::optional<Strategy> strategy_from_name(std::string_view name);
 enum class Heuristic { balance, power };
 // How render() samples a BRDF that has no sampler of its own (docs/render.md, "Choosing the BRDF
 // sampler"): its tabulated sampler (settings.tabulation), the cosine-weighted hemisphere, or
-// (automatic) the table for a peaked BRDF and the cosine for a broad one. Peaked: the cosine's
-// relative variance of the directional-albedo estimator (render::measure_sampling at 8 ωo,
-// kChoiceSamples each, the render's seed) is at least kPeakedRatio times the table's. Equal-time
-// renderings under four environments found the cosine better on broad lobes (its samples cost
-// half as much, and scrambled Sobol points stay stratified through its smooth map) and the
-// table on peaked ones (docs/performance.md). The choice depends on the BRDF and the settings
-// only, not on timings, so the image stays a function of the settings. The env strategy (which
-// draws no BRDF sample) keeps the table.
+// (automatic) the one that suits the BRDF under the environment:
+// - the table when the cosine misses energy: the table's directional-albedo estimate (summed
+//   over the ωo of render::measure_sampling, kChoiceSamples each, the render's seed) is
+//   significantly above the cosine's (a near-delta lobe the cosine's samples never reach);
+// - else the table when the BRDF is peaked for this environment: the cosine's relative variance
+//   of the albedo estimator is at least peaked_ratio(env) times the table's;
+// - else the cosine.
+// Equal-time renderings found the cosine better on broad lobes (its samples cost half as much,
+// and scrambled Sobol points stay stratified through its smooth map) and the table on peaked
+// ones, the crossing later the less of its light an environment leaves to the BRDF sampler
+// (EnvMap::residual_fraction: a dark studio's lights are the environment sampler's). The choice
+// depends on the BRDF, the environment and the settings only, not on timings, so the image stays
+// a function of the settings. The env strategy (which draws no BRDF sample) keeps the table.
 enum class BrdfSampling { automatic, table, cosine };
 // "auto", "table" or "cosine"; nullopt for another name.
 std::optional<BrdfSampling> brdf_sampling_from_name(std::string_view name);
-inline constexpr double kPeakedRatio = 300;
+// peaked_ratio(env) = kPeakedRatio / max(r, kMinResidual)^kResidualExponent, r =
+// env.residual_fraction(): 150 under a constant environment, 445 under the built-in sky, 1490
+// under the studio, 1060 under uffizi.hdr.
+inline constexpr double kPeakedRatio = 150, kResidualExponent = 1.5, kMinResidual = 0.1;
+double peaked_ratio(const EnvMap& env);
 inline constexpr std::size_t kChoiceSamples = 2048;
 enum class Sequence { sobol, random };  // scrambled Sobol (0,2) points per pixel, or independent
 
@@ -97,15 +106,19 @@ struct RenderResult {
   std::string sampler;  // which BRDF sampler was used (and why, when render() chose it)
 };
 
-// The BRDF as render() samples it under `settings` (brdf_sampling, tabulation, threads, the time
-// budget of the table's build): the BRDF itself when it has a sampler of its own, else its table
-// or the cosine; `why` is empty, or says what was measured when the choice was automatic. The BRDF
-// must outlive the result. Throws TimeBudgetExceeded as render() does.
+// The BRDF as render() samples it under `env` and `settings` (brdf_sampling, tabulation, threads,
+// the time budget of the table's build): the BRDF itself when it has a sampler of its own, else its
+// table or the cosine; `why` is empty, or says what was measured when the choice was automatic. The
+// BRDF must outlive the result. Throws TimeBudgetExceeded as render() does.
 struct ChosenSampler {
   std::shared_ptr<const Brdf> brdf;
   std::string why;
   double albedo_variance_ratio = NAN;  // the cosine's ÷ the table's, when measured
+  double threshold = NAN;              // peaked_ratio(env), when measured
 };
+ChosenSampler choose_brdf_sampler(const Brdf& brdf, const EnvMap& env,
+                                  const RenderSettings& settings);
+// The choice under the built-in sky (render's default environment), for a caller that has none.
 ChosenSampler choose_brdf_sampler(const Brdf& brdf, const RenderSettings& settings);
 
 // The image's relative variance per pixel sample, in luminance: Σ variance × spp / Σ mean² over

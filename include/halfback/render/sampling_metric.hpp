@@ -1,4 +1,4 @@
-// How well a sampler importance-samples a BRDF (issue 36; docs/render.md, "Comparing samplers"):
+// How well a sampler importance-samples a BRDF (docs/render.md, "Comparing samplers"):
 // the variance of the one-sample estimator of the directional albedo, f = ρ(ωi, ωo) cos θi /
 // p(ωi | ωo) with ωi drawn by the sampler, over a set of ωo covering the hemisphere, grazing
 // included, and the time per sample; efficiency = 1 / (variance × time per sample), reported

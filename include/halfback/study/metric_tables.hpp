@@ -3,9 +3,8 @@
 // follows: part files, Python's dicts, the CSV files and merges. Every table's first column is
 // "parameterization"; a BRDF's table holds the rows of each parameterization together.
 //
-// A new metric: its table's file in src/study/ (table_NAME.cpp: its columns, how its records
-// become rows and back), its declarations below, its entry in study_tables(), its computation
-// in study_brdf() and its section of the report.
+// The tables come from the list of metrics (metric.hpp): each metric says which tables it has.
+// The tables below are those of the first metrics; a metric's table may as well be in its file.
 #pragma once
 
 #include <span>
@@ -24,9 +23,9 @@ struct TableDef {
   void (*derive)(const BrdfResult& result, MetricTable& into) = nullptr;
 };
 
-// Every table, in the order of the CSV files: azimuthal, separability, gonio, budget, image,
-// sampling, fit.
-std::span<const TableDef> study_tables();
+// Every table of every metric of study_metrics(), in the order of the CSV files: azimuthal,
+// separability, gonio, budget, image, sampling, fit, then those of metrics registered later.
+std::vector<TableDef> study_tables();
 // The stored tables (those of study_tables() that are not derived), without rows, in order.
 std::vector<MetricTable> stored_tables();
 
@@ -55,8 +54,8 @@ std::vector<GonioPoint> gonio_points(const BrdfResult& result, Space space, int 
 struct GonioCurve {
   std::vector<double> samples, errors;
 };
-GonioCurve gonio_curve(const std::vector<GonioPoint>& points, Design layout,
-                       Spacing spacing = Spacing::own);
+GonioCurve gonio_curve(const std::vector<GonioPoint>& points, acquire::Design layout,
+                       acquire::Spacing spacing = acquire::Spacing::own);
 
 // budget (derived from gonio): the measurements each design needs to reach the target errors.
 inline constexpr double kTargetErrors[] = {0.05, 0.02, 0.01};
@@ -74,12 +73,5 @@ MetricTable sampling_table();
 void add_sampling(MetricTable& table, Space space, const SamplingPoint& point);
 std::vector<SamplingPoint> sampling_points(const BrdfResult& result, Space space,
                                            std::string_view sampler = "tabulated");
-
-// fit: a model fitted to the measurements of each design (isotropic form, own spacing) against
-// the same model fitted to the whole BRDF; excess = layout_loss / whole_loss − 1 (derived when
-// the row is added).
-MetricTable fit_table();
-void add_fit(MetricTable& table, Space space, const FitPoint& point);
-std::vector<FitPoint> fit_points(const BrdfResult& result, Space space);
 
 }  // namespace halfback::study

@@ -1,69 +1,22 @@
-// The quantitative comparison of the parameterizations (issue 6; docs/study.md): metrics of how
+// The quantitative comparison of the parameterizations (docs/study.md): metrics of how
 // well a BRDF is represented in each parameterization, all computed under one measure on the
 // space of direction pairs, so that the parameterizations are compared on the same footing.
 //
-// Measure: dμ = cos θi cos θo dωi dωo (the projected solid angles: the weight of a pair in
-// rendering), written in each parameterization's isotropic coordinates (a, b, φ) with the core's
-// Jacobian, dωi dωo = J₃(a, b, φ) da db dφ (batch.hpp, jacobian of an isotropic form).
-// Values: the luminance Y = 0.2126 r + 0.7152 g + 0.0722 b of ρ, in an error space T
-// (docs/study.md, "Error spaces"): linear (Y), log (ln(1 + Y)), cube root (Y^⅓), or two published
-// ones that also see the pair's cosines:
-//   nielsen  ln(1 + Y c / ε), c = max(cos θi cos θo, 0.01), ε = 0.001: a difference of two values
-//            is Nielsen et al. 2015's log-relative mapping ln((Y c + ε)/(Y_ref c + ε)) (the clamp
-//            of c and ε are those of their code release);
-//   low      ln(1 + Y cos θi): the cosine-weighted log of Löw et al. 2012.
-// Quadrature: the midpoint rule on a regular grid of cell centres of (a, b, φ) over the ranges of
-// resample.hpp's default grids; cells outside the domain have weight 0.
+// The BRDF is sampled under the measure dμ = cos θi cos θo dωi dωo, in an error space, by
+// acquire/samples.hpp.
 #pragma once
 
-#include <array>
-#include <cstddef>
-#include <optional>
-#include <span>
-#include <string_view>
 #include <vector>
 
-#include "halfback/brdf/brdf.hpp"
-#include "halfback/core/space.hpp"
+#include "halfback/acquire/samples.hpp"
 
 namespace halfback::study {
-
-enum class ErrorSpace { linear, log, cbrt, nielsen, low };
-inline constexpr std::array<ErrorSpace, 5> kErrorSpaces{
-    ErrorSpace::linear, ErrorSpace::log, ErrorSpace::cbrt, ErrorSpace::nielsen, ErrorSpace::low};
-std::string_view name_of(ErrorSpace s);
-std::optional<ErrorSpace> parse_error_space(std::string_view name);
-
-// The value every metric compares: the luminance of ρ (Rgb::luminance) at a pair whose
-// directions have the cosines cos_i = cos θi and cos_o = cos θo, mapped to the error space.
-double to_error_space(double luminance, ErrorSpace es, double cos_i, double cos_o);
-
-struct IsoGrid {
-  std::size_t a = 64, b = 64, phi = 64;  // cells of the two magnitudes and of the azimuth
-};
-
-// An isotropic BRDF sampled on the isotropic grid of one parameterization.
-struct IsoSamples {
-  Space space = space_of<Hybrid>;
-  IsoGrid grid;
-  std::vector<double> value;  // a.b.phi values (φ fastest) in the error space; 0 where invalid
-  std::vector<double> weight;  // dμ of each cell: J₃ cos θi cos θo Δa Δb Δφ; 0 where invalid
-  double total_weight() const;
-};
-
-// Throws std::invalid_argument for Space::dirs or an empty grid.
-IsoSamples sample_isotropic(const Brdf& brdf, Space space, const IsoGrid& grid, ErrorSpace es);
-// The same from values measured at the cells' centres (values[p] at cell p, in the grid's order, φ
-// fastest): a value that is not finite is no measurement (weight 0). Throws std::invalid_argument
-// for an empty grid or a count of values other than its cells'.
-IsoSamples isotropic_samples_of(std::span<const Rgb> values, Space space, const IsoGrid& grid,
-                                ErrorSpace es);
 
 // Azimuthal dependence: the relative error of replacing the BRDF by its μ-weighted average over
 // the relative azimuth φ of the parameterization, ρ̄(a, b) = ∫ρ dμ(φ | a, b):
 //   E = ( ∫ (ρ − ρ̄)² dμ / ∫ ρ² dμ )^½.
 // 0 when the BRDF depends on (a, b) only; how "2D" the BRDF is in this parameterization.
-double azimuthal_error(const IsoSamples& s);
+double azimuthal_error(const acquire::IsoSamples& s);
 
 // Separability, relative errors of the best rank-r approximations (r = each of `ranks`) in the
 // μ-weighted L² norm, E_r = min ( Σ w (M − U Vᵀ)² / Σ w M² )^½ over U, V of r columns (weighted
@@ -71,26 +24,15 @@ double azimuthal_error(const IsoSamples& s);
 //   of the 2D projection ρ̄(a, b) (weights ∫dμ over φ), a matrix over a × b;
 //   of the 3D table unfolded along its azimuth, a matrix over (a, b) × φ.
 // A table of rank r on the domain has E_r = 0 whatever the domain's shape.
-std::vector<double> separability_2d(const IsoSamples& s, const std::vector<int>& ranks);
-std::vector<double> separability_unfolded(const IsoSamples& s, const std::vector<int>& ranks);
+std::vector<double> separability_2d(const acquire::IsoSamples& s, const std::vector<int>& ranks);
+std::vector<double> separability_unfolded(const acquire::IsoSamples& s,
+                                          const std::vector<int>& ranks);
 
-// The 4D versions, for anisotropic BRDFs: the BRDF on a grid of cell centres of the full form
-// (a, φa, b, φb) of a parameterization — (θh, φh, θd, φd), (‖h̄‖, φh, ‖k̄‖, φk), (‖h̄‖, φh, ‖k‖, φk)
-// or (θi, φi, θo, φo) — with dμ = J₄ cos θi cos θo da dφa db dφb (the core's 4D Jacobian).
-struct FullSamples {
-  Space space = space_of<Hybrid>;
-  std::array<std::size_t, 4> counts{16, 32, 16, 32};  // cells of a, φa, b, φb
-  std::vector<double> value;   // row-major (φb fastest), in the error space; 0 where invalid
-  std::vector<double> weight;  // dμ of each cell; 0 where invalid
-  double total_weight() const;
-};
-FullSamples sample_full(const Brdf& brdf, Space space, const std::array<std::size_t, 4>& counts,
-                        ErrorSpace es);
 // Azimuthal dependence in 4D: the error of replacing ρ by its μ-weighted mean over the second
 // azimuth φb (φd, φk or φo) at fixed (a, φa, b), Stark's reduction applied to anisotropic data.
-double azimuthal_error(const FullSamples& s);
+double azimuthal_error(const acquire::FullSamples& s);
 // Separability in 4D: the best rank-r approximations of the table unfolded as (a, φa) × (b, φb),
 // e.g. a function of the half vector times a function of the difference vector in halfdiff.
-std::vector<double> separability_4d(const FullSamples& s, const std::vector<int>& ranks);
+std::vector<double> separability_4d(const acquire::FullSamples& s, const std::vector<int>& ranks);
 
 }  // namespace halfback::study

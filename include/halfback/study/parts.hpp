@@ -1,4 +1,4 @@
-// The study as independent per-BRDF parts (issue 14; docs/study.md, "Running on whole databases"
+// The study as independent per-BRDF parts (docs/study.md, "Running on whole databases"
 // and "Scaling out"): the settings of a run as typed options (the CLI's and Python's), one BRDF's
 // result as tables of CSV text that round-trip exactly, the part files a run writes one BRDF at a
 // time (so that --resume continues an interrupted run) and their merge into one report.
@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "halfback/study/design.hpp"
+#include "halfback/acquire/design.hpp"
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
 
@@ -27,15 +27,15 @@ struct StudySettings {
   std::string space = "log";  // --error-space: parse_error_space()
   // --designs: parse_spacing() names. `learned` needs the profiles of the study's BRDFs (below).
   std::vector<std::string> designs{"own", "angle", "merl", "learned"};
-  bool quick = false, no_gonio = false, no_images = false, no_sampling = false;
-  // --sampler-kib: the sampling metric's table sizes (KiB); empty: the default (64, 1024).
-  std::vector<std::size_t> sampler_kib;
-  std::size_t sampler_samples = 0;  // per outgoing direction; 0: the default
-  // The fit metric (StudyConfig::fit_model, ...): --fit-model (empty: the default), --fit-loss,
-  // --fit-budgets (empty: the default), --no-fit.
-  std::string fit_model, fit_loss;
-  std::vector<std::size_t> fit_budgets;
-  bool no_fit = false;
+  bool quick = false;
+  // --metrics: the metrics to run (metric.hpp's names); empty: those on by default. Metrics that
+  // cannot be turned off (azimuthal, separability) run whether listed or not.
+  std::vector<std::string> metrics;
+  // --no-NAME: metrics not to run (of those --metrics or the defaults name).
+  std::vector<std::string> off;
+  // The metrics' options given (MetricOption::key -> text, e.g. fit_budgets -> "1000,3000");
+  // those not given take their default (or --quick's).
+  std::map<std::string, std::string> options;
   // --nielsen-counts (empty: the default); the database itself is StudyConfig::nielsen.
   std::vector<std::size_t> nielsen_counts;
   std::vector<std::size_t> budgets, budgets_4d;
@@ -60,7 +60,7 @@ bool wants_learned(const StudyConfig& config);
 // fingerprint of the whole list, which describe_config() records.
 struct LabeledProfile {
   std::string label;  // study_label() of the BRDF
-  DesignProfile profile;
+  acquire::DesignProfile profile;
 };
 LabeledProfile study_profile(const Brdf& brdf, const std::string& label, const StudyConfig& config);
 std::string profile_text(const LabeledProfile& profile);

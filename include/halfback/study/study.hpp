@@ -1,4 +1,4 @@
-// The study of one BRDF in every parameterization (issue 6; docs/study.md): the metrics of
+// The study of one BRDF in every parameterization (docs/study.md): the metrics of
 // metrics.hpp, the virtual gonio-reflectometer of gonio.hpp and the image-space error of its
 // reconstructions (image_metrics.hpp), as one table per metric (metric_tables.hpp). report.hpp
 // writes the results of a set of BRDFs.
@@ -8,20 +8,22 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "halfback/acquire/gonio.hpp"
+#include "halfback/acquire/nielsen.hpp"
 #include "halfback/brdf/brdf.hpp"
 #include "halfback/core/space.hpp"
 #include "halfback/render/envmap.hpp"
 #include "halfback/render/image.hpp"
-#include "halfback/study/gonio.hpp"
+#include "halfback/render/renderer.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metrics.hpp"
-#include "halfback/study/nielsen.hpp"
 #include "halfback/study/table.hpp"
 
 namespace halfback::study {
@@ -32,23 +34,27 @@ namespace halfback::study {
 // ortho, hybrid, rectified-hybrid, ..., spherical.
 std::vector<Space> default_studied();
 
-// Stated maxima of a study's work (StudyConfig::validate refuses more): a budget's tables and the
-// test pairs take tens of bytes per sample, so these keep one study within a few GB and hours.
-inline constexpr std::size_t kMaxSampleBudget = 10'000'000;         // 10x the default largest (4D)
+// Stated maxima of a study's work (StudyConfig::validate refuses more; the sample budget's,
+// acquire::kMaxSampleBudget, is a plan's too): a budget's tables and the test pairs take tens of
+// bytes per sample, so these keep one study within a few GB and hours.
 inline constexpr std::size_t kMaxTestPairs = 10'000'000;            // 50x the default
 inline constexpr std::size_t kMaxGridCells = std::size_t(1) << 24;  // metrics 1-2, either form
 inline constexpr std::size_t kMaxImageSize = 4096;                  // pixels a side, metric 4
 inline constexpr std::size_t kMaxSamplerKib = 256 * 1024;           // a table of metric 5
 inline constexpr std::size_t kMaxSamplerSamples = 1 << 20;          // per ωo, metric 5
 
+// Every option of every metric of study_metrics() with its default value (metric.hpp), but the
+// first option of a metric not on by default, which is empty (the metric off).
+std::map<std::string, std::string> default_metric_options();
+
 struct StudyConfig {
   // The parameterizations compared, in the order of every table's rows and the report's columns.
   std::vector<Space> params = default_studied();
-  ErrorSpace space = ErrorSpace::log;
+  acquire::ErrorSpace space = acquire::ErrorSpace::log;
   // Made smaller by --quick (parts.hpp, apply_quick): the report says so (its headline can differ
   // from a full run's).
   bool quick = false;
-  IsoGrid grid{64, 64, 64};                              // metrics 1-2, isotropic form
+  acquire::IsoGrid grid{64, 64, 64};                     // metrics 1-2, isotropic form
   std::array<std::size_t, 4> full_grid{16, 32, 16, 32};  // metrics 1-2, full form (anisotropic)
   std::vector<int> ranks{1, 2, 4, 8};
   // Metric 3: budgets of the 3D (isotropic form) and 4D (full form, anisotropic BRDFs only)
@@ -67,38 +73,30 @@ struct StudyConfig {
   std::vector<render::Environment> environments;  // empty: no image-space error
   std::size_t image_budget = 10000;
   int image_size = 96, image_spp = 16;
-  // Designs (design.hpp; issue 14): the spacings of the gonio-reflectometer's cells. The own
+  // Designs (design.hpp): the spacings of the gonio-reflectometer's cells. The own
   // spacing runs in both layouts (regular and stratified), the others in the regular layout only;
   // a spacing identical to own for a parameterization (angle in halfdiff) copies its results.
   // The learned spacing uses the warps in `learned` (learn_warps(), leave-one-out: set them for
   // each BRDF from the profiles of the others, taken on `profile_grid`); a parameterization
   // without learned warps has no learned rows.
-  std::vector<Spacing> spacings{Spacing::own, Spacing::angle, Spacing::merl, Spacing::learned};
-  std::vector<LearnedWarps> learned;
-  IsoGrid profile_grid{32, 32, 32};
+  std::vector<acquire::Spacing> spacings{acquire::Spacing::own, acquire::Spacing::angle,
+                                         acquire::Spacing::merl, acquire::Spacing::learned};
+  std::vector<acquire::LearnedWarps> learned;
+  acquire::IsoGrid profile_grid{32, 32, 32};
   // A fingerprint of the profiles the learned warps come from (parts.hpp: learned_fingerprint),
   // empty without them: part of the settings of a run, so that parts learned from other BRDFs
   // are never resumed or merged with these.
   std::string learned_from;
-  // Metric 5 (issue 36): the tabulated importance sampler of the BRDF in each parameterization's
-  // chart, tables of each of these sizes (KiB; empty: no sampling metric), measured by
-  // render::measure_sampling with `sampler_samples` samples per ωo.
-  std::vector<std::size_t> sampler_kib{64, 1024};
-  std::size_t sampler_samples = 4096;
-  // Metric 6 (issue 37): `fit_model` (empty: no fit metric) fitted under `fit_loss` (fit.hpp's
-  // names) to the measurements of the isotropic gonio-reflectometer's designs (own spacing) at
-  // each of `fit_budgets` (ascending), under both FitWeights, and to the whole BRDF on fit()'s
-  // layout of `fit_samples` pairs; isotropic BRDFs only.
-  std::string fit_model = "lambert+ggx";
-  std::string fit_loss = "ngan";
-  std::vector<std::size_t> fit_budgets{1000, 10000};
-  std::size_t fit_samples = 20000;
-  // Nielsen et al. 2015's minimal sampling (nielsen.hpp; issue 33), with a database (none: no
+  // The options of the metrics (metric.hpp: MetricOption), as text by key ("fit_model"), e.g.
+  // the sampling metric's sampler_kib and the fit metric's fit_model: every option of every
+  // metric of study_metrics(), a metric that is off with its first option empty.
+  std::map<std::string, std::string> options = default_metric_options();
+  // Nielsen et al. 2015's minimal sampling (nielsen.hpp), with a database (none: no
   // rows): rows of halfdiff's gonio table, design nielsen, at each of `nielsen_counts`
   // measurements (ascending), isotropic BRDFs only, from the basis without the database's member
   // like the BRDF (leave-one-out). `nielsen_from` names the database (nielsen_fingerprint) in the
   // settings of a run, so that parts from other databases are never resumed or merged with these.
-  std::shared_ptr<const NielsenDatabase> nielsen;
+  std::shared_ptr<const acquire::NielsenDatabase> nielsen;
   std::vector<std::size_t> nielsen_counts{1, 2, 5, 10, 20, 40, 100};
   std::string nielsen_from;
   // Called from worker threads as stages finish (e.g. "gonio hybrid"): for progress displays.
@@ -108,18 +106,20 @@ struct StudyConfig {
   // unsorted budgets, an image budget that is not one of them, sizes of 0). No budgets: no
   // gonio-reflectometer and no images.
   void validate() const;
+  // The option of that key; std::logic_error when no metric has it (a bug).
+  const std::string& option(const std::string& key) const;
 };
 
 // The typed records of the gonio and image tables' rows (metric_tables.hpp).
 struct GonioPoint {
-  Design design = Design::regular;  // the layout
+  acquire::Design design = acquire::Design::regular;  // the layout
   std::size_t budget = 0, samples = 0;
   double error = 0;
-  Spacing spacing = Spacing::own;
+  acquire::Spacing spacing = acquire::Spacing::own;
 };
 
 struct ImagePoint {
-  Design design = Design::regular;
+  acquire::Design design = acquire::Design::regular;
   std::size_t samples = 0;
   std::string environment;
   double relative_rmse = 0, mean_delta_e = 0, p95_delta_e = 0;
@@ -145,8 +145,9 @@ struct SamplingPoint {
   // both 0 where there is none (an anisotropic BRDF, one the export refuses, or no size that fits).
   double vndf_warp_kib = 0, efficiency_vs_vndf_warp = 0;
   // The fitted-mixture sampler (Sztrajman et al. 2021 sample their neural BRDFs through fitted
-  // analytic lobes): config.fit_model fitted to the whole BRDF, sampled as the mixture of its
-  // lobes' own samplers; this table's efficiency against it, 0 where there is no fit.
+  // analytic lobes): the fit metric's model (option fit_model) fitted to the whole BRDF, sampled as
+  // the mixture of its lobes' own samplers; this table's efficiency against it, 0 where there is no
+  // fit.
   double efficiency_vs_fitted_mixture = 0;
   // The sphere of the image protocol (under the study's first environment) rendered with this
   // sampler's samples alone and with MIS (one environment and one BRDF sample): the image's
@@ -155,28 +156,6 @@ struct SamplingPoint {
   // against the same strategy with cosine sampling.
   double pixel_relative_variance_brdf = 0, pixel_relative_variance_mis = 0;
   double pixel_efficiency_vs_cosine_brdf = 0, pixel_efficiency_vs_cosine_mis = 0;
-};
-
-// A row of the fit table (metric 6, issue 37): `model` fitted under `loss` to the `samples`
-// measurements of a design at `budget`, and to the whole BRDF (fit()'s layout): both fits' losses
-// on the whole BRDF's layout, and the largest relative change of a shape parameter (not a colour
-// channel) between them.
-// How the fit weights a design's measurements: each 1 (as a laboratory fits its data; the design's
-// density then weights the loss), or by the solid angle dωi dωo of its cell (so that the loss
-// estimates the same integral as the whole fit's).
-enum class FitWeights { uniform, solid_angle };
-inline constexpr std::array<FitWeights, 2> kFitWeights{FitWeights::uniform,
-                                                       FitWeights::solid_angle};
-std::string_view name_of(FitWeights w);  // "uniform", "solid-angle"
-std::optional<FitWeights> parse_fit_weights(std::string_view name);
-
-struct FitPoint {
-  Design design = Design::regular;
-  std::size_t budget = 0, samples = 0;
-  FitWeights weights = FitWeights::uniform;
-  std::string model, loss;
-  double whole_loss = 0, layout_loss = 0, shape_change = 0;
-  std::string spec;  // the layout's fit
 };
 
 struct BrdfResult {
@@ -198,6 +177,10 @@ struct BrdfResult {
 // Every metric of `brdf` in every parameterization of config.params (one task each; the
 // renderings then use all cores). Throws what the metrics throw.
 BrdfResult study_brdf(const Brdf& brdf, const std::string& label, const StudyConfig& config);
+
+// The render settings of the study's image protocol: config.image_size, image_spp and seed,
+// environment sampling only (the same light directions for every BRDF).
+render::RenderSettings image_settings(const StudyConfig& config);
 
 // The image-space error of `test` against `reference` under `env` with the study's image
 // protocol (config.image_size, image_spp and seed; environment sampling, so both are evaluated at

@@ -1,4 +1,5 @@
-// Reading input files within bounds (docs/reliability-round3-readers.md, class C).
+// Reading input files within bounds (docs/reliability/readers.md, "A reader reads what the file's
+// header declares, and nothing more").
 //
 // The rule for every reader: learn the file's size before anything else, read the header, work
 // out from it the size the file must have, refuse a file of any other size (truncated, or

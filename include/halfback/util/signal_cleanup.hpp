@@ -28,6 +28,12 @@ void install_temporary_cleanup_handlers();
 
 // Registers a temporary file (made absolute, so that a later chdir does not matter). Returns a
 // slot to unregister, or -1 when the table is full or the path too long (see above).
+// Ignores SIGXFSZ, so that a write beyond the file size limit (ulimit -f, RLIMIT_FSIZE) fails
+// with EFBIG, which AtomicFile reports as an error ("File too large") after removing its
+// temporary, instead of killing the process with no message and the temporary left behind.
+// Programs call it at the start of main() (Python's interpreter ignores SIGXFSZ itself).
+void ignore_file_size_signal();
+
 int register_temporary(const std::filesystem::path& path) noexcept;
 
 // Forgets a slot returned by register_temporary (-1 is ignored). Call it after the file has been

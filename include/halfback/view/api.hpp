@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -33,19 +34,34 @@ inline constexpr std::size_t kMaxPolarSamples = 2001;  // polar plot samples per
 // `halfback info --albedo-samples`): at the limits 181 × 256² ≈ 12 M evaluations a request.
 inline constexpr std::size_t kMaxAlbedoAngles = 181, kMaxAlbedoSamples = 256;
 // A fit (/api/fit): at most this many sample pairs (about 1 s for an embedded material, 6 starts),
-// and one fit at a time in the server (a second one is answered 503 while the first runs).
+// at most kMaxFitTermSamples terms × samples (a sum's cost grows with its terms), and one fit at a
+// time in the server (a second one is answered 503 while the first runs).
 inline constexpr std::size_t kMaxFitSamples = 20000;
+inline constexpr std::size_t kMaxFitTermSamples = 4 * kMaxFitSamples;
+// The deadline of one request's computation (ApiConfig::compute_seconds): a fit, the fields of a
+// slices or albedo request and a render give up past it (503), and as soon as their client leaves
+// or the server stops (Request::abandoned, Api::stop).
+inline constexpr double kComputeSeconds = 60;
 inline constexpr int kMaxRenderSide = 512;             // sphere render side
 inline constexpr int kMaxRenderSpp = 64;               // samples per pixel of one pass
 inline constexpr std::size_t kMaxBrdfsPerRequest = 8;  // brdf= repeated in /api/point
 inline constexpr std::size_t kMaxBrdfsPerSlices = 2;   // brdf= repeated in /api/slices
 inline constexpr std::size_t kMaxCachedBrdfs = 32;     // loaded BRDFs kept (least recent dropped)
+// A /api/slices answer: at most the bytes of 8 RGB fields of 512² (25 MB, 24 MiB): BRDFs × forms
+// × n² × channels × 4 above it is a 400.
+inline constexpr std::size_t kMaxSlicesBytes = 8 * 512 * 512 * 3 * sizeof(float);
+// Parameterizations built for requests (dupuy-jakob:BRDF, never registered): at most this many
+// kept (least recent dropped), and named by one request.
+inline constexpr std::size_t kMaxCachedForms = 4;
 
 struct Request {
   std::string method = "GET";
   std::string path = "/";
   std::vector<std::pair<std::string, std::string>> query;  // decoded, in order (keys may repeat)
   std::map<std::string, std::string> headers;              // names in lower case
+  // Whether the answer is no longer wanted (its client left): polled by long computations, which
+  // then give up. Empty: wanted until the computation's deadline.
+  std::function<bool()> abandoned;
 
   // The first value of a query key, or nullptr.
   const std::string* param(std::string_view key) const;
@@ -67,6 +83,7 @@ struct ApiConfig {
   std::vector<std::string> specs;            // the BRDFs named on the command line, in order
   std::vector<std::filesystem::path> roots;  // directories whose files may be loaded
   int threads = 0;                           // as in core/parallel.hpp
+  double compute_seconds = kComputeSeconds;  // the deadline of one request's computation
 };
 
 // A fresh token: 128 random bits (std::random_device) as 32 hexadecimal digits.
@@ -85,6 +102,9 @@ class Api {
 
   // Sets the port once the server knows it (port 0 picks one when binding).
   void set_port(int port);
+  // The server stops: every computation in progress gives up at its next poll, and every request
+  // from now on is answered 503. Thread-safe; for Server::stop().
+  void stop();
   const ApiConfig& config() const;
   // Loads every BRDF of config().specs (they are then cached). Throws, the message naming the
   // spec: std::invalid_argument for a spec that names nothing or holds a bad value (load_brdf's),
@@ -98,8 +118,9 @@ class Api {
   // socket adapter and the fuzzer call. A malformed query is a 400; so is a Host, Origin or
   // Cookie header given twice (which one would the checks read?).
   using RawHeaders = std::vector<std::pair<std::string, std::string>>;
-  Response handle_target(std::string method, std::string_view target,
-                         const RawHeaders& headers) const;
+  // `abandoned` becomes the Request's.
+  Response handle_target(std::string method, std::string_view target, const RawHeaders& headers,
+                         std::function<bool()> abandoned = {}) const;
 
  private:
   struct State;

@@ -2,6 +2,7 @@
 // server.cpp alone) that hands every request to an Api and writes its response back.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -17,9 +18,10 @@ inline constexpr double kRequestHeadSeconds = 4;
 // a response is written within kResponseWriteSeconds of its first byte (the largest, 12 MB of
 // slices, takes milliseconds on loopback): a client that reads slower is dropped;
 inline constexpr double kResponseWriteSeconds = 10;
-// one client address holds at most kConnectionsPerClient connections at once: another is
-// answered 503 and closed at once.
-inline constexpr int kConnectionsPerClient = 32;
+// at most kMaxConnections connections are open at once, whatever their address: a new one at
+// that bound closes the connection that has waited longest for a request head (idle, or
+// trickling one in); when every connection is being answered, the new one is answered 503.
+inline constexpr std::size_t kMaxConnections = 128;
 
 class Server {
  public:
@@ -35,7 +37,9 @@ class Server {
   int bind(const std::string& host, int port);
   // Serves until stop() (returns false when the listening loop fails).
   bool run();
-  // Stops run() from another thread.
+  // Stops run() from another thread: every computation in progress gives up (Api::stop), every
+  // connection is shut down, and run() returns once their threads end (at once but for a
+  // computation that polls no deadline: a single slice, hemisphere or point-light field).
   void stop();
   // Serves one connected socket on the calling thread, as run() serves an accepted connection
   // (its requests, with every limit above), and closes it; after bind(), without run(). For the

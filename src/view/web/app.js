@@ -10,7 +10,7 @@ const $ = (id) => document.getElementById(id);
 const DEG = Math.PI / 180;
 // One colour per BRDF shown, in the order of loaded(): the first, the compare one, the others.
 const COLOURS = ['#ff9a3c', '#3cc8ff', '#9be37a', '#e879f9', '#f7d154', '#ff6b6b', '#a0a4ff', '#5eead4'];
-const MAX_MORE = COLOURS.length - 2;  // BRDFs added beside the first and the compare one
+const MAX_MORE = COLOURS.length - 1;  // BRDFs added beside the first (with the compare one: 8 in all)
 const DRAG = 128;  // slice resolution (at most) while dragging; at rest: the side on screen
 // The slices' side on screen (CSS pixels): as large as the panel allows with at least 256 px and
 // at most 480 px each; their resolution at rest is that side in device pixels (at most 512).
@@ -34,6 +34,7 @@ const state = {
   hemi: 'rho', env: 'sky', exposure: 0, polar: 'linear', pose: 0, lobe: 'rho', lobeScale: 'linear',
   more: [],  // further BRDFs, drawn in the plots (not in the slices, which show one or a pair)
 };
+const MODES = { b: 'the second', diff: 'the difference', ratio: 'the ratio' };
 let info = null;
 let cursor = null;      // the last /api/point answer
 let pinned = false;
@@ -44,13 +45,16 @@ const pending = new Set();
 const stats = { updates: 0, lastUpdateMs: 0, sliceDraws: 0 };
 
 // --- state <-> URL ------------------------------------------------------------------------
+// Whether the fragment names BRDFs (else the command line's are shown).
 function readHash() {
   const h = new URLSearchParams(location.hash.slice(1));
+  const named = ['a', 'b', 'more'].some((k) => h.has(k));
   for (const k of Object.keys(state)) {
     if (!h.has(k)) continue;
     if (Array.isArray(state[k])) state[k] = h.getAll(k).filter(Boolean).slice(0, MAX_MORE);
     else state[k] = typeof state[k] === 'number' ? Number(h.get(k)) : h.get(k);
   }
+  return named;
 }
 // At most ten writes a second (the last one always made): a moving slider sends ~60 input events
 // a second, and Chromium throttles history.replaceState (each one a message to the browser).
@@ -117,14 +121,28 @@ async function idle() {
   while (pending.size) await Promise.allSettled([...pending]);
 }
 const spheres = new Set();  // the progressive renders, apart: they run for seconds
-async function spheresDone() {
-  while (spheres.size) await Promise.allSettled([...spheres]);
+// Resolves when the progressive renders have ended or every sphere has drawn `passes` passes
+// (a layout test needs one), or after `seconds`; gives the fewest passes drawn.
+async function spheresDone(passes = PASSES, seconds = Infinity) {
+  const canvases = () => [...document.querySelectorAll('#spheres canvas[id^="sphere-"]')];
+  const fewest = () => Math.min(PASSES, ...canvases().map((c) => Number(c.dataset.passes || 0)));
+  const end = performance.now() + 1000 * seconds;
+  while (spheres.size && fewest() < passes && performance.now() < end)
+    await Promise.race([...spheres, new Promise((r) => setTimeout(r, 100))]);
+  return fewest();
 }
-window.halfback = { addBrdf, state, stats, idle, spheresDone, cursor: () => cursor, lobe: () => lobeData, albedo: () => albedoCurves };
+// Ends the progressive renders at the pass they are at (a measurement of the other views wants
+// the cores to itself); resolves when their last request has returned.
+async function stopSpheres() {
+  ++sphereGeneration;
+  await Promise.allSettled([...spheres]);
+}
+window.halfback = { addBrdf, state, stats, idle, spheresDone, stopSpheres, cursor: () => cursor, lobe: () => lobeData, albedo: () => albedoCurves };
 
 const specs = () => (state.b && state.mode !== 'a' ? [state.a, state.b] : [state.a]);
 const formInfo = (space) => info.forms.find((f) => f.space === space);
-const loaded = () => [state.a, state.b, ...state.more].filter(Boolean);  // every BRDF shown
+// Every BRDF shown (at most one per colour).
+const loaded = () => [state.a, state.b, ...state.more].filter(Boolean).slice(0, COLOURS.length);
 // style.css has the classes swatch-0 … swatch-7 in COLOURS (the page's policy forbids inline styles).
 const swatch = (b) => `<span class="swatch-${b}">■</span>`;
 
@@ -271,9 +289,10 @@ function showNumber(input, text) {
 }
 // A typed angle in [lo, hi] degrees, or null after saying in the status line what is wrong.
 function typedAngle(input, name, lo, hi) {
-  const v = input.value.trim() === '' ? NaN : Number(input.value);
+  const typed = input.value.trim();
+  const v = typed === '' ? NaN : Number(typed);
   if (Number.isFinite(v) && v >= lo && v <= hi) return v;
-  setStatus(`${name} must be a number of degrees in [${lo}, ${hi}], not '${input.value}'`, true);
+  setStatus(`${name} must be a number of degrees in [${lo}, ${hi}], ${typed === '' ? 'not empty' : `not '${typed}'`}`, true);
   return null;
 }
 function setupTypedAngles() {
@@ -305,29 +324,50 @@ function blackOutside(canvas) {  // the corners outside the disk
   ctx.restore();
 }
 function diskFromEvent(e) {
-  const r = e.target.getBoundingClientRect();
+  const r = $('hemisphere').getBoundingClientRect();
   return [2 * (e.clientX - r.left) / r.width - 1, 1 - 2 * (e.clientY - r.top) / r.height];
 }
-let dragging = false;
+// A press on the hemisphere becomes a drag (ωo follows the pointer, anywhere in the window) once
+// the pointer has moved 4 px; a press released before that is a click: it pins the hovered ωi
+// and leaves ωo where it was.
+let dragging = false, press = null, dragged = false;
+const DRAG_START = 4;
 function setupHemisphere() {
   const c = $('hemisphere');
-  c.addEventListener('mousedown', (e) => { dragging = true; moveWo(e); });
+  c.addEventListener('mousedown', (e) => {
+    if (e.button !== 0) return;
+    press = [e.clientX, e.clientY];
+    dragged = false;
+    e.preventDefault();  // no text selection while dragging
+    document.activeElement?.blur();  // a typed θo or φo is done (its field shows the drag)
+  });
+  window.addEventListener('mousemove', (e) => {
+    if (!press) return;
+    if (!dragging && Math.hypot(e.clientX - press[0], e.clientY - press[1]) < DRAG_START) return;
+    dragging = dragged = true;
+    moveWo(e);
+  });
   window.addEventListener('mouseup', () => {
+    press = null;
     if (!dragging) return;
     dragging = false;
     refineSoon();
   });
-  c.addEventListener('mousemove', (e) => {
-    if (dragging) moveWo(e);
-    else if (!pinned) hoverWi(e);
+  c.addEventListener('mousemove', (e) => { if (!press && !pinned) hoverWi(e); });
+  c.addEventListener('click', (e) => {
+    if (dragged) { dragged = false; return; }  // the end of a drag
+    pinned = !pinned;
+    hoverWi(e);
   });
-  c.addEventListener('click', (e) => { if (!dragging) { pinned = !pinned; hoverWi(e); } });
 }
+// ωo at the pointer; a pointer outside the disk puts it on the rim (θo = 89.9°) in its direction.
 function moveWo(e) {
-  const [u, v] = diskFromEvent(e);
+  let [u, v] = diskFromEvent(e);
+  const r = Math.hypot(u, v);
+  if (!(r <= 1)) { u /= r; v /= r; }
   const d = V.diskDirection(u, v);
   if (!d) return;
-  state.to = Math.acos(Math.min(1, d[2])) / DEG;
+  state.to = Math.min(89.9, Math.acos(Math.min(1, d[2])) / DEG);
   state.po = ((Math.atan2(d[1], d[0]) / DEG) + 360) % 360;
   interactive = true;
   changed({ slices: false, sphere: false });
@@ -371,7 +411,7 @@ let albedoCurves = [];  // per BRDF loaded: the /api/albedo answer
 const updateAlbedo = coalesced(async () => {
   const list = loaded();
   albedoCurves = await Promise.all(list.map((s) => getJson('albedo-' + s, '/api/albedo', [['brdf', s], ['n', 64]])));
-  V.drawAlbedo($('albedo'), albedoCurves, COLOURS, list.map(specLabel));
+  V.drawAlbedo($('albedo'), albedoCurves, COLOURS, list.map(specLabel), list.map(fullSpec));
 });
 
 // --- polar plot ------------------------------------------------------------------------------
@@ -382,14 +422,16 @@ const updatePolar = coalesced(async () => {
   drawPolar();
 });
 function drawPolar() {
-  V.drawPolar($('polar'), polarCurves, state.polar, COLOURS, polarCursorAngle(), loaded().map(specLabel));
+  V.drawPolar($('polar'), polarCurves, state.polar, COLOURS, polarCursorAngle(), loaded().map(specLabel), loaded().map(fullSpec));
 }
 function setupPolar() {
   const svg = $('polar');
   const pick = (e, click) => {
     if (pinned && !click) return;
     const r = svg.getBoundingClientRect();
-    const x = -1.15 + 2.3 * (e.clientX - r.left) / r.width, y = -1.15 + 1.35 * (e.clientY - r.top) / r.height;
+    const vb = svg.viewBox.baseVal;  // its height grows with the legend below the plot
+    const x = vb.x + vb.width * (e.clientX - r.left) / r.width, y = vb.y + vb.height * (e.clientY - r.top) / r.height;
+    if (y > 0) return;
     const t = Math.atan2(x, -y);
     if (Math.abs(t) > Math.PI / 2) return;
     if (click) pinned = !pinned;
@@ -414,7 +456,8 @@ function restartSphere() {
     const canvas = document.createElement('canvas');
     canvas.id = `sphere-${b}`;
     const cap = document.createElement('figcaption');
-    cap.innerHTML = `${swatch(b)} ${escapeHtml(specLabel(s))}, the environment`;
+    cap.innerHTML = `${swatch(b)}&nbsp;${escapeHtml(specLabel(s))}, the environment`;
+    cap.title = fullSpec(s);
     fig.append(canvas, cap);
     box.append(fig, pointLightFigure(s, b));
     const p = sphereLoop(gen, s, b, canvas).catch((e) => { if (!isAbort(e)) setStatus(e.message, true); })
@@ -446,7 +489,8 @@ function pointLightFigure(spec, b) {
   const canvas = Object.assign(document.createElement('canvas'), { id: `pointlight-${b}` });
   canvas.dataset.spec = spec;
   const cap = document.createElement('figcaption');
-  cap.innerHTML = `${swatch(b)} ${escapeHtml(specLabel(spec))}, a light from ωo`;
+  cap.innerHTML = `${swatch(b)}&nbsp;${escapeHtml(specLabel(spec))}, a light from ωo`;
+  cap.title = fullSpec(spec);
   fig.append(canvas, cap);
   return fig;
 }
@@ -494,7 +538,7 @@ function showCursor() {
   }
   html += heading('ρ', ['r', 'g', 'b'], ['sr⁻¹', 'sr⁻¹', 'sr⁻¹']);
   c.rho.forEach((r, b) => {
-    html += row(`${swatch(b)} ρ ${escapeHtml(specLabel(r.brdf))}`, ['r', 'g', 'b'], r.rgb, `rho-${b}`);
+    html += row(`<span title="${escapeHtml(fullSpec(r.brdf))}">${swatch(b)} ρ ${escapeHtml(specLabel(r.brdf))}</span>`, ['r', 'g', 'b'], r.rgb, `rho-${b}`);
   });
   $('cursor').innerHTML = `${html}</table>`;
 }
@@ -549,11 +593,34 @@ function polarCursorAngle() {
   return Math.atan2(c[0] * v.wi[0] + c[1] * v.wi[1], v.wi[2]) / DEG;
 }
 
-// What a user recognizes: a BRDF named on the command line by its spec, not by its "arg:N" id.
-function specLabel(spec) {
-  if (fitLabels.has(spec)) return fitLabels.get(spec);
+// A BRDF's whole spec: one named on the command line by what was given there, not its "arg:N".
+function fullSpec(spec) {
   const arg = /^arg:(\d+)$/.exec(spec);
   return arg && info && info.specs[Number(arg[1])] !== undefined ? info.specs[Number(arg[1])] : spec;
+}
+// What a legend says: the whole spec, but a file by its name alone (each term of a sum); the
+// whole spec is its title (on hover).
+function specLabel(spec) {
+  if (fitLabels.has(spec)) return fitLabels.get(spec);
+  const whole = fullSpec(spec);
+  const isFile = (t) => t.startsWith('file:') || /[/\\]/.test(t);
+  const short = (t) => (isFile(t) ? t.replace(/^file:/, '').split(/[/\\]/).pop() : t);
+  return sumTerms(whole).map(short).join('+');
+}
+// A spec typed in the load box, as the server reads it: a BRDF of the command line (as given
+// there) is arg:N; a path, relative to a --root, is file:PATH (an absolute one ending in a file
+// listed under a root is that file); models, embedded:NAME, file:PATH and arg:N stay as typed.
+function typedSpec(text) {
+  const given = info.specs.indexOf(text);
+  if (given >= 0) return `arg:${given}`;
+  if (info.files.includes(text)) return `file:${text}`;
+  const term = (t) => {
+    if (/^(arg|file|embedded):/.test(t) || info.models.some((m) => m.name === t.split(':')[0])) return t;
+    const listed = info.files.filter((f) => t === f || t.endsWith(`/${f}`)).sort((x, y) => y.length - x.length)[0];
+    if (listed) return `file:${listed}`;
+    return /[/\\]/.test(t) || /\.(bsdf|binary|h5|alta|txt)$/i.test(t) ? `file:${t}` : t;
+  };
+  return sumTerms(text).map(term).join('+');
 }
 
 // --- model sliders -----------------------------------------------------------------------------
@@ -622,6 +689,8 @@ function paramControl(term, t, p) {
   }
   input.dataset.param = p.name;
   input.dataset.term = t;
+  // Only a parameter the spec names, or the user moved, is written into the spec.
+  if (values[p.name] !== undefined) input.dataset.set = '1';
   // A parameter that defaults to another (alpha_x to alpha) follows it until it is moved.
   if (p.default_from && values[p.name] === undefined) input.dataset.follows = p.default_from;
   const out = document.createElement('output');
@@ -630,6 +699,7 @@ function paramControl(term, t, p) {
   input.out = out;
   input.addEventListener('input', () => {
     delete input.dataset.follows;  // moved by the user: it has its own value from now on
+    input.dataset.set = '1';
     if (input.map) {
       const value = input.map.fromSlider(input.value);
       out.textContent = Number(value).toPrecision(3);
@@ -655,17 +725,18 @@ function moveFollowers(t, name, value) {
   }
 }
 // Logarithmic over ranges of two decades or more (a roughness in [0.001, 10]: α = 0.2 at 58 % of
-// the track; from 0, over [0.001, max] with the first position 0, when max > 100), linear
-// otherwise (albedos, f0); a position is 0 … 1000.
+// the track), and over [0, max] with max ≥ 100, from 0 at the first position, then max / 10⁴ …
+// max (an index of refraction η or k in [0, 100]: η = 1.5 at 54 %), or 0.001 … max when max >
+// 100; linear otherwise (albedos, f0); a position is 0 … 1000.
 function sliderMap(p) {
   const lo = p.min, hi = p.max;
-  const log = lo > 0 ? hi / lo >= 100 : lo === 0 && hi > 100;
+  const log = lo > 0 ? hi / lo >= 100 : lo === 0 && hi >= 100;
   if (!log) {
     return { toSlider: (v) => 1000 * (v - lo) / (hi - lo), fromSlider: (s) => lo + (hi - lo) * s / 1000 };
   }
-  const floor = Math.max(lo, 1e-3), a = Math.log10(floor), b = Math.log10(hi);
+  const floor = lo > 0 ? lo : hi > 100 ? 1e-3 : hi * 1e-4, a = Math.log10(floor), b = Math.log10(hi);
   return {
-    toSlider: (v) => 1000 * (Math.log10(Math.min(Math.max(v, floor), hi)) - a) / (b - a),
+    toSlider: (v) => (lo === 0 && v <= 0 ? 0 : 1000 * (Math.log10(Math.min(Math.max(v, floor), hi)) - a) / (b - a)),
     fromSlider: (s) => (Number(s) === 0 ? lo : Math.min(hi, Math.pow(10, a + (b - a) * s / 1000))),
   };
 }
@@ -675,11 +746,11 @@ function sliderSpec() {
     if (!term.model) return term.fixed;
     const items = [];
     for (const input of document.querySelectorAll(`#sliders [data-term="${t}"][data-param]`)) {
-      if (input.dataset.follows) continue;
+      if (input.dataset.follows || !input.dataset.set) continue;
       const v = input.map ? Number(Number(input.map.fromSlider(input.value)).toPrecision(4)) : input.value;
       items.push(`${input.dataset.param}=${v}`);
     }
-    return `${term.model.name}:${items.join(',')}`;
+    return items.length ? `${term.model.name}:${items.join(',')}` : term.model.name;
   }).join('+');
 }
 
@@ -725,12 +796,16 @@ function refineSoon() {
 }
 
 function ensureOption(select, value, label) {
-  if (![...select.options].some((o) => o.value === value)) select.append(new Option(label || value, value));
+  if (![...select.options].some((o) => o.value === value)) {
+    const o = new Option(label || specLabel(value), value);
+    o.title = fullSpec(value);
+    select.append(o);
+  }
   select.value = value;
 }
 function fillSelects() {
   const groups = [
-    ['command line', info.specs.map((s, i) => [`arg:${i}`, s])],
+    ['command line', info.specs.map((s, i) => [`arg:${i}`, specLabel(`arg:${i}`), s])],
     ['models', info.models.map((m) => [m.name, m.name])],
     ['embedded', info.embedded.map((n) => [`embedded:${n}`, n])],
     ['files', info.files.map((f) => [`file:${f}`, f])],
@@ -741,7 +816,7 @@ function fillSelects() {
       if (!items.length) continue;
       const g = document.createElement('optgroup');
       g.label = title;
-      for (const [v, l] of items) g.append(new Option(l, v));
+      for (const [v, l, title] of items) g.append(Object.assign(new Option(l, v), { title: title || l }));
       sel.append(g);
     }
   }
@@ -774,15 +849,18 @@ function showMore() {
   state.more.forEach((spec, k) => {
     const chip = Object.assign(document.createElement('span'), { className: 'chip' });
     chip.innerHTML = `${swatch(loaded().indexOf(spec))} ${escapeHtml(specLabel(spec))}`;
+    chip.title = fullSpec(spec);
     const x = Object.assign(document.createElement('button'), { type: 'button', textContent: '×', title: 'remove from the plots' });
     x.addEventListener('click', () => { state.more.splice(k, 1); showMore(); changed(); });
     chip.append(x);
     box.append(chip);
   });
 }
-function addBrdf(spec) {
-  if (loaded().includes(spec)) return setStatus(`${spec} is already shown`);
-  if (state.more.length >= MAX_MORE) return setStatus(`at most ${COLOURS.length} BRDFs at once`, true);
+async function addBrdf(spec) {
+  if (loaded().includes(spec)) return setStatus(`${specLabel(spec)} is already shown`);
+  if (loaded().length >= COLOURS.length) {
+    return setStatus(`at most ${COLOURS.length} BRDFs at once (${loaded().length} shown: remove one first)`, true);
+  }
   return getJson(null, '/api/brdf', [['brdf', spec]]).then((r) => {
     state.more.push(spec);
     setStatus(`added ${r.name}`);
@@ -805,20 +883,31 @@ function setup() {
   $('brdf-b').addEventListener('change', (e) => {
     state.b = e.target.value;
     if (state.b && state.mode === 'a') { state.mode = 'diff'; $('mode').value = 'diff'; }
+    if (!state.b) { state.mode = 'a'; $('mode').value = 'a'; }
+    syncModes();
     changed();
   });
-  $('mode').addEventListener('change', (e) => { state.mode = e.target.value; changed({ sphere: false }); });
+  $('mode').addEventListener('change', (e) => {
+    if (e.target.value !== 'a' && !state.b) {  // nothing to compare with: say so, show the first
+      setStatus(`show ${MODES[e.target.value]}: choose a compare BRDF first`, true);
+      e.target.value = 'a';
+      return;
+    }
+    state.mode = e.target.value;
+    changed({ sphere: false });
+  });
   $('add-brdf').addEventListener('click', () => {
     const spec = $('load-spec').value.trim();
-    if (spec) addBrdf(spec);
+    if (spec) addBrdf(typedSpec(spec));
   });
   $('load-form').addEventListener('submit', (e) => {
     e.preventDefault();
-    const spec = $('load-spec').value.trim();
-    if (!spec) return;
+    const typed = $('load-spec').value.trim();
+    if (!typed) return;
+    const spec = typedSpec(typed);
     getJson(null, '/api/brdf', [['brdf', spec]]).then((r) => {
       state.a = spec;
-      ensureOption($('brdf-a'), spec, `${spec} (${r.name})`);
+      ensureOption($('brdf-a'), spec, `${specLabel(spec)} (${r.name})`);
       setStatus(`loaded ${r.name}`);
       changed({ sliders: true });
     }).catch((err) => setStatus(err.message, true));
@@ -873,6 +962,7 @@ async function runFit() {
     fitLabels.set(r.spec, `fit of ${specLabel(target)}: ${model} (${loss})`);
     state.b = r.spec;
     ensureOption($('brdf-b'), r.spec, fitLabels.get(r.spec));
+    syncModes();
     if (state.mode === 'a') { state.mode = 'diff'; $('mode').value = 'diff'; }
     showFit();
     setStatus(`fitted ${model} to ${specLabel(target)}: ${loss} loss ${r.loss.value.toPrecision(4)} in ${r.seconds.toFixed(2)} s`);
@@ -956,12 +1046,74 @@ function panelFigure(target) {
       if (!copy.getAttribute('viewBox')) copy.setAttribute('viewBox', `0 0 ${r.w} ${r.h}`);
       parts.push(new XMLSerializer().serializeToString(copy));
     } else if (!e.querySelector('svg, canvas')) {  // a text (a colour bar's box is drawn as its SVG)
-      parts.push(text(textOf(e).replace(/\s+/g, ' ').trim(), r.x, r.y + 12, e.tagName === 'H2' ? 13 : 11, e.tagName === 'H2' ? '#e6e6ea' : '#9a9cab'));
+      const h2 = e.tagName === 'H2', size = h2 ? 13 : 11;
+      // In lines within the element's width, as the page wraps it, swatches in their colours.
+      wrapRuns(runsOf(e, h2 ? '#e6e6ea' : '#9a9cab'), Math.max(r.w, 40), `${size}px sans-serif`).forEach((line, k) => {
+        const spans = line.map(([t, fill]) => `<tspan fill="${fill}">${esc(t)}</tspan>`).join('');
+        parts.push(`<text x="${r.x}" y="${r.y + 12 + k * (size + 3)}" font-family="sans-serif" font-size="${size}" xml:space="preserve">${spans}</text>`);
+      });
     }
   }
   const w = Math.ceil(Math.max(box.width, 16 + 7 * title.length)), h = Math.ceil(box.height + top);
   return { svg: `<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="${w}" height="${h}" viewBox="0 0 ${w} ${h}">`
     + `<rect width="${w}" height="${h}" fill="#202229"/>${parts.join('')}</svg>`, w, h };
+}
+// An element's text as runs [text, colour]: a swatch (class swatch-N) in its BRDF's colour.
+function runsOf(e, fill) {
+  const runs = [];
+  const walk = (n, colour) => {
+    if (n.nodeType === Node.TEXT_NODE || n.tagName === 'INPUT' || n.tagName === 'SELECT') {
+      runs.push([textOf(n), colour]);
+      return;
+    }
+    if (n.nodeType !== Node.ELEMENT_NODE) return;
+    const m = /(?:^|\s)swatch-(\d)(?:\s|$)/.exec(n.getAttribute('class') || '');
+    for (const c of n.childNodes) walk(c, m ? COLOURS[Number(m[1])] : colour);
+  };
+  walk(e, fill);
+  return runs;
+}
+// Runs laid out in lines of at most `width` pixels, as the page wraps them: at spaces (not at a
+// no-break space), a word wider than a line cut where the line ends (overflow-wrap: anywhere).
+let measurer = null;
+function wrapRuns(runs, width, font) {
+  measurer ||= document.createElement('canvas').getContext('2d');
+  measurer.font = font;
+  const m = (t) => measurer.measureText(t).width, gap = m(' ');
+  const words = [];  // [text, colour, a space before it]
+  let space = false;
+  for (const [t, colour] of runs) {
+    for (const piece of t.split(/([ \t\n\r]+)/)) {
+      if (!piece) continue;
+      if (/^[ \t\n\r]+$/.test(piece)) { space = words.length > 0; continue; }
+      words.push([piece.replace(/\u00a0/g, ' '), colour, space]);
+      space = false;
+    }
+  }
+  const lines = [];
+  let line = [], used = 0;
+  const put = (t, colour) => {
+    const last = line[line.length - 1];
+    if (last && last[1] === colour) last[0] += t; else line.push([t, colour]);
+    used += m(t);
+  };
+  const breakLine = () => { if (line.length) lines.push(line); line = []; used = 0; };
+  for (const [word, colour, before] of words) {
+    let w = word, sep = before && line.length > 0;
+    while (m(w) > width) {  // too wide for any line: fill this one with its beginning
+      const room = width - used - (sep ? gap : 0);
+      let n = w.length - 1;
+      while (n > 0 && m(w.slice(0, n)) > room) n -= 1;
+      if (n === 0 && !line.length) n = 1;
+      if (n > 0) { put((sep ? ' ' : '') + w.slice(0, n), colour); w = w.slice(n); }
+      breakLine();
+      sep = false;
+    }
+    if (line.length && used + (sep ? gap : 0) + m(w) > width) { breakLine(); sep = false; }
+    put((sep ? ' ' : '') + w, colour);
+  }
+  breakLine();
+  return lines;
 }
 // An element's text with the values of its fields (θo = 45.0°, not θo = °).
 function textOf(e) {
@@ -984,20 +1136,38 @@ function exportView(target, kind) {
 }
 window.halfback.figure = (target) => panelFigure(target).svg;
 
+// "show" offers the second, the difference and the ratio only with a compare BRDF.
+function syncModes() {
+  for (const o of $('mode').options) o.disabled = o.value !== 'a' && !state.b;
+}
+
 async function main() {
-  readHash();
+  const named = readHash();
   try {
     info = await getJson(null, '/api/info');
   } catch (e) {
     setStatus(e.message, true);
     return;
   }
-  if (!state.a) state.a = info.specs.length ? 'arg:0' : 'ggx:alpha=0.2';
-  if (!state.b && info.specs.length > 1 && !location.hash) state.b = '';
+  // Every BRDF of the command line is shown (unless the URL names others): the first, the second
+  // as the compare one, the others beside them in the plots.
+  let note = '';
+  if (!named && info.specs.length) {
+    state.a = 'arg:0';
+    state.b = info.specs.length > 1 ? 'arg:1' : '';
+    state.more = info.specs.slice(2, COLOURS.length).map((_, k) => `arg:${k + 2}`);
+    if (info.specs.length > COLOURS.length) note = `; ${info.specs.length} BRDFs given: the first ${COLOURS.length} are shown (one colour each)`;
+  }
+  if (!state.a) state.a = 'ggx:alpha=0.2';
+  if (state.mode !== 'a' && !state.b) {
+    note += `; show ${MODES[state.mode] || state.mode}: no compare BRDF, the first is shown`;
+    state.mode = 'a';
+  }
   fillSelects();
   ensureOption($('brdf-a'), state.a);
   if (state.b) ensureOption($('brdf-b'), state.b);
   $('mode').value = state.mode;
+  syncModes();
   $('azimuth').value = state.az;
   $('azimuth-value').value = state.az;
   $('pose').value = state.pose;
@@ -1015,6 +1185,6 @@ async function main() {
   setup();
   showMore();
   changed({ sliders: true });
-  setStatus('ready');
+  setStatus(`ready${note}`, Boolean(note));
 }
 main();

@@ -233,13 +233,39 @@ export function colourbarSvg(scale, unit, width = 256) {
   }
   svg.append(el('defs', {}), el('rect', { x: pad, y: 0, width, height: barH, fill: `url(#${id})` }));
   svg.firstChild.append(grad);
-  for (const tick of scaleTicks(scale)) {
+  for (const tick of spacedTicks(scale, width)) {
     const x = pad + width * (tick.t - scale.lo) / (scale.hi - scale.lo);
     svg.append(el('line', { x1: x, x2: x, y1: barH, y2: barH + 4, stroke: '#9a9cab' }));
-    svg.append(text(tick.label, { x, y: barH + 14, 'text-anchor': 'middle' }));
+    svg.append(text(tick.label, { x, y: barH + 14, 'text-anchor': 'middle', class: 'tick' }));
   }
   svg.append(text(unit, { x: pad, y: h - 3 }));
   return svg;
+}
+// The ticks of a colour bar `width` pixels wide whose labels (10 px) do not touch: the ones that
+// would are left out, the more important first kept — 0 and then the outer decades of a
+// difference (each ± pair kept or left out together), else from left to right.
+let measurer = null;
+function labelWidth(label) {
+  measurer ||= document.createElement('canvas').getContext('2d');
+  measurer.font = '10px system-ui, sans-serif';
+  return measurer.measureText(label).width;
+}
+export function spacedTicks(scale, width) {
+  const ticks = scaleTicks(scale).map((k) => ({ ...k, x: width * (k.t - scale.lo) / (scale.hi - scale.lo), w: labelWidth(k.label) }));
+  let groups = ticks.map((k) => [k]);
+  if (scale.diverge) {
+    const byMagnitude = new Map();
+    for (const k of ticks) {
+      const key = Math.abs(k.t).toFixed(9);
+      byMagnitude.set(key, [...(byMagnitude.get(key) || []), k]);
+    }
+    groups = [...byMagnitude.entries()].sort((p, q) => Number(p[0]) - Number(q[0]));
+    groups = [...groups.slice(0, 1), ...groups.slice(1).reverse()].map((e) => e[1]);
+  }
+  const kept = [], gap = 4;
+  const free = (k) => kept.every((q) => k.x + k.w / 2 + gap <= q.x - q.w / 2 || q.x + q.w / 2 + gap <= k.x - k.w / 2);
+  for (const g of groups) if (g.every(free)) kept.push(...g);
+  return kept.sort((p, q) => p.t - q.t);
 }
 function text(content, attrs) {
   const t = el('text', { fill: '#9a9cab', 'font-size': 10, 'font-family': 'system-ui, sans-serif', ...attrs });
@@ -324,9 +350,13 @@ function el(name, attrs) {
 }
 
 // The polar plot: per BRDF, ρ along the two curves as the radius (t from the vertical).
-export function drawPolar(svg, curves, kind, colours, cursor, names = []) {
+// The legend is below the plot, a row per BRDF (its title, on hover, the whole spec: titles).
+export function drawPolar(svg, curves, kind, colours, cursor, names = [], titles = names) {
   svg.replaceChildren();
-  svg.append(el('rect', { x: -1.15, y: -1.15, width: 2.3, height: 1.35, fill: '#111217' }));
+  const height = 1.35 + (names.length ? 0.05 + 0.08 * names.length : 0);
+  svg.setAttribute('viewBox', `-1.15 -1.15 2.3 ${height}`);
+  svg.setAttribute('height', Math.round(Number(svg.getAttribute('width') || 460) * height / 2.3));
+  svg.append(el('rect', { x: -1.15, y: -1.15, width: 2.3, height, fill: '#111217' }));
   for (const r of [0.25, 0.5, 0.75, 1]) {
     svg.append(el('path', { d: `M ${-r} 0 A ${r} ${r} 0 0 1 ${r} 0`, fill: 'none', stroke: '#333842', 'stroke-width': 0.005 }));
   }
@@ -358,22 +388,28 @@ export function drawPolar(svg, curves, kind, colours, cursor, names = []) {
     t.textContent = content;
     svg.append(t);
   };
-  for (let a = -90; a <= 90; a += 30) {
+  for (let a = -90; a <= 90; a += 30) {  // ±90° above the base line, clear of the radii's values
     const t = a * Math.PI / 180;
-    small(`${Math.abs(a)}°`, 1.08 * Math.sin(t), -1.08 * Math.cos(t) + 0.02);
+    small(`${Math.abs(a)}°`, 1.085 * Math.sin(t), Math.abs(a) === 90 ? -0.025 : -1.08 * Math.cos(t) + 0.02);
   }
-  names.forEach((name, b) => {  // the legend
-    const y = -1.06 + 0.08 * b;
-    svg.append(el('line', { x1: -1.1, x2: -1.0, y1: y - 0.018, y2: y - 0.018, stroke: colours[b], 'stroke-width': 0.015 }));
-    small(name, -0.97, y, 'start');
+  names.forEach((name, b) => {  // the legend, below the radius' label
+    const y = 0.29 + 0.08 * b;
+    const g = el('g', { class: 'legend' });
+    const title = el('title', {});
+    title.textContent = titles[b] || name;
+    g.append(title, el('line', { x1: -1.1, x2: -1.0, y1: y - 0.018, y2: y - 0.018, stroke: colours[b], 'stroke-width': 0.015 }));
+    svg.append(g);
+    const t = el('text', { x: -0.97, y, fill: '#9a9cab', 'font-size': 0.055, 'font-family': 'system-ui, sans-serif' });
+    t.textContent = name;
+    g.append(t);
   });
   const valueAt = (r) => (kind === 'log' ? 10 ** (lo + r * (Math.log10(max) - lo)) : r * max);
-  if (max > 0) for (const r of [0.25, 0.5, 0.75, 1]) small(shortNumber(Number(valueAt(r).toPrecision(2))), r, 0.06);
+  if (max > 0) for (const r of [0.25, 0.5, 0.75, 1]) small(shortNumber(Number(valueAt(r).toPrecision(2))), r, 0.075);
   if (cursor !== null && cursor !== undefined) {
     const t = cursor * Math.PI / 180;
     svg.append(el('line', { x1: 0, y1: 0, x2: 1.05 * Math.sin(t), y2: -1.05 * Math.cos(t), stroke: '#ff3b6b', 'stroke-width': 0.01 }));
   }
-  const label = el('text', { x: -1.1, y: 0.15, fill: '#9a9cab', 'font-size': 0.06, 'font-family': 'system-ui, sans-serif' });
+  const label = el('text', { x: -1.1, y: 0.17, fill: '#9a9cab', 'font-size': 0.06, 'font-family': 'system-ui, sans-serif' });
   label.textContent = `radius: luminance of ρ (sr⁻¹${kind === 'log' ? ', log scale' : ''}); ← back   mirror →`;
   svg.append(label);
 }
@@ -401,7 +437,7 @@ export function drawSphere(canvas, sum, passes, w, h, exposure) {
 
 // The albedo plot: per BRDF, the luminance of its directional albedo against θi (degrees), with
 // a band of ±2 standard errors; axes ticked; a legend; the dashed line at 1.
-export function drawAlbedo(svg, curves, colours, names) {
+export function drawAlbedo(svg, curves, colours, names, titles = names) {
   svg.replaceChildren();
   const W = 460, H = 270, left = 48, right = 12, top = 12, bottom = 40;
   const lumOf = (v) => 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
@@ -435,6 +471,9 @@ export function drawAlbedo(svg, curves, colours, names) {
     svg.append(el('path', { d: `${band}Z`, fill: colours[b], 'fill-opacity': 0.25, stroke: 'none' }));
     svg.append(el('path', { d: line, fill: 'none', stroke: colours[b], 'stroke-width': 2 }));
     svg.append(el('line', { x1: left + 8, x2: left + 26, y1: top + 12 + 14 * b, y2: top + 12 + 14 * b, stroke: colours[b], 'stroke-width': 2 }));
-    svg.append(text(names[b] || c.brdf, { x: left + 30, y: top + 16 + 14 * b, fill: '#e6e6ea' }));
+    const g = el('g', { class: 'legend' }), title = el('title', {});
+    title.textContent = titles[b] || names[b] || c.brdf;
+    g.append(title, text(names[b] || c.brdf, { x: left + 30, y: top + 16 + 14 * b, fill: '#e6e6ea' }));
+    svg.append(g);
   });
 }

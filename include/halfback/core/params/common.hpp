@@ -133,7 +133,7 @@ enum class AxisKind {
   length,   // a dimensionless length in [lo, hi]
 };
 // What a non-azimuthal coordinate is a function of, for the designs that re-space it as an angle
-// (study/design.hpp): the angle itself, or its sine (‖h̄‖ ≈ sin θh, ‖k‖ = sin θd).
+// (acquire/design.hpp): the angle itself, or its sine (‖h̄‖ ≈ sin θh, ‖k‖ = sin θd).
 enum class AngleEncoding { none, angle, sine };
 struct Axis {
   std::string_view column;  // CSV and NumPy name, e.g. "theta_h"

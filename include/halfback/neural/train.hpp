@@ -1,0 +1,62 @@
+// Training a neural BRDF (Sztrajman, Rainer, Ritschel, Weyrich 2021, "Neural BRDF Representation
+// and Importance Sampling") from any BRDF, on the CPU: the authors' architecture, loss, sampling
+// and optimizer by default (docs/neural.md restates them from their paper and code), and a network
+// that formats/nbrdf.hpp reads and write_nbrdf writes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/formats/nbrdf.hpp"
+
+namespace halfback {
+
+struct NbrdfTrainProgress {
+  std::size_t epoch = 0, epochs = 0;  // epochs done, of
+  double loss = 0;                    // the mean of the epoch's batch losses
+  double seconds = 0;                 // since training began
+};
+
+struct NbrdfTrainOptions {
+  // The input: "" for Sztrajman et al.'s (sin θh, 0, cos θh, d), or a built-in parameterization
+  // whose isotropic coordinates (3) the network takes instead (formats/nbrdf.hpp reads both).
+  std::string param;
+  std::vector<std::size_t> hidden{21, 21};  // hidden widths (1 to 15 layers of 1 to 64 units)
+  std::size_t samples = 640000;             // pairs drawn (the authors: 800,000 × 0.8); 1 to 10^7
+  std::size_t epochs = 100;                 // passes over the pairs, shuffled each time; 1 to 10^6
+  std::size_t batch = 512;                  // pairs per Adam step; 1 to 65,536
+  double learning_rate = 5e-4;              // Adam's, in (0, 1]
+  std::uint64_t seed = 0;                   // the pairs, the initial weights and the shuffles
+  int threads = 0;  // core's parallel_for (0: all); the result does not depend on it
+  // Called after each epoch (on the calling thread), when set.
+  std::function<void(const NbrdfTrainProgress&)> progress;
+};
+
+// Throws std::invalid_argument naming the option (by the CLI's name: --hidden, --samples, ...)
+// when a value is outside the range above.
+void check_nbrdf_train_options(const NbrdfTrainOptions& options);
+
+struct NbrdfTrainResult {
+  NbrdfNetwork network;              // float32, as written and read
+  std::size_t drawn = 0, pairs = 0;  // pairs drawn, and kept (both directions above the horizon)
+  std::size_t steps = 0;             // Adam steps
+  std::vector<double> epoch_losses;  // the mean batch loss of each epoch
+  double loss = 0;     // the loss of `network` (its float32 weights) over all kept pairs
+  double seconds = 0;  // the training steps' wall time
+};
+
+// Trains a network on `brdf` (check_nbrdf_train_options first). The result depends only on the
+// BRDF's values, the options and the seed, not on the thread count. Throws std::domain_error for
+// an anisotropic BRDF (the network is isotropic), naming a pair where ρ is NaN, infinite or
+// negative, or when ρ is 0 at every pair drawn.
+NbrdfTrainResult train_nbrdf(const Brdf& brdf, const NbrdfTrainOptions& options);
+
+// The notes write_nbrdf stores in the .json for a result: the source BRDF and the settings.
+std::vector<NbrdfNote> nbrdf_train_notes(const Brdf& brdf, const NbrdfTrainOptions& options,
+                                         const NbrdfTrainResult& result);
+
+}  // namespace halfback

@@ -1,0 +1,309 @@
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+#include <stdexcept>
+
+#include "halfback/brdf/rho_bound.hpp"
+#include "halfback/core/parallel.hpp"
+#include "halfback/neural/train.hpp"
+#include "halfback/util/format_error.hpp"
+#include "neural/trainer.hpp"
+
+namespace halfback {
+namespace neural {
+namespace {
+
+constexpr double kDegrees = 180.0 / std::numbers::pi;
+
+// The pair of Rusinkiewicz's angles with φh = 0 and d = ωo (formats/nbrdf.hpp): ωo is d rotated
+// by θh about the binormal, ωi its mirror about h.
+DirPair<double> pair_of_angles(double theta_h, double theta_d, double phi_d) {
+  const double sh = std::sin(theta_h), ch = std::cos(theta_h);
+  const double dx = std::sin(theta_d) * std::cos(phi_d), dy = std::sin(theta_d) * std::sin(phi_d),
+               dz = std::cos(theta_d);
+  const Vec3<double> wo{ch * dx + sh * dz, dy, -sh * dx + ch * dz};
+  const double h_dot = sh * wo.x + ch * wo.z;
+  const Vec3<double> wi{2 * h_dot * sh - wo.x, -wo.y, 2 * h_dot * ch - wo.z};
+  return {wi, wo};
+}
+
+std::string describe(const DirPair<double>& pair, const Rgb& rho) {
+  const auto x = nbrdf::encode(pair);
+  return fmt::format("θh = {:.2f}°, θd = {:.2f}°, φd = {:.2f}° (ρ = {}, {}, {})",
+                     std::atan2(x[0], x[2]) * kDegrees,
+                     std::atan2(std::hypot(x[3], x[4]), x[5]) * kDegrees,
+                     std::atan2(x[4], x[3]) * kDegrees, rho.r, rho.g, rho.b);
+}
+
+void require_valid(const Brdf& brdf, const DirPair<double>& pair, const Rgb& rho) {
+  for (const double v : {rho.r, rho.g, rho.b})
+    if (!std::isfinite(v) || v < 0)
+      throw std::domain_error(fmt::format(
+          "{} is {} at {}: a network can only be trained on finite, non-negative values",
+          brdf.name(),
+          std::isnan(v)   ? "NaN"
+          : std::isinf(v) ? "infinite"
+                          : "negative",
+          describe(pair, rho)));
+  if (!rho_within_bound(rho))  // a network that learnt it would be refused by the reader
+    throw std::domain_error(brdf.name() + ": " +
+                            rho_above_bound(std::max({rho.r, rho.g, rho.b}), describe(pair, rho)));
+}
+
+}  // namespace
+
+double cosine_weight(const double* x) {
+  return std::clamp(x[2] * x[5] - x[0] * x[3], 0.0, 1.0);
+}
+
+TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64_t seed,
+                                std::optional<Space> param) {
+  if (!brdf.isotropic())
+    throw std::domain_error(brdf.name() +
+                            " is anisotropic: a neural BRDF of this form is isotropic (its "
+                            "pairs have φh = 0), it would hold one azimuthal slice");
+  Rng rng(seed);
+  std::vector<DirPair<double>> pairs;
+  pairs.reserve(drawn);
+  for (std::size_t i = 0; i < drawn; ++i) {
+    const double theta_h = rng.uniform() * std::numbers::pi / 2;
+    const double theta_d = rng.uniform() * std::numbers::pi / 2;
+    const double phi_d = rng.uniform() * 2 * std::numbers::pi;
+    const DirPair<double> pair = pair_of_angles(theta_h, theta_d, phi_d);
+    if (pair.wi.z > 0 && pair.wo.z > 0) pairs.push_back(pair);
+  }
+  if (pairs.empty())
+    throw std::domain_error(
+        fmt::format("none of the {} pairs drawn has both directions above the horizon", drawn));
+  std::vector<Rgb> rho(pairs.size());
+  brdf.eval_batch(pairs, rho);
+  TrainingSet set;
+  const auto n = Eigen::Index(pairs.size());
+  set.inputs.resize(param ? 3 : nbrdf::kInputs, n);
+  set.targets.resize(nbrdf::kOutputs, n);
+  set.cosine.resize(n);
+  bool any_nonzero = false;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const DirPair<double>& pair = pairs[std::size_t(j)];
+    const Rgb& value = rho[std::size_t(j)];
+    require_valid(brdf, pair, value);
+    any_nonzero = any_nonzero || value.r > 0 || value.g > 0 || value.b > 0;
+    set.targets.col(j) << value.r, value.g, value.b;
+    if (param) {
+      const auto q = param->param().forward_iso(pair);
+      for (std::size_t i = 0; i < 3; ++i) set.inputs(Eigen::Index(i), j) = float(q[i]);
+      set.cosine[j] = std::clamp(pair.wo.z, 0.0, 1.0);
+      continue;
+    }
+    const auto x = nbrdf::encode(pair);
+    for (std::size_t i = 0; i < nbrdf::kInputs; ++i) set.inputs(Eigen::Index(i), j) = float(x[i]);
+    set.cosine[j] = cosine_weight(set.inputs.col(j).data());
+  }
+  if (!any_nonzero)
+    throw std::domain_error(fmt::format("{} is 0 at all {} pairs drawn: nothing to train on",
+                                        brdf.name(), pairs.size()));
+  return set;
+}
+
+namespace {
+
+// One chunk's loss sum and gradient (of the sum, scaled by `scale`).
+double chunk_loss(const MlpLayout& layout, const Vector& params, const TrainingSet& set,
+                  std::span<const std::size_t> columns, double scale, Vector* gradient) {
+  const auto n = Eigen::Index(columns.size());
+  Matrix x(set.inputs.rows(), n), target(set.targets.rows(), n);
+  Vector cosine(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const auto c = Eigen::Index(columns[std::size_t(j)]);
+    x.col(j) = set.inputs.col(c);
+    target.col(j) = set.targets.col(c);
+    cosine[j] = set.cosine[c];
+  }
+  Activations act;
+  forward(layout, params, x, act);
+  if (!gradient) return log_loss_sum(act.outputs(), target, cosine, nullptr);
+  Matrix dy;
+  const double sum = log_loss_sum(act.outputs(), target, cosine, &dy);
+  dy *= scale;
+  gradient->setZero(Eigen::Index(layout.size()));
+  backward(layout, params, act, dy, *gradient);
+  return sum;
+}
+
+}  // namespace
+
+double loss_and_gradient(const MlpLayout& layout, const Vector& params, const TrainingSet& set,
+                         std::span<const std::size_t> batch, int threads, Vector* gradient) {
+  if (batch.empty()) throw std::invalid_argument("an empty batch");
+  const std::size_t chunks = (batch.size() + kChunk - 1) / kChunk;
+  const double scale = 1.0 / double(batch.size() * set.targets.rows());
+  std::vector<double> sums(chunks);
+  std::vector<Vector> gradients(gradient ? chunks : 0);
+  parallel_for(
+      chunks, 1,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t c = begin; c < end; ++c) {
+          const std::size_t first = c * kChunk, count = std::min(kChunk, batch.size() - first);
+          sums[c] = chunk_loss(layout, params, set, batch.subspan(first, count), scale,
+                               gradient ? &gradients[c] : nullptr);
+        }
+      },
+      threads);
+  // The reduction in the chunks' order: the same sums whatever ran where.
+  double sum = 0;
+  for (std::size_t c = 0; c < chunks; ++c) sum += sums[c];
+  if (gradient) {
+    *gradient = gradients[0];
+    for (std::size_t c = 1; c < chunks; ++c) *gradient += gradients[c];
+  }
+  return sum * scale;
+}
+
+double mean_loss(const MlpLayout& layout, const Vector& params, const TrainingSet& set,
+                 int threads) {
+  std::vector<std::size_t> all(set.size());
+  std::iota(all.begin(), all.end(), std::size_t{0});
+  return loss_and_gradient(layout, params, set, all, threads, nullptr);
+}
+
+Trainer::Trainer(MlpLayout layout, Vector params, AdamSettings adam, int threads)
+    : layout_(std::move(layout)),
+      params_(std::move(params)),
+      adam_(layout_.size(), adam),
+      threads_(threads) {}
+
+double Trainer::step(const TrainingSet& set, std::span<const std::size_t> batch) {
+  const double loss = loss_and_gradient(layout_, params_, set, batch, threads_, &gradient_);
+  adam_.step(params_, gradient_);
+  return loss;
+}
+
+}  // namespace neural
+
+void check_nbrdf_train_options(const NbrdfTrainOptions& o) {
+  auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
+  if (o.hidden.empty() || o.hidden.size() + 1 > nbrdf::kMaxLayers)
+    fail(fmt::format("--hidden: {} hidden layers, expected 1 to {}", o.hidden.size(),
+                     nbrdf::kMaxLayers - 1));
+  for (const std::size_t width : o.hidden)
+    if (width == 0 || width > nbrdf::kMaxWidth)
+      fail(fmt::format("--hidden: a layer of {} units, expected 1 to {} (the reader's widest)",
+                       width, nbrdf::kMaxWidth));
+  if (!o.param.empty()) {
+    try {
+      nbrdf::input_space(o.param, "--param");
+    } catch (const std::exception&) {
+      fail(fmt::format("--param '{}': expected {} (a built-in parameterization)", o.param,
+                       parameterization_names()));
+    }
+  }
+  if (o.samples == 0 || o.samples > 10'000'000)
+    fail(fmt::format("--samples: {}, expected 1 to 10000000", o.samples));
+  if (o.epochs == 0 || o.epochs > 1'000'000)
+    fail(fmt::format("--epochs: {}, expected 1 to 1000000", o.epochs));
+  if (o.batch == 0 || o.batch > 65536)
+    fail(fmt::format("--batch: {}, expected 1 to 65536", o.batch));
+  if (!(o.learning_rate > 0 && o.learning_rate <= 1))
+    fail(fmt::format("--learning-rate: {}, expected a number in (0, 1]", o.learning_rate));
+  if (o.threads < 0) fail(fmt::format("--threads: {}, expected 0 or more", o.threads));
+}
+
+namespace {
+
+// One pass over the pairs in a new shuffle of `order`; returns the mean of the batch losses and
+// adds the steps to `steps`.
+double run_epoch(neural::Trainer& trainer, const neural::TrainingSet& set,
+                 std::vector<std::size_t>& order, neural::Rng& rng, std::size_t batch,
+                 std::size_t& steps) {
+  for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+  double sum = 0;
+  std::size_t batches = 0;
+  for (std::size_t first = 0; first < order.size(); first += batch, ++batches) {
+    const std::size_t count = std::min(batch, order.size() - first);
+    sum += trainer.step(set, std::span(order).subspan(first, count));
+  }
+  steps += batches;
+  return sum / double(batches);
+}
+
+// What is written must read back: every weight finite and ρ within the reader's bound
+// (NbrdfBrdf's checks). A guard: with the targets within the bound and Adam's steps of about the
+// learning rate at most, no training of the tests reaches it.
+void require_readable(const NbrdfNetwork& network, const NbrdfTrainOptions& options) {
+  try {
+    NbrdfBrdf(network, "trained");
+  } catch (const FormatError& e) {
+    throw std::domain_error(
+        fmt::format("the trained network (learning rate {}) is not one the reader takes: {}",
+                    options.learning_rate, e.what()));
+  }
+}
+
+}  // namespace
+
+NbrdfTrainResult train_nbrdf(const Brdf& brdf, const NbrdfTrainOptions& options) {
+  using namespace neural;
+  check_nbrdf_train_options(options);
+  const std::optional<Space> param = nbrdf::input_space(options.param, "--param");
+  const TrainingSet set = sample_training_set(brdf, options.samples, options.seed, param);
+  std::vector<std::size_t> widths{std::size_t(set.inputs.rows())};
+  widths.insert(widths.end(), options.hidden.begin(), options.hidden.end());
+  widths.push_back(nbrdf::kOutputs);
+  MlpLayout layout(widths);
+  // A stream for the weights and shuffles apart from the pairs'.
+  Rng rng(options.seed ^ 0x6e62726466ULL);  // "nbrdf"
+  Vector initial = sztrajman_initial_parameters(layout, rng);
+  AdamSettings adam;
+  adam.learning_rate = options.learning_rate;
+  Trainer trainer(layout, std::move(initial), adam, options.threads);
+
+  NbrdfTrainResult result;
+  result.drawn = options.samples;
+  result.pairs = set.size();
+  std::vector<std::size_t> order(set.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t epoch = 0; epoch < options.epochs; ++epoch) {
+    result.epoch_losses.push_back(run_epoch(trainer, set, order, rng, options.batch, result.steps));
+    if (options.progress) {
+      NbrdfTrainProgress p;
+      p.epoch = epoch + 1;
+      p.epochs = options.epochs;
+      p.loss = result.epoch_losses.back();
+      p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      options.progress(p);
+    }
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.network = network_of(layout, trainer.parameters());
+  result.network.source = brdf.name();
+  result.network.input = options.param;
+  require_readable(result.network, options);
+  const Vector rounded = parameters_of(layout, result.network);
+  result.loss = mean_loss(layout, rounded, set, options.threads);
+  return result;
+}
+
+std::vector<NbrdfNote> nbrdf_train_notes(const Brdf& brdf, const NbrdfTrainOptions& o,
+                                         const NbrdfTrainResult& r) {
+  std::string hidden;
+  for (const std::size_t w : o.hidden) {
+    if (!hidden.empty()) hidden += ',';  // (appended apart: GCC 12's false -Wrestrict, bug 105329)
+    hidden += std::to_string(w);
+  }
+  return {{"trained_from", brdf.name()},
+          {"trainer", "halfback nbrdf train (Sztrajman et al. 2021's loss, sampling and Adam)"},
+          {"hidden", hidden},
+          {"samples", fmt::format("{} drawn, {} kept", r.drawn, r.pairs)},
+          {"epochs", std::to_string(o.epochs)},
+          {"batch", std::to_string(o.batch)},
+          {"learning_rate", fmt::format("{}", o.learning_rate)},
+          {"seed", std::to_string(o.seed)},
+          {"loss", fmt::format("{:.6g}", r.loss)}};
+}
+
+}  // namespace halfback

@@ -1,0 +1,205 @@
+// Training a network from a BRDF: the result read back by the reader, its independence of the
+// thread count, and the BRDFs it refuses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include "halfback/core/space.hpp"
+#include "halfback/formats/nbrdf.hpp"
+#include "halfback/loader/load.hpp"
+#include "halfback/neural/train.hpp"
+#include "neural/mlp.hpp"
+#include "neural/trainer.hpp"
+#include "support/test_support.hpp"
+
+namespace halfback {
+namespace {
+
+NbrdfTrainOptions small_options(std::size_t samples = 4000, std::size_t epochs = 3) {
+  NbrdfTrainOptions o;
+  o.samples = samples;
+  o.epochs = epochs;
+  o.batch = 256;
+  o.seed = 5;
+  return o;
+}
+
+// A BRDF that is `value` where θo (the view direction's) exceeds `from` degrees, else Lambert's
+// 0.5/π.
+class OddBrdf final : public Brdf {
+ public:
+  OddBrdf(double value, double from) : value_(value), from_(from) {}
+  std::string name() const override { return "odd"; }
+  std::string description() const override { return "a test BRDF"; }
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return false; }
+  Rgb eval(const DirPair<double>& p) const override {
+    if (p.wi.z < 0 || p.wo.z < 0) return {};
+    const double v =
+        std::acos(p.wo.z) * 180 / std::numbers::pi > from_ ? value_ : 0.5 / std::numbers::pi;
+    return {v, v, v};
+  }
+
+ private:
+  double value_, from_;
+};
+
+template <typename F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(NbrdfTrain, WrittenNetworkReadsBackAndEvaluatesAsTrained) {
+  const BrdfPtr ggx = load_brdf("ggx:alpha=0.3");
+  const NbrdfTrainResult r = train_nbrdf(*ggx, small_options());
+  EXPECT_EQ(r.epoch_losses.size(), 3u);
+  EXPECT_LT(r.epoch_losses.back(), r.epoch_losses.front());
+  EXPECT_GT(r.pairs, 2000u);  // about 2/3 of the pairs have both directions up
+  EXPECT_LT(r.pairs, 4000u);
+  test::TempDir tmp;
+  write_nbrdf(tmp / "g.h5", r.network, nbrdf_train_notes(*ggx, {}, r));
+  ASSERT_TRUE(std::filesystem::exists(tmp / "g.json"));
+  const auto read = load_nbrdf(tmp / "g.h5");
+  EXPECT_EQ(read->architecture(), "6-21-21-3");
+  ASSERT_EQ(read->network().layers.size(), 3u);
+  for (std::size_t l = 0; l < 3; ++l) {
+    EXPECT_EQ(read->network().layers[l].kernel, r.network.layers[l].kernel);
+    EXPECT_EQ(read->network().layers[l].bias, r.network.layers[l].bias);
+  }
+  // The reader (float32) against the trained weights in double, on the reader's float inputs.
+  const neural::MlpLayout layout = neural::layout_of(r.network);
+  const neural::Vector params = neural::parameters_of(layout, r.network);
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(0, 1);
+  double worst = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const double ti = std::acos(u(rng)), to = std::acos(u(rng)), pi = 2 * std::numbers::pi * u(rng);
+    const DirPair<double> pair{
+        {std::sin(ti) * std::cos(pi), std::sin(ti) * std::sin(pi), std::cos(ti)},
+        {std::sin(to), 0, std::cos(to)}};
+    const auto x = nbrdf::encode(pair);
+    neural::Matrix input(6, 1);
+    for (int k = 0; k < 6; ++k) input(k, 0) = float(x[std::size_t(k)]);
+    neural::Activations act;
+    neural::forward(layout, params, input, act);
+    const Rgb got = read->eval(pair);
+    const double want[3] = {std::max(std::expm1(act.outputs()(0, 0)), 0.0),
+                            std::max(std::expm1(act.outputs()(1, 0)), 0.0),
+                            std::max(std::expm1(act.outputs()(2, 0)), 0.0)};
+    const double have[3] = {got.r, got.g, got.b};
+    for (int k = 0; k < 3; ++k)
+      worst = std::max(worst, std::abs(have[k] - want[k]) / (1 + want[k]));
+  }
+  EXPECT_LE(worst, 1e-6);  // float32 evaluation against double, relative to 1 + ρ
+}
+
+TEST(NbrdfTrain, NetworkOfAParameterizationsCoordinatesReadsBackAndEvaluatesAsTrained) {
+  const BrdfPtr ggx = load_brdf("ggx:alpha=0.3");
+  NbrdfTrainOptions o = small_options(4000, 3);
+  o.param = "hybrid";
+  const NbrdfTrainResult r = train_nbrdf(*ggx, o);
+  EXPECT_LT(r.epoch_losses.back(), r.epoch_losses.front());
+  test::TempDir tmp;
+  write_nbrdf(tmp / "h.h5", r.network);
+  const auto read = load_nbrdf(tmp / "h.h5");
+  EXPECT_EQ(read->architecture(), "3-21-21-3");
+  EXPECT_EQ(read->network().input, "hybrid");
+  const neural::MlpLayout layout = neural::layout_of(r.network);
+  const neural::Vector params = neural::parameters_of(layout, r.network);
+  const ParamDescriptor& hybrid = space_from_name("hybrid")->param();
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(0, 1);
+  double worst = 0;
+  for (int i = 0; i < 500; ++i) {
+    const double ti = std::acos(u(rng)), to = std::acos(u(rng)), pi = 2 * std::numbers::pi * u(rng);
+    const DirPair<double> pair{
+        {std::sin(ti) * std::cos(pi), std::sin(ti) * std::sin(pi), std::cos(ti)},
+        {std::sin(to), 0, std::cos(to)}};
+    const auto q = hybrid.forward_iso(pair);
+    neural::Matrix input(3, 1);
+    for (int k = 0; k < 3; ++k) input(k, 0) = float(q[std::size_t(k)]);
+    neural::Activations act;
+    neural::forward(layout, params, input, act);
+    const Rgb got = read->eval(pair);
+    const double have[3] = {got.r, got.g, got.b};
+    for (int k = 0; k < 3; ++k) {
+      const double want = std::max(std::expm1(act.outputs()(k, 0)), 0.0);
+      worst = std::max(worst, std::abs(have[k] - want) / (1 + want));
+    }
+  }
+  EXPECT_LE(worst, 1e-6);
+  o.param = "dupuy-jakob:ggx";
+  EXPECT_NE(error_of([&] { check_nbrdf_train_options(o); }).find("--param 'dupuy-jakob:ggx'"),
+            std::string::npos);
+}
+
+TEST(NbrdfTrain, ResultDependsOnTheSeedNotOnTheThreads) {
+  const BrdfPtr ggx = load_brdf("ggx:alpha=0.2");
+  NbrdfTrainOptions o = small_options(2000, 2);
+  o.threads = 1;
+  const NbrdfTrainResult one = train_nbrdf(*ggx, o);
+  o.threads = 2;
+  const NbrdfTrainResult two = train_nbrdf(*ggx, o);
+  o.seed = 6;
+  const NbrdfTrainResult other = train_nbrdf(*ggx, o);
+  for (std::size_t l = 0; l < 3; ++l) {
+    EXPECT_EQ(one.network.layers[l].kernel, two.network.layers[l].kernel);
+    EXPECT_EQ(one.network.layers[l].bias, two.network.layers[l].bias);
+  }
+  EXPECT_EQ(one.loss, two.loss);
+  EXPECT_NE(one.network.layers[0].kernel, other.network.layers[0].kernel);
+}
+
+TEST(NbrdfTrain, RefusesValuesItCannotTrainOn) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const NbrdfTrainOptions o = small_options(500, 1);
+  std::string e = error_of([&] { train_nbrdf(OddBrdf(nan, 60), o); });
+  EXPECT_NE(e.find("odd is NaN at θh = "), std::string::npos) << e;
+  e = error_of([&] { train_nbrdf(OddBrdf(inf, 80), o); });
+  EXPECT_NE(e.find("odd is infinite at"), std::string::npos) << e;
+  e = error_of([&] { train_nbrdf(OddBrdf(1e30, 70), o); });
+  EXPECT_NE(e.find("odd: ρ = 1e+30 sr⁻¹ at θh = "), std::string::npos) << e;
+  EXPECT_NE(e.find("above the bound of 1e+10 sr⁻¹"), std::string::npos) << e;
+  e = error_of([&] { train_nbrdf(OddBrdf(-1, 85), o); });
+  EXPECT_NE(e.find("odd is negative at"), std::string::npos) << e;
+  e = error_of([&] { train_nbrdf(*load_brdf("lambert:albedo=0"), o); });
+  EXPECT_NE(e.find("is 0 at all"), std::string::npos) << e;
+  e = error_of([&] { train_nbrdf(*load_brdf("ggx:alpha_x=0.1,alpha_y=0.4"), o); });
+  EXPECT_NE(e.find("is anisotropic"), std::string::npos) << e;
+}
+
+TEST(NbrdfTrain, RefusesOptionsOutOfRange) {
+  const BrdfPtr lambert = load_brdf("lambert");
+  auto with = [](auto change) {
+    NbrdfTrainOptions o;
+    change(o);
+    return error_of([&] { check_nbrdf_train_options(o); });
+  };
+  EXPECT_EQ(with([](auto&) {}), "no error");
+  EXPECT_NE(with([](auto& o) {
+              o.hidden = {21, 0};
+            }).find("--hidden: a layer of 0 units"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.hidden = {65}; }).find("expected 1 to 64"), std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.hidden.assign(16, 4); }).find("16 hidden layers"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.samples = 0; }).find("--samples: 0"), std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.epochs = 0; }).find("--epochs: 0"), std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.batch = 100000; }).find("--batch: 100000"), std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.learning_rate = std::nan(""); }).find("--learning-rate"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace halfback

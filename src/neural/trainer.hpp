@@ -1,0 +1,70 @@
+// The training of a neural BRDF's network (private header of src/neural; the public entry is
+// halfback/neural/train.hpp): the training pairs of a BRDF, the loss and its gradient over a
+// batch, parallel over fixed chunks of the batch, and Adam's steps.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include "halfback/brdf/brdf.hpp"
+#include "halfback/core/space.hpp"
+#include "neural/mlp.hpp"
+
+namespace halfback::neural {
+
+// Training pairs, one column each: the network's input x (6), the target ρ (3), the loss's cosine
+// weight c.
+struct TrainingSet {
+  Matrix inputs, targets;
+  Vector cosine;
+  std::size_t size() const { return std::size_t(inputs.cols()); }
+};
+
+// Sztrajman et al.'s cosine weight of an input x = (h, d): the z of the direction d stands for
+// (d rotated back by θh about the binormal), clamped to [0, 1]: c = clamp(hz dz − hx dx, 0, 1).
+double cosine_weight(const double* x);
+
+// Their sampling of training pairs: θh, θd uniform in [0, π/2], φd uniform in [0, 2π), φh = 0;
+// the pair of those angles (d is ωo, formats/nbrdf.hpp), the input the reader computes for it
+// (nbrdf::encode, rounded to float as the reader evaluates it) and ρ = brdf.eval_batch(pair).
+// `drawn` pairs are drawn; those with a direction at or below the horizon are dropped (the authors
+// drop MERL's unmeasured values, which are those). Throws std::domain_error for an anisotropic
+// BRDF, naming the pair when ρ is NaN, infinite or negative there, or when it is 0 at every kept
+// pair.
+// With `param`, the input is the pair's isotropic coordinates in it (rounded to float) and c the
+// view direction's cosine (the same direction, computed from the pair).
+TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64_t seed,
+                                std::optional<Space> param = std::nullopt);
+
+// Samples per chunk of a batch: each chunk's loss and gradient are computed apart (in parallel)
+// and summed in the chunks' order, so the result depends on neither the thread count nor the
+// schedule.
+inline constexpr std::size_t kChunk = 64;
+
+// The mean of log_loss_sum over the columns `batch` of `set` and its 3 channels, and (when
+// `gradient` is not null) its gradient with respect to the parameters, resized to the layout.
+double loss_and_gradient(const MlpLayout& layout, const Vector& params, const TrainingSet& set,
+                         std::span<const std::size_t> batch, int threads, Vector* gradient);
+
+// The mean loss over all of `set` (chunks of kChunk, summed in order).
+double mean_loss(const MlpLayout& layout, const Vector& params, const TrainingSet& set,
+                 int threads);
+
+class Trainer {
+ public:
+  Trainer(MlpLayout layout, Vector params, AdamSettings adam, int threads);
+  // One Adam step on the columns `batch` of `set`; returns the batch's mean loss before the step.
+  double step(const TrainingSet& set, std::span<const std::size_t> batch);
+  const Vector& parameters() const { return params_; }
+  const MlpLayout& layout() const { return layout_; }
+
+ private:
+  MlpLayout layout_;
+  Vector params_, gradient_;
+  Adam adam_;
+  int threads_;
+};
+
+}  // namespace halfback::neural

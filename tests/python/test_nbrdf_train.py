@@ -1,0 +1,83 @@
+"""halfback.nbrdf_train: the trained network, written and read back by halfback, evaluates as
+NumPy evaluates the trained weights (the encoding restated in test_nbrdf.py); its .json is the
+Keras model description with the input named; bad input raises and writes nothing."""
+
+import json
+
+import numpy as np
+import pytest
+
+import halfback
+from helpers import main_thread_turns_during
+from test_nbrdf import numpy_network_input, random_pairs
+
+
+def numpy_network(layers, x):
+    """The network in float64 from its float32 weights: ReLU hidden layers, max(exp(y) - 1, 0)."""
+    x = x.astype(np.float64)
+    for i, (kernel, bias) in enumerate(layers):
+        x = x @ kernel.astype(np.float64) + bias.astype(np.float64)
+        if i + 1 < len(layers):
+            x = np.maximum(x, 0)
+    return np.maximum(np.expm1(x), 0)
+
+
+def test_trained_network_reads_back_and_evaluates_as_numpy(tmp_path):
+    out = tmp_path / "g.h5"
+    r = halfback.nbrdf_train("ggx:alpha=0.3", str(out), samples=4000, epochs=3, seed=1)
+    assert r["h5"] == str(out) and r["json"] == str(tmp_path / "g.json")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.h5", "g.json"]
+    assert [k.shape for k, _ in r["layers"]] == [(6, 21), (21, 21), (21, 3)]
+    assert all(k.dtype == np.float32 and b.dtype == np.float32 for k, b in r["layers"])
+    assert r["epoch_losses"][-1] < r["epoch_losses"][0] and r["steps"] > 0
+    assert 2000 < r["pairs"] < 4000 == r["drawn"]
+
+    description = json.loads((tmp_path / "g.json").read_text())
+    dense = [l["config"] for l in description["config"]["layers"] if l["class_name"] == "Dense"]
+    assert [(d["units"], d["activation"]) for d in dense] == [(21, "relu"), (21, "relu"), (3, "linear")]
+    assert description["config"]["layers"][-1]["class_name"] == "Lambda"
+    assert description["halfback"]["input"] == "sztrajman-halfdiff"
+    assert description["halfback"]["trained_from"] == "ggx"
+
+    try:
+        import h5py  # not in Debian 12's default set; the weights then come from the trainer
+    except ImportError:
+        h5py = None
+    if h5py is not None:
+        with h5py.File(out, "r") as f:
+            for i, (kernel, bias) in enumerate(r["layers"]):
+                g = f[f"dense_{i + 1}"]
+                np.testing.assert_array_equal(g[f"dense_{i + 1}/kernel:0"][()], kernel)
+                np.testing.assert_array_equal(g[f"dense_{i + 1}/bias:0"][()], bias)
+
+    b = halfback.load(str(out))
+    assert b.name == "nbrdf:g"
+    wi, wo = random_pairs(20000, 3)
+    got = b.eval(wi, wo)
+    want = numpy_network(r["layers"], numpy_network_input(wi, wo))
+    # halfback's float32 evaluation against float64, relative to 1 + rho (the loss's scale).
+    err = np.abs(got - want) / (1 + want)
+    assert err.max() <= 1e-6, err.max()
+
+
+def test_training_releases_the_gil_and_depends_on_the_seed_only(tmp_path):
+    a, turns = main_thread_turns_during(
+        lambda: halfback.nbrdf_train("lambert", str(tmp_path / "a.h5"), samples=20000, epochs=4,
+                                     threads=1))
+    assert turns >= 20, "the main thread did not run during nbrdf_train: the GIL was held"
+    b = halfback.nbrdf_train("lambert", str(tmp_path / "b.h5"), samples=20000, epochs=4, threads=2)
+    assert (tmp_path / "a.h5").read_bytes() == (tmp_path / "b.h5").read_bytes()
+    assert a["loss"] == b["loss"]
+
+
+def test_bad_input_raises_and_writes_nothing(tmp_path):
+    out = str(tmp_path / "x.h5")
+    with pytest.raises(RuntimeError, match="is 0 at all"):
+        halfback.nbrdf_train("lambert:albedo=0", out, samples=500, epochs=1)
+    with pytest.raises(ValueError, match="hidden"):
+        halfback.nbrdf_train("lambert", out, hidden=[0])
+    with pytest.raises(ValueError, match="samples"):
+        halfback.nbrdf_train("lambert", out, samples=0)
+    with pytest.raises(ValueError, match="NAME.h5"):
+        halfback.nbrdf_train("lambert", str(tmp_path / "x.json"), samples=500, epochs=1)
+    assert list(tmp_path.iterdir()) == []
