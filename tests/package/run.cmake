@@ -32,6 +32,21 @@ foreach(forbidden cairo OpenEXR Imath eigen3 glib)
     message(FATAL_ERROR "the core consumer is compiled with a ${forbidden} path:\n${commands}")
   endif()
 endforeach()
+# A consumer of the acquisition layer alone (a laboratory's planning tool): found without Ceres or
+# Eigen and compiled without Cairo's, Ceres's or Eigen's include paths. OpenEXR and HDF5 stay on its
+# link line: they come through formats, whose MERL/RGL writers a reconstruction uses, and formats
+# is one library (docs/architecture.md).
+step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/acquire -B ${WORK_DIR}/acquire-build -G ${GENERATOR}
+     -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release)
+step(${CMAKE_COMMAND} --build ${WORK_DIR}/acquire-build)
+step(${WORK_DIR}/acquire-build/acquire_consumer)
+file(READ ${WORK_DIR}/acquire-build/compile_commands.json commands)
+foreach(forbidden cairo ceres eigen3)
+  string(FIND "${commands}" "${forbidden}" at)
+  if(NOT at EQUAL -1)
+    message(FATAL_ERROR "the acquire consumer is compiled with a ${forbidden} path:\n${commands}")
+  endif()
+endforeach()
 # The installed Python package, when the module was built.
 set(pydir ${WORK_DIR}/prefix/lib/python3/dist-packages)
 if(PYTHON AND EXISTS ${pydir}/halfback/__init__.py)
