@@ -117,7 +117,7 @@ def test_callables_that_fail_a_check_are_refused_with_its_message():
         return -np.ones((len(wi), 3))
 
     def one_way(wi, wo):  # depends on wi alone: not reciprocal
-        return np.repeat((0.1 + wi[:, 2:3]) / np.pi, 3, axis=1)
+        return np.repeat((0.1 + 0.5 * wi[:, 2:3]) / np.pi, 3, axis=1)
 
     def anisotropic(wi, wo):
         return np.repeat((0.1 + 0.05 * wi[:, 0:1] * wo[:, 0:1]) / np.pi, 3, axis=1)
