@@ -29,6 +29,8 @@ export class MeshView {
     head.append(this.meshSelect.parentElement, this.lightSelect.parentElement);
     this.figures = document.createElement('div');
     this.figures.id = 'meshes';
+    // Side by side, wrapping within the panel (each caption under its image), as the spheres.
+    Object.assign(this.figures.style, { display: 'flex', flexWrap: 'wrap', gap: '8px', maxWidth: '100%' });
     this.note = document.createElement('p');
     this.note.className = 'note';
     this.note.id = 'mesh-note';
@@ -69,7 +71,9 @@ export class MeshView {
       const canvas = Object.assign(document.createElement('canvas'), { id: `mesh-${b}`, title: 'drag to turn the mesh' });
       canvas.style.width = canvas.style.height = '256px';
       canvas.dataset.spec = spec;
+      Object.assign(fig.style, { margin: '0', width: '256px', textAlign: 'center' });
       const cap = document.createElement('figcaption');
+      cap.style.overflowWrap = 'anywhere';  // a long spec wraps under its image
       cap.innerHTML = `${this.o.swatch(b)}&nbsp;${escape(this.o.label(spec))}`;
       cap.title = this.o.title(spec);
       fig.append(canvas, cap);
