@@ -52,7 +52,16 @@ for seed in "/api/info?token=t" "/?token=t" "/static/app.js?token=t" \
     "/api/slices?token=t&brdf=arg:0&forms=dupuy-jakob:file:../x&n=2" \
     "/api/render?token=t&brdf=arg:0&env=/etc/passwd" \
     "/api/fit?token=t&brdf=arg:1&model=lambert%2Blambert%2Blambert%2Blambert%2Blambert&samples=20000" \
-    "/api/slices?token=t&brdf=arg:0&brdf=arg:1&n=512&values=rgb"; do
+    "/api/slices?token=t&brdf=arg:0&brdf=arg:1&n=512&values=rgb" \
+    "/api/mesh?token=t&brdf=arg:0&brdf=arg:1&light=point&theta_l=30&phi_l=45&size=16" \
+    "/api/mesh?token=t&brdf=arg:1&mesh=embedded:rounded-cube&light=env&env=studio&size=8&spp=2&pass=3&yaw=-40&pitch=80" \
+    "/api/mesh?token=t&brdf=arg:0&mesh=file:../x.obj&size=8" \
+    "/api/mesh?token=t&brdf=arg:0&mesh=/etc/passwd&light=env&env=file:../x.hdr" \
+    "/api/polar?token=t&brdf=arg:0&brdf=arg:1&brdf=lambert&n=9" \
+    "/api/hemisphere?token=t&brdf=arg:0&brdf=arg:1&brdf=ggx&colour=rho&values=luminance&n=8" \
+    "/api/pointlight?token=t&brdf=arg:0&brdf=arg:1&size=8&theta_l=20" \
+    "/api/albedo?token=t&brdf=arg:0&brdf=arg:1&angles=3&n=2" \
+    "/api/polar?token=t&brdf=a&brdf=b&brdf=c&brdf=d&brdf=e&brdf=f&brdf=g&brdf=h&brdf=i"; do
   printf '%s' "$seed" > "$corpus/view/seed$k"
   k=$((k + 1))
 done

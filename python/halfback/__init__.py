@@ -11,10 +11,14 @@ the paper's Figure 1. study_brdf() studies one BRDF (any engine can map it over 
 database) and merge_study() writes the report of the results (docs/study.md).
 """
 
+import atexit
 import math
+import os
+import weakref
 
 from ._core import (
     Brdf,
+    check_brdf,
     columns,
     convert,
     hemisphere,
@@ -24,8 +28,10 @@ from ._core import (
     models,
     Parameterization,
     parameterizations,
+    register_brdf,
     register_parameterization,
     simd_isa,
+    Viewer,
     ssim,
     valid,
 )
@@ -122,8 +128,43 @@ nbrdf_train.__doc__ = _core.nbrdf_train.__doc__
 merge_study.__doc__ = _core.merge_study.__doc__
 study_profile.__doc__ = _core.study_profile.__doc__
 
+_viewers = weakref.WeakSet()
+
+
+def view(*brdfs, roots=(), host="127.0.0.1", port=0, threads=0, workers=16, open=False):
+    """Starts the explorer of `halfback view` in this process (a notebook or a script) and returns
+    a Viewer (url, stop(), wait(); in a notebook its link shows as the cell's output).
+
+    brdfs: specs ("ggx:alpha=0.2", a file, "embedded:NAME"), Brdf objects, or Python callables
+    eval(wi, wo) -> rho on (N, 3) arrays, registered by register_brdf under their __name__ (and
+    checked first: a callable that raises, returns NaN or the wrong shape is refused with the
+    check's message). roots: directories whose files the page may open (--root). The server
+    stops with stop(), at the end of a `with` block, or when the interpreter exits; a script
+    keeps it running with wait()."""
+    items = []
+    for b in brdfs:
+        if callable(b) and not isinstance(b, (str, Brdf)):
+            name = getattr(b, "__name__", "")
+            b = register_brdf(name if name.isidentifier() else "function", b)
+        items.append(b)
+    viewer = _core._view(items, [os.fspath(r) for r in roots], host, port, threads, workers)
+    _viewers.add(viewer)
+    if open:
+        import webbrowser
+
+        webbrowser.open(viewer.url)
+    return viewer
+
+
+@atexit.register
+def _stop_viewers():
+    for v in list(_viewers):
+        v.stop()
+
+
 __all__ = [
     "Brdf",
+    "check_brdf",
     "columns",
     "convert",
     "emit",
@@ -143,9 +184,12 @@ __all__ = [
     "models",
     "published_fits",
     "reconstruct",
+    "register_brdf",
     "simd_isa",
     "ssim",
     "study_brdf",
     "study_profile",
     "valid",
+    "view",
+    "Viewer",
 ]

@@ -86,6 +86,18 @@ int run_view(const ViewOptions& o) {
   config.threads = o.threads;
   for (const std::string& r : o.roots) config.roots.emplace_back(r);
   view::keep_freed_memory();
+  // Block the stop signals before any thread exists, so that they all inherit the mask: loading
+  // the specs starts the parallel loop's threads (a measured file, a neural BRDF), and one of
+  // them without the mask took a Ctrl-C by the default action (killed, not a clean stop).
+  sigset_t signals;
+  sigemptyset(&signals);
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&signals, s);
+  sigset_t previous;
+  pthread_sigmask(SIG_BLOCK, &signals, &previous);
+  struct RestoreMask {
+    const sigset_t& mask;
+    ~RestoreMask() { pthread_sigmask(SIG_SETMASK, &mask, nullptr); }
+  } restore{previous};
   view::Api api(std::move(config));  // throws for a --root that is not a directory
   try {
     api.load_specs();  // a bad command-line BRDF fails here, not in the page
@@ -97,12 +109,6 @@ int run_view(const ViewOptions& o) {
                              "learns the token can use the server",
                              o.host));
 
-  // Block the stop signals before any server thread exists, so that they all inherit the mask.
-  sigset_t signals;
-  sigemptyset(&signals);
-  for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&signals, s);
-  sigset_t previous;
-  pthread_sigmask(SIG_BLOCK, &signals, &previous);
   view::Server server(api, o.workers);
   const int port = server.bind(o.host, o.port);
   const std::string shown = o.host.find(':') != std::string::npos ? "[" + o.host + "]" : o.host;
@@ -115,7 +121,6 @@ int run_view(const ViewOptions& o) {
   const bool ok = server.run();
   done = true;
   waiter.join();
-  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
   if (!ok) throw std::runtime_error("the server stopped with an error");
   return kExitOk;
 }

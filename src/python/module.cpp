@@ -41,6 +41,7 @@ using namespace halfback;
 namespace halfback::python {
 
 PyBrdf load_py_brdf(const std::string& spec) {
+  if (BrdfPtr python = registered_python_brdf(spec)) return PyBrdf{python, spec};
   std::error_code ec;
   const std::filesystem::path path(spec);
   std::string kept = spec;  // a file, absolute: a worker in another directory finds it
@@ -49,7 +50,7 @@ PyBrdf load_py_brdf(const std::string& spec) {
 }
 
 BrdfPtr brdf_of(const py::object& brdf) {
-  return py::isinstance<py::str>(brdf) ? load_brdf(brdf.cast<std::string>())
+  return py::isinstance<py::str>(brdf) ? load_py_brdf(brdf.cast<std::string>()).brdf
                                        : brdf.cast<const PyBrdf&>().brdf;
 }
 
@@ -710,4 +711,5 @@ PYBIND11_MODULE(_core, m) {
   halfback::python::bind_nbrdf(m);
   halfback::python::bind_user_parameterizations(m);
   halfback::python::bind_acquisition(m);
+  halfback::python::bind_view(m);
 }

@@ -23,7 +23,12 @@ PyBrdf load_py_brdf(const std::string& spec);
 // A BRDF argument: a spec, as for load(), or a Brdf.
 BrdfPtr brdf_of(const pybind11::object& brdf);
 
+// The BRDF register_brdf registered as spec "python:NAME"; nullptr for a spec of another kind,
+// ValueError for a name not registered (view_bindings.cpp).
+BrdfPtr registered_python_brdf(const std::string& spec);
+
 void bind_fit(pybind11::module_& m);    // fit_bindings.cpp
+void bind_view(pybind11::module_& m);   // view_bindings.cpp
 void bind_study(pybind11::module_& m);  // study_bindings.cpp (and the SSIM)
 void bind_nbrdf(pybind11::module_& m);  // nbrdf_bindings.cpp
 

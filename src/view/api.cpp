@@ -87,7 +87,8 @@ struct Api::State {
   Catalog catalog;
   std::atomic<int> fits_running = 0;
   std::atomic<bool> stopping = false;
-  explicit State(ApiConfig c) : config(std::move(c)), catalog(config.specs, config.roots) {}
+  explicit State(ApiConfig c)
+      : config(std::move(c)), catalog(config.specs, config.roots, config.given) {}
 };
 
 Api::Api(ApiConfig config) : state_(std::make_unique<State>(std::move(config))) {}
@@ -253,6 +254,7 @@ Response route(const Catalog& catalog, const Request& r, const ApiConfig& c,
   if (p == "/api/point") return point_response(catalog, r);
   if (p == "/api/render") return render_response(catalog, r, c.threads, budget);
   if (p == "/api/pointlight") return point_light_response(catalog, r, c.threads);
+  if (p == "/api/mesh") return mesh_response(catalog, r, c.threads, budget);
   if (p == "/api/fit") return fit_response(catalog, r, c.threads, fits_running, budget);
   return error(404, fmt::format("no such resource '{}'", p.substr(0, 128)));
 }

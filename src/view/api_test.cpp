@@ -22,10 +22,12 @@
 #include "halfback/core/batch.hpp"
 #include "halfback/fit/fit.hpp"
 #include "halfback/loader/load.hpp"
+#include "halfback/render/mesh.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/util/text_encoding.hpp"
 #include "json.hpp"
 #include "support/test_support.hpp"
+#include "web_assets.hpp"
 
 namespace halfback::view {
 namespace {
@@ -94,7 +96,7 @@ TEST(ViewApi, EveryEndpointChecksTokenOriginAndHost) {
   Api api(config());
   for (const char* path :
        {"/api/info", "/api/brdf", "/api/slices", "/api/hemisphere", "/api/polar", "/api/point",
-        "/api/render", "/api/albedo", "/api/pointlight", "/api/fit"}) {
+        "/api/render", "/api/albedo", "/api/pointlight", "/api/fit", "/api/mesh"}) {
     Request r = get(path, {{"brdf", "arg:0"}});
     r.query.pop_back();  // the token
     EXPECT_TRUE(has_error(api.handle(r), 403, "token")) << path;
@@ -834,6 +836,17 @@ TEST(ViewApi, EverySpecParameterIsConfinedToTheRoots) {
       {"/api/fit",
        {{"brdf", "lambert"}, {"model", "lambert"}, {"loss", "ngan"}, {"samples", "100"}},
        {"brdf", "model"}},
+      {"/api/mesh",
+       {{"brdf", "lambert"},
+        {"mesh", "embedded:rounded-cube"},
+        {"light", "env"},
+        {"env", "sky"},
+        {"size", "8"},
+        {"spp", "1"},
+        {"pass", "0"},
+        {"yaw", "10"},
+        {"pitch", "5"}},
+       {"brdf", "mesh", "env"}},
   };
   // The hemisphere's brdf= is read with colour=rho only.
   const auto adjust = [](const Endpoint& e, const std::string& key, Query q) {
@@ -1001,6 +1014,156 @@ TEST(ViewApi, LoadsAFileUnderARoot) {
 
 // A response's JSON: keys in the order set, strings escaped, NaN and infinities as null, and
 // text that is not UTF-8 made so as valid_utf8 does (one U+FFFD per byte of a cut sequence).
+// A view of N BRDFs is one request: polar, hemisphere, point light and albedo answer every
+// brdf= in order, each part the answer of its own single-BRDF request; more than 8 is a 413.
+TEST(ViewApi, BatchedEndpointsAnswerEveryBrdfInOneRequest) {
+  Api api(config());
+  const std::vector<std::string> specs = {"arg:0", "lambert:albedo=0.4", "ggx:alpha=0.1"};
+  const auto with_brdfs = [&](std::vector<std::pair<std::string, std::string>> q,
+                              const std::vector<std::string>& list) {
+    for (const std::string& b : list) q.emplace_back("brdf", b);
+    return q;
+  };
+  // Binary answers: the concatenation of the single answers, X-Halfback-Brdfs the count.
+  for (const auto& [path, query] :
+       std::vector<std::pair<std::string, std::vector<std::pair<std::string, std::string>>>>{
+           {"/api/hemisphere", {{"colour", "rho"}, {"values", "luminance"}, {"n", "8"}}},
+           {"/api/pointlight", {{"size", "8"}, {"theta_l", "20"}}},
+           {"/api/mesh", {{"size", "8"}, {"theta_l", "20"}}}}) {
+    const Response all = api.handle(get(path, with_brdfs(query, specs)));
+    ASSERT_EQ(all.status, 200) << path << all.body;
+    EXPECT_EQ(header_of(all, "X-Halfback-Brdfs"), "3") << path;
+    std::string joined;
+    for (const std::string& b : specs) {
+      const Response one = api.handle(get(path, with_brdfs(query, {b})));
+      ASSERT_EQ(one.status, 200) << path;
+      joined += one.body;
+    }
+    EXPECT_EQ(all.body, joined) << path;
+  }
+  // JSON answers: `curves`, one per brdf=, each the single answer's.
+  const Json polar = Json::parse(
+      api.handle(get("/api/polar", with_brdfs({{"n", "7"}, {"theta_o", "30"}}, specs))).body);
+  const Json albedo = Json::parse(
+      api.handle(get("/api/albedo", with_brdfs({{"angles", "3"}, {"n", "4"}}, specs))).body);
+  ASSERT_EQ(polar["curves"].size(), 3u);
+  ASSERT_EQ(albedo["curves"].size(), 3u);
+  for (std::size_t b = 0; b < specs.size(); ++b) {
+    const Json p1 = Json::parse(
+        api.handle(get("/api/polar", with_brdfs({{"n", "7"}, {"theta_o", "30"}}, {specs[b]})))
+            .body);
+    EXPECT_EQ(polar["curves"][b]["in_plane"], p1["in_plane"]);
+    EXPECT_EQ(polar["curves"][b]["across"], p1["across"]);
+    EXPECT_EQ(polar["curves"][b]["brdf"], specs[b]);
+    const Json a1 = Json::parse(
+        api.handle(get("/api/albedo", with_brdfs({{"angles", "3"}, {"n", "4"}}, {specs[b]}))).body);
+    EXPECT_EQ(albedo["curves"][b]["albedo"], a1["albedo"]);
+  }
+  // The bound: at most 8 BRDFs (8 RGB fields of 512² are the bytes of the slices' bound).
+  const std::vector<std::string> nine(9, "lambert");
+  for (const char* path :
+       {"/api/polar", "/api/hemisphere", "/api/pointlight", "/api/albedo", "/api/mesh"})
+    EXPECT_TRUE(
+        has_error(api.handle(get(path, with_brdfs({{"colour", "rho"}}, nine))), 413, "at most 8"))
+        << path;
+}
+
+// The lit mesh: the embedded mesh (or an OBJ under a root) rendered by render/mesh.hpp, under the
+// point light or an environment; files confined and bounded as every file of a request.
+TEST(ViewApi, MeshIsTheRenderersImage) {
+  test::TempDir root, outside;
+  {
+    std::ofstream(root.path() / "tri.obj") << "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
+    std::ofstream(root.path() / "bad.obj") << "v 0 0 0\nv 1 q 0\n";
+    std::ofstream(root.path() / "tri.txt") << "v 0 0 0\n";
+    std::ofstream(outside.path() / "o.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  }
+  std::filesystem::create_symlink(outside.path() / "o.obj", root.path() / "link.obj");
+  { std::ofstream(root.path() / "huge.obj") << "v 0 0 0\n"; }
+  std::filesystem::resize_file(root.path() / "huge.obj", kMaxMeshBytes + 1);  // sparse
+  Api api(config({root.path()}));
+  const Response r = api.handle(get("/api/mesh", {{"brdf", kSpec},
+                                                  {"theta_l", "30"},
+                                                  {"phi_l", "90"},
+                                                  {"size", "16"},
+                                                  {"yaw", "20"},
+                                                  {"pitch", "-10"}}));
+  ASSERT_EQ(r.status, 200) << r.body;
+  std::string text;
+  for (const WebAsset& m : embedded_meshes())
+    if (m.name == "rounded-cube.obj")
+      text.assign(reinterpret_cast<const char*>(m.bytes.data()), m.bytes.size());
+  const render::Mesh mesh = render::parse_obj(text, "rounded-cube");
+  render::MeshSettings s;
+  s.width = s.height = 16;
+  s.yaw_deg = 20;
+  s.pitch_deg = -10;
+  const double t = 30 * (std::numbers::pi / 180.0), p = 90 * (std::numbers::pi / 180.0);
+  const auto expected = render::render_mesh_point_light(
+      *load_brdf(kSpec), mesh, {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)},
+      s);
+  EXPECT_EQ(floats_of(r), expected.rgb);
+  // Under an environment, by passes: another pass, another estimate.
+  const auto env = [&](std::string pass) {
+    return api.handle(get("/api/mesh", {{"brdf", "lambert"},
+                                        {"light", "env"},
+                                        {"env", "studio"},
+                                        {"size", "8"},
+                                        {"pass", std::move(pass)}}));
+  };
+  ASSERT_EQ(env("0").status, 200);
+  EXPECT_NE(env("0").body, env("1").body);
+  EXPECT_EQ(env("1").body, env("1").body);
+  const auto mesh_of = [&](const std::string& m) {
+    return api.handle(get("/api/mesh", {{"brdf", "lambert"}, {"mesh", m}, {"size", "8"}}));
+  };
+  EXPECT_EQ(mesh_of("file:tri.obj").status, 200);
+  const Response bad = mesh_of("file:bad.obj");
+  EXPECT_TRUE(has_error(bad, 400, "line 2"));
+  EXPECT_EQ(bad.body.find(root.path().string()), std::string::npos);  // the root is not told
+  EXPECT_TRUE(has_error(mesh_of("file:tri.txt"), 400, ".obj"));
+  EXPECT_TRUE(has_error(mesh_of("file:huge.obj"), 413, "above the limit"));
+  EXPECT_TRUE(has_error(mesh_of("file:link.obj"), 403, "outside"));
+  EXPECT_TRUE(has_error(mesh_of("file:../o.obj"), 403, ".."));
+  EXPECT_TRUE(has_error(mesh_of((outside.path() / "o.obj").string()), 403, "path"));
+  EXPECT_TRUE(has_error(mesh_of("embedded:teapot"), 404, "no such embedded mesh"));
+  EXPECT_TRUE(has_error(mesh_of("sphere"), 400, "unknown mesh"));
+  EXPECT_TRUE(has_error(mesh_of(std::string(kMaxSpecBytes + 1, 'a')), 413, "longer"));
+  const auto bad_param = [&](std::string key, std::string value) {
+    return api.handle(get("/api/mesh", {{"brdf", "lambert"}, {std::move(key), std::move(value)}}));
+  };
+  EXPECT_TRUE(has_error(bad_param("light", "sun"), 400, "light"));
+  EXPECT_TRUE(has_error(bad_param("pitch", "91"), 400, "pitch"));
+  EXPECT_TRUE(has_error(bad_param("size", "513"), 400, "size"));
+  EXPECT_TRUE(has_error(bad_param("spp", "65"), 400, "spp"));
+  const Json info = Json::parse(api.handle(get("/api/info")).body);
+  EXPECT_EQ(info["meshes"], Json::array({"embedded:rounded-cube", "file:bad.obj", "file:huge.obj",
+                                         "file:tri.obj"}));
+}
+
+// A BRDF given as an object (halfback.view's Python callables) is served as arg:N, whatever its
+// spec says: the spec only names it.
+TEST(ViewApi, GivenBrdfObjectsAreServedByIndex) {
+  ApiConfig c = config();
+  c.specs = {"python:mine", kSpec};
+  c.given = {load_brdf("lambert:albedo=0.25")};
+  Api api(c);
+  EXPECT_NO_THROW(api.load_specs());
+  const Json b = Json::parse(api.handle(get("/api/brdf", {{"brdf", "arg:0"}})).body);
+  EXPECT_EQ(b["name"], load_brdf("lambert:albedo=0.25")->name());
+  const Response s = api.handle(
+      get("/api/slices",
+          {{"brdf", "arg:0"}, {"forms", "halfdiff"}, {"n", "4"}, {"values", "luminance"}}));
+  ASSERT_EQ(s.status, 200);
+  for (const float v : floats_of(s)) {
+    if (!std::isnan(v)) {
+      EXPECT_NEAR(v, 0.25 / std::numbers::pi, 1e-6);
+    }
+  }
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "arg:1"}})).status, 200);        // loaded by spec
+  EXPECT_EQ(api.handle(get("/api/brdf", {{"brdf", "python:mine"}})).status, 400);  // not a model
+}
+
 TEST(ViewJson, EscapesNullsAndMakesUtf8) {
   Json j;
   j["s"] = "a\"b\\c\n\x01";

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <algorithm>
 #include <cctype>
+#include <fstream>
+#include <iterator>
 #include <system_error>
 
 #include "halfback/formats/adaptive_param.hpp"
@@ -11,6 +13,7 @@
 #include "halfback/render/renderer.hpp"
 #include "halfback/util/format_error.hpp"
 #include "halfback/view/api.hpp"
+#include "web_assets.hpp"
 
 namespace halfback::view {
 
@@ -45,6 +48,12 @@ bool is_environment_file(const fs::path& p) {
   return e == ".hdr" || e == ".exr";
 }
 
+bool is_mesh_file(const fs::path& p) {
+  return lower_extension(p) == ".obj";
+}
+
+constexpr std::size_t kMaxCachedMeshes = 4;
+
 bool is_brdf_file(const fs::path& p) {
   const std::string e = lower_extension(p);
   return e == ".binary" || e == ".bsdf" || e == ".h5" || e == ".alta" || e == ".txt";
@@ -52,8 +61,10 @@ bool is_brdf_file(const fs::path& p) {
 
 }  // namespace
 
-Catalog::Catalog(std::vector<std::string> specs, const std::vector<fs::path>& roots)
-    : specs_(std::move(specs)) {
+Catalog::Catalog(std::vector<std::string> specs, const std::vector<fs::path>& roots,
+                 std::vector<BrdfPtr> given)
+    : specs_(std::move(specs)), given_(std::move(given)) {
+  given_.resize(specs_.size());
   for (const fs::path& root : roots) {
     std::error_code ec;
     fs::path canonical = fs::canonical(root, ec);
@@ -148,6 +159,7 @@ BrdfPtr Catalog::load_term(std::string_view spec) const {
     if (n.empty() || index >= specs_.size())
       throw RequestError(404, fmt::format("'{}': the command line named {} BRDF(s) (arg:0 ...)",
                                           spec, specs_.size()));
+    if (given_[index]) return given_[index];
     return load_brdf(specs_[index]);
   }
   if (starts_with(spec, "file:")) {
@@ -302,6 +314,53 @@ std::shared_ptr<const render::EnvMap> Catalog::environment(std::string_view spec
   return map;
 }
 
+std::shared_ptr<const render::Mesh> Catalog::mesh(std::string_view spec) const {
+  if (spec.size() > kMaxSpecBytes)
+    throw RequestError(413, fmt::format("mesh spec longer than {} bytes", kMaxSpecBytes));
+  refuse_paths(spec);
+  {
+    std::lock_guard lock(mutex_);
+    if (auto it = meshes_.find(spec); it != meshes_.end()) return it->second;
+  }
+  std::string text, name;
+  if (starts_with(spec, "embedded:")) {
+    name = std::string(spec.substr(9));
+    bool found = false;
+    for (const WebAsset& m : embedded_meshes())
+      if (m.name == name + ".obj") {
+        text.assign(reinterpret_cast<const char*>(m.bytes.data()), m.bytes.size());
+        found = true;
+      }
+    if (!found)
+      throw RequestError(404, fmt::format("'{}': no such embedded mesh (embedded:{})",
+                                          spec.substr(0, 256), kEmbeddedMesh));
+  } else if (starts_with(spec, "file:")) {
+    const std::string_view relative = spec.substr(5);
+    const fs::path path = resolve(relative);
+    if (!is_mesh_file(path))
+      throw RequestError(400, fmt::format("'{}': a mesh file is a Wavefront .obj", spec));
+    std::error_code ec;
+    const auto size = fs::file_size(path, ec);
+    if (ec) throw RequestError(400, fmt::format("'{}': cannot be read", spec));
+    if (size > kMaxMeshBytes)
+      throw RequestError(413, fmt::format("'{}': {} bytes, above the limit of {} for a mesh", spec,
+                                          size, kMaxMeshBytes));
+    std::ifstream in(path, std::ios::binary);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (!in && !in.eof()) throw RequestError(400, fmt::format("'{}': cannot be read", spec));
+    name = std::string(relative);  // the root's place on disk is not the page's business
+  } else {
+    throw RequestError(400, fmt::format("unknown mesh '{}' (expected embedded:{} or "
+                                        "file:PATH.obj under a --root)",
+                                        spec.substr(0, 256), kEmbeddedMesh));
+  }
+  auto mesh = std::make_shared<const render::Mesh>(render::parse_obj(text, name));
+  std::lock_guard lock(mutex_);
+  if (meshes_.size() >= kMaxCachedMeshes) meshes_.clear();
+  meshes_.emplace(std::string(spec), mesh);
+  return mesh;
+}
+
 Catalog::Listing Catalog::list_files(std::size_t limit) const {
   Listing listing;
   for (const fs::path& root : roots_) {
@@ -316,12 +375,15 @@ Catalog::Listing Catalog::list_files(std::size_t limit) const {
       const std::string rel = it->path().lexically_relative(root).generic_string();
       if (is_environment_file(real) && listing.environments.size() < limit)
         listing.environments.push_back(rel);
+      else if (is_mesh_file(real) && listing.meshes.size() < limit)
+        listing.meshes.push_back(rel);
       else if (is_brdf_file(real) && listing.brdfs.size() < limit)
         listing.brdfs.push_back(rel);
     }
   }
   std::sort(listing.brdfs.begin(), listing.brdfs.end());
   std::sort(listing.environments.begin(), listing.environments.end());
+  std::sort(listing.meshes.begin(), listing.meshes.end());
   return listing;
 }
 

@@ -5,6 +5,10 @@
 //   file:PATH      a file under one of the --root directories (PATH relative to the root);
 //   embedded:NAME  a material compiled into the library;
 //   anything else  an analytic model spec for model_registry() ("ggx:alpha=0.2"), never a file.
+//   arg:N          also a BRDF given as an object (a Python callable: Catalog's `given`), never
+//                  loaded from its spec;
+// A mesh spec (/api/mesh) is embedded:NAME (the meshes compiled into the server) or file:PATH (a
+// .obj under a root, at most kMaxMeshBytes).
 // An environment spec is a built-in name (sky, default, studio, sunset), "constant:V" or
 // "constant:R,G,B", or file:PATH (a .hdr or .exr under a root).
 //
@@ -35,6 +39,7 @@
 #include "fields.hpp"
 #include "halfback/brdf/brdf.hpp"
 #include "halfback/render/envmap.hpp"
+#include "halfback/render/mesh.hpp"
 
 namespace halfback::view {
 
@@ -58,7 +63,9 @@ void refuse_paths(std::string_view spec);
 
 class Catalog {
  public:
-  Catalog(std::vector<std::string> specs, const std::vector<std::filesystem::path>& roots);
+  // `given`: BRDFs given as objects, by index of `specs` (nullptr, or missing: load the spec).
+  Catalog(std::vector<std::string> specs, const std::vector<std::filesystem::path>& roots,
+          std::vector<BrdfPtr> given = {});
 
   const std::vector<std::string>& specs() const { return specs_; }
 
@@ -71,6 +78,8 @@ class Catalog {
   // and never registered, so that requests do not grow the process's registry. nullopt for a
   // name that is neither (after refuse_paths: a name holding a path is a 403).
   std::optional<ViewForm> form(std::string_view name) const;
+  // The mesh of a request spec (see above); cached (the last kMaxCachedMeshes).
+  std::shared_ptr<const render::Mesh> mesh(std::string_view spec) const;
   // The environment of a request spec; cached.
   std::shared_ptr<const render::EnvMap> environment(std::string_view spec) const;
 
@@ -79,10 +88,11 @@ class Catalog {
   std::filesystem::path resolve(std::string_view relative) const;
 
   // Root-relative paths (generic form) of the files under the roots whose extension suggests a
-  // BRDF (.binary, .bsdf, .h5, .alta, .txt) or an environment (.hdr, .exr); at most `limit` of
+  // BRDF (.binary, .bsdf, .h5, .alta, .txt), an environment (.hdr, .exr) or a mesh (.obj); at
+  // most `limit` of
   // each, sorted.
   struct Listing {
-    std::vector<std::string> brdfs, environments;
+    std::vector<std::string> brdfs, environments, meshes;
   };
   Listing list_files(std::size_t limit) const;
 
@@ -103,10 +113,12 @@ class Catalog {
   void evict_locked() const;  // drops the least recently used BRDFs beyond kMaxCachedBrdfs
 
   std::vector<std::string> specs_;
+  std::vector<BrdfPtr> given_;
   std::vector<std::filesystem::path> roots_;  // canonical
   mutable std::mutex mutex_;
   mutable std::map<std::string, Entry, std::less<>> brdfs_;
   mutable std::map<std::string, std::shared_ptr<const render::EnvMap>, std::less<>> envs_;
+  mutable std::map<std::string, std::shared_ptr<const render::Mesh>, std::less<>> meshes_;
   mutable std::map<std::string, FormEntry, std::less<>> forms_;
   mutable std::uint64_t clock_ = 0;
 };

@@ -18,6 +18,7 @@
 #include "halfback/fit/fit.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/render/brdf_sampler.hpp"
+#include "halfback/render/mesh.hpp"
 #include "halfback/render/renderer.hpp"
 #include "json.hpp"
 
@@ -185,6 +186,29 @@ std::vector<const std::string*> all_params(const Request& r, std::string_view ke
   return out;
 }
 
+// The BRDFs of a request's brdf= (1 to kMaxBrdfsPerRequest, in order): a view of N BRDFs is one
+// request, one round trip.
+std::vector<std::pair<std::string, BrdfPtr>> brdfs_param(const Catalog& catalog, const Request& r) {
+  const std::vector<const std::string*> specs = all_params(r, "brdf");
+  if (specs.empty()) throw RequestError(400, "missing query parameter 'brdf'");
+  if (specs.size() > kMaxBrdfsPerRequest)
+    throw RequestError(413, fmt::format("at most {} brdf= per request (got {})",
+                                        kMaxBrdfsPerRequest, specs.size()));
+  std::vector<std::pair<std::string, BrdfPtr>> out;
+  for (const std::string* s : specs) out.emplace_back(*s, catalog.brdf(*s));
+  return out;
+}
+
+// The bytes of `count` float fields of n × n × channels, or a 400 above kMaxSlicesBytes.
+void check_field_bytes(std::string_view what, std::size_t count, std::size_t n,
+                       std::size_t channels) {
+  const std::size_t bytes = count * n * n * channels * sizeof(float);
+  if (bytes > kMaxSlicesBytes)
+    throw RequestError(400, fmt::format("{}: {} field(s) of {}² pixels x {} channel(s) is {} "
+                                        "bytes, above the limit of {} (fewer BRDFs or pixels)",
+                                        what, count, n, channels, bytes, kMaxSlicesBytes));
+}
+
 // `values=`: rgb (the default) or luminance.
 RhoValues values_param(const Request& r) {
   const std::string* v = r.param("values");
@@ -288,12 +312,15 @@ Response info_response(const Catalog& catalog) {
   j["files"] = files.brdfs;
   Json& environments = j["environments"] = Json::array({"sky", "studio", "sunset"});
   for (const std::string& f : files.environments) environments.push_back("file:" + f);
+  Json& meshes = j["meshes"] = Json::array({"embedded:" + std::string(kEmbeddedMesh)});
+  for (const std::string& f : files.meshes) meshes.push_back("file:" + f);
   Json& limits = j["limits"];
   limits["grid"] = kMaxGridSide;
   limits["polar"] = kMaxPolarSamples;
   limits["render"] = kMaxRenderSide;
   limits["spp"] = kMaxRenderSpp;
   limits["fit_samples"] = kMaxFitSamples;
+  limits["brdfs"] = kMaxBrdfsPerRequest;
   Json& losses = j["losses"] = Json::array();
   for (const fit::Loss l : fit::kLosses) losses.push_back(fit::name_of(l));
   return json(j);
@@ -373,21 +400,40 @@ Response hemisphere_response(const Catalog& catalog, const Request& request, int
   const std::size_t n = whole(request, "n", 128, 2, kMaxGridSide);
   const Vec3<double> wo = outgoing(request);
   const RhoValues values = space.is_dirs() ? values_param(request) : RhoValues::rgb;
-  BrdfPtr brdf;
-  if (space.is_dirs()) brdf = catalog.brdf(required(request, "brdf"));
-  return floats(hemisphere_field(brdf.get(), space, wo, n, threads, values), n, n,
-                channels_of(values));
+  if (!space.is_dirs())
+    return floats(hemisphere_field(nullptr, space, wo, n, threads, values), n, n,
+                  channels_of(values));
+  // ρ of every BRDF of brdf= (one field each, in order): one request for all the BRDFs shown.
+  const auto brdfs = brdfs_param(catalog, request);
+  check_field_bytes("/api/hemisphere", brdfs.size(), n, channels_of(values));
+  std::vector<std::vector<float>> fields;
+  for (const auto& [spec, brdf] : brdfs)
+    fields.push_back(hemisphere_field(brdf.get(), space, wo, n, threads, values));
+  Response res = floats(fields, n, n, channels_of(values));
+  res.headers.emplace_back("X-Halfback-Brdfs", std::to_string(brdfs.size()));
+  return res;
 }
 
 Response polar_response(const Catalog& catalog, const Request& request) {
   const std::size_t n = whole(request, "n", 181, 2, kMaxPolarSamples);
   const Vec3<double> wo = outgoing(request);
-  const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
-  const PolarCurves c = polar_curves(*brdf, wo, n);
-  Json j;
-  j["angles_deg"] = c.angles_deg;
-  j["in_plane"] = rgb_list(c.in_plane);
-  j["across"] = rgb_list(c.across);
+  const auto brdfs = brdfs_param(catalog, request);
+  // `curves`: one per brdf= (in order); the first one's also at the top level.
+  Json j, curves = Json::array();
+  for (const auto& [spec, brdf] : brdfs) {
+    const PolarCurves c = polar_curves(*brdf, wo, n);
+    if (curves.empty()) {
+      j["angles_deg"] = c.angles_deg;
+      j["in_plane"] = rgb_list(c.in_plane);
+      j["across"] = rgb_list(c.across);
+    }
+    Json curve;
+    curve["brdf"] = spec;
+    curve["in_plane"] = rgb_list(c.in_plane);
+    curve["across"] = rgb_list(c.across);
+    curves.push_back(std::move(curve));
+  }
+  j["curves"] = std::move(curves);
   return json(j);
 }
 
@@ -395,35 +441,46 @@ Response albedo_response(const Catalog& catalog, const Request& request, int thr
                          const Budget& budget) {
   const std::size_t angles = whole(request, "angles", 90, 2, kMaxAlbedoAngles);  // 0°, 1°, …, 89°
   const int n = int(whole(request, "n", 64, 1, kMaxAlbedoSamples));
-  const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
+  const auto brdfs = brdfs_param(catalog, request);
   // θi from 0° to 89° (90° itself grazes: the cosine-weighted integral is 0 there for most BRDFs
   // and undefined for measured ones), each estimate the one `halfback info` prints (same seed).
   std::vector<double> theta(angles);
-  std::vector<AlbedoEstimate> a(angles);
   for (std::size_t k = 0; k < angles; ++k) theta[k] = 89.0 * double(k) / double(angles - 1);
+  std::vector<AlbedoEstimate> a(angles * brdfs.size());
   parallel_for(
-      angles, 1,
+      a.size(), 1,
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end && !budget.expired(); ++k) {
-          const double t = theta[k] * kDegree;
-          a[k] = directional_albedo(*brdf, {std::sin(t), 0, std::cos(t)}, n);
+          const double t = theta[k % angles] * kDegree;
+          a[k] = directional_albedo(*brdfs[k / angles].second, {std::sin(t), 0, std::cos(t)}, n);
         }
       },
       threads);
   budget.check("the albedo curve");
-  Json j;
-  j["brdf"] = brdf->name();
+  // `curves`: one per brdf= (in order); the first one's also at the top level.
+  Json j, curves = Json::array();
   j["samples"] = n * n;
   j["theta_deg"] = theta;
-  const auto rgbs = [&a](Rgb AlbedoEstimate::*member) {
-    Json list = Json::array();
-    for (const AlbedoEstimate& e : a) list.push_back(rgb_json(e.*member));
-    return list;
-  };
-  j["albedo"] = rgbs(&AlbedoEstimate::mean);
-  j["standard_error"] = rgbs(&AlbedoEstimate::standard_error);
-  Json& measured = j["measured"] = Json::array();
-  for (const AlbedoEstimate& e : a) measured.push_back(e.measured);
+  for (std::size_t b = 0; b < brdfs.size(); ++b) {
+    const auto rgbs = [&](Rgb AlbedoEstimate::*member) {
+      Json list = Json::array();
+      for (std::size_t k = 0; k < angles; ++k) list.push_back(rgb_json(a[b * angles + k].*member));
+      return list;
+    };
+    Json curve;
+    curve["brdf"] = brdfs[b].second->name();
+    curve["spec"] = brdfs[b].first;
+    curve["samples"] = n * n;
+    curve["theta_deg"] = theta;
+    curve["albedo"] = rgbs(&AlbedoEstimate::mean);
+    curve["standard_error"] = rgbs(&AlbedoEstimate::standard_error);
+    Json& measured = curve["measured"] = Json::array();
+    for (std::size_t k = 0; k < angles; ++k) measured.push_back(a[b * angles + k].measured);
+    if (b == 0)
+      for (const char* key : {"brdf", "albedo", "standard_error", "measured"}) j[key] = curve[key];
+    curves.push_back(std::move(curve));
+  }
+  j["curves"] = std::move(curves);
   return json(j);
 }
 
@@ -539,10 +596,67 @@ Response point_light_response(const Catalog& catalog, const Request& request, in
   const double phi = number(request, "phi_l", 0, -360, 360) * kDegree;
   const Vec3<double> light{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
                            std::cos(theta)};
-  const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
-  const render::RenderResult result = render::render_point_light(*brdf, light, s);
-  Response res = floats(result.image.rgb, std::size_t(s.width), std::size_t(s.height), 3);
-  res.headers.emplace_back("X-Halfback-Spp", std::to_string(result.spp));
+  // Every BRDF of brdf= (one image each, in order): one request for all the spheres shown.
+  const auto brdfs = brdfs_param(catalog, request);
+  check_field_bytes("/api/pointlight", brdfs.size(), std::size_t(s.width), 3);
+  std::vector<std::vector<float>> images;
+  int spp = 0;
+  for (const auto& [spec, brdf] : brdfs) {
+    render::RenderResult result = render::render_point_light(*brdf, light, s);
+    images.push_back(std::move(result.image.rgb));
+    spp = result.spp;
+  }
+  Response res = floats(images, std::size_t(s.width), std::size_t(s.height), 3);
+  res.headers.emplace_back("X-Halfback-Spp", std::to_string(spp));
+  res.headers.emplace_back("X-Halfback-Brdfs", std::to_string(brdfs.size()));
+  return res;
+}
+
+// The mesh of `mesh=` (embedded:NAME or file:PATH.obj) under a point light (light=point, from
+// theta_l, phi_l in camera space as /api/pointlight) or an environment (light=env, env= as
+// /api/render; pass= the seed), turned by yaw and pitch (degrees): one image per brdf=.
+Response mesh_response(const Catalog& catalog, const Request& request, int threads,
+                       const Budget& budget) {
+  render::MeshSettings s;
+  s.width = s.height = int(whole(request, "size", 256, 8, std::size_t(kMaxRenderSide)));
+  s.spp = int(whole(request, "spp", 4, 1, std::size_t(kMaxRenderSpp)));
+  s.supersample = 2;
+  s.seed = whole(request, "pass", 0, 0, 1u << 20) + 1;
+  s.yaw_deg = number(request, "yaw", 35, -360, 360);
+  s.pitch_deg = number(request, "pitch", 25, -90, 90);
+  s.threads = threads;
+  const std::string* light = request.param("light");
+  const bool point = !light || *light == "point";
+  if (!point && *light != "env")
+    throw RequestError(
+        400, fmt::format("parameter 'light': '{}' is not point or env", light->substr(0, 64)));
+  const std::string* mesh_spec = request.param("mesh");
+  const std::string default_mesh = "embedded:" + std::string(kEmbeddedMesh);
+  const auto mesh = catalog.mesh(mesh_spec ? *mesh_spec : default_mesh);
+  const auto brdfs = brdfs_param(catalog, request);
+  check_field_bytes("/api/mesh", brdfs.size(), std::size_t(s.width), 3);
+  std::shared_ptr<const render::EnvMap> env;
+  Vec3<double> dir{0, 0, 1};
+  if (point) {
+    const double theta = number(request, "theta_l", 0, 0, 90) * kDegree;
+    const double phi = number(request, "phi_l", 0, -360, 360) * kDegree;
+    dir = {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+  } else {
+    const std::string* env_spec = request.param("env");
+    env = catalog.environment(env_spec ? std::string_view(*env_spec) : "sky");
+  }
+  std::vector<std::vector<float>> images;
+  for (const auto& [spec, brdf] : brdfs) {
+    budget.check("the mesh");
+    render::Image image =
+        point ? render::render_mesh_point_light(*brdf, *mesh, dir, s)
+              : render::render_mesh_environment(*catalog.sampled_brdf(spec), *env, *mesh, s);
+    images.push_back(std::move(image.rgb));
+  }
+  budget.check("the mesh");
+  Response res = floats(images, std::size_t(s.width), std::size_t(s.height), 3);
+  res.headers.emplace_back("X-Halfback-Brdfs", std::to_string(brdfs.size()));
+  res.headers.emplace_back("X-Halfback-Triangles", std::to_string(mesh->triangles.size()));
   return res;
 }
 

@@ -46,6 +46,8 @@ Response point_response(const Catalog& catalog, const Request& request);
 Response render_response(const Catalog& catalog, const Request& request, int threads,
                          const Budget& budget);
 Response point_light_response(const Catalog& catalog, const Request& request, int threads);
+Response mesh_response(const Catalog& catalog, const Request& request, int threads,
+                       const Budget& budget);
 // `running` counts the fits in progress: a request made while one runs is answered 503.
 // A fit of more than kMaxFitTermSamples terms × samples is a 400.
 Response fit_response(const Catalog& catalog, const Request& request, int threads,

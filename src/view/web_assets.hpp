@@ -13,5 +13,7 @@ struct WebAsset {
 };
 
 std::span<const WebAsset> web_assets();
+// The meshes of the lit mesh view (data/meshes/, "NAME.obj"), the same way.
+std::span<const WebAsset> embedded_meshes();
 
 }  // namespace halfback::view

@@ -199,7 +199,12 @@ def main():
         with tempfile.TemporaryDirectory() as root:
             os.symlink("/etc", os.path.join(root, "link-out"))
             spec = "ggx:alpha=0.3,f0=0.9"
-            proc, base, token = start_server(args.halfback, [spec, "embedded:pink-felt"], root)
+            specs = [spec, "embedded:pink-felt"]
+            if args.measure_only:  # the three BRDFs of the given-BRDF checks
+                specs = [os.path.join(REPO, "data", "rgl", "ilm_l3_37_metallic_rgb.bsdf"),
+                         os.path.join(REPO, "data", "nbrdf", "gold-metallic-paint3.h5"),
+                         "lambert:albedo=0.2+ggx:alpha=0.15,f0=0.9"]
+            proc, base, token = start_server(args.halfback, specs, root)
             try:
                 if args.measure_only:
                     measure_only(base, token)
@@ -321,13 +326,44 @@ def measure_all(driver):
     check(fps_slider > 0 and fps_drag > 0, "updates measured")
 
 
+# The benchmark's browser: Chromium as a user starts it, without a GL flag. On a machine without
+# a GPU it then runs WebGL 2 (the lobe) on ANGLE over SwiftShader, as --use-angle=swiftshader
+# does; --use-gl=swiftshader has no WebGL 2 at all (no lobe drawn: a faster page that is not the
+# user's). The renderer it uses is printed with the rates.
+MEASURE_FLAGS = ["--headless=new", "--no-sandbox", "--disable-dev-shm-usage"]
+
+
+def make_measure_driver():
+    options = webdriver.ChromeOptions()
+    options.binary_location = "/usr/bin/chromium"
+    for a in MEASURE_FLAGS:
+        options.add_argument(a)
+    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+
+
 def measure_only(base, token):
-    driver = make_driver()
-    driver.set_script_timeout(300)
+    """The rates with three BRDFs (a measured file, a neural BRDF, a sum of models) and every
+    view on screen (the window as tall as the page)."""
+    driver = make_measure_driver()
+    driver.set_script_timeout(600)
     try:
+        driver.set_window_size(1600, 1250)
         driver.get(f"{base}?token={token}")
-        WebDriverWait(driver, 60).until(lambda d: d.find_element(By.ID, "status").text == "ready")
+        WebDriverWait(driver, 120).until(lambda d: d.find_element(By.ID, "status").text.startswith("ready"))
+        for k in range(3):
+            driver.execute_async_script("Promise.resolve(window.halfback.addBrdf(arguments[0])).then(arguments[1]);", f"arg:{k}")
         wait_idle(driver)
+        height = driver.execute_script("return document.documentElement.scrollHeight;")
+        driver.set_window_size(1600, height + 140)
+        time.sleep(0.5)
+        wait_idle(driver)
+        renderer = driver.execute_script("""const g = document.createElement('canvas').getContext('webgl2');
+            if (!g) return 'no WebGL 2';
+            const e = g.getExtension('WEBGL_debug_renderer_info');
+            return e ? g.getParameter(e.UNMASKED_RENDERER_WEBGL) : g.getParameter(g.RENDERER);""")
+        shown = driver.execute_script("return window.halfback.state.a ? 1 + (window.halfback.state.b ? 1 : 0) + window.halfback.state.more.length : 0;")
+        print(f"measure: Chromium {driver.capabilities.get('browserVersion')} with {' '.join(MEASURE_FLAGS)} "
+              f"(no GL flag): WebGL 2 on {renderer}; {shown} BRDFs shown, window 1600 x {height + 140}")
         measure_all(driver)
     finally:
         driver.quit()
@@ -1093,6 +1129,8 @@ def given_brdfs_checks(halfback, screenshots):
     names = ["ilm_l3_37_metallic_rgb.bsdf", "gold-metallic-paint3.h5", given[2]]
     with tempfile.TemporaryDirectory() as root:
         shutil.copy(measured, root)
+        subprocess.run([sys.executable, os.path.join(REPO, "scripts", "make_mesh.py"),
+                        os.path.join(root, "cube.obj"), "--u", "12", "--v", "6"], check=True)
         with open(os.path.join(root, "not-a-brdf.bsdf"), "w") as f:
             f.write("not a BRDF\n")
         proc, base, token = start_server(halfback, given, root)
@@ -1126,7 +1164,9 @@ def given_brdfs_checks(halfback, screenshots):
             driver.set_window_size(1600, 1250)
             time.sleep(0.5)
             wait_idle(driver)
-            for name in ["slices", "hemisphere", "polar", "lobe", "albedo", "sphere"]:
+            guarded(driver, check_one_request_per_view, driver)
+            guarded(driver, check_mesh, driver, screenshots)
+            for name in ["slices", "hemisphere", "polar", "lobe", "albedo", "sphere", "mesh"]:
                 panel = driver.find_element(By.ID, f"{name}-panel")
                 driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", panel)
                 panel.screenshot(os.path.join(screenshots, f"view-three-{name}.png"))
@@ -1152,6 +1192,79 @@ def given_brdfs_checks(halfback, screenshots):
                 proc.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 proc.kill()
+
+
+def api_requests(driver):
+    """The page's requests so far, by path: {path: count} (Resource Timing)."""
+    return driver.execute_script("""const n = {};
+        for (const e of performance.getEntriesByType('resource')) {
+          const p = new URL(e.name).pathname;
+          if (p.startsWith('/api/')) n[p] = (n[p] || 0) + 1;
+        }
+        return n;""")
+
+
+def check_one_request_per_view(driver):
+    """With three BRDFs shown, an ωo typed (at rest) costs one request per view: the hemisphere
+    and the lobe (/api/hemisphere, 2), the polar plot, the point-lit spheres and the mesh (1
+    each); the page before batching sent one per BRDF and view."""
+    shown = driver.execute_script("return 1 + (window.halfback.state.b ? 1 : 0) + window.halfback.state.more.length;")
+    check(shown >= 3, f"one request per view: {shown} BRDFs shown")
+    driver.execute_script("performance.setResourceTimingBufferSize(10000); performance.clearResourceTimings();")
+    type_into(driver, "theta-o", "33")
+    wait_idle(driver)
+    # The mesh follows without holding the page's idle(): its request ends when it ends.
+    WebDriverWait(driver, 120).until(lambda d: api_requests(d).get("/api/mesh"))
+    time.sleep(0.5)
+    wait_idle(driver)
+    n = api_requests(driver)
+    check(n.get("/api/polar") == 1 and n.get("/api/pointlight") == 1 and n.get("/api/hemisphere") == 2
+          and n.get("/api/mesh") == 1,
+          f"one request per view for {shown} BRDFs when ωo moves (polar 1, point light 1, mesh 1, "
+          f"hemisphere and lobe 2): {n}")
+
+
+def check_mesh(driver, screenshots):
+    """The lit mesh: one image per BRDF shown, the server's (/api/mesh) as drawn; the environment
+    refines by passes; a drag turns it; an OBJ under the root is offered and drawn."""
+    def mesh_state():
+        return driver.execute_script("""return [...document.querySelectorAll('#meshes canvas')].map((c) =>
+            ({ passes: Number(c.dataset.passes || 0), spec: c.dataset.spec, lit: c.sum ? c.sum.filter((v) => v > 0).length : 0 }));""")
+    WebDriverWait(driver, 120).until(lambda d: all(m["passes"] >= 1 for m in mesh_state()) and mesh_state())
+    shown = driver.execute_script("return 1 + (window.halfback.state.b ? 1 : 0) + window.halfback.state.more.length;")
+    state = mesh_state()
+    check(len(state) == shown and all(m["lit"] > 1000 for m in state),
+          f"lit mesh: an image per BRDF shown ({shown}), each lit: {state}")
+    same = driver.execute_async_script("""const done = arguments[0];
+        const c = document.getElementById('mesh-0'), q = new URLSearchParams(location.search);
+        const p = new URLSearchParams({ brdf: c.dataset.spec, mesh: document.getElementById('mesh-mesh').value,
+          size: c.width, yaw: '35.00', pitch: '25.00', light: 'point', theta_l: window.halfback.state.to,
+          phi_l: window.halfback.state.po, token: q.get('token') });
+        fetch('/api/mesh?' + p).then((r) => r.arrayBuffer()).then((b) => {
+          const f = new Float32Array(b);
+          let diff = 0;
+          for (let k = 0; k < f.length; ++k) diff = Math.max(diff, Math.abs(f[k] - c.sum[k]));
+          done([f.length, c.sum.length, diff]);
+        });""")
+    check(same[0] == same[1] and same[2] == 0, f"lit mesh: the first image is the server's /api/mesh: {same}")
+    options = driver.execute_script("return [...document.getElementById('mesh-mesh').options].map((o) => o.value);")
+    check(options == ["embedded:rounded-cube", "file:cube.obj"], f"lit mesh: the meshes offered {options}")
+    driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", driver.find_element(By.ID, "mesh-panel"))
+    total = "const c = document.getElementById('mesh-0'); return c.sum ? [c.sum.length, c.sum.reduce((a, v) => a + v, 0)] : [0, 0];"
+    before = driver.execute_script(total)
+    canvas = driver.find_element(By.ID, "mesh-0")
+    ActionChains(driver).move_to_element(canvas).click_and_hold().move_by_offset(60, 20).release().perform()
+    turned = WebDriverWait(driver, 120).until(
+        lambda d: (lambda now: now[0] == before[0] and now[1] != before[1])(d.execute_script(total)))
+    check(turned, "lit mesh: a drag turns the mesh")
+    driver.execute_script("""const s = document.getElementById('mesh-light'); s.value = 'env'; s.dispatchEvent(new Event('change'));""")
+    WebDriverWait(driver, 240).until(lambda d: all(m["passes"] >= 2 for m in mesh_state()))
+    check(True, "lit mesh: the environment refines by passes")
+    driver.find_element(By.ID, "mesh-panel").screenshot(os.path.join(screenshots, "view-three-mesh-env.png"))
+    driver.execute_script("""const s = document.getElementById('mesh-mesh'); s.value = 'file:cube.obj'; s.dispatchEvent(new Event('change'));
+        const l = document.getElementById('mesh-light'); l.value = 'point'; l.dispatchEvent(new Event('change'));""")
+    WebDriverWait(driver, 120).until(lambda d: all(m["passes"] == 1 for m in mesh_state()))
+    check(all(m["lit"] > 1000 for m in mesh_state()), "lit mesh: an OBJ under the root is drawn")
 
 
 def guarded(driver, check_fn, *args):

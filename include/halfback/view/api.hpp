@@ -23,6 +23,10 @@
 #include <utility>
 #include <vector>
 
+namespace halfback {
+class Brdf;
+}  // namespace halfback
+
 namespace halfback::view {
 
 // Limits of one request (docs/view.md, "Limits").
@@ -50,6 +54,10 @@ inline constexpr std::size_t kMaxCachedBrdfs = 32;     // loaded BRDFs kept (lea
 // A /api/slices answer: at most the bytes of 8 RGB fields of 512² (25 MB, 24 MiB): BRDFs × forms
 // × n² × channels × 4 above it is a 400.
 inline constexpr std::size_t kMaxSlicesBytes = 8 * 512 * 512 * 3 * sizeof(float);
+// The lit mesh view (/api/mesh): a mesh file under a root of at most this many bytes; the mesh
+// of the page when it names none.
+inline constexpr std::size_t kMaxMeshBytes = 64u << 20;
+inline constexpr std::string_view kEmbeddedMesh = "rounded-cube";
 // Parameterizations built for requests (dupuy-jakob:BRDF, never registered): at most this many
 // kept (least recent dropped), and named by one request.
 inline constexpr std::size_t kMaxCachedForms = 4;
@@ -77,10 +85,13 @@ struct Response {
 };
 
 struct ApiConfig {
-  std::string token;                         // required on every request (empty: refused always)
-  std::string host = "127.0.0.1";            // the bound address, as given to --host
-  int port = 0;                              // the bound port (after binding port 0)
-  std::vector<std::string> specs;            // the BRDFs named on the command line, in order
+  std::string token;               // required on every request (empty: refused always)
+  std::string host = "127.0.0.1";  // the bound address, as given to --host
+  int port = 0;                    // the bound port (after binding port 0)
+  std::vector<std::string> specs;  // the BRDFs named on the command line, in order
+  // BRDFs given as objects (a Python callable: halfback.view), by index of `specs`: served as
+  // arg:N, the spec only naming it (nullptr, or fewer than `specs`: the spec is loaded).
+  std::vector<std::shared_ptr<const Brdf>> given;
   std::vector<std::filesystem::path> roots;  // directories whose files may be loaded
   int threads = 0;                           // as in core/parallel.hpp
   double compute_seconds = kComputeSeconds;  // the deadline of one request's computation

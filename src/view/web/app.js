@@ -5,6 +5,8 @@
 import { getJson, getField, getFields, isAbort } from './api.js';
 import * as V from './views.js';
 import { LobeView, lobeMesh } from './lobe.js';
+import * as B from './batch.js';
+import { MeshView } from './mesh.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = Math.PI / 180;
@@ -250,8 +252,8 @@ const updateHemisphere = coalesced(async () => {
   const n = interactive ? DRAG : 256;
   const common = [['theta_o', state.to], ['phi_o', state.po], ['n', n]];
   if (state.hemi === 'rho') {
-    const fields = await Promise.all(specs().map((s) => getField(null, '/api/hemisphere',
-      [['brdf', s], ['colour', 'rho'], ['values', 'luminance'], ...common])));
+    const fields = await B.fieldsOf(null, '/api/hemisphere', specs(),
+      [['colour', 'rho'], ['values', 'luminance'], ...common]);
     hemiField = { rho: fields };
   } else {
     hemiField = { coords: await getField(null, '/api/hemisphere', [['colour', state.hemi], ...common]) };
@@ -386,9 +388,8 @@ const LOBE_N = 96;
 const updateLobe = coalesced(async () => {
   if (!lobe || !lobe.available) return;
   const list = loaded();
-  const fields = await Promise.all(list.map((s) => getField(null, '/api/hemisphere',
-    [['brdf', s], ['colour', 'rho'], ['values', 'luminance'], ['theta_o', state.to], ['phi_o', state.po],
-      ['n', LOBE_N]])));
+  const fields = await B.fieldsOf(null, '/api/hemisphere', list,
+    [['colour', 'rho'], ['values', 'luminance'], ['theta_o', state.to], ['phi_o', state.po], ['n', LOBE_N]]);
   const options = { cosine: state.lobe === 'cos', log: state.lobeScale === 'log' };
   // One radius scale for all: the largest value of any BRDF shown is 1.
   const meshes = fields.map((f) => lobeMesh(f, options));
@@ -410,15 +411,15 @@ function setupLobe() {
 let albedoCurves = [];  // per BRDF loaded: the /api/albedo answer
 const updateAlbedo = coalesced(async () => {
   const list = loaded();
-  albedoCurves = await Promise.all(list.map((s) => getJson('albedo-' + s, '/api/albedo', [['brdf', s], ['n', 64]])));
+  albedoCurves = await B.albedoCurves('albedo', list, [['n', 64]]);
   V.drawAlbedo($('albedo'), albedoCurves, COLOURS, list.map(specLabel), list.map(fullSpec));
 });
 
 // --- polar plot ------------------------------------------------------------------------------
 let polarCurves = [];
 const updatePolar = coalesced(async () => {
-  polarCurves = await Promise.all(loaded().map((s) => getJson(null, '/api/polar',
-    [['brdf', s], ['theta_o', state.to], ['phi_o', state.po], ['n', interactive ? 91 : 181]])));
+  polarCurves = await B.polarCurves(null, loaded(),
+    [['theta_o', state.to], ['phi_o', state.po], ['n', interactive ? 91 : 181]]);
   drawPolar();
 });
 function drawPolar() {
@@ -496,8 +497,9 @@ function pointLightFigure(spec, b) {
 }
 const updatePointLights = coalesced(async () => {
   const canvases = [...document.querySelectorAll('#spheres canvas[id^="pointlight-"]')];
-  const fields = await Promise.all(canvases.map((c) => getField(null, '/api/pointlight',
-    [['brdf', c.dataset.spec], ['theta_l', state.to], ['phi_l', state.po], ['size', SPHERE], ['spp', 4]])));
+  updateMesh();
+  const fields = await B.fieldsOf(null, '/api/pointlight', canvases.map((c) => c.dataset.spec),
+    [['theta_l', state.to], ['phi_l', state.po], ['size', SPHERE], ['spp', 4]]);
   canvases.forEach((c, k) => {
     c.sum = Float32Array.from(fields[k].data);
     c.dataset.passes = 1;
@@ -505,7 +507,18 @@ const updatePointLights = coalesced(async () => {
   });
 });
 const idleFrame = () => new Promise((r) => setTimeout(r, 30));
+// The lit mesh (mesh.js): follows the BRDFs, ωo at rest, the environment and the exposure.
+let meshView = null;
+function updateMesh() {
+  if (!info) return;
+  if (!meshView) {
+    meshView = new MeshView($('mesh-panel'), { meshes: info.meshes, colours: COLOURS, label: specLabel,
+      title: fullSpec, swatch, onError: (m) => setStatus(m, true) });
+  }
+  meshView.update({ specs: loaded(), to: state.to, po: state.po, env: state.env, exposure: state.exposure });
+}
 function redrawSpheres() {
+  updateMesh();
   for (const c of document.querySelectorAll('#spheres canvas'))
     if (c.sum) V.drawSphere(c, c.sum, Number(c.dataset.passes), SPHERE, SPHERE, state.exposure);
 }
