@@ -115,14 +115,16 @@ def test_study_spacings_key_and_its_older_name():
 
 
 def test_render_says_which_sampler_it_used():
-    img = halfback.load("ggx:alpha=0.05").render(width=16, height=16, spp=1)
+    measured = halfback.load("embedded:gold-metallic-paint3")  # no sampler of its own
+    img = measured.render(width=16, height=16, spp=1)
     assert isinstance(img, np.ndarray) and isinstance(img, halfback.RenderedImage)
     assert img.shape == (16, 16, 3) and img.dtype == np.float32
     # auto chose, and says so with the measured ratio against its threshold.
     assert "chosen:" in img.sampler and "threshold" in img.sampler, img.sampler
-    table = halfback.load("ggx:alpha=0.05").render(width=16, height=16, spp=1,
-                                                   brdf_sampling="table")
-    assert "chosen" not in table.sampler and table.sampler != ""
+    table = measured.render(width=16, height=16, spp=1, brdf_sampling="table")
+    assert table.sampler.startswith("tabulated") and "chosen" not in table.sampler
+    assert halfback.load("ggx:alpha=0.2").render(width=8, height=8, spp=1).sampler == (
+        "own sampler of ggx")
     # Kept through pickling (a Dask worker's result) and slicing.
     back = pickle.loads(pickle.dumps(img))
     assert back.sampler == img.sampler
