@@ -34,7 +34,8 @@ def main(out, size=201):
             ax = axes[row, col]
             ax.set_facecolor("0.8")  # outside the domain
             for letter, colour in FUNCTIONS:
-                t = halfback.load(f"test:{letter}").resample(param, "slice", size, azimuth=azimuth,
+                t = halfback.load(f"test:{letter}").resample(param, "slice", size,
+                                                            azimuth=np.radians(azimuth),
                                                             nodes=True)
                 x, y = t["axes"]
                 values = np.where(t["valid"], t["rho"][..., 0], np.nan)

@@ -16,6 +16,8 @@ import math
 import os
 import weakref
 
+import numpy as _np
+
 from ._core import (
     Brdf,
     check_brdf,
@@ -38,6 +40,28 @@ from ._core import (
 from . import _core
 
 __version__ = _core.__version__
+
+
+class RenderedImage(_np.ndarray):
+    """Brdf.render()'s image: an (H, W, 3) float32 numpy array of linear radiance, row 0 at the
+    top, with `sampler`: the BRDF sampler used and, when brdf_sampling="auto" chose it, why (the
+    line `halfback render` prints on stderr)."""
+
+    def __new__(cls, image, sampler=""):
+        obj = _np.asarray(image).view(cls)
+        obj.sampler = sampler
+        return obj
+
+    def __array_finalize__(self, obj):
+        self.sampler = getattr(obj, "sampler", "")
+
+    def __reduce__(self):  # pickled with its sampler (Dask workers send results back)
+        rebuild, args, state = super().__reduce__()
+        return rebuild, args, (state, self.sampler)
+
+    def __setstate__(self, state):
+        array_state, self.sampler = state
+        super().__setstate__(array_state)
 
 
 # Python functions, not the module's built-ins: pickle sends a Python function by its name, so
@@ -87,8 +111,8 @@ def published_fits(path):
     return _core.published_fits(str(path))
 
 
-def plan(param="hybrid", design="regular", budget=10000, spacing="own", full=False, max_theta=90.0,
-         seed=1, instrument="light-detector"):
+def plan(param="hybrid", design="regular", budget=10000, spacing="own", full=False,
+         max_theta=math.pi / 2, seed=1, instrument="light-detector"):
     return _core.plan(param, design, budget, spacing, full, max_theta, seed, instrument)
 
 
@@ -97,7 +121,8 @@ def plan_main(pilot, values):
     return _core.plan_main(os.fspath(pilot) if not isinstance(pilot, str) else pilot, values)
 
 
-def plan_error(plan, values, truth, test_pairs=200000, seed=1, max_theta=85.0, space="log"):
+def plan_error(plan, values, truth, test_pairs=200000, seed=1, max_theta=math.radians(85),
+               space="log"):
     import os
     return _core.plan_error(os.fspath(plan) if not isinstance(plan, str) else plan, values, truth,
                             test_pairs, seed, max_theta, space)
@@ -185,6 +210,7 @@ __all__ = [
     "published_fits",
     "reconstruct",
     "register_brdf",
+    "RenderedImage",
     "simd_isa",
     "ssim",
     "study_brdf",

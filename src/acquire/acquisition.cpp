@@ -392,7 +392,8 @@ AcquisitionPlan nielsen_plan(std::shared_ptr<const NielsenDatabase> database, st
   const std::size_t candidates = database->configurations().size();
   if (count < 1 || count > candidates)
     throw std::invalid_argument(fmt::format(
-        "count {}: expected 1 to {} (the database's candidate configurations within the reach)",
+        "budget {}: expected 1 to {} (the database's candidate configurations within the "
+        "reach)",
         count, candidates));
   AcquisitionPlan::NielsenDesign n;
   n.basis = std::make_shared<const NielsenBasis>(database, std::vector<std::size_t>{});

@@ -284,8 +284,9 @@ Command register_compare(CLI::App& parent) {
       ->check(non_negative_integer());
   app->add_option("--json", o->json, "Also write the numbers as JSON, replaced only on success")
       ->type_name("FILE");
-  app->add_option("-o,--out", o->figure,
-                  "Figure: slices of A, B and log10(B/A), and both albedos (.png, .svg or .pdf)")
+  app->add_option("-o,--output,--out", o->figure,
+                  "Figure: slices of A, B and log10(B/A), and both albedos (.png, .svg or .pdf; "
+                  "--out is an alias)")
       ->type_name("FIG");
   app->footer(
       "Prints the error of B against A (the reference) in each loss of `halfback fit` and in\n"

@@ -59,6 +59,7 @@ Command register_factor(CLI::App& parent) {
       "factor", "Fit a factored model (sum of separable terms) of a BRDF in a parameterization");
   app->add_option("--brdf", o->brdf, "BRDF SPEC to factor: a file or a model")->required();
   app->add_option("--param", o->param, "Parameterization whose isotropic coordinates separate")
+      ->type_name("PARAM")
       ->check(parameterization_validator())
       ->capture_default_str();
   app->add_option("--rank", o->rank, "Separable terms per colour channel")

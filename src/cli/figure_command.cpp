@@ -56,7 +56,7 @@ struct SliceArgs {
   std::string params = "halfdiff,ortho,hybrid";
   std::string azimuths = "0,45,90";
   std::string levels = "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9";
-  std::string colour = "luminance";
+  std::string colour = "rgb";
   double scale = 2;
   int threads = 0;
   std::string out = "slices.png";
@@ -87,12 +87,12 @@ struct MaterialArgs {
 
 std::vector<Space> parameterization_list(const std::string& list) {
   std::vector<Space> spaces;
-  for (const std::string& n : split_list(list, "--param", "parameterization")) {
+  for (const std::string& n : split_list(list, "--params", "parameterization")) {
     std::string problem;
     const auto s = space_or_message(n, problem);
-    if (!problem.empty()) throw UsageError("--param " + problem);
+    if (!problem.empty()) throw UsageError("--params " + problem);
     if (!s || *s == Space::dirs)
-      throw UsageError(fmt::format("--param: unknown parameterization '{}' (expected {})", n,
+      throw UsageError(fmt::format("--params: unknown parameterization '{}' (expected {})", n,
                                    parameterization_names()));
     spaces.push_back(*s);
   }
@@ -101,10 +101,10 @@ std::vector<Space> parameterization_list(const std::string& list) {
 
 // The output's format, checked before any work.
 void check_output(const std::string& out) {
-  if (out.empty()) throw UsageError("--out: no file name given");
+  if (out.empty()) throw UsageError("--output: no file name given");
   if (!figure::format_from_path(out))
     throw UsageError(fmt::format(
-        "--out '{}': cannot tell the figure format: use a .png, .svg or .pdf file name", out));
+        "--output '{}': cannot tell the figure format: use a .png, .svg or .pdf file name", out));
 }
 
 void check_scale(double scale) {
@@ -253,7 +253,7 @@ int run_material(const MaterialArgs& a) {
 }
 
 int run_paper(const PaperArgs& a) {
-  if (a.out.empty()) throw UsageError("--out: no folder given");
+  if (a.out.empty()) throw UsageError("--output: no folder given");
   figure::PaperFigureOptions o;
   o.png = o.svg = o.pdf = false;
   for (const std::string& f : split_list(a.formats, "--formats", "format")) {
@@ -319,8 +319,10 @@ Command add_hemisphere(CLI::App& figure) {
       "hemisphere",
       "Figure 1: every incoming direction of the hemisphere for fixed outgoing directions, "
       "coloured by the pair's two non-azimuthal coordinates (red, green)");
-  h->add_option("--param", hemi->params,
-                "Parameterizations, one row each (" + parameterization_names(", ") + ")")
+  h->add_option("--params,--param", hemi->params,
+                "Parameterizations, comma-separated, one row each (" +
+                    parameterization_names(", ") + "; --param is an alias)")
+      ->type_name("PARAM,...")
       ->capture_default_str();
   h->add_option("--elevations", hemi->elevations,
                 "Polar angles θo of ωo from the normal, in degrees, one column each")
@@ -339,7 +341,9 @@ Command add_hemisphere(CLI::App& figure) {
                 "Threads: 0 all cores, 1 the calling thread, n at most n")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  h->add_option("-o,--out", hemi->out, "Output file: .png, .svg or .pdf")->capture_default_str();
+  h->add_option("-o,--output,--out", hemi->out,
+                "Output file: .png, .svg or .pdf (--out is an alias)")
+      ->capture_default_str();
   return {h, [hemi] { return run_hemisphere(*hemi); }};
 }
 
@@ -353,7 +357,10 @@ Command add_slices(CLI::App& figure) {
                 "test:S,G,F (any of the paper's test functions, as isolines), or a BRDF: a "
                 "file (MERL, RGL, ALTA) or a model spec such as ggx:alpha=0.2")
       ->capture_default_str();
-  s->add_option("--param", sl->params, "Parameterizations, one row each")->capture_default_str();
+  s->add_option("--params,--param", sl->params,
+                "Parameterizations, comma-separated, one row each (--param is an alias)")
+      ->type_name("PARAM,...")
+      ->capture_default_str();
   s->add_option("--azimuths", sl->azimuths,
                 "Relative azimuths in degrees (φd for halfdiff, φk − φh for ortho and hybrid), "
                 "one column each")
@@ -361,14 +368,15 @@ Command add_slices(CLI::App& figure) {
   s->add_option("--levels", sl->levels, "Isoline levels of the test functions")
       ->capture_default_str();
   s->add_option("--colour", sl->colour,
-                "For a BRDF: luminance (viridis of log luminance) or rgb (tone-mapped)")
+                "For a BRDF: rgb (tone-mapped) or luminance (viridis of log luminance)")
       ->capture_default_str();
   s->add_option("--scale", sl->scale, "Pixels per point of the PNG (and of the rasters)")
       ->capture_default_str();
   s->add_option("--threads", sl->threads, "Threads: 0 all cores, 1 the calling thread, n at most n")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  s->add_option("-o,--out", sl->out, "Output file: .png, .svg or .pdf")->capture_default_str();
+  s->add_option("-o,--output,--out", sl->out, "Output file: .png, .svg or .pdf (--out is an alias)")
+      ->capture_default_str();
   return {s, [sl] { return run_slices(*sl); }};
 }
 
@@ -379,7 +387,8 @@ Command add_paper(CLI::App& figure) {
       "Figures 1 (three views), 2 and 3-5 (the paper's MERL materials as neural fits, then RGL "
       "measurements and analytic models) on their default settings, into a folder, and print "
       "where they are");
-  p->add_option("-o,--out", pa->out, "Output folder (created if missing)")
+  p->add_option("-o,--output,--out", pa->out,
+                "Output folder (created if missing; --out is an alias)")
       ->type_name("DIR")
       ->required();
   p->add_option("--formats", pa->formats, "Formats to write: png, svg, pdf")->capture_default_str();
@@ -418,7 +427,9 @@ Command add_material(CLI::App& figure) {
                 "Environments: sky, studio, sunset, constant:V, constant:R,G,B or .hdr/.exr "
                 "files, comma-separated")
       ->capture_default_str();
-  m->add_option("--param", ma->params, "Parameterizations, one row of slices each")
+  m->add_option("--params,--param", ma->params,
+                "Parameterizations, comma-separated, one row of slices each (--param is an alias)")
+      ->type_name("PARAM,...")
       ->capture_default_str();
   m->add_option("--azimuths", ma->azimuths, "Relative azimuths of the slices, in degrees")
       ->capture_default_str();
@@ -435,7 +446,8 @@ Command add_material(CLI::App& figure) {
   m->add_option("--threads", ma->threads, "Threads: 0 all cores, 1 the calling thread, n at most n")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  m->add_option("-o,--out", ma->out, "Output file: .png, .svg or .pdf")->capture_default_str();
+  m->add_option("-o,--output,--out", ma->out, "Output file: .png, .svg or .pdf (--out is an alias)")
+      ->capture_default_str();
   return {m, [ma] { return run_material(*ma); }};
 }
 
@@ -449,11 +461,11 @@ Command register_figure(CLI::App& parent) {
   app->require_subcommand(1, 1);
   app->footer(
       "Examples:\n"
-      "  halfback figure paper --out figures\n"
-      "  halfback figure hemisphere --param halfdiff,hybrid --elevations 0,60 --out fig1.pdf\n"
-      "  halfback figure slices --brdf test:S,G,F --azimuths 0,45,90 --out fig2.svg\n"
-      "  halfback figure slices --brdf ggx:alpha=0.1 --colour rgb --out ggx.png\n"
-      "  halfback figure material --brdf embedded:acrylic_felt_green --env studio --out felt.pdf\n"
+      "  halfback figure paper -o figures\n"
+      "  halfback figure hemisphere --params halfdiff,hybrid --elevations 0,60 -o fig1.pdf\n"
+      "  halfback figure slices --brdf test:S,G,F --azimuths 0,45,90 -o fig2.svg\n"
+      "  halfback figure slices --brdf ggx:alpha=0.1 --colour luminance -o ggx.png\n"
+      "  halfback figure material --brdf embedded:acrylic_felt_green --env studio -o felt.pdf\n"
       "See docs/figures.md.");
   // In the order of `halfback figure --help`.
   const Command hemisphere = add_hemisphere(*app), slices = add_slices(*app),

@@ -93,7 +93,7 @@ Command add_train(CLI::App& parent) {
   app->add_option("--param", o->param,
                   "Input: a built-in parameterization's isotropic coordinates instead of the "
                   "authors' (sin theta_h, 0, cos theta_h, d)")
-      ->type_name("P");
+      ->type_name("PARAM");
   app->add_option("--hidden", o->hidden, "Hidden layer widths, comma-separated (1-64 units)")
       ->capture_default_str();
   app->add_option("--samples", o->samples, "Pairs drawn (uniform in theta_h, theta_d, phi_d)")

@@ -27,10 +27,10 @@ struct PlanOptions {
   std::string pilot, pilot_measurements;
   std::string instrument = "light-detector";
   // What the designs learn from: Nielsen's database (or BRDFs whose profiles the learned spacing
-  // takes), a study's profiles, the label of one left out; Nielsen's count and Tikhonov weight.
+  // takes), a study's profiles, the label of one left out; Nielsen's Tikhonov weight (its count
+  // of measurements is the budget).
   std::vector<std::string> database, profiles;
   std::string leave_out;
-  std::size_t count = 0;
   double eta = acquire::NielsenOptions{}.eta;
   // The options of the setup given on the command line (refused with --pilot, whose sidecar
   // holds the setup).
@@ -38,9 +38,9 @@ struct PlanOptions {
 };
 
 // The options that set up a plan, which --pilot takes from the pilot's sidecar instead.
-constexpr const char* kSetupOptions[] = {
-    "--param", "--design",   "--instrument", "--spacing", "--budget",    "--max-theta", "--seed",
-    "--full",  "--database", "--profiles",   "--count",   "--leave-out", "--eta"};
+constexpr const char* kSetupOptions[] = {"--param",    "--design",    "--instrument", "--spacing",
+                                         "--budget",   "--max-theta", "--seed",       "--full",
+                                         "--database", "--profiles",  "--leave-out",  "--eta"};
 
 constexpr double kDeg = 180 / std::numbers::pi;
 
@@ -109,7 +109,7 @@ acquire::AcquisitionPlan main_stage_asked(const PlanOptions& o) {
 acquire::AcquisitionPlan dupuy_jakob_asked(const PlanOptions& o, acquire::Instrument instrument) {
   refuse_options(o,
                  {"--param", "--spacing", "--full", "--max-theta", "--seed", "--database",
-                  "--profiles", "--leave-out", "--count", "--eta"},
+                  "--profiles", "--leave-out", "--eta"},
                  "the layout is Dupuy & Jakob's own (their parameterization, to 90°), sized by "
                  "--budget alone");
   try {
@@ -120,21 +120,24 @@ acquire::AcquisitionPlan dupuy_jakob_asked(const PlanOptions& o, acquire::Instru
 }
 
 acquire::AcquisitionPlan nielsen_asked(const PlanOptions& o, acquire::Instrument instrument) {
-  refuse_options(o, {"--param", "--spacing", "--full", "--budget", "--profiles", "--leave-out"},
-                 "Nielsen's design measures --count configurations of its --database's basis "
+  refuse_options(o, {"--param", "--spacing", "--full", "--profiles", "--leave-out"},
+                 "Nielsen's design measures --budget configurations of its --database's basis "
                  "(MERL's bins)");
   if (o.database.empty())
     throw UsageError("--design nielsen needs its --database (two or more isotropic BRDFs)");
-  if (o.count == 0) throw UsageError("--design nielsen needs --count (measurements, >= 1)");
+  if (std::find(o.setup_given.begin(), o.setup_given.end(), "--budget") == o.setup_given.end())
+    throw UsageError(
+        "--design nielsen needs --budget (its measurements, >= 1; --count is its older "
+        "name)");
   acquire::NielsenOptions options;  // the study's: its reach, seed and Tikhonov weight
   options.max_theta_deg = o.settings.max_theta;
   options.seed = o.settings.seed;
   options.eta = o.eta;
   const auto database = nielsen_database(o.database, options, "--database");
   try {
-    return acquire::nielsen_plan(database, o.count, instrument);
+    return acquire::nielsen_plan(database, o.settings.budget, instrument);
   } catch (const std::invalid_argument& e) {
-    throw UsageError(fmt::format("--{}", e.what()));  // "--count 0: expected 1 to ..."
+    throw UsageError(fmt::format("--{}", e.what()));  // "--budget 0: expected 1 to ..."
   }
 }
 
@@ -162,7 +165,7 @@ acquire::AcquisitionPlan plan_asked(const PlanOptions& o) {
     settings.design = "regular";
     settings.spacing = "learned";
   }
-  refuse_options(o, {"--count", "--eta"}, "those are Nielsen's design's");
+  refuse_options(o, {"--eta"}, "that is Nielsen's design's");
   if (settings.spacing == "learned") {
     if (o.profiles.empty() && o.database.empty())
       throw UsageError(
@@ -251,13 +254,14 @@ Command register_plan(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand(
       "plan", "Measurement plan of a design for a real gonio-reflectometer (CSV + JSON sidecar)");
   app->add_option("--param", o->settings.param, "Parameterization whose cells are measured")
+      ->type_name("PARAM")
       ->capture_default_str();
   app->add_option("--design", o->settings.design,
                   "regular (cell centres), stratified (a random point in each cell), "
                   "sequential (a pilot grid, then a grid where the pilot's values ask: this "
                   "plans the pilot, --pilot the rest), learned (the regular grid in warps "
                   "learned from --profiles or --database), dupuy-jakob (Dupuy & Jakob's layout: "
-                  "the retro-reflection, then with --pilot the slices) or nielsen (--count "
+                  "the retro-reflection, then with --pilot the slices) or nielsen (--budget "
                   "directions of the basis of --database)")
       ->capture_default_str();
   app->add_option("--instrument", o->instrument,
@@ -292,15 +296,14 @@ Command register_plan(CLI::App& parent) {
   app->add_option("--leave-out", o->leave_out,
                   "The learned spacing: the label of a profile not to learn from (as the study "
                   "leaves out the BRDF it studies)");
-  app->add_option("--count", o->count, "Nielsen's design: the measurements (directions)")
-      ->check(CLI::Range(std::size_t{1}, acquire::kMaxSampleBudget));
   app->add_option("--eta", o->eta,
                   "Nielsen's design: the Tikhonov weight of its reconstruction (the study's "
                   "--nielsen-eta)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app->add_option("--budget", o->settings.budget,
-                  "Cells wanted inside the domain (dupuy-jakob: the layout's measurements)")
+  app->add_option("--budget,--count", o->settings.budget,
+                  "Measurements: the cells wanted inside the domain (dupuy-jakob: the layout's "
+                  "measurements; nielsen: its directions, no default; --count is an alias)")
       ->check(CLI::Range(std::size_t{1}, acquire::kMaxSampleBudget))
       ->capture_default_str();
   app->add_flag("--full", o->settings.full, "Plan the full (4D) form, for anisotropic materials");
@@ -325,7 +328,7 @@ Command register_plan(CLI::App& parent) {
       "  halfback plan --design dupuy-jakob --budget 10000 -o retro.csv\n"
       "  halfback plan --design learned --param hybrid --profiles study/profiles/log-32x32x32 "
       "-o learned.csv\n"
-      "  halfback plan --design nielsen --database merl-networks/ --count 20 -o nielsen.csv");
+      "  halfback plan --design nielsen --database merl-networks/ --budget 20 -o nielsen.csv");
   const auto sidecar = [o] {
     const std::filesystem::path csv(o->output);
     if (csv.extension() != ".csv") return std::vector<std::string>{};

@@ -1,6 +1,5 @@
 // halfback render: a unit sphere of any BRDF under an environment map, direct lighting by
 // multiple importance sampling (docs/render.md).
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -81,8 +80,12 @@ int run_render(const RenderOptions& o) {
     warn("render",
          std::to_string(r.nonfinite) +
              " samples were NaN or infinite and were counted as 0 (those pixels are biased dark)");
-  if (!o.quiet && isatty(fileno(stderr)))
-    std::fprintf(stderr, "%s: %d x %d, %d spp, %.2f s (+%.2f s sampler setup), %s\n",
+  // One line, on a terminal or not: a script learns which BRDF sampler was used (with
+  // --brdf-sampling auto: which one was chosen, and the measurement that chose it).
+  if (!o.quiet)
+    std::fprintf(stderr,
+                 "halfback render: %s: %d x %d, %d spp, %.2f s (+%.2f s sampler set-up); BRDF "
+                 "sampler: %s\n",
                  o.output.c_str(), o.width, o.height, r.spp, r.seconds, r.sampler_seconds,
                  r.sampler.c_str());
   return kExitOk;
@@ -139,9 +142,10 @@ Command register_render(CLI::App& parent) {
   app->add_option("--heuristic", o->heuristic, "MIS weights: power or balance")
       ->check(CLI::IsMember({"power", "balance"}))
       ->capture_default_str();
-  app->add_option("--sampling-param", o->sampling,
+  app->add_option("--param,--sampling-param", o->sampling,
                   "parameterization whose chart the tabulated sampler of measured BRDFs uses: " +
-                      parameterization_names())
+                      parameterization_names() + " (--sampling-param is an alias)")
+      ->type_name("PARAM")
       ->check(parameterization_validator())
       ->capture_default_str();
   app->add_option("--brdf-sampling", o->brdf_sampling,
@@ -155,7 +159,9 @@ Command register_render(CLI::App& parent) {
   app->add_option("--threads", o->threads, "worker threads (0: all cores)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  app->add_flag("-q,--quiet", o->quiet, "no progress bar or summary");
+  app->add_flag("-q,--quiet", o->quiet,
+                "no progress bar, and no summary line on stderr (the image's size, samples, "
+                "times and the BRDF sampler used: with auto, the one chosen and why)");
   return {app, [o] { return run_render(*o); }};
 }
 

@@ -95,6 +95,7 @@ Command register_resample(CLI::App& parent) {
       "resample", "Tabulate a BRDF on a regular grid of a parameterization (.exr, .npz, .npy)");
   app->add_option("--brdf", o->brdf, "BRDF SPEC: a MERL, RGL or ALTA file, or a model")->required();
   app->add_option("--param", o->param, "Parameterization: " + parameterization_names())
+      ->type_name("PARAM")
       ->capture_default_str();
   app->add_option("--kind", o->kind,
                   "full (4D), isotropic (3D, phi_h = 0) or slice (2D, at --azimuth)")

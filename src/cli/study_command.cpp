@@ -53,9 +53,9 @@ study::StudyConfig make_config(const StudyOptions& o) {
   if (!o.metrics.empty()) s.metrics = split_list(o.metrics, "--metrics", "metric");
   for (const auto& [key, value] : o.metric_options)
     if (!value.empty()) s.options[key] = value;
-  s.designs = split_list(o.designs, "--designs", "design");
+  s.designs = split_list(o.designs, "--spacings", "spacing");
   if (!o.nielsen_counts.empty())
-    s.nielsen_counts = count_list(o.nielsen_counts, "--nielsen-counts", "measurement count");
+    s.nielsen_counts = count_list(o.nielsen_counts, "--nielsen-budgets", "measurement budget");
   if (!o.params.empty()) s.params = split_list(o.params, "--params", "parameterization");
   try {
     return study::make_config(s);
@@ -307,7 +307,7 @@ void set_nielsen_database(study::StudyConfig& config, const std::vector<std::str
   const std::size_t candidates = config.nielsen->configurations().size();
   if (!config.nielsen_counts.empty() && config.nielsen_counts.back() > candidates)
     throw UsageError(
-        fmt::format("--nielsen-counts: {} measurements asked, Nielsen's database has {} candidate "
+        fmt::format("--nielsen-budgets: {} measurements asked, Nielsen's database has {} candidate "
                     "configurations within --max-theta",
                     config.nielsen_counts.back(), candidates));
   config.nielsen_from = acquire::nielsen_fingerprint(*config.nielsen);
@@ -415,30 +415,36 @@ Command register_study(CLI::App& parent) {
   app->add_option("specs", o->specs,
                   "BRDFs: files (MERL, RGL, ALTA, neural BRDF .h5), directories of files, or model "
                   "specs");
-  app->add_option("-o,--out", o->out, "Output directory (created if missing)")
+  app->add_option("-o,--output,--out", o->out,
+                  "Output directory (created if missing; --out is an alias)")
       ->type_name("DIR")
       ->capture_default_str();
   app->add_option("--params", o->params,
                   "Parameterizations compared, comma-separated, in the order of the tables: " +
-                      parameterization_names(", ") + " (default: all of them, spherical last)");
+                      parameterization_names(", ") + " (default: all of them, spherical last)")
+      ->type_name("PARAM,...");
   app->add_option("--space,--error-space", o->settings.space,
                   "Error space: linear, log (ln(1 + Y)), cbrt (Y^(1/3)), nielsen (Nielsen et al. "
                   "2015's log-relative mapping) or low (Low et al. 2012's cosine-weighted log)")
       ->capture_default_str();
-  app->add_option("--designs", o->designs,
-                  "Designs of the gonio-reflectometer, comma-separated: own (uniform in the "
-                  "coordinates), angle (sine-like magnitudes through asin), merl (angle, and sqrt "
-                  "of the half-vector angle), learned (warps fitted on the other BRDFs' profiles, "
-                  "computed first and kept in OUT/profiles/)")
+  app->add_option("--spacings,--designs", o->designs,
+                  "Spacings of the gonio-reflectometer's cells, comma-separated: own (uniform in "
+                  "the coordinates), angle (sine-like magnitudes through asin), merl (angle, and "
+                  "sqrt of the half-vector angle), learned (warps fitted on the other BRDFs' "
+                  "profiles, computed first and kept in OUT/profiles/); each is measured in the "
+                  "regular and the stratified design (--designs is an alias)")
       ->capture_default_str();
   app->add_flag("--quick", o->settings.quick,
                 "A small study: 24 x 24 x 32 grids, budgets 1000,10000, 20000 test pairs, "
                 "48^2 images");
   app->add_option("--budgets", o->budgets,
-                  "Gonio-reflectometer budgets, ascending (default 1000,3000,10000,30000,100000)");
+                  "Gonio-reflectometer budgets, ascending, comma-separated (default "
+                  "1000,3000,10000,30000,100000)")
+      ->type_name("N,...");
   app->add_option("--budgets-4d", o->budgets_4d,
-                  "Budgets of the 4D gonio-reflectometer of anisotropic BRDFs "
-                  "(default 1000,10000,100000,1000000)");
+                  "Budgets of the 4D gonio-reflectometer of anisotropic BRDFs, comma-separated "
+                  "(default 1000,10000,100000,1000000)")
+      ->type_name("N,...");
   app->add_option("--test-pairs", o->settings.test_pairs,
                   "Pairs the reconstructions are checked at (default 200000)")
       ->check(CLI::Range(std::size_t(100), study::kMaxTestPairs));
@@ -471,9 +477,10 @@ Command register_study(CLI::App& parent) {
                   "design nielsen (docs/acquisition.md)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  app->add_option("--nielsen-counts", o->nielsen_counts,
-                  "Measurement counts of Nielsen's design, ascending, comma-separated (default "
-                  "1,2,5,10,20,40,100)");
+  app->add_option("--nielsen-budgets,--nielsen-counts", o->nielsen_counts,
+                  "Measurement budgets of Nielsen's design, ascending, comma-separated (default "
+                  "1,2,5,10,20,40,100; --nielsen-counts is an alias)")
+      ->type_name("N,...");
   app->add_option("--nielsen-eta", o->nielsen_eta,
                   "Tikhonov weight of Nielsen's reconstruction (their release's example: 40)")
       ->capture_default_str();
@@ -481,11 +488,11 @@ Command register_study(CLI::App& parent) {
   app->add_flag("--full-report", o->full_report,
                 "The whole report on stdout (by default: its summary and where the files are)");
   app->add_flag("--resume", o->resume,
-                "Continue an interrupted run in --out: the BRDFs whose results it holds "
+                "Continue an interrupted run in --output: the BRDFs whose results it holds "
                 "(OUT/parts/) are not studied again (same options required)");
   app->add_option("--merge", o->merge,
-                  "Write the report of the results of several runs (their --out directories, "
-                  "with the same options) into --out, instead of studying BRDFs")
+                  "Write the report of the results of several runs (their --output directories, "
+                  "with the same options) into --output, instead of studying BRDFs")
       ->expected(1, -1);
   app->footer(
       "Metrics (docs/study.md), under the measure cos(theta_i) cos(theta_o) dwi dwo:\n"
@@ -496,16 +503,17 @@ Command register_study(CLI::App& parent) {
       "                    (3), the 4D table as (a, phi_a) x (b, phi_b) (4)\n"
       "  gonio.csv         brdf,parameterization,design,samples,error,dims,budget,spacing: the\n"
       "                    virtual gonio-reflectometer (regular and stratified layouts; the\n"
-      "                    spacing of --designs)\n"
+      "                    spacing of --spacings)\n"
       "  budget.csv        the samples each needs to reach errors of 0.05, 0.02, 0.01\n"
       "  image.csv         brdf,parameterization,design,samples,environment,relative_rmse,\n"
       "                    mean_delta_e2000,p95_delta_e2000,mae,rmse,ssim\n"
       "  parts/            each BRDF's results as soon as it is finished (--resume, --merge)\n"
       "  profiles/         each BRDF's profile for the learned design (--resume reuses them)\n"
       "Examples:\n"
-      "  halfback study --out study ggx:alpha=0.2 ../shared/data/rgl\n"
-      "  halfback study --out study --resume ggx:alpha=0.2 ../shared/data/rgl   (after Ctrl-C)\n"
-      "  halfback study --merge run1 run2 --out all");
+      "  halfback study --output study ggx:alpha=0.2 ../shared/data/rgl\n"
+      "  halfback study --output study --resume ggx:alpha=0.2 ../shared/data/rgl   (after "
+      "Ctrl-C)\n"
+      "  halfback study --merge run1 run2 --output all");
   return {app, [o] { return o->merge.empty() ? run_study(*o) : run_merge(*o); }};
 }
 

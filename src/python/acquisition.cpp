@@ -3,6 +3,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -72,6 +73,7 @@ py::dict plan(const std::string& param, const std::string& design, std::size_t b
   if (!instrument)
     throw py::value_error("instrument '" + instrument_name +
                           "': expected light-detector or sample-turning");
+  max_theta = reach_degrees(max_theta, "max_theta");  // radians in, degrees for plan_setup
   acquire::AcquisitionPlan a;
   if (design == "dupuy-jakob") {  // its own layout: the budget alone (a ValueError below it)
     {
@@ -133,13 +135,14 @@ double plan_error(const std::string& sidecar, const py::object& values, const py
     throw py::value_error("space '" + space + "': expected linear, log, cbrt, nielsen or low");
   if (test_pairs < 100 || test_pairs > 10000000)
     throw py::value_error("test_pairs: expected 100 to 10000000");
+  const double reach = reach_degrees(max_theta, "max_theta");
   const acquire::AcquisitionPlan a = sidecar_plan(sidecar);
   const std::vector<Rgb> v = row_values(values, a.measured.size());
   const BrdfPtr t = brdf_of(truth);
   py::gil_scoped_release release;
   const auto reconstruction = acquire::reconstruct_any(a, v, "measured");
   return acquire::reconstruction_error(
-      *reconstruction, acquire::draw_test_pairs(*t, test_pairs, seed, *es, max_theta));
+      *reconstruction, acquire::draw_test_pairs(*t, test_pairs, seed, *es, reach));
 }
 
 py::dict reconstruct(const std::string& sidecar, const py::object& values, const std::string& out,
@@ -169,10 +172,25 @@ py::dict reconstruct(const std::string& sidecar, const py::object& values, const
 
 }  // namespace
 
+double reach_degrees(double max_theta, std::string_view argument) {
+  constexpr double lo = std::numbers::pi / 180, hi = std::numbers::pi / 2;
+  if (!(max_theta >= lo * (1 - 1e-12) && max_theta <= hi * (1 + 1e-12))) {
+    const std::string v = py::repr(py::float_(max_theta)).cast<std::string>();
+    throw py::value_error(std::string(argument) + " = " + v +
+                          ": the reach is in radians, from pi/180 to pi/2 (1 to 90 degrees); "
+                          "every angle of the Python API is in radians (for degrees: "
+                          "math.radians(" +
+                          v + "))");
+  }
+  // Rounded to 1e-9 degrees, so that math.radians(85) is 85 degrees exactly: the settings a study
+  // records (and merge_study compares) are the CLI's --max-theta 85.
+  return std::clamp(std::round(max_theta * kDeg * 1e9) / 1e9, 1.0, 90.0);
+}
+
 void bind_acquisition(py::module_& m) {
   m.def("plan", &plan, py::arg("param") = "hybrid", py::arg("design") = "regular",
         py::arg("budget") = 10000, py::arg("spacing") = "own", py::arg("full") = false,
-        py::arg("max_theta") = 90.0, py::arg("seed") = 1, py::arg("instrument") = "light-detector",
+        py::arg("max_theta") = std::numbers::pi / 2, py::arg("seed") = 1, py::arg("instrument") = "light-detector",
         R"doc(The measurement plan of a design for a gonio-reflectometer, as `halfback plan`
 (docs/acquisition.md): a dict of positions_deg (rows x 4, degrees: the motors named in motors,
 light zenith, light azimuth, detector zenith, detector azimuth for the light-detector instrument;
@@ -181,7 +199,8 @@ one), wi and wo (rows x 3), row_of_point (the row each point of the design takes
 cell_order_travel_deg, and sidecar (the JSON text that reconstruct() reads; save it beside your
 measurements), positions (the same angles in radians). The sequential design's plan is its pilot,
 Dupuy & Jakob's ("dupuy-jakob", sized by budget alone) its retro-reflection: plan_main() plans
-the rest from their values.)doc");
+the rest from their values. max_theta: the instrument's reach from the normal, in radians (as every
+angle of the Python API; `halfback plan --max-theta` takes degrees), from pi/180 to pi/2.)doc");
   m.def(
       "plan_main", &plan_main, py::arg("pilot"), py::arg("values"),
       R"doc(The main stage of a two-stage plan from its pilot, as `halfback plan --pilot`: pilot is
@@ -190,11 +209,12 @@ PLAN.json path), values the values measured at its rows ((rows, 3) or (rows,); N
 Dupuy & Jakob's layout needs every row). Returns a dict as plan() does; its "sidecar" is what
 reconstruct() reads.)doc");
   m.def("plan_error", &plan_error, py::arg("plan"), py::arg("values"), py::arg("truth"),
-        py::arg("test_pairs") = 200000, py::arg("seed") = 1, py::arg("max_theta") = 85.0,
+        py::arg("test_pairs") = 200000, py::arg("seed") = 1,
+        py::arg("max_theta") = 85 * std::numbers::pi / 180,
         py::arg("space") = "log",
         R"doc(The study's error (metric 3, docs/study.md) of the reconstruction of a plan's
 measured values against `truth` (a spec or Brdf): the relative error over test_pairs pairs drawn
-from the measure within max_theta degrees (the study's defaults), in the error space `space`. For a
+from the measure within max_theta radians of the normal (the study's defaults: 85 degrees), in the error space `space`. For a
 plan of design `learned`, `sequential` (its main stage) or `dupuy-jakob` (its slices), the number
 the study reports for that design and budget when the values are the truth's.)doc");
   m.def("_reconstruct", &reconstruct, py::arg("plan"), py::arg("values"), py::arg("out"),

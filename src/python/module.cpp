@@ -360,11 +360,14 @@ py::dict resample_brdf(const PyBrdf& b, const std::string& param, const std::str
                        const py::object& size, double azimuth, bool nodes, const py::dict& ranges) {
   const Space space = parse_space(param, "param");
   const std::vector<std::size_t> counts = grid_counts(size);
-  // Radians, as every angle of the Python API (the CLI's --azimuth is in degrees); wrapped into
-  // [0, 2π) as the CLI wraps (class 8).
-  if (!std::isfinite(azimuth))
-    throw py::value_error("azimuth: " + python_repr(py::float_(azimuth)) +
-                          " is not a finite angle in radians");
+  // Radians, as every angle of the Python API (the CLI's --azimuth is in degrees), from -2π to
+  // 2π, wrapped into [0, 2π): a value beyond is refused rather than wrapped, since it is most
+  // likely in degrees (azimuth=90 would silently be 90 - 28π radians).
+  if (!(std::abs(azimuth) <= 2 * std::numbers::pi))
+    throw py::value_error("azimuth = " + python_repr(py::float_(azimuth)) +
+                          ": expected radians from -2 pi to 2 pi (every angle of the Python API "
+                          "is in radians; for degrees: math.radians(" +
+                          python_repr(py::float_(azimuth)) + "))");
   GridSpec g = default_grid(space, parse_kind(kind), counts, wrap_azimuth_radians(azimuth));
   g.sampling = nodes ? GridSampling::nodes : GridSampling::centres;
   for (const auto& [key, value] : ranges) {
@@ -449,9 +452,9 @@ py::dict hemisphere_view(const std::string& param, double theta_o, std::size_t p
   return d;
 }
 
-py::array_t<float> render_brdf(const PyBrdf& b, const std::string& env, int width, int height,
-                               int spp, std::uint64_t seed, const std::string& strategy,
-                               int threads, const std::string& brdf_sampling) {
+py::object render_brdf(const PyBrdf& b, const std::string& env, int width, int height, int spp,
+                       std::uint64_t seed, const std::string& strategy, int threads,
+                       const std::string& brdf_sampling) {
   render::RenderSettings s;
   s.width = width;
   s.height = height;
@@ -475,7 +478,8 @@ py::array_t<float> render_brdf(const PyBrdf& b, const std::string& env, int widt
   }
   py::array_t<float> img({py::ssize_t(r.image.height), py::ssize_t(r.image.width), py::ssize_t(3)});
   std::copy(r.image.rgb.begin(), r.image.rgb.end(), img.mutable_data());
-  return img;
+  // The array, with the BRDF sampler used (the line `halfback render` prints on stderr).
+  return py::module_::import("halfback").attr("RenderedImage")(img, r.sampler);
 }
 
 void bind_conversions(py::module_& m) {
@@ -601,7 +605,8 @@ a direction that is not a unit vector raises ValueError naming the row.)doc")
            R"doc(The BRDF on a regular grid of a parameterization (as `halfback resample`).
 
 kind: "full" (4 axes), "isotropic" (3 axes, phi_h = 0) or "slice" (2 axes at relative azimuth
-`azimuth`, in radians, wrapped into [0, 2 pi): every angle of the Python API is in radians). size: samples per axis, an int or one per axis. Samples at cell centres,
+`azimuth`, in radians from -2 pi to 2 pi, wrapped into [0, 2 pi): every angle of the Python API is
+in radians; a value beyond is a ValueError). size: samples per axis, an int or one per axis. Samples at cell centres,
 or at nodes including both ends with nodes=True. ranges: {axis name: (lo, hi)}.
 Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape...) bool, axes
 (sample positions), axis_names, metadata.)doc")
@@ -615,7 +620,9 @@ brdf_sampling (a BRDF without a sampler of its own): "table", "cosine", or "auto
 the cosine's samples miss energy that the table finds, or when the BRDF is peaked for this
 environment, its albedo variance under the cosine at least a threshold times the table's that
 rises as the environment leaves less of its light to the BRDF sampler; else the cosine; as
-`halfback render --brdf-sampling`, docs/render.md).)doc")
+`halfback render --brdf-sampling`, docs/render.md). The array is a halfback.RenderedImage (a numpy
+array) whose `sampler` says which BRDF sampler was used and, when "auto" chose it, why (the
+measured albedo variance ratio and its threshold), as `halfback render` says on stderr.)doc")
       .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; })
       .def_property_readonly(
           "spec", [](const PyBrdf& b) { return b.spec; },

@@ -15,6 +15,7 @@
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
 #include "halfback/util/output_dir.hpp"
+#include "acquisition.hpp"
 #include "py_brdf.hpp"
 
 namespace py = pybind11;
@@ -92,7 +93,7 @@ void read_setting(PySettings& out, const std::string& key, const py::handle& v) 
     s.params = setting<std::vector<std::string>>(v, key);
   else if (key == "space" || key == "error_space")
     s.space = setting<std::string>(v, key);
-  else if (key == "designs") {
+  else if (key == "spacings" || key == "designs") {  // "designs": the older name
     s.designs = setting<std::vector<std::string>>(v, key);
     out.designs_given = true;
   } else if (key == "profiles") {
@@ -116,15 +117,15 @@ void read_setting(PySettings& out, const std::string& key, const py::handle& v) 
     s.image_size = setting<int>(v, key);
   else if (key == "image_spp")
     s.image_spp = setting<int>(v, key);
-  else if (key == "max_theta")
-    s.max_theta = setting<double>(v, key);
+  else if (key == "max_theta")  // radians, as every angle of the Python API
+    s.max_theta = reach_degrees(setting<double>(v, key), "settings[\"max_theta\"]");
   else if (key == "seed")
     s.seed = setting<std::uint64_t>(v, key);
   else if (key == "env")
     s.environments = setting<std::vector<std::string>>(v, key);
   else
     throw py::value_error("settings: unknown key '" + key +
-                          "' (accepted: params, space, designs, profiles, quick, budgets, "
+                          "' (accepted: params, space, spacings, profiles, quick, budgets, "
                           "budgets_4d, test_pairs, env, image_budget, image_size, image_spp, "
                           "max_theta, seed, metrics, " +
                           metric_setting_keys() + ")");
@@ -314,11 +315,13 @@ Returns a dict: relative_rmse, mean_delta_e2000, p95_delta_e2000, mae, rmse, ssi
 
 spec: a file or model spec, as for load(). settings: a dict of the options of `halfback study`
 with '-' spelled '_': params (a list of parameterization names; missing: all of them, spherical
-last), space (the error space), designs (a list), quick, budgets, budgets_4d,
-test_pairs, env (a list), image_budget, image_size, image_spp, max_theta, seed, metrics (a list
+last), space (the error space), spacings (a list; "designs" is its older name), quick, budgets,
+budgets_4d, test_pairs, env (a list), image_budget, image_size, image_spp, max_theta (the
+reach, in radians as every angle of the Python API, from pi/180 to pi/2; default 85 degrees;
+`halfback study --max-theta` takes degrees), seed, metrics (a list
 of the metrics to run), and per metric of the study's list no_NAME (no_gonio, no_images,
 no_sampling, no_fit) and its options (sampler_kib (a list), sampler_samples, fit_model, fit_loss,
-fit_budgets (a list), fit_samples) (missing: the defaults), and, for the learned design (a default design), profiles: the
+fit_budgets (a list), fit_samples) (missing: the defaults), and, for the learned spacing (a default one), profiles: the
 study_profile() texts of every BRDF of the study, this one's included, in the study's order (the
 warps are learned from all but this one's; without them, a ValueError).
 Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image": one

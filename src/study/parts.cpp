@@ -146,12 +146,12 @@ StudyConfig make_config(const StudySettings& o) {
     const auto spacing = parse_spacing(name);
     if (!spacing)
       throw std::invalid_argument(
-          fmt::format("--designs: '{}' is not a design (own, angle, merl or learned)", name));
+          fmt::format("--spacings: '{}' is not a spacing (own, angle, merl or learned)", name));
     if (std::find(c.spacings.begin(), c.spacings.end(), *spacing) != c.spacings.end())
-      throw std::invalid_argument(fmt::format("--designs: '{}' is given twice", name));
+      throw std::invalid_argument(fmt::format("--spacings: '{}' is given twice", name));
     c.spacings.push_back(*spacing);
   }
-  if (c.spacings.empty()) throw std::invalid_argument("--designs: no design given");
+  if (c.spacings.empty()) throw std::invalid_argument("--spacings: no spacing given");
   if (o.quick) apply_quick(c);
   check_ascending(o.budgets, "--budgets");
   check_ascending(o.budgets_4d, "--budgets-4d");
@@ -162,7 +162,7 @@ StudyConfig make_config(const StudySettings& o) {
   if (o.image_spp) c.image_spp = o.image_spp;
   check_metric_names(o);
   apply_options(o, c);
-  check_ascending(o.nielsen_counts, "--nielsen-counts");
+  check_ascending(o.nielsen_counts, "--nielsen-budgets");
   if (!o.nielsen_counts.empty()) c.nielsen_counts = o.nielsen_counts;
   c.seed = o.seed;
   c.max_theta_deg = o.max_theta;
@@ -609,7 +609,7 @@ void merge_into(MergedParts& into, const std::string& settings, const std::strin
         "'{}' and '{}' were run with different settings{}", into.source_of.begin()->second, source,
         learned_only ? " (their learned designs come from different sets of BRDFs: run the "
                        "study over all of them, or pass every profile to study_brdf, or leave "
-                       "out the learned design with --designs own,angle,merl)"
+                       "out the learned spacing with --spacings own,angle,merl)"
                      : ""));
   }
   for (BrdfResult& b : results) {

@@ -255,7 +255,7 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
        "halfback convert: error: --from: unknown coordinates 'hybird' (expected one of: " +
            space_names() + kFamilies + ")\n" + hint},
       {{"render", "--brdf", "lambert", "--sampling-param", "polar", "-o", "never.png"},
-       "halfback render: error: --sampling-param: unknown parameterization 'polar' (expected one "
+       "halfback render: error: --param: unknown parameterization 'polar' (expected one "
        "of: " +
            parameterization_names(", ") + kFamilies +
            ")\nRun 'halfback render --help' for more information.\n"},
@@ -749,7 +749,7 @@ TEST_F(CliTest, ExitStatusesOfFilesThatOptionsName) {
   };
   rows.push_back({nielsen, 1, "not finite"});
   rows.back().args.insert(rows.back().args.end(), {"--nielsen-database", "holes.binary"});
-  rows.push_back({nielsen, 2, "--nielsen-counts: 1000000 measurements asked"});
+  rows.push_back({nielsen, 2, "--nielsen-budgets: 1000000 measurements asked"});
   rows.back().args.insert(rows.back().args.end(),
                           {"--nielsen-database", "lambert", "--nielsen-counts", "1000000"});
   for (const Row& row : rows) {
@@ -1262,7 +1262,7 @@ TEST_F(CliTest, NielsenAndLearnedPlans) {
            {{"plan", "--design", "nielsen", "--count", "3"}, 2, "needs its --database"},
            {{"plan", "--design", "nielsen", "--database", "lambert", "--database", "ggx"},
             2,
-            "needs --count"},
+            "needs --budget"},
            {{"plan", "--design", "nielsen", "--count", "3", "--database", "lambert"},
             2,
             "at least two"},
@@ -1270,11 +1270,11 @@ TEST_F(CliTest, NielsenAndLearnedPlans) {
              "--database", "lambert"},
             2,
             "no-such.binary"},
-           {too_many, 2, "--count 1000000: expected 1 to"},
-           {{"plan", "--design", "nielsen", "--count", "3", "--budget", "10", "--database",
-             "lambert", "--database", "ggx"},
+           {too_many, 2, "--budget 1000000: expected 1 to"},
+           {{"plan", "--design", "nielsen", "--budget", "3", "--eta", "1", "--database", "lambert",
+             "--database", "ggx", "--full"},
             2,
-            "--budget with --design nielsen"},
+            "--full with --design nielsen"},
            {{"plan", "--design", "learned"}, 2, "needs what to learn from"},
            {{"plan", "--design", "learned", "--database", "lambert", "--leave-out", "lambert"},
             2,
@@ -2668,7 +2668,7 @@ TEST_F(CliTest, StudyWithNielsensDatabase) {
     r = run({"study", "--quick", "--params", "halfdiff", "--nielsen-database", "lambert",
              "--nielsen-counts", counts, "-o", "s4", "lambert"});
     EXPECT_EQ(r.status, 2) << counts << ": " << r.err;
-    EXPECT_NE(r.err.find("--nielsen-counts"), std::string::npos) << counts << ": " << r.err;
+    EXPECT_NE(r.err.find("--nielsen-budgets"), std::string::npos) << counts << ": " << r.err;
   }
   r = run({"study", "--quick", "--params", "hybrid", "--nielsen-database", "lambert", "-o", "s2",
            "lambert"});
@@ -2691,7 +2691,7 @@ TEST_F(CliTest, StudyBadInput) {
       << r.err;
   r = run({"study", "--designs", "own,uniform", "lambert"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("'uniform' is not a design"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--spacings: 'uniform' is not a spacing"), std::string::npos) << r.err;
   fs::create_directories(path("empty"));
   r = run({"study", "-o", "st", "empty"});
   EXPECT_EQ(r.status, 2);

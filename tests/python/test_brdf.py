@@ -241,19 +241,23 @@ def test_isotropic_needs_a_parameterization_on_one_side():
         assert r.returncode == 2 and "isotropic needs a parameterization" in r.stderr
 
 
-def test_slice_azimuths_wrap_into_0_2pi_and_nan_raises():
-    # Radians, as every angle of the Python API (docs/reliability/python.md).
+def test_slice_azimuths_wrap_into_0_2pi_and_beyond_two_turns_raise():
+    # Radians, as every angle of the Python API (docs/reliability/python.md), from -2 pi to 2 pi:
+    # a value beyond (90, meant as degrees) is refused, not wrapped.
     b = halfback.load("ggx:alpha=0.3")
     ref = b.resample("hybrid", "slice", 12, azimuth=1.5 * np.pi)
     assert ref["valid"].any()
     assert ref["metadata"]["slice_azimuth"] == pytest.approx(1.5 * np.pi)
-    for az in (-0.5 * np.pi, 3.5 * np.pi, 1.5 * np.pi - 20 * np.pi):
+    for az in (-0.5 * np.pi, np.nextafter(-0.5 * np.pi, 0)):
         t = b.resample("hybrid", "slice", 12, azimuth=az)
         np.testing.assert_array_equal(t["valid"], ref["valid"])
         np.testing.assert_allclose(t["rho"], ref["rho"], rtol=1e-12)  # fmod's last bit
         assert t["metadata"]["slice_azimuth"] == pytest.approx(ref["metadata"]["slice_azimuth"])
-    for az in (float("nan"), float("inf")):
-        with pytest.raises(ValueError, match="azimuth"):
+    zero = b.resample("hybrid", "slice", 12, azimuth=0.0)
+    np.testing.assert_array_equal(b.resample("hybrid", "slice", 12, azimuth=2 * np.pi)["rho"],
+                                  zero["rho"])
+    for az in (3.5 * np.pi, -2.5 * np.pi, 90.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="azimuth.*radians"):
             b.resample("hybrid", "slice", 12, azimuth=az)
 
 

@@ -137,7 +137,7 @@ def test_fit_samples_have_the_cli_bound():
 
 
 def test_plan_and_reconstruct(tmp_path):
-    p = halfback.plan("halfdiff", budget=400, max_theta=85)
+    p = halfback.plan("halfdiff", budget=400, max_theta=np.radians(85))
     rows = p["positions_deg"].shape[0]
     assert p["wi"].shape == (rows, 3) and p["wo"].shape == (rows, 3)
     assert (p["positions_deg"][:, 1] == 0).all()  # the light at azimuth 0 (isotropy)
@@ -161,7 +161,7 @@ def test_plan_and_reconstruct(tmp_path):
     with pytest.raises(ValueError, match="design 'sobol'"):
         halfback.plan(design="sobol")
     # The sample-turning instrument: the same rows, its motors; the tilt is θi.
-    s = halfback.plan("halfdiff", budget=400, max_theta=85, instrument="sample-turning")
+    s = halfback.plan("halfdiff", budget=400, max_theta=np.radians(85), instrument="sample-turning")
     assert s["motors"] == ["sample_tilt", "sample_spin", "detector_zenith", "detector_azimuth"]
     assert s["positions_deg"].shape == p["positions_deg"].shape
     assert np.allclose(s["positions_deg"][:, 0], np.degrees(np.arccos(s["wi"][:, 2])))

@@ -24,14 +24,14 @@ def study_error(design, budget, settings):
 
 def test_sequential_main_stage_is_the_studys_design(tmp_path):
     truth = halfback.load(TRUTH)
-    pilot = halfback.plan("halfdiff", design="sequential", budget=3000, max_theta=85)
+    pilot = halfback.plan("halfdiff", design="sequential", budget=3000, max_theta=np.radians(85))
     # Every angle of the Python API in radians; the CSV's degrees beside them.
     assert np.allclose(pilot["positions"], np.radians(pilot["positions_deg"]))
     values = truth.eval(pilot["wi"], pilot["wo"])
     main = halfback.plan_main(pilot["sidecar"], values)
     assert '"stage":"main"' in main["sidecar"] and '"learned_warps"' in main["sidecar"]
     measured = truth.eval(main["wi"], main["wo"])
-    error = halfback.plan_error(main["sidecar"], measured, truth, test_pairs=20000, max_theta=85)
+    error = halfback.plan_error(main["sidecar"], measured, truth, test_pairs=20000, max_theta=np.radians(85))
     settings = {"params": ["halfdiff"], "budgets": [3000], "designs": ["own"],
                 "test_pairs": 20000, "no_images": True, "no_sampling": True, "no_fit": True}
     assert error == pytest.approx(study_error("sequential", 3000, settings), rel=1e-9)
@@ -104,7 +104,7 @@ def test_learned_plan_from_a_studys_profiles_is_the_studys_design(tmp_path):
     wo = np.stack([table["wo_x"], table["wo_y"], table["wo_z"]], axis=1)
     truth = halfback.load(TRUTH)
     error = halfback.plan_error(tmp_path / "l.json", truth.eval(wi, wo), truth, test_pairs=20000,
-                               max_theta=85)
+                               max_theta=np.radians(85))
     assert error == pytest.approx(study[0], rel=1e-9)
     # Without TRUTH left out, its own profile is learned from: other warps, another error.
     done = subprocess.run([cli, "plan", "--design", "learned", "--param", "halfdiff", "--budget",

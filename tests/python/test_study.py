@@ -67,7 +67,7 @@ def test_bad_settings_are_clear_errors():
         halfback.study_brdf("lambert", {"budget": [100]})
     with pytest.raises(ValueError, match="--error-space 'sqrt'"):
         halfback.study_brdf("lambert", {"space": "sqrt"})
-    with pytest.raises(ValueError, match="--designs: 'sqrt' is not a design"):
+    with pytest.raises(ValueError, match="--spacings: 'sqrt' is not a spacing"):
         halfback.study_brdf("lambert", {"designs": ["own", "sqrt"]})
     # The learned design, asked for, without the profiles it learns from (left out of the
     # defaults when there are none: test_study_brdf_defaults_work_alone).

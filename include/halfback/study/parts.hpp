@@ -25,7 +25,7 @@ struct StudySettings {
   // --params: names of parameterizations (space_from_name); empty: default_studied().
   std::vector<std::string> params;
   std::string space = "log";  // --error-space: parse_error_space()
-  // --designs: parse_spacing() names. `learned` needs the profiles of the study's BRDFs (below).
+  // --spacings: parse_spacing() names. `learned` needs the profiles of the study's BRDFs (below).
   std::vector<std::string> designs{"own", "angle", "merl", "learned"};
   bool quick = false;
   // --metrics: the metrics to run (metric.hpp's names); empty: those on by default. Metrics that
@@ -36,7 +36,7 @@ struct StudySettings {
   // The metrics' options given (MetricOption::key -> text, e.g. fit_budgets -> "1000,3000");
   // those not given take their default (or --quick's).
   std::map<std::string, std::string> options;
-  // --nielsen-counts (empty: the default); the database itself is StudyConfig::nielsen.
+  // --nielsen-budgets (empty: the default); the database itself is StudyConfig::nielsen.
   std::vector<std::size_t> nielsen_counts;
   std::vector<std::size_t> budgets, budgets_4d;
   std::size_t test_pairs = 0, image_budget = 0;
@@ -47,7 +47,7 @@ struct StudySettings {
 };
 
 // The configuration of the settings (environments loaded). Throws std::invalid_argument naming
-// the option (--error-space, --designs, --budgets, ...) and what it accepts.
+// the option (--error-space, --spacings, --budgets, ...) and what it accepts.
 StudyConfig make_config(const StudySettings& settings);
 
 // Whether `config` asks for the learned design (then each BRDF needs the others' profiles).
