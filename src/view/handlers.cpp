@@ -351,7 +351,7 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end && !budget.expired(); ++k)
           fields[k] = slice_field(*brdfs[k / forms.size()], forms[k % forms.size()], radians, n,
-                                  threads, values, pose);
+                                  threads, values, pose, [&] { return budget.expired(); });
       },
       threads);
   budget.check("the slices");
@@ -366,7 +366,8 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
   return res;
 }
 
-Response hemisphere_response(const Catalog& catalog, const Request& request, int threads) {
+Response hemisphere_response(const Catalog& catalog, const Request& request, int threads,
+                             const Budget& budget) {
   const std::string* colour = request.param("colour");
   ViewForm space;
   if (colour && *colour != "rho") space = space_param(catalog, request, "colour", true);
@@ -375,8 +376,11 @@ Response hemisphere_response(const Catalog& catalog, const Request& request, int
   const RhoValues values = space.is_dirs() ? values_param(request) : RhoValues::rgb;
   BrdfPtr brdf;
   if (space.is_dirs()) brdf = catalog.brdf(required(request, "brdf"));
-  return floats(hemisphere_field(brdf.get(), space, wo, n, threads, values), n, n,
-                channels_of(values));
+  budget.check("the hemisphere");
+  const std::vector<float> field =
+      hemisphere_field(brdf.get(), space, wo, n, threads, values, [&] { return budget.expired(); });
+  budget.check("the hemisphere");
+  return floats(field, n, n, channels_of(values));
 }
 
 Response polar_response(const Catalog& catalog, const Request& request) {
@@ -530,7 +534,8 @@ Response render_response(const Catalog& catalog, const Request& request, int thr
 
 // The sphere under a distant light from (theta_l, phi_l) in camera space (degrees; θ = 0: from
 // the camera, φ = 0: from the right), evaluated at k × k positions per pixel (no noise).
-Response point_light_response(const Catalog& catalog, const Request& request, int threads) {
+Response point_light_response(const Catalog& catalog, const Request& request, int threads,
+                              const Budget& budget) {
   render::RenderSettings s;
   s.width = s.height = int(whole(request, "size", 128, 8, std::size_t(kMaxRenderSide)));
   s.spp = int(whole(request, "spp", 4, 1, std::size_t(kMaxRenderSpp)));
@@ -540,7 +545,15 @@ Response point_light_response(const Catalog& catalog, const Request& request, in
   const Vec3<double> light{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
                            std::cos(theta)};
   const BrdfPtr brdf = catalog.brdf(required(request, "brdf"));
-  const render::RenderResult result = render::render_point_light(*brdf, light, s);
+  budget.check("the point-light image");
+  s.time_budget = std::max(budget.seconds_left(), 1e-3);  // checked at every row of the image
+  render::RenderResult result;
+  try {
+    result = render::render_point_light(*brdf, light, s);
+  } catch (const render::TimeBudgetExceeded&) {
+    budget.check("the point-light image");
+    throw RequestError(503, "the point-light image was not complete within its time");
+  }
   Response res = floats(result.image.rgb, std::size_t(s.width), std::size_t(s.height), 3);
   res.headers.emplace_back("X-Halfback-Spp", std::to_string(result.spp));
   return res;
