@@ -89,8 +89,16 @@ artifacts="$build/artifacts"
 mkdir -p "$artifacts"
 
 status=0
-# Seeds of the plans' sidecars: small plans written by the planner itself, and broken ones.
-"$build/fuzz/make_plan_seeds" "$corpus/plan"
+# Seeds of the plans' sidecars: small plans written by the planner itself (the pilots that
+# `plan --pilot` reads among them), broken ones, and sidecars above 1 MiB in plan_big.
+"$build/fuzz/make_plan_seeds" "$corpus/plan" "$corpus/plan_big"
+# The sidecars above 1 MiB, each run once (the fuzzing below cuts its inputs at -max_len).
+echo "== plan_fuzz: the sidecars above 1 MiB, once each"
+if ! "$build/fuzz/plan_fuzz" "$corpus"/plan_big/*.json 2>"$build/plan_big_fuzz.log"; then
+  echo "plan_fuzz FAILED on a sidecar above 1 MiB; see $build/plan_big_fuzz.log" >&2
+  tail -40 "$build/plan_big_fuzz.log" >&2
+  status=1
+fi
 for target in merl rgl alta npy h5 factored envmap view view_wire plan; do
   case "$target" in
     merl) max_len=4096 ;;     # full-size files are built inside the target

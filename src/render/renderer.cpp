@@ -594,11 +594,22 @@ RenderResult render_point_light(const Brdf& brdf, const Vec3<double>& light,
   r.image.width = s.width;
   r.image.height = s.height;
   r.image.rgb.assign(3 * std::size_t(s.width) * std::size_t(s.height), 0.0f);
+  // The time budget ran out: checked at every pixel (a pixel of a sum of hundreds of costly terms
+  // takes milliseconds; a row of them seconds).
+  std::atomic<bool> out_of_time{false};
+  const auto past_budget = [&] {
+    return s.time_budget > 0 &&
+           std::chrono::duration<double>(Clock::now() - start).count() > s.time_budget;
+  };
   parallel_for(
       std::size_t(s.height), 1,
       [&](std::size_t begin, std::size_t end) {
-        for (std::size_t py = begin; py < end; ++py)
+        for (std::size_t py = begin; py < end && !out_of_time; ++py) {
           for (int px = 0; px < s.width; ++px) {
+            if (past_budget()) {
+              out_of_time = true;
+              break;
+            }
             Rgb sum;
             for (int j = 0; j < k; ++j)
               for (int i = 0; i < k; ++i) {
@@ -617,8 +628,12 @@ RenderResult render_point_light(const Brdf& brdf, const Vec3<double>& light,
             out[1] = float(sum.g * inv);
             out[2] = float(sum.b * inv);
           }
+        }
       },
       s.threads);
+  if (out_of_time)
+    throw TimeBudgetExceeded("the time budget of " + format_seconds(s.time_budget) +
+                             " ran out before the point-light image was complete");
   for (std::size_t p = 0; p < r.image.rgb.size(); p += 3)
     r.nonfinite_pixels += !(std::isfinite(r.image.rgb[p]) && std::isfinite(r.image.rgb[p + 1]) &&
                             std::isfinite(r.image.rgb[p + 2]));

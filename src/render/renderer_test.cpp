@@ -770,5 +770,35 @@ TEST(PointLight, LightFromTheSideAndTheHighlight) {
   EXPECT_THROW(render_point_light(*load_brdf("lambert"), {NAN, 0, 1}, s), std::invalid_argument);
 }
 
+// The point-light image keeps its time budget, checked at every pixel: an image of a sum of 300
+// He lobes at 256² × 16 positions (about 15 s) with a budget of 0.2 s throws TimeBudgetExceeded
+// soon after it; with no budget (0) or a budget it keeps, the image is the same.
+TEST(PointLight, KeepsItsTimeBudget) {
+  std::string he;
+  for (int k = 0; k < 300; ++k) he += (k ? "+" : "") + std::string("he");
+  const BrdfPtr heavy = load_brdf(he);
+  RenderSettings s;
+  s.width = s.height = 256;
+  s.spp = 16;
+  s.threads = 1;
+  s.time_budget = 0.2;
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_THROW(render_point_light(*heavy, {0, 0, 1}, s), TimeBudgetExceeded);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+#if defined(__SANITIZE_ADDRESS__)
+  EXPECT_LT(seconds, 5.0);
+#else
+  EXPECT_LT(seconds, 1.0);
+#endif
+  RenderSettings small;
+  small.width = small.height = 16;
+  small.spp = 4;
+  const BrdfPtr ggx = load_brdf("ggx:alpha=0.3");
+  const RenderResult free = render_point_light(*ggx, {0, 0, 1}, small);
+  small.time_budget = 60;
+  EXPECT_EQ(render_point_light(*ggx, {0, 0, 1}, small).image.rgb, free.image.rgb);
+}
+
 }  // namespace
 }  // namespace halfback::render

@@ -248,12 +248,12 @@ Response route(const Catalog& catalog, const Request& r, const ApiConfig& c,
   if (p == "/api/info") return info_response(catalog);
   if (p == "/api/brdf") return brdf_response(catalog, r);
   if (p == "/api/slices") return slices_response(catalog, r, c.threads, budget);
-  if (p == "/api/hemisphere") return hemisphere_response(catalog, r, c.threads);
+  if (p == "/api/hemisphere") return hemisphere_response(catalog, r, c.threads, budget);
   if (p == "/api/polar") return polar_response(catalog, r);
   if (p == "/api/albedo") return albedo_response(catalog, r, c.threads, budget);
   if (p == "/api/point") return point_response(catalog, r);
   if (p == "/api/render") return render_response(catalog, r, c.threads, budget);
-  if (p == "/api/pointlight") return point_light_response(catalog, r, c.threads);
+  if (p == "/api/pointlight") return point_light_response(catalog, r, c.threads, budget);
   if (p == "/api/mesh") return mesh_response(catalog, r, c.threads, budget);
   if (p == "/api/fit") return fit_response(catalog, r, c.threads, fits_running, budget);
   return error(404, fmt::format("no such resource '{}'", p.substr(0, 128)));

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
+#include <span>
 
 #include "halfback/core/batch.hpp"
 #include "halfback/core/parallel.hpp"
@@ -17,15 +19,24 @@ namespace {
 
 constexpr float kNanF = std::numeric_limits<float>::quiet_NaN();
 
-// ρ of the pairs whose flag is set, as float RGB or luminance (NaN elsewhere).
+// ρ of the pairs whose flag is set, as float RGB or luminance (NaN elsewhere); evaluated a block
+// of kEvalBlock pairs at a time, `expired` (if given) asked before each: true, and the result is
+// empty (a sum of hundreds of costly terms takes about a minute for a field of 512²).
+constexpr std::size_t kEvalBlock = 1024;
+
 std::vector<float> eval_where(const Brdf& brdf, const std::vector<DirPair<double>>& pairs,
-                              const std::vector<std::uint8_t>& valid, RhoValues values) {
+                              const std::vector<std::uint8_t>& valid, RhoValues values,
+                              const std::function<bool()>& expired) {
   std::vector<DirPair<double>> packed;
   packed.reserve(pairs.size());
   for (std::size_t k = 0; k < pairs.size(); ++k)
     if (valid[k]) packed.push_back(pairs[k]);
   std::vector<Rgb> rho(packed.size());
-  brdf.eval_batch(packed, rho);
+  for (std::size_t b = 0; b < packed.size(); b += kEvalBlock) {
+    if (expired && expired()) return {};
+    const std::size_t m = std::min(kEvalBlock, packed.size() - b);
+    brdf.eval_batch(std::span(packed).subspan(b, m), std::span(rho).subspan(b, m));
+  }
   const std::size_t channels = channels_of(values);
   std::vector<float> out(channels * pairs.size(), kNanF);
   std::size_t m = 0;
@@ -107,7 +118,8 @@ void form_to_pairs(const ViewForm& form, bool isotropic, std::vector<double>& q,
 }
 
 std::vector<float> slice_field(const Brdf& brdf, const ViewForm& form, double azimuth,
-                               std::size_t n, int threads, RhoValues values, double pose) {
+                               std::size_t n, int threads, RhoValues values, double pose,
+                               const std::function<bool()>& expired) {
   // The grid of figure/slices.hpp (pixel centres), converted to direction pairs by the core's
   // batch engine (SIMD, with the domain mask): the same pairs as figure::sample_slice, which
   // converts one tuple at a time and costs several times more (docs/performance.md, "Viewer").
@@ -132,11 +144,12 @@ std::vector<float> slice_field(const Brdf& brdf, const ViewForm& form, double az
       turn(p.wo);
     }
   }
-  return eval_where(brdf, pairs, valid, values);
+  return eval_where(brdf, pairs, valid, values, expired);
 }
 
 std::vector<float> hemisphere_field(const Brdf* brdf, const ViewForm& space, const Vec3<double>& wo,
-                                    std::size_t n, int threads, RhoValues values) {
+                                    std::size_t n, int threads, RhoValues values,
+                                    const std::function<bool()>& expired) {
   const auto view = figure::HemisphereView::around({0, 0, 1}, figure::Projection::equal_area);
   const figure::Grid grid = figure::Grid::pixel_centres(n, n, -1, 1, -1, 1);
   std::vector<DirPair<double>> pairs(grid.size());
@@ -154,7 +167,7 @@ std::vector<float> hemisphere_field(const Brdf* brdf, const ViewForm& space, con
           }
       },
       threads);
-  if (space.is_dirs()) return eval_where(*brdf, pairs, inside, values);
+  if (space.is_dirs()) return eval_where(*brdf, pairs, inside, values, expired);
   if (space.own) return own_coordinates(*space.own, pairs, inside);
   // The coordinates, through the batch engine (the numbers `halfback convert` gives).
   std::vector<double> wi_x(grid.size()), wi_y(grid.size()), wi_z(grid.size());

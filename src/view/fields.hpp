@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -49,16 +50,19 @@ inline std::size_t channels_of(RhoValues v) {
 // centres of figure::Grid::pixel_centres). `pose` (radians) turns every pair about the normal
 // from the form's canonical pose (its first azimuth, φh or φi, = 0) to that azimuth: the slice
 // of an anisotropic BRDF at another orientation (an isotropic BRDF's does not change).
+// `expired` (if given) is asked between blocks of evaluations of ρ: true, and the field is
+// returned empty (the caller's deadline, its client gone; see hemisphere_field too).
 std::vector<float> slice_field(const Brdf& brdf, const ViewForm& form, double azimuth,
                                std::size_t n, int threads, RhoValues values = RhoValues::rgb,
-                               double pose = 0);
+                               double pose = 0, const std::function<bool()>& expired = {});
 
 // The hemisphere of ωi for a given ωo, seen from above (x right, y up) in the equal-area
 // projection r = √2 sin(θi/2), on the n × n pixel centres of [−1, 1]²: ρ(ωi, ωo) when `space`
 // is dirs (as `values` says), else the three isotropic coordinates of (ωi, ωo) in that
-// parameterization.
+// parameterization. `expired` as in slice_field (asked only where ρ is evaluated).
 std::vector<float> hemisphere_field(const Brdf* brdf, const ViewForm& space, const Vec3<double>& wo,
-                                    std::size_t n, int threads, RhoValues values = RhoValues::rgb);
+                                    std::size_t n, int threads, RhoValues values = RhoValues::rgb,
+                                    const std::function<bool()>& expired = {});
 
 // ρ along two great half-circles of ωi through the zenith side, for angles t from −90° to 90°
 // (n samples): in the plane of incidence (t > 0 towards the mirror direction of ωo) and across

@@ -378,7 +378,7 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end && !budget.expired(); ++k)
           fields[k] = slice_field(*brdfs[k / forms.size()], forms[k % forms.size()], radians, n,
-                                  threads, values, pose);
+                                  threads, values, pose, [&] { return budget.expired(); });
       },
       threads);
   budget.check("the slices");
@@ -393,22 +393,31 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
   return res;
 }
 
-Response hemisphere_response(const Catalog& catalog, const Request& request, int threads) {
+Response hemisphere_response(const Catalog& catalog, const Request& request, int threads,
+                             const Budget& budget) {
   const std::string* colour = request.param("colour");
   ViewForm space;
   if (colour && *colour != "rho") space = space_param(catalog, request, "colour", true);
   const std::size_t n = whole(request, "n", 128, 2, kMaxGridSide);
   const Vec3<double> wo = outgoing(request);
   const RhoValues values = space.is_dirs() ? values_param(request) : RhoValues::rgb;
-  if (!space.is_dirs())
-    return floats(hemisphere_field(nullptr, space, wo, n, threads, values), n, n,
-                  channels_of(values));
+  const auto expired = [&] { return budget.expired(); };
+  if (!space.is_dirs()) {
+    budget.check("the hemisphere");
+    const std::vector<float> field =
+        hemisphere_field(nullptr, space, wo, n, threads, values, expired);
+    budget.check("the hemisphere");
+    return floats(field, n, n, channels_of(values));
+  }
   // ρ of every BRDF of brdf= (one field each, in order): one request for all the BRDFs shown.
   const auto brdfs = brdfs_param(catalog, request);
   check_field_bytes("/api/hemisphere", brdfs.size(), n, channels_of(values));
   std::vector<std::vector<float>> fields;
-  for (const auto& [spec, brdf] : brdfs)
-    fields.push_back(hemisphere_field(brdf.get(), space, wo, n, threads, values));
+  for (const auto& [spec, brdf] : brdfs) {
+    budget.check("the hemisphere");
+    fields.push_back(hemisphere_field(brdf.get(), space, wo, n, threads, values, expired));
+  }
+  budget.check("the hemisphere");
   Response res = floats(fields, n, n, channels_of(values));
   res.headers.emplace_back("X-Halfback-Brdfs", std::to_string(brdfs.size()));
   return res;
@@ -587,7 +596,8 @@ Response render_response(const Catalog& catalog, const Request& request, int thr
 
 // The sphere under a distant light from (theta_l, phi_l) in camera space (degrees; θ = 0: from
 // the camera, φ = 0: from the right), evaluated at k × k positions per pixel (no noise).
-Response point_light_response(const Catalog& catalog, const Request& request, int threads) {
+Response point_light_response(const Catalog& catalog, const Request& request, int threads,
+                              const Budget& budget) {
   render::RenderSettings s;
   s.width = s.height = int(whole(request, "size", 128, 8, std::size_t(kMaxRenderSide)));
   s.spp = int(whole(request, "spp", 4, 1, std::size_t(kMaxRenderSpp)));
@@ -602,7 +612,15 @@ Response point_light_response(const Catalog& catalog, const Request& request, in
   std::vector<std::vector<float>> images;
   int spp = 0;
   for (const auto& [spec, brdf] : brdfs) {
-    render::RenderResult result = render::render_point_light(*brdf, light, s);
+    budget.check("the point-light image");
+    s.time_budget = std::max(budget.seconds_left(), 1e-3);  // checked at every row of the image
+    render::RenderResult result;
+    try {
+      result = render::render_point_light(*brdf, light, s);
+    } catch (const render::TimeBudgetExceeded&) {
+      budget.check("the point-light image");
+      throw RequestError(503, "the point-light image was not complete within its time");
+    }
     images.push_back(std::move(result.image.rgb));
     spp = result.spp;
   }

@@ -38,14 +38,16 @@ Response info_response(const Catalog& catalog);
 Response brdf_response(const Catalog& catalog, const Request& request);
 Response slices_response(const Catalog& catalog, const Request& request, int threads,
                          const Budget& budget);
-Response hemisphere_response(const Catalog& catalog, const Request& request, int threads);
+Response hemisphere_response(const Catalog& catalog, const Request& request, int threads,
+                             const Budget& budget);
 Response polar_response(const Catalog& catalog, const Request& request);
 Response albedo_response(const Catalog& catalog, const Request& request, int threads,
                          const Budget& budget);
 Response point_response(const Catalog& catalog, const Request& request);
 Response render_response(const Catalog& catalog, const Request& request, int threads,
                          const Budget& budget);
-Response point_light_response(const Catalog& catalog, const Request& request, int threads);
+Response point_light_response(const Catalog& catalog, const Request& request, int threads,
+                              const Budget& budget);
 Response mesh_response(const Catalog& catalog, const Request& request, int threads,
                        const Budget& budget);
 // `running` counts the fits in progress: a request made while one runs is answered 503.

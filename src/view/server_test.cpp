@@ -19,6 +19,9 @@
 #include <thread>
 #include <vector>
 
+#include "halfback/core/space.hpp"
+#include "halfback/loader/load.hpp"
+
 namespace halfback::view::server_test {  // (a unity build with api_test.cpp)
 namespace {
 
@@ -354,6 +357,94 @@ TEST(ViewServer, RepeatedHostOrOriginHeadersAreRefused) {
   const std::string origin = "Origin: http://127.0.0.1:" + std::to_string(s.port) + "\r\n";
   EXPECT_EQ(get_info(s.port, 5, origin), "HTTP/1.1 200 OK");
   EXPECT_EQ(get_info(s.port, 5, origin + origin), "HTTP/1.1 400 Bad Request");
+}
+
+// A whole response to a GET of `target` (Connection: close), read to the end within `seconds`:
+// its head (status line and headers) and its body.
+struct Answer {
+  std::string head, body;
+  std::string status() const { return head.substr(0, head.find("\r\n")); }
+  std::string header(const std::string& name) const {
+    const std::size_t at = head.find("\r\n" + name + ": ");
+    if (at == std::string::npos) return "";
+    const std::size_t from = at + name.size() + 4;
+    return head.substr(from, head.find("\r\n", from) - from);
+  }
+};
+
+Answer get_all(int port, const std::string& target, double seconds) {
+  const int fd = send_get(port, target);
+  std::string all;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  std::vector<char> buf(1 << 16);
+  while (fd >= 0) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    pollfd p{fd, POLLIN, 0};
+    if (left.count() <= 0 || ::poll(&p, 1, int(left.count())) <= 0) break;
+    const ssize_t n = ::read(fd, buf.data(), buf.size());
+    if (n <= 0) break;
+    all.append(buf.data(), std::size_t(n));
+  }
+  if (fd >= 0) ::close(fd);
+  const std::size_t end = all.find("\r\n\r\n");
+  if (end == std::string::npos) return {all, ""};
+  return {all.substr(0, end + 2), all.substr(end + 4)};
+}
+
+// The explorer's finding on the wire: each distinct dupuy-jakob:BRDF form of a request (in
+// forms=, colour= and form=) is answered with its own values, and none is registered: /api/info
+// lists the same forms after 30 of them as before, the process's registry is unchanged, and a
+// request naming more than kMaxCachedForms is a 413. (Before, each registered a parameterization
+// for the life of the process: /api/info grew by one form a request.)
+TEST(ViewServer, RequestFormsDoNotAccumulate) {
+  register_brdf_parameterization_families();  // as `halfback view` has them
+  Running s;
+  const std::size_t registered = parameterizations().size();
+  const Answer before = get_all(s.port, "/api/info?", 10);
+  ASSERT_EQ(before.status(), "HTTP/1.1 200 OK");
+  std::string previous;
+  for (int k = 0; k < 30; ++k) {
+    const std::string form = "dupuy-jakob:ggx:alpha=0." + std::to_string(10 + k);
+    const std::string target = k % 3 == 0   ? "/api/slices?brdf=ggx:alpha=0.3&n=8&forms=" + form
+                               : k % 3 == 1 ? "/api/hemisphere?n=4&colour=" + form
+                                            : "/api/point?iso=1&coords=0.5,0.3,0.7&form=" + form;
+    const Answer a = get_all(s.port, target, 10);
+    ASSERT_EQ(a.status(), "HTTP/1.1 200 OK") << target << ": " << a.body;
+    if (k % 3 == 0) {
+      EXPECT_EQ(a.header("X-Halfback-Forms"), form);
+      EXPECT_NE(a.body, previous);  // its own form's values, not a cached neighbour's
+      previous = a.body;
+    }
+  }
+  EXPECT_EQ(parameterizations().size(), registered);
+  EXPECT_EQ(get_all(s.port, "/api/info?", 10).body, before.body);
+  std::string many;
+  for (std::size_t k = 0; k <= kMaxCachedForms; ++k)
+    many += (k ? "," : "") + std::string("dupuy-jakob:ggx:alpha=0.") + std::to_string(k + 1);
+  EXPECT_EQ(get_all(s.port, "/api/slices?brdf=lambert&n=2&forms=" + many, 10).status(),
+            "HTTP/1.1 413 Payload Too Large");
+}
+
+// The explorer's finding on the wire: slices answers stay within kMaxSlicesBytes. Two BRDFs,
+// every form, n = 512 in RGB (50 MB before) is a 400 naming the bound, with a small body; the
+// page's largest request (the same in luminance) is a 200 whose body, read to its end, has the
+// length it declares, within the bound.
+TEST(ViewServer, SlicesAnswersStayWithinTheirBound) {
+  Running s;
+  const Answer big =
+      get_all(s.port, "/api/slices?brdf=lambert&brdf=ggx:alpha=0.2&n=512&values=rgb", 30);
+  EXPECT_EQ(big.status(), "HTTP/1.1 400 Bad Request");
+  EXPECT_NE(big.body.find("above the limit"), std::string::npos) << big.body.substr(0, 200);
+  EXPECT_LT(big.body.size(), 1024u);
+  const Answer page =
+      get_all(s.port, "/api/slices?brdf=lambert&brdf=ggx:alpha=0.2&n=512&values=luminance", 120);
+  ASSERT_EQ(page.status(), "HTTP/1.1 200 OK") << page.body.substr(0, 200);
+  const std::string length = page.header("Content-Length");
+  ASSERT_FALSE(length.empty()) << page.head;
+  EXPECT_EQ(std::stoul(length), page.body.size());
+  EXPECT_LE(page.body.size(), kMaxSlicesBytes);
+  EXPECT_EQ(page.body.size(), 2 * parameterizations().size() * 512 * 512 * sizeof(float));
 }
 
 }  // namespace

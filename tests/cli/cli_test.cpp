@@ -69,6 +69,23 @@ void put(const fs::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
 }
 
+// The lines of a section of a help text ("Options", "Subcommands"): those after its title line
+// ("Options:") up to the next empty line.
+std::vector<std::string> help_section(const std::string& help, const std::string& title) {
+  std::vector<std::string> lines;
+  std::istringstream in(help);
+  bool inside = false;
+  for (std::string line; std::getline(in, line);) {
+    if (!inside) {
+      inside = line == title + ":";
+      continue;
+    }
+    if (line.empty()) break;
+    lines.push_back(line);
+  }
+  return lines;
+}
+
 class CliTest : public testing::Test {
  protected:
   // A test may leave a read-only folder "ro": made writable again so that the directory can be
@@ -128,6 +145,72 @@ class CliTest : public testing::Test {
     for (const auto& e : fs::directory_iterator(dir_.path())) names.push_back(e.path().filename());
     std::sort(names.begin(), names.end());
     return names;
+  }
+
+  // Every output option the tool registers, read from its help as a user reads it (`halfback
+  // --help`, then each command's and each subcommand's): "COMMAND [SUBCOMMAND]" -> the names of
+  // each option that the output rule treats as an output (-o, --output, --out, --json, --emit), as
+  // the help lists them ("-o,--output"). A command added with an output is in it with no test's
+  // edit.
+  std::map<std::string, std::vector<std::vector<std::string>>> registered_outputs() const {
+    static const std::set<std::string> kOutputNames{"-o", "--output", "--out", "--json", "--emit"};
+    std::map<std::string, std::vector<std::vector<std::string>>> found;
+    std::vector<std::vector<std::string>> todo{{}};
+    while (!todo.empty()) {
+      const std::vector<std::string> words = todo.back();
+      todo.pop_back();
+      std::vector<std::string> args = words;
+      args.push_back("--help");
+      const Result r = run(args);
+      std::string command;
+      for (const std::string& w : words) command += (command.empty() ? "" : " ") + w;
+      EXPECT_EQ(r.status, 0) << command << " --help: " << r.err;
+      for (const std::string& line : help_section(r.out, "Options")) {
+        if (!line.starts_with("  -")) continue;  // a description's continued line
+        std::vector<std::string> names;
+        std::istringstream first(line.substr(2, line.find(' ', 2) - 2));
+        for (std::string name; std::getline(first, name, ',');) names.push_back(name);
+        if (std::ranges::any_of(names,
+                                [](const std::string& n) { return kOutputNames.contains(n); }))
+          found[command].push_back(names);
+      }
+      for (const std::string& line : help_section(r.out, "Subcommands"))
+        if (line.size() > 2 && line[2] != ' ') {
+          std::vector<std::string> sub = words;
+          sub.push_back(line.substr(2, line.find(' ', 2) - 2));
+          todo.push_back(std::move(sub));
+        }
+    }
+    return found;
+  }
+
+  // Fails for each registered output (registered_outputs) that none of `command_lines` writes
+  // through: a line of the command (its words first) that gives one of the option's names.
+  void expect_every_output_written(
+      const std::vector<std::vector<std::string>>& command_lines) const {
+    const auto registered = registered_outputs();
+    std::size_t options = 0;
+    for (const auto& [command, outputs] : registered) {
+      std::vector<std::string> words;
+      std::istringstream in(command);
+      for (std::string w; in >> w;) words.push_back(w);
+      for (const std::vector<std::string>& names : outputs) {
+        ++options;
+        const bool written = std::ranges::any_of(command_lines, [&](const auto& args) {
+          if (args.size() < words.size() || !std::equal(words.begin(), words.end(), args.begin()))
+            return false;
+          return std::ranges::any_of(args, [&](const std::string& a) {
+            return std::ranges::any_of(
+                names, [&](const std::string& n) { return a == n || a.starts_with(n + "="); });
+          });
+        });
+        std::string all;
+        for (const std::string& n : names) all += (all.empty() ? "" : ",") + n;
+        EXPECT_TRUE(written) << "no case writes through `halfback " << command << " " << all << "`";
+      }
+    }
+    // The help was read: 19 output options in 17 commands when this was written (more is fine).
+    EXPECT_GE(options, 19u);
   }
 
   test::TempDir dir_;        // the test's own, removed after it
@@ -2189,7 +2272,7 @@ TEST_F(CliTest, OutputThatNamesAnInputIsRefusedBeforeAnyWork) {
   };
   values("p.csv", "lab.csv");
   values("pilot.csv", "pv.csv");
-  for (const char* link : {"f.binary", "f.bsdf", "f.npy", "f.png"})
+  for (const char* link : {"f.binary", "f.bsdf", "f.npy", "f.png", "g.h5"})
     fs::create_symlink("f.json", path(link));
   fs::create_symlink("lab.csv", path("lab.binary"));
   fs::create_directories(path("st"));
@@ -2233,7 +2316,19 @@ TEST_F(CliTest, OutputThatNamesAnInputIsRefusedBeforeAnyWork) {
       {{"figure", "paper", "--material", "figs/m.png", "--formats", "png", "--render-size", "16",
         "--spp", "1", "--out", "figs"},
        {"figs/m.png"}},
+      // The weights (g.h5, a link to the input), then the description beside them (f.json).
+      {{"nbrdf", "train", "--brdf", "f.json", "--hidden", "2", "--samples", "1000", "--epochs", "1",
+        "-o", "g.h5"},
+       {"f.json"}},
+      {{"nbrdf", "train", "--brdf", "f.json", "--hidden", "2", "--samples", "1000", "--epochs", "1",
+        "-o", "f.weights"},
+       {"f.json"}},
+      {{"compare", "f.json", "lambert", "--samples", "100", "--json", "f.json"}, {"f.json"}},
+      {{"compare", "lambert", "f.json", "--samples", "100", "-o", "f.png"}, {"f.json"}},
   };
+  std::vector<std::vector<std::string>> lines;
+  for (const Case& c : cases) lines.push_back(c.args);
+  expect_every_output_written(lines);  // every command that writes, each of its outputs
   for (const Case& c : cases) {
     std::map<std::string, std::string> before;
     for (const std::string& f : c.inputs) before[f] = slurp(path(f));
@@ -2248,6 +2343,77 @@ TEST_F(CliTest, OutputThatNamesAnInputIsRefusedBeforeAnyWork) {
   }
 }
 
+// The command lines of the two tests below: every command that writes, through each of its outputs
+// (expect_every_output_written), with inputs in the test's folder and outputs under `at` (a
+// folder and '/', or ""). Each output is larger than 1 KiB, the smallest `ulimit -f`; fit's
+// --emit case writes its JSON (600 bytes) outside `at`, so that the failing write is the emit's.
+struct WriteCase {
+  std::vector<std::string> args;
+  std::vector<std::string> outputs;  // each holds "old" before, and after
+};
+
+std::vector<WriteCase> write_cases(const std::string& at) {
+  const auto o = [&](const std::string& name) { return at + name; };
+  return {
+      {{"convert", "--from", "dirs", "--to", "hybrid", "-i", "pairs.csv", "-o", o("c.csv")},
+       {o("c.csv")}},
+      {{"eval", "--brdf", "lambert", "-i", "pairs.csv", "-o", o("e.csv")}, {o("e.csv")}},
+      {{"factor", "--brdf", "lambert", "--counts", "16,16,16", "-o", o("f.json")}, {o("f.json")}},
+      {{"plan", "--budget", "300", "-o", o("q.csv")}, {o("q.csv"), o("q.json")}},
+      {{"reconstruct", "--plan", "p.json", "--measurements", "lab.csv", "-o", o("m.binary")},
+       {o("m.binary")}},
+      {{"export-merl", "--brdf", "lambert", "-o", o("x.binary")}, {o("x.binary")}},
+      {{"export-rgl", "--brdf", "lambert", "--theta-i", "2", "--resolution", "8",
+        "--vndf-resolution", "8", "-o", o("x.bsdf")},
+       {o("x.bsdf")}},
+      {{"resample", "--brdf", "lambert", "--size", "16", "-o", o("x.npy")}, {o("x.npy")}},
+      {{"render", "--brdf", "lambert", "--width", "16", "--height", "16", "--spp", "1", "-o",
+        o("x.exr")},
+       {o("x.exr")}},
+      {{"figure", "slices", "--brdf", "lambert", "--out", o("x.png")}, {o("x.png")}},
+      {{"figure", "hemisphere", "--param", "hybrid", "--elevations", "0", "--scale", "0.5", "--out",
+        o("h.png")},
+       {o("h.png")}},
+      {{"figure", "material", "--brdf", "lambert", "--render-size", "16", "--spp", "1", "--out",
+        o("m.png")},
+       {o("m.png")}},
+      {{"figure", "paper", "--no-materials", "--formats", "png", "--out", o("figs")},
+       {o("figs/fig1-hemisphere.png")}},
+      {{"study", "--quick", "--no-gonio", "--no-sampling", "--no-fit", "--test-pairs", "1000", "-o",
+        o("st"), "lambert"},
+       {o("st/report.md")}},
+      // Three lobes: 1.7 KB of JSON.
+      {{"fit", "--brdf", "ggx:alpha=0.3", "--model", "lambert+ggx+ggx", "--samples", "200", "-o",
+        o("fit.json")},
+       {o("fit.json")}},
+      {{"fit", "--brdf", "lambert", "--model", "lambert", "--samples", "100", "-o", "fe.json",
+        "--emit", "blender:" + o("b.py")},
+       {"fe.json", o("b.py")}},
+      {{"compare", "lambert", "ggx:alpha=0.3", "--samples", "200", "--test-pairs", "100",
+        "--albedo-samples", "4", "--json", o("c.json")},
+       {o("c.json")}},
+      {{"compare", "lambert", "ggx:alpha=0.3", "--samples", "200", "--test-pairs", "100",
+        "--albedo-samples", "4", "-o", o("c.png")},
+       {o("c.png")}},
+      // A tiny training (0.04 s): 9.8 KB of weights and 1.4 KB of description.
+      {{"nbrdf", "train", "--brdf", "lambert", "--hidden", "2", "--samples", "1000", "--epochs",
+        "1", "--batch", "100", "-o", o("n.h5")},
+       {o("n.h5"), o("n.json")}},
+  };
+}
+
+std::vector<std::vector<std::string>> command_lines(const std::vector<WriteCase>& cases) {
+  std::vector<std::vector<std::string>> lines;
+  for (const WriteCase& c : cases) lines.push_back(c.args);
+  return lines;
+}
+
+std::string joined(const std::vector<std::string>& args) {
+  std::string line;
+  for (const std::string& a : args) line += " " + a;
+  return line;
+}
+
 // Past the file size limit (`ulimit -f`), every command that writes fails with a message naming
 // the limit (status 1), the old file kept and no temporary left: SIGXFSZ is ignored, so that the
 // write fails with EFBIG, as a full disk fails with ENOSPC (the tool died of SIGXFSZ, status 153,
@@ -2259,39 +2425,15 @@ TEST_F(CliTest, FileSizeLimitLeavesTheOldFileAndNoTemporary) {
   for (std::size_t k = 0; k < parse(slurp(path("p.csv"))).rows(); ++k)
     lab += std::to_string(k) + ",0.1\n";
   put(path("lab.csv"), lab);
-  struct Case {
-    std::vector<std::string> args;
-    std::vector<std::string> outputs;  // each holds "old" before, and after
-  };
-  const std::vector<Case> cases = {
-      {{"convert", "--from", "dirs", "--to", "hybrid", "-i", "pairs.csv", "-o", "c.csv"},
-       {"c.csv"}},
-      {{"eval", "--brdf", "lambert", "-i", "pairs.csv", "-o", "e.csv"}, {"e.csv"}},
-      {{"factor", "--brdf", "lambert", "--counts", "16,16,16", "-o", "f.json"}, {"f.json"}},
-      {{"plan", "--budget", "300", "-o", "q.csv"}, {"q.csv", "q.json"}},
-      {{"reconstruct", "--plan", "p.json", "--measurements", "lab.csv", "-o", "m.binary"},
-       {"m.binary"}},
-      {{"export-merl", "--brdf", "lambert", "-o", "x.binary"}, {"x.binary"}},
-      {{"export-rgl", "--brdf", "lambert", "--theta-i", "2", "--resolution", "8",
-        "--vndf-resolution", "8", "-o", "x.bsdf"},
-       {"x.bsdf"}},
-      {{"resample", "--brdf", "lambert", "--size", "16", "-o", "x.npy"}, {"x.npy"}},
-      {{"render", "--brdf", "lambert", "--width", "16", "--height", "16", "--spp", "1", "-o",
-        "x.exr"},
-       {"x.exr"}},
-      {{"figure", "slices", "--brdf", "lambert", "--out", "x.png"}, {"x.png"}},
-      {{"study", "--quick", "--no-gonio", "--no-sampling", "--no-fit", "--test-pairs", "1000", "-o",
-        "st", "lambert"},
-       {"st/report.md"}},
-  };
-  fs::create_directories(path("st"));
-  for (const Case& c : cases) {
+  const std::vector<WriteCase> cases = write_cases("");
+  expect_every_output_written(command_lines(cases));
+  for (const char* folder : {"st", "figs"}) fs::create_directories(path(folder));
+  for (const WriteCase& c : cases) {
     for (const std::string& f : c.outputs) put(path(f), "old\n");
     file_limit_kib_ = 1;
     const Result r = run(c.args);
     file_limit_kib_ = 0;
-    std::string line;
-    for (const std::string& a : c.args) line += " " + a;
+    const std::string line = joined(c.args);
     EXPECT_EQ(r.status, 1) << line << "\n" << r.err;
     EXPECT_NE(r.err.find("file size limit"), std::string::npos) << line << "\n" << r.err;
     for (const std::string& f : c.outputs) EXPECT_EQ(slurp(path(f)), "old\n") << line << ": " << f;
@@ -2300,27 +2442,46 @@ TEST_F(CliTest, FileSizeLimitLeavesTheOldFileAndNoTemporary) {
   }
 }
 
-// A full file system (ENOSPC) fails the same way: the old file kept, no temporary, a message. The
-// test mounts a 64 KiB tmpfs, which needs the privilege to mount (skipped without it).
+// A full file system (ENOSPC) fails the same way for every command that writes: the old file
+// kept, no temporary, a message. The test mounts a 64 KiB tmpfs and fills it before each command
+// (the old files are in it), which needs the privilege to mount (CI runs as root; skipped
+// without it).
 TEST_F(CliTest, FullDiskLeavesTheOldFileAndNoTemporary) {
+  put(path("pairs.csv"), dirs_csv(well_conditioned_pairs(200, 7)));
+  ASSERT_EQ(run({"plan", "--budget", "300", "-o", "p.csv"}).status, 0);
+  std::string lab = "row,value\n";
+  for (std::size_t k = 0; k < parse(slurp(path("p.csv"))).rows(); ++k)
+    lab += std::to_string(k) + ",0.1\n";
+  put(path("lab.csv"), lab);
   const fs::path full = path("full");
   fs::create_directories(full);
   if (::mount("tmpfs", full.c_str(), "tmpfs", 0, "size=64k") != 0)
     GTEST_SKIP() << "cannot mount a tmpfs: " << std::strerror(errno);
-  for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"export-merl", "--brdf", "lambert", "-o", "full/x.binary"},
-        std::vector<std::string>{"plan", "--budget", "2000", "-o", "full/q.csv"}}) {
-    put(full / "x.binary", "old\n");
-    put(full / "q.csv", "old\n");
-    const Result r = run(args);
-    EXPECT_EQ(r.status, 1) << args[0] << ": " << r.err;
-    EXPECT_NE(r.err.find("the file system is full"), std::string::npos) << args[0] << ": " << r.err;
-    EXPECT_EQ(slurp(full / "x.binary"), "old\n") << args[0];
-    EXPECT_EQ(slurp(full / "q.csv"), "old\n") << args[0];
-    for (const auto& e : fs::directory_iterator(full))
-      EXPECT_FALSE(e.path().filename().string().starts_with(".")) << args[0] << ": " << e.path();
+  struct Unmount {
+    fs::path at;
+    ~Unmount() { EXPECT_EQ(::umount2(at.c_str(), MNT_DETACH), 0) << std::strerror(errno); }
+  } unmount{full};
+  const std::vector<WriteCase> cases = write_cases("full/");
+  expect_every_output_written(command_lines(cases));
+  for (const WriteCase& c : cases) {
+    for (const auto& e : fs::directory_iterator(full)) fs::remove_all(e.path());
+    for (const std::string& f : c.outputs) {
+      fs::create_directories(path(f).parent_path());
+      put(path(f), "old\n");
+    }
+    {  // fill the file system: every further write fails with ENOSPC
+      std::ofstream filler(full / "filler", std::ios::binary);
+      const std::string block(4096, 'x');
+      for (int k = 0; k < 64 && filler.write(block.data(), block.size()); ++k) filler.flush();
+    }
+    const std::string line = joined(c.args);
+    const Result r = run(c.args);
+    EXPECT_EQ(r.status, 1) << line << "\n" << r.err;
+    EXPECT_NE(r.err.find("the file system is full"), std::string::npos) << line << "\n" << r.err;
+    for (const std::string& f : c.outputs) EXPECT_EQ(slurp(path(f)), "old\n") << line << ": " << f;
+    for (const auto& e : fs::recursive_directory_iterator(dir_.path()))
+      EXPECT_FALSE(e.path().filename().string().starts_with(".")) << line << ": " << e.path();
   }
-  EXPECT_EQ(::umount2(full.c_str(), MNT_DETACH), 0) << std::strerror(errno);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -3076,6 +3237,87 @@ TEST_F(CliTest, ViewOnATakenPortFailsNamingThePort) {
             std::string::npos)
       << r.err;
   EXPECT_EQ(r.out, "");
+}
+
+// The command lines of a text that fit or render a MERL file named merl.binary: docs' lines
+// "$ halfback ..." (`prompt`), or every line of the text beginning with "halfback " (after
+// spaces), each joined with the lines its trailing '\' continues.
+std::vector<std::string> merl_examples(const std::string& text, bool prompt) {
+  std::vector<std::string> commands;
+  std::istringstream in(text);
+  std::string command;
+  bool continued = false;
+  for (std::string line; std::getline(in, line);) {
+    const std::size_t b = line.find_first_not_of(' ');
+    line = b == std::string::npos ? "" : line.substr(b);
+    if (!continued) {
+      if (prompt ? !line.starts_with("$ halfback ") : !line.starts_with("halfback ")) continue;
+      command = prompt ? line.substr(2) : line;
+    } else {
+      command += " " + line;
+    }
+    continued = !command.empty() && command.back() == '\\';
+    if (continued) {
+      command.pop_back();
+      continue;
+    }
+    std::string normal;  // spaces as one
+    std::istringstream words(command);
+    for (std::string w; words >> w;) normal += (normal.empty() ? "" : " ") + w;
+    if (normal.find("merl.binary") != std::string::npos) commands.push_back(normal);
+  }
+  return commands;
+}
+
+// The docs' examples that fit and render a MERL file run as written on a file that export-merl
+// made: docs/cli.md's "$ halfback ... merl.binary" lines (a render of the fit's printed spec,
+// `render --brdf "$(halfback fit --brdf merl.binary ...)"`, and a fit with --emit),
+// docs/fit.md's, and `halfback fit --help`'s example, read from them (a changed example is run
+// as changed; one removed fails the count), run by the shell with `halfback` on the PATH. Each
+// exits 0 with no warning and writes the files it names. On the file written before every bin a
+// valid pair is looked up in had a value, the fit failed ("not finite ... at 100 of 20000
+// samples"), the render warned of NaN samples, and the pipeline ended with "--brdf: an empty
+// value".
+TEST_F(CliTest, DocsMerlExamplesRunAsWritten) {
+  std::vector<std::string> commands;
+  const auto add = [&](const std::vector<std::string>& found, const char* where,
+                       std::size_t expected) {
+    EXPECT_GE(found.size(), expected) << where << ": the examples with merl.binary are gone";
+    for (const std::string& c : found)
+      if (std::ranges::find(commands, c) == commands.end()) commands.push_back(c);
+  };
+  add(merl_examples(slurp(HALFBACK_SOURCE_DIR "/docs/cli.md"), true), "docs/cli.md", 2);
+  add(merl_examples(slurp(HALFBACK_SOURCE_DIR "/docs/fit.md"), false), "docs/fit.md", 1);
+  const Result help = run({"fit", "--help"});
+  ASSERT_EQ(help.status, 0);
+  add(merl_examples(help.out, false), "halfback fit --help", 1);
+  ASSERT_TRUE(std::ranges::any_of(commands, [](const std::string& c) {
+    return c.find("\"$(halfback fit") != std::string::npos;
+  })) << "no render of a fit's spec among the examples";
+  // A diffuse and a glossy lobe, tabulated: grazing bins hold values (ggx near its mirror).
+  Result r = run(
+      {"export-merl", "--brdf", "lambert:albedo=0.3+ggx:alpha=0.2,f0=0.5", "-o", "merl.binary"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string bin = fs::path(HALFBACK_CLI_PATH).parent_path().string();
+  for (const std::string& command : commands) {
+    std::vector<std::string> named;  // the files the command writes: -o FILE, --emit T:FILE
+    std::istringstream words(command);
+    for (std::string w, previous; words >> w; previous = w) {
+      while (!w.empty() && (w.back() == ')' || w.back() == '"')) w.pop_back();  // "$(... -o F)"
+      if (previous == "-o") named.push_back(w);
+      if (previous == "--emit") named.push_back(w.substr(w.find(':') + 1));
+    }
+    ASSERT_FALSE(named.empty()) << command;
+    for (const std::string& f : named) fs::remove(path(f));
+    const test::Spawned s = test::spawn_and_wait(
+        dir_.path(), {"/bin/bash", "-c", "PATH=\"" + bin + ":$PATH\"; set -o pipefail; " + command},
+        "/dev/null", path(".out"), path(".err"));
+    const std::string err = slurp(path(".err"));
+    EXPECT_EQ(s.status, 0) << command << "\n" << err;
+    EXPECT_EQ(err.find("warning"), std::string::npos) << command << "\n" << err;
+    for (const std::string& f : named)
+      EXPECT_GT(fs::exists(path(f)) ? fs::file_size(path(f)) : 0, 0u) << command << ": " << f;
+  }
 }
 
 // `halfback fit`: the spec it prints is the fitted model, which `info` and `eval` read back, and

@@ -139,8 +139,9 @@ RenderResult render_sampled(const Brdf& brdf, const EnvMap& env, const RenderSet
 // right, +y up; (0, 0, 1): from the camera). A pixel is the mean of ρ(ωi, ωo) cos θi over a
 // stratified k × k grid of positions in it (k² = spp rounded down to a square): ωi the light, ωo
 // the camera, in the shading frame of render(); 0 in the background and where the light or the
-// camera is below the surface. No sampling: no noise. Uses width, height, spp, projection and
-// threads of `settings`; throws std::invalid_argument for invalid settings or light.
+// camera is below the surface. No sampling: no noise. Uses width, height, spp, projection,
+// threads and time_budget of `settings` (checked at every pixel: past it, TimeBudgetExceeded, no
+// image); throws std::invalid_argument for invalid settings or light.
 RenderResult render_point_light(const Brdf& brdf, const Vec3<double>& light,
                                 const RenderSettings& settings);
 
