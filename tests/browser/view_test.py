@@ -1269,7 +1269,7 @@ LOBE_PIXELS = """
     return Array.from(g.getImageData(0, 0, c.width, c.height).data);"""
 
 
-def check_lobe(driver, base, token):
+def check_lobe_see_through(driver, base, token):
     """The lobe of two Lambertian BRDFs, one inside the other (radius 1 and ⅓): at the default
     opacity the inner one shows through the outer one (it was hidden by an opaque first
     surface); at opacity 1 it is hidden; the legend names both and says what radius 1 is (ρ =
@@ -1319,6 +1319,14 @@ VIEW_SIZES = """
              albedo: w('#albedo'), sphere: w('#spheres canvas'), slice: w('#slices canvas') };"""
 
 
+def wait_laid_out(driver):
+    """Until the page has laid its views out for the window's width (200 ms after a resize, later
+    on a loaded machine), and their requests have answered."""
+    WebDriverWait(driver, 30).until(lambda d: d.execute_script(
+        "return window.halfback.stats.layoutWidth === window.innerWidth;"))
+    wait_idle(driver)
+
+
 def check_views_grow(sizes):
     """Every view is larger at 2400 px than at 1100 px, and never smaller at a wider window
     (the hemisphere stayed 256 px, the lobe 400, the polar and albedo plots 460 × 270, and
@@ -1364,7 +1372,7 @@ def given_brdfs_checks(halfback, screenshots):
             for width in [1100, 1600, 2400]:
                 driver.set_window_size(width, 1250)
                 time.sleep(0.5)  # the slices are laid out again 200 ms after a resize
-                wait_idle(driver)
+                wait_laid_out(driver)
                 sizes[width] = driver.execute_script(VIEW_SIZES)
                 check_wraps(driver, width)
                 guarded(driver, check_sphere_export, driver, width)
@@ -1402,7 +1410,7 @@ def given_brdfs_checks(halfback, screenshots):
             logs = [l for l in driver.get_log("browser") if l["level"] == "SEVERE"
                     and "not-a-brdf" not in l["message"]]  # the refused file's 400: expected
             check(not logs, f"three BRDFs: no errors in the browser console {logs[:3]}")
-            guarded(driver, check_lobe, driver, base, token)
+            guarded(driver, check_lobe_see_through, driver, base, token)
         finally:
             driver.quit()
             proc.send_signal(signal.SIGINT)

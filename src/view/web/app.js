@@ -923,6 +923,7 @@ function layout() {
   }
   if (hemiN() !== hemiWas) track(updateHemisphere());
   if (fitSphereSide() !== sphereSide && $('spheres').childElementCount) restartSphere();
+  stats.layoutWidth = window.innerWidth;  // the window width the views were laid out for
 }
 
 // --- updates ------------------------------------------------------------------------------------

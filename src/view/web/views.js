@@ -475,7 +475,7 @@ export function drawTheta(svg, curves, colours, names, titles, { quantity = 'rho
     svg.append(el('line', { x1: left, x2: W - right, y1: y(t.v), y2: y(t.v), stroke: '#262932' }));
     svg.append(text(t.label, { x: left - 6, y: y(t.v) + 3, 'text-anchor': 'end', class: 'y-tick' }));
   }
-  svg.append(text('← side of ωo      θi (in the plane) or angle from the mirror (across)      mirror side →',
+  svg.append(text('θi, solid; angle from the mirror, dashed (mirror side →)',
     { x: (left + W - right) / 2, y: H - 6, 'text-anchor': 'middle', fill: '#e6e6ea' }));
   svg.append(text(`${quantity === 'cos' ? 'ρ cos θi' : 'ρ'} (sr⁻¹${scale === 'log' ? ', log' : ''})`,
     { x: 0, y: 0, 'text-anchor': 'middle', fill: '#e6e6ea', transform: `translate(12 ${(top + H - bottom) / 2}) rotate(-90)` }));
