@@ -1270,15 +1270,20 @@ LOBE_PIXELS = """
 
 
 def check_lobe_see_through(driver, base, token):
-    """The lobe of two Lambertian BRDFs, one inside the other (radius 1 and ⅓): at the default
+    """The BRDFs of a URL are shown and named; the lobe of two Lambertian BRDFs, one inside the other (radius 1 and ⅓): at the default
     opacity the inner one shows through the outer one (it was hidden by an opaque first
     surface); at opacity 1 it is hidden; the legend names both and says what radius 1 is (ρ =
     0.9/π = 0.29 sr⁻¹); zooming in makes the lobe larger."""
-    q = urllib.parse.urlencode([("a", "lambert:albedo=0.9"), ("b", "lambert:albedo=0.3")])
+    specs = ["lambert:albedo=0.9", "lambert:albedo=0.3", "lambert:albedo=0.1"]
+    q = urllib.parse.urlencode([("a", specs[0]), ("b", specs[1]), ("more", specs[2])])
     driver.get("about:blank")  # a new page, not a new fragment of this one
     driver.get(f"{base}?token={token}#{q}")
     WebDriverWait(driver, 60).until(lambda d: d.find_element(By.ID, "status").text.startswith("ready"))
     wait_idle(driver)
+    chips = driver.execute_script("return [...document.querySelectorAll('#more .chip .name')].map((e) => e.textContent);")
+    check(chips == specs and [n for n, _ in legend_names(driver, "polar")] == specs,
+          f"the BRDFs the URL names are all shown and named (chips {chips})")
+    chip(driver, specs[2], "show").click()  # the two of the check below
     lobe = driver.find_element(By.ID, "lobe")
     driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", lobe)
 
