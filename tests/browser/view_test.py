@@ -1202,7 +1202,8 @@ def check_theta_plot(driver, halfback, names, given):
             errors = [e * want / (v1 - v0) for e, want in zip(errors, lum)]
         check(decades and max(errors) < 0.005,
               f"the θ plot ({quantity}, {scale} axis) draws halfback eval's ρ{' cos θi' if quantity == 'cos' else ''} "
-              f"of the sum ({'decades' if decades else 'NOT decades'}; errors {[round(e, 4) for e in errors]})")
+              f"of the sum ({'ticks at decades' if decades and scale == 'log' else 'ticks' if decades else 'NOT decades'}; "
+              f"errors {[f'{e:.1e}' for e in errors]})")
     driver.execute_script("""for (const [id, v] of [['theta-quantity', 'rho'], ['theta-scale', 'log']]) {
         const s = document.getElementById(id); s.value = v; s.dispatchEvent(new Event('change')); }""")
 
