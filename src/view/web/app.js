@@ -10,18 +10,33 @@ import { MeshView } from './mesh.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = Math.PI / 180;
-// One colour per BRDF shown, in the order of loaded(): the first, the compare one, the others.
+// One colour per BRDF shown, in the order of loaded(): the first, the compare one, the others
+// (the defaults; a BRDF's chip chooses another: state.colours).
 const COLOURS = ['#ff9a3c', '#3cc8ff', '#9be37a', '#e879f9', '#f7d154', '#ff6b6b', '#a0a4ff', '#5eead4'];
+const palette = () => COLOURS.map((c, b) => (/^#[0-9a-f]{6}$/i.test(state.colours[b] || '') ? state.colours[b] : c));
+// The swatches (class swatch-N) take their colour from the CSS variables --cN.
+function applyPalette() {
+  palette().forEach((c, b) => document.documentElement.style.setProperty(`--c${b}`, c));
+}
 const MAX_MORE = COLOURS.length - 1;  // BRDFs added beside the first (with the compare one: 8 in all)
 const DRAG = 128;  // slice resolution (at most) while dragging; at rest: the side on screen
-// The slices' side on screen (CSS pixels): as large as the panel allows with at least 256 px and
-// at most 480 px each; their resolution at rest is that side in device pixels (at most 512).
+// The layout grows with the window: the panels of the views are `viewSize()` CSS pixels wide or
+// more (0.3 of the window, 330 … 760 px; as many in a row as fit, then they wrap), and each view
+// takes its panel's width.
+const viewSize = () => Math.round(Math.max(330, Math.min(760, 0.3 * window.innerWidth)));
+// The slices' side on screen (CSS pixels), growing with the window: for one BRDF as large as the
+// panel allows with at least 0.55 of a view (240 px or more) each; for several (a row each)
+// half a view (200 px or more), so that the rows stay short. They wrap. Their resolution at
+// rest is that side in device pixels (at most 512).
 let sliceSide = 256;
 const fullSide = () => Math.min(512, Math.round(sliceSide * (window.devicePixelRatio || 1)));
-function fitSliceSide() {
-  const available = $('slices').clientWidth || 1200, axes = 48 + 12;  // axes and the gap
-  const columns = Math.max(1, Math.floor((available + 12) / (256 + axes)));
-  return Math.max(200, Math.min(480, Math.floor((available + 12) / columns) - axes - 4));
+function fitSliceSide(rows = 1) {
+  const available = ($('slices').clientWidth || 1200) - (rows > 1 ? 24 : 0), axes = 48 + 12;  // axes and the gap
+  const forms = info ? info.forms.length : 4;
+  if (rows > 1) return Math.min(480, Math.max(200, Math.round(0.5 * viewSize())), Math.floor(available + 12 - axes - 4));
+  const least = Math.max(240, Math.round(0.55 * viewSize()));
+  const columns = Math.max(1, Math.min(forms, Math.floor((available + 12) / (least + axes))));
+  return Math.max(128, Math.min(480, Math.floor((available + 12) / columns) - axes - 4));
 }
 // While a slider moves, the slices' side adapts (64 … 128): smaller when an update (request and
 // drawing) took longer than 45 ms, larger again below 25 ms.
@@ -34,7 +49,10 @@ function adaptDragSide(ms) {
 const state = {
   a: '', b: '', mode: 'a', az: 0, scale: 'log', levels: 'auto', to: 45, po: 180,
   hemi: 'rho', env: 'sky', exposure: 0, polar: 'linear', pose: 0, lobe: 'rho', lobeScale: 'linear',
-  more: [],  // further BRDFs, drawn in the plots (not in the slices, which show one or a pair)
+  more: [],  // further BRDFs, drawn in every view
+  hide: [],  // the BRDFs hidden (their specs): kept, not drawn
+  colours: [],  // a colour chosen per place in loaded() ('' or absent: COLOURS)
+  polarY: 'rho', theta: 'rho', thetaScale: 'log', lobeOpacity: 0.55, lobeZoom: 1,
 };
 const MODES = { b: 'the second', diff: 'the difference', ratio: 'the ratio' };
 let info = null;
@@ -53,7 +71,8 @@ function readHash() {
   const named = ['a', 'b', 'more'].some((k) => h.has(k));
   for (const k of Object.keys(state)) {
     if (!h.has(k)) continue;
-    if (Array.isArray(state[k])) state[k] = h.getAll(k).filter(Boolean).slice(0, MAX_MORE);
+    if (k === 'colours') state[k] = h.getAll(k).slice(0, COLOURS.length);
+    else if (Array.isArray(state[k])) state[k] = h.getAll(k).filter(Boolean).slice(0, k === 'hide' ? COLOURS.length : MAX_MORE);
     else state[k] = typeof state[k] === 'number' ? Number(h.get(k)) : h.get(k);
   }
   return named;
@@ -139,63 +158,94 @@ async function stopSpheres() {
   ++sphereGeneration;
   await Promise.allSettled([...spheres]);
 }
-window.halfback = { addBrdf, state, stats, idle, spheresDone, stopSpheres, cursor: () => cursor, lobe: () => lobeData, albedo: () => albedoCurves };
+window.halfback = { addBrdf, state, stats, idle, spheresDone, stopSpheres, cursor: () => cursor, lobe: () => lobeData,
+  albedo: () => albedoCurves, polar: () => polarCurves, theta: () => thetaAxis };
 
-const specs = () => (state.b && state.mode !== 'a' ? [state.a, state.b] : [state.a]);
+// What the slices and the hemisphere show: the pair (second, difference, ratio), or every BRDF
+// shown (the hemisphere: the first of them).
+const pairMode = () => Boolean(state.b) && state.mode !== 'a';
+const specs = () => (pairMode() ? [state.a, state.b] : [visible()[0]?.spec || state.a]);
 const formInfo = (space) => info.forms.find((f) => f.space === space);
-// Every BRDF shown (at most one per colour).
+// Every BRDF loaded (at most one per colour); its place in this list is its colour.
 const loaded = () => [state.a, state.b, ...state.more].filter(Boolean).slice(0, COLOURS.length);
+// The BRDFs drawn: those loaded and not hidden, each { spec, b } with b its colour's place.
+const visible = () => loaded().map((spec, b) => ({ spec, b })).filter((v) => !state.hide.includes(v.spec));
 // style.css has the classes swatch-0 … swatch-7 in COLOURS (the page's policy forbids inline styles).
 const swatch = (b) => `<span class="swatch-${b}">■</span>`;
 
 // --- slices ---------------------------------------------------------------------------------
-const sliceCanvases = {};
+// One row of slices per BRDF shown, in its colour (the same colour scale for all), or one row of
+// the pair's second, difference or ratio. sliceRows[r][space] is a canvas.
+let sliceRows = [];
+let builtKey = '';  // the rows built: sliceKey() when they were built
+const sliceKey = () => (pairMode() ? 'pair' : visible().map((v) => `${v.b}:${v.spec}`).join('|'));
+// /api/slices answers at most this many BRDFs a request: more are asked in requests side by side.
+const sliceBatch = () => (info && info.limits && info.limits.slices_brdfs) || 2;
 function buildSlices() {
   const box = $('slices');
   box.replaceChildren();
-  sliceSide = fitSliceSide();
-  for (const f of info.forms) {
-    const div = document.createElement('div');
-    div.className = 'slice';
-    const canvas = document.createElement('canvas');
-    canvas.id = `slice-${f.space}`;
-    canvas.dataset.space = f.space;
-    canvas.style.width = canvas.style.height = `${sliceSide}px`;
-    const plot = Object.assign(document.createElement('div'), { className: 'plot' });
-    plot.append(V.sliceAxes(f.axes, [plain(f.axes[0].label), plain(f.axes[1].label)], sliceSide), canvas);
-    div.append(Object.assign(document.createElement('h2'), { textContent: f.space, title: f.summary }), plot,
-      Object.assign(document.createElement('span'), {
-        className: 'axis',
-        textContent: `at the relative azimuth ${plain(f.azimuth_label)}`,
-      }));
-    box.append(div);
-    sliceCanvases[f.space] = canvas;
-    canvas.addEventListener('mousemove', (e) => pointerOnSlice(e, f, false));
-    canvas.addEventListener('click', (e) => pointerOnSlice(e, f, true));
-  }
+  const rows = pairMode() ? [null] : visible();
+  sliceSide = fitSliceSide(rows.length);
+  builtKey = sliceKey();
+  sliceRows = rows.map((row, r) => {
+    const group = Object.assign(document.createElement('div'), { className: 'slice-group' });
+    if (row) {
+      const name = Object.assign(document.createElement('div'), { className: 'row-name', title: fullSpec(row.spec) });
+      name.innerHTML = `${swatch(row.b)} ${escapeHtml(specLabel(row.spec))}`;
+      group.append(name);
+    }
+    const line = Object.assign(document.createElement('div'), { className: 'slice-row' });
+    const canvases = {};
+    for (const f of info.forms) {
+      const div = document.createElement('div');
+      div.className = 'slice';
+      const canvas = document.createElement('canvas');
+      canvas.id = r ? `slice-${f.space}-${r}` : `slice-${f.space}`;
+      canvas.dataset.space = f.space;
+      canvas.dataset.row = r;
+      canvas.style.width = canvas.style.height = `${sliceSide}px`;
+      const plot = Object.assign(document.createElement('div'), { className: 'plot' });
+      plot.append(V.sliceAxes(f.axes, [plain(f.axes[0].label), plain(f.axes[1].label)], sliceSide), canvas);
+      div.append(Object.assign(document.createElement('h2'), { textContent: f.space, title: f.summary }), plot,
+        Object.assign(document.createElement('span'), {
+          className: 'axis',
+          textContent: `at the relative azimuth ${plain(f.azimuth_label)}`,
+        }));
+      line.append(div);
+      canvases[f.space] = canvas;
+      canvas.addEventListener('mousemove', (e) => pointerOnSlice(e, f, false));
+      canvas.addEventListener('click', (e) => pointerOnSlice(e, f, true));
+    }
+    group.append(line);
+    box.append(group);
+    return canvases;
+  });
 }
-// A window resized: slices of the side that fits, drawn again.
+// A window resized: every view of the size that fits, drawn again.
 let resizeTimer = 0;
 window.addEventListener('resize', () => {
   clearTimeout(resizeTimer);
-  resizeTimer = setTimeout(() => {
-    if (!info || fitSliceSide() === sliceSide) return;
-    buildSlices();
-    track(updateSlices());
-  }, 200);
+  resizeTimer = setTimeout(() => { if (info) layout(); }, 200);
 });
 const plain = (label) => label.replace(/_/g, '').replace(/[{}]/g, '');
 
-let sliceFields = {};  // per form: [field of the first BRDF, of the second]
-// The four forms' slices of every BRDF shown, in one request (/api/slices).
+let sliceFields = {};  // { key: sliceKey() of the request, perForm: { space: [field per row BRDF] } }
+// The forms' slices of every BRDF of the rows (or of the pair), in one request per two BRDFs
+// (/api/slices), side by side.
 const updateSlices = coalesced(async () => {
-  const list = specs(), moving = interactive, n = moving ? dragSide : fullSide();
+  if (builtKey !== sliceKey()) buildSlices();
+  const key = builtKey, list = pairMode() ? [state.a, state.b] : visible().map((v) => v.spec);
+  const moving = interactive, n = moving ? dragSide : fullSide();
   const t0 = performance.now();
-  const { fields, headers } = await getFields(null, '/api/slices',
-    [...list.map((s) => ['brdf', s]), ['azimuth', state.az], ['pose', state.pose], ['n', n], ['values', 'luminance']]);
-  const forms = headers.get('X-Halfback-Forms').split(',');
-  sliceFields = {};
-  forms.forEach((space, f) => { sliceFields[space] = list.map((_, b) => fields[b * forms.length + f]); });
+  const batches = [];
+  for (let k = 0; k < list.length; k += sliceBatch()) batches.push(list.slice(k, k + sliceBatch()));
+  const answers = await Promise.all(batches.map((group) => getFields(null, '/api/slices',
+    [...group.map((s) => ['brdf', s]), ['azimuth', state.az], ['pose', state.pose], ['n', n], ['values', 'luminance']])));
+  if (!answers.length) return;
+  const forms = answers[0].headers.get('X-Halfback-Forms').split(',');
+  const fields = answers.flatMap((a) => a.fields);
+  sliceFields = { key, perForm: {} };
+  forms.forEach((space, f) => { sliceFields.perForm[space] = list.map((_, b) => fields[b * forms.length + f]); });
   const t1 = performance.now();
   drawSlices();
   stats.sliceFetchMs = t1 - t0;  // the request (server and transfer)
@@ -205,20 +255,26 @@ const updateSlices = coalesced(async () => {
   if (moving) adaptDragSide(performance.now() - t0);
 });
 function drawSlices() {
-  const scalars = {};
-  let mode = 'a';
-  for (const f of info.forms) {
-    const [a, b] = sliceFields[f.space] || [];
-    if (!a) return;
-    mode = b ? state.mode : 'a';
-    scalars[f.space] = V.sliceScalar(a, b, mode);
-  }
-  const scale = V.makeScale(Object.values(scalars), mode, state.scale);
+  if (!sliceFields.perForm || sliceFields.key !== builtKey) return;  // the rows changed: a new update comes
+  const pair = sliceFields.key === 'pair', mode = pair ? state.mode : 'a';
+  const scalars = sliceRows.map((_, r) => {
+    const out = {};
+    for (const f of info.forms) {
+      const fields = sliceFields.perForm[f.space];
+      if (!fields) return null;
+      out[f.space] = pair ? V.sliceScalar(fields[0], fields[1], mode) : V.luminanceOf(fields[r]);
+    }
+    return out;
+  });
+  if (scalars.some((x) => !x)) return;
+  const scale = V.makeScale(scalars.flatMap((x) => Object.values(x)), mode, state.scale);
   const levels = V.isoLevels(state.levels, scale);
-  for (const f of info.forms) {
-    const field = sliceFields[f.space][0];
-    V.drawScalar(sliceCanvases[f.space], scalars[f.space], field.width, field.height, scale, levels);
-  }
+  sliceRows.forEach((canvases, r) => {
+    for (const f of info.forms) {
+      const field = sliceFields.perForm[f.space][pair ? 0 : r];
+      V.drawScalar(canvases[f.space], scalars[r][f.space], field.width, field.height, scale, levels);
+    }
+  });
   drawColourbar(scale);
   markSlices();
 }
@@ -226,13 +282,13 @@ function drawColourbar(scale) {
   $('colorbar').replaceChildren(V.colourbarSvg(scale, `${scaleUnit(scale)}; hatched: outside the valid domain`, 320));
 }
 // What a colour scale's ticks are, in words (the ticks are values of it, not of a transform).
-function scaleUnit(scale) {
+function scaleUnit(scale, name = '') {
   const names = () => [specLabel(state.a), specLabel(state.b)];
   if (scale.mode === 'ratio') return `ratio of luminances, ${names()[0]} / ${names()[1]} (log scale)`;
   if (scale.mode === 'diff') {
     return `difference of luminances, ${names()[0]} − ${names()[1]} (sr⁻¹${scale.kind === 'log' ? ', log scale beyond ±' + V.shortNumber(scale.eps) : ''})`;
   }
-  return `luminance of ρ (sr⁻¹${scale.kind === 'log' ? ', log scale' : ''})`;
+  return `luminance of ρ${name ? ` of ${name}` : ''} (sr⁻¹${scale.kind === 'log' ? ', log scale' : ''})`;
 }
 
 function pointerOnSlice(e, f, click) {
@@ -248,8 +304,39 @@ function pointerOnSlice(e, f, click) {
 const wo = () => [Math.sin(state.to * DEG) * Math.cos(state.po * DEG),
   Math.sin(state.to * DEG) * Math.sin(state.po * DEG), Math.cos(state.to * DEG)];
 let hemiField = null;
+// The hemisphere's side on screen (CSS pixels): its panel's width (at most 640); at rest its
+// resolution is that side in device pixels (at most 512).
+let hemiSide = 256;
+const HEMI_MARGIN = 20;  // room for the φ labels around the disk
+const hemiN = () => Math.min(512, Math.round(hemiSide * (window.devicePixelRatio || 1)));
+// The θ circles (every 30°) and φ lines (every 45°) over the disk, labelled: SVG, so that they
+// export as they are; the equal-area radius of θ is √2 sin(θ/2).
+function drawHemiMarks() {
+  const svg = $('hemi-marks'), m = HEMI_MARGIN, R = hemiSide / 2, c = m + R, size = hemiSide + 2 * m;
+  svg.replaceChildren();
+  for (const [k, v] of Object.entries({ width: size, height: size, viewBox: `0 0 ${size} ${size}` })) svg.setAttribute(k, v);
+  const add = (name, attrs, content) => {
+    const e = document.createElementNS('http://www.w3.org/2000/svg', name);
+    for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+    if (content !== undefined) e.textContent = content;
+    svg.append(e);
+    return e;
+  };
+  const line = { stroke: '#ffffff', 'stroke-opacity': 0.35, 'stroke-width': 1, fill: 'none' };
+  for (const t of [30, 60]) add('circle', { cx: c, cy: c, r: R * Math.SQRT2 * Math.sin(t * DEG / 2), ...line, class: 'theta-mark', 'data-theta': t });
+  for (let p = 0; p < 360; p += 45) {
+    add('line', { x1: c, y1: c, x2: c + R * Math.cos(p * DEG), y2: c - R * Math.sin(p * DEG), ...line, class: 'phi-mark', 'data-phi': p });
+    add('text', { x: c + (R + 11) * Math.cos(p * DEG), y: c - (R + 11) * Math.sin(p * DEG) + 4, fill: '#9a9cab', 'font-size': 10,
+      'font-family': 'system-ui, sans-serif', 'text-anchor': 'middle', class: 'phi-label' }, `${p}°`);
+  }
+  for (const t of [30, 60, 90]) {  // along φ = 112.5°, between two lines
+    const r = R * Math.SQRT2 * Math.sin(t * DEG / 2) - 3, a = 112.5 * DEG;
+    add('text', { x: c + r * Math.cos(a), y: c - r * Math.sin(a), fill: '#ffffff', 'fill-opacity': 0.75, 'font-size': 10,
+      'font-family': 'system-ui, sans-serif', 'text-anchor': 'middle', class: 'theta-label' }, `θ ${t}°`);
+  }
+}
 const updateHemisphere = coalesced(async () => {
-  const n = interactive ? DRAG : 256;
+  const n = interactive ? DRAG : hemiN();
   const common = [['theta_o', state.to], ['phi_o', state.po], ['n', n]];
   if (state.hemi === 'rho') {
     const fields = await B.fieldsOf(null, '/api/hemisphere', specs(),
@@ -271,7 +358,7 @@ function drawHemisphere() {
     const scale = V.makeScale([s], mode, 'log');
     V.drawScalar(canvas, s, a.width, a.height, scale, []);
     blackOutside(canvas);
-    $('hemi-colorbar').replaceChildren(V.colourbarSvg(scale, scaleUnit(scale)));
+    $('hemi-colorbar').replaceChildren(V.colourbarSvg(scale, scaleUnit(scale, specLabel(specs()[0]))));
   } else {
     const axes = formInfo(state.hemi).axes;
     V.drawCoordinates(canvas, hemiField.coords, axes);
@@ -385,45 +472,90 @@ function hoverWi(e) {
 let lobe = null;
 let lobeData = [];  // per BRDF loaded: the lobeMesh drawn (for the test's read-back)
 const LOBE_N = 96;
+let lobeShown = [];  // the { spec, b } of each surface
 const updateLobe = coalesced(async () => {
   if (!lobe || !lobe.available) return;
-  const list = loaded();
-  const fields = await B.fieldsOf(null, '/api/hemisphere', list,
+  const list = visible();
+  const fields = await B.fieldsOf(null, '/api/hemisphere', list.map((v) => v.spec),
     [['colour', 'rho'], ['values', 'luminance'], ['theta_o', state.to], ['phi_o', state.po], ['n', LOBE_N]]);
   const options = { cosine: state.lobe === 'cos', log: state.lobeScale === 'log' };
   // One radius scale for all: the largest value of any BRDF shown is 1.
   const meshes = fields.map((f) => lobeMesh(f, options));
-  const max = Math.max(...meshes.map((m) => m.max));
+  const max = Math.max(0, ...meshes.map((m) => m.max));
   lobeData = fields.map((f) => lobeMesh(f, { ...options, max }));
-  lobe.set(lobeData.map((mesh, b) => ({ mesh, colour: hexColour(COLOURS[b]) })), wo());
+  lobeShown = list;
+  drawLobe();
 });
+// The surfaces in their colours, see-through at the chosen opacity (each shows through the
+// others), and the legend: the BRDFs and what the rings on the ground mean.
+function drawLobe() {
+  if (!lobe || !lobe.available) return;
+  lobe.opacity = state.lobeOpacity;
+  lobe.zoom = state.lobeZoom;
+  lobe.set(lobeData.map((mesh, k) => ({ mesh, colour: hexColour(palette()[lobeShown[k].b]) })), wo());
+  const max = lobeData.length ? lobeData[0].max : 0, what = state.lobe === 'cos' ? 'ρ cos θi' : 'ρ';
+  const ring = (r) => V.shortNumber(Number((state.lobeScale === 'log' ? max * 10 ** (3 * (r - 1)) : r * max).toPrecision(2)));
+  const names = lobeShown.map((v) => `<span title="${escapeHtml(fullSpec(v.spec))}">${swatch(v.b)}&nbsp;${escapeHtml(specLabel(v.spec))}</span>`);
+  $('lobe-note').textContent = 'Each ωi pushed out by the radius below (one scale for every BRDF); grey: the normal; red: ωo; white: its mirror direction. Drag to turn.';
+  $('lobe-legend').innerHTML = `${names.join(' ')}<br>Radius: ${what} over its largest value shown, ${escapeHtml(ring(1))} sr⁻¹`
+    + `${state.lobeScale === 'log' ? ' (3 decades)' : ''}; rings on the ground at radius ½ (${escapeHtml(ring(0.5))}) and 1 (${escapeHtml(ring(1))}).`;
+  window.halfback.lobeScale = { max, half: ring(0.5), one: ring(1) };
+}
 const hexColour = (hex) => [1, 3, 5].map((k) => parseInt(hex.slice(k, k + 2), 16) / 255);
 function setupLobe() {
   lobe = new LobeView($('lobe'));
   if (!lobe.available) $('lobe-note').textContent = 'This browser has no WebGL 2: no 3D lobe.';
   $('lobe-radius').addEventListener('change', (e) => { state.lobe = e.target.value; writeHash(); track(updateLobe()); });
   $('lobe-scale').addEventListener('change', (e) => { state.lobeScale = e.target.value; writeHash(); track(updateLobe()); });
+  $('lobe-opacity').addEventListener('input', (e) => { state.lobeOpacity = Number(e.target.value); writeHash(); drawLobe(); });
+  $('lobe-zoom').addEventListener('input', (e) => { state.lobeZoom = Number(e.target.value); writeHash(); drawLobe(); });
   $('lobe-radius').value = state.lobe;
   $('lobe-scale').value = state.lobeScale;
+  $('lobe-opacity').value = state.lobeOpacity;
+  $('lobe-zoom').value = state.lobeZoom;
 }
 
 // --- albedo plot ------------------------------------------------------------------------------
 let albedoCurves = [];  // per BRDF loaded: the /api/albedo answer
+let albedoShown = [];  // the { spec, b } of each curve
 const updateAlbedo = coalesced(async () => {
-  const list = loaded();
-  albedoCurves = await B.albedoCurves('albedo', list, [['n', 64]]);
-  V.drawAlbedo($('albedo'), albedoCurves, COLOURS, list.map(specLabel), list.map(fullSpec));
+  const list = visible();
+  albedoCurves = await B.albedoCurves('albedo', list.map((v) => v.spec), [['n', 64]]);
+  albedoShown = list;
+  drawAlbedo();
 });
+function drawAlbedo() {
+  const list = albedoShown, w = plotWidth('albedo-panel');
+  V.drawAlbedo($('albedo'), albedoCurves, list.map((v) => palette()[v.b]), list.map((v) => specLabel(v.spec)),
+    list.map((v) => fullSpec(v.spec)), w, Math.round(0.6 * w));
+}
 
 // --- polar plot ------------------------------------------------------------------------------
-let polarCurves = [];
+let polarCurves = [], polarShown = [], polarThetaO = 45;
+// The polar plot and the plot against θi draw the same curves (/api/polar, one request a BRDF).
 const updatePolar = coalesced(async () => {
-  polarCurves = await B.polarCurves(null, loaded(),
-    [['theta_o', state.to], ['phi_o', state.po], ['n', interactive ? 91 : 181]]);
+  const list = visible(), thetaO = state.to;
+  polarCurves = await B.polarCurves(null, list.map((v) => v.spec),
+    [['theta_o', thetaO], ['phi_o', state.po], ['n', interactive ? 91 : 181]]);
+  polarShown = list;
+  polarThetaO = thetaO;
   drawPolar();
 });
 function drawPolar() {
-  V.drawPolar($('polar'), polarCurves, state.polar, COLOURS, polarCursorAngle(), loaded().map(specLabel), loaded().map(fullSpec));
+  const list = polarShown, colours = list.map((v) => palette()[v.b]);
+  const names = list.map((v) => specLabel(v.spec)), titles = list.map((v) => fullSpec(v.spec));
+  V.drawPolar($('polar'), polarCurves, state.polar, colours, polarCursorAngle(), names, titles,
+    { quantity: state.polarY, thetaO: polarThetaO, width: plotWidth('polar-panel') });
+  const w = plotWidth('theta-panel');
+  thetaAxis = V.drawTheta($('theta'), polarCurves, colours, names, titles,
+    { quantity: state.theta, scale: state.thetaScale, thetaO: polarThetaO, width: w, height: Math.round(0.6 * w), cursor: polarCursorAngle() });
+}
+let thetaAxis = null;  // what drawTheta drew: its y range and ticks (the test reads them)
+// A plot's width: its panel's, within the panel's padding (at most 900 CSS pixels).
+function plotWidth(panel) {
+  const p = $(panel), style = getComputedStyle(p);
+  const inner = p.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight);
+  return Math.max(240, Math.min(900, Math.floor(inner || 460)));
 }
 function setupPolar() {
   const svg = $('polar');
@@ -446,16 +578,23 @@ function setupPolar() {
 
 // --- sphere ----------------------------------------------------------------------------------
 let sphereGeneration = 0;
-// The spheres are rendered at their size on screen (256 CSS pixels) in device pixels: sharp.
-const SPHERE = Math.min(512, Math.round(256 * (window.devicePixelRatio || 1))), PASSES = 32, SPP = 4;
+// The spheres are rendered at their size on screen (0.6 of a view, 256 … 420 CSS pixels: it grows
+// with the window) in device pixels: sharp.
+let sphereSide = 256, SPHERE = 256;
+const PASSES = 32, SPP = 4;
+const fitSphereSide = () => Math.max(256, Math.min(420, Math.round(0.6 * viewSize())));
 function restartSphere() {
   const gen = ++sphereGeneration;
   const box = $('spheres');
   box.replaceChildren();
-  loaded().forEach((s, b) => {
+  sphereSide = fitSphereSide();
+  SPHERE = Math.min(512, Math.round(sphereSide * (window.devicePixelRatio || 1)));
+  visible().forEach(({ spec: s, b }) => {
     const fig = document.createElement('figure');
     const canvas = document.createElement('canvas');
     canvas.id = `sphere-${b}`;
+    fig.style.width = `${sphereSide}px`;
+    canvas.style.width = canvas.style.height = `${sphereSide}px`;
     const cap = document.createElement('figcaption');
     cap.innerHTML = `${swatch(b)}&nbsp;${escapeHtml(specLabel(s))}, the environment`;
     cap.title = fullSpec(s);
@@ -489,6 +628,8 @@ function pointLightFigure(spec, b) {
   const fig = document.createElement('figure');
   const canvas = Object.assign(document.createElement('canvas'), { id: `pointlight-${b}` });
   canvas.dataset.spec = spec;
+  fig.style.width = `${sphereSide}px`;
+  canvas.style.width = canvas.style.height = `${sphereSide}px`;
   const cap = document.createElement('figcaption');
   cap.innerHTML = `${swatch(b)}&nbsp;${escapeHtml(specLabel(spec))}, a light from ωo`;
   cap.title = fullSpec(spec);
@@ -551,6 +692,7 @@ function showCursor() {
   }
   html += heading('ρ', ['r', 'g', 'b'], ['sr⁻¹', 'sr⁻¹', 'sr⁻¹']);
   c.rho.forEach((r, b) => {
+    if (state.hide.includes(r.brdf)) return;  // hidden: not listed
     html += row(`<span title="${escapeHtml(fullSpec(r.brdf))}">${swatch(b)} ρ ${escapeHtml(specLabel(r.brdf))}</span>`, ['r', 'g', 'b'], r.rgb, `rho-${b}`);
   });
   $('cursor').innerHTML = `${html}</table>`;
@@ -582,12 +724,15 @@ function cursorInView() {
 function markSlices() {
   if (!cursor || !cursor.valid) return;
   for (const f of cursor.forms) {
-    const fi = formInfo(f.space), canvas = sliceCanvases[f.space];
-    if (!canvas || !canvas.width) continue;
-    V.restore(canvas);
-    let d = Math.abs(f.iso[2] - state.az * DEG) % (2 * Math.PI);
-    d = Math.min(d, 2 * Math.PI - d);
-    V.drawMarker(canvas, f.iso[0] / fi.axes[0].max, f.iso[1] / fi.axes[1].max, d < 0.5 * DEG);
+    const fi = formInfo(f.space);
+    for (const canvases of sliceRows) {
+      const canvas = canvases[f.space];
+      if (!canvas || !canvas.width) continue;
+      V.restore(canvas);
+      let d = Math.abs(f.iso[2] - state.az * DEG) % (2 * Math.PI);
+      d = Math.min(d, 2 * Math.PI - d);
+      V.drawMarker(canvas, f.iso[0] / fi.axes[0].max, f.iso[1] / fi.axes[1].max, d < 0.5 * DEG);
+    }
   }
 }
 function markHemisphere() {
@@ -767,6 +912,33 @@ function sliderSpec() {
   }).join('+');
 }
 
+// --- layout --------------------------------------------------------------------------------------
+// Every view grows with the window: the panels are viewSize() wide or more (CSS: --view) and
+// wrap; each view takes its panel's width (the slices: fitSliceSide, the spheres: fitSphereSide),
+// drawn again at its new size (a canvas at its size in device pixels).
+let lobeSide = 400;
+function layout() {
+  document.documentElement.style.setProperty('--view', `${viewSize()}px`);
+  const hemiWas = hemiN();
+  hemiSide = Math.max(200, Math.min(640, plotWidth('hemisphere-panel') - 2 * HEMI_MARGIN));
+  $('hemisphere').style.width = $('hemisphere').style.height = `${hemiSide}px`;
+  drawHemiMarks();
+  lobeSide = Math.max(240, Math.min(720, plotWidth('lobe-panel')));
+  const c = $('lobe'), px = Math.round(lobeSide * (window.devicePixelRatio || 1));
+  c.style.width = c.style.height = `${lobeSide}px`;
+  if (c.width !== px) { c.width = px; c.height = px; if (lobe) lobe.draw(); }
+  drawPolar();
+  drawAlbedo();
+  const rows = pairMode() ? 1 : visible().length;
+  if (fitSliceSide(rows) !== sliceSide) {
+    buildSlices();
+    track(updateSlices());
+  }
+  if (hemiN() !== hemiWas) track(updateHemisphere());
+  if (fitSphereSide() !== sphereSide && $('spheres').childElementCount) restartSphere();
+  stats.layoutWidth = window.innerWidth;  // the window width the views were laid out for
+}
+
 // --- updates ------------------------------------------------------------------------------------
 function changed({ slices = true, sphere = true, sliders = false } = {}) {
   writeHash();
@@ -780,6 +952,7 @@ function changed({ slices = true, sphere = true, sliders = false } = {}) {
     track(updatePointLights());
   }
   if (sphere === true) {  // a BRDF changed: the views that do not depend on ωo too
+    showMore();
     restartSphere();
     track(updateAlbedo());
   }
@@ -855,19 +1028,77 @@ function setPose(degrees) {
   track(showPoseControl());
 }
 
-// The BRDFs added to the plots: a chip each (its colour, its name, × to remove it).
+// Every BRDF loaded: a chip each, in the header: its colour (a colour picker), its name (the whole
+// spec on hover), whether it is shown, solo (it alone; again: all of them), × to remove an
+// added one.
 function showMore() {
   const box = $('more');
   box.replaceChildren();
-  state.more.forEach((spec, k) => {
-    const chip = Object.assign(document.createElement('span'), { className: 'chip' });
-    chip.innerHTML = `${swatch(loaded().indexOf(spec))} ${escapeHtml(specLabel(spec))}`;
-    chip.title = fullSpec(spec);
-    const x = Object.assign(document.createElement('button'), { type: 'button', textContent: '×', title: 'remove from the plots' });
-    x.addEventListener('click', () => { state.more.splice(k, 1); showMore(); changed(); });
-    chip.append(x);
+  state.hide = state.hide.filter((s) => loaded().includes(s));
+  applyPalette();
+  const list = loaded(), shown = visible();
+  list.forEach((spec, b) => {
+    const hidden = state.hide.includes(spec), name = specLabel(spec);
+    const chip = Object.assign(document.createElement('span'), { className: `chip${hidden ? ' hidden' : ''}` });
+    chip.dataset.spec = spec;
+    chip.dataset.slot = b;
+    const colour = Object.assign(document.createElement('input'), { type: 'color', className: 'colour', value: palette()[b], title: `the colour of ${name}` });
+    colour.addEventListener('input', () => setColour(b, colour.value));
+    const role = spec === state.a ? 'first' : spec === state.b ? 'compare' : '';
+    const label = Object.assign(document.createElement('span'), { className: 'name', textContent: name, title: fullSpec(spec) });
+    const show = Object.assign(document.createElement('input'), { type: 'checkbox', className: 'show', checked: !hidden, title: `show ${name} (unticked: hidden in every view)` });
+    show.addEventListener('change', () => setHidden(spec, !show.checked));
+    const alone = shown.length === 1 && shown[0].spec === spec && list.length > 1;
+    const solo = Object.assign(document.createElement('button'), { type: 'button', className: `solo${alone ? ' on' : ''}`, textContent: 'solo',
+      title: alone ? 'show every BRDF again' : `show ${name} alone` });
+    solo.addEventListener('click', () => soloBrdf(spec));
+    chip.append(colour, label);
+    if (role) chip.append(Object.assign(document.createElement('span'), { className: 'role', textContent: role }));
+    chip.append(show, solo);
+    const k = state.more.indexOf(spec);
+    if (k >= 0 && spec !== state.a && spec !== state.b) {
+      const x = Object.assign(document.createElement('button'), { type: 'button', className: 'remove', textContent: '×', title: `remove ${name}` });
+      x.addEventListener('click', () => { state.more.splice(state.more.indexOf(spec), 1); showMore(); changed(); });
+      chip.append(x);
+    }
     box.append(chip);
   });
+}
+function setHidden(spec, hide) {
+  if (hide && !state.hide.includes(spec) && visible().length <= 1) {
+    setStatus('one BRDF at least is shown: tick another first', true);
+    showMore();
+    return;
+  }
+  state.hide = hide ? [...state.hide.filter((s) => s !== spec), spec] : state.hide.filter((s) => s !== spec);
+  showMore();
+  visibilityChanged();
+}
+function soloBrdf(spec) {
+  const shown = visible(), alone = shown.length === 1 && shown[0].spec === spec;
+  state.hide = alone ? [] : loaded().filter((s) => s !== spec);
+  showMore();
+  visibilityChanged();
+}
+function setColour(b, colour) {
+  state.colours = palette().map((c, k) => (k === b ? colour : state.colours[k] || ''));
+  while (state.colours.length && !state.colours[state.colours.length - 1]) state.colours.pop();
+  applyPalette();
+  writeHash();
+  drawPolar();
+  drawAlbedo();
+  drawLobe();
+}
+// A BRDF shown or hidden: every view that draws them all again.
+function visibilityChanged() {
+  writeHash();
+  track(updateSlices());
+  track(updateHemisphere());
+  track(updatePolar());
+  track(updateLobe());
+  track(updateAlbedo());
+  restartSphere();
+  showCursor();
 }
 async function addBrdf(spec) {
   if (loaded().includes(spec)) return setStatus(`${specLabel(spec)} is already shown`);
@@ -945,6 +1176,9 @@ function setup() {
   $('levels').addEventListener('change', (e) => { state.levels = e.target.value || 'auto'; writeHash(); drawSlices(); });
   $('hemi-colour').addEventListener('change', (e) => { state.hemi = e.target.value; writeHash(); track(updateHemisphere()); });
   $('polar-scale').addEventListener('change', (e) => { state.polar = e.target.value; writeHash(); drawPolar(); });
+  $('polar-quantity').addEventListener('change', (e) => { state.polarY = e.target.value; writeHash(); drawPolar(); });
+  $('theta-quantity').addEventListener('change', (e) => { state.theta = e.target.value; writeHash(); drawPolar(); });
+  $('theta-scale').addEventListener('change', (e) => { state.thetaScale = e.target.value; writeHash(); drawPolar(); });
   $('env').addEventListener('change', (e) => { state.env = e.target.value; writeHash(); restartSphere(); });
   $('exposure').addEventListener('input', (e) => { state.exposure = Number(e.target.value); writeHash(); redrawSpheres(); });
   setupHemisphere();
@@ -1022,11 +1256,12 @@ function setupExports() {
 }
 // What a figure of the view says above it: the view, the BRDFs, the state that picks the slice.
 function figureTitle(target) {
-  const names = (target === 'slices' || target === 'hemisphere' ? specs() : loaded()).map(specLabel);
+  const names = (target === 'hemisphere' || (target === 'slices' && pairMode()) ? specs() : visible().map((v) => v.spec)).map(specLabel);
   const wo = `θo = ${state.to.toFixed(1)}°, φo = ${state.po.toFixed(1)}°`;
   const what = {
     slices: `slices at the relative azimuth ${state.az}°${$('pose-box').hidden ? '' : `, orientation ${state.pose}°`}`,
-    hemisphere: `hemisphere of ωi, ${wo}`, polar: `polar plot of ρ, ${wo}`, lobe: `lobe of ρ(·, ωo), ${wo}`,
+    hemisphere: `hemisphere of ωi, ${wo}`, polar: `polar plot of ${state.polarY === 'cos' ? 'ρ cos θi' : 'ρ'}, ${wo}`, lobe: `lobe of ρ(·, ωo), ${wo}`,
+    theta: `${state.theta === 'cos' ? 'ρ cos θi' : 'ρ'} against θi (${state.thetaScale} axis), ${wo}`,
     albedo: 'directional albedo', sphere: `lit sphere, environment ${state.env}, exposure ${state.exposure}`,
   }[target];
   const shown = state.mode !== 'a' && state.b && (target === 'slices' || target === 'hemisphere')
@@ -1044,7 +1279,7 @@ function panelFigure(target) {
   const text = (t, x, y, size, colour) => `<text x="${x}" y="${y}" font-family="sans-serif" font-size="${size}" fill="${colour}">${esc(t)}</text>`;
   const title = figureTitle(target);
   parts.push(text(title, 8, 18, 13, '#e6e6ea'));
-  for (const e of panel.querySelectorAll('canvas, svg, h2, .axis, figcaption, .note')) {
+  for (const e of panel.querySelectorAll('canvas, svg, h2, .axis, figcaption, .note, .row-name')) {
     if (e.closest('svg') !== e && e.closest('svg')) continue;  // inside a plot: part of it
     if (e.closest('.panel-head') && e.tagName !== 'H2') continue;  // controls
     const r = at(e);
@@ -1081,7 +1316,7 @@ function runsOf(e, fill) {
     }
     if (n.nodeType !== Node.ELEMENT_NODE) return;
     const m = /(?:^|\s)swatch-(\d)(?:\s|$)/.exec(n.getAttribute('class') || '');
-    for (const c of n.childNodes) walk(c, m ? COLOURS[Number(m[1])] : colour);
+    for (const c of n.childNodes) walk(c, m ? palette()[Number(m[1])] : colour);
   };
   walk(e, fill);
   return runs;
@@ -1192,11 +1427,17 @@ async function main() {
       { value: f.space, textContent: f.space, title: f.summary }));
   $('hemi-colour').value = state.hemi;
   $('polar-scale').value = state.polar;
+  $('polar-quantity').value = state.polarY;
+  $('theta-quantity').value = state.theta;
+  $('theta-scale').value = state.thetaScale;
   ensureOption($('env'), state.env);
   $('exposure').value = state.exposure;
+  applyPalette();
+  document.documentElement.style.setProperty('--view', `${viewSize()}px`);
   buildSlices();
   setup();
   showMore();
+  layout();
   changed({ sliders: true });
   setStatus(`ready${note}`, Boolean(note));
 }

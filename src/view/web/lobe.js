@@ -107,6 +107,8 @@ export class LobeView {
     this.pitch = 0.45;
     this.meshes = [];
     this.lines = [];
+    this.opacity = 0.55;  // of every surface: below 1 each shows through the others
+    this.zoom = 1;
     if (!this.gl) return;
     const gl = this.gl, p = gl.createProgram();
     gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, VERTEX));
@@ -151,15 +153,18 @@ export class LobeView {
       vertices: this.buffer(mesh.positions), elements: this.buffer(mesh.indices, gl.ELEMENT_ARRAY_BUFFER),
       count: mesh.indices.length, colour,
     }));
-    const circle = [];
+    // Rings on the ground at radius 1 (the largest value shown) and ½: the scale.
+    const circle = [], half = [];
     for (let k = 0; k < 64; ++k) {
       const a = 2 * Math.PI * k / 64, b = 2 * Math.PI * (k + 1) / 64;
       circle.push(Math.cos(a), Math.sin(a), 0, Math.cos(b), Math.sin(b), 0);
+      half.push(0.5 * Math.cos(a), 0.5 * Math.sin(a), 0, 0.5 * Math.cos(b), 0.5 * Math.sin(b), 0);
     }
     const mirror = [-wo[0], -wo[1], wo[2]];
     for (const l of this.lines) gl.deleteBuffer(l.vertices);
     this.lines = [
       { data: circle, colour: [0.45, 0.47, 0.55, 1] },
+      { data: half, colour: [0.33, 0.35, 0.42, 1] },
       { data: [0, 0, 0, 0, 0, 1.15], colour: [0.75, 0.75, 0.8, 1] },  // the normal
       { data: [0, 0, 0, ...wo.map((x) => 1.15 * x)], colour: [1, 0.23, 0.42, 1] },  // ωo
       { data: [0, 0, 0, ...mirror.map((x) => 1.15 * x)], colour: [1, 1, 1, 1] },  // its mirror
@@ -175,7 +180,7 @@ export class LobeView {
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     gl.enable(gl.DEPTH_TEST);
     gl.useProgram(this.program);
-    const { matrix, eye } = orbit(this.yaw, this.pitch, 3.2);
+    const { matrix, eye } = orbit(this.yaw, this.pitch, 3.2 / (this.zoom || 1));
     gl.uniformMatrix4fv(this.at.view, false, multiply(perspective(35, c.width / c.height, 0.1, 20), matrix));
     gl.uniform3fv(this.at.eye, eye);
     const attrib = (b) => {
@@ -190,14 +195,21 @@ export class LobeView {
       gl.drawArrays(gl.LINES, 0, l.count);
     }
     gl.uniform1i(this.at.lit, 1);
-    gl.enable(gl.BLEND);
-    gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
-    this.meshes.forEach((m, b) => {
+    // See-through surfaces write no depth, so that none hides another (an opaque first surface
+    // around the others hid them); at opacity 1 they are solid and the nearest one shows.
+    const opacity = Math.min(1, Math.max(0.05, this.opacity));
+    if (opacity < 1) {
+      gl.enable(gl.BLEND);
+      gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
+      gl.depthMask(false);
+    }
+    this.meshes.forEach((m) => {
       attrib(m.vertices);
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, m.elements);
-      gl.uniform4fv(this.at.colour, [...m.colour, b ? 0.6 : 1]);  // the second one see-through
+      gl.uniform4fv(this.at.colour, [...m.colour, opacity]);
       gl.drawElements(gl.TRIANGLES, m.count, gl.UNSIGNED_INT, 0);
     });
+    gl.depthMask(true);
     gl.disable(gl.BLEND);
   }
 }

@@ -349,13 +349,29 @@ function el(name, attrs) {
   return e;
 }
 
-// The polar plot: per BRDF, ρ along the two curves as the radius (t from the vertical).
-// The legend is below the plot, a row per BRDF (its title, on hover, the whole spec: titles).
-export function drawPolar(svg, curves, kind, colours, cursor, names = [], titles = names) {
+// The values a curve of /api/polar gives a plot: the luminance of ρ, or of ρ cos θi (quantity
+// 'cos'); in the plane of incidence θi is the angle t itself, across it (t from the mirror
+// direction, turned about the horizontal perpendicular to the plane) cos θi = cos θo cos t.
+export function polarValues(curve, key, quantity, thetaO) {
+  return curve.angles_deg.map((deg, i) => {
+    const y = lum(curve[key][i]), t = deg * Math.PI / 180;
+    if (quantity !== 'cos') return y;
+    return y * Math.max(0, key === 'in_plane' ? Math.cos(t) : Math.cos(thetaO * Math.PI / 180) * Math.cos(t));
+  });
+}
+
+// The polar plot: per BRDF, ρ (or ρ cos θi) along the two curves as the radius (t from the
+// vertical), `width` CSS pixels wide; texts 11 px whatever the width. The legend is below the
+// plot, a row per BRDF (its title, on hover, the whole spec: titles).
+export function drawPolar(svg, curves, kind, colours, cursor, names = [], titles = names,
+  { quantity = 'rho', thetaO = 45, width = 460 } = {}) {
   svg.replaceChildren();
-  const height = 1.35 + (names.length ? 0.05 + 0.08 * names.length : 0);
+  const u = 2.3 / width;  // viewBox units per pixel
+  const below = names.length ? (50 + 16 * names.length) * u : 40 * u;
+  const height = 1.15 + below;
   svg.setAttribute('viewBox', `-1.15 -1.15 2.3 ${height}`);
-  svg.setAttribute('height', Math.round(Number(svg.getAttribute('width') || 460) * height / 2.3));
+  svg.setAttribute('width', width);
+  svg.setAttribute('height', Math.round(width * height / 2.3));
   svg.append(el('rect', { x: -1.15, y: -1.15, width: 2.3, height, fill: '#111217' }));
   for (const r of [0.25, 0.5, 0.75, 1]) {
     svg.append(el('path', { d: `M ${-r} 0 A ${r} ${r} 0 0 1 ${r} 0`, fill: 'none', stroke: '#333842', 'stroke-width': 0.005 }));
@@ -364,9 +380,9 @@ export function drawPolar(svg, curves, kind, colours, cursor, names = [], titles
     const t = a * Math.PI / 180;
     svg.append(el('line', { x1: 0, y1: 0, x2: Math.sin(t), y2: -Math.cos(t), stroke: '#333842', 'stroke-width': 0.005 }));
   }
+  const values = curves.map((c) => ({ in_plane: polarValues(c, 'in_plane', quantity, thetaO), across: polarValues(c, 'across', quantity, thetaO) }));
   let max = 0, min = Infinity;
-  for (const c of curves) for (const k of ['in_plane', 'across']) for (const v of c[k]) {
-    const y = lum(v);
+  for (const c of values) for (const k of ['in_plane', 'across']) for (const y of c[k]) {
     if (y > max) max = y;
     if (y > 0 && y < min) min = y;
   }
@@ -376,42 +392,116 @@ export function drawPolar(svg, curves, kind, colours, cursor, names = [], titles
     for (const k of ['in_plane', 'across']) {
       let d = '';
       c.angles_deg.forEach((deg, i) => {
-        const t = deg * Math.PI / 180, r = radius(lum(c[k][i]));
+        const t = deg * Math.PI / 180, r = radius(values[b][k][i]);
         d += `${i ? 'L' : 'M'} ${(r * Math.sin(t)).toFixed(5)} ${(-r * Math.cos(t)).toFixed(5)} `;
       });
       svg.append(el('path', { d, fill: 'none', stroke: colours[b], 'stroke-width': 0.012, 'stroke-dasharray': k === 'across' ? '0.04 0.025' : 'none' }));
     }
   });
   // Angles from the normal along the arc; the radius' values (luminance of ρ) along the base.
+  const fs = 11 * u;
   const small = (content, x, y, anchor = 'middle') => {
-    const t = el('text', { x, y, fill: '#9a9cab', 'font-size': 0.055, 'text-anchor': anchor, 'font-family': 'system-ui, sans-serif' });
+    const t = el('text', { x, y, fill: '#9a9cab', 'font-size': fs, 'text-anchor': anchor, 'font-family': 'system-ui, sans-serif' });
     t.textContent = content;
     svg.append(t);
   };
   for (let a = -90; a <= 90; a += 30) {  // ±90° above the base line, clear of the radii's values
     const t = a * Math.PI / 180;
-    small(`${Math.abs(a)}°`, 1.085 * Math.sin(t), Math.abs(a) === 90 ? -0.025 : -1.08 * Math.cos(t) + 0.02);
+    small(`${Math.abs(a)}°`, (1 + 0.085 * 460 * u) * Math.sin(t), Math.abs(a) === 90 ? -5 * u : -(1 + 0.08 * 460 * u) * Math.cos(t) + 4 * u);
   }
   names.forEach((name, b) => {  // the legend, below the radius' label
-    const y = 0.29 + 0.08 * b;
+    const y = 58 * u + 16 * u * b;
     const g = el('g', { class: 'legend' });
     const title = el('title', {});
     title.textContent = titles[b] || name;
-    g.append(title, el('line', { x1: -1.1, x2: -1.0, y1: y - 0.018, y2: y - 0.018, stroke: colours[b], 'stroke-width': 0.015 }));
+    g.append(title, el('line', { x1: -1.1, x2: -1.1 + 20 * u, y1: y - 4 * u, y2: y - 4 * u, stroke: colours[b], 'stroke-width': 3 * u }));
     svg.append(g);
-    const t = el('text', { x: -0.97, y, fill: '#9a9cab', 'font-size': 0.055, 'font-family': 'system-ui, sans-serif' });
+    const t = el('text', { x: -1.1 + 26 * u, y, fill: '#9a9cab', 'font-size': fs, 'font-family': 'system-ui, sans-serif' });
     t.textContent = name;
     g.append(t);
   });
   const valueAt = (r) => (kind === 'log' ? 10 ** (lo + r * (Math.log10(max) - lo)) : r * max);
-  if (max > 0) for (const r of [0.25, 0.5, 0.75, 1]) small(shortNumber(Number(valueAt(r).toPrecision(2))), r, 0.075);
+  if (max > 0) for (const r of [0.25, 0.5, 0.75, 1]) small(shortNumber(Number(valueAt(r).toPrecision(2))), r, 15 * u);
   if (cursor !== null && cursor !== undefined) {
     const t = cursor * Math.PI / 180;
     svg.append(el('line', { x1: 0, y1: 0, x2: 1.05 * Math.sin(t), y2: -1.05 * Math.cos(t), stroke: '#ff3b6b', 'stroke-width': 0.01 }));
   }
-  const label = el('text', { x: -1.1, y: 0.17, fill: '#9a9cab', 'font-size': 0.06, 'font-family': 'system-ui, sans-serif' });
-  label.textContent = `radius: luminance of ρ (sr⁻¹${kind === 'log' ? ', log scale' : ''}); ← back   mirror →`;
+  const label = el('text', { x: -1.1, y: 34 * u, fill: '#9a9cab', 'font-size': 12 * u, 'font-family': 'system-ui, sans-serif' });
+  label.textContent = `radius: luminance of ${quantity === 'cos' ? 'ρ cos θi' : 'ρ'} (sr⁻¹${kind === 'log' ? ', log scale' : ''}); ← back   mirror →`;
   svg.append(label);
+}
+
+// ρ (or ρ cos θi) against the angle, the polar plot's curves drawn flat: x from −90° (the side
+// of ωo) to 90° (the mirror side), y linear or logarithmic (decades), `width` × `height` CSS
+// pixels; a legend at the top right; the cursor's angle as a vertical line.
+export function drawTheta(svg, curves, colours, names, titles, { quantity = 'rho', scale = 'log', thetaO = 45, width = 460, height = 270, cursor = null } = {}) {
+  svg.replaceChildren();
+  const W = width, H = height, left = 52, right = 12, top = 12, bottom = 40;
+  const total = H + (names.length ? 8 + 14 * names.length : 0);  // the legend below the plot
+  svg.setAttribute('width', W);
+  svg.setAttribute('height', total);
+  svg.setAttribute('viewBox', `0 0 ${W} ${total}`);
+  svg.append(el('rect', { x: 0, y: 0, width: W, height: total, fill: '#111217' }));
+  const values = curves.map((c) => ({ in_plane: polarValues(c, 'in_plane', quantity, thetaO), across: polarValues(c, 'across', quantity, thetaO) }));
+  let max = 0, min = Infinity;
+  for (const c of values) for (const k of ['in_plane', 'across']) for (const y of c[k]) {
+    if (y > max) max = y;
+    if (y > 0 && y < min) min = y;
+  }
+  if (!(max > 0)) { max = 1; min = 0.1; }
+  let y0, y1, ticks;
+  if (scale === 'log') {  // whole decades, at most 8 of them below the largest value
+    y1 = Math.ceil(Math.log10(max) - 1e-9);
+    y0 = Math.max(Math.floor(Math.log10(min)), y1 - 8);
+    if (y0 >= y1) y0 = y1 - 1;
+    ticks = [];
+    for (let k = y0; k <= y1; ++k) ticks.push({ v: k, label: shortNumber(10 ** k) });
+  } else {
+    const step = niceStep(max / 4);
+    y0 = 0;
+    y1 = Math.ceil(max / step - 1e-9) * step;
+    ticks = [];
+    for (let v = 0; v <= y1 + 1e-9 * step; v += step) ticks.push({ v, label: shortNumber(Number(v.toPrecision(6))) });
+  }
+  const tf = (v) => (scale === 'log' ? (v > 0 ? Math.log10(v) : NaN) : v);
+  const x = (deg) => left + (W - left - right) * (deg + 90) / 180;
+  const y = (t) => top + (H - top - bottom) * (1 - (t - y0) / (y1 - y0));
+  svg.append(el('rect', { x: left, y: top, width: W - left - right, height: H - top - bottom, fill: '#0b0c10' }));
+  for (let d = -90; d <= 90; d += 30) {
+    svg.append(el('line', { x1: x(d), x2: x(d), y1: y(y0), y2: y(y0) + 4, stroke: '#6a6d7a' }));
+    svg.append(text(`${d}°`, { x: x(d), y: y(y0) + 15, 'text-anchor': 'middle', class: 'x-tick' }));
+  }
+  for (const t of ticks) {
+    svg.append(el('line', { x1: left, x2: W - right, y1: y(t.v), y2: y(t.v), stroke: '#262932' }));
+    svg.append(text(t.label, { x: left - 6, y: y(t.v) + 3, 'text-anchor': 'end', class: 'y-tick' }));
+  }
+  svg.append(text('θi, solid; angle from the mirror, dashed (mirror side →)',
+    { x: (left + W - right) / 2, y: H - 6, 'text-anchor': 'middle', fill: '#e6e6ea' }));
+  svg.append(text(`${quantity === 'cos' ? 'ρ cos θi' : 'ρ'} (sr⁻¹${scale === 'log' ? ', log' : ''})`,
+    { x: 0, y: 0, 'text-anchor': 'middle', fill: '#e6e6ea', transform: `translate(12 ${(top + H - bottom) / 2}) rotate(-90)` }));
+  curves.forEach((c, b) => {
+    for (const k of ['in_plane', 'across']) {
+      let d = '', pen = false;
+      c.angles_deg.forEach((deg, i) => {
+        const t = tf(values[b][k][i]);
+        if (!Number.isFinite(t)) { pen = false; return; }
+        const ty = Math.max(y0, Math.min(y1, t));
+        d += `${pen ? 'L' : 'M'}${x(deg).toFixed(2)},${y(ty).toFixed(2)} `;
+        pen = true;
+      });
+      svg.append(el('path', { d, fill: 'none', stroke: colours[b], 'stroke-width': 2, 'stroke-dasharray': k === 'across' ? '6 4' : 'none', class: `curve-${k}` }));
+    }
+    const ly = H + 10 + 14 * b;
+    svg.append(el('line', { x1: left, x2: left + 18, y1: ly - 4, y2: ly - 4, stroke: colours[b], 'stroke-width': 2 }));
+    const g = el('g', { class: 'legend' }), title = el('title', {});
+    title.textContent = titles[b] || names[b];
+    g.append(title, text(names[b], { x: left + 22, y: ly, fill: '#e6e6ea' }));
+    svg.append(g);
+  });
+  if (cursor !== null && cursor !== undefined) {
+    svg.append(el('line', { x1: x(cursor), x2: x(cursor), y1: top, y2: y(y0), stroke: '#ff3b6b', 'stroke-width': 1.5 }));
+  }
+  return { y0, y1, scale, ticks };
 }
 const lum = (v) => (v[0] === null ? 0 : 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]);
 
@@ -437,9 +527,12 @@ export function drawSphere(canvas, sum, passes, w, h, exposure) {
 
 // The albedo plot: per BRDF, the luminance of its directional albedo against θi (degrees), with
 // a band of ±2 standard errors; axes ticked; a legend; the dashed line at 1.
-export function drawAlbedo(svg, curves, colours, names, titles = names) {
+export function drawAlbedo(svg, curves, colours, names, titles = names, width = 460, height = 270) {
   svg.replaceChildren();
-  const W = 460, H = 270, left = 48, right = 12, top = 12, bottom = 40;
+  const W = width, H = height, left = 48, right = 12, top = 12, bottom = 40;
+  svg.setAttribute('width', W);
+  svg.setAttribute('height', H);
+  svg.setAttribute('viewBox', `0 0 ${W} ${H}`);
   const lumOf = (v) => 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
   let ymax = 0;
   for (const c of curves) c.albedo.forEach((a, k) => { ymax = Math.max(ymax, lumOf(a) + 2 * lumOf(c.standard_error[k])); });
