@@ -353,7 +353,9 @@ Command add_slices(CLI::App& figure) {
                 "test:S,G,F (any of the paper's test functions, as isolines), or a BRDF: a "
                 "file (MERL, RGL, ALTA) or a model spec such as ggx:alpha=0.2")
       ->capture_default_str();
-  s->add_option("--param", sl->params, "Parameterizations, one row each")->capture_default_str();
+  s->add_option("--param", sl->params,
+                "Parameterizations, one row each (" + parameterization_names(", ") + ")")
+      ->capture_default_str();
   s->add_option("--azimuths", sl->azimuths,
                 "Relative azimuths in degrees (φd for halfdiff, φk − φh for ortho and hybrid), "
                 "one column each")
@@ -418,7 +420,8 @@ Command add_material(CLI::App& figure) {
                 "Environments: sky, studio, sunset, constant:V, constant:R,G,B or .hdr/.exr "
                 "files, comma-separated")
       ->capture_default_str();
-  m->add_option("--param", ma->params, "Parameterizations, one row of slices each")
+  m->add_option("--param", ma->params,
+                "Parameterizations, one row of slices each (" + parameterization_names(", ") + ")")
       ->capture_default_str();
   m->add_option("--azimuths", ma->azimuths, "Relative azimuths of the slices, in degrees")
       ->capture_default_str();
