@@ -1,9 +1,8 @@
 """halfback: exact, fast BRDF parameterizations (Barla, Belcour, Pacanowski 2015).
 
-Parameterization names (every one: parameterizations()): "dirs" (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z), "spherical"
-(theta_i, phi_i, theta_o, phi_o), "halfdiff" (theta_h, phi_h, theta_d, phi_d), "ortho"
-(hbar, phi_h, kbar, phi_k) and "hybrid" (hbar, phi_h, k, phi_k). With isotropic=True, phi_h is
-dropped and the second azimuth is relative. Conventions and derivations: docs/math.md.
+Forms: "dirs" (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z) and the parameterizations in the table below
+(their columns; parameterizations() gives each one's summary and axes). With isotropic=True,
+phi_h is dropped and the second azimuth is relative. Conventions and derivations: docs/math.md.
 
 BRDFs: load(spec) gives a Brdf (analytic models, MERL, RGL, ALTA files, embedded materials) with
 vectorized eval(wi, wo), info, albedo(), resample() and render(); hemisphere() gives the data of
@@ -62,6 +61,18 @@ class RenderedImage(_np.ndarray):
     def __setstate__(self, state):
         array_state, self.sampler = state
         super().__setstate__(array_state)
+
+
+def _parameterization_table():
+    """The built-in parameterizations and their columns, aligned, for the module's docstring."""
+    rows = [(f'"{p["name"]}"', ", ".join(a["column"] for a in p["axes"]))
+            for p in parameterizations()]
+    width = max(len(name) for name, _ in rows)
+    return "".join(f"  {name:<{width}}  {cols}\n" for name, cols in rows)
+
+
+if __doc__ is not None:  # None under python -OO
+    __doc__ += "\nParameterizations:\n" + _parameterization_table()
 
 
 # Python functions, not the module's built-ins: pickle sends a Python function by its name, so

@@ -81,6 +81,15 @@ Command register_factor(CLI::App& parent);
 Command register_nbrdf(CLI::App& parent);
 Command register_compare(CLI::App& parent);
 
+// The command reference, generated from the apps registered under `root` (the options, their
+// values, defaults and descriptions, each app's description and footer): "man", the man page
+// docs/halfback.1; "markdown", the option tables of docs/cli.md, one block per command and
+// subcommand between the lines "<!-- BEGIN generated: halfback NAME -->" and "<!-- END generated:
+// halfback NAME -->". Printed by the hidden `halfback --help-reference=man|markdown`;
+// scripts/cli_reference.py writes both into docs/ (reference.cpp). Another format: UsageError.
+std::string command_reference(const CLI::App& root, std::string_view format,
+                              std::string_view version);
+
 // "halfback COMMAND: warning: MESSAGE" on stderr.
 void warn(std::string_view command, std::string_view message);
 

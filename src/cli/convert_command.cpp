@@ -9,6 +9,7 @@
 // problem are kept as valid = 0 rows (nan coordinates) and one warning on stderr counts them.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -234,19 +235,26 @@ int run_convert(const ConvertOptions& o) {
   return kExitOk;
 }
 
+// The columns of every form, from the registry (built-in and registered parameterizations), in
+// columns as wide as the longest name and column list.
 std::string columns_help() {
-  std::string s =
-      "Columns of each form (the input header must list exactly these, in this order):\n";
   std::vector<Space> spaces{Space::dirs};
   for (Space p : parameterizations()) spaces.push_back(p);
+  std::size_t name_width = 0, columns_width = 0;
   for (Space space : spaces) {
-    s += fmt::format("  {:<10} {}", name_of(space), join(column_names({space, false})));
-    if (space != Space::dirs)
-      s += fmt::format("{:<{}}isotropic: {}", "", 31 - join(column_names({space, false})).size(),
-                       join(column_names({space, true})));
-    s += '\n';
+    name_width = std::max(name_width, name_of(space).size());
+    columns_width = std::max(columns_width, join(column_names({space, false})).size());
   }
-  return s;
+  std::string s =
+      "Columns of each form (the input header must list exactly these, in this order):\n";
+  s += fmt::format("  {:<{}}  {:<{}}  {}\n", "form", name_width, "columns", columns_width,
+                   "with --isotropic");
+  for (Space space : spaces) {
+    s += fmt::format("  {:<{}}  {:<{}}  {}\n", name_of(space), name_width,
+                     join(column_names({space, false})), columns_width,
+                     space == Space::dirs ? "(none)" : join(column_names({space, true})));
+  }
+  return s + "\n";
 }
 
 }  // namespace
@@ -264,10 +272,17 @@ Command register_convert(CLI::App& parent) {
       ->type_name("NAME")
       ->check(space_name_validator());
   app->add_flag("--isotropic", options->isotropic,
-                "Isotropic (3-column) form for the side(s) that are not dirs");
-  app->add_flag("--jacobian", options->jacobian, "Append a jacobian column");
+                "Isotropic (3-column) form for the side(s) that are not dirs: phi_h dropped and "
+                "the second azimuth relative, the coordinates of the pair turned about the normal "
+                "to phi_h = 0 (its canonical pose; isotropic to dirs gives that pose); an error "
+                "with --from dirs --to dirs");
+  app->add_flag("--jacobian", options->jacobian,
+                "Append a jacobian column: J with dwi dwo = J dq, q the --to coordinates (the "
+                "--from ones when --to is dirs; for an isotropic form, the measure of its 3 "
+                "coordinates); nan on invalid rows; an error with --from dirs --to dirs");
   app->add_flag("--skip-invalid", options->skip_invalid,
-                "Write bad input rows as valid = 0 rows instead of failing");
+                "Write bad input rows as valid = 0 rows of nan instead of failing, and count them "
+                "in one warning");
   app->add_option("-i,--input", options->input, "Input CSV file; - for stdin (the default)")
       ->type_name("FILE");
   app->add_option("-o,--output", options->output,

@@ -358,7 +358,8 @@ Command add_slices(CLI::App& figure) {
                 "file (MERL, RGL, ALTA) or a model spec such as ggx:alpha=0.2")
       ->capture_default_str();
   s->add_option("--params,--param", sl->params,
-                "Parameterizations, comma-separated, one row each (--param is an alias)")
+                "Parameterizations, comma-separated, one row each (" +
+                    parameterization_names(", ") + "; --param is an alias)")
       ->type_name("PARAM,...")
       ->capture_default_str();
   s->add_option("--azimuths", sl->azimuths,
@@ -428,7 +429,8 @@ Command add_material(CLI::App& figure) {
                 "files, comma-separated")
       ->capture_default_str();
   m->add_option("--params,--param", ma->params,
-                "Parameterizations, comma-separated, one row of slices each (--param is an alias)")
+                "Parameterizations, comma-separated, one row of slices each (" +
+                    parameterization_names(", ") + "; --param is an alias)")
       ->type_name("PARAM,...")
       ->capture_default_str();
   m->add_option("--azimuths", ma->azimuths, "Relative azimuths of the slices, in degrees")

@@ -4,10 +4,12 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "command.hpp"
@@ -22,11 +24,28 @@
 namespace halfback::cli {
 namespace {
 
-constexpr const char* kDescription =
-    "halfback: parameterizations of BRDF direction pairs (Barla et al. 2015): convert between\n"
-    "directions and the spherical, half/difference, orthographic and hybrid coordinates;\n"
-    "inspect, evaluate, resample and export BRDFs (analytic models, MERL, RGL, ALTA); render\n"
-    "them on a sphere; draw the paper's figures.\n";
+// What `halfback --help` says first: what the tool does, and every parameterization it knows
+// (the built-in ones and the families), from the registry, in an aligned table.
+std::string description() {
+  std::string s =
+      "halfback: the parameterizations of BRDF direction pairs (Barla et al. 2015) and the BRDF\n"
+      "tools built on them: convert between directions and coordinates; inspect, evaluate,\n"
+      "resample, export, fit and factor BRDFs (analytic models, MERL, RGL, ALTA, neural); plan "
+      "and\n"
+      "reconstruct measurements; compare the parameterizations (study); render, draw and explore\n"
+      "BRDFs.\n\nParameterizations (the names of convert --from/--to and of every option that "
+      "takes "
+      "one):\n";
+  std::vector<std::pair<std::string, std::string>> rows;
+  for (Space p : parameterizations())
+    rows.emplace_back(std::string(name_of(p)), std::string(p.param().summary()));
+  for (const std::string& family : parameterization_families())
+    rows.emplace_back(family, "a family: one parameterization per argument");
+  std::size_t width = 0;
+  for (const auto& row : rows) width = std::max(width, row.first.size());
+  for (const auto& [name, summary] : rows) s += fmt::format("  {:<{}}  {}\n", name, width, summary);
+  return s;
+}
 
 constexpr const char* kFooter =
     "Run 'halfback COMMAND --help' for the options and examples of a command.\n"
@@ -115,7 +134,7 @@ std::string parsed_command_name(const CLI::App*& deepest) {
 
 int run(int argc, char** argv) {
   register_brdf_parameterization_families();
-  CLI::App app(kDescription, "halfback");
+  CLI::App app(description(), "halfback");
   app.set_version_flag("--version", version_text,
                        "Print the version and the SIMD instruction set in use, and exit");
   app.set_help_flag("-h,--help", "Print this help and exit");
@@ -125,6 +144,11 @@ int run(int argc, char** argv) {
 
   std::vector<Command> commands;
   for (RegisterCommand add : command_table()) commands.push_back(add(app));
+  // Hidden: the command reference generated from the apps above (reference.cpp).
+  std::string reference_format;
+  app.add_option("--help-reference", reference_format,
+                 "Print the command reference, man or markdown, and exit")
+      ->group("");
   harden_options(app);  // one rule for every option's value (class G)
 
   try {
@@ -154,6 +178,15 @@ int run(int argc, char** argv) {
     const CLI::App* deepest = &app;
     report_error(parsed_command_name(deepest), e.what());
     return kExitDataError;
+  }
+  if (!reference_format.empty()) {
+    try {
+      fmt::print("{}", command_reference(app, reference_format, HALFBACK_VERSION));
+      return kExitOk;
+    } catch (const UsageError& e) {
+      report_error("halfback", e.what());
+      return kExitUsageError;
+    }
   }
   for (const Command& command : commands)
     if (command.app->parsed()) return run_command("halfback " + command.app->get_name(), command);

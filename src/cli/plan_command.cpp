@@ -253,7 +253,8 @@ Command register_plan(CLI::App& parent) {
   auto o = std::make_shared<PlanOptions>();
   CLI::App* app = parent.add_subcommand(
       "plan", "Measurement plan of a design for a real gonio-reflectometer (CSV + JSON sidecar)");
-  app->add_option("--param", o->settings.param, "Parameterization whose cells are measured")
+  app->add_option("--param", o->settings.param,
+                  "Parameterization whose cells are measured: " + parameterization_names())
       ->type_name("PARAM")
       ->capture_default_str();
   app->add_option("--design", o->settings.design,

@@ -150,10 +150,16 @@ Command register_render(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--brdf-sampling", o->brdf_sampling,
                   "how a BRDF without a sampler of its own is sampled: table (the tabulated "
-                  "sampler), cosine, or auto (the table when the cosine's samples miss energy the "
-                  "table finds, or when the BRDF is peaked for this environment: the cosine's "
-                  "albedo variance at least a threshold times the table's, the threshold higher "
-                  "the less light the environment leaves to the BRDF sampler; else the cosine)")
+                  "sampler), cosine, or auto: both samplers estimate the BRDF's directional "
+                  "albedo (8 directions, 2048 samples each), and auto takes the table when the "
+                  "cosine's estimate misses energy the table's finds, or when the ratio of the "
+                  "two estimates' variances (cosine over table) is at least a threshold that "
+                  "rises as the environment leaves less of its light to the BRDF sampler (150 "
+                  "under a constant environment, 445 under sky, 1499 under studio); else the "
+                  "cosine. E.g. embedded:pink-felt (a ratio of 30) gets the cosine and "
+                  "embedded:gold-metallic-paint3 (7.6e3) the table under both; a ratio of 900 "
+                  "gets the table under sky and the cosine under studio. The summary says which "
+                  "and why (docs/render.md)")
       ->check(CLI::IsMember({"auto", "table", "cosine"}))
       ->capture_default_str();
   app->add_option("--threads", o->threads, "worker threads (0: all cores)")
@@ -162,6 +168,14 @@ Command register_render(CLI::App& parent) {
   app->add_flag("-q,--quiet", o->quiet,
                 "no progress bar, and no summary line on stderr (the image's size, samples, "
                 "times and the BRDF sampler used: with auto, the one chosen and why)");
+  app->footer(
+      "Examples:\n"
+      "  halfback render --brdf ggx:alpha=0.2,f0=0.9 -o ggx.png\n"
+      "  halfback render --brdf embedded:gold-metallic-paint3 --env studio --spp 256 -o gold.exr\n"
+      "  halfback render --brdf embedded:pink-felt --brdf-sampling cosine -o felt.png\n"
+      "  halfback render --brdf merl.binary --env uffizi.hdr --brdf-sampling table --filmic \\\n"
+      "      --time-budget 10 -o merl.png\n"
+      "See docs/render.md.");
   return {app, [o] { return run_render(*o); }};
 }
 

@@ -403,6 +403,13 @@ void add_metric_options(CLI::App& app, StudyOptions& o) {
   }
 }
 
+// The parameterizations a study compares when --params is not given (default_studied()).
+std::string default_studied_names() {
+  std::string s;
+  for (Space p : study::default_studied()) s += (s.empty() ? "" : ",") + std::string(name_of(p));
+  return s;
+}
+
 }  // namespace
 
 Command register_study(CLI::App& parent) {
@@ -419,9 +426,12 @@ Command register_study(CLI::App& parent) {
                   "Output directory (created if missing; --out is an alias)")
       ->type_name("DIR")
       ->capture_default_str();
-  app->add_option("--params", o->params,
-                  "Parameterizations compared, comma-separated, in the order of the tables: " +
-                      parameterization_names(", ") + " (default: all of them, spherical last)")
+  app->add_option(
+      "--params", o->params,
+      "Parameterizations compared, comma-separated, in the order of the tables: " +
+          parameterization_names(", ") +
+          " (default: those studied without being asked, the spherical baseline last: " +
+          default_studied_names() + ")")
       ->type_name("PARAM,...");
   app->add_option("--space,--error-space", o->settings.space,
                   "Error space: linear, log (ln(1 + Y)), cbrt (Y^(1/3)), nielsen (Nielsen et al. "

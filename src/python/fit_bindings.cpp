@@ -163,26 +163,45 @@ std::string emit(const std::string& spec, const std::string& target, const std::
 
 }  // namespace
 
+// fit()'s docstring, with every loss of the registry (fit::kLosses).
+const std::string& fit_doc() {
+  static const std::string doc =
+      [] {
+        std::string own, bbm;
+        for (fit::Loss l : fit::kLosses) {
+          std::string& list = fit::is_bbm(l) ? bbm : own;
+          list += (list.empty() ? "" : ", ") + std::string(fit::name_of(l));
+        }
+        return R"doc(Fits an analytic model or a sum of lobes ("lambert+ggx"; values given, as in
+"ggx:f0=0.9", are held) to a BRDF (a spec, as for load(), or a Brdf), as `halfback fit`
+(docs/fit.md), the GIL released while it runs.
+loss: one of halfback's losses,
+  )doc" + own + R"doc(,
+or of the published losses exactly as BBM defines them, measured on BBM's grid (samples then
+unused),
+  )doc" + bbm + R"doc(
+(docs/fit.md, "Losses" and "Published losses").
+starts: when not empty, the only starts (specs of the same terms whose values set the fitted
+parameters).
+max_iterations: of each Levenberg-Marquardt run.
+Returns a dict: spec (load() reads it), loss, loss_value, layout ("halfdiff-halton", or
+"halfdiff-halton-turned" for a model that can be anisotropic), samples (those fitted), missing
+(left out: NaN values) and out_of_reach (left out: θi or θo above max_theta, radians),
+parameters (a list of dicts: term, model, name, value, fitted, min, max; a parameter without
+effect is not fitted), terms (a list of dicts: model, albedo_share, loss_without, dead: a dead
+lobe has a share below 1e-4 or a loss_without within 0.1 % of loss_value), starts, iterations,
+seconds. A bad model or loss raises ValueError; a target the fit cannot use (not finite, negative or zero where sampled,
+anisotropic) raises RuntimeError.)doc";
+      }();
+  return doc;
+}
+
 void bind_fit(py::module_& m) {
   m.def("fit", &fit_brdf, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
         py::arg("samples") = 20000, py::arg("threads") = 0,
         py::arg("starts") = std::vector<std::string>{}, py::arg("max_iterations") = 200,
-        py::arg("max_theta") = std::numbers::pi / 2,
-        R"doc(Fits an analytic model or a sum of lobes ("lambert+ggx"; values given, as in
-"ggx:f0=0.9", are held) to a BRDF (a spec, as for load(), or a Brdf), as `halfback fit`
-(docs/fit.md), the GIL released while it runs. loss: one of halfback.fit's losses (ngan, low-e1,
-..., and the published bbm-* ones, measured on BBM's grid; samples then unused). starts: when
-not empty, the only starts (specs of the same terms whose values set the fitted parameters).
-max_iterations: of each Levenberg-Marquardt run.
-Returns a dict: spec (load() reads it), loss, loss_value, layout ("halfdiff-halton", or
-"halfdiff-halton-turned" for a model that can be anisotropic), samples (those fitted), missing
-(left out: NaN values) and out_of_reach (left out: θi or θo above max_theta, radians), parameters (a list of
-dicts: term, model, name, value, fitted, min, max; a parameter without effect is not fitted),
-terms (a list of dicts: model, albedo_share, loss_without, dead: a dead lobe has a share below
-1e-4 or a loss_without within 0.1 % of loss_value), starts,
-iterations, seconds. A bad model or
-loss raises ValueError; a target the fit cannot use (not finite, negative or zero where sampled,
-anisotropic) raises RuntimeError.)doc");
+        py::arg("max_theta") = std::numbers::pi / 2, fit_doc().c_str());
+
   m.def("fit_loss", &fit_loss, py::arg("brdf"), py::arg("model"), py::arg("loss") = "ngan",
         py::arg("samples") = 20000, py::arg("threads") = 0,
         R"doc(The loss of `model` (a spec or a Brdf) against `brdf` on fit()'s layout of `samples`

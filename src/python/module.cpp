@@ -482,6 +482,47 @@ py::object render_brdf(const PyBrdf& b, const std::string& env, int width, int h
   return py::module_::import("halfback").attr("RenderedImage")(img, r.sampler);
 }
 
+// convert()'s docstring, with the columns of every form from the registry (the built-in
+// parameterizations, and those registered before the module was imported), aligned.
+const std::string& convert_doc() {
+  static const std::string doc = [] {
+    std::vector<Space> spaces{Space::dirs};
+    for (Space p : parameterizations()) spaces.push_back(p);
+    const auto joined = [](Form f) {
+      std::string s;
+      for (std::string_view c : column_names(f)) s += (s.empty() ? "" : ", ") + std::string(c);
+      return s;
+    };
+    std::size_t name_width = 0, columns_width = 0;
+    for (Space space : spaces) {
+      name_width = std::max(name_width, name_of(space).size() + 2);
+      columns_width = std::max(columns_width, joined({space, false}).size());
+    }
+    std::string s = R"doc(Converts N tuples from one parameterization to another.
+
+x: array of shape (N, 6) for "dirs" or (N, 4) / (N, 3) for a parameterization (every one:
+parameterizations()), columns in the CLI's order:
+)doc";
+    const auto row = [&](std::string name, std::string columns, const std::string& iso) {
+      name.resize(name_width, ' ');
+      columns.resize(columns_width, ' ');
+      return "  " + name + "  " + columns + "  " + iso + "\n";
+    };
+    s += row("form", "columns", "isotropic=True");
+    for (Space space : spaces)
+      s += row('"' + std::string(name_of(space)) + '"', joined({space, false}),
+               space == Space::dirs ? "(none)" : joined({space, true}));
+    s += "isotropic: use the 3-coordinate isotropic form of every parameterization side.\n";
+    return s +
+           R"doc(Returns an array of the same dtype (float32 stays float32, anything else becomes float64); rows
+whose input is invalid (not unit, below the horizon, outside the domain, NaN) are NaN.
+out: an existing (N, dim) array of the result's dtype to write into (and return), e.g. to convert
+many batches without allocating; when it overlaps x (other than being x itself), x is copied
+first, so the result is always that of a separate out.)doc";
+  }();
+  return doc;
+}
+
 void bind_conversions(py::module_& m) {
   m.def(
       "simd_isa", [] { return std::string(simd_isa_name(simd_isa())); },
@@ -500,17 +541,7 @@ not bit for bit.)doc");
         return dispatch(x, from, to, {.result = true}, out).result;
       },
       py::arg("x"), py::arg("src"), py::arg("dst"), py::arg("isotropic") = false,
-      py::arg("out") = py::none(),
-      R"doc(Converts N tuples from one parameterization to another.
-
-x: array of shape (N, 6) for "dirs" (wi_x, wi_y, wi_z, wo_x, wo_y, wo_z) or (N, 4) / (N, 3) for a
-parameterization ("spherical", "halfdiff", "ortho", "hybrid"), columns in the CLI's order.
-isotropic: use the 3-coordinate isotropic form of every parameterization side.
-Returns an array of the same dtype (float32 stays float32, anything else becomes float64); rows
-whose input is invalid (not unit, below the horizon, outside the domain, NaN) are NaN.
-out: an existing (N, dim) array of the result's dtype to write into (and return), e.g. to convert
-many batches without allocating; when it overlaps x (other than being x itself), x is copied
-first, so the result is always that of a separate out.)doc");
+      py::arg("out") = py::none(), convert_doc().c_str());
 
   m.def(
       "valid",
@@ -616,13 +647,18 @@ Returns a dict: rho (shape..., 3) float64 (NaN outside the domain), valid (shape
            R"doc(A unit sphere of the BRDF under an environment (as `halfback render`): an (H, W, 3)
 float32 array of linear radiance, row 0 at the top. env: "sky" (a sky with a sun; "default" is its older name), "studio", "sunset",
 "constant:V", "constant:R,G,B" or a .hdr/.exr file. strategy: "mis", "brdf" or "env".
-brdf_sampling (a BRDF without a sampler of its own): "table", "cosine", or "auto" (the table when
-the cosine's samples miss energy that the table finds, or when the BRDF is peaked for this
-environment, its albedo variance under the cosine at least a threshold times the table's that
-rises as the environment leaves less of its light to the BRDF sampler; else the cosine; as
-`halfback render --brdf-sampling`, docs/render.md). The array is a halfback.RenderedImage (a numpy
-array) whose `sampler` says which BRDF sampler was used and, when "auto" chose it, why (the
-measured albedo variance ratio and its threshold), as `halfback render` says on stderr.)doc")
+brdf_sampling (a BRDF without a sampler of its own): "table", "cosine", or "auto": both samplers
+estimate the BRDF's directional albedo, and auto takes the table when the cosine's estimate misses
+energy the table's finds, or when the ratio of the two estimates' variances (cosine over table)
+is at least a threshold that rises as the environment leaves less of its light to the BRDF
+sampler (150 under a constant environment, 445 under "sky", 1499 under "studio"); else the
+cosine (as `halfback render --brdf-sampling`, docs/render.md). E.g. "embedded:pink-felt" (a
+ratio of 30) gets the cosine and "embedded:gold-metallic-paint3" (7.6e3) the table under both; a
+ratio of 900 gets the table under "sky" and the cosine under "studio". The array is a halfback.RenderedImage (a numpy array)
+whose `sampler` says which BRDF sampler was used and, when "auto" chose it, why (the measured
+albedo variance ratio and its threshold), as `halfback render` says on stderr:
+  img = halfback.load("embedded:gold-metallic-paint3").render(env="studio", spp=16)
+  print(img.sampler))doc")
       .def("__repr__", [](const PyBrdf& b) { return "<halfback.Brdf " + b.brdf->name() + ">"; })
       .def_property_readonly(
           "spec", [](const PyBrdf& b) { return b.spec; },

@@ -288,7 +288,8 @@ class FitMetric final : public Metric {
         "(default lambert+ggx; docs/study.md)";
     loss.key = "fit_loss";
     loss.default_value = "ngan";
-    loss.help = "Loss of the fit metric (default ngan; `halfback fit --loss`)";
+    loss.help = "Loss of the fit metric, one of " + fit::loss_names() +
+                " (default ngan; `halfback fit --loss`)";
     budgets.key = "fit_budgets";
     budgets.kind = MetricOption::Kind::counts;
     budgets.default_value = "1000,10000";

@@ -303,8 +303,8 @@ TEST_F(CliTest, HelpAndVersion) {
   r = run({"convert", "--help"});
   EXPECT_EQ(r.status, 0);
   for (const char* s : {"--from", "--to", "--isotropic", "--jacobian", "--skip-invalid", "--input",
-                        "--output", "Examples:", "hbar,phi_h,k,phi_k", "isotropic: hbar,k,dphi",
-                        "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z"})
+                        "--output", "Examples:", "hbar,phi_h,k,phi_k", "with --isotropic",
+                        "hbar,k,dphi", "wi_x,wi_y,wi_z,wo_x,wo_y,wo_z"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
   r = run({"--version"});
   EXPECT_EQ(r.status, 0);
