@@ -17,8 +17,11 @@ using namespace halfback;
 constexpr const char* kTarget = "embedded:gold-metallic-paint3";
 // A fit of `model` to the target from state.range(0) samples on one thread, from `starts` (the
 // automatic ones if empty).
+// With state.range(1) == 0: the fitter without its shortcuts (fit::detail::set_fit_shortcuts), the
+// baseline of the same run.
 void fit_run(benchmark::State& state, const char* model, std::vector<std::string> starts) {
   const BrdfPtr target = load_brdf(kTarget);
+  fit::detail::set_fit_shortcuts(state.range(1) != 0);
   fit::FitOptions o;
   o.samples = std::size_t(state.range(0));
   o.threads = 1;
@@ -33,6 +36,7 @@ void fit_run(benchmark::State& state, const char* model, std::vector<std::string
   state.counters["fit_loss"] = r.loss_value;
   state.counters["fit_iterations"] = r.iterations;
   state.counters["fit_starts"] = double(r.starts);
+  fit::detail::set_fit_shortcuts(true);
 }
 
 void BM_FitLambertGgx(benchmark::State& state) {
@@ -74,14 +78,26 @@ void BM_HeLossAtSamples(benchmark::State& state) {
 }
 
 BENCHMARK(BM_ModelLossAtSamples)->Arg(100000)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FitLambertGgxOneStart)->Arg(100000)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK(BM_FitLambertGgx)->Arg(100000)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_FitLambertGgxOneStart)
+    ->Args({100000, 0})
+    ->Args({100000, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK(BM_FitLambertGgx)
+    ->Args({100000, 0})
+    ->Args({100000, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 BENCHMARK(BM_HeLossAtSamples)
     ->Args({100000, 0})
     ->Args({100000, 1})
     ->Args({100000, 2})
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FitLambertHe)->Arg(20000)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_FitLambertHe)
+    ->Args({20000, 0})
+    ->Args({20000, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 
 }  // namespace
 

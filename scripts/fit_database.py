@@ -50,24 +50,34 @@ def main():
     ap.add_argument("--loss", default="ngan")
     ap.add_argument("--samples", type=int, default=20000)
     ap.add_argument("--workers", type=int, default=2, help="fits at once (each on one thread)")
+    ap.add_argument("--per-folder", type=int, default=0,
+                    help="only the first N networks of each folder (0: all; a subset to time)")
+    ap.add_argument("--no-shortcuts", action="store_true",
+                    help="the fitter without its shortcuts (the baseline of docs/fit.md, "
+                         "\"What a fit costs\")")
     a = ap.parse_args()
+    if a.no_shortcuts:
+        halfback._core._set_fit_shortcuts(False)
     models = [m for m in a.models.split(",") if m]
     known = set(halfback.models())
     for m in models:
         for term in m.split("+"):
             if term.split(":")[0] not in known:
                 sys.exit(f"fit_database.py: --models: '{term}' is not a model of halfback")
-    paths = sorted(p for d in a.nbrdf for p in pathlib.Path(d).glob("*.h5"))
+    paths = []
+    for d in a.nbrdf:
+        found = sorted(pathlib.Path(d).glob("*.h5"))
+        paths += found[:a.per_folder] if a.per_folder > 0 else found
     if not paths:
         sys.exit(f"fit_database.py: no NAME.h5 in {' '.join(a.nbrdf)}")
-    t0 = time.monotonic()
+    t0, c0 = time.monotonic(), time.process_time()
     rows = []
     with concurrent.futures.ThreadPoolExecutor(a.workers) as pool:  # fit releases the GIL
         futures = [pool.submit(one, p, m, a.loss, a.samples) for p in paths for m in models]
         for k, f in enumerate(concurrent.futures.as_completed(futures), 1):
             rows.append(f.result())
             print(f"\r{k}/{len(futures)} fits, {time.monotonic() - t0:.0f} s", end="", file=sys.stderr)
-    wall = time.monotonic() - t0
+    wall, cpu = time.monotonic() - t0, time.process_time() - c0
     print(file=sys.stderr)
     rows.sort(key=lambda r: (r["folder"], r["material"], r["model"]))
     out = pathlib.Path(a.out)
@@ -76,8 +86,8 @@ def main():
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    print(f"{len(rows)} fits of {len(paths)} BRDFs in {wall:.0f} s ({a.workers} at once), "
-          f"loss {a.loss}, {a.samples} samples")
+    print(f"{len(rows)} fits of {len(paths)} BRDFs in {wall:.0f} s wall, {cpu:.0f} s CPU "
+          f"({a.workers} at once), loss {a.loss}, {a.samples} samples")
     print("| model | median loss | median seconds |")
     print("|---|---|---|")
     for m in models:

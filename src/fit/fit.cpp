@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -352,6 +353,33 @@ std::string term_spec(const Model& m, std::size_t term) {
   return s;
 }
 
+// Term t of `m` as a BRDF; null when the model refuses the values.
+BrdfPtr term_brdf(const Model& m, std::size_t t) {
+  try {
+    return load_brdf(term_spec(m, t));
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+// `m` with parameter i at `value`.
+Model moved(const Model& m, std::size_t i, double value) {
+  Model out = m;
+  out.params[i].value = value;
+  return out;
+}
+
+// The values of term t of `m` at `pairs`; empty when the model refuses the values.
+std::vector<Rgb> term_values_at(const Model& m, std::size_t t,
+                                std::span<const DirPair<double>> pairs) {
+  const BrdfPtr b = term_brdf(m, t);
+  std::vector<Rgb> v;
+  if (!b) return v;
+  v.reserve(pairs.size());
+  for (const DirPair<double>& p : pairs) v.push_back(b->eval(p));
+  return v;
+}
+
 }  // namespace
 
 std::string spec_of(const Model& m) {
@@ -472,6 +500,18 @@ int channel_of(const Param& p) {
 
 // ---- The least-squares problem -------------------------------------------------------------
 
+namespace detail {
+namespace {
+std::atomic<bool> shortcuts_on{true};
+}  // namespace
+void set_fit_shortcuts(bool on) {
+  shortcuts_on = on;
+}
+bool fit_shortcuts() {
+  return shortcuts_on;
+}
+}  // namespace detail
+
 namespace {
 
 // The fitted parameters of each term (indices into Model::params), one Ceres block per term
@@ -541,11 +581,17 @@ class FitCost final : public ceres::CostFunction {
         sum_(samples.pairs.size()),
         shifted_(samples.pairs.size()),
         shifted_sum_(samples.pairs.size()),
-        shifted_r_(3 * samples.pairs.size()) {
+        shifted_r_(3 * samples.pairs.size()),
+        shortcuts_(detail::fit_shortcuts()),
+        valid_(blocks.term.size(), false),
+        at_(blocks.term.size()) {
     set_num_residuals(int(3 * samples.pairs.size()));
-    for (const auto& ps : blocks.params) {
-      mutable_parameter_block_sizes()->push_back(int(ps.size()));
-      groups_.push_back(difference_groups(model, ps));
+    for (std::size_t b = 0; b < blocks.params.size(); ++b) {
+      mutable_parameter_block_sizes()->push_back(int(blocks.params[b].size()));
+      groups_.push_back(difference_groups(model, blocks.params[b]));
+      scales_.emplace_back();
+      for (const auto& group : groups_.back())
+        scales_.back().push_back(shortcuts_ && scales_term(b, group));
     }
     // Terms without a fitted parameter are constant: their sum once.
     std::vector<Rgb> v(s_.pairs.size());
@@ -575,13 +621,70 @@ class FitCost final : public ceres::CostFunction {
 
   bool stop() const { return cancelled_ && cancelled_(); }
 
+  // Whether `group` (indices into block b) is the three channels of a parameter to which ρ of the
+  // term is proportional, channel by channel (an albedo: ρ_c = a_c X, X not depending on a):
+  // checked at up to 256 of the samples, the block's other values at the start, with the channels
+  // at two sets of values of different ratios. A model that refuses the values: not a scale.
+  bool scales_term(std::size_t b, const std::vector<std::size_t>& group) const {
+    if (group.size() != 3) return false;
+    const std::vector<std::size_t>& ps = blocks_.params[b];
+    Model base = model_, other = model_;
+    double ratio[3] = {0, 0, 0};
+    for (std::size_t j : group) {
+      const Param& p = model_.params[ps[j]];
+      const int c = channel_of(p);
+      if (c < 0) return false;
+      static constexpr double kOther[3] = {0.2, 0.7, 0.1};
+      const double u = p.min + 0.4 * (p.max - p.min), w = p.min + kOther[c] * (p.max - p.min);
+      if (!(u != 0 && std::isfinite(u) && std::isfinite(w))) return false;
+      base.params[ps[j]].value = u;
+      other.params[ps[j]].value = w;
+      ratio[c] = w / u;
+    }
+    const std::size_t stride = std::max<std::size_t>(s_.pairs.size() / 256, 1);
+    std::vector<DirPair<double>> probe;
+    for (std::size_t i = 0; i < s_.pairs.size(); i += stride) probe.push_back(s_.pairs[i]);
+    const std::vector<Rgb> u = term_values_at(base, blocks_.term[b], probe),
+                           w = term_values_at(other, blocks_.term[b], probe);
+    if (u.empty() || w.empty()) return false;
+    bool any = false;
+    const auto same = [](double a, double b) {
+      return std::isfinite(a) && std::abs(a - b) <= 1e-12 * std::max(std::abs(a), std::abs(b));
+    };
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      const double uv[3] = {u[i].r, u[i].g, u[i].b}, wv[3] = {w[i].r, w[i].g, w[i].b};
+      for (int c = 0; c < 3; ++c) {
+        if (!same(wv[c], uv[c] * ratio[c])) return false;
+        any = any || uv[c] != 0;
+      }
+    }
+    return any;
+  }
+
+  // Whether the columns of group g of block b at block values x come from the term's values by
+  // scaling (scales_term, and no channel at or near 0, where the term is 0 and tells nothing).
+  bool scaled(std::size_t b, std::size_t g, const double* x, const double* h) const {
+    if (!scales_[b][g]) return false;
+    for (std::size_t j : groups_[b][g])
+      if (!(std::abs(x[j]) >= std::abs(h[j]))) return false;
+    return true;
+  }
+
   // False (a failed evaluation, which ends the solve with the callback below) once cancelled.
   bool evaluate(double const* const* values, double* r, double** jacobians) const {
     const std::size_t n = s_.pairs.size(), nb = blocks_.term.size();
     sum_ = fixed_;
     for (std::size_t b = 0; b < nb; ++b) {
       if (stop()) return false;
-      term_values(b, values[b], terms_[b]);
+      // Ceres evaluates an accepted step twice (its cost, then its Jacobian): a term whose block
+      // values are those of its last evaluation is reused, bit for bit.
+      const std::size_t np = blocks_.params[b].size();
+      if (!(shortcuts_ && valid_[b] && std::equal(values[b], values[b] + np, at_[b].begin()))) {
+        valid_[b] = false;
+        term_values(b, values[b], terms_[b]);
+        at_[b].assign(values[b], values[b] + np);
+        valid_[b] = true;
+      }
       for (std::size_t i = 0; i < n; ++i) sum_[i] = sum_[i] + terms_[b][i];
     }
     residuals(loss_, s_, target_, sum_, r, threads_);
@@ -590,17 +693,18 @@ class FitCost final : public ceres::CostFunction {
     if (!jacobians) return true;
     for (std::size_t b = 0; b < nb; ++b)
       if (jacobians[b])
-        for (const auto& group : groups_[b]) {
+        for (std::size_t g = 0; g < groups_[b].size(); ++g) {
           if (stop()) return false;
-          difference_columns(b, values[b], group, r, jacobians[b]);
+          difference_columns(b, values[b], g, r, jacobians[b]);
         }
     return true;
   }
 
   // The Jacobian's columns of the parameters `group` of block b (indices into the block), from
   // one shifted evaluation of the term. A colour channel's column is zero off its channel.
-  void difference_columns(std::size_t b, const double* x, const std::vector<std::size_t>& group,
-                          const double* r, double* jac) const {
+  void difference_columns(std::size_t b, const double* x, std::size_t g, const double* r,
+                          double* jac) const {
+    const std::vector<std::size_t>& group = groups_[b][g];
     const std::size_t np = blocks_.params[b].size(), n = s_.pairs.size();
     std::vector<double> v(x, x + np), h(np, 0.0);
     for (std::size_t j : group) {
@@ -611,8 +715,19 @@ class FitCost final : public ceres::CostFunction {
       if (x[j] + h[j] > p.max) h[j] = -h[j];
       v[j] = x[j] + h[j];
     }
-    term_values(b, v.data(), shifted_);
-    for (std::size_t i = 0; i < n; ++i) shifted_sum_[i] = sum_[i] - terms_[b][i] + shifted_[i];
+    if (scaled(b, g, x, h.data())) {
+      // ρ of the term is proportional to each channel of the group: shifting channel c by h_c
+      // scales the term's channel c by 1 + h_c / x_c, no evaluation needed.
+      double f[3] = {0, 0, 0};
+      for (std::size_t j : group) f[channel_of(model_.params[blocks_.params[b][j]])] = h[j] / x[j];
+      for (std::size_t i = 0; i < n; ++i) {
+        const Rgb& t = terms_[b][i];
+        shifted_sum_[i] = sum_[i] + Rgb{t.r * f[0], t.g * f[1], t.b * f[2]};
+      }
+    } else {
+      term_values(b, v.data(), shifted_);
+      for (std::size_t i = 0; i < n; ++i) shifted_sum_[i] = sum_[i] - terms_[b][i] + shifted_[i];
+    }
     residuals(loss_, s_, target_, shifted_sum_, shifted_r_.data(), threads_);
     for (std::size_t j : group) {
       const int channel = group.size() > 1 ? channel_of(model_.params[blocks_.params[b][j]]) : -1;
@@ -634,6 +749,10 @@ class FitCost final : public ceres::CostFunction {
   mutable std::vector<std::vector<Rgb>> terms_;                // scratch, per block
   mutable std::vector<Rgb> sum_, shifted_, shifted_sum_;
   mutable std::vector<double> shifted_r_;
+  bool shortcuts_;                         // detail::fit_shortcuts() when made
+  std::vector<std::vector<bool>> scales_;  // per block and group: scales_term()
+  mutable std::vector<bool> valid_;        // per block: terms_[b] is the term at at_[b]
+  mutable std::vector<std::vector<double>> at_;
 };
 
 void throw_if_cancelled(const FitOptions& o) {
@@ -666,6 +785,7 @@ Solved solve_from(const Model& start, const Samples& s, std::span<const Rgb> tar
   for (std::size_t b = 0; b < x.size(); ++b)
     for (std::size_t i : blocks.params[b])
       x[b].push_back(std::clamp(start.params[i].value, start.params[i].min, start.params[i].max));
+  const bool shortcuts = detail::fit_shortcuts();
   ceres::Problem problem;
   std::vector<double*> ptrs;
   for (auto& v : x) ptrs.push_back(v.data());
@@ -686,6 +806,10 @@ Solved solve_from(const Model& start, const Samples& s, std::span<const Rgb> tar
   options.parameter_tolerance = 1e-10;
   options.logging_type = ceres::SILENT;
   options.num_threads = 1;  // the residuals run on the project's parallel loop
+  // With bounds, Ceres projects each step and checks it by an Armijo line search; its default cubic
+  // interpolation asks for the gradient, a whole Jacobian, at every point it tries. Quadratic
+  // interpolation needs values only (detail::set_fit_shortcuts, docs/fit.md).
+  if (shortcuts) options.line_search_interpolation_type = ceres::QUADRATIC;
   CancelCallback cancel(o.cancelled);
   options.callbacks.push_back(&cancel);
   ceres::Solver::Summary summary;
@@ -993,33 +1117,6 @@ double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t sam
 // ---- What the model can do: anisotropy, parameters without effect, dead lobes ---------------
 
 namespace {
-
-// Term t of `m` as a BRDF; null when the model refuses the values.
-BrdfPtr term_brdf(const Model& m, std::size_t t) {
-  try {
-    return load_brdf(term_spec(m, t));
-  } catch (const std::exception&) {
-    return nullptr;
-  }
-}
-
-// `m` with parameter i at `value`.
-Model moved(const Model& m, std::size_t i, double value) {
-  Model out = m;
-  out.params[i].value = value;
-  return out;
-}
-
-// The values of term t of `m` at `pairs`; empty when the model refuses the values.
-std::vector<Rgb> term_values_at(const Model& m, std::size_t t,
-                                std::span<const DirPair<double>> pairs) {
-  const BrdfPtr b = term_brdf(m, t);
-  std::vector<Rgb> v;
-  if (!b) return v;
-  v.reserve(pairs.size());
-  for (const DirPair<double>& p : pairs) v.push_back(b->eval(p));
-  return v;
-}
 
 // Whether moving parameter i to 25 % or 75 % of its range changes its term at `probe` (a value
 // the model refuses counts as a change: the parameter matters).

@@ -217,6 +217,9 @@ factor` (docs/fit.md, "Factored models"), the GIL released while it runs: a dict
 JSON file: write it to a .json file, which load() reads), numbers (its size), relative_error
 (μ-weighted, in log(1 + ρ), on its grid) and sweeps. A bad rank, counts or parameterization, or
 an anisotropic BRDF, raises ValueError; a BRDF not finite somewhere, RuntimeError.)doc");
+  m.def("_set_fit_shortcuts", &fit::detail::set_fit_shortcuts, py::arg("on"),
+        R"doc(Turns the fitter's shortcuts on (the default) or off, for measuring their effect
+(docs/fit.md, "What a fit costs"); the results agree to the optimizer's tolerance.)doc");
   m.def("fit_samples", &fit_samples, py::arg("n"),
         R"doc(fit()'s layout of n pairs (docs/fit.md, "Sample layout") as a dict of arrays: wi and
 wo (n, 3), weight (n,; mean 1) and cos_i (n,). A prefix of the layout of more pairs is the layout

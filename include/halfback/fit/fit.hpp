@@ -222,4 +222,15 @@ double loss_value(std::span<const Rgb> target_rgb, const Brdf& model, Loss loss,
 double loss_of(const Brdf& target, const Brdf& model, Loss loss, std::size_t samples,
                int threads = 0, std::optional<BbmGrid> grid = std::nullopt);
 
+namespace detail {
+// The fitter's shortcuts (docs/fit.md, "What a fit costs"), on by default: Ceres's bounded line
+// search interpolates quadratically (values only, no Jacobian at its trial points); a term whose
+// values are those of its last evaluation is not evaluated again; a parameter to which the term
+// is proportional channel by channel (an albedo) gets its Jacobian columns from the term's
+// values. Off: the fitter as before them (the benchmarks' and tests' baseline). Read when a
+// solve starts; set it between fits, not during one.
+void set_fit_shortcuts(bool on);
+bool fit_shortcuts();
+}  // namespace detail
+
 }  // namespace halfback::fit
