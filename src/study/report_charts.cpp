@@ -249,8 +249,8 @@ figure::Scene designs_chart(const std::vector<BrdfResult>& results, const StudyC
   figure::BarChart chart;
   chart.title = fmt::format("Designs: median relative error ({} space) at N = {}",
                             name_of(config.space), ref);
-  chart.x_label =
-      fmt::format("median over {} BRDFs of the reconstruction's relative error", c.brdfs.size());
+  chart.x_label = fmt::format("median over {} of the reconstruction's relative error",
+                              brdf_count(c.brdfs.size()));
   for (const DesignKey& k : c.keys) chart.series.push_back(design_name(k));
   chart.rows = param_names(c.params);
   chart.values = c.median;

@@ -51,6 +51,9 @@ std::size_t reference_budget(const StudyConfig& config);
 
 double median(std::vector<double> v);
 
+// "1 BRDF", "2 BRDFs".
+std::string brdf_count(std::size_t n);
+
 // The mean image-space error of one parameterization's renderings of a design, over the
 // environments (INFINITY when there is none).
 struct MeanImageError {

@@ -31,7 +31,7 @@ std::string report_header(const std::vector<BrdfResult>& results, const StudyCon
       "# halfback study\n\n"
       "Measure: cos θi cos θo dωi dωo, through each parameterization's Jacobian. Values: the "
       "luminance of ρ in the **{}** error space. Metrics 1–2 on a {} × {} × {} grid of cell "
-      "centres of each isotropic form (midpoint rule){}. Definitions: docs/study.md. {} BRDFs "
+      "centres of each isotropic form (midpoint rule){}. Definitions: docs/study.md. {} "
       "in {:.1f} s.{}{}\n\n",
       name_of(config.space), config.grid.a, config.grid.b, config.grid.phi,
       any_aniso ? fmt::format(", and {} × {} × {} × {} cells of the full form for the anisotropic "
@@ -39,7 +39,7 @@ std::string report_header(const std::vector<BrdfResult>& results, const StudyCon
                               config.full_grid[0], config.full_grid[1], config.full_grid[2],
                               config.full_grid[3])
                 : "",
-      results.size(), seconds, left_out(config),
+      brdf_count(results.size()), seconds, left_out(config),
       config.quick
           ? "\n\n**A quick run** (`--quick`: smaller grids, fewer budgets and test pairs): "
             "its headline can differ from a full run's; do not quote it as the study's "
@@ -62,9 +62,10 @@ std::string summary_section(const std::vector<BrdfResult>& results,
                             const std::vector<SummaryMetric>& metrics, const ReportPlots& plots) {
   const std::vector<Space>& params = params_of(results);
   std::string md = fmt::format(
-      "## Summary\n\nFor each kind of BRDF and each metric below: the median relative error of "
-      "each parameterization over the BRDFs of that kind measured in all {}, and in "
-      "parentheses the number of BRDFs on which it has the lowest error (ties count for each). "
+      "## Summary\n\nFor each kind of BRDF and each metric below: the median relative error "
+      "(for importance sampling, relative variance; lower is better) of each parameterization "
+      "over the BRDFs of that kind measured in all {}, and in parentheses the number of BRDFs "
+      "on which it has the lowest value (ties count for each). "
       "The lowest median is in bold. The kind comes from the label (the reader's prefix for a "
       "file; a model's spec is a model).\n\n",
       params.size() == 1 ? "of them" : count_in_words(params.size()));
@@ -177,8 +178,9 @@ std::string design_conclusions(const DesignComparison& c, std::size_t ref) {
             : fmt::format("**The parameterization with the most wins changes, from {} to {}.** ",
                           name_of(c.params[top_before]), name_of(c.params[top_after]));
   md += n_changed == 0 ? std::string("No BRDF changes its best parameterization.\n\n")
-                       : fmt::format("{} of {} BRDFs change their best parameterization: {}.\n\n",
-                                     n_changed, c.brdfs.size(), changed);
+                       : fmt::format("{} of {} {} their best parameterization: {}.\n\n", n_changed,
+                                     brdf_count(c.brdfs.size()),
+                                     n_changed == 1 ? "changes" : "change", changed);
   return md + angle_line(c);
 }
 
@@ -195,10 +197,10 @@ std::string designs_section(const std::vector<BrdfResult>& results, const StudyC
       "each design (docs/study.md, “Designs”): the cells uniform in the parameterization's own "
       "coordinates (regular or stratified), in angle (the sine-like magnitudes through their "
       "arcsine), in MERL's spacing (angle, and √ of the half-vector angle), or in warps learned "
-      "from the other BRDFs (leave-one-out). Median relative error over the {} isotropic BRDFs "
-      "measured in every design; the lowest of each parameterization in bold, its best "
+      "from the other BRDFs (leave-one-out). Median relative error over the {} "
+      "measured in every design (isotropic); the lowest of each parameterization in bold, its best "
       "design:\n\n",
-      ref, c.brdfs.size());
+      ref, brdf_count(c.brdfs.size()));
   md += design_median_table(c);
   md += "\nBest against best, per BRDF (each parameterization in its best design):\n\n" +
         best_design_table(c, ref);

@@ -329,5 +329,29 @@ TEST(Report, SummaryGroupsTheBrdfsByKind) {
   EXPECT_NE(s.find("![Summary](summary.png)"), std::string::npos);
 }
 
+// The summary and header of the report's odd cases: an embedded material is a kind of its own,
+// not a model; one BRDF is "1 BRDF"; a parameterization that never reaches E* on most BRDFs has
+// no multiple for a median ("×inf" before).
+TEST(Report, SummaryKindsCountsAndUnreachedMedians) {
+  const test::TempDir tmp;
+  const StudyOutput one = write_study(tmp.path(), {fake("embedded:gold-metallic-paint3", true)},
+                                      config_of_fakes(), 1.0);
+  EXPECT_NE(one.markdown.find("| embedded materials | 1 |"), std::string::npos) << one.markdown;
+  EXPECT_EQ(one.markdown.find("| models |"), std::string::npos);
+  EXPECT_NE(one.markdown.find("Definitions: docs/study.md. 1 BRDF in"), std::string::npos);
+  EXPECT_EQ(one.markdown.find("1 BRDFs"), std::string::npos);
+  // E* is halfdiff's error at 1000 (k = 1, E* = 0.5); ortho (k = 2000) needs 1000 · 2000^1.5
+  // measurements, past the largest budget (10^6), on both BRDFs.
+  const std::vector<double> ks{1, 2000, 3, 4};
+  const StudyOutput two = write_study(
+      tmp.path(), {to_result(fake_numbers("x", true, ks)), to_result(fake_numbers("y", true, ks))},
+      config_of_fakes(), 1.0);
+  EXPECT_EQ(two.markdown.find("×inf"), std::string::npos) << two.markdown;
+  EXPECT_NE(two.markdown.find("Median over the BRDFs: halfdiff ×1, ortho not reached (2 of 2 not "
+                              "reached)"),
+            std::string::npos)
+      << two.markdown;
+}
+
 }  // namespace
 }  // namespace halfback::study

@@ -9,7 +9,9 @@
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metric.hpp"
 #include "halfback/study/metric_tables.hpp"
+#include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
+#include "support/test_support.hpp"
 
 namespace halfback::study {
 namespace {
@@ -178,6 +180,37 @@ TEST(SamplingTable, SettingsAreChecked) {
   EXPECT_THROW(c.validate(), std::invalid_argument);
   c.options["sampler_samples"] = "2";
   EXPECT_NO_THROW(c.validate());
+}
+
+// The report's Summary (what `halfback study` prints) gives the sampling metric too: with
+// --no-gonio it is the only one asked for beyond metrics 1-2.
+TEST(SamplingTable, TheSummaryHasTheSamplingMetric) {
+  StudyConfig c = sampling_only();
+  c.params = {space_of<HalfDiff>, space_of<Spherical>};
+  c.options["sampler_kib"] = "8,16";
+  c.options["sampler_samples"] = "256";
+  c.image_size = 24;
+  find_metric("fit")->switch_off(c);
+  models::MicrofacetParams p;
+  p.alpha_x = p.alpha_y = 0.08;
+  const std::vector<BrdfResult> results{
+      study_brdf(models::Lambert(Rgb{0.5, 0.5, 0.5}), "lambert", c),
+      study_brdf(models::Microfacet(p), "ggx", c)};
+  const test::TempDir tmp;
+  const std::string md = write_study(tmp.path(), results, c, 1.0).markdown;
+  const std::size_t summary = md.find("## Summary"), next = md.find("\n## ", summary);
+  ASSERT_NE(summary, std::string::npos);
+  const std::string head = md.substr(summary, next - summary);
+  const std::size_t at = head.find(
+      "**importance sampling, relative variance of the albedo estimate, tables of 8 KiB**");
+  ASSERT_NE(at, std::string::npos) << head;
+  // Its table: the two BRDFs, halfdiff's chart the better sampler of the glossy lobe.
+  EXPECT_NE(head.find("| models | 2 |", at), std::string::npos) << head;
+  const auto halfdiff = sampling_points(results[1], space_of<HalfDiff>, "tabulated");
+  const auto spherical = sampling_points(results[1], space_of<Spherical>, "tabulated");
+  ASSERT_FALSE(halfdiff.empty());
+  ASSERT_FALSE(spherical.empty());
+  EXPECT_LT(halfdiff.front().relative_variance, spherical.front().relative_variance);
 }
 
 }  // namespace
