@@ -248,8 +248,10 @@ std::string kind_of(const std::string& label) {
 // that c compares (INFINITY for the others).
 SummaryMetric best_design_metric(const std::vector<BrdfResult>& results, const DesignComparison& c,
                                  std::size_t ref) {
-  SummaryMetric best{
-      fmt::format("gonio-reflectometer, N = {}, each in its best design", ref), "best", {}};
+  SummaryMetric best{fmt::format("gonio-reflectometer, N = {}, each in its best design", ref),
+                     "best",
+                     {},
+                     "acquisition: each in its best design"};
   for (const BrdfResult& b : results) {
     best.values.emplace_back(c.params.size(), INFINITY);
     if (std::find(c.brdfs.begin(), c.brdfs.end(), &b) != c.brdfs.end())
@@ -269,7 +271,8 @@ SummaryMetric sampling_summary_metric(const std::vector<BrdfResult>& results,
                               "tables of {} KiB",
                               kib),
                   "",
-                  {}};
+                  {},
+                  "importance sampling (a table of equal memory)"};
   const std::vector<Space>& params = params_of(results);
   for (const BrdfResult& b : results) {
     m.values.emplace_back(params.size(), INFINITY);
@@ -290,10 +293,17 @@ std::string brdf_count(std::size_t n) {
 std::vector<SummaryMetric> summary_metrics(const std::vector<BrdfResult>& results,
                                            const StudyConfig& config, const Contents& has) {
   const std::size_t ref = has.gonio ? reference_budget(config) : 0;
-  SummaryMetric azimuthal{"azimuthal dependence", "", {}},
-      separability{"separability (rank 1, 2D projection)", "", {}},
-      own{fmt::format("gonio-reflectometer, N = {}, own regular design", ref), "own", {}},
-      image{"image-space relative RMSE (regular design)", "", {}};
+  SummaryMetric azimuthal{"azimuthal dependence", "", {}, "compactness: dropping the azimuth"},
+      separability{
+          "separability (rank 1, 2D projection)", "", {}, "compactness: one separable term"},
+      own{fmt::format("gonio-reflectometer, N = {}, own regular design", ref),
+          "own",
+          {},
+          "interpolation from a gonio-reflectometer (regular grid)"},
+      image{"image-space relative RMSE (regular design)",
+            "",
+            {},
+            "renderings of the interpolated measurements"};
   for (const BrdfResult& b : results) {
     auto v = paired_metric_values(b, ref);
     azimuthal.values.push_back(std::move(v[0]));

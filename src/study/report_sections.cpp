@@ -58,6 +58,80 @@ std::string count_in_words(std::size_t n) {
 
 }  // namespace
 
+namespace {
+
+// The lowest and second-lowest medians of `med` (NaN: not measured), as indices; second is
+// med.size() when fewer than two are measured.
+std::pair<std::size_t, std::size_t> two_lowest(const std::vector<double>& med) {
+  std::size_t first = med.size(), second = med.size();
+  for (std::size_t i = 0; i < med.size(); ++i) {
+    if (!std::isfinite(med[i])) continue;
+    if (first == med.size() || med[i] < med[first]) {
+      second = first;
+      first = i;
+    } else if (second == med.size() || med[i] < med[second]) {
+      second = i;
+    }
+  }
+  return {first, second};
+}
+
+// "×1.9" (how many times the winner's median the runner-up's is), "tie" when equal to 3 digits.
+std::string margin(double winner, double runner_up) {
+  if (!(winner > 0)) return runner_up > 0 ? std::string("exact") : std::string("tie");
+  const double r = runner_up / winner;
+  return r < 1.0005 ? std::string("tie") : fmt::format("×{:.3g}", r);
+}
+
+}  // namespace
+
+std::string answers_section(const std::vector<BrdfResult>& results,
+                            const std::vector<SummaryMetric>& metrics) {
+  const std::vector<Space>& params = params_of(results);
+  if (params.size() < 2) return {};
+  const Kinds kinds = kinds_of(results);
+  std::string rows;
+  for (const SummaryMetric& m : metrics) {
+    if (m.use.empty()) continue;
+    std::vector<std::size_t> all(results.size());
+    for (std::size_t j = 0; j < all.size(); ++j) all[j] = j;
+    const auto [med, n] = medians(m, all);
+    const auto [first, second] = two_lowest(med);
+    if (n == 0 || second == med.size()) continue;
+    Wins wins(params);
+    for (std::size_t j : all)
+      if (std::all_of(m.values[j].begin(), m.values[j].end(),
+                      [](double v) { return std::isfinite(v); }))
+        wins.add(m.values[j]);
+    std::string by_kind;
+    if (kinds.size() > 1)
+      for (const auto& [kind, rows_of_kind] : kinds) {
+        if (kind == "all") continue;
+        const auto [kmed, kn] = medians(m, rows_of_kind);
+        const auto [kfirst, ksecond] = two_lowest(kmed);
+        if (kn == 0 || ksecond == kmed.size()) continue;
+        by_kind += fmt::format("{}{} ({}): {} {}", by_kind.empty() ? "" : "; ", kind, kn,
+                               name_of(params[kfirst]), margin(kmed[kfirst], kmed[ksecond]));
+      }
+    rows += fmt::format("| {} | **{}** {:.4g} | {} {:.4g} | {} | {} of {} | {} |\n", m.use,
+                        name_of(params[first]), med[first], name_of(params[second]), med[second],
+                        margin(med[first], med[second]), wins.count(first), n,
+                        by_kind.empty() ? "–" : by_kind);
+  }
+  if (rows.empty()) return {};
+  return fmt::format(
+             "## Answers\n\nWhich parameterization for what, on the {} of this run: per use, "
+             "the parameterization with the lowest median (over the BRDFs measured in all of "
+             "them; the metrics and kinds of the Summary below, lower is better), the "
+             "runner-up, the margin (runner-up's median over the winner's), on how many BRDFs "
+             "the winner is the lowest, and the winner of each kind of BRDF with its margin. "
+             "docs/answers.md answers the same on the whole shared data.\n\n"
+             "| use | winner (median) | runner-up | margin | winner lowest on | by kind |\n"
+             "|---|---|---|---|---|---|\n",
+             brdf_count(results.size())) +
+         rows + "\n";
+}
+
 std::string summary_section(const std::vector<BrdfResult>& results,
                             const std::vector<SummaryMetric>& metrics, const ReportPlots& plots) {
   const std::vector<Space>& params = params_of(results);

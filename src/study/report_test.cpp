@@ -353,5 +353,24 @@ TEST(Report, SummaryKindsCountsAndUnreachedMedians) {
       << two.markdown;
 }
 
+// The report's first section answers "which parameterization for what" on its BRDFs: per use,
+// the winner, the runner-up and the margin, and the winner per kind.
+TEST(Report, AnswersSectionComesFirst) {
+  const test::TempDir tmp;
+  // halfdiff has k = 1, ortho k = 2: every error of ortho is twice halfdiff's.
+  const std::string md =
+      write_study(tmp.path(), {fake("x", true), fake("nbrdf:y", true)}, config_of_fakes(), 1.0)
+          .markdown;
+  const std::size_t answers = md.find("## Answers"), summary = md.find("## Summary");
+  ASSERT_NE(answers, std::string::npos) << md;
+  EXPECT_LT(answers, summary);
+  EXPECT_NE(md.find("| compactness: dropping the azimuth | **halfdiff** 0.1 | ortho 0.2 | ×2 | 2 "
+                    "of 2 | models (1): halfdiff ×2; neural BRDFs (1): halfdiff ×2 |"),
+            std::string::npos)
+      << md.substr(answers, summary - answers);
+  EXPECT_NE(md.find("| interpolation from a gonio-reflectometer (regular grid) | **halfdiff**"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace halfback::study
