@@ -99,7 +99,8 @@ TEST(Report, RenderingColumnsFitTheirHeads) {
     if (const auto* t = std::get_if<figure::TextItem>(&item);
         t && t->halign == figure::HAlign::centre)
       heads.push_back(t);
-    if (const auto* i = std::get_if<figure::ImageItem>(&item)) images.push_back(i->x);
+    if (const auto* i = std::get_if<figure::ImageItem>(&item); i && images.size() < 4)
+      images.push_back(i->x);  // the first row's: the renderings (the differences follow)
   }
   ASSERT_EQ(heads.size(), 4u);  // BRDF, then the three parameterizations
   ASSERT_EQ(images.size(), 4u);
@@ -370,6 +371,40 @@ TEST(Report, AnswersSectionComesFirst) {
       << md.substr(answers, summary - answers);
   EXPECT_NE(md.find("| interpolation from a gonio-reflectometer (regular grid) | **halfdiff**"),
             std::string::npos);
+}
+
+// Under each reconstruction's rendering, its difference from the BRDF's: black where they agree
+// (the common noise cancels), brighter with the relative difference, white from 50 % on.
+TEST(Report, RenderingsShowTheirDifferenceImages) {
+  FakeBrdf b;
+  b.label = "a";
+  for (Space s : {space_of<HalfDiff>, space_of<Hybrid>}) {
+    FakeParam p;
+    p.space = s;
+    b.params.push_back(p);
+  }
+  BrdfResult r = to_result(b);
+  const render::Image grey{4, 4, std::vector<float>(4 * 4 * 3, 0.5f)};
+  render::Image brighter = grey;
+  for (float& v : brighter.rgb) v = 0.5f * 1.25f;  // 25 % above: half the full scale
+  r.example_images = {grey, grey, brighter};
+  const figure::Scene sc = report::examples_chart({r}, config_of_fakes());
+  std::vector<const figure::ImageItem*> images;
+  for (const figure::Item& item : sc.items)
+    if (const auto* i = std::get_if<figure::ImageItem>(&item)) images.push_back(i);
+  ASSERT_EQ(images.size(), 5u);  // the BRDF, two reconstructions, two differences
+  // In the order drawn: BRDF, halfdiff, (its difference), hybrid, (its difference).
+  const figure::ImageItem& same = *images[2];
+  const figure::ImageItem& off = *images[4];
+  EXPECT_GT(same.y, images[1]->y);  // below its rendering
+  EXPECT_EQ(same.x, images[1]->x);
+  for (std::size_t p = 0; p < 16; ++p) {
+    EXPECT_EQ(same.rgba[4 * p], 0);  // no difference: black
+    // 25 % of the mean is half the full scale: u = 1.5 on the 0-3 ramp (red full, green half).
+    EXPECT_EQ(off.rgba[4 * p], 255);
+    EXPECT_NEAR(off.rgba[4 * p + 1], 128, 1);
+    EXPECT_EQ(off.rgba[4 * p + 2], 0);
+  }
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 // charts ranked as they should be on a broad and a glossy lobe; the report's section.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "halfback/models/analytic.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
@@ -11,6 +13,7 @@
 #include "halfback/study/metric_tables.hpp"
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
+#include "report_internal.hpp"
 #include "support/test_support.hpp"
 
 namespace halfback::study {
@@ -186,7 +189,7 @@ TEST(SamplingTable, SettingsAreChecked) {
 // --no-gonio it is the only one asked for beyond metrics 1-2.
 TEST(SamplingTable, TheSummaryHasTheSamplingMetric) {
   StudyConfig c = sampling_only();
-  c.params = {space_of<HalfDiff>, space_of<Spherical>};
+  c.params = {space_of<HalfDiff>, space_of<StereoHalfDiff>, space_of<Spherical>};
   c.options["sampler_kib"] = "8,16";
   c.options["sampler_samples"] = "256";
   c.image_size = 24;
@@ -211,6 +214,23 @@ TEST(SamplingTable, TheSummaryHasTheSamplingMetric) {
   ASSERT_FALSE(halfdiff.empty());
   ASSERT_FALSE(spherical.empty());
   EXPECT_LT(halfdiff.front().relative_variance, spherical.front().relative_variance);
+
+  // The plot: one curve per sampler chart, named by the parameterizations that share it
+  // (halfdiff's is stereo-halfdiff's: one curve, not one hidden under the other), the cosine in
+  // a colour no chart has.
+  const report::ReportPlots plots = report::report_plots(results, c, report::contents_of(results),
+                                                         report::summary_metrics(results, c, {}));
+  std::vector<std::string> texts;
+  for (const figure::Item& item : plots.sampling.items)
+    if (const auto* t = std::get_if<figure::TextItem>(&item)) texts.push_back(t->text);
+  const auto has = [&](const std::string& s) {
+    return std::find(texts.begin(), texts.end(), s) != texts.end();
+  };
+  EXPECT_TRUE(has("halfdiff / stereo-halfdiff tabulated"));
+  EXPECT_TRUE(has("spherical factored"));
+  EXPECT_FALSE(has("stereo-halfdiff tabulated"));
+  EXPECT_FALSE(has("halfdiff tabulated"));
+  EXPECT_TRUE(has("cosine"));
 }
 
 }  // namespace
