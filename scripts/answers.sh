@@ -13,7 +13,7 @@
 # its parts, docs/answers.md) and resumable: run the same command again after an interruption and
 # the studies continue where they stopped (`halfback study --resume`).
 #
-# --quick: the same steps on 8 BRDFs with the study's --quick settings (about three minutes on 2
+# --quick: the same steps on 8 BRDFs with the study's --quick settings (about two minutes on 2
 # cores): a check that the pipeline works, not numbers to quote.
 # --update-docs: write the figures to docs/answers-data/ and the tables into docs/answers.md
 # (only from a whole run; a quick run's numbers never go into the docs).
@@ -71,7 +71,7 @@ if [ $quick = 1 ]; then
   brdfs=("${files[@]}" ggx:alpha=0.2 beckmann:alpha=0.2,f0=0.9 lambert)
   nielsen=()
   for m in nickel delrin blue-fabric white-paint brass; do
-    nielsen+=(--nielsen-database "$data/nbrdf/merl_nbrdf/$m.h5")
+    nielsen+=("--nielsen-database=$data/nbrdf/merl_nbrdf/$m.h5")
   done
   settings=(--quick --env sky --image-size 32 --image-spp 4)
   dj_brdfs=("${files[@]}")
@@ -80,7 +80,7 @@ if [ $quick = 1 ]; then
 else
   folders=("$data/nbrdf/merl_nbrdf" "$data/nbrdf/rgl-isotropic_nbrdf" "$data/rgl")
   brdfs=("${folders[@]}" "$data/alta" "${models[@]}")
-  nielsen=(--nielsen-database "$data/nbrdf/merl_nbrdf")
+  nielsen=("--nielsen-database=$data/nbrdf/merl_nbrdf")
   settings=(--env "sky,studio,sunset,$data/envmaps/uffizi.hdr,$data/envmaps/grace.hdr")
   dj_brdfs=("${folders[@]}")
   factored=()
@@ -89,7 +89,7 @@ else
 fi
 
 say "the study (every metric) of ${#brdfs[@]} BRDF specs into $out/study"
-study "$out/study" "${settings[@]}" "${nielsen[@]}" "${brdfs[@]}"
+study "$out/study" "${settings[@]}" "${nielsen[@]}" -- "${brdfs[@]}"
 say "Dupuy & Jakob's layout into $out/dupuy-jakob"
 dj_quick=()
 [ $quick = 1 ] && dj_quick=(--quick)

@@ -170,7 +170,7 @@ py::dict study_one_brdf(const std::string& spec, const py::object& settings) {
                    "study_brdf: the learned design (one of the default designs) is left out: it "
                    "needs settings['profiles'], the study_profile() of every BRDF of the study; "
                    "give them, or name settings['designs'] to choose the designs",
-                   1) != 0)
+                   2) != 0)  // the caller of halfback.study_brdf, not the module's wrapper
     throw py::error_already_set();
   study::BrdfResult result;
   std::string described;

@@ -210,12 +210,15 @@ figure::Scene sampling_chart(const std::vector<BrdfResult>& results, const Study
     it->second.push_back(s);
   }
   constexpr int kCosineColour = 7;  // the palette's grey, for no chart
+  constexpr double kEfficiencyFloor = 1e-3;
   figure::LogLogChart c;
   c.title = fmt::format(
       "Importance sampling: each chart's efficiency against cosine sampling over "
       "the {}, sorted",
       brdf_count(sampled.size()));
-  c.x_label = "fraction of the BRDFs (each curve sorted; higher is better)";
+  c.x_label =
+      "fraction of the BRDFs (each curve sorted; higher is better; below 0.001, where the cosine "
+      "is exact, drawn at 0.001)";
   c.y_label = "efficiency vs cosine";
   c.linear_x = true;
   for (const std::size_t kib : option_counts(config, "sampler_kib"))
@@ -232,7 +235,10 @@ figure::Scene sampling_chart(const std::vector<BrdfResult>& results, const Study
             for (const SamplingPoint& p : sampling_points(*b, charts[k].second.front(), sampler))
               if (p.kib == kib) {
                 const double v = pixels ? p.pixel_efficiency_vs_cosine_mis : p.efficiency_vs_cosine;
-                if (v > 0 && std::isfinite(v)) e.push_back(v);
+                // A BRDF that the cosine samples exactly (a Lambertian: no variance) has an
+                // efficiency of ~0 against it; drawn at the floor, it does not stretch the axis
+                // over twenty decades.
+                if (std::isfinite(v)) e.push_back(std::max(v, kEfficiencyFloor));
               }
           if (e.empty()) continue;
           std::sort(e.begin(), e.end());

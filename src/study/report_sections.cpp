@@ -76,11 +76,13 @@ std::pair<std::size_t, std::size_t> two_lowest(const std::vector<double>& med) {
   return {first, second};
 }
 
-// "×1.9" (how many times the winner's median the runner-up's is), "tie" when equal to 3 digits.
+// "×1.90" (how many times the winner's median the runner-up's is), "tie" when equal to 3 digits.
 std::string margin(double winner, double runner_up) {
   if (!(winner > 0)) return runner_up > 0 ? std::string("exact") : std::string("tie");
   const double r = runner_up / winner;
-  return r < 1.0005 ? std::string("tie") : fmt::format("×{:.3g}", r);
+  return r < 1.0005 ? std::string("tie")
+         : r < 10   ? fmt::format("×{:.2f}", r)
+                    : fmt::format("×{:.3g}", r);
 }
 
 }  // namespace
