@@ -216,9 +216,7 @@ figure::Scene sampling_chart(const std::vector<BrdfResult>& results, const Study
       "Importance sampling: each chart's efficiency against cosine sampling over "
       "the {}, sorted",
       brdf_count(sampled.size()));
-  c.x_label =
-      "fraction of the BRDFs (each curve sorted; higher is better; below 0.001, where the cosine "
-      "is exact, drawn at 0.001)";
+  c.x_label = "fraction of the BRDFs, each curve sorted (below 0.001: drawn at 0.001)";
   c.y_label = "efficiency vs cosine";
   c.linear_x = true;
   for (const std::size_t kib : option_counts(config, "sampler_kib"))

@@ -60,20 +60,28 @@ std::string count_in_words(std::size_t n) {
 
 namespace {
 
-// The lowest and second-lowest medians of `med` (NaN: not measured), as indices; second is
-// med.size() when fewer than two are measured.
+// The lowest median of `med` (NaN: not measured) and the lowest of those that differ from it,
+// as indices (med.size(): none). Parameterizations with the very same median (those that share a
+// sampler chart share its numbers) are tied with the first, not runners-up.
 std::pair<std::size_t, std::size_t> two_lowest(const std::vector<double>& med) {
   std::size_t first = med.size(), second = med.size();
-  for (std::size_t i = 0; i < med.size(); ++i) {
-    if (!std::isfinite(med[i])) continue;
-    if (first == med.size() || med[i] < med[first]) {
-      second = first;
-      first = i;
-    } else if (second == med.size() || med[i] < med[second]) {
+  for (std::size_t i = 0; i < med.size(); ++i)
+    if (std::isfinite(med[i]) && (first == med.size() || med[i] < med[first])) first = i;
+  for (std::size_t i = 0; i < med.size(); ++i)
+    if (first != med.size() && std::isfinite(med[i]) && med[i] != med[first] &&
+        (second == med.size() || med[i] < med[second]))
       second = i;
-    }
-  }
   return {first, second};
+}
+
+// "halfdiff", or "halfdiff = stereo-halfdiff" for the parameterizations tied at med[first].
+std::string tied_names(const std::vector<Space>& params, const std::vector<double>& med,
+                       std::size_t first) {
+  std::string names;
+  for (std::size_t i = 0; i < med.size(); ++i)
+    if (med[i] == med[first])
+      names += (names.empty() ? "" : " = ") + std::string(name_of(params[i]));
+  return names;
 }
 
 // "×1.90" (how many times the winner's median the runner-up's is), "tie" when equal to 3 digits.
@@ -112,12 +120,13 @@ std::string answers_section(const std::vector<BrdfResult>& results,
         const auto [kmed, kn] = medians(m, rows_of_kind);
         const auto [kfirst, ksecond] = two_lowest(kmed);
         if (kn == 0 || ksecond == kmed.size()) continue;
-        by_kind += fmt::format("{}{} ({}): {} {}", by_kind.empty() ? "" : "; ", kind, kn,
-                               name_of(params[kfirst]), margin(kmed[kfirst], kmed[ksecond]));
+        by_kind +=
+            fmt::format("{}{} ({}): {} {}", by_kind.empty() ? "" : "; ", kind, kn,
+                        tied_names(params, kmed, kfirst), margin(kmed[kfirst], kmed[ksecond]));
       }
     rows += fmt::format("| {} | **{}** {:.4g} | {} {:.4g} | {} | {} of {} | {} |\n", m.use,
-                        name_of(params[first]), med[first], name_of(params[second]), med[second],
-                        margin(med[first], med[second]), wins.count(first), n,
+                        tied_names(params, med, first), med[first], tied_names(params, med, second),
+                        med[second], margin(med[first], med[second]), wins.count(first), n,
                         by_kind.empty() ? "–" : by_kind);
   }
   if (rows.empty()) return {};

@@ -215,6 +215,14 @@ TEST(SamplingTable, TheSummaryHasTheSamplingMetric) {
   ASSERT_FALSE(spherical.empty());
   EXPECT_LT(halfdiff.front().relative_variance, spherical.front().relative_variance);
 
+  // The Answers section names parameterizations that share a sampler together, never one as the
+  // other's runner-up ("tie").
+  const std::size_t row = md.find("| importance sampling (a table of equal memory) |");
+  ASSERT_NE(row, std::string::npos) << md;
+  const std::string answer = md.substr(row, md.find('\n', row) - row);
+  EXPECT_NE(answer.find("halfdiff = stereo-halfdiff"), std::string::npos) << answer;
+  EXPECT_EQ(answer.find("tie"), std::string::npos) << answer;
+
   // The plot: one curve per sampler chart, named by the parameterizations that share it
   // (halfdiff's is stereo-halfdiff's: one curve, not one hidden under the other), the cosine in
   // a colour no chart has.
