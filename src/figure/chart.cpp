@@ -153,15 +153,26 @@ Scene loglog_chart(const LogLogChart& c) {
     const std::pair<int, int> xd = p.series.empty() ? std::pair{0, 1} : decades(xmin, xmax);
     const std::pair<int, int> yd = p.series.empty() ? std::pair{-1, 0} : decades(ymin, ymax);
     const int xlo = xd.first, xhi = xd.second, ylo = yd.first, yhi = yd.second;
-    auto px = [&](double x) { return x0 + w * (std::log10(x) - xlo) / double(xhi - xlo); };
+    const bool linear = c.linear_x;
+    const double xspan = xmax > 0 ? xmax : 1;
+    auto px = [&](double x) {
+      return linear ? x0 + w * x / xspan : x0 + w * (std::log10(x) - xlo) / double(xhi - xlo);
+    };
     auto py = [&](double y) { return y0 + h - h * (std::log10(y) - ylo) / double(yhi - ylo); };
     sc.text({x0 + w / 2, y0 - 6}, escape_markup(p.title), 8.5, HAlign::centre);
     // Grid lines at the decades, and at 2 and 5 times them when the axis spans one decade.
-    for (int d = xlo; d <= xhi; ++d) {
-      const double x = px(std::pow(10.0, d));
-      sc.line({x, y0}, {x, y0 + h}, grid);
-      sc.text({x, y0 + h + 11}, fmt::format("10^{{{}}}", d), 7.5, HAlign::centre);
-    }
+    if (linear)
+      for (int q = 0; q <= 4; ++q) {
+        const double x = x0 + w * q / 4.0;
+        sc.line({x, y0}, {x, y0 + h}, grid);
+        sc.text({x, y0 + h + 11}, fmt::format("{:g}", xspan * q / 4.0), 7.5, HAlign::centre);
+      }
+    else
+      for (int d = xlo; d <= xhi; ++d) {
+        const double x = px(std::pow(10.0, d));
+        sc.line({x, y0}, {x, y0 + h}, grid);
+        sc.text({x, y0 + h + 11}, fmt::format("10^{{{}}}", d), 7.5, HAlign::centre);
+      }
     for (int d = ylo; d <= yhi; ++d) {
       const double y = py(std::pow(10.0, d));
       sc.line({x0, y}, {x0 + w, y}, grid);

@@ -46,6 +46,7 @@ struct PySettings {
   std::vector<std::string> profiles;
   bool has_profiles = false;
   bool designs_given = false;
+  bool learned_left_out = false;  // the default designs without profiles: learned left out
 };
 
 // The keys of the metrics in the settings dict (study::study_metrics()): no_NAME for each metric
@@ -139,7 +140,8 @@ PySettings study_settings(const py::object& settings) {
   // The defaults work alone (a new user's first call, docs/reliability/python.md): without
   // profiles, the default designs leave out the learned one, which needs the profiles of the
   // study's other BRDFs; asked for by name, it still needs them.
-  if (!out.has_profiles && !out.designs_given) std::erase(s.designs, std::string("learned"));
+  if (!out.has_profiles && !out.designs_given)
+    out.learned_left_out = std::erase(s.designs, std::string("learned")) > 0;
   return out;
 }
 
@@ -162,6 +164,15 @@ study::StudyConfig config_for(const PySettings& s, const std::string& label) {
 
 py::dict study_one_brdf(const std::string& spec, const py::object& settings) {
   const PySettings s = study_settings(settings);
+  // Not silently: the caller learns that a default design is not in the result, and how to have
+  // it (a UserWarning, which a script can turn into an error or silence).
+  if (s.learned_left_out &&
+      PyErr_WarnEx(PyExc_UserWarning,
+                   "study_brdf: the learned design (one of the default designs) is left out: it "
+                   "needs settings['profiles'], the study_profile() of every BRDF of the study; "
+                   "give them, or name settings['designs'] to choose the designs",
+                   2) != 0)  // the caller of halfback.study_brdf, not the module's wrapper
+    throw py::error_already_set();
   study::BrdfResult result;
   std::string described;
   {
@@ -321,9 +332,11 @@ reach, in radians as every angle of the Python API, from pi/180 to pi/2; default
 `halfback study --max-theta` takes degrees), seed, metrics (a list
 of the metrics to run), and per metric of the study's list no_NAME (no_gonio, no_images,
 no_sampling, no_fit) and its options (sampler_kib (a list), sampler_samples, fit_model, fit_loss,
-fit_budgets (a list), fit_samples) (missing: the defaults), and, for the learned spacing (a default one), profiles: the
-study_profile() texts of every BRDF of the study, this one's included, in the study's order (the
-warps are learned from all but this one's; without them, a ValueError).
+fit_budgets (a list), fit_samples) (missing: the defaults), and, for the learned spacing (a
+default one), profiles: the study_profile() texts of every BRDF of the study, this one's
+included, in the study's order (the warps are learned from all but this one's). Without profiles,
+the default spacings leave the learned one out with a UserWarning; a `spacings` list that names
+"learned" without profiles raises a ValueError.
 Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image": one
 row per parameterization and measurement, as in the CSV files of the study, numbers in exact round-trip form, e.g. for
 pandas.read_csv(io.StringIO(t))), "settings" (the resolved settings, which merge_study checks)

@@ -223,6 +223,41 @@ std::vector<std::pair<Space, FitPoint>> fit_rows(const Brdf& brdf, const StudyCo
 
 // Per design and budget, each parameterization's median excess of the fit from its measurements
 // over the whole fit and median shape change, and which has the lowest excess per BRDF.
+// A BRDF that the model fits exactly (e.g. a GGX model fitted by lambert+ggx) has its whole fit's
+// loss at round-off; a ratio of two losses there is noise ("5.6e+08 %", "-23 %"). Such BRDFs are
+// left out of the medians and compared in absolute terms below the table.
+bool whole_fit_exact(const BrdfResult& b, const std::vector<Space>& params) {
+  for (Space s : params)
+    for (const FitPoint& p : fit_points(b, s)) return p.whole_loss < kRoundOffLoss;
+  return false;
+}
+
+// The BRDFs fitted exactly, and per parameterization the largest loss on the whole BRDF of their
+// fits from measurements: how far from exact the measurements' fits are, in absolute terms.
+std::string exact_fits_text(const std::vector<BrdfResult>& results,
+                            const std::vector<Space>& params) {
+  std::string labels;
+  std::vector<double> worst(params.size(), -1);
+  for (const BrdfResult& b : results) {
+    if (!whole_fit_exact(b, params)) continue;
+    labels += (labels.empty() ? "" : ", ") + b.label;
+    for (std::size_t k = 0; k < params.size(); ++k)
+      for (const FitPoint& p : fit_points(b, params[k]))
+        worst[k] = std::max(worst[k], p.layout_loss);
+  }
+  if (labels.empty()) return {};
+  std::string losses;
+  for (std::size_t k = 0; k < params.size(); ++k)
+    if (worst[k] >= 0)
+      losses += fmt::format("{}{} {:.2g}{}", losses.empty() ? "" : ", ", name_of(params[k]),
+                            worst[k], worst[k] < kRoundOffLoss ? " (exact too)" : "");
+  return fmt::format(
+      "\nFitted exactly by the model (the whole fit's loss below {:.0e}, round-off, where a "
+      "ratio of losses means nothing), left out of the medians and counts above: {}. The "
+      "largest loss on the whole BRDF of their fits from measurements: {}.\n",
+      kRoundOffLoss, labels, losses);
+}
+
 std::string fit_tables(const std::vector<BrdfResult>& results, const FitSettings& fit) {
   const std::vector<Space>& params = report::params_of(results);
   std::string md = report::table_header("weights | design | budget", params);
@@ -233,6 +268,7 @@ std::string fit_tables(const std::vector<BrdfResult>& results, const FitSettings
         std::vector<std::vector<double>> excess(params.size()), change(params.size());
         report::Wins wins(params);
         for (const BrdfResult& b : results) {
+          if (whole_fit_exact(b, params)) continue;
           std::vector<double> row(params.size(), NAN);
           for (std::size_t k = 0; k < params.size(); ++k)
             for (const FitPoint& p : fit_points(b, params[k]))
@@ -253,7 +289,7 @@ std::string fit_tables(const std::vector<BrdfResult>& results, const FitSettings
         wins_text +=
             fmt::format("- {}, {} at {}: {}\n", name_of(w), name_of(d), budget, wins.text());
       }
-  return md + "\nLowest excess (BRDFs):\n\n" + wins_text + "\n";
+  return md + exact_fits_text(results, params) + "\nLowest excess (BRDFs):\n\n" + wins_text + "\n";
 }
 
 // Fitting from measurements (metric 6; docs/study.md): does the parameterization of a design change

@@ -32,6 +32,10 @@ inline constexpr std::array<FitWeights, 2> kFitWeights{FitWeights::uniform,
 std::string_view name_of(FitWeights w);  // "uniform", "solid-angle"
 std::optional<FitWeights> parse_fit_weights(std::string_view name);
 
+// A fit's loss below this is round-off: the model reproduces the BRDF exactly (the losses of a
+// real fit are many orders of magnitude above it), and a ratio of two such losses is noise.
+inline constexpr double kRoundOffLoss = 1e-20;
+
 struct FitPoint {
   acquire::Design design = acquire::Design::regular;
   std::size_t budget = 0, samples = 0;

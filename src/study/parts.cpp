@@ -202,18 +202,21 @@ std::string describe_config(const StudyConfig& c) {
                                   ? std::string()
                                   : fmt::format("nielsen_from = {}\nnielsen_counts = {}\n",
                                                 c.nielsen_from, joined(c.nielsen_counts));
+  // A quick run says so (its report warns that its headline is not the study's), in a line of its
+  // own: the settings of a full run read as before.
+  const std::string quick = c.quick ? "quick = 1\n" : "";
   return fmt::format(
       "parameterizations = {}\nspace = {}\ngrid = {},{},{}\nfull_grid = {}\nranks = {}\nbudgets = "
       "{}\nbudgets_4d = {}\n"
       "test_pairs = {}\nmax_theta_deg = {}\nseed = {}\nenvironments = {}\nimage_budget = {}\n"
       "image_size = {}\nimage_spp = {}\ndesigns = {}\nprofile_grid = {},{},{}\n"
-      "learned_from = {}\n{}{}",
+      "learned_from = {}\n{}{}{}",
       joined(names_of(c.params)), name_of(c.space), c.grid.a, c.grid.b, c.grid.phi,
       joined(std::vector<std::size_t>(c.full_grid.begin(), c.full_grid.end())), joined(c.ranks),
       joined(c.budgets), joined(c.budgets_4d), c.test_pairs, format_csv_number(c.max_theta_deg),
       c.seed, envs, c.image_budget, c.image_size, c.image_spp, joined(names_of(c.spacings)),
-      c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from, metric_lines,
-      nielsen);
+      c.profile_grid.a, c.profile_grid.b, c.profile_grid.phi, c.learned_from, metric_lines, nielsen,
+      quick);
 }
 
 namespace {
@@ -293,6 +296,11 @@ StudyConfig config_from_description(std::string_view text, const std::string& so
     throw std::runtime_error(fmt::format("{}: a grid has the wrong number of axes", source));
   c.profile_grid = {profile_grid[0], profile_grid[1], profile_grid[2]};
   c.learned_from = get("learned_from");
+  if (const auto it = kv.find("quick"); it != kv.end()) {
+    if (it->second != "1")
+      throw std::runtime_error(fmt::format("{}: quick = '{}': expected 1", source, it->second));
+    c.quick = true;
+  }
   // The metrics' options. A run's settings without a metric's lines (written before it was
   // added): the metric off, its other options at their defaults.
   for (const Metric* m : study_metrics()) {

@@ -121,6 +121,14 @@ TEST(StudyParts, SettingsRoundTrip) {
   EXPECT_EQ(back.space, ErrorSpace::nielsen);
   EXPECT_EQ(back.spacings, (std::vector<Spacing>{Spacing::merl, Spacing::own, Spacing::learned}));
   EXPECT_EQ(back.learned_from, c.learned_from);
+  // A quick run stays one through its parts (a merge's report warns as the run's own does); a
+  // full run's settings have no such line.
+  EXPECT_TRUE(back.quick);
+  EXPECT_NE(text.find("\nquick = 1\n"), std::string::npos);
+  s.quick = false;
+  EXPECT_EQ(describe_config(make_config(s)).find("quick"), std::string::npos);
+  EXPECT_FALSE(config_from_description(describe_config(make_config(s)), "test").quick);
+  s.quick = true;
   // A setting that changes the results changes the description.
   s.seed = 8;
   EXPECT_NE(describe_config(make_config(s)), text);

@@ -43,7 +43,7 @@ StudyOutput write_study(const std::filesystem::path& dir, const std::vector<Brdf
   const std::vector<SummaryMetric> summary = summary_metrics(results, config, has);
   const ReportPlots plots = report_plots(results, config, has, summary);
   std::string md = report_header(results, config, has.anisotropic, seconds) +
-                   summary_section(results, summary, plots);
+                   answers_section(results, summary) + summary_section(results, summary, plots);
   for (const Metric* m : study_metrics()) md += m->report_section(results, config, plots);
   md += files_and_networks_section(results, config);
   md += files_paragraph(out.files);

@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "halfback/study/metric.hpp"
 #include "report_internal.hpp"
 
 namespace halfback::study::report {
@@ -229,14 +230,15 @@ std::vector<std::vector<double>> paired_metric_values(const BrdfResult& b, std::
 
 namespace {
 
-// The kind of a BRDF, from its label: a file's label starts with its reader's prefix, a model's
-// is its spec.
+// The kind of a BRDF, from its label: a file's label starts with its reader's prefix, a material
+// compiled into the library with "embedded:", a model's is its spec.
 std::string kind_of(const std::string& label) {
   static constexpr std::pair<std::string_view, std::string_view> kKinds[] = {
       {"nbrdf:", "neural BRDFs"},
       {"merl:", "MERL files"},
       {"rgl:", "RGL files"},
-      {"alta:", "ALTA files"}};
+      {"alta:", "ALTA files"},
+      {"embedded:", "embedded materials"}};
   for (const auto& [prefix, kind] : kKinds)
     if (label.starts_with(prefix)) return std::string(kind);
   return "models";
@@ -246,8 +248,10 @@ std::string kind_of(const std::string& label) {
 // that c compares (INFINITY for the others).
 SummaryMetric best_design_metric(const std::vector<BrdfResult>& results, const DesignComparison& c,
                                  std::size_t ref) {
-  SummaryMetric best{
-      fmt::format("gonio-reflectometer, N = {}, each in its best design", ref), "best", {}};
+  SummaryMetric best{fmt::format("gonio-reflectometer, N = {}, each in its best design", ref),
+                     "best",
+                     {},
+                     "acquisition: each in its best design"};
   for (const BrdfResult& b : results) {
     best.values.emplace_back(c.params.size(), INFINITY);
     if (std::find(c.brdfs.begin(), c.brdfs.end(), &b) != c.brdfs.end())
@@ -257,15 +261,49 @@ SummaryMetric best_design_metric(const std::vector<BrdfResult>& results, const D
   return best;
 }
 
+// Importance sampling at the smallest table size: the relative variance of the albedo estimate
+// of each parameterization's tabulated sampler (INFINITY where not measured).
+SummaryMetric sampling_summary_metric(const std::vector<BrdfResult>& results,
+                                      const StudyConfig& config) {
+  const std::vector<std::size_t> sizes = option_counts(config, "sampler_kib");
+  const std::size_t kib = sizes.empty() ? 0 : *std::min_element(sizes.begin(), sizes.end());
+  SummaryMetric m{fmt::format("importance sampling, relative variance of the albedo estimate, "
+                              "tables of {} KiB",
+                              kib),
+                  "",
+                  {},
+                  "importance sampling (a table of equal memory)"};
+  const std::vector<Space>& params = params_of(results);
+  for (const BrdfResult& b : results) {
+    m.values.emplace_back(params.size(), INFINITY);
+    for (std::size_t i = 0; i < params.size(); ++i)
+      for (const SamplingPoint& p : sampling_points(b, params[i], "tabulated"))
+        if (p.kib == kib && std::isfinite(p.relative_variance))
+          m.values.back()[i] = p.relative_variance;
+  }
+  return m;
+}
+
 }  // namespace
+
+std::string brdf_count(std::size_t n) {
+  return fmt::format("{} BRDF{}", n, n == 1 ? "" : "s");
+}
 
 std::vector<SummaryMetric> summary_metrics(const std::vector<BrdfResult>& results,
                                            const StudyConfig& config, const Contents& has) {
   const std::size_t ref = has.gonio ? reference_budget(config) : 0;
-  SummaryMetric azimuthal{"azimuthal dependence", "", {}},
-      separability{"separability (rank 1, 2D projection)", "", {}},
-      own{fmt::format("gonio-reflectometer, N = {}, own regular design", ref), "own", {}},
-      image{"image-space relative RMSE (regular design)", "", {}};
+  SummaryMetric azimuthal{"azimuthal dependence", "", {}, "compactness: dropping the azimuth"},
+      separability{
+          "separability (rank 1, 2D projection)", "", {}, "compactness: one separable term"},
+      own{fmt::format("gonio-reflectometer, N = {}, own regular design", ref),
+          "own",
+          {},
+          "interpolation from a gonio-reflectometer (regular grid)"},
+      image{"image-space relative RMSE (regular design)",
+            "",
+            {},
+            "renderings of the interpolated measurements"};
   for (const BrdfResult& b : results) {
     auto v = paired_metric_values(b, ref);
     azimuthal.values.push_back(std::move(v[0]));
@@ -278,6 +316,7 @@ std::vector<SummaryMetric> summary_metrics(const std::vector<BrdfResult>& result
   const DesignComparison c = has.gonio ? compare_designs(results, ref) : DesignComparison{};
   if (c.keys.size() >= 2 && !c.brdfs.empty()) m.push_back(best_design_metric(results, c, ref));
   if (has.images) m.push_back(std::move(image));
+  if (has.sampling) m.push_back(sampling_summary_metric(results, config));
   return m;
 }
 

@@ -183,57 +183,77 @@ figure::Scene strategies_chart(const std::vector<BrdfResult>& results) {
 }
 
 // Metric 5: each sampler's efficiency against the cosine, one panel per table size and measure
-// (the albedo estimator, the pixels with MIS), against the first parameterization's tabulated
-// albedo efficiency at that size (how peaked the BRDF is: broad on the left); per
-// parameterization the tabulated sampler solid and the factored one dashed, and the cosine's 1.
+// (the albedo estimator, the pixels with MIS). One curve per sampler chart (parameterizations
+// that share a chart share its sampler and its curve, named by all of them) and per sampler
+// (tabulated solid, factored dashed): its efficiencies over the BRDFs sorted, against the
+// fraction of the BRDFs, so that a curve above another is the better sampler over the database;
+// the cosine's 1 in a colour of its own.
 figure::Scene sampling_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
   const std::vector<Space>& params = params_of(results);
   std::vector<const BrdfResult*> sampled;
   for (const BrdfResult& b : results)
     if (!b.table("sampling").rows.empty()) sampled.push_back(&b);
   if (sampled.empty() || params.empty()) return {};
+  // The charts in the order of their first parameterization, each with its parameterizations.
+  std::vector<std::pair<std::string, std::vector<Space>>> charts;
+  for (Space s : params) {
+    std::string chart;
+    for (const BrdfResult* b : sampled)
+      if (const auto points = sampling_points(*b, s, "tabulated"); !points.empty()) {
+        chart = points.front().chart;
+        break;
+      }
+    if (chart.empty()) continue;
+    auto it =
+        std::find_if(charts.begin(), charts.end(), [&](const auto& c) { return c.first == chart; });
+    if (it == charts.end()) it = charts.insert(charts.end(), {chart, {}});
+    it->second.push_back(s);
+  }
+  constexpr int kCosineColour = 7;  // the palette's grey, for no chart
+  constexpr double kEfficiencyFloor = 1e-3;
   figure::LogLogChart c;
-  c.title = "Importance sampling: efficiency against cosine sampling, by how peaked the BRDF is";
-  c.x_label =
-      fmt::format("{} table's albedo efficiency vs cosine (broad ← → peaked)", name_of(params[0]));
+  c.title = fmt::format(
+      "Importance sampling: each chart's efficiency against cosine sampling over "
+      "the {}, sorted",
+      brdf_count(sampled.size()));
+  c.x_label = "fraction of the BRDFs, each curve sorted (below 0.001: drawn at 0.001)";
   c.y_label = "efficiency vs cosine";
-  for (const std::size_t kib : option_counts(config, "sampler_kib")) {
-    const auto efficiency = [&](const BrdfResult& b, Space s, std::string_view sampler,
-                                bool pixels) {
-      for (const SamplingPoint& p : sampling_points(b, s, sampler))
-        if (p.kib == kib) return pixels ? p.pixel_efficiency_vs_cosine_mis : p.efficiency_vs_cosine;
-      return 0.0;
-    };
-    std::vector<const BrdfResult*> order = sampled;
-    std::stable_sort(order.begin(), order.end(), [&](const BrdfResult* a, const BrdfResult* b) {
-      return efficiency(*a, params[0], "tabulated", false) <
-             efficiency(*b, params[0], "tabulated", false);
-    });
+  c.linear_x = true;
+  for (const std::size_t kib : option_counts(config, "sampler_kib"))
     for (const bool pixels : {false, true}) {
       figure::LogLogPanel panel{
           fmt::format("{} KiB, {}", kib, pixels ? "pixels (MIS)" : "directional albedo"), {}};
-      for (std::size_t k = 0; k < params.size(); ++k)
+      for (std::size_t k = 0; k < charts.size(); ++k) {
+        std::string names;
+        for (Space s : charts[k].second)
+          names += (names.empty() ? "" : " / ") + std::string(name_of(s));
         for (const char* sampler : {"tabulated", "factored"}) {
-          figure::LineSeries line{fmt::format("{} {}", name_of(params[k]), sampler),
-                                  int(k),
+          std::vector<double> e;
+          for (const BrdfResult* b : sampled)
+            for (const SamplingPoint& p : sampling_points(*b, charts[k].second.front(), sampler))
+              if (p.kib == kib) {
+                const double v = pixels ? p.pixel_efficiency_vs_cosine_mis : p.efficiency_vs_cosine;
+                // A BRDF that the cosine samples exactly (a Lambertian: no variance) has an
+                // efficiency of ~0 against it; drawn at the floor, it does not stretch the axis
+                // over twenty decades.
+                if (std::isfinite(v)) e.push_back(std::max(v, kEfficiencyFloor));
+              }
+          if (e.empty()) continue;
+          std::sort(e.begin(), e.end());
+          figure::LineSeries line{fmt::format("{} {}", names, sampler),
+                                  int(k % kCosineColour),
                                   std::string_view(sampler) == "factored",
                                   {},
-                                  {}};
-          for (const BrdfResult* b : order) {
-            const double x = efficiency(*b, params[0], "tabulated", false);
-            const double e = efficiency(*b, params[k], sampler, pixels);
-            if (!(e > 0 && std::isfinite(e) && x > 0 && std::isfinite(x))) continue;
-            line.x.push_back(x);
-            line.y.push_back(e);
-          }
-          if (!line.x.empty()) panel.series.push_back(std::move(line));
+                                  std::move(e)};
+          for (std::size_t i = 0; i < line.y.size(); ++i)
+            line.x.push_back((double(i) + 0.5) / double(line.y.size()));
+          panel.series.push_back(std::move(line));
         }
+      }
       if (panel.series.empty()) continue;
-      const double lo = panel.series.front().x.front(), hi = panel.series.front().x.back();
-      panel.series.push_back({"cosine", int(params.size()), false, {lo, hi}, {1, 1}});
+      panel.series.push_back({"cosine", kCosineColour, false, {1e-3, 1}, {1, 1}});
       c.panels.push_back(std::move(panel));
     }
-  }
   if (c.panels.empty()) return {};
   c.columns = 2;
   c.panel_width = 320;
@@ -249,8 +269,8 @@ figure::Scene designs_chart(const std::vector<BrdfResult>& results, const StudyC
   figure::BarChart chart;
   chart.title = fmt::format("Designs: median relative error ({} space) at N = {}",
                             name_of(config.space), ref);
-  chart.x_label =
-      fmt::format("median over {} BRDFs of the reconstruction's relative error", c.brdfs.size());
+  chart.x_label = fmt::format("median over {} of the reconstruction's relative error",
+                              brdf_count(c.brdfs.size()));
   for (const DesignKey& k : c.keys) chart.series.push_back(design_name(k));
   chart.rows = param_names(c.params);
   chart.values = c.median;
@@ -294,11 +314,56 @@ void save_plot(const figure::Scene& sc, const std::filesystem::path& dir, const 
 
 }  // namespace
 
+namespace {
+
+// The luminance of a rendering's pixels.
+std::vector<double> luminance(const render::Image& im) {
+  std::vector<double> y(std::size_t(im.width) * std::size_t(im.height));
+  for (std::size_t p = 0; p < y.size(); ++p)
+    y[p] = 0.2126 * im.rgb[3 * p] + 0.7152 * im.rgb[3 * p + 1] + 0.0722 * im.rgb[3 * p + 2];
+  return y;
+}
+
+// The difference of a reconstruction's rendering from the BRDF's, |Y − Y_ref| over the mean of
+// Y_ref over the pixels it lights, as a "hot" ramp: black 0, red, yellow, white at kFullScale and
+// above. The two are rendered with the same random numbers, so their common noise cancels.
+constexpr double kDifferenceFullScale = 0.5;
+figure::ImageItem difference_item(const render::Image& test, const render::Image& reference,
+                                  double x, double y, double size) {
+  const std::vector<double> t = luminance(test), r = luminance(reference);
+  double sum = 0;
+  std::size_t lit = 0;
+  for (double v : r)
+    if (v > 0 && std::isfinite(v)) sum += v, ++lit;
+  const double mean = lit ? sum / double(lit) : 1;
+  figure::ImageItem item;
+  item.x = x;
+  item.y = y;
+  item.width = item.height = size;
+  item.px_width = std::size_t(reference.width);
+  item.px_height = std::size_t(reference.height);
+  item.rgba.resize(4 * r.size());
+  for (std::size_t p = 0; p < r.size(); ++p) {
+    const double d = std::abs(t[p] - r[p]) / mean;
+    const double u = std::isfinite(d) ? std::clamp(3 * d / kDifferenceFullScale, 0.0, 3.0) : 3.0;
+    const double rgb[3] = {std::min(u, 1.0), std::clamp(u - 1, 0.0, 1.0),
+                           std::clamp(u - 2, 0.0, 1.0)};
+    for (int c = 0; c < 3; ++c) item.rgba[4 * p + c] = std::uint8_t(std::lround(255 * rgb[c]));
+    item.rgba[4 * p + 3] = 255;
+  }
+  item.smooth = true;
+  return item;
+}
+
+}  // namespace
+
 // The renderings of the BRDFs and of their regular-design reconstructions under the first
-// environment, side by side (the same tone mapping for a row), for the eye.
+// environment, side by side (the same tone mapping for a row), for the eye; under each
+// reconstruction its difference from the BRDF's rendering (difference_item), which shows the
+// reconstruction's error where the renderings alone show mostly their common noise.
 figure::Scene examples_chart(const std::vector<BrdfResult>& results, const StudyConfig& config) {
   const std::vector<Space>& params = params_of(results);
-  const double cell = 66, gap = 4, label_w = 250, top = 78;
+  const double cell = 66, gap = 4, label_w = 250, top = 92;
   const std::size_t columns = params.size() + 1;  // the BRDF, then its reconstructions
   std::size_t rows = 0;
   for (const BrdfResult& b : results) rows += b.example_images.size() == columns;
@@ -309,8 +374,12 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
       "The BRDF and its reconstructions from {} measurements (regular design), under {}",
       config.image_budget, config.environments.front().label);
   const std::string note = fmt::format(
-      "{} environment samples per pixel, the same in every image: the noise is common to a row",
+      "{} environment samples per pixel, the same in every image: the noise is common to a row.",
       config.image_spp);
+  const std::string note2 = fmt::format(
+      "Under each reconstruction: |its luminance − the BRDF's| over the BRDF's mean luminance, "
+      "black 0, red, yellow, white ≥ {:g} %.",
+      100 * kDifferenceFullScale);
   std::vector<std::string> heads{"BRDF"};
   for (const std::string& name : param_names(params)) heads.push_back(figure::escape_markup(name));
   // The columns' pitch: a cell, or the widest head (a parameterization's name is wider than a
@@ -318,12 +387,15 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
   double pitch = cell + gap;
   for (const std::string& head : heads)
     pitch = std::max(pitch, figure::snap(figure::approx_text_width(head, 9) + 8));
+  const double row_h = 2 * (cell + gap) + 6;
   sc.width = figure::snap(
-      std::max(label_w + double(columns) * pitch + 10, 24 + 13 * 0.62 * double(title.size())));
-  sc.height = figure::snap(top + 14 + double(rows) * (cell + gap) + 10);
+      std::max({label_w + double(columns) * pitch + 10, 24 + 13 * 0.62 * double(title.size()),
+                24 + 9.5 * 0.55 * double(note2.size())}));
+  sc.height = figure::snap(top + 14 + double(rows) * row_h + 10);
   sc.text({12, 24}, figure::escape_markup(title), 13, figure::HAlign::left,
           figure::VAlign::baseline, figure::kBlack, 0, true);
   sc.text({12, 42}, figure::escape_markup(note), 9.5);
+  sc.text({12, 56}, figure::escape_markup(note2), 9.5);
   for (std::size_t k = 0; k < heads.size(); ++k)
     sc.text({label_w + double(k) * pitch + cell / 2, top - 8}, heads[k], 9, figure::HAlign::centre);
   double y = top;
@@ -331,9 +403,15 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
     if (b.example_images.size() != columns) continue;
     sc.text({label_w - 8, y + cell / 2}, figure::escape_markup(b.label), 8.5, figure::HAlign::right,
             figure::VAlign::middle);
-    for (std::size_t k = 0; k < b.example_images.size(); ++k)
+    sc.text({label_w - 8, y + cell + gap + cell / 2}, "difference", 8, figure::HAlign::right,
+            figure::VAlign::middle);
+    for (std::size_t k = 0; k < b.example_images.size(); ++k) {
       sc.add(figure::rendering_item(b.example_images[k], label_w + double(k) * pitch, y, cell));
-    y += cell + gap;
+      if (k > 0)
+        sc.add(difference_item(b.example_images[k], b.example_images[0],
+                               label_w + double(k) * pitch, y + cell + gap, cell));
+    }
+    y += row_h;
   }
   return sc;
 }

@@ -51,6 +51,9 @@ std::size_t reference_budget(const StudyConfig& config);
 
 double median(std::vector<double> v);
 
+// "1 BRDF", "2 BRDFs".
+std::string brdf_count(std::size_t n);
+
 // The mean image-space error of one parameterization's renderings of a design, over the
 // environments (INFINITY when there is none).
 struct MeanImageError {
@@ -109,6 +112,7 @@ struct SummaryMetric {
   std::string name;
   std::string chart_row;  // the metric's rows in the summary plot ("own", "best"); empty: none
   std::vector<std::vector<double>> values;
+  std::string use;  // the use it answers for, in the report's Answers ("importance sampling")
 };
 std::vector<SummaryMetric> summary_metrics(const std::vector<BrdfResult>& results,
                                            const StudyConfig& config, const Contents& has);
@@ -198,6 +202,10 @@ std::string summary_table(const SummaryMetric& m, const std::vector<Space>& para
 
 std::string report_header(const std::vector<BrdfResult>& results, const StudyConfig& config,
                           bool any_aniso, double seconds);
+// The report's first section: per use (a summary metric), the parameterization with the lowest
+// median over all BRDFs, by how much, and which wins on each kind of BRDF.
+std::string answers_section(const std::vector<BrdfResult>& results,
+                            const std::vector<SummaryMetric>& metrics);
 std::string summary_section(const std::vector<BrdfResult>& results,
                             const std::vector<SummaryMetric>& metrics, const ReportPlots& plots);
 std::string azimuthal_section(const std::vector<BrdfResult>& results, bool any_aniso);

@@ -31,7 +31,7 @@ std::string report_header(const std::vector<BrdfResult>& results, const StudyCon
       "# halfback study\n\n"
       "Measure: cos θi cos θo dωi dωo, through each parameterization's Jacobian. Values: the "
       "luminance of ρ in the **{}** error space. Metrics 1–2 on a {} × {} × {} grid of cell "
-      "centres of each isotropic form (midpoint rule){}. Definitions: docs/study.md. {} BRDFs "
+      "centres of each isotropic form (midpoint rule){}. Definitions: docs/study.md. {} "
       "in {:.1f} s.{}{}\n\n",
       name_of(config.space), config.grid.a, config.grid.b, config.grid.phi,
       any_aniso ? fmt::format(", and {} × {} × {} × {} cells of the full form for the anisotropic "
@@ -39,7 +39,7 @@ std::string report_header(const std::vector<BrdfResult>& results, const StudyCon
                               config.full_grid[0], config.full_grid[1], config.full_grid[2],
                               config.full_grid[3])
                 : "",
-      results.size(), seconds, left_out(config),
+      brdf_count(results.size()), seconds, left_out(config),
       config.quick
           ? "\n\n**A quick run** (`--quick`: smaller grids, fewer budgets and test pairs): "
             "its headline can differ from a full run's; do not quote it as the study's "
@@ -58,13 +58,99 @@ std::string count_in_words(std::size_t n) {
 
 }  // namespace
 
+namespace {
+
+// The lowest median of `med` (NaN: not measured) and the lowest of those that differ from it,
+// as indices (med.size(): none). Parameterizations with the very same median (those that share a
+// sampler chart share its numbers) are tied with the first, not runners-up.
+std::pair<std::size_t, std::size_t> two_lowest(const std::vector<double>& med) {
+  std::size_t first = med.size(), second = med.size();
+  for (std::size_t i = 0; i < med.size(); ++i)
+    if (std::isfinite(med[i]) && (first == med.size() || med[i] < med[first])) first = i;
+  for (std::size_t i = 0; i < med.size(); ++i)
+    if (first != med.size() && std::isfinite(med[i]) && med[i] != med[first] &&
+        (second == med.size() || med[i] < med[second]))
+      second = i;
+  return {first, second};
+}
+
+// "halfdiff", or "halfdiff = stereo-halfdiff" for the parameterizations tied at med[first].
+std::string tied_names(const std::vector<Space>& params, const std::vector<double>& med,
+                       std::size_t first) {
+  std::string names;
+  for (std::size_t i = 0; i < med.size(); ++i)
+    if (med[i] == med[first])
+      names += (names.empty() ? "" : " = ") + std::string(name_of(params[i]));
+  return names;
+}
+
+// "×1.90" (how many times the winner's median the runner-up's is), "tie" when equal to 3 digits.
+std::string margin(double winner, double runner_up) {
+  if (!(winner > 0)) return runner_up > 0 ? std::string("exact") : std::string("tie");
+  const double r = runner_up / winner;
+  return r < 1.0005 ? std::string("tie")
+         : r < 10   ? fmt::format("×{:.2f}", r)
+                    : fmt::format("×{:.3g}", r);
+}
+
+}  // namespace
+
+std::string answers_section(const std::vector<BrdfResult>& results,
+                            const std::vector<SummaryMetric>& metrics) {
+  const std::vector<Space>& params = params_of(results);
+  if (params.size() < 2) return {};
+  const Kinds kinds = kinds_of(results);
+  std::string rows;
+  for (const SummaryMetric& m : metrics) {
+    if (m.use.empty()) continue;
+    std::vector<std::size_t> all(results.size());
+    for (std::size_t j = 0; j < all.size(); ++j) all[j] = j;
+    const auto [med, n] = medians(m, all);
+    const auto [first, second] = two_lowest(med);
+    if (n == 0 || second == med.size()) continue;
+    Wins wins(params);
+    for (std::size_t j : all)
+      if (std::all_of(m.values[j].begin(), m.values[j].end(),
+                      [](double v) { return std::isfinite(v); }))
+        wins.add(m.values[j]);
+    std::string by_kind;
+    if (kinds.size() > 1)
+      for (const auto& [kind, rows_of_kind] : kinds) {
+        if (kind == "all") continue;
+        const auto [kmed, kn] = medians(m, rows_of_kind);
+        const auto [kfirst, ksecond] = two_lowest(kmed);
+        if (kn == 0 || ksecond == kmed.size()) continue;
+        by_kind +=
+            fmt::format("{}{} ({}): {} {}", by_kind.empty() ? "" : "; ", kind, kn,
+                        tied_names(params, kmed, kfirst), margin(kmed[kfirst], kmed[ksecond]));
+      }
+    rows += fmt::format("| {} | **{}** {:.4g} | {} {:.4g} | {} | {} of {} | {} |\n", m.use,
+                        tied_names(params, med, first), med[first], tied_names(params, med, second),
+                        med[second], margin(med[first], med[second]), wins.count(first), n,
+                        by_kind.empty() ? "–" : by_kind);
+  }
+  if (rows.empty()) return {};
+  return fmt::format(
+             "## Answers\n\nWhich parameterization for what, on the {} of this run: per use, "
+             "the parameterization with the lowest median (over the BRDFs measured in all of "
+             "them; the metrics and kinds of the Summary below, lower is better), the "
+             "runner-up, the margin (runner-up's median over the winner's), on how many BRDFs "
+             "the winner is the lowest, and the winner of each kind of BRDF with its margin. "
+             "docs/answers.md answers the same on the whole shared data.\n\n"
+             "| use | winner (median) | runner-up | margin | winner lowest on | by kind |\n"
+             "|---|---|---|---|---|---|\n",
+             brdf_count(results.size())) +
+         rows + "\n";
+}
+
 std::string summary_section(const std::vector<BrdfResult>& results,
                             const std::vector<SummaryMetric>& metrics, const ReportPlots& plots) {
   const std::vector<Space>& params = params_of(results);
   std::string md = fmt::format(
-      "## Summary\n\nFor each kind of BRDF and each metric below: the median relative error of "
-      "each parameterization over the BRDFs of that kind measured in all {}, and in "
-      "parentheses the number of BRDFs on which it has the lowest error (ties count for each). "
+      "## Summary\n\nFor each kind of BRDF and each metric below: the median relative error "
+      "(for importance sampling, relative variance; lower is better) of each parameterization "
+      "over the BRDFs of that kind measured in all {}, and in parentheses the number of BRDFs "
+      "on which it has the lowest value (ties count for each). "
       "The lowest median is in bold. The kind comes from the label (the reader's prefix for a "
       "file; a model's spec is a model).\n\n",
       params.size() == 1 ? "of them" : count_in_words(params.size()));
@@ -177,8 +263,9 @@ std::string design_conclusions(const DesignComparison& c, std::size_t ref) {
             : fmt::format("**The parameterization with the most wins changes, from {} to {}.** ",
                           name_of(c.params[top_before]), name_of(c.params[top_after]));
   md += n_changed == 0 ? std::string("No BRDF changes its best parameterization.\n\n")
-                       : fmt::format("{} of {} BRDFs change their best parameterization: {}.\n\n",
-                                     n_changed, c.brdfs.size(), changed);
+                       : fmt::format("{} of {} {} their best parameterization: {}.\n\n", n_changed,
+                                     brdf_count(c.brdfs.size()),
+                                     n_changed == 1 ? "changes" : "change", changed);
   return md + angle_line(c);
 }
 
@@ -195,10 +282,10 @@ std::string designs_section(const std::vector<BrdfResult>& results, const StudyC
       "each design (docs/study.md, “Designs”): the cells uniform in the parameterization's own "
       "coordinates (regular or stratified), in angle (the sine-like magnitudes through their "
       "arcsine), in MERL's spacing (angle, and √ of the half-vector angle), or in warps learned "
-      "from the other BRDFs (leave-one-out). Median relative error over the {} isotropic BRDFs "
-      "measured in every design; the lowest of each parameterization in bold, its best "
+      "from the other BRDFs (leave-one-out). Median relative error over the {} "
+      "measured in every design (isotropic); the lowest of each parameterization in bold, its best "
       "design:\n\n",
-      ref, c.brdfs.size());
+      ref, brdf_count(c.brdfs.size()));
   md += design_median_table(c);
   md += "\nBest against best, per BRDF (each parameterization in its best design):\n\n" +
         best_design_table(c, ref);

@@ -229,11 +229,20 @@ std::string matching_budget_table(const std::vector<BrdfResult>& results, std::s
     }
     md += "\n";
   }
+  // A BRDF on which the largest budget does not reach E* counts as above every multiple; when
+  // it is half of them or more, the median is not a multiple.
   std::string medians;
-  for (std::size_t i = 0; i < params.size(); ++i)
-    if (!ratios[i].empty())
-      medians += fmt::format("{}{} ×{:.3g}", medians.empty() ? "" : ", ", name_of(params[i]),
-                             median(ratios[i]));
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    if (ratios[i].empty()) continue;
+    const auto unreached = std::size_t(
+        std::count_if(ratios[i].begin(), ratios[i].end(), [](double r) { return std::isinf(r); }));
+    const double m = median(ratios[i]);
+    const std::string tail =
+        unreached == 0 ? "" : fmt::format(" ({} of {} not reached)", unreached, ratios[i].size());
+    medians +=
+        fmt::format("{}{} {}{}", medians.empty() ? "" : ", ", name_of(params[i]),
+                    std::isinf(m) ? std::string("not reached") : fmt::format("×{:.3g}", m), tail);
+  }
   if (!medians.empty()) md += "\nMedian over the BRDFs: " + medians + ".\n";
   if (!exact.empty())
     md += "\nLeft out, reconstructed exactly (E* = 0) by at least one parameterization: " + exact +

@@ -95,11 +95,15 @@ TEST(Report, RenderingColumnsFitTheirHeads) {
   const figure::Scene sc = report::examples_chart({r}, config_of_fakes());
   std::vector<const figure::TextItem*> heads;
   std::vector<double> images;
+  double first_row_y = -1;
   for (const figure::Item& item : sc.items) {
     if (const auto* t = std::get_if<figure::TextItem>(&item);
         t && t->halign == figure::HAlign::centre)
       heads.push_back(t);
-    if (const auto* i = std::get_if<figure::ImageItem>(&item)) images.push_back(i->x);
+    if (const auto* i = std::get_if<figure::ImageItem>(&item)) {
+      if (first_row_y < 0) first_row_y = i->y;
+      if (i->y == first_row_y) images.push_back(i->x);  // the renderings, not their differences
+    }
   }
   ASSERT_EQ(heads.size(), 4u);  // BRDF, then the three parameterizations
   ASSERT_EQ(images.size(), 4u);
@@ -327,6 +331,84 @@ TEST(Report, SummaryGroupsTheBrdfsByKind) {
   EXPECT_LT(s.find("| RGL files"), s.find("| models"));  // kinds in the order they first appear
   EXPECT_TRUE(std::filesystem::exists(tmp.path() / "summary.png"));
   EXPECT_NE(s.find("![Summary](summary.png)"), std::string::npos);
+}
+
+// The summary and header of the report's odd cases: an embedded material is a kind of its own,
+// not a model; one BRDF is "1 BRDF"; a parameterization that never reaches E* on most BRDFs has
+// no multiple for a median ("×inf" before).
+TEST(Report, SummaryKindsCountsAndUnreachedMedians) {
+  const test::TempDir tmp;
+  const StudyOutput one = write_study(tmp.path(), {fake("embedded:gold-metallic-paint3", true)},
+                                      config_of_fakes(), 1.0);
+  EXPECT_NE(one.markdown.find("| embedded materials | 1 |"), std::string::npos) << one.markdown;
+  EXPECT_EQ(one.markdown.find("| models |"), std::string::npos);
+  EXPECT_NE(one.markdown.find("Definitions: docs/study.md. 1 BRDF in"), std::string::npos);
+  EXPECT_EQ(one.markdown.find("1 BRDFs"), std::string::npos);
+  // E* is halfdiff's error at 1000 (k = 1, E* = 0.5); ortho (k = 2000) needs 1000 · 2000^1.5
+  // measurements, past the largest budget (10^6), on both BRDFs.
+  const std::vector<double> ks{1, 2000, 3, 4};
+  const StudyOutput two = write_study(
+      tmp.path(), {to_result(fake_numbers("x", true, ks)), to_result(fake_numbers("y", true, ks))},
+      config_of_fakes(), 1.0);
+  EXPECT_EQ(two.markdown.find("×inf"), std::string::npos) << two.markdown;
+  EXPECT_NE(two.markdown.find("Median over the BRDFs: halfdiff ×1, ortho not reached (2 of 2 not "
+                              "reached)"),
+            std::string::npos)
+      << two.markdown;
+}
+
+// The report's first section answers "which parameterization for what" on its BRDFs: per use,
+// the winner, the runner-up and the margin, and the winner per kind.
+TEST(Report, AnswersSectionComesFirst) {
+  const test::TempDir tmp;
+  // halfdiff has k = 1, ortho k = 2: every error of ortho is twice halfdiff's.
+  const std::string md =
+      write_study(tmp.path(), {fake("x", true), fake("nbrdf:y", true)}, config_of_fakes(), 1.0)
+          .markdown;
+  const std::size_t answers = md.find("## Answers"), summary = md.find("## Summary");
+  ASSERT_NE(answers, std::string::npos) << md;
+  EXPECT_LT(answers, summary);
+  EXPECT_NE(
+      md.find("| compactness: dropping the azimuth | **halfdiff** 0.1 | ortho 0.2 | ×2.00 | 2 "
+              "of 2 | models (1): halfdiff ×2.00; neural BRDFs (1): halfdiff ×2.00 |"),
+      std::string::npos)
+      << md.substr(answers, summary - answers);
+  EXPECT_NE(md.find("| interpolation from a gonio-reflectometer (regular grid) | **halfdiff**"),
+            std::string::npos);
+}
+
+// Under each reconstruction's rendering, its difference from the BRDF's: black where they agree
+// (the common noise cancels), brighter with the relative difference, white from 50 % on.
+TEST(Report, RenderingsShowTheirDifferenceImages) {
+  FakeBrdf b;
+  b.label = "a";
+  for (Space s : {space_of<HalfDiff>, space_of<Hybrid>}) {
+    FakeParam p;
+    p.space = s;
+    b.params.push_back(p);
+  }
+  BrdfResult r = to_result(b);
+  const render::Image grey{4, 4, std::vector<float>(4 * 4 * 3, 0.5f)};
+  render::Image brighter = grey;
+  for (float& v : brighter.rgb) v = 0.5f * 1.25f;  // 25 % above: half the full scale
+  r.example_images = {grey, grey, brighter};
+  const figure::Scene sc = report::examples_chart({r}, config_of_fakes());
+  std::vector<const figure::ImageItem*> images;
+  for (const figure::Item& item : sc.items)
+    if (const auto* i = std::get_if<figure::ImageItem>(&item)) images.push_back(i);
+  ASSERT_EQ(images.size(), 5u);  // the BRDF, two reconstructions, two differences
+  // In the order drawn: BRDF, halfdiff, (its difference), hybrid, (its difference).
+  const figure::ImageItem& same = *images[2];
+  const figure::ImageItem& off = *images[4];
+  EXPECT_GT(same.y, images[1]->y);  // below its rendering
+  EXPECT_EQ(same.x, images[1]->x);
+  for (std::size_t p = 0; p < 16; ++p) {
+    EXPECT_EQ(same.rgba[4 * p], 0);  // no difference: black
+    // 25 % of the mean is half the full scale: u = 1.5 on the 0-3 ramp (red full, green half).
+    EXPECT_EQ(off.rgba[4 * p], 255);
+    EXPECT_NEAR(off.rgba[4 * p + 1], 128, 1);
+    EXPECT_EQ(off.rgba[4 * p + 2], 0);
+  }
 }
 
 }  // namespace

@@ -3,13 +3,18 @@
 // charts ranked as they should be on a broad and a glossy lobe; the report's section.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "halfback/models/analytic.hpp"
 #include "halfback/render/brdf_sampler.hpp"
 #include "halfback/render/renderer.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metric.hpp"
 #include "halfback/study/metric_tables.hpp"
+#include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
+#include "report_internal.hpp"
+#include "support/test_support.hpp"
 
 namespace halfback::study {
 namespace {
@@ -178,6 +183,62 @@ TEST(SamplingTable, SettingsAreChecked) {
   EXPECT_THROW(c.validate(), std::invalid_argument);
   c.options["sampler_samples"] = "2";
   EXPECT_NO_THROW(c.validate());
+}
+
+// The report's Summary (what `halfback study` prints) gives the sampling metric too: with
+// --no-gonio it is the only one asked for beyond metrics 1-2.
+TEST(SamplingTable, TheSummaryHasTheSamplingMetric) {
+  StudyConfig c = sampling_only();
+  c.params = {space_of<HalfDiff>, space_of<StereoHalfDiff>, space_of<Spherical>};
+  c.options["sampler_kib"] = "8,16";
+  c.options["sampler_samples"] = "256";
+  c.image_size = 24;
+  find_metric("fit")->switch_off(c);
+  models::MicrofacetParams p;
+  p.alpha_x = p.alpha_y = 0.08;
+  const std::vector<BrdfResult> results{
+      study_brdf(models::Lambert(Rgb{0.5, 0.5, 0.5}), "lambert", c),
+      study_brdf(models::Microfacet(p), "ggx", c)};
+  const test::TempDir tmp;
+  const std::string md = write_study(tmp.path(), results, c, 1.0).markdown;
+  const std::size_t summary = md.find("## Summary"), next = md.find("\n## ", summary);
+  ASSERT_NE(summary, std::string::npos);
+  const std::string head = md.substr(summary, next - summary);
+  const std::size_t at = head.find(
+      "**importance sampling, relative variance of the albedo estimate, tables of 8 KiB**");
+  ASSERT_NE(at, std::string::npos) << head;
+  // Its table: the two BRDFs, halfdiff's chart the better sampler of the glossy lobe.
+  EXPECT_NE(head.find("| models | 2 |", at), std::string::npos) << head;
+  const auto halfdiff = sampling_points(results[1], space_of<HalfDiff>, "tabulated");
+  const auto spherical = sampling_points(results[1], space_of<Spherical>, "tabulated");
+  ASSERT_FALSE(halfdiff.empty());
+  ASSERT_FALSE(spherical.empty());
+  EXPECT_LT(halfdiff.front().relative_variance, spherical.front().relative_variance);
+
+  // The Answers section names parameterizations that share a sampler together, never one as the
+  // other's runner-up ("tie").
+  const std::size_t row = md.find("| importance sampling (a table of equal memory) |");
+  ASSERT_NE(row, std::string::npos) << md;
+  const std::string answer = md.substr(row, md.find('\n', row) - row);
+  EXPECT_NE(answer.find("halfdiff = stereo-halfdiff"), std::string::npos) << answer;
+  EXPECT_EQ(answer.find("tie"), std::string::npos) << answer;
+
+  // The plot: one curve per sampler chart, named by the parameterizations that share it
+  // (halfdiff's is stereo-halfdiff's: one curve, not one hidden under the other), the cosine in
+  // a colour no chart has.
+  const report::ReportPlots plots = report::report_plots(results, c, report::contents_of(results),
+                                                         report::summary_metrics(results, c, {}));
+  std::vector<std::string> texts;
+  for (const figure::Item& item : plots.sampling.items)
+    if (const auto* t = std::get_if<figure::TextItem>(&item)) texts.push_back(t->text);
+  const auto has = [&](const std::string& s) {
+    return std::find(texts.begin(), texts.end(), s) != texts.end();
+  };
+  EXPECT_TRUE(has("halfdiff / stereo-halfdiff tabulated"));
+  EXPECT_TRUE(has("spherical factored"));
+  EXPECT_FALSE(has("stereo-halfdiff tabulated"));
+  EXPECT_FALSE(has("halfdiff tabulated"));
+  EXPECT_TRUE(has("cosine"));
 }
 
 }  // namespace

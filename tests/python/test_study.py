@@ -196,8 +196,24 @@ def test_learned_design_on_dask_equals_the_cli_run(tmp_path):
 def test_study_brdf_defaults_work_alone():
     # A new user's first call (docs/reliability/python.md): without profiles the default designs
     # leave out the learned one (it needs the other BRDFs' profiles); asked for by name, it still
-    # needs them.
-    r = halfback.study_brdf("ggx:alpha=0.2", {"quick": True, "no_images": True})
+    # needs them. Not silently: a UserWarning names the design left out and how to have it.
+    with pytest.warns(UserWarning, match=r"learned design .* is left out.*settings\['profiles'\]"):
+        r = halfback.study_brdf("ggx:alpha=0.2", {"quick": True, "no_images": True})
     assert "designs = own,angle,merl" in r["settings"]
     with pytest.raises(ValueError, match="learned design needs"):
         halfback.study_brdf("ggx:alpha=0.2", {"quick": True, "designs": ["own", "learned"]})
+
+
+def test_merged_quick_results_keep_the_quick_run_warning(tmp_path):
+    # The report merge_study writes from quick results warns as `halfback study --quick` does:
+    # its headline is not the study's.
+    settings = {"quick": True, "no_images": True, "no_sampling": True, "no_fit": True,
+                "designs": ["own"], "params": ["halfdiff", "spherical"]}
+    r = halfback.study_brdf("ggx:alpha=0.2", settings)
+    assert "quick = 1" in r["settings"]
+    md = halfback.merge_study(str(tmp_path / "merged"), [r])["markdown"]
+    assert "**A quick run**" in md
+    full = dict(settings, quick=False, budgets=[100, 300], test_pairs=500)
+    md_full = halfback.merge_study(str(tmp_path / "full"),
+                                   [halfback.study_brdf("ggx:alpha=0.2", full)])["markdown"]
+    assert "**A quick run**" not in md_full

@@ -42,10 +42,14 @@ struct LogLogChart {
   std::vector<LogLogPanel> panels;  // laid out row by row, `columns` per row
   int columns = 4;
   double panel_width = 170, panel_height = 120;
+  // x on a linear axis from 0 to the panel's largest x instead (e.g. the fraction of BRDFs of a
+  // sorted curve); y stays logarithmic.
+  bool linear_x = false;
 };
 
-// Each panel's axes span the decades around its own values. Throws std::invalid_argument for no
-// panels, a series with mismatched or no points, or a value that is not finite and > 0.
+// Each panel's axes span the decades around its own values (x: from 0 with linear_x). Throws
+// std::invalid_argument for no panels, a series with mismatched or no points, or a value that is
+// not finite and > 0.
 Scene loglog_chart(const LogLogChart& chart);
 
 }  // namespace halfback::figure
