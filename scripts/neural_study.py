@@ -6,8 +6,9 @@ Usage: scripts/neural_study.py OUT [BRDF...] [--params LIST] [--widths LIST] [--
                                [--epochs E] [--ranks LIST] [--models LIST] [--halfback EXE]
                                [--threads T] [--no-study] [--no-others]
 
-BRDF...: files or specs (default: every RGL file of ../shared/data/rgl, "the whole"; give a few
-for a subset). For them:
+BRDF...: files, folders (their .bsdf, .h5, .binary and .dat files, in subfolders too) or specs
+(default: ../shared/data/rgl; the whole shared data is ../shared/data/nbrdf ../shared/data/rgl
+../shared/data/alta; give a few files for a subset). For them:
 
 1. `halfback study BRDF... --metrics neural` into OUT/study (networks of each parameterization's
    coordinates at each hidden width, Sztrajman et al.'s vectors beside halfdiff, one training
@@ -38,8 +39,14 @@ DEFAULT_PARAMS = "halfdiff,hybrid,ortho,rectified-hybrid,stereographic,dupuy-jak
 COLOURS = ["#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666"]
 
 
+class Refused(Exception):
+    """A command's data error (status 1): e.g. a fit of a BRDF with missing values."""
+
+
 def run(command):
     result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode == 1:
+        raise Refused(f"{' '.join(map(str, command))}: {result.stderr.strip()}")
     if result.returncode != 0:
         sys.exit(f"{' '.join(map(str, command))} failed ({result.returncode}): {result.stderr.strip()}")
     return result.stdout
@@ -52,13 +59,42 @@ def log_error(exe, brdf, model, json_path):
 
 
 def stem(spec):
-    return pathlib.Path(spec.split(":")[0] if ":" in spec and not pathlib.Path(spec).exists() else spec).stem
+    """A name for a BRDF's models: its folder and file stem (rgl.cardboard_rgb), or the spec."""
+    path = pathlib.Path(spec)
+    if path.exists():
+        return f"{path.parent.name}.{path.stem}"
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in spec)
 
 
 def analytic_size(spec):
     """The numbers of a fitted model's spec "a:x=1,y=2+b:z=3": its parameters."""
     return sum(len([kv for kv in term.split(":", 1)[1].split(",") if "=" in kv]) if ":" in term else 0
                for term in spec.split("+"))
+
+
+def add_others(args, exe, brdf, params, models_dir, points):
+    """The analytic fits and factored models of one BRDF, measured; adds them to points."""
+    name = stem(brdf)
+    for model in args.models.split(","):
+        fit_json = models_dir / f"{name}.{model}.fit.json"
+        spec_file = models_dir / f"{name}.{model}.spec"
+        if not spec_file.exists():
+            spec_file.write_text(run([exe, "fit", "--brdf", brdf, "--model", model, "-o", str(fit_json)]).strip())
+        spec = spec_file.read_text().strip()
+        error = log_error(exe, brdf, spec, models_dir / f"{name}.{model}.compare.json")
+        points.setdefault(("analytic fit", model, 0), [4 * analytic_size(spec), []])[1].append(error)
+    for param in params:
+        if ":" in param:  # a family's member: factor takes built-in and registered ones
+            continue
+        for rank in map(int, args.ranks.split(",")):
+            model = models_dir / f"{name}.{param}.r{rank}.json"
+            if not model.exists():
+                run([exe, "factor", "--brdf", brdf, "--param", param, "--rank", str(rank), "-o", str(model),
+                    "--threads", args.threads])
+            counts = [32, 32, 32]  # factor's default --counts
+            size = 3 * rank * sum(counts) + 3
+            error = log_error(exe, brdf, str(model), models_dir / f"{name}.{param}.r{rank}.compare.json")
+            points.setdefault(("factored", param, rank), [4 * size, []])[1].append(error)
 
 
 def main():
@@ -80,7 +116,13 @@ def main():
 
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    brdfs = args.brdfs or sorted(str(p) for p in (ROOT.parent / "shared/data/rgl").glob("*.bsdf"))
+    brdfs = []
+    for spec in args.brdfs or [str(ROOT.parent / "shared/data/rgl")]:
+        path = pathlib.Path(spec)
+        if path.is_dir():  # its BRDF files, in its folders too (the study reads each as a file)
+            brdfs += sorted(str(p) for p in path.rglob("*") if p.suffix in (".bsdf", ".h5", ".binary", ".dat"))
+        else:
+            brdfs.append(spec)
     params = args.params.split(",")
     exe = args.halfback
 
@@ -102,27 +144,10 @@ def main():
         models_dir = out / "models"
         models_dir.mkdir(exist_ok=True)
         for brdf in brdfs:
-            name = stem(brdf)
-            for model in args.models.split(","):
-                fit_json = models_dir / f"{name}.{model}.fit.json"
-                spec_file = models_dir / f"{name}.{model}.spec"
-                if not spec_file.exists():
-                    spec_file.write_text(run([exe, "fit", "--brdf", brdf, "--model", model, "-o", str(fit_json)]).strip())
-                spec = spec_file.read_text().strip()
-                error = log_error(exe, brdf, spec, models_dir / f"{name}.{model}.compare.json")
-                points.setdefault(("analytic fit", model, 0), [4 * analytic_size(spec), []])[1].append(error)
-            for param in params:
-                if ":" in param:  # a family's member: factor takes built-in and registered ones
-                    continue
-                for rank in map(int, args.ranks.split(",")):
-                    model = models_dir / f"{name}.{param}.r{rank}.json"
-                    if not model.exists():
-                        run([exe, "factor", "--brdf", brdf, "--param", param, "--rank", str(rank), "-o", str(model),
-                            "--threads", args.threads])
-                    counts = [32, 32, 32]  # factor's default --counts
-                    size = 3 * rank * sum(counts) + 3
-                    error = log_error(exe, brdf, str(model), models_dir / f"{name}.{param}.r{rank}.compare.json")
-                    points.setdefault(("factored", param, rank), [4 * size, []])[1].append(error)
+            try:
+                add_others(args, exe, brdf, params, models_dir, points)
+            except Refused as e:  # no other models for this BRDF
+                print(f"skipped: {e}", file=sys.stderr)
 
     summary = [{"kind": k[0], "parameterization": k[1], "size": k[2], "bytes": v[0], "brdfs": len(v[1]),
                 "median_error": statistics.median(v[1]), "errors": v[1]} for k, v in sorted(points.items())]
@@ -150,11 +175,11 @@ def main():
             if ps:
                 ax.plot([p["bytes"] for p in ps], [p["median_error"] for p in ps], marker=marker, linestyle=style,
                         color=colour[label], label=f"{kind}, {label}")
-    for p in summary:
-        if p["kind"] == "analytic fit":
-            ax.plot(p["bytes"], p["median_error"], "kx", markersize=9)
-            ax.annotate(p["parameterization"], (p["bytes"], p["median_error"]), textcoords="offset points",
-                        xytext=(6, 4), fontsize=8)
+    fits = [p for p in summary if p["kind"] == "analytic fit"]
+    for i, p in enumerate(fits):
+        ax.plot(p["bytes"], p["median_error"], "kx", markersize=9)
+        ax.annotate(p["parameterization"], (p["bytes"], p["median_error"]), textcoords="offset points",
+                    xytext=(-10, 8 if i % 2 == 0 else -14), fontsize=8)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("bytes (4 per number)")
