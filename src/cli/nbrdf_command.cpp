@@ -19,7 +19,8 @@ namespace {
 struct NbrdfTrainCommandOptions {
   std::string brdf, output, param, hidden = "21,21";
   std::size_t samples = 640000, epochs = 100, batch = 512;
-  double learning_rate = 5e-4;
+  double learning_rate = 5e-4, final_learning_rate = 0;
+  std::size_t restarts = 1, restart_epochs = 5;
   std::uint64_t seed = 0;
   int threads = 0;
   bool quiet = false;
@@ -33,6 +34,9 @@ NbrdfTrainOptions train_options(const NbrdfTrainCommandOptions& o) {
   options.epochs = o.epochs;
   options.batch = o.batch;
   options.learning_rate = o.learning_rate;
+  options.final_learning_rate = o.final_learning_rate;
+  options.restarts = o.restarts;
+  options.restart_epochs = o.restart_epochs;
   options.seed = o.seed;
   options.threads = o.threads;
   try {
@@ -101,6 +105,14 @@ Command add_train(CLI::App& parent) {
   app->add_option("--epochs", o->epochs, "Passes over the pairs")->capture_default_str();
   app->add_option("--batch", o->batch, "Pairs per Adam step")->capture_default_str();
   app->add_option("--learning-rate", o->learning_rate, "Adam's learning rate")
+      ->capture_default_str();
+  app->add_option("--final-learning-rate", o->final_learning_rate,
+                  "Learning rate of the last epoch, reached geometrically (0: constant)")
+      ->capture_default_str();
+  app->add_option("--restarts", o->restarts,
+                  "Networks started; the lowest loss after --restart-epochs goes on (1-64)")
+      ->capture_default_str();
+  app->add_option("--restart-epochs", o->restart_epochs, "Epochs of each restart before the choice")
       ->capture_default_str();
   app->add_option("--seed", o->seed, "Seed of the pairs, initial weights and shuffles")
       ->capture_default_str();

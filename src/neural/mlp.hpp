@@ -99,6 +99,8 @@ class Adam {
   Adam(std::size_t parameters, AdamSettings settings);
   void step(Vector& params, const Vector& gradient);
   std::size_t steps() const { return t_; }
+  // The learning rate of the next steps (a schedule's).
+  void set_learning_rate(double rate) { s_.learning_rate = rate; }
 
  private:
   AdamSettings s_;

@@ -1,12 +1,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numbers>
 #include <numeric>
 #include <stdexcept>
 
+#include "formats/nbrdf_kernel.hpp"
 #include "halfback/brdf/rho_bound.hpp"
 #include "halfback/core/parallel.hpp"
 #include "halfback/neural/train.hpp"
@@ -209,6 +211,13 @@ void check_nbrdf_train_options(const NbrdfTrainOptions& o) {
     fail(fmt::format("--batch: {}, expected 1 to 65536", o.batch));
   if (!(o.learning_rate > 0 && o.learning_rate <= 1))
     fail(fmt::format("--learning-rate: {}, expected a number in (0, 1]", o.learning_rate));
+  if (!(o.final_learning_rate >= 0 && o.final_learning_rate <= o.learning_rate))
+    fail(fmt::format("--final-learning-rate: {}, expected 0 (none) or a number in (0, {}]",
+                     o.final_learning_rate, o.learning_rate));
+  if (o.restarts == 0 || o.restarts > 64)
+    fail(fmt::format("--restarts: {}, expected 1 to 64", o.restarts));
+  if (o.restart_epochs == 0 || o.restart_epochs > 1'000'000)
+    fail(fmt::format("--restart-epochs: {}, expected 1 to 1000000", o.restart_epochs));
   if (o.threads < 0) fail(fmt::format("--threads: {}, expected 0 or more", o.threads));
 }
 
@@ -243,49 +252,169 @@ void require_readable(const NbrdfNetwork& network, const NbrdfTrainOptions& opti
   }
 }
 
-}  // namespace
-
-NbrdfTrainResult train_nbrdf(const Brdf& brdf, const NbrdfTrainOptions& options) {
+// The training of train_nbrdf and train_nbrdf_on: the network's input from `param` (none:
+// Sztrajman et al.'s); `input_name` goes to result.network.input.
+NbrdfTrainResult train(const Brdf& brdf, const NbrdfTrainOptions& options,
+                       const std::optional<Space>& param, const std::string& input_name,
+                       bool readable) {
   using namespace neural;
-  check_nbrdf_train_options(options);
-  const std::optional<Space> param = nbrdf::input_space(options.param, "--param");
   const TrainingSet set = sample_training_set(brdf, options.samples, options.seed, param);
   std::vector<std::size_t> widths{std::size_t(set.inputs.rows())};
   widths.insert(widths.end(), options.hidden.begin(), options.hidden.end());
   widths.push_back(nbrdf::kOutputs);
   MlpLayout layout(widths);
-  // A stream for the weights and shuffles apart from the pairs'.
-  Rng rng(options.seed ^ 0x6e62726466ULL);  // "nbrdf"
-  Vector initial = sztrajman_initial_parameters(layout, rng);
   AdamSettings adam;
   adam.learning_rate = options.learning_rate;
-  Trainer trainer(layout, std::move(initial), adam, options.threads);
+  // One candidate per restart, each with its own stream for the weights and shuffles apart from
+  // the pairs' (the first one's is that of a training without restarts).
+  struct Candidate {
+    Rng rng;
+    Trainer trainer;
+    std::vector<std::size_t> order;
+    std::vector<double> epoch_losses;
+  };
+  std::vector<Candidate> candidates;
+  for (std::size_t r = 0; r < options.restarts; ++r) {
+    Rng rng(options.seed ^ 0x6e62726466ULL ^ (r * 0x9e3779b97f4a7c15ULL));  // "nbrdf"
+    Vector initial = sztrajman_initial_parameters(layout, rng);
+    std::vector<std::size_t> order(set.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    candidates.push_back(
+        {rng, Trainer(layout, std::move(initial), adam, options.threads), std::move(order), {}});
+  }
 
   NbrdfTrainResult result;
   result.drawn = options.samples;
   result.pairs = set.size();
-  std::vector<std::size_t> order(set.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
   const auto start = std::chrono::steady_clock::now();
-  for (std::size_t epoch = 0; epoch < options.epochs; ++epoch) {
-    result.epoch_losses.push_back(run_epoch(trainer, set, order, rng, options.batch, result.steps));
-    if (options.progress) {
-      NbrdfTrainProgress p;
-      p.epoch = epoch + 1;
-      p.epochs = options.epochs;
-      p.loss = result.epoch_losses.back();
-      p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      options.progress(p);
+  auto report = [&](std::size_t epoch, double loss) {
+    if (!options.progress) return;
+    NbrdfTrainProgress p;
+    p.epoch = epoch;
+    p.epochs = options.epochs;
+    p.loss = loss;
+    p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    options.progress(p);
+  };
+  // The schedule (NbrdfTrainOptions::final_learning_rate).
+  auto rate_of = [&](std::size_t epoch) {
+    if (!(options.final_learning_rate > 0) || options.epochs < 2) return options.learning_rate;
+    const double f = double(epoch) / double(options.epochs - 1);
+    return options.learning_rate * std::pow(options.final_learning_rate / options.learning_rate, f);
+  };
+  // With restarts, every candidate runs restart_epochs epochs and the one of the lowest loss on
+  // all the pairs goes on (ties: the first).
+  const std::size_t probe =
+      options.restarts > 1 ? std::min(options.restart_epochs, options.epochs) : 0;
+  std::size_t best = 0;
+  if (probe > 0) {
+    double lowest = INFINITY;
+    for (std::size_t r = 0; r < candidates.size(); ++r) {
+      Candidate& c = candidates[r];
+      for (std::size_t epoch = 0; epoch < probe; ++epoch) {
+        c.trainer.set_learning_rate(rate_of(epoch));
+        c.epoch_losses.push_back(
+            run_epoch(c.trainer, set, c.order, c.rng, options.batch, result.steps));
+      }
+      const double loss = mean_loss(layout, c.trainer.parameters(), set, options.threads);
+      if (loss < lowest) lowest = loss, best = r;
     }
+    report(probe, candidates[best].epoch_losses.back());
   }
+  Candidate& chosen = candidates[best];
+  for (std::size_t epoch = probe; epoch < options.epochs; ++epoch) {
+    chosen.trainer.set_learning_rate(rate_of(epoch));
+    chosen.epoch_losses.push_back(
+        run_epoch(chosen.trainer, set, chosen.order, chosen.rng, options.batch, result.steps));
+    report(epoch + 1, chosen.epoch_losses.back());
+  }
+  result.epoch_losses = chosen.epoch_losses;
+  const Trainer& trainer = chosen.trainer;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.network = network_of(layout, trainer.parameters());
   result.network.source = brdf.name();
-  result.network.input = options.param;
-  require_readable(result.network, options);
+  result.network.input = input_name;
+  if (readable) require_readable(result.network, options);
   const Vector rounded = parameters_of(layout, result.network);
   result.loss = mean_loss(layout, rounded, set, options.threads);
   return result;
+}
+
+// The network of a trained result evaluated as the reader evaluates it, with any input space.
+class TrainedNbrdf final : public Brdf {
+ public:
+  TrainedNbrdf(NbrdfNetwork network, std::optional<Space> input, std::string label)
+      : network_(std::move(network)), input_(input), label_(std::move(label)) {
+    const std::size_t inputs = input_ ? 3 : nbrdf::kInputs;
+    if (network_.layers.empty() || network_.layers.front().inputs != inputs ||
+        network_.layers.back().outputs != nbrdf::kOutputs ||
+        network_.layers.size() > nbrdf::kMaxLayers)
+      throw std::invalid_argument(fmt::format(
+          "trained_nbrdf_brdf: a network of {} layers from {} to {} values, expected {} to {}",
+          network_.layers.size(), network_.layers.empty() ? 0 : network_.layers.front().inputs,
+          network_.layers.empty() ? 0 : network_.layers.back().outputs, inputs, nbrdf::kOutputs));
+    for (const NbrdfLayer& l : network_.layers)
+      if (l.outputs > nbrdf::kMaxWidth || l.inputs > nbrdf::kMaxWidth)
+        throw std::invalid_argument(
+            fmt::format("trained_nbrdf_brdf: a layer of {} units, expected at most {}", l.outputs,
+                        nbrdf::kMaxWidth));
+  }
+  std::string name() const override { return label_; }
+  std::string description() const override {
+    return fmt::format("a trained network of {} layers on {}", network_.layers.size(),
+                       input_ ? std::string(name_of(*input_)) : "Sztrajman et al.'s input");
+  }
+  bool isotropic() const override { return true; }
+  bool reciprocal() const override { return false; }
+  Rgb eval(const DirPair<double>& pair) const override {
+    const double v[6] = {pair.wi.x, pair.wi.y, pair.wi.z, pair.wo.x, pair.wo.y, pair.wo.z};
+    for (const double c : v)
+      if (std::isnan(c)) return {NAN, NAN, NAN};
+    if (!(pair.wi.z >= 0 && pair.wo.z >= 0)) return {0, 0, 0};
+    std::array<float, nbrdf::kInputs> x{};
+    if (input_) {
+      const auto q = input_->param().forward_iso(pair);
+      for (std::size_t i = 0; i < 3; ++i) x[i] = float(q[i]);
+    } else {
+      const auto e = nbrdf::encode(pair);
+      for (std::size_t i = 0; i < nbrdf::kInputs; ++i) x[i] = float(e[i]);
+    }
+    const auto rho = nbrdf_detail::evaluate_one(network_, x);
+    return {rho[0], rho[1], rho[2]};
+  }
+  void eval_batch(std::span<const DirPair<double>> pairs, std::span<Rgb> out) const override {
+    if (out.size() != pairs.size())
+      throw std::invalid_argument("trained network: output size differs from the pairs'");
+    parallel_for(pairs.size(), 4096, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) out[i] = eval(pairs[i]);
+    });
+  }
+
+ private:
+  NbrdfNetwork network_;
+  std::optional<Space> input_;
+  std::string label_;
+};
+
+}  // namespace
+
+NbrdfTrainResult train_nbrdf(const Brdf& brdf, const NbrdfTrainOptions& options) {
+  check_nbrdf_train_options(options);
+  return train(brdf, options, nbrdf::input_space(options.param, "--param"), options.param, true);
+}
+
+NbrdfTrainResult train_nbrdf_on(const Brdf& brdf, const NbrdfTrainOptions& options, Space input) {
+  if (!options.param.empty())
+    throw std::invalid_argument(
+        fmt::format("train_nbrdf_on: --param '{}' and an input space: give one", options.param));
+  if (input.is_dirs())
+    throw std::invalid_argument("train_nbrdf_on: the input must be a parameterization, not dirs");
+  check_nbrdf_train_options(options);
+  return train(brdf, options, input, std::string(name_of(input)), false);
+}
+
+BrdfPtr trained_nbrdf_brdf(NbrdfNetwork network, std::optional<Space> input, std::string label) {
+  return std::make_shared<TrainedNbrdf>(std::move(network), input, std::move(label));
 }
 
 std::vector<NbrdfNote> nbrdf_train_notes(const Brdf& brdf, const NbrdfTrainOptions& o,
@@ -302,6 +431,8 @@ std::vector<NbrdfNote> nbrdf_train_notes(const Brdf& brdf, const NbrdfTrainOptio
           {"epochs", std::to_string(o.epochs)},
           {"batch", std::to_string(o.batch)},
           {"learning_rate", fmt::format("{}", o.learning_rate)},
+          {"final_learning_rate", fmt::format("{}", o.final_learning_rate)},
+          {"restarts", fmt::format("{} of {} epochs", o.restarts, o.restart_epochs)},
           {"seed", std::to_string(o.seed)},
           {"loss", fmt::format("{:.6g}", r.loss)}};
 }

@@ -199,6 +199,91 @@ TEST(NbrdfTrain, RefusesOptionsOutOfRange) {
   EXPECT_NE(with([](auto& o) { o.batch = 100000; }).find("--batch: 100000"), std::string::npos);
   EXPECT_NE(with([](auto& o) { o.learning_rate = std::nan(""); }).find("--learning-rate"),
             std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.final_learning_rate = 1e-3; }).find("--final-learning-rate"),
+            std::string::npos);  // above the learning rate
+  EXPECT_NE(with([](auto& o) { o.final_learning_rate = -1; }).find("--final-learning-rate"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.restarts = 0; }).find("--restarts: 0"), std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.restarts = 65; }).find("--restarts: 65"), std::string::npos);
+  EXPECT_NE(with([](auto& o) { o.restart_epochs = 0; }).find("--restart-epochs: 0"),
+            std::string::npos);
+  // train_nbrdf_on: an input space and --param at once, or the dirs space.
+  NbrdfTrainOptions o = small_options();
+  o.param = "hybrid";
+  EXPECT_THROW(train_nbrdf_on(*lambert, o, *space_from_name("halfdiff")), std::invalid_argument);
+  o.param.clear();
+  EXPECT_THROW(train_nbrdf_on(*lambert, o, Space::dirs), std::invalid_argument);
+}
+
+// Restarts: the first candidate is the training without restarts (the same stream), so the
+// chosen one's loss is at most its loss, over seeds where another candidate was chosen too; a
+// schedule ending at the learning rate is no schedule, a falling one changes the result.
+TEST(NbrdfTrain, RestartsKeepTheLowestLossAndAFlatScheduleChangesNothing) {
+  const BrdfPtr brdf = load_brdf("lambert:albedo=0.2+ggx:alpha=0.2,f0=0.8");
+  int other_chosen = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    NbrdfTrainOptions one = small_options(3000, 2);
+    one.seed = seed;
+    one.learning_rate = 3e-3;
+    const NbrdfTrainResult plain = train_nbrdf(*brdf, one);
+    NbrdfTrainOptions four = one;
+    four.restarts = 4;
+    four.restart_epochs = 2;
+    const NbrdfTrainResult best = train_nbrdf(*brdf, four);
+    EXPECT_EQ(best.steps, 4 * plain.steps);
+    EXPECT_LE(best.loss, plain.loss * (1 + 1e-6)) << seed;
+    other_chosen += best.network.layers[0].kernel != plain.network.layers[0].kernel;
+  }
+  EXPECT_GT(other_chosen, 0);  // else the test would not see a choice
+  const NbrdfTrainOptions one = small_options(3000, 2);
+  const NbrdfTrainResult plain = train_nbrdf(*brdf, one);
+  NbrdfTrainOptions flat = one;
+  flat.final_learning_rate = flat.learning_rate;
+  EXPECT_EQ(train_nbrdf(*brdf, flat).network.layers[0].kernel, plain.network.layers[0].kernel);
+  NbrdfTrainOptions falling = one;
+  falling.final_learning_rate = one.learning_rate / 100;
+  EXPECT_NE(train_nbrdf(*brdf, falling).network.layers[0].kernel, plain.network.layers[0].kernel);
+}
+
+// Any parameterization's space as the input: for a built-in one the same network as --param, and
+// trained_nbrdf_brdf evaluates it as the reader does; a family's member (Dupuy & Jakob's warp of
+// a BRDF) trains and evaluates too, though no file can carry it.
+TEST(NbrdfTrain, AnySpaceAsTheInputTrainsAndEvaluatesInMemory) {
+  const BrdfPtr brdf = load_brdf("lambert:albedo=0.2+ggx:alpha=0.3,f0=0.8");
+  NbrdfTrainOptions by_name = small_options();
+  by_name.param = "hybrid";
+  const NbrdfTrainResult named = train_nbrdf(*brdf, by_name);
+  const NbrdfTrainResult spaced =
+      train_nbrdf_on(*brdf, small_options(), *space_from_name("hybrid"));
+  ASSERT_EQ(spaced.network.input, "hybrid");
+  for (std::size_t l = 0; l < named.network.layers.size(); ++l)
+    EXPECT_EQ(named.network.layers[l].kernel, spaced.network.layers[l].kernel);
+  const NbrdfBrdf reader(named.network, "named");
+  const BrdfPtr memory = trained_nbrdf_brdf(spaced.network, space_from_name("hybrid"), "memory");
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto direction = [&] {
+    const double z = u(rng), phi = 2 * std::numbers::pi * u(rng), s = std::sqrt(1 - z * z);
+    return Vec3<double>{s * std::cos(phi), s * std::sin(phi), z};
+  };
+  for (int i = 0; i < 500; ++i) {
+    const DirPair<double> p{direction(), direction()};
+    const Rgb a = reader.eval(p), b = memory->eval(p);
+    EXPECT_EQ(a.r, b.r);
+    EXPECT_EQ(a.g, b.g);
+    EXPECT_EQ(a.b, b.b);
+  }
+  register_brdf_parameterization_families();
+  const std::optional<Space> warp = space_from_name("dupuy-jakob:ggx:alpha=0.3");
+  ASSERT_TRUE(warp);
+  const NbrdfTrainResult warped = train_nbrdf_on(*brdf, small_options(), *warp);
+  EXPECT_EQ(warped.network.input, name_of(*warp));
+  EXPECT_THROW(NbrdfBrdf(warped.network, "warped"), FormatError);  // the reader refuses it
+  const BrdfPtr w = trained_nbrdf_brdf(warped.network, warp, "warped");
+  const Rgb v = w->eval({{0, 0, 1}, {0, 0, 1}});
+  EXPECT_TRUE(std::isfinite(v.r) && v.r > 0);
+  // A network whose first layer does not take the input's width.
+  EXPECT_THROW(trained_nbrdf_brdf(warped.network, std::nullopt, "x"), std::invalid_argument);
 }
 
 }  // namespace

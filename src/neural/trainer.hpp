@@ -58,6 +58,7 @@ class Trainer {
   // One Adam step on the columns `batch` of `set`; returns the batch's mean loss before the step.
   double step(const TrainingSet& set, std::span<const std::size_t> batch);
   const Vector& parameters() const { return params_; }
+  void set_learning_rate(double rate) { adam_.set_learning_rate(rate); }
   const MlpLayout& layout() const { return layout_; }
 
  private:

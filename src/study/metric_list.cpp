@@ -10,11 +10,12 @@ const Metric& gonio_metric();
 const Metric& image_metric();
 const Metric& sampling_metric();
 const Metric& fit_metric();
+const Metric& neural_metric();
 
 std::span<const Metric* const> builtin_metrics() {
   static const Metric* const kMetrics[] = {
-      &azimuthal_metric(), &separability_metric(), &gonio_metric(),
-      &image_metric(),     &sampling_metric(),     &fit_metric(),
+      &azimuthal_metric(), &separability_metric(), &gonio_metric(),  &image_metric(),
+      &sampling_metric(),  &fit_metric(),          &neural_metric(),
   };
   return kMetrics;
 }

@@ -103,6 +103,20 @@ def test_metrics_and_their_options_are_settings_keys():
         halfback.study_brdf("lambert", {"fit_budgets": "many"})
 
 
+def test_the_neural_metric_runs_when_named():
+    # Off by default; named, a network per width on each parameterization's coordinates, and
+    # halfdiff's with Sztrajman et al.'s vectors.
+    settings = {"params": ["halfdiff", "hybrid"], "quick": True, "no_gonio": True, "no_sampling": True,
+                "no_fit": True}
+    assert len(halfback.study_brdf("lambert", settings)["neural"].splitlines()) == 1
+    d = halfback.study_brdf("lambert", {**settings, "metrics": ["neural"], "neural_widths": [2, 4],
+                                        "neural_samples": 2000, "neural_epochs": 2})
+    rows = d["neural"].splitlines()
+    assert len(rows) == 1 + 2 * 3
+    assert sum(",vectors," in r for r in rows) == 2
+    assert "\nneural_widths = 2,4\n" in d["settings"]
+
+
 def test_functions_travel_to_other_processes():
     # Engines pickle the task's function to send it to worker processes (a real cluster): by
     # name, so these are the same functions on arrival (a pybind11 built-in does not pickle).

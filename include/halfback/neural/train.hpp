@@ -7,10 +7,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
+#include "halfback/core/space.hpp"
 #include "halfback/formats/nbrdf.hpp"
 
 namespace halfback {
@@ -30,8 +32,17 @@ struct NbrdfTrainOptions {
   std::size_t epochs = 100;                 // passes over the pairs, shuffled each time; 1 to 10^6
   std::size_t batch = 512;                  // pairs per Adam step; 1 to 65,536
   double learning_rate = 5e-4;              // Adam's, in (0, 1]
-  std::uint64_t seed = 0;                   // the pairs, the initial weights and the shuffles
-  int threads = 0;  // core's parallel_for (0: all); the result does not depend on it
+  // A schedule: when positive (and at most learning_rate), the learning rate of epoch e of E
+  // (from 0) is learning_rate · (final_learning_rate / learning_rate)^(e / (E − 1)), falling
+  // geometrically to it at the last epoch; 0: constant (the authors').
+  double final_learning_rate = 0;
+  // Restarts: `restarts` networks from different initial weights each train `restart_epochs`
+  // epochs, and the one of the lowest loss on all the pairs goes on to `epochs` in all (1: no
+  // restarts, the authors' training). 1 to 64; restart_epochs 1 to 10^6.
+  std::size_t restarts = 1;
+  std::size_t restart_epochs = 5;
+  std::uint64_t seed = 0;  // the pairs, the initial weights and the shuffles
+  int threads = 0;         // core's parallel_for (0: all); the result does not depend on it
   // Called after each epoch (on the calling thread), when set.
   std::function<void(const NbrdfTrainProgress&)> progress;
 };
@@ -54,6 +65,21 @@ struct NbrdfTrainResult {
 // an anisotropic BRDF (the network is isotropic), naming a pair where ρ is NaN, infinite or
 // negative, or when ρ is 0 at every pair drawn.
 NbrdfTrainResult train_nbrdf(const Brdf& brdf, const NbrdfTrainOptions& options);
+
+// The same training with the isotropic coordinates of `input` as the network's input: any
+// parameterization's space, a registered one or a family's member (dupuy-jakob:BRDF) included,
+// for comparisons within one process (the study's neural metric); options.param must be empty.
+// result.network.input names the space; a network of a space other than a built-in
+// parameterization is not one the reader (or write_nbrdf) takes: evaluate it with
+// trained_nbrdf_brdf(). Throws as train_nbrdf, and std::invalid_argument for a non-empty
+// options.param or the `dirs` space.
+NbrdfTrainResult train_nbrdf_on(const Brdf& brdf, const NbrdfTrainOptions& options, Space input);
+
+// A BRDF that evaluates a trained network in memory, as the reader does (float32, ρ = max(e^y −
+// 1, 0), 0 below the horizon, NaN for a NaN pair): its input Sztrajman et al.'s (`input` empty) or
+// the isotropic coordinates of `input`. Throws std::invalid_argument when the first layer's width
+// is not the input's (6 or 3) or the last's is not 3.
+BrdfPtr trained_nbrdf_brdf(NbrdfNetwork network, std::optional<Space> input, std::string label);
 
 // The notes write_nbrdf stores in the .json for a result: the source BRDF and the settings.
 std::vector<NbrdfNote> nbrdf_train_notes(const Brdf& brdf, const NbrdfTrainOptions& options,
