@@ -264,9 +264,9 @@ std::vector<study::LabeledProfile> profile_pass(const std::vector<std::string>& 
           specs[k], profiles[k].label));
   const auto kept = std::count(reused.begin(), reused.end(), 1);
   fmt::print(stderr,
-             "halfback study: profiles of {} BRDFs for the learned design in {:.1f} s ({:.1f} CPU "
+             "halfback study: profiles of {} BRDF{} for the learned design in {:.1f} s ({:.1f} CPU "
              "s){}\n",
-             specs.size(),
+             specs.size(), specs.size() == 1 ? "" : "s",
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
              cpu_seconds() - cpu0, kept ? fmt::format("; {} kept from the earlier run", kept) : "");
   return profiles;
