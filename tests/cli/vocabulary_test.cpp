@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstddef>
 #include <filesystem>
 #include <fstream>
@@ -148,6 +149,18 @@ bool count_type(const std::string& type) {
          type.starts_with("N=") || type.starts_with("N,");
 }
 
+// Whether the option takes a value: CLI11 prints its type (PARAM, UINT, TEXT:{...}, N, ...) in
+// capitals after the names, where a flag's help starts with its description.
+bool takes_value(const CliOption& o) {
+  std::size_t letters = 0;
+  while (letters < o.type.size() && std::isalpha(static_cast<unsigned char>(o.type[letters])))
+    ++letters;
+  if (letters == 0) return false;
+  for (std::size_t k = 0; k < letters; ++k)
+    if (!std::isupper(static_cast<unsigned char>(o.type[k]))) return false;
+  return true;
+}
+
 // The ideas an option expresses, each with the name the vocabulary gives it (empty: the option
 // has it).
 struct Finding {
@@ -164,7 +177,8 @@ std::vector<Finding> check(const CliOption& o) {
   if (o.has("-o") || o.has("--out") || o.has("--output"))
     expect("output", o.has("-o") && p == "--output", "the output is -o,--output");
   if (contains(o.text, "all cores")) expect("threads", p == "--threads", "threads are --threads");
-  if (std::regex_search(o.text, std::regex("[Pp]arameterizations?\\b"))) {
+  // (A flag that names parameterizations in its help, as --no-neural does, takes none.)
+  if (takes_value(o) && std::regex_search(o.text, std::regex("[Pp]arameterizations?\\b"))) {
     const std::string want = list ? "--params" : "--param";
     const std::string type = list ? "PARAM,..." : "PARAM";
     expect("parameterization", p == want && o.type.starts_with(type),
