@@ -427,11 +427,11 @@ Command register_study(CLI::App& parent) {
       ->type_name("DIR")
       ->capture_default_str();
   app->add_option(
-      "--params", o->params,
-      "Parameterizations compared, comma-separated, in the order of the tables: " +
-          parameterization_names(", ") +
-          " (default: those studied without being asked, the spherical baseline last: " +
-          default_studied_names() + ")")
+         "--params", o->params,
+         "Parameterizations compared, comma-separated, in the order of the tables: " +
+             parameterization_names(", ") +
+             " (default: those studied without being asked, the spherical baseline last: " +
+             default_studied_names() + ")")
       ->type_name("PARAM,...");
   app->add_option("--space,--error-space", o->settings.space,
                   "Error space: linear, log (ln(1 + Y)), cbrt (Y^(1/3)), nielsen (Nielsen et al. "

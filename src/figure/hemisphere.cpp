@@ -326,9 +326,9 @@ HemisphereFigure hemisphere_figure(const HemisphereOptions& o) {
   sc.width = snap(left + double(cols) * D + double(cols - 1) * gap + key_gap + key + right);
   // The heading, subtitle and notes are wrapped to the width (a figure of one or two columns is
   // narrower than their lines): the margins above and below grow with their lines.
-  const auto heading = wrap_text(
-      "Incoming directions ωi for a fixed ωo, coloured by the coordinates of (ωi, ωo)",
-      sc.width - left - 8, 12);
+  const auto heading =
+      wrap_text("Incoming directions ωi for a fixed ωo, coloured by the coordinates of (ωi, ωo)",
+                sc.width - left - 8, 12);
   const auto subtitle = wrap_text(
       "red: first coordinate / range, green: second / range; isolines every 10° or 0.1 "
       "(white: first, black dashed: second)",

@@ -15,7 +15,8 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 void check(bool ok, const char* model, const char* param, double value) {
-  if (!ok) throw std::invalid_argument(fmt::format("{}: {} = {} is out of range", model, param, value));
+  if (!ok)
+    throw std::invalid_argument(fmt::format("{}: {} = {} is out of range", model, param, value));
 }
 
 void check_albedo(const char* model, const Rgb& a) {
@@ -28,7 +29,8 @@ bool above(const DirPair<double>& p) {
 
 }  // namespace
 
-Ward::Ward(Rgb albedo, double roughness, bool duer) : albedo_(albedo), alpha_(roughness), duer_(duer) {
+Ward::Ward(Rgb albedo, double roughness, bool duer)
+    : albedo_(albedo), alpha_(roughness), duer_(duer) {
   check_albedo(duer ? "ward-duer" : "ward", albedo);
   check(std::isfinite(roughness) && roughness > 0, duer ? "ward-duer" : "ward", "roughness",
         roughness);
@@ -55,9 +57,10 @@ BlinnPhong::BlinnPhong(Rgb albedo, double sharpness) : albedo_(albedo), n_(sharp
 }
 
 std::string BlinnPhong::description() const {
-  return fmt::format("Phong lobe about the mirror direction (Ngan et al.'s Blinn-Phong, as BBM), "
-                     "sharpness {:g}",
-                     n_);
+  return fmt::format(
+      "Phong lobe about the mirror direction (Ngan et al.'s Blinn-Phong, as BBM), "
+      "sharpness {:g}",
+      n_);
 }
 
 Rgb BlinnPhong::eval(const DirPair<double>& p) const {
@@ -82,9 +85,10 @@ Lafortune::Lafortune(Rgb albedo, double cxy, double cz, double sharpness)
 }
 
 std::string Lafortune::description() const {
-  return fmt::format("Lafortune lobe with Ngan et al.'s normalisation (as BBM), Cxy : Cz = {:g} : "
-                     "{:g}, sharpness {:g}",
-                     cxy_, cz_, n_);
+  return fmt::format(
+      "Lafortune lobe with Ngan et al.'s normalisation (as BBM), Cxy : Cz = {:g} : "
+      "{:g}, sharpness {:g}",
+      cxy_, cz_, n_);
 }
 
 Rgb Lafortune::eval(const DirPair<double>& p) const {
@@ -131,15 +135,17 @@ void register_ngan_lobe_models(ModelRegistry& registry) {
                   return std::make_shared<BlinnPhong>(albedo_of(a), a["sharpness"]);
                 }});
   auto lafortune = albedo_params();
-  lafortune.push_back({"cxy", "Cxy: the lobe's weight of x and y (negative: forward)", -0.577, -1, 1});
+  lafortune.push_back(
+      {"cxy", "Cxy: the lobe's weight of x and y (negative: forward)", -0.577, -1, 1});
   lafortune.push_back({"cz", "Cz: the lobe's weight of z", 0.577, 0, 1});
   lafortune.push_back({"sharpness", "exponent n of the lobe", 100, 0.1, 1e6});
-  registry.add({"lafortune",
-                "Lafortune lobe as BBM's NganLafortune (Ngan et al. 2005): albedo max(0, C.(wi*wo))^n "
-                "(n+2) / (2 pi max(Cxy^2, Cz^2)^(n/2))",
-                lafortune, [](const ModelArgs& a) {
-                  return std::make_shared<Lafortune>(albedo_of(a), a["cxy"], a["cz"], a["sharpness"]);
-                }});
+  registry.add(
+      {"lafortune",
+       "Lafortune lobe as BBM's NganLafortune (Ngan et al. 2005): albedo max(0, C.(wi*wo))^n "
+       "(n+2) / (2 pi max(Cxy^2, Cz^2)^(n/2))",
+       lafortune, [](const ModelArgs& a) {
+         return std::make_shared<Lafortune>(albedo_of(a), a["cxy"], a["cz"], a["sharpness"]);
+       }});
 }
 
 }  // namespace halfback::models

@@ -45,14 +45,14 @@ TEST(NganLobes, ValuesAreTheFormulas) {
     EXPECT_NEAR(Ward({0.2, 0.2, 0.2}, a, true).eval(p).g,
                 0.2 * e / (std::cos(c[0]) * std::cos(c[2])), 1e-12 * (1 + e));
     const double m = std::max(0.0, cos_mirror(c[0], c[1], c[2], c[3])), n = 40;
-    EXPECT_NEAR(BlinnPhong({0.1, 0.1, 0.1}, n).eval(p).g, 0.1 * (n + 2) / (2 * kPi) * std::pow(m, n),
-                1e-12);
+    EXPECT_NEAR(BlinnPhong({0.1, 0.1, 0.1}, n).eval(p).g,
+                0.1 * (n + 2) / (2 * kPi) * std::pow(m, n), 1e-12);
     // Lafortune with Cxy = −Cz: Ngan's normalisation makes it the Phong lobe of the same n.
     EXPECT_NEAR(Lafortune({0.1, 0.1, 0.1}, -0.577, 0.577, n).eval(p).g,
                 BlinnPhong({0.1, 0.1, 0.1}, n).eval(p).g, 1e-10);
     // A general Lafortune lobe from its definition.
-    const double cxy = -0.7, cz = 0.3, d = cxy * (p.wi.x * p.wo.x + p.wi.y * p.wo.y) +
-                                            cz * p.wi.z * p.wo.z;
+    const double cxy = -0.7, cz = 0.3,
+                 d = cxy * (p.wi.x * p.wo.x + p.wi.y * p.wo.y) + cz * p.wi.z * p.wo.z;
     EXPECT_NEAR(Lafortune({1, 1, 1}, cxy, cz, 3).eval(p).g,
                 std::pow(std::max(0.0, d), 3) * 5 / (2 * kPi * std::pow(0.49, 1.5)), 1e-12);
   }
@@ -96,7 +96,8 @@ TEST(NganLobes, Normalisations) {
 TEST(NganLobes, RegisteredWithBbmsNames) {
   ModelRegistry r;
   register_analytic_models(r);
-  const BrdfPtr w = r.create("ward:albedo_r=0.00774,albedo_g=0.00547,albedo_b=0.00339,roughness=0.0162");
+  const BrdfPtr w =
+      r.create("ward:albedo_r=0.00774,albedo_g=0.00547,albedo_b=0.00339,roughness=0.0162");
   EXPECT_EQ(w->name(), "ward");
   EXPECT_GT(w->eval(pair_of(0.3, 0, 0.3, kPi)).r, 0);
   EXPECT_EQ(r.create("lafortune:albedo=0.0238,cxy=-0.577,cz=0.577,sharpness=4060")->name(),

@@ -141,8 +141,8 @@ double plan_error(const std::string& sidecar, const py::object& values, const py
   const BrdfPtr t = brdf_of(truth);
   py::gil_scoped_release release;
   const auto reconstruction = acquire::reconstruct_any(a, v, "measured");
-  return acquire::reconstruction_error(
-      *reconstruction, acquire::draw_test_pairs(*t, test_pairs, seed, *es, reach));
+  return acquire::reconstruction_error(*reconstruction,
+                                       acquire::draw_test_pairs(*t, test_pairs, seed, *es, reach));
 }
 
 py::dict reconstruct(const std::string& sidecar, const py::object& values, const std::string& out,
@@ -190,7 +190,8 @@ double reach_degrees(double max_theta, std::string_view argument) {
 void bind_acquisition(py::module_& m) {
   m.def("plan", &plan, py::arg("param") = "hybrid", py::arg("design") = "regular",
         py::arg("budget") = 10000, py::arg("spacing") = "own", py::arg("full") = false,
-        py::arg("max_theta") = std::numbers::pi / 2, py::arg("seed") = 1, py::arg("instrument") = "light-detector",
+        py::arg("max_theta") = std::numbers::pi / 2, py::arg("seed") = 1,
+        py::arg("instrument") = "light-detector",
         R"doc(The measurement plan of a design for a gonio-reflectometer, as `halfback plan`
 (docs/acquisition.md): a dict of positions_deg (rows x 4, degrees: the motors named in motors,
 light zenith, light azimuth, detector zenith, detector azimuth for the light-detector instrument;
@@ -210,8 +211,7 @@ Dupuy & Jakob's layout needs every row). Returns a dict as plan() does; its "sid
 reconstruct() reads.)doc");
   m.def("plan_error", &plan_error, py::arg("plan"), py::arg("values"), py::arg("truth"),
         py::arg("test_pairs") = 200000, py::arg("seed") = 1,
-        py::arg("max_theta") = 85 * std::numbers::pi / 180,
-        py::arg("space") = "log",
+        py::arg("max_theta") = 85 * std::numbers::pi / 180, py::arg("space") = "log",
         R"doc(The study's error (metric 3, docs/study.md) of the reconstruction of a plan's
 measured values against `truth` (a spec or Brdf): the relative error over test_pairs pairs drawn
 from the measure within max_theta radians of the normal (the study's defaults: 85 degrees), in the error space `space`. For a

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "acquisition.hpp"
 #include "halfback/loader/load.hpp"
 #include "halfback/study/image_metrics.hpp"
 #include "halfback/study/metric.hpp"
@@ -15,7 +16,6 @@
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
 #include "halfback/util/output_dir.hpp"
-#include "acquisition.hpp"
 #include "py_brdf.hpp"
 
 namespace py = pybind11;

@@ -38,6 +38,7 @@ int main() {
     std::fprintf(stderr, "reconstruction of a constant is off by %g\n", error);
     return 1;
   }
-  std::printf("acquire consumer: %zu rows measured, constant reconstructed\n", plan.measured.size());
+  std::printf("acquire consumer: %zu rows measured, constant reconstructed\n",
+              plan.measured.size());
   return 0;
 }
