@@ -1018,7 +1018,11 @@ TEST(ViewApi, RequestsDoNotGrowProcessWideState) {
   // 64 MB over 9 000 requests: a leak of 7 KB a request, or a cache that keeps what it was given
   // (a form kept was 1.3 MB: 50 of them). The growth is recorded (--gtest_output=xml).
   RecordProperty("rss_growth_bytes", std::to_string(growth));
+#if !defined(__SANITIZE_ADDRESS__)
+  // (Not under ASan: its quarantine keeps freed blocks resident, 256 MB by default; 148 MB
+  // after 360 requests.)
   EXPECT_LT(growth, std::size_t(64) << 20) << "resident set grew by " << growth << " bytes";
+#endif
 }
 
 // A parameterization built for a request is the registry's member of the same name, value for
