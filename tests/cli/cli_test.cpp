@@ -213,6 +213,14 @@ class CliTest : public testing::Test {
     EXPECT_GE(options, 19u);
   }
 
+  // The inputs of write_cases(): pairs.csv, a 300-point plan p.csv and lab.csv (a value a row).
+  void write_case_inputs();
+  // A write that failed as it must: status 1, `message` in the error, every output still "old"
+  // and no temporary (a dot file) anywhere in the test's folder.
+  void expect_failed_write_left_old_files(const std::string& line, const Result& r,
+                                          const std::vector<std::string>& outputs,
+                                          const std::string& message);
+
   test::TempDir dir_;        // the test's own, removed after it
   long file_limit_kib_ = 0;  // > 0: run() runs the tool under bash's `ulimit -f` of this many KiB
 };
@@ -2408,6 +2416,25 @@ std::vector<std::vector<std::string>> command_lines(const std::vector<WriteCase>
   return lines;
 }
 
+void CliTest::write_case_inputs() {
+  put(path("pairs.csv"), dirs_csv(well_conditioned_pairs(200, 7)));
+  ASSERT_EQ(run({"plan", "--budget", "300", "-o", "p.csv"}).status, 0);
+  std::string lab = "row,value\n";
+  for (std::size_t k = 0; k < parse(slurp(path("p.csv"))).rows(); ++k)
+    lab += std::to_string(k) + ",0.1\n";
+  put(path("lab.csv"), lab);
+}
+
+void CliTest::expect_failed_write_left_old_files(const std::string& line, const Result& r,
+                                                 const std::vector<std::string>& outputs,
+                                                 const std::string& message) {
+  EXPECT_EQ(r.status, 1) << line << "\n" << r.err;
+  EXPECT_NE(r.err.find(message), std::string::npos) << line << "\n" << r.err;
+  for (const std::string& f : outputs) EXPECT_EQ(slurp(path(f)), "old\n") << line << ": " << f;
+  for (const auto& e : fs::recursive_directory_iterator(dir_.path()))
+    EXPECT_FALSE(e.path().filename().string().starts_with(".")) << line << ": " << e.path();
+}
+
 std::string joined(const std::vector<std::string>& args) {
   std::string line;
   for (const std::string& a : args) line += " " + a;
@@ -2419,12 +2446,8 @@ std::string joined(const std::vector<std::string>& args) {
 // write fails with EFBIG, as a full disk fails with ENOSPC (the tool died of SIGXFSZ, status 153,
 // with no message and the temporary left).
 TEST_F(CliTest, FileSizeLimitLeavesTheOldFileAndNoTemporary) {
-  put(path("pairs.csv"), dirs_csv(well_conditioned_pairs(200, 7)));
-  ASSERT_EQ(run({"plan", "--budget", "300", "-o", "p.csv"}).status, 0);
-  std::string lab = "row,value\n";
-  for (std::size_t k = 0; k < parse(slurp(path("p.csv"))).rows(); ++k)
-    lab += std::to_string(k) + ",0.1\n";
-  put(path("lab.csv"), lab);
+  write_case_inputs();
+  if (HasFatalFailure()) return;
   const std::vector<WriteCase> cases = write_cases("");
   expect_every_output_written(command_lines(cases));
   for (const char* folder : {"st", "figs"}) fs::create_directories(path(folder));
@@ -2433,12 +2456,7 @@ TEST_F(CliTest, FileSizeLimitLeavesTheOldFileAndNoTemporary) {
     file_limit_kib_ = 1;
     const Result r = run(c.args);
     file_limit_kib_ = 0;
-    const std::string line = joined(c.args);
-    EXPECT_EQ(r.status, 1) << line << "\n" << r.err;
-    EXPECT_NE(r.err.find("file size limit"), std::string::npos) << line << "\n" << r.err;
-    for (const std::string& f : c.outputs) EXPECT_EQ(slurp(path(f)), "old\n") << line << ": " << f;
-    for (const auto& e : fs::recursive_directory_iterator(dir_.path()))
-      EXPECT_FALSE(e.path().filename().string().starts_with(".")) << line << ": " << e.path();
+    expect_failed_write_left_old_files(joined(c.args), r, c.outputs, "file size limit");
   }
 }
 
@@ -2447,12 +2465,8 @@ TEST_F(CliTest, FileSizeLimitLeavesTheOldFileAndNoTemporary) {
 // (the old files are in it), which needs the privilege to mount (CI runs as root; skipped
 // without it).
 TEST_F(CliTest, FullDiskLeavesTheOldFileAndNoTemporary) {
-  put(path("pairs.csv"), dirs_csv(well_conditioned_pairs(200, 7)));
-  ASSERT_EQ(run({"plan", "--budget", "300", "-o", "p.csv"}).status, 0);
-  std::string lab = "row,value\n";
-  for (std::size_t k = 0; k < parse(slurp(path("p.csv"))).rows(); ++k)
-    lab += std::to_string(k) + ",0.1\n";
-  put(path("lab.csv"), lab);
+  write_case_inputs();
+  if (HasFatalFailure()) return;
   const fs::path full = path("full");
   fs::create_directories(full);
   if (::mount("tmpfs", full.c_str(), "tmpfs", 0, "size=64k") != 0)
@@ -2474,13 +2488,8 @@ TEST_F(CliTest, FullDiskLeavesTheOldFileAndNoTemporary) {
       const std::string block(4096, 'x');
       for (int k = 0; k < 64 && filler.write(block.data(), block.size()); ++k) filler.flush();
     }
-    const std::string line = joined(c.args);
     const Result r = run(c.args);
-    EXPECT_EQ(r.status, 1) << line << "\n" << r.err;
-    EXPECT_NE(r.err.find("the file system is full"), std::string::npos) << line << "\n" << r.err;
-    for (const std::string& f : c.outputs) EXPECT_EQ(slurp(path(f)), "old\n") << line << ": " << f;
-    for (const auto& e : fs::recursive_directory_iterator(dir_.path()))
-      EXPECT_FALSE(e.path().filename().string().starts_with(".")) << line << ": " << e.path();
+    expect_failed_write_left_old_files(joined(c.args), r, c.outputs, "the file system is full");
   }
 }
 
