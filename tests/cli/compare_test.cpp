@@ -41,22 +41,11 @@ class CompareCli : public testing::Test {
 
   // Runs halfback with `args` in the test's folder.
   Outcome run(const std::vector<std::string>& args) const {
-    const fs::path out = path(".stdout"), err = path(".stderr");
     std::vector<std::string> argv{HALFBACK_CLI_PATH};
     argv.insert(argv.end(), args.begin(), args.end());
-    const test::Spawned spawned =
-        test::spawn_and_wait(dir_.path(), std::move(argv), "/dev/null", out, err);
-    Outcome r;
-    if (!spawned.started) {
-      ADD_FAILURE() << "cannot run " << HALFBACK_CLI_PATH << ": " << spawned.error;
-      return r;
-    }
-    r.status = spawned.status;
-    r.out = read_all(out);
-    r.err = read_all(err);
-    fs::remove(out);
-    fs::remove(err);
-    return r;
+    const test::Captured ran = test::run_captured(dir_.path(), std::move(argv));
+    if (!ran.started) ADD_FAILURE() << "cannot run " << HALFBACK_CLI_PATH << ": " << ran.error;
+    return {ran.status, ran.out, ran.err};
   }
 
   // The names in the test's folder (no leftover temporary files).

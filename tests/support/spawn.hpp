@@ -9,6 +9,8 @@
 
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,30 @@ inline Spawned spawn_and_wait(const std::filesystem::path& dir, std::vector<std:
   waitpid(pid, &status, 0);
   s.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return s;
+}
+
+// A program run by run_captured(): how it started and ended, and what it wrote.
+struct Captured : Spawned {
+  std::string out, err;
+};
+
+// Runs argv in `dir` with standard input /dev/null, its standard output and error captured
+// through two files in `dir` (removed after).
+inline Captured run_captured(const std::filesystem::path& dir, std::vector<std::string> argv) {
+  const std::filesystem::path out = dir / ".stdout", err = dir / ".stderr";
+  Captured c;
+  static_cast<Spawned&>(c) = spawn_and_wait(dir, std::move(argv), "/dev/null", out, err);
+  const auto read = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  c.out = read(out);
+  c.err = read(err);
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return c;
 }
 
 }  // namespace halfback::test
