@@ -57,18 +57,14 @@ struct CliOption {
 class Vocabulary : public testing::Test {
  protected:
   std::string help(const std::string& command) {
-    const fs::path out = dir_ / "out", err = dir_ / "err";
     std::vector<std::string> argv{HALFBACK_CLI_PATH};
     std::istringstream words(command);
     for (std::string w; words >> w;) argv.push_back(w);
     argv.push_back("--help");
-    const test::Spawned s = test::spawn_and_wait(dir_.path(), argv, "/dev/null", out, err);
-    EXPECT_TRUE(s.started) << s.error;
-    EXPECT_EQ(s.status, 0) << command;
-    std::ifstream in(out);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
+    const test::Captured ran = test::run_captured(dir_.path(), std::move(argv));
+    EXPECT_TRUE(ran.started) << ran.error;
+    EXPECT_EQ(ran.status, 0) << command;
+    return ran.out;
   }
 
   // The names listed in a help's "Subcommands:" section.
