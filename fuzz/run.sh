@@ -52,6 +52,8 @@ for seed in "/api/info?token=t" "/?token=t" "/static/app.js?token=t" \
     "/api/slices?token=t&brdf=arg:0&forms=dupuy-jakob:file:../x&n=2" \
     "/api/render?token=t&brdf=arg:0&env=/etc/passwd" \
     "/api/fit?token=t&brdf=arg:1&model=lambert%2Blambert%2Blambert%2Blambert%2Blambert&samples=20000" \
+    "/api/fit?token=t&brdf=arg:1&model=ggx+&samples=100" \
+    "/api/fit?token=t&brdf=arg:1&model=+ggx+:+alpha+=0.3&samples=100" \
     "/api/slices?token=t&brdf=arg:0&brdf=arg:1&n=512&values=rgb" \
     "/api/mesh?token=t&brdf=arg:0&brdf=arg:1&light=point&theta_l=30&phi_l=45&size=16" \
     "/api/mesh?token=t&brdf=arg:1&mesh=embedded:rounded-cube&light=env&env=studio&size=8&spp=2&pass=3&yaw=-40&pitch=80" \

@@ -118,7 +118,7 @@ std::vector<std::string> ModelRegistry::names() const {
   return r;
 }
 
-BrdfPtr ModelRegistry::create(std::string_view spec) const {
+ParsedModelSpec ModelRegistry::parse(std::string_view spec) const {
   const std::string spec_s(spec);
   const std::size_t colon = spec.find(':');
   const std::string_view name = trim(spec.substr(0, colon));
@@ -130,8 +130,7 @@ BrdfPtr ModelRegistry::create(std::string_view spec) const {
         "'" + spec_s + "' is neither an existing file nor a known BRDF model" +
         (known.empty() ? std::string(" (no models are registered)") : " (models: " + known + ")"));
   }
-  ModelArgs args;
-  for (const auto& p : info->params) args.set(p.name, p.default_value);
+  ParsedModelSpec parsed{info, {}};
   std::set<std::string, std::less<>> given;
   if (colon != std::string_view::npos) {
     std::string_view rest = spec.substr(colon + 1);
@@ -182,15 +181,29 @@ BrdfPtr ModelRegistry::create(std::string_view spec) const {
               "model '" + info->name + "': " + param->name + "=" + std::string(text) +
               " is outside [" + format_number(param->min) + ", " + format_number(param->max) + "]");
       }
-      args.set(param->name, v);
+      parsed.given.emplace_back(param->name, v);
       if (comma == std::string_view::npos) break;
       rest.remove_prefix(comma + 1);
     }
   }
-  // Parameters not given that default to another one (declared before, so already final).
-  for (const auto& p : info->params)
-    if (!p.default_from.empty() && !given.count(p.name)) args.set(p.name, args[p.default_from]);
-  return info->factory(args);
+  return parsed;
 }
+
+BrdfPtr ModelRegistry::create(std::string_view spec) const {
+  const ParsedModelSpec parsed = parse(spec);
+  const ModelInfo& info = *parsed.info;
+  ModelArgs args;
+  for (const auto& p : info.params) args.set(p.name, p.default_value);
+  for (const auto& [name, value] : parsed.given) args.set(name, value);
+  // Parameters not given that default to another one (declared before, so already final).
+  const auto is_given = [&](const std::string& name) {
+    return std::any_of(parsed.given.begin(), parsed.given.end(),
+                       [&](const auto& g) { return g.first == name; });
+  };
+  for (const auto& p : info.params)
+    if (!p.default_from.empty() && !is_given(p.name)) args.set(p.name, args[p.default_from]);
+  return info.factory(args);
+}
+
 
 }  // namespace halfback

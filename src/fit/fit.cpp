@@ -266,50 +266,17 @@ std::vector<std::string_view> split_terms(std::string_view spec) {
   return terms;
 }
 
-struct TermSpec {
-  std::string name;
-  std::vector<std::pair<std::string, double>> given;
-};
-
-TermSpec parse_term(std::string_view text, const ModelRegistry& registry) {
-  if (text.empty()) throw std::invalid_argument("empty model term");
-  // The registry validates names, keys and ranges, with its own messages.
-  (void)registry.create(text);
-  TermSpec t;
-  const std::size_t colon = text.find(':');
-  t.name = std::string(text.substr(0, colon));
-  const ModelInfo* info = registry.find(t.name);
-  if (colon == std::string_view::npos) return t;
-  std::string_view rest = text.substr(colon + 1);
-  while (!rest.empty()) {
-    const std::size_t comma = rest.find(',');
-    const std::string_view item = rest.substr(0, comma);
-    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
-    const std::size_t eq = item.find('=');
-    const std::string key =
-        eq == std::string_view::npos ? info->params.at(0).name : std::string(item.substr(0, eq));
-    const std::string value(eq == std::string_view::npos ? item : item.substr(eq + 1));
-    const ModelParam* p = find_param(*info, key);
-    if (!p->choices.empty()) {
-      const auto it = std::find(p->choices.begin(), p->choices.end(), value);
-      t.given.emplace_back(key, double(it - p->choices.begin()));
-    } else {
-      t.given.emplace_back(key, std::stod(value));  // the registry has checked it
-    }
-  }
-  return t;
-}
-
 }  // namespace
 
 Model parse_model(std::string_view text) {
   const ModelRegistry& registry = model_registry();
   Model m;
   for (std::string_view term_text : split_terms(text)) {
-    const TermSpec t = parse_term(term_text, registry);
-    const ModelInfo& info = *registry.find(t.name);
+    if (term_text.empty()) throw std::invalid_argument("empty model term");
+    const ParsedModelSpec t = registry.parse(term_text);
+    const ModelInfo& info = *t.info;
     const std::size_t term = m.terms.size();
-    m.terms.push_back(t.name);
+    m.terms.push_back(info.name);
     for (const ModelParam& p : info.params) {
       const auto given = std::find_if(t.given.begin(), t.given.end(),
                                       [&](const auto& g) { return g.first == p.name; });
@@ -331,7 +298,7 @@ Model parse_model(std::string_view text) {
                                 [&](const auto& g) { return g.first == source->name; });
       if (source_given) continue;
       if (!p.choices.empty() || has_channels(info, p) || (!p.default_from.empty() && !channel) ||
-          held_by_rule(t.name, p.name))
+          held_by_rule(info.name, p.name))
         continue;
       out.fitted = true;
       m.params.push_back(out);

@@ -79,6 +79,26 @@ TEST(FitModel, GivenValuesAreHeldAndTheSpecRoundTrips) {
   EXPECT_NO_THROW(load_brdf(spec_of(m)));
 }
 
+
+// A spec reads the same to the fit as to the loader: spaces around names, keys and values (a '+'
+// in a URL's query is a space) are ignored, and a malformed term is refused with a message naming
+// what is wrong (not a crash: the fit once looked the untrimmed name up).
+TEST(FitModel, ReadsASpecAsTheLoaderDoes) {
+  EXPECT_EQ(spec_of(parse_model(" ggx : alpha = 0.3 , f0=0.5 ")),
+            spec_of(parse_model("ggx:alpha=0.3,f0=0.5")));
+  EXPECT_EQ(parse_model("ggx ").terms, (std::vector<std::string>{"ggx"}));
+  const std::pair<const char*, const char*> bad[] = {
+      {"ggx+", "ggx+"},         {"", "empty"},           {"ggx:alpha", "alpha"},
+      {"ggx: nope=1", "nope"}, {"ggx:alpha=9", "alpha"}, {"lambert+ggx:alpha=x", "'x'"}};
+  for (const auto& [spec, named] : bad) {
+    try {
+      (void)parse_model(spec);
+      ADD_FAILURE() << "'" << spec << "' was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  }
+}
 // The fit differences the three channels of a colour parameter at once (docs/fit.md, "Solver"),
 // which holds because NAME_r drives the red channel only: checked for every registered model that
 // has colour parameters, at 64 pairs of the layout, each channel shifted by a tenth of its range.

@@ -84,7 +84,7 @@ inline std::size_t pick_lobe(std::span<const double> w, double& u) {
   // half (k ≥ 4), cos < 0 in the left half (2 ≤ k < 6).
   const bool near_y = (k == 1) | (k == 2) | (k == 5) | (k == 6);
   const double ms = (near_y ? c8 : s8) * (k >= 4 ? -1.0 : 1.0);
-  const double mc = (near_y ? s8 : c8) * ((k >= 2) & (k < 6) ? -1.0 : 1.0);
+  const double mc = (near_y ? s8 : c8) * ((k >= 2 && k < 6) ? -1.0 : 1.0);
   sin_out = ms * ct + mc * st;
   cos_out = mc * ct - ms * st;
 }

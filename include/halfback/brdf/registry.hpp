@@ -9,6 +9,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
@@ -52,6 +53,13 @@ struct ModelInfo {
   std::function<BrdfPtr(const ModelArgs&)> factory;
 };
 
+// A spec as the registry read it: the model and the parameters given, in the spec's order (a
+// named value as its index in the parameter's choices), each checked against its range.
+struct ParsedModelSpec {
+  const ModelInfo* info = nullptr;  // never nullptr in a value returned by parse()
+  std::vector<std::pair<std::string, double>> given;
+};
+
 class ModelRegistry {
  public:
   // Registers a model; throws std::invalid_argument on a malformed entry (bad or duplicate name,
@@ -65,9 +73,12 @@ class ModelRegistry {
   std::vector<std::string> names() const;  // sorted
 
   // Parses "name", "name:key=value,key=value" or "name:value,key=value" (a value without a key
-  // sets the model's first parameter, so "test:S" is "test:fn=S") and creates the model. Throws
-  // std::invalid_argument with a message for users: unknown model (listing the known ones),
-  // unknown or repeated parameter, a value that is not a number or is out of range.
+  // sets the model's first parameter, so "test:S" is "test:fn=S"; spaces around names, keys and
+  // values are ignored). Throws std::invalid_argument with a message for users: unknown model
+  // (listing the known ones), unknown or repeated parameter, a value that is not a number or is
+  // out of range.
+  ParsedModelSpec parse(std::string_view spec) const;
+  // parse(), then the model with every parameter not given at its default.
   BrdfPtr create(std::string_view spec) const;
 
  private:
