@@ -205,5 +205,4 @@ BrdfPtr ModelRegistry::create(std::string_view spec) const {
   return info.factory(args);
 }
 
-
 }  // namespace halfback
