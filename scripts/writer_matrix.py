@@ -16,7 +16,9 @@ and each output is read:
   albedo       the luminance directional albedo of output and source (its reciprocal part for a
                writer whose output is reciprocal: RECIPROCAL_WRITERS) at θi = 0, 30, 60, 80, 85°
                (Monte Carlo, the same ωo for both: the cosine and three GGX lobes about the mirror
-               direction, balance heuristic), the ratio output / source;
+               direction, balance heuristic), the ratio output / source; and max_albedo, the
+               largest RGB albedo of the output at those θi where the source's is at most 1
+               (a writer that keeps the energy fails if it exceeds 1 by 3 standard errors);
   error        the study's measure against the source: relative L2 of ln(1 + Y) over pairs drawn
                from cos θi cos θo dωi dωo (Y the luminance);
   info, eval, fit, render, study
@@ -88,8 +90,10 @@ def albedo_directions(wi, n, rng):
     return wo, pdf / (1 + len(ALPHAS)), len(out) * k
 
 
-def albedo_ratios(source, out, n=100000):
-    ratios = []
+def albedos(source, out, n=100000):
+    """Per θi of ANGLES: the RGB directional albedos of source and output, and their standard
+    errors (Monte Carlo over the same ωo for both)."""
+    result = []
     for i, t in enumerate(ANGLES):
         th = np.radians(t)
         wi = np.array([np.sin(th), 0, np.cos(th)])
@@ -97,11 +101,37 @@ def albedo_ratios(source, out, n=100000):
         up = wo[:, 2] > 0
         wo, pdf = wo[up], pdf[up]
         wis = np.tile(wi, (len(wo), 1))
-        w = wo[:, 2] / pdf
-        a = np.nansum((source.eval(wis, wo) @ LUMINANCE) * w) / total
-        b = np.nansum((out.eval(wis, wo) @ LUMINANCE) * w) / total
+        w = (wo[:, 2] / pdf)[:, None]
+        terms = []
+        for brdf in (source, out):
+            f = np.nan_to_num(brdf.eval(wis, wo) * w)
+            # The samples below the horizon count as zeros in the mean over `total`.
+            mean = f.sum(axis=0) / total
+            var = (np.sum(f * f, axis=0) / total - mean * mean) / total
+            terms += [mean, np.sqrt(np.maximum(var, 0))]
+        result.append(terms)
+    return result
+
+
+def albedo_ratios(found):
+    """The luminance albedo ratio output / source per θi of albedos()."""
+    ratios = []
+    for a, _, b, _ in found:
+        a, b = a @ LUMINANCE, b @ LUMINANCE
         ratios.append(b / a if a > 0 else float("nan"))
     return ratios
+
+
+def above_one(found):
+    """The largest output albedo (any θi, any channel) where the source's is at most 1, and
+    whether it exceeds 1 by more than three standard errors: an export that creates light."""
+    worst, created = 0.0, False
+    for a, _, b, sb in found:
+        for c in range(3):
+            if a[c] <= 1:
+                worst = max(worst, b[c])
+                created |= bool(b[c] > 1 + 3 * sb[c])
+    return worst, created
 
 
 def cosine_directions(n, rng):
@@ -272,7 +302,7 @@ def main():
     if any(w not in WRITERS for w in writers):
         p.error(f"--writers: one of {', '.join(WRITERS)}")
     fields = ["source", "writer", "status", "nonfinite", "error"] + \
-        [f"albedo_{t}" for t in ANGLES] + ["commands_failed"]
+        [f"albedo_{t}" for t in ANGLES] + ["max_albedo", "commands_failed"]
     rows, failures = [], []
     for source in sources:
         src = halfback.load(source)
@@ -290,18 +320,23 @@ def main():
                     row["status"] = "written"
                     row["nonfinite"] = nonfinite(o)
                     row["error"] = f"{study_error(ref, o):.4f}"
-                    ratios = albedo_ratios(ref, o)
+                    found = albedos(ref, o)
+                    ratios = albedo_ratios(found)
                     for t, r in zip(ANGLES, ratios):
                         row[f"albedo_{t}"] = f"{r:.4f}"
+                    most, created = above_one(found)
+                    bound = TOLERANCE[writer]
+                    row["max_albedo"] = f"{most:.4f}"
                     row["commands_failed"] = "" if args.no_commands else " ".join(
                         commands(args.halfback, out, tmp))
                     worst = max(abs(r - 1) for t, r in zip(ANGLES, ratios) if t <= 80)
-                    bound = TOLERANCE[writer]
-                    if row["nonfinite"] or row["commands_failed"] or \
+                    # Light created: a failure for the writers that keep the energy (bounded).
+                    created = created and bound is not None
+                    if row["nonfinite"] or row["commands_failed"] or created or \
                             (bound is not None and not worst <= bound):
                         failures.append(f"{source} {writer}: nonfinite {row['nonfinite']}, "
-                                        f"albedo ratios {ratios}, commands failed "
-                                        f"'{row['commands_failed']}'")
+                                        f"albedo ratios {ratios}, largest albedo {most:.4f}, "
+                                        f"commands failed '{row['commands_failed']}'")
                 rows.append(row)
                 print(",".join(str(row.get(f, "")) for f in fields), flush=True)
     if args.csv:
@@ -325,9 +360,11 @@ def summarize(rows):
                   for r in cells for t in ANGLES if t <= 80]
         worst = max(ratios)
         errors = sorted(float(r["error"]) for r in cells)
+        most = max((float(r["max_albedo"]), r["source"]) for r in cells)
         print(f"# {writer}: {len(cells)} written; worst albedo ratio (<= 80°) {worst[1]:.3f} "
               f"({worst[3]}, {worst[2]}°); non-finite {sum(int(r['nonfinite']) for r in cells)}; "
-              f"error median {errors[len(errors) // 2]:.4f}, max {errors[-1]:.4f}")
+              f"error median {errors[len(errors) // 2]:.4f}, max {errors[-1]:.4f}; largest "
+              f"albedo where the source's is <= 1: {most[0]:.4f} ({most[1]})")
 
 
 if __name__ == "__main__":
