@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -74,8 +75,28 @@ std::string metric_settings_doc() {
       options += fmt::format("{}{} ({})", options.empty() ? "" : ", ", own[i].key,
                              python_option_values(*m, i));
   }
-  return fmt::format("per metric of the study's list no_NAME ({}) and its options: {}", offs,
-                     options);
+  const std::string text = fmt::format(
+      "per metric of the study's list no_NAME ({}) and its options, each missing one taking its "
+      "default: {}",
+      offs, options);
+  // In lines of at most 100 characters, as the rest of the docstring.
+  std::string wrapped;
+  std::size_t line = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find(' ', at), text.size());
+    const std::size_t word = end - at;
+    if (line && line + 1 + word > 100) {
+      wrapped += '\n';
+      line = 0;
+    } else if (line) {
+      wrapped += ' ';
+      ++line;
+    }
+    wrapped.append(text, at, word);
+    line += word;
+    at = end + 1;
+  }
+  return wrapped;
 }
 
 // A metric's key of the settings dict (no_NAME, or an option: text, an integer or a list of
@@ -349,13 +370,13 @@ with '-' spelled '_': params (a list of parameterization names; missing: all of 
 last), space (the error space), spacings (a list; "designs" is its older name), quick, budgets,
 budgets_4d, test_pairs, env (a list), image_budget, image_size, image_spp, max_theta (the
 reach, in radians as every angle of the Python API, from pi/180 to pi/2; default 85 degrees;
-`halfback study --max-theta` takes degrees), seed, metrics (a list
-of the metrics to run), and )doc") +
-      metric_settings_doc() + R"doc( (missing: the defaults),
-and, for the learned spacing (a default one), profiles: the study_profile() texts of every BRDF of the study, this one's
-included, in the study's order (the warps are learned from all but this one's). Without profiles,
-the default spacings leave the learned one out with a UserWarning; a `spacings` list that names
-"learned" without profiles raises a ValueError.
+`halfback study --max-theta` takes degrees), seed, metrics (a list of the metrics to run), and
+)doc") +
+      metric_settings_doc() + R"doc(;
+and, for the learned spacing (a default one), profiles: the study_profile() texts of every BRDF of
+the study, this one's included, in the study's order (the warps are learned from all but this
+one's). Without profiles, the default spacings leave the learned one out with a UserWarning; a
+`spacings` list that names "learned" without profiles raises a ValueError.
 Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image": one
 row per parameterization and measurement, as in the CSV files of the study, numbers in exact round-trip form, e.g. for
 pandas.read_csv(io.StringIO(t))), "settings" (the resolved settings, which merge_study checks)
