@@ -371,6 +371,16 @@ int run_merge(const StudyOptions& o) {
   return kExitOk;
 }
 
+// The help of option `index` of `m`: what it sets, then its values as the settings resolve them
+// (study::option_default), e.g. "... (default 1000,10000; --quick 1000)".
+std::string metric_option_help(const study::Metric& m, std::size_t index) {
+  const study::OptionDefault d = study::option_default(m, index);
+  std::string values = "default " + d.value;
+  if (d.quick != d.value) values += "; --quick " + d.quick;
+  if (d.when_run) values += fmt::format("; the metric runs with --metrics {}", m.name());
+  return fmt::format("{} ({})", m.options().at(index).help, values);
+}
+
 // --metrics, and per metric of the list (study::study_metrics()) that can be turned off, --no-NAME,
 // and its options (--fit-model for the option fit_model).
 void add_metric_options(CLI::App& app, StudyOptions& o) {
@@ -391,11 +401,13 @@ void add_metric_options(CLI::App& app, StudyOptions& o) {
           fmt::format("Not the {} metric{}", name,
                       m->description().empty() ? "" : fmt::format(" ({})", m->description())));
     }
-    for (const study::MetricOption& option : m->options()) {
+    const std::vector<study::MetricOption> options = m->options();
+    for (std::size_t i = 0; i < options.size(); ++i) {
+      const study::MetricOption& option = options[i];
       std::string flag = "--" + option.key;
       std::replace(flag.begin(), flag.end(), '_', '-');
       using Kind = study::MetricOption::Kind;
-      app.add_option(flag, o.metric_options[option.key], option.help)
+      app.add_option(flag, o.metric_options[option.key], metric_option_help(*m, i))
           ->type_name(option.kind == Kind::count    ? "N"
                       : option.kind == Kind::counts ? "N,..."
                                                     : "TEXT");

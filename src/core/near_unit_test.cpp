@@ -156,9 +156,9 @@ void expect_batch_round_trips(const std::vector<T>& pairs) {
   }
 }
 
-// The reproductions of the issue: ‖h̄‖ = 1.0000004 from a direction 4e-7 long, and ωi = ωo exactly
-// on the horizon, where ‖h̄‖ rounds to 1 + 2e-16.
-TEST(NearUnitDirections, IssueReproductions) {
+// The two pairs that once left the valid domain: ‖h̄‖ = 1.0000004 from a direction 4e-7 long, and
+// ωi = ωo exactly on the horizon, where ‖h̄‖ rounds to 1 + 2e-16.
+TEST(NearUnitDirections, LongAndHorizonPairsConvert) {
   const Form dirs{Space::dirs, false}, ortho{space_of<Ortho>, false};
   const double s = std::sqrt(1 + 8e-7);
   const double x = 0.6 * s, y = 0.8 * s;

@@ -492,7 +492,7 @@ TEST(Registry, DefaultFromIsCheckedWhenAdded) {
   EXPECT_NO_THROW(r.add(tinted_model()));
 }
 
-// The reproductions of the issue: each was silently treated as "not given" (or let through).
+// Values out of range, each once silently treated as "not given" (or let through).
 TEST(BuiltinModels, EveryParameterIsCheckedAgainstItsRange) {
   const std::pair<const char*, const char*> cases[] = {
       {"lambert:albedo_r=-0.3", "albedo_r=-0.3 is outside [0, 1]"},

@@ -1,9 +1,11 @@
 // The study in Python (docs/study.md, "Running on whole databases"): halfback.study_brdf,
 // study_profile, merge_study, and the SSIM of its image-space error (docs/study.md).
+#include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 #include "halfback/study/report.hpp"
 #include "halfback/study/study.hpp"
 #include "halfback/util/output_dir.hpp"
+#include "metric_settings.hpp"
 #include "py_brdf.hpp"
 
 namespace py = pybind11;
@@ -58,6 +61,42 @@ std::string metric_setting_keys() {
     for (const study::MetricOption& o : m->options()) keys += (keys.empty() ? "" : ", ") + o.key;
   }
   return keys;
+}
+
+// study_brdf's documentation of the metrics' keys, from the list (study::study_metrics()): no_NAME
+// for each metric that can be turned off, and each option with its values as the settings
+// resolve them (study::option_default).
+std::string metric_settings_doc() {
+  std::string offs, options;
+  for (const study::Metric* m : study::study_metrics()) {
+    if (m->switchable()) offs += (offs.empty() ? "no_" : ", no_") + std::string(m->name());
+    const std::vector<study::MetricOption> own = m->options();
+    for (std::size_t i = 0; i < own.size(); ++i)
+      options += fmt::format("{}{} ({})", options.empty() ? "" : ", ", own[i].key,
+                             python_option_values(*m, i));
+  }
+  const std::string text = fmt::format(
+      "per metric of the study's list no_NAME ({}) and its options, each missing one taking its "
+      "default: {}",
+      offs, options);
+  // In lines of at most 100 characters, as the rest of the docstring.
+  std::string wrapped;
+  std::size_t line = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find(' ', at), text.size());
+    const std::size_t word = end - at;
+    if (line && line + 1 + word > 100) {
+      wrapped += '\n';
+      line = 0;
+    } else if (line) {
+      wrapped += ' ';
+      ++line;
+    }
+    wrapped.append(text, at, word);
+    line += word;
+    at = end + 1;
+  }
+  return wrapped;
 }
 
 // A metric's key of the settings dict (no_NAME, or an option: text, an integer or a list of
@@ -321,27 +360,30 @@ study's image protocol: both rendered on a sphere under env (a built-in name, a 
 .exr/.hdr file) by environment sampling with the same random numbers, compared over the sphere's
 pixels. settings: study settings (image_size, image_spp, seed; default 96, 16, the study's seed).
 Returns a dict: relative_rmse, mean_delta_e2000, p95_delta_e2000, mae, rmse, ssim, pixels.)doc");
-  m.def("study_brdf", &study_one_brdf, py::arg("spec"), py::arg("settings") = py::none(),
-        R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
+  // Built once, from the list of metrics (pybind11 keeps a copy).
+  const std::string study_brdf_doc =
+      std::string(
+          R"doc(The study of one BRDF (as `halfback study SPEC`), the GIL released while it runs.
 
 spec: a file or model spec, as for load(). settings: a dict of the options of `halfback study`
 with '-' spelled '_': params (a list of parameterization names; missing: all of them, spherical
 last), space (the error space), spacings (a list; "designs" is its older name), quick, budgets,
 budgets_4d, test_pairs, env (a list), image_budget, image_size, image_spp, max_theta (the
 reach, in radians as every angle of the Python API, from pi/180 to pi/2; default 85 degrees;
-`halfback study --max-theta` takes degrees), seed, metrics (a list
-of the metrics to run), and per metric of the study's list no_NAME (no_gonio, no_images,
-no_sampling, no_fit) and its options (sampler_kib (a list), sampler_samples, fit_model, fit_loss,
-fit_budgets (a list), fit_samples) (missing: the defaults), and, for the learned spacing (a
-default one), profiles: the study_profile() texts of every BRDF of the study, this one's
-included, in the study's order (the warps are learned from all but this one's). Without profiles,
-the default spacings leave the learned one out with a UserWarning; a `spacings` list that names
-"learned" without profiles raises a ValueError.
+`halfback study --max-theta` takes degrees), seed, metrics (a list of the metrics to run), and
+)doc") +
+      metric_settings_doc() + R"doc(;
+and, for the learned spacing (a default one), profiles: the study_profile() texts of every BRDF of
+the study, this one's included, in the study's order (the warps are learned from all but this
+one's). Without profiles, the default spacings leave the learned one out with a UserWarning; a
+`spacings` list that names "learned" without profiles raises a ValueError.
 Returns a dict of tables as CSV text ("brdf", "azimuthal", "separability", "gonio", "image": one
 row per parameterization and measurement, as in the CSV files of the study, numbers in exact round-trip form, e.g. for
 pandas.read_csv(io.StringIO(t))), "settings" (the resolved settings, which merge_study checks)
 and "renderings" (the example images, (H, W, 3) float32). Independent of any other BRDF: map it
-over BRDFs with any engine (docs/study.md, "Scaling out").)doc");
+over BRDFs with any engine (docs/study.md, "Scaling out").)doc";
+  m.def("study_brdf", &study_one_brdf, py::arg("spec"), py::arg("settings") = py::none(),
+        study_brdf_doc.c_str());
   m.def("study_profile", &study_one_profile, py::arg("spec"), py::arg("settings") = py::none(),
         R"doc(The profile of one BRDF for the learned design (as text), the GIL released: what the
 learned warps of the other BRDFs are fitted on. settings: as for study_brdf (its error space

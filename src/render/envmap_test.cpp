@@ -293,8 +293,8 @@ void expect_refused_small(const std::filesystem::path& p, const std::string& wor
 TEST(EnvMapAllocation, ExrHeaderClaimingHugeSizeFailsBeforeAllocating) {
   const test::TempDir tmp;
   const auto small = tmp / "small.exr";
-  // Noise, so that the file (about 20 KB, as in the issue) holds the offset table of the claimed
-  // size and OpenEXR opens it.
+  // Noise, so that the file (about 20 KB) holds the offset table of the claimed size and OpenEXR
+  // opens it.
   Image img{96, 48, std::vector<float>(96 * 48 * 3)};
   std::mt19937 rng(4);
   std::uniform_real_distribution<float> u(0, 1);

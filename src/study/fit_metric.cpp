@@ -320,26 +320,23 @@ class FitMetric final : public Metric {
     model.key = "fit_model";
     model.default_value = "lambert+ggx";
     model.help =
-        "Model of the fit metric, fitted to each design's measurements and to the whole BRDF "
-        "(default lambert+ggx; docs/study.md)";
+        "Model of the fit metric (docs/study.md), fitted to each design's measurements and to the "
+        "whole BRDF";
     loss.key = "fit_loss";
     loss.default_value = "ngan";
-    loss.help = "Loss of the fit metric, one of " + fit::loss_names() +
-                " (default ngan; `halfback fit --loss`)";
+    loss.help = "Loss of the fit metric (`halfback fit --loss`), one of " + fit::loss_names();
     budgets.key = "fit_budgets";
     budgets.kind = MetricOption::Kind::counts;
     budgets.default_value = "1000,10000";
     budgets.quick_value = "1000";
     budgets.noun = "sample budget";
-    budgets.help =
-        "Measurement budgets of the fit metric, ascending, comma-separated (default 1000,10000; "
-        "--quick 1000)";
+    budgets.help = "Measurement budgets of the fit metric, ascending, comma-separated";
     samples.key = "fit_samples";
     samples.kind = MetricOption::Kind::count;
     samples.default_value = "20000";
     samples.quick_value = "5000";
     samples.noun = "sample count";
-    samples.help = "Pairs of the whole BRDF's fit of the fit metric (default 20000; --quick 5000)";
+    samples.help = "Pairs of the whole BRDF's fit of the fit metric";
     return {model, loss, budgets, samples};
   }
   void validate(const StudyConfig& config) const override {

@@ -135,12 +135,20 @@ std::vector<std::size_t> option_counts(const StudyConfig& config, const std::str
   return values;
 }
 
+OptionDefault option_default(const Metric& metric, std::size_t index) {
+  const MetricOption o = metric.options().at(index);
+  return {o.default_value, o.quick_value.empty() ? o.default_value : o.quick_value,
+          index == 0 && !metric.on_by_default()};
+}
+
 std::map<std::string, std::string> default_metric_options() {
   std::map<std::string, std::string> options;
   for (const Metric* m : study_metrics()) {
     const std::vector<MetricOption> own = m->options();
-    for (std::size_t i = 0; i < own.size(); ++i)
-      options[own[i].key] = i == 0 && !m->on_by_default() ? std::string() : own[i].default_value;
+    for (std::size_t i = 0; i < own.size(); ++i) {
+      const OptionDefault d = option_default(*m, i);
+      options[own[i].key] = d.when_run ? std::string() : d.value;
+    }
   }
   return options;
 }

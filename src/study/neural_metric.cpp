@@ -157,28 +157,26 @@ class NeuralMetric final : public Metric {
     widths.default_value = "8,16,21,32,64";
     widths.quick_value = "8,21";
     widths.noun = "hidden width";
-    widths.help =
-        "Hidden widths of the neural metric's networks (two layers each), ascending, 1 to 64 "
-        "(default 8,16,21,32,64; --quick 8,21; the metric runs with --metrics neural)";
+    widths.help = fmt::format(
+        "Hidden widths of the neural metric's networks (two layers each), ascending, 1 to {}",
+        nbrdf::kMaxWidth);
     samples.key = "neural_samples";
     samples.kind = MetricOption::Kind::count;
     samples.default_value = "100000";
     samples.quick_value = "20000";
     samples.noun = "pair count";
-    samples.help =
-        "Pairs drawn to train each network of the neural metric (default 100000; "
-        "--quick 20000)";
+    samples.help = "Pairs drawn to train each network of the neural metric";
     epochs.key = "neural_epochs";
     epochs.kind = MetricOption::Kind::count;
     epochs.default_value = "20";
     epochs.quick_value = "5";
     epochs.noun = "epoch count";
-    epochs.help = "Epochs of each network of the neural metric (default 20; --quick 5)";
+    epochs.help = "Epochs of each network of the neural metric";
     rate.key = "neural_learning_rate";
     rate.default_value = "0.001";
     rate.help =
         "Adam's first learning rate of the neural metric, falling to a hundredth at the last "
-        "epoch (default 0.001)";
+        "epoch";
     return {widths, samples, epochs, rate};
   }
   void validate(const StudyConfig& config) const override {

@@ -39,9 +39,11 @@ void apply_quick(StudyConfig& c) {
   c.test_pairs = 20000;
   c.image_size = 48;
   c.image_spp = 8;
-  for (const Metric* m : study_metrics())
-    for (const MetricOption& o : m->options())
-      if (!o.quick_value.empty() && !c.option(o.key).empty()) c.options[o.key] = o.quick_value;
+  for (const Metric* m : study_metrics()) {
+    const std::vector<MetricOption> own = m->options();
+    for (std::size_t i = 0; i < own.size(); ++i)
+      if (!c.option(own[i].key).empty()) c.options[own[i].key] = option_default(*m, i).quick;
+  }
 }
 
 bool named(const std::vector<std::string>& names, std::string_view name) {
@@ -85,9 +87,8 @@ void apply_options(const StudySettings& o, StudyConfig& c) {
           it != o.options.end() && !it->second.empty()) {
         check_option_text(own[i], it->second, flag);
         c.options[own[i].key] = it->second;
-      } else if (i == 0 && !m->on_by_default() && runs(o, *m)) {
-        c.options[own[i].key] =
-            o.quick && !own[i].quick_value.empty() ? own[i].quick_value : own[i].default_value;
+      } else if (const OptionDefault d = option_default(*m, i); d.when_run && runs(o, *m)) {
+        c.options[own[i].key] = o.quick ? d.quick : d.value;
       }
     }
   }

@@ -330,14 +330,14 @@ class SamplingMetric final : public Metric {
     kib.noun = "table size";
     kib.help =
         "Sizes of the samplers' tables (tabulated and factored) compared by the sampling metric, "
-        "KiB, comma-separated (default 64,1024; --quick 64)";
+        "KiB, comma-separated";
     MetricOption samples;
     samples.key = "sampler_samples";
     samples.kind = MetricOption::Kind::count;
     samples.default_value = "4096";
     samples.quick_value = "1024";
     samples.noun = "sample count";
-    samples.help = "Samples per outgoing direction of the sampling metric (default 4096)";
+    samples.help = "Samples per outgoing direction of the sampling metric";
     return {kib, samples};
   }
   void validate(const StudyConfig& config) const override {

@@ -1,5 +1,6 @@
 """Every built-in parameterization and loss is named where the Python API lists them: the module's
-docstring, convert()'s and fit()'s (the lists are generated from the registries)."""
+docstring, convert()'s and fit()'s, and every study setting in study_brdf()'s (the lists are
+generated from the registries)."""
 
 import re
 
@@ -54,3 +55,14 @@ def test_render_docstring_says_what_auto_measures():
     doc = halfback.Brdf.render.__doc__
     assert "variances" in doc and "pilot" not in doc
     assert 'render(env="studio"' in doc
+
+
+def test_every_study_setting_is_in_study_brdfs_docstring():
+    # The metrics' keys and their values are generated from the study's list of metrics.
+    with pytest.raises(ValueError) as e:
+        halfback.study_brdf("lambert", {"no_such_key": 1})
+    accepted = re.search(r"\(accepted: (.*)\)", str(e.value)).group(1).split(", ")
+    doc = halfback.study_brdf.__doc__
+    absent = [key for key in accepted if not re.search(rf"(?<!\w){key}(?!\w)", doc)]
+    assert not absent, f"study_brdf's docstring lacks {absent}"
+    assert "fit_budgets (default [1000, 10000]; quick: [1000])" in " ".join(doc.split())

@@ -40,9 +40,11 @@ struct MetricOption {
   enum class Kind { text, count, counts };
   std::string key;
   Kind kind = Kind::text;
-  std::string default_value;   // as text ("1000,10000")
-  std::string quick_value;     // under --quick; empty: the default
-  std::string help;            // the CLI's help
+  std::string default_value;  // as text ("1000,10000")
+  std::string quick_value;    // under --quick; empty: the default
+  // What it sets, for the CLI's help and Python's docstring, without its values: they follow from
+  // default_value and quick_value (option_default()), never written here.
+  std::string help;
   std::string noun = "value";  // what one number is, for errors ("sample budget")
 };
 
@@ -144,6 +146,17 @@ void register_metric(const Metric& metric);
 const Metric* find_metric(std::string_view name);
 // "azimuthal, separability, ...".
 std::string metric_names();
+
+// What option `index` of `metric` is worth when it is not given, as the settings resolve it
+// (default_metric_options(), make_config()) and as the CLI's help and Python's docstring say it:
+// `value` without --quick, `quick` with it (equal when the option has no quick value);
+// `when_run`: the first option of a metric off by default, empty (the metric off) unless the
+// metric is asked for (--metrics), then `value` (`quick`).
+struct OptionDefault {
+  std::string value, quick;
+  bool when_run = false;
+};
+OptionDefault option_default(const Metric& metric, std::size_t index);
 
 // A metric option's value as numbers (MetricOption::Kind count/counts), read from `config`.
 // std::invalid_argument naming the option when the text is not of its kind.

@@ -1,0 +1,128 @@
+// `halfback study --help` says each metric option's values as the study resolves them: the help
+// of --fit-budgets holds "default X", X being what make_config() gives fit_budgets when it is not
+// given, and "--quick Y" when --quick gives another value Y. The words of the option
+// (MetricOption::help) repeat none of these values, so that the help cannot drift from them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "halfback/study/metric.hpp"
+#include "halfback/study/parts.hpp"
+#include "support/spawn.hpp"
+#include "support/test_support.hpp"
+
+// A named namespace: the test files are compiled as one unity translation unit.
+namespace halfback::study_help_test {
+
+// The help of each option of a help's "Options:" section, by its names as listed
+// ("--fit-budgets"), its wrapped lines joined.
+std::map<std::string, std::string> option_help(const std::string& help_text) {
+  std::map<std::string, std::string> found;
+  std::string last;
+  std::istringstream lines(help_text);
+  bool in_section = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.starts_with("Options:")) {
+      in_section = true;
+      continue;
+    }
+    if (!in_section) continue;
+    if (line.empty() || !line.starts_with(" ")) break;
+    if (line.starts_with("  -")) {
+      const std::size_t end = line.find(' ', 2);
+      last = line.substr(2, end - 2);
+      found[last] = end == std::string::npos ? "" : line.substr(end);
+    } else if (!last.empty()) {
+      (found[last] += ' ') += line.substr(line.find_first_not_of(' '));
+    }
+  }
+  return found;
+}
+
+// Whether `text` holds `value` as a whole value: not inside a longer number or list of numbers
+// ("64" is not in "1,64" nor in "640").
+bool has_value(const std::string& text, const std::string& value) {
+  const auto digit = [&](std::size_t i) {
+    return i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]));
+  };
+  const auto joiner = [&](std::size_t i) {
+    return i < text.size() && (text[i] == ',' || text[i] == '.');
+  };
+  for (std::size_t at = text.find(value); at != std::string::npos; at = text.find(value, at + 1)) {
+    const std::size_t end = at + value.size();
+    const bool before = at > 0 && (digit(at - 1) || (at > 1 && joiner(at - 1) && digit(at - 2)));
+    const bool after = digit(end) || (joiner(end) && digit(end + 1));
+    if (!before && !after) return true;
+  }
+  return false;
+}
+
+TEST(StudyHelp, HasValueFindsWholeValuesOnly) {
+  EXPECT_TRUE(has_value("(default 64,1024; --quick 64)", "64,1024"));
+  EXPECT_TRUE(has_value("default 20.", "20"));
+  EXPECT_FALSE(has_value("1 to 640", "64"));
+  EXPECT_FALSE(has_value("sizes 64,1024", "64"));
+  EXPECT_FALSE(has_value("0.0011", "0.001"));
+  EXPECT_FALSE(has_value("widths 1,64", "64"));
+}
+
+TEST(StudyHelp, MetricOptionsSayTheValuesTheStudyUses) {
+  // Every metric asked for, so that the options of those off by default have their values too.
+  study::StudySettings settings;
+  settings.designs = {"own"};
+  for (const study::Metric* m : study::study_metrics())
+    if (m->switchable()) settings.metrics.emplace_back(m->name());
+  const study::StudyConfig plain = study::make_config(settings);
+  settings.quick = true;
+  const study::StudyConfig quick = study::make_config(settings);
+
+  test::TempDir dir;
+  const test::Captured ran = test::run_captured(dir.path(), {HALFBACK_CLI_PATH, "study", "--help"});
+  ASSERT_TRUE(ran.started) << ran.error;
+  ASSERT_EQ(ran.status, 0) << ran.err;
+  const std::map<std::string, std::string> help = option_help(ran.out);
+
+  std::size_t checked = 0;
+  for (const study::Metric* m : study::study_metrics()) {
+    for (const study::MetricOption& o : m->options()) {
+      std::string flag = "--" + o.key;
+      std::replace(flag.begin(), flag.end(), '_', '-');
+      const auto it = help.find(flag);
+      ASSERT_NE(it, help.end()) << flag << " is not in `halfback study --help`";
+      const std::string& line = it->second;
+      const std::string value = plain.option(o.key), quick_value = quick.option(o.key);
+      ASSERT_FALSE(value.empty()) << o.key;
+      EXPECT_TRUE(line.find("default " + value + ";") != std::string::npos ||
+                  line.find("default " + value + ")") != std::string::npos)
+          << flag << ": the study's default is " << value << "; the help says: " << line;
+      if (quick_value != value) {
+        EXPECT_TRUE(line.find("--quick " + quick_value + ";") != std::string::npos ||
+                    line.find("--quick " + quick_value + ")") != std::string::npos)
+            << flag << ": --quick gives " << quick_value << "; the help says: " << line;
+      } else {
+        EXPECT_EQ(line.find("--quick"), std::string::npos)
+            << flag << ": --quick leaves it at " << value << "; the help says: " << line;
+      }
+      // The values come from the option's fields only, not from its words.
+      EXPECT_EQ(o.help.find("default"), std::string::npos) << flag << ": " << o.help;
+      EXPECT_EQ(o.help.find("--quick"), std::string::npos) << flag << ": " << o.help;
+      for (const std::string& v : {value, quick_value}) {
+        const bool number = std::any_of(v.begin(), v.end(), [](char c) {
+          return std::isdigit(static_cast<unsigned char>(c)) != 0;
+        });
+        if (number) {
+          EXPECT_FALSE(has_value(o.help, v)) << flag << " repeats " << v << ": " << o.help;
+        }
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 4u) << "the metrics' options";
+}
+
+}  // namespace halfback::study_help_test
