@@ -58,12 +58,20 @@ void require_valid(const Brdf& brdf, const DirPair<double>& pair, const Rgb& rho
 
 }  // namespace
 
+Loss loss_of(const std::string& name) {
+  if (name == kNbrdfLosses[0]) return Loss::sztrajman;
+  if (name == kNbrdfLosses[1]) return Loss::study_log;
+  throw std::invalid_argument(
+      fmt::format("--loss '{}': expected {} (the authors') or {} (the study's log measure)", name,
+                  kNbrdfLosses[0], kNbrdfLosses[1]));
+}
+
 double cosine_weight(const double* x) {
   return std::clamp(x[2] * x[5] - x[0] * x[3], 0.0, 1.0);
 }
 
 TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64_t seed,
-                                std::optional<Space> param) {
+                                std::optional<Space> param, Loss loss) {
   if (!brdf.isotropic())
     throw std::domain_error(brdf.name() +
                             " is anisotropic: a neural BRDF of this form is isotropic (its "
@@ -71,7 +79,18 @@ TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64
   Rng rng(seed);
   std::vector<DirPair<double>> pairs;
   pairs.reserve(drawn);
+  // A direction of density cos θ / π on the hemisphere, above the horizon (z ≥ 2^−26.5).
+  auto cosine_direction = [&rng] {
+    const double u = rng.uniform(), phi = 2 * std::numbers::pi * rng.uniform();
+    const double r = std::sqrt(u);
+    return Vec3<double>{r * std::cos(phi), r * std::sin(phi), std::sqrt(1 - u)};
+  };
   for (std::size_t i = 0; i < drawn; ++i) {
+    if (loss == Loss::study_log) {
+      const Vec3<double> wi = cosine_direction();
+      pairs.push_back({wi, cosine_direction()});
+      continue;
+    }
     const double theta_h = rng.uniform() * std::numbers::pi / 2;
     const double theta_d = rng.uniform() * std::numbers::pi / 2;
     const double phi_d = rng.uniform() * 2 * std::numbers::pi;
@@ -84,6 +103,7 @@ TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64
   std::vector<Rgb> rho(pairs.size());
   brdf.eval_batch(pairs, rho);
   TrainingSet set;
+  set.loss = loss;
   const auto n = Eigen::Index(pairs.size());
   set.inputs.resize(param ? 3 : nbrdf::kInputs, n);
   set.targets.resize(nbrdf::kOutputs, n);
@@ -127,9 +147,13 @@ double chunk_loss(const MlpLayout& layout, const Vector& params, const TrainingS
   }
   Activations act;
   forward(layout, params, x, act);
-  if (!gradient) return log_loss_sum(act.outputs(), target, cosine, nullptr);
+  auto loss_sum = [&](Matrix* dy) {
+    return set.loss == Loss::study_log ? study_log_loss_sum(act.outputs(), target, dy)
+                                       : log_loss_sum(act.outputs(), target, cosine, dy);
+  };
+  if (!gradient) return loss_sum(nullptr);
   Matrix dy;
-  const double sum = log_loss_sum(act.outputs(), target, cosine, &dy);
+  const double sum = loss_sum(&dy);
   dy *= scale;
   gradient->setZero(Eigen::Index(layout.size()));
   backward(layout, params, act, dy, *gradient);
@@ -142,7 +166,9 @@ double loss_and_gradient(const MlpLayout& layout, const Vector& params, const Tr
                          std::span<const std::size_t> batch, int threads, Vector* gradient) {
   if (batch.empty()) throw std::invalid_argument("an empty batch");
   const std::size_t chunks = (batch.size() + kChunk - 1) / kChunk;
-  const double scale = 1.0 / double(batch.size() * set.targets.rows());
+  // Sztrajman et al.'s loss is a mean over the channels too; the study's log loss sums its terms.
+  const double per_column = set.loss == Loss::study_log ? 1.0 : double(set.targets.rows());
+  const double scale = 1.0 / (double(batch.size()) * per_column);
   std::vector<double> sums(chunks);
   std::vector<Vector> gradients(gradient ? chunks : 0);
   parallel_for(
@@ -218,6 +244,7 @@ void check_nbrdf_train_options(const NbrdfTrainOptions& o) {
     fail(fmt::format("--restarts: {}, expected 1 to 64", o.restarts));
   if (o.restart_epochs == 0 || o.restart_epochs > 1'000'000)
     fail(fmt::format("--restart-epochs: {}, expected 1 to 1000000", o.restart_epochs));
+  neural::loss_of(o.loss);  // names --loss when unknown
   if (o.threads < 0) fail(fmt::format("--threads: {}, expected 0 or more", o.threads));
 }
 
@@ -258,7 +285,8 @@ NbrdfTrainResult train(const Brdf& brdf, const NbrdfTrainOptions& options,
                        const std::optional<Space>& param, const std::string& input_name,
                        bool readable) {
   using namespace neural;
-  const TrainingSet set = sample_training_set(brdf, options.samples, options.seed, param);
+  const TrainingSet set =
+      sample_training_set(brdf, options.samples, options.seed, param, loss_of(options.loss));
   std::vector<std::size_t> widths{std::size_t(set.inputs.rows())};
   widths.insert(widths.end(), options.hidden.begin(), options.hidden.end());
   widths.push_back(nbrdf::kOutputs);
@@ -425,7 +453,12 @@ std::vector<NbrdfNote> nbrdf_train_notes(const Brdf& brdf, const NbrdfTrainOptio
     hidden += std::to_string(w);
   }
   return {{"trained_from", brdf.name()},
-          {"trainer", "halfback nbrdf train (Sztrajman et al. 2021's loss, sampling and Adam)"},
+          {"trainer", o.loss == kNbrdfLosses[0]
+                          ? "halfback nbrdf train (Sztrajman et al. 2021's loss, sampling and Adam)"
+                          : "halfback nbrdf train (halfback's loss in the study's log measure, its "
+                            "pairs drawn from cos θi cos θo dωi dωo; Sztrajman et al. 2021's "
+                            "network and Adam)"},
+          {"loss_function", o.loss},
           {"hidden", hidden},
           {"samples", fmt::format("{} drawn, {} kept", r.drawn, r.pairs)},
           {"epochs", std::to_string(o.epochs)},
