@@ -92,11 +92,11 @@ double log_loss_sum(const Matrix& y, const Matrix& target, const Vector& cosine,
   return sum;
 }
 
-double study_log_loss_sum(const Matrix& y, const Matrix& target, Matrix* dy) {
-  if (y.rows() != 3 || target.rows() != 3 || target.cols() != y.cols())
-    throw std::invalid_argument("study_log_loss_sum: 3 channels, one target per column");
-  const Rgb weight{Rgb{1, 0, 0}.luminance(), Rgb{0, 1, 0}.luminance(), Rgb{0, 0, 1}.luminance()};
-  const double w[3] = {weight.r, weight.g, weight.b};
+double study_log_loss_sum(const Matrix& y, const Matrix& target, const Vector& weight, Matrix* dy) {
+  if (y.rows() != 3 || target.rows() != 3 || target.cols() != y.cols() || weight.size() != y.cols())
+    throw std::invalid_argument("study_log_loss_sum: 3 channels, one target and weight per column");
+  const double w[3] = {Rgb{1, 0, 0}.luminance(), Rgb{0, 1, 0}.luminance(),
+                       Rgb{0, 0, 1}.luminance()};
   if (dy) dy->resize(y.rows(), y.cols());
   double sum = 0;
   for (Eigen::Index j = 0; j < y.cols(); ++j) {
@@ -110,9 +110,9 @@ double study_log_loss_sum(const Matrix& y, const Matrix& target, Matrix* dy) {
     for (int k = 0; k < 3; ++k) {
       const double dk = y(k, j) - std::log1p(target(k, j));
       channels += dk * dk;
-      if (dy) (*dy)(k, j) = 2 * dlum * w[k] * e[k] / s + 2.0 / 3.0 * dk;
+      if (dy) (*dy)(k, j) = weight[j] * (2 * dlum * w[k] * e[k] / s + 2.0 / 3.0 * dk);
     }
-    sum += dlum * dlum + channels / 3;
+    sum += weight[j] * (dlum * dlum + channels / 3);
   }
   return sum;
 }

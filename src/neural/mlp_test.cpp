@@ -97,6 +97,9 @@ TEST(NbrdfMlp, BackwardPassMatchesCentralDifferences) {
 TEST(NbrdfMlp, StudyLogBackwardPassMatchesCentralDifferences) {
   TrainingSet set = inputs_only(150, 2);
   set.loss = Loss::study_log;
+  set.weight.resize(Eigen::Index(set.size()));
+  Rng rng(4);
+  for (Eigen::Index j = 0; j < set.weight.size(); ++j) set.weight[j] = 0.2 + 1.8 * rng.uniform();
   set_targets_from(set, kSztrajman, random_parameters(kSztrajman, 0.5, 3));
   set.targets = set.targets.cwiseMax(0.0);  // a BRDF's values: ≥ 0, some 0
   const auto [worst, scale] = gradient_against_differences(set);
@@ -106,17 +109,20 @@ TEST(NbrdfMlp, StudyLogBackwardPassMatchesCentralDifferences) {
 
 // The study's log loss of a fixed batch against its definition restated apart: ρ̂ = e^y − 1 per
 // channel, the luminances Ŷ and Y with Rec. 709's weights, and the term
-// (ln(1 + Ŷ) − ln(1 + Y))² + ⅓ Σ_k (ln(1 + ρ̂_k) − ln(1 + ρ_k))², summed over the columns; and its
-// derivative in each y against central differences of the restatement.
+// (ln(1 + Ŷ) − ln(1 + Y))² + ⅓ Σ_k (ln(1 + ρ̂_k) − ln(1 + ρ_k))², its weighted sum over the
+// columns; and its derivative in each y against central differences of the restatement.
 TEST(NbrdfMlp, StudyLogLossIsItsDefinitionOnAFixedBatch) {
   Rng rng(11);
   const Eigen::Index n = 40;
   Matrix y(3, n), target(3, n), dy;
-  for (Eigen::Index j = 0; j < n; ++j)
+  Vector weight(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    weight[j] = 0.1 + 2 * rng.uniform();
     for (Eigen::Index k = 0; k < 3; ++k) {
       y(k, j) = -0.8 + 4.0 * rng.uniform();  // ρ̂ from −0.55 (a negative output) to 19
       target(k, j) = j % 7 == 0 ? 0.0 : std::pow(10.0, -3 + 5 * rng.uniform());
     }
+  }
   auto restated = [](const Matrix& yy, const Matrix& t, Eigen::Index j) {
     const double lum[3] = {0.2126, 0.7152, 0.0722};
     double y_hat = 0, y_true = 0, channels = 0;
@@ -131,8 +137,8 @@ TEST(NbrdfMlp, StudyLogLossIsItsDefinitionOnAFixedBatch) {
     return d * d + channels / 3;
   };
   double expected = 0;
-  for (Eigen::Index j = 0; j < n; ++j) expected += restated(y, target, j);
-  const double sum = study_log_loss_sum(y, target, &dy);
+  for (Eigen::Index j = 0; j < n; ++j) expected += weight[j] * restated(y, target, j);
+  const double sum = study_log_loss_sum(y, target, weight, &dy);
   EXPECT_NEAR(sum, expected, 1e-9 * expected);
   EXPECT_GT(expected, 1.0);  // not a vanishing loss
   double worst = 0, scale = 0;
@@ -142,14 +148,15 @@ TEST(NbrdfMlp, StudyLogLossIsItsDefinitionOnAFixedBatch) {
       Matrix plus = y, minus = y;
       plus(k, j) += h;
       minus(k, j) -= h;
-      const double fd = (restated(plus, target, j) - restated(minus, target, j)) / (2 * h);
+      const double fd =
+          weight[j] * (restated(plus, target, j) - restated(minus, target, j)) / (2 * h);
       worst = std::max(worst, std::abs(fd - dy(k, j)));
       scale = std::max(scale, std::abs(dy(k, j)));
     }
   EXPECT_LE(worst, 1e-7 * scale) << "largest difference " << worst << ", scale " << scale;
   // Where the network is exact the term and its derivative vanish.
   Matrix exact = target.array().log1p();
-  EXPECT_NEAR(study_log_loss_sum(exact, target, &dy), 0.0, 1e-24);
+  EXPECT_NEAR(study_log_loss_sum(exact, target, weight, &dy), 0.0, 1e-24);
   EXPECT_LE(dy.cwiseAbs().maxCoeff(), 1e-12);
 }
 

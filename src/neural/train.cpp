@@ -66,6 +66,18 @@ Loss loss_of(const std::string& name) {
                   kNbrdfLosses[0], kNbrdfLosses[1]));
 }
 
+double study_log_density(const DirPair<double>& pair) {
+  const Vec3<double>&wi = pair.wi, &wo = pair.wo;
+  if (!(wi.z > 0 && wo.z > 0)) return 0;
+  Vec3<double> h{wi.x + wo.x, wi.y + wo.y, wi.z + wo.z};
+  const double norm = std::sqrt(h.x * h.x + h.y * h.y + h.z * h.z);
+  h = {h.x / norm, h.y / norm, h.z / norm};
+  const double cos_h = std::min(h.z, 1.0), sin_h = std::sqrt(1 - cos_h * cos_h);
+  const double cos_d = std::min(wi.x * h.x + wi.y * h.y + wi.z * h.z, 1.0),
+               sin_d = std::sqrt(1 - cos_d * cos_d);
+  return 8 / std::numbers::pi * wi.z * wo.z * cos_d * sin_h * sin_d;
+}
+
 double cosine_weight(const double* x) {
   return std::clamp(x[2] * x[5] - x[0] * x[3], 0.0, 1.0);
 }
@@ -86,7 +98,7 @@ TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64
     return Vec3<double>{r * std::cos(phi), r * std::sin(phi), std::sqrt(1 - u)};
   };
   for (std::size_t i = 0; i < drawn; ++i) {
-    if (loss == Loss::study_log) {
+    if (loss == Loss::study_log && rng.uniform() < 0.5) {
       const Vec3<double> wi = cosine_direction();
       pairs.push_back({wi, cosine_direction()});
       continue;
@@ -108,6 +120,16 @@ TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64
   set.inputs.resize(param ? 3 : nbrdf::kInputs, n);
   set.targets.resize(nbrdf::kOutputs, n);
   set.cosine.resize(n);
+  if (loss == Loss::study_log) {
+    // f_μ / q with q = ½ f_μ + ½ f_a, f_a = 2/π³ the authors' density, times kept / drawn.
+    const double authors = 2 / std::pow(std::numbers::pi, 3);
+    const double kept = double(pairs.size()) / double(drawn);
+    set.weight.resize(n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double f = study_log_density(pairs[std::size_t(j)]);
+      set.weight[j] = kept * f / (0.5 * f + 0.5 * authors);
+    }
+  }
   bool any_nonzero = false;
   for (Eigen::Index j = 0; j < n; ++j) {
     const DirPair<double>& pair = pairs[std::size_t(j)];
@@ -138,17 +160,18 @@ double chunk_loss(const MlpLayout& layout, const Vector& params, const TrainingS
                   std::span<const std::size_t> columns, double scale, Vector* gradient) {
   const auto n = Eigen::Index(columns.size());
   Matrix x(set.inputs.rows(), n), target(set.targets.rows(), n);
-  Vector cosine(n);
+  Vector cosine(n), weight(set.weight.size() > 0 ? n : 0);
   for (Eigen::Index j = 0; j < n; ++j) {
     const auto c = Eigen::Index(columns[std::size_t(j)]);
     x.col(j) = set.inputs.col(c);
     target.col(j) = set.targets.col(c);
     cosine[j] = set.cosine[c];
+    if (weight.size() > 0) weight[j] = set.weight[c];
   }
   Activations act;
   forward(layout, params, x, act);
   auto loss_sum = [&](Matrix* dy) {
-    return set.loss == Loss::study_log ? study_log_loss_sum(act.outputs(), target, dy)
+    return set.loss == Loss::study_log ? study_log_loss_sum(act.outputs(), target, weight, dy)
                                        : log_loss_sum(act.outputs(), target, cosine, dy);
   };
   if (!gradient) return loss_sum(nullptr);

@@ -22,10 +22,11 @@ enum class Loss { sztrajman, study_log };
 Loss loss_of(const std::string& name);
 
 // Training pairs, one column each: the network's input x (6), the target ρ (3), the loss's cosine
-// weight c (Sztrajman et al.'s loss), and the loss they were drawn for.
+// weight c (Sztrajman et al.'s loss) or the pair's weight (the study's log loss), and the loss
+// they were drawn for.
 struct TrainingSet {
   Matrix inputs, targets;
-  Vector cosine;
+  Vector cosine, weight;
   Loss loss = Loss::sztrajman;
   std::size_t size() const { return std::size_t(inputs.cols()); }
 };
@@ -37,18 +38,26 @@ double cosine_weight(const double* x);
 // The training pairs of `loss`, `drawn` of them drawn. Sztrajman et al.'s: θh, θd uniform in
 // [0, π/2], φd uniform in [0, 2π), φh = 0, the pair of those angles (d is ωo, formats/nbrdf.hpp);
 // those with a direction at or below the horizon are dropped (the authors drop MERL's unmeasured
-// values, which are those). The study's log loss: ωi and ωo drawn independently with the density
-// cos θ / π on the hemisphere (z = √(1 − u), u uniform in [0, 1): every pair is kept), so that a
-// mean over the pairs estimates an integral over μ = cos θi cos θo dωi dωo. Each pair gets the
-// input the reader computes for it (nbrdf::encode, rounded to float as the reader evaluates it)
-// and ρ = brdf.eval_batch(pair). Throws std::domain_error for an anisotropic
-// BRDF, naming the pair when ρ is NaN, infinite or negative there, or when it is 0 at every kept
-// pair.
-// With `param`, the input is the pair's isotropic coordinates in it (rounded to float) and c the
-// view direction's cosine (the same direction, computed from the pair).
+// values, which are those). The study's log loss: each pair, with probability ½, either drawn
+// from μ = cos θi cos θo dωi dωo (ωi and ωo independent, of density cos θ / π on the hemisphere)
+// or as the authors draw theirs (dropped when below the horizon), and weighted by
+// f_μ / (½ f_μ + ½ f_a), the densities in (θh, θd, φd) of μ (normalized, study_log_density) and of
+// the authors' sampling (2/π³), times kept / drawn: the mean of the weighted terms over the kept
+// pairs estimates their mean over μ without bias, with the authors' density of pairs near the
+// specular peak (docs/neural.md, "The losses"). Each pair gets the input the reader computes for
+// it (nbrdf::encode, rounded to float as the reader evaluates it) and ρ = brdf.eval_batch(pair).
+// Throws std::domain_error for an anisotropic BRDF, naming the pair when ρ is NaN, infinite or
+// negative there, or when it is 0 at every kept pair. With `param`, the input is the pair's
+// isotropic coordinates in it (rounded to float) and c the view direction's cosine (the same
+// direction, computed from the pair).
 TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64_t seed,
                                 std::optional<Space> param = std::nullopt,
                                 Loss loss = Loss::sztrajman);
+
+// The density of μ = cos θi cos θo dωi dωo / π² (a probability) in Rusinkiewicz's (θh, θd, φd)
+// of an isotropic pair (φh integrated out): with dωi dωo = 4 cos θd dωh dωd,
+// f_μ = (8/π) cos θi cos θo cos θd sin θh sin θd; 0 for a pair with a direction below the horizon.
+double study_log_density(const DirPair<double>& pair);
 
 // Samples per chunk of a batch: each chunk's loss and gradient are computed apart (in parallel)
 // and summed in the chunks' order, so the result depends on neither the thread count nor the
