@@ -115,12 +115,14 @@ Command add_train(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--restart-epochs", o->restart_epochs, "Epochs of each restart before the choice")
       ->capture_default_str();
-  app->add_option("--loss", o->loss,
-                  "sztrajman: the authors' (pairs uniform in theta_h, theta_d, phi_d; mean of "
-                  "|ln(1 + rho' cos) - ln(1 + rho cos)| over the channels); study-log: the study's "
-                  "log measure (pairs drawn from cos_i cos_o dw_i dw_o; mean of "
-                  "(ln(1 + Y') - ln(1 + Y))^2 + 1/3 sum_k (ln(1 + rho'_k) - ln(1 + rho_k))^2, Y "
-                  "the luminance)")
+  app->add_option(
+         "--loss", o->loss,
+         "sztrajman: the authors' (pairs uniform in theta_h, theta_d, phi_d; mean of "
+         "|ln(1 + rho' cos) - ln(1 + rho cos)| over the channels); study-log: the study's "
+         "log measure (half the pairs from cos_i cos_o dw_i dw_o, half the authors', weighted to "
+         "the former; weighted mean of "
+         "(ln(1 + Y') - ln(1 + Y))^2 + 1/3 sum_k (ln(1 + rho'_k) - ln(1 + rho_k))^2, Y "
+         "the luminance)")
       ->capture_default_str()
       ->type_name("LOSS");
   app->add_option("--seed", o->seed, "Seed of the pairs, initial weights and shuffles")

@@ -479,7 +479,7 @@ std::vector<NbrdfNote> nbrdf_train_notes(const Brdf& brdf, const NbrdfTrainOptio
           {"trainer", o.loss == kNbrdfLosses[0]
                           ? "halfback nbrdf train (Sztrajman et al. 2021's loss, sampling and Adam)"
                           : "halfback nbrdf train (halfback's loss in the study's log measure, its "
-                            "pairs drawn from cos θi cos θo dωi dωo; Sztrajman et al. 2021's "
+                            "pairs weighted to cos θi cos θo dωi dωo; Sztrajman et al. 2021's "
                             "network and Adam)"},
           {"loss_function", o.loss},
           {"hidden", hidden},

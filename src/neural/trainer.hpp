@@ -16,7 +16,7 @@
 namespace halfback::neural {
 
 // The losses (NbrdfTrainOptions::loss): Sztrajman et al.'s (log_loss_sum) on their pairs, or
-// halfback's in the study's log measure (study_log_loss_sum) on pairs drawn from μ.
+// halfback's in the study's log measure (study_log_loss_sum) on pairs weighted to μ.
 enum class Loss { sztrajman, study_log };
 // Throws std::invalid_argument naming --loss and the names it takes.
 Loss loss_of(const std::string& name);

@@ -98,7 +98,7 @@ built-in parameterization whose isotropic coordinates the network takes instead.
 final_learning_rate, restarts, restart_epochs: the learning-rate schedule and the restarts of
 `--final-learning-rate`, `--restarts`, `--restart-epochs` (docs/neural.md). loss: "sztrajman"
 (the authors' loss and pairs) or "study-log" (halfback's loss in the study's log measure, on
-pairs drawn from cos theta_i cos theta_o dw_i dw_o), as `--loss` (docs/neural.md, "The losses"). Returns a dict: h5, json, layers (a list of (kernel (inputs, outputs), bias)
+pairs weighted to cos theta_i cos theta_o dw_i dw_o), as `--loss` (docs/neural.md, "The losses"). Returns a dict: h5, json, layers (a list of (kernel (inputs, outputs), bias)
 float32 arrays, as written), loss (of the written network over the pairs), epoch_losses, drawn,
 pairs (kept: both directions above the horizon), steps, seconds. Options out of range raise
 ValueError; an anisotropic BRDF, or one that is NaN, infinite or negative where sampled, or 0 at

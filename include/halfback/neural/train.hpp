@@ -49,8 +49,9 @@ struct NbrdfTrainOptions {
   // The loss and the pairs it is the mean over (docs/neural.md, "The losses"): "sztrajman", the
   // authors' (θh, θd, φd uniform, the pairs with a direction at or below the horizon dropped; the
   // mean over the three channels of |ln(1 + ρ̂ c) − ln(1 + ρ c)|, c = cos θo), or "study-log",
-  // halfback's, whose expectation is the study's log measure: pairs drawn from
-  // μ = cos θi cos θo dωi dωo (both directions cosine-distributed, independently), the mean of
+  // halfback's, whose expectation is the study's log measure: half the pairs drawn from
+  // μ = cos θi cos θo dωi dωo (both directions cosine-distributed, independently), half the
+  // authors' way, weighted to μ; the weighted mean of
   // (ln(1 + Ŷ) − ln(1 + Y))² + ⅓ Σ_k (ln(1 + ρ̂_k) − ln(1 + ρ_k))², Y the luminance.
   std::string loss = "sztrajman";
   std::uint64_t seed = 0;  // the pairs, the initial weights and the shuffles
