@@ -2,14 +2,17 @@
 """halfback's neural BRDFs against the authors' published ones, on the RGL measurements.
 
 Usage: scripts/nbrdf_vs_published.py [--rgl DIR] [--published DIR] [--out DIR] [--halfback EXE]
-                                     [--lock FILE] [--threads T] [--train-args ARGS] [--also DIR]
+                                     [--lock FILE] [--threads T] [--train-args ARGS] [--loss LOSS]
+                                     [--materials A,B,...] [--also DIR] [--baseline JSON]
                                      [--markdown FILE] [--json FILE]
 (with PYTHONPATH naming halfback's Python module, e.g. build/release/python)
 
 For each RGL file NAME.bsdf of --rgl that has a published network NAME.h5 in --published
 (Sztrajman et al. 2021's, asztr/Neural-BRDF), trains a network from the file with
 `halfback nbrdf train` at the default size (6-21-21-3), one thread, with --train-args (default:
-a learning rate of 1e-3 falling to 1e-5, 3 restarts; '' for the authors' settings) into
+a learning rate of 1e-3 falling to 1e-5, 3 restarts; '' for the authors' settings) and
+`--loss LOSS` (default sztrajman, the authors' loss; study-log, halfback's loss in the study's
+log measure: docs/neural.md, "The losses") into
 OUT/NAME.h5 (a network already there is kept, so a run can be resumed: delete it to train
 again), then measures both networks against the RGL file, each with the same pairs:
 
@@ -21,6 +24,10 @@ again), then measures both networks against the RGL file, each with the same pai
   default space and the one the verdict uses;
 - the study's image metric (halfback.image_error: a sphere under the `sky` environment, the
   study's protocol): the relative RMSE of the radiance and the mean CIEDE2000 difference.
+
+--materials restricts the run to the named materials; --also adds a column of the study log
+error of networks trained otherwise (NAME.h5 in a folder), --baseline one of the halfback
+networks of an earlier run's --json (e.g. the authors' loss, against this run's study-log).
 
 Prints a Markdown table (and writes it to --markdown), the count of materials where halfback's
 network is at least as accurate as the published one in the study's measure, and writes every
@@ -124,6 +131,11 @@ def main():
     parser.add_argument("--train-args", default=DEFAULT_TRAIN_ARGS,
                         help=f"options of `nbrdf train` beside the default size (default '{DEFAULT_TRAIN_ARGS}'; "
                         "'' for the authors' settings)")
+    parser.add_argument("--loss", default="sztrajman", choices=["sztrajman", "study-log"],
+                        help="`nbrdf train --loss` (default sztrajman, the authors')")
+    parser.add_argument("--materials", help="only these materials (comma-separated names)")
+    parser.add_argument("--baseline", metavar="JSON",
+                        help="an earlier run's --json: its halfback study log error in a column of its own")
     parser.add_argument("--also", metavar="DIR",
                         help="networks NAME.h5 trained otherwise (e.g. with the authors' settings): their study "
                         "log error in a column of their own")
@@ -135,8 +147,19 @@ def main():
     out_dir.mkdir(parents=True, exist_ok=True)
     materials = sorted(p.stem for p in pathlib.Path(args.rgl).glob("*.bsdf")
                        if (pathlib.Path(args.published) / f"{p.stem}.h5").exists())
+    if args.materials:
+        wanted = args.materials.split(",")
+        unknown = sorted(set(wanted) - set(materials))
+        if unknown:
+            sys.exit(f"--materials: no RGL file with a published network named {', '.join(unknown)}")
+        materials = [m for m in materials if m in wanted]
     if not materials:
         sys.exit(f"no RGL file of {args.rgl} has a published network in {args.published}")
+    baseline = {}
+    if args.baseline:
+        for row in json.loads(pathlib.Path(args.baseline).read_text())["materials"]:
+            baseline[row["material"]] = row["halfback"]["study"]["log"]
+    train_args = args.train_args.split() + ["--loss", args.loss]
 
     wi, wo = authors_pairs(args.pairs, 7)
     wi /= np.linalg.norm(wi, axis=1, keepdims=True)
@@ -147,7 +170,7 @@ def main():
     for name in materials:
         rgl = pathlib.Path(args.rgl) / f"{name}.bsdf"
         ours = out_dir / f"{name}.h5"
-        summary = train(args.halfback, rgl, ours, args.threads, args.lock, args.train_args.split())
+        summary = train(args.halfback, rgl, ours, args.threads, args.lock, train_args)
         if summary:
             print(summary, file=sys.stderr)
         truth = halfback.load(str(rgl)).eval(wi, wo)
@@ -165,8 +188,10 @@ def main():
     lines = [
         "| RGL material | loss, halfback | loss, published | study log error, halfback | published "
         "| linear, halfback | published | image rel. RMSE, halfback | published | mean ΔE00, halfback "
-        "| published |" + (" study log error, `--also` |" if args.also else ""),
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |" + (" --- |" if args.also else ""),
+        "| published |" + (" study log error, `--also` |" if args.also else "")
+        + (" study log error, `--baseline` |" if args.baseline else ""),
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |" + (" --- |" if args.also else "")
+        + (" --- |" if args.baseline else ""),
     ]
     wins = {"loss": 0, "log": 0, "linear": 0, "image": 0}
     for r in results:
@@ -186,6 +211,10 @@ def main():
                  *pair(h["image"]["mean_delta_e2000"], p["image"]["mean_delta_e2000"], "{:.3f}")]
         if args.also:
             cells.append(f"{r['also']['log']:.4f}" if r.get("also") else "–")
+        if args.baseline:
+            b = baseline.get(r["material"])
+            cells.append(f"{b:.4f}" if b is not None else "–")
+            r["baseline_log"] = b
         lines.append(f"| {r['material']} | " + " | ".join(cells) + " |")
     n = len(results)
     lines.append("")
@@ -197,7 +226,8 @@ def main():
     if args.markdown:
         pathlib.Path(args.markdown).write_text(table)
     if args.json:
-        pathlib.Path(args.json).write_text(json.dumps({"materials": results, "wins": wins, "count": n}, indent=2))
+        pathlib.Path(args.json).write_text(json.dumps({"materials": results, "wins": wins, "count": n, "loss": args.loss,
+                                                     "train_args": args.train_args}, indent=2))
 
 
 if __name__ == "__main__":

@@ -113,11 +113,11 @@ def emit(spec, target, name="halfback_fit"):
 
 def nbrdf_train(brdf, output, hidden=(21, 21), samples=640000, epochs=100, batch=512,
                 learning_rate=5e-4, seed=0, threads=0, param="", final_learning_rate=0.0, restarts=1,
-                restart_epochs=5):
+                restart_epochs=5, loss="sztrajman"):
     import os
     return _core.nbrdf_train(brdf, os.fspath(output), list(hidden), samples, epochs, batch,
                              learning_rate, seed, threads, param, final_learning_rate, restarts,
-                             restart_epochs)
+                             restart_epochs, loss)
 
 
 def published_fits(path):

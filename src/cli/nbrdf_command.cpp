@@ -17,7 +17,7 @@ namespace halfback::cli {
 namespace {
 
 struct NbrdfTrainCommandOptions {
-  std::string brdf, output, param, hidden = "21,21";
+  std::string brdf, output, param, hidden = "21,21", loss{kNbrdfLosses[0]};
   std::size_t samples = 640000, epochs = 100, batch = 512;
   double learning_rate = 5e-4, final_learning_rate = 0;
   std::size_t restarts = 1, restart_epochs = 5;
@@ -37,6 +37,7 @@ NbrdfTrainOptions train_options(const NbrdfTrainCommandOptions& o) {
   options.final_learning_rate = o.final_learning_rate;
   options.restarts = o.restarts;
   options.restart_epochs = o.restart_epochs;
+  options.loss = o.loss;
   options.seed = o.seed;
   options.threads = o.threads;
   try {
@@ -100,7 +101,7 @@ Command add_train(CLI::App& parent) {
       ->type_name("PARAM");
   app->add_option("--hidden", o->hidden, "Hidden layer widths, comma-separated (1-64 units)")
       ->capture_default_str();
-  app->add_option("--samples", o->samples, "Pairs drawn (uniform in theta_h, theta_d, phi_d)")
+  app->add_option("--samples", o->samples, "Pairs drawn (as --loss draws them)")
       ->capture_default_str();
   app->add_option("--epochs", o->epochs, "Passes over the pairs")->capture_default_str();
   app->add_option("--batch", o->batch, "Pairs per Adam step")->capture_default_str();
@@ -114,6 +115,16 @@ Command add_train(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--restart-epochs", o->restart_epochs, "Epochs of each restart before the choice")
       ->capture_default_str();
+  app->add_option(
+         "--loss", o->loss,
+         "sztrajman: the authors' (pairs uniform in theta_h, theta_d, phi_d; mean of "
+         "|ln(1 + rho' cos) - ln(1 + rho cos)| over the channels); study-log: the study's "
+         "log measure (half the pairs from cos_i cos_o dw_i dw_o, half the authors', weighted to "
+         "the former; weighted mean of "
+         "(ln(1 + Y') - ln(1 + Y))^2 + 1/3 sum_k (ln(1 + rho'_k) - ln(1 + rho_k))^2, Y "
+         "the luminance)")
+      ->capture_default_str()
+      ->type_name("LOSS");
   app->add_option("--seed", o->seed, "Seed of the pairs, initial weights and shuffles")
       ->capture_default_str();
   app->add_option("--threads", o->threads, "worker threads (0: all cores; same result for any)")

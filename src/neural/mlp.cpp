@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "halfback/core/rgb.hpp"
+
 namespace halfback::neural {
 
 MlpLayout::MlpLayout(std::vector<std::size_t> widths) : widths_(std::move(widths)) {
@@ -86,6 +88,31 @@ double log_loss_sum(const Matrix& y, const Matrix& target, const Vector& cosine,
         (*dy)(k, j) = sign * c * e / predicted;
       }
     }
+  }
+  return sum;
+}
+
+double study_log_loss_sum(const Matrix& y, const Matrix& target, const Vector& weight, Matrix* dy) {
+  if (y.rows() != 3 || target.rows() != 3 || target.cols() != y.cols() || weight.size() != y.cols())
+    throw std::invalid_argument("study_log_loss_sum: 3 channels, one target and weight per column");
+  const double w[3] = {Rgb{1, 0, 0}.luminance(), Rgb{0, 1, 0}.luminance(),
+                       Rgb{0, 0, 1}.luminance()};
+  if (dy) dy->resize(y.rows(), y.cols());
+  double sum = 0;
+  for (Eigen::Index j = 0; j < y.cols(); ++j) {
+    // ln(1 + Ŷ) = ln Σ w_k e^{y_k}, shifted by the largest y against overflow.
+    const double top = y.col(j).maxCoeff();
+    double e[3], s = 0;
+    for (int k = 0; k < 3; ++k) s += w[k] * (e[k] = std::exp(y(k, j) - top));
+    const Rgb rho{target(0, j), target(1, j), target(2, j)};
+    const double dlum = top + std::log(s) - std::log1p(rho.luminance());
+    double channels = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double dk = y(k, j) - std::log1p(target(k, j));
+      channels += dk * dk;
+      if (dy) (*dy)(k, j) = weight[j] * (2 * dlum * w[k] * e[k] / s + 2.0 / 3.0 * dk);
+    }
+    sum += weight[j] * (dlum * dlum + channels / 3);
   }
   return sum;
 }

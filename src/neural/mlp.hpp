@@ -88,6 +88,13 @@ void backward(const MlpLayout& layout, const Vector& params, const Activations& 
 // with sign(0) = 0 (as TensorFlow's derivative of |x|).
 double log_loss_sum(const Matrix& y, const Matrix& target, const Vector& cosine, Matrix* dy);
 
+// halfback's loss term in the study's log measure (docs/neural.md, "The losses"), summed over the
+// columns with the weights `weight` (n): Σ_j weight_j [(ln(1 + Ŷ) − ln(1 + Y))² + ⅓ Σ_k (ln(1 +
+// ρ̂_k) − ln(1 + ρ_k))²], with ρ̂ = exp(y) − 1 (so ln(1 + ρ̂_k) = y_k and ln(1 + Ŷ) = ln Σ_k w_k
+// exp(y_k)), ρ the target (3 × n) and Ŷ, Y the luminances (Rgb::luminance's weights w, which sum
+// to 1). Writes d(sum)/dy into `dy` when it is not null.
+double study_log_loss_sum(const Matrix& y, const Matrix& target, const Vector& weight, Matrix* dy);
+
 // Adam (Kingma and Ba 2015) as Keras 2.2 implements it, the optimizer of Sztrajman et al.: at step
 // t, lr_t = lr √(1 − β2^t) / (1 − β1^t), m ← β1 m + (1 − β1) g, v ← β2 v + (1 − β2) g²,
 // p ← p − lr_t m / (√v + ε), with ε = 1e-7 (Keras's K.epsilon(), their epsilon=None).

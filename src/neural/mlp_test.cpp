@@ -7,6 +7,8 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "neural/mlp.hpp"
@@ -59,14 +61,15 @@ std::vector<std::size_t> first(std::size_t n) {
   return v;
 }
 
-TEST(NbrdfMlp, BackwardPassMatchesCentralDifferences) {
+// The largest difference between the gradient of the loss of `set` at random parameters and its
+// central differences, and the gradient's largest component.
+std::pair<double, double> gradient_against_differences(const TrainingSet& set) {
   const Vector params = random_parameters(kSztrajman, 0.5, 1);
-  TrainingSet set = inputs_only(150, 2);  // three chunks, the last partial
-  set_targets_from(set, kSztrajman, random_parameters(kSztrajman, 0.5, 3));
   const std::vector<std::size_t> batch = first(set.size());
   Vector gradient;
   loss_and_gradient(kSztrajman, params, set, batch, 1, &gradient);
-  ASSERT_EQ(std::size_t(gradient.size()), kSztrajman.size());
+  if (std::size_t(gradient.size()) != kSztrajman.size())
+    throw std::logic_error("the gradient is not of the layout's size");
   double worst = 0;
   for (Eigen::Index i = 0; i < params.size(); ++i) {
     const double h = 1e-6;
@@ -78,11 +81,83 @@ TEST(NbrdfMlp, BackwardPassMatchesCentralDifferences) {
                       (2 * h);
     worst = std::max(worst, std::abs(fd - gradient[i]));
   }
+  return {worst, gradient.cwiseAbs().maxCoeff()};
+}
+
+TEST(NbrdfMlp, BackwardPassMatchesCentralDifferences) {
+  TrainingSet set = inputs_only(150, 2);  // three chunks, the last partial
+  set_targets_from(set, kSztrajman, random_parameters(kSztrajman, 0.5, 3));
+  const auto [worst, scale] = gradient_against_differences(set);
   // Relative to the gradient's largest component (the small ones carry the differences'
   // rounding, ~1e-10 absolute).
-  const double scale = gradient.cwiseAbs().maxCoeff();
   EXPECT_GT(scale, 1e-3);
   EXPECT_LE(worst, 1e-6 * scale) << "largest difference " << worst << ", gradient scale " << scale;
+}
+
+TEST(NbrdfMlp, StudyLogBackwardPassMatchesCentralDifferences) {
+  TrainingSet set = inputs_only(150, 2);
+  set.loss = Loss::study_log;
+  set.weight.resize(Eigen::Index(set.size()));
+  Rng rng(4);
+  for (Eigen::Index j = 0; j < set.weight.size(); ++j) set.weight[j] = 0.2 + 1.8 * rng.uniform();
+  set_targets_from(set, kSztrajman, random_parameters(kSztrajman, 0.5, 3));
+  set.targets = set.targets.cwiseMax(0.0);  // a BRDF's values: ≥ 0, some 0
+  const auto [worst, scale] = gradient_against_differences(set);
+  EXPECT_GT(scale, 1e-3);
+  EXPECT_LE(worst, 1e-6 * scale) << "largest difference " << worst << ", gradient scale " << scale;
+}
+
+// The study's log loss of a fixed batch against its definition restated apart: ρ̂ = e^y − 1 per
+// channel, the luminances Ŷ and Y with Rec. 709's weights, and the term
+// (ln(1 + Ŷ) − ln(1 + Y))² + ⅓ Σ_k (ln(1 + ρ̂_k) − ln(1 + ρ_k))², its weighted sum over the
+// columns; and its derivative in each y against central differences of the restatement.
+TEST(NbrdfMlp, StudyLogLossIsItsDefinitionOnAFixedBatch) {
+  Rng rng(11);
+  const Eigen::Index n = 40;
+  Matrix y(3, n), target(3, n), dy;
+  Vector weight(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    weight[j] = 0.1 + 2 * rng.uniform();
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      y(k, j) = -0.8 + 4.0 * rng.uniform();  // ρ̂ from −0.55 (a negative output) to 19
+      target(k, j) = j % 7 == 0 ? 0.0 : std::pow(10.0, -3 + 5 * rng.uniform());
+    }
+  }
+  auto restated = [](const Matrix& yy, const Matrix& t, Eigen::Index j) {
+    const double lum[3] = {0.2126, 0.7152, 0.0722};
+    double y_hat = 0, y_true = 0, channels = 0;
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      const double rho_hat = std::expm1(yy(k, j));
+      y_hat += lum[k] * rho_hat;
+      y_true += lum[k] * t(k, j);
+      const double d = std::log1p(rho_hat) - std::log1p(t(k, j));
+      channels += d * d;
+    }
+    const double d = std::log1p(y_hat) - std::log1p(y_true);
+    return d * d + channels / 3;
+  };
+  double expected = 0;
+  for (Eigen::Index j = 0; j < n; ++j) expected += weight[j] * restated(y, target, j);
+  const double sum = study_log_loss_sum(y, target, weight, &dy);
+  EXPECT_NEAR(sum, expected, 1e-9 * expected);
+  EXPECT_GT(expected, 1.0);  // not a vanishing loss
+  double worst = 0, scale = 0;
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index k = 0; k < 3; ++k) {
+      const double h = 1e-6;
+      Matrix plus = y, minus = y;
+      plus(k, j) += h;
+      minus(k, j) -= h;
+      const double fd =
+          weight[j] * (restated(plus, target, j) - restated(minus, target, j)) / (2 * h);
+      worst = std::max(worst, std::abs(fd - dy(k, j)));
+      scale = std::max(scale, std::abs(dy(k, j)));
+    }
+  EXPECT_LE(worst, 1e-7 * scale) << "largest difference " << worst << ", scale " << scale;
+  // Where the network is exact the term and its derivative vanish.
+  Matrix exact = target.array().log1p();
+  EXPECT_NEAR(study_log_loss_sum(exact, target, weight, &dy), 0.0, 1e-24);
+  EXPECT_LE(dy.cwiseAbs().maxCoeff(), 1e-12);
 }
 
 TEST(NbrdfMlp, LossGradientIsSztrajmansAtOnePoint) {

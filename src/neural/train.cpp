@@ -58,12 +58,32 @@ void require_valid(const Brdf& brdf, const DirPair<double>& pair, const Rgb& rho
 
 }  // namespace
 
+Loss loss_of(const std::string& name) {
+  if (name == kNbrdfLosses[0]) return Loss::sztrajman;
+  if (name == kNbrdfLosses[1]) return Loss::study_log;
+  throw std::invalid_argument(
+      fmt::format("--loss '{}': expected {} (the authors') or {} (the study's log measure)", name,
+                  kNbrdfLosses[0], kNbrdfLosses[1]));
+}
+
+double study_log_density(const DirPair<double>& pair) {
+  const Vec3<double>&wi = pair.wi, &wo = pair.wo;
+  if (!(wi.z > 0 && wo.z > 0)) return 0;
+  Vec3<double> h{wi.x + wo.x, wi.y + wo.y, wi.z + wo.z};
+  const double norm = std::sqrt(h.x * h.x + h.y * h.y + h.z * h.z);
+  h = {h.x / norm, h.y / norm, h.z / norm};
+  const double cos_h = std::min(h.z, 1.0), sin_h = std::sqrt(1 - cos_h * cos_h);
+  const double cos_d = std::min(wi.x * h.x + wi.y * h.y + wi.z * h.z, 1.0),
+               sin_d = std::sqrt(1 - cos_d * cos_d);
+  return 8 / std::numbers::pi * wi.z * wo.z * cos_d * sin_h * sin_d;
+}
+
 double cosine_weight(const double* x) {
   return std::clamp(x[2] * x[5] - x[0] * x[3], 0.0, 1.0);
 }
 
 TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64_t seed,
-                                std::optional<Space> param) {
+                                std::optional<Space> param, Loss loss) {
   if (!brdf.isotropic())
     throw std::domain_error(brdf.name() +
                             " is anisotropic: a neural BRDF of this form is isotropic (its "
@@ -71,7 +91,18 @@ TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64
   Rng rng(seed);
   std::vector<DirPair<double>> pairs;
   pairs.reserve(drawn);
+  // A direction of density cos θ / π on the hemisphere, above the horizon (z ≥ 2^−26.5).
+  auto cosine_direction = [&rng] {
+    const double u = rng.uniform(), phi = 2 * std::numbers::pi * rng.uniform();
+    const double r = std::sqrt(u);
+    return Vec3<double>{r * std::cos(phi), r * std::sin(phi), std::sqrt(1 - u)};
+  };
   for (std::size_t i = 0; i < drawn; ++i) {
+    if (loss == Loss::study_log && rng.uniform() < 0.5) {
+      const Vec3<double> wi = cosine_direction();
+      pairs.push_back({wi, cosine_direction()});
+      continue;
+    }
     const double theta_h = rng.uniform() * std::numbers::pi / 2;
     const double theta_d = rng.uniform() * std::numbers::pi / 2;
     const double phi_d = rng.uniform() * 2 * std::numbers::pi;
@@ -84,10 +115,21 @@ TrainingSet sample_training_set(const Brdf& brdf, std::size_t drawn, std::uint64
   std::vector<Rgb> rho(pairs.size());
   brdf.eval_batch(pairs, rho);
   TrainingSet set;
+  set.loss = loss;
   const auto n = Eigen::Index(pairs.size());
   set.inputs.resize(param ? 3 : nbrdf::kInputs, n);
   set.targets.resize(nbrdf::kOutputs, n);
   set.cosine.resize(n);
+  if (loss == Loss::study_log) {
+    // f_μ / q with q = ½ f_μ + ½ f_a, f_a = 2/π³ the authors' density, times kept / drawn.
+    const double authors = 2 / std::pow(std::numbers::pi, 3);
+    const double kept = double(pairs.size()) / double(drawn);
+    set.weight.resize(n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double f = study_log_density(pairs[std::size_t(j)]);
+      set.weight[j] = kept * f / (0.5 * f + 0.5 * authors);
+    }
+  }
   bool any_nonzero = false;
   for (Eigen::Index j = 0; j < n; ++j) {
     const DirPair<double>& pair = pairs[std::size_t(j)];
@@ -118,18 +160,23 @@ double chunk_loss(const MlpLayout& layout, const Vector& params, const TrainingS
                   std::span<const std::size_t> columns, double scale, Vector* gradient) {
   const auto n = Eigen::Index(columns.size());
   Matrix x(set.inputs.rows(), n), target(set.targets.rows(), n);
-  Vector cosine(n);
+  Vector cosine(n), weight(set.weight.size() > 0 ? n : 0);
   for (Eigen::Index j = 0; j < n; ++j) {
     const auto c = Eigen::Index(columns[std::size_t(j)]);
     x.col(j) = set.inputs.col(c);
     target.col(j) = set.targets.col(c);
     cosine[j] = set.cosine[c];
+    if (weight.size() > 0) weight[j] = set.weight[c];
   }
   Activations act;
   forward(layout, params, x, act);
-  if (!gradient) return log_loss_sum(act.outputs(), target, cosine, nullptr);
+  auto loss_sum = [&](Matrix* dy) {
+    return set.loss == Loss::study_log ? study_log_loss_sum(act.outputs(), target, weight, dy)
+                                       : log_loss_sum(act.outputs(), target, cosine, dy);
+  };
+  if (!gradient) return loss_sum(nullptr);
   Matrix dy;
-  const double sum = log_loss_sum(act.outputs(), target, cosine, &dy);
+  const double sum = loss_sum(&dy);
   dy *= scale;
   gradient->setZero(Eigen::Index(layout.size()));
   backward(layout, params, act, dy, *gradient);
@@ -142,7 +189,9 @@ double loss_and_gradient(const MlpLayout& layout, const Vector& params, const Tr
                          std::span<const std::size_t> batch, int threads, Vector* gradient) {
   if (batch.empty()) throw std::invalid_argument("an empty batch");
   const std::size_t chunks = (batch.size() + kChunk - 1) / kChunk;
-  const double scale = 1.0 / double(batch.size() * set.targets.rows());
+  // Sztrajman et al.'s loss is a mean over the channels too; the study's log loss sums its terms.
+  const double per_column = set.loss == Loss::study_log ? 1.0 : double(set.targets.rows());
+  const double scale = 1.0 / (double(batch.size()) * per_column);
   std::vector<double> sums(chunks);
   std::vector<Vector> gradients(gradient ? chunks : 0);
   parallel_for(
@@ -218,6 +267,7 @@ void check_nbrdf_train_options(const NbrdfTrainOptions& o) {
     fail(fmt::format("--restarts: {}, expected 1 to 64", o.restarts));
   if (o.restart_epochs == 0 || o.restart_epochs > 1'000'000)
     fail(fmt::format("--restart-epochs: {}, expected 1 to 1000000", o.restart_epochs));
+  neural::loss_of(o.loss);  // names --loss when unknown
   if (o.threads < 0) fail(fmt::format("--threads: {}, expected 0 or more", o.threads));
 }
 
@@ -258,7 +308,8 @@ NbrdfTrainResult train(const Brdf& brdf, const NbrdfTrainOptions& options,
                        const std::optional<Space>& param, const std::string& input_name,
                        bool readable) {
   using namespace neural;
-  const TrainingSet set = sample_training_set(brdf, options.samples, options.seed, param);
+  const TrainingSet set =
+      sample_training_set(brdf, options.samples, options.seed, param, loss_of(options.loss));
   std::vector<std::size_t> widths{std::size_t(set.inputs.rows())};
   widths.insert(widths.end(), options.hidden.begin(), options.hidden.end());
   widths.push_back(nbrdf::kOutputs);
@@ -425,7 +476,12 @@ std::vector<NbrdfNote> nbrdf_train_notes(const Brdf& brdf, const NbrdfTrainOptio
     hidden += std::to_string(w);
   }
   return {{"trained_from", brdf.name()},
-          {"trainer", "halfback nbrdf train (Sztrajman et al. 2021's loss, sampling and Adam)"},
+          {"trainer", o.loss == kNbrdfLosses[0]
+                          ? "halfback nbrdf train (Sztrajman et al. 2021's loss, sampling and Adam)"
+                          : "halfback nbrdf train (halfback's loss in the study's log measure, its "
+                            "pairs weighted to cos θi cos θo dωi dωo; Sztrajman et al. 2021's "
+                            "network and Adam)"},
+          {"loss_function", o.loss},
           {"hidden", hidden},
           {"samples", fmt::format("{} drawn, {} kept", r.drawn, r.pairs)},
           {"epochs", std::to_string(o.epochs)},

@@ -207,12 +207,62 @@ TEST(NbrdfTrain, RefusesOptionsOutOfRange) {
   EXPECT_NE(with([](auto& o) { o.restarts = 65; }).find("--restarts: 65"), std::string::npos);
   EXPECT_NE(with([](auto& o) { o.restart_epochs = 0; }).find("--restart-epochs: 0"),
             std::string::npos);
+  EXPECT_EQ(with([](auto& o) { o.loss = "study-log"; }), "no error");
+  EXPECT_NE(with([](auto& o) { o.loss = "l2"; }).find("--loss 'l2': expected sztrajman"),
+            std::string::npos);
   // train_nbrdf_on: an input space and --param at once, or the dirs space.
   NbrdfTrainOptions o = small_options();
   o.param = "hybrid";
   EXPECT_THROW(train_nbrdf_on(*lambert, o, *space_from_name("halfdiff")), std::invalid_argument);
   o.param.clear();
   EXPECT_THROW(train_nbrdf_on(*lambert, o, Space::dirs), std::invalid_argument);
+}
+
+// The study's log loss: half its pairs from μ = cos θi cos θo dωi dωo, half the authors' way, and
+// weights that make a mean over the kept pairs a mean over μ. Weighted, the two cosines (from the
+// reader's input: cos θo = hz dz − hx dx, cos θi = hz dz + hx dx) have μ's moments: mean 2/3
+// each, mean square 1/2, mean product 4/9 (independent, each of density 2 cos θ), and the weights
+// mean 1 (f_μ is a probability density); unweighted they do not (the authors' half draws more
+// pairs near the peak and the horizon). study_log_density is μ's density: its mean over the
+// authors' box, times the box's volume π³/2, is 1.
+TEST(NbrdfTrain, StudyLogPairsAreWeightedToTheMeasure) {
+  const BrdfPtr lambert = load_brdf("lambert");
+  const std::size_t n = 100000;
+  const neural::TrainingSet set =
+      neural::sample_training_set(*lambert, n, 3, std::nullopt, neural::Loss::study_log);
+  EXPECT_NEAR(double(set.size()) / double(n), 0.5 + 0.5 * 0.617, 0.01);
+  ASSERT_EQ(set.weight.size(), Eigen::Index(set.size()));
+  double w = 0, ci = 0, co = 0, co2 = 0, product = 0, plain_co = 0;
+  for (Eigen::Index j = 0; j < Eigen::Index(set.size()); ++j) {
+    const double* x = set.inputs.col(j).data();
+    const double i = x[2] * x[5] + x[0] * x[3], o = x[2] * x[5] - x[0] * x[3], v = set.weight[j];
+    w += v, ci += v * i, co += v * o, co2 += v * o * o, product += v * i * o, plain_co += o;
+  }
+  const double m = double(set.size());
+  // Standard errors about 0.002 (weights of spread about 1, cosines of 0.24, 80,000 pairs): the
+  // bounds are about 4 of them.
+  EXPECT_NEAR(w / m, 1.0, 0.01);
+  EXPECT_NEAR(ci / m, 2.0 / 3, 0.008);
+  EXPECT_NEAR(co / m, 2.0 / 3, 0.008);
+  EXPECT_NEAR(co2 / m, 0.5, 0.008);
+  EXPECT_NEAR(product / m, 4.0 / 9, 0.008);
+  EXPECT_GT(std::abs(plain_co / m - 2.0 / 3), 0.03);  // the weights matter
+
+  neural::Rng rng(8);
+  double integral = 0;
+  const std::size_t boxes = 200000;
+  for (std::size_t k = 0; k < boxes; ++k) {
+    const double th = rng.uniform() * std::numbers::pi / 2,
+                 td = rng.uniform() * std::numbers::pi / 2,
+                 pd = rng.uniform() * 2 * std::numbers::pi;
+    const double sh = std::sin(th), ch = std::cos(th), dx = std::sin(td) * std::cos(pd),
+                 dy = std::sin(td) * std::sin(pd), dz = std::cos(td);
+    const Vec3<double> wo{ch * dx + sh * dz, dy, -sh * dx + ch * dz};
+    const double hw = sh * wo.x + ch * wo.z;
+    const Vec3<double> wi{2 * hw * sh - wo.x, -wo.y, 2 * hw * ch - wo.z};
+    integral += neural::study_log_density({wi, wo});
+  }
+  EXPECT_NEAR(integral / double(boxes) * std::pow(std::numbers::pi, 3) / 2, 1.0, 0.01);
 }
 
 // Restarts: the first candidate is the training without restarts (the same stream), so the

@@ -35,7 +35,8 @@ py::dict nbrdf_train(const py::object& brdf, const std::string& output,
                      const std::vector<std::size_t>& hidden, std::size_t samples,
                      std::size_t epochs, std::size_t batch, double learning_rate,
                      std::uint64_t seed, int threads, const std::string& param,
-                     double final_learning_rate, std::size_t restarts, std::size_t restart_epochs) {
+                     double final_learning_rate, std::size_t restarts, std::size_t restart_epochs,
+                     const std::string& loss) {
   NbrdfTrainOptions o;
   o.param = param;
   o.hidden = hidden;
@@ -46,6 +47,7 @@ py::dict nbrdf_train(const py::object& brdf, const std::string& output,
   o.final_learning_rate = final_learning_rate;
   o.restarts = restarts;
   o.restart_epochs = restart_epochs;
+  o.loss = loss;
   o.seed = seed;
   o.threads = threads;
   try {
@@ -87,14 +89,16 @@ void bind_nbrdf(py::module_& m) {
         py::arg("epochs") = 100, py::arg("batch") = 512, py::arg("learning_rate") = 5e-4,
         py::arg("seed") = 0, py::arg("threads") = 0, py::arg("param") = "",
         py::arg("final_learning_rate") = 0.0, py::arg("restarts") = 1,
-        py::arg("restart_epochs") = 5,
+        py::arg("restart_epochs") = 5, py::arg("loss") = std::string(kNbrdfLosses[0]),
         R"doc(Trains a neural BRDF (Sztrajman et al. 2021) on a BRDF (a spec or a Brdf), as
 `halfback nbrdf train` (docs/neural.md), the GIL released while it runs, and writes `output`
 (NAME.h5, the Keras weights) and NAME.json (the Keras model description) beside it; load()
 reads the result. param: "" for the authors' input (sin theta_h, 0, cos theta_h, d), or a
 built-in parameterization whose isotropic coordinates the network takes instead.
 final_learning_rate, restarts, restart_epochs: the learning-rate schedule and the restarts of
-`--final-learning-rate`, `--restarts`, `--restart-epochs` (docs/neural.md). Returns a dict: h5, json, layers (a list of (kernel (inputs, outputs), bias)
+`--final-learning-rate`, `--restarts`, `--restart-epochs` (docs/neural.md). loss: "sztrajman"
+(the authors' loss and pairs) or "study-log" (halfback's loss in the study's log measure, on
+pairs weighted to cos theta_i cos theta_o dw_i dw_o), as `--loss` (docs/neural.md, "The losses"). Returns a dict: h5, json, layers (a list of (kernel (inputs, outputs), bias)
 float32 arrays, as written), loss (of the written network over the pairs), epoch_losses, drawn,
 pairs (kept: both directions above the horizon), steps, seconds. Options out of range raise
 ValueError; an anisotropic BRDF, or one that is NaN, infinite or negative where sampled, or 0 at

@@ -1922,6 +1922,7 @@ TEST_F(CliTest, NbrdfTrainBadInputWritesNothing) {
   expect_error({"--brdf", "lambert", "--batch", "0", "-o", "keep.h5"}, 2, "--batch: 0");
   expect_error({"--brdf", "lambert", "--param", "nonesuch", "-o", "keep.h5"}, 2,
                "--param 'nonesuch'");
+  expect_error({"--brdf", "lambert", "--loss", "l2", "-o", "keep.h5"}, 2, "--loss 'l2'");
   // Outputs naming an input: the weights, or the .json written beside them.
   ASSERT_EQ(run({"nbrdf", "train", "--brdf", "lambert", "--samples", "500", "--epochs", "1", "-o",
                  "net.h5"})

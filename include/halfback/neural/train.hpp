@@ -4,11 +4,13 @@
 // that formats/nbrdf.hpp reads and write_nbrdf writes.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "halfback/brdf/brdf.hpp"
@@ -22,6 +24,9 @@ struct NbrdfTrainProgress {
   double loss = 0;                    // the mean of the epoch's batch losses
   double seconds = 0;                 // since training began
 };
+
+// The names NbrdfTrainOptions::loss takes, the default first.
+inline constexpr std::array<std::string_view, 2> kNbrdfLosses{"sztrajman", "study-log"};
 
 struct NbrdfTrainOptions {
   // The input: "" for Sztrajman et al.'s (sin θh, 0, cos θh, d), or a built-in parameterization
@@ -41,6 +46,14 @@ struct NbrdfTrainOptions {
   // restarts, the authors' training). 1 to 64; restart_epochs 1 to 10^6.
   std::size_t restarts = 1;
   std::size_t restart_epochs = 5;
+  // The loss and the pairs it is the mean over (docs/neural.md, "The losses"): "sztrajman", the
+  // authors' (θh, θd, φd uniform, the pairs with a direction at or below the horizon dropped; the
+  // mean over the three channels of |ln(1 + ρ̂ c) − ln(1 + ρ c)|, c = cos θo), or "study-log",
+  // halfback's, whose expectation is the study's log measure: half the pairs drawn from
+  // μ = cos θi cos θo dωi dωo (both directions cosine-distributed, independently), half the
+  // authors' way, weighted to μ; the weighted mean of
+  // (ln(1 + Ŷ) − ln(1 + Y))² + ⅓ Σ_k (ln(1 + ρ̂_k) − ln(1 + ρ_k))², Y the luminance.
+  std::string loss = "sztrajman";
   std::uint64_t seed = 0;  // the pairs, the initial weights and the shuffles
   int threads = 0;         // core's parallel_for (0: all); the result does not depend on it
   // Called after each epoch (on the calling thread), when set.
