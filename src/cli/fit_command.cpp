@@ -171,6 +171,16 @@ void warn_dead_lobes(const fit::FitResult& r) {
                  r.loss_without[t]);
 }
 
+// A warning on stderr when the fitted model reflects more light than it receives.
+void warn_energy(const fit::FitResult& r) {
+  if (fit::creates_energy(r))
+    fmt::print(stderr,
+               "halfback fit: warning: the fitted model reflects more light than it receives: "
+               "directional albedo {:.3f} (± {:.3f}) at θi = {}° (docs/fit.md, \"Energy\"); a "
+               "renderer gains energy from it\n",
+               r.max_albedo, r.max_albedo_error, r.max_albedo_theta_deg);
+}
+
 int run_fit(const FitCommandOptions& o) {
   if (o.output == "-")
     throw UsageError("-o: fit writes its JSON to a file (the spec goes to stdout)");
@@ -218,6 +228,7 @@ int run_fit(const FitCommandOptions& o) {
     fmt::print(stderr, "halfback fit: {} material 'halfback_fit' written to {}\n",
                fit::name_of(e.renderer), e.path);
   warn_dead_lobes(r);
+  warn_energy(r);
   return kExitOk;
 }
 

@@ -52,6 +52,11 @@ Json fit_json(const FitResult& r, std::string_view brdf, std::string_view model)
   j["samples"]["out_of_reach"] = r.out_of_reach;
   j["terms"] = Json::array();
   for (std::size_t t = 0; t < r.model.terms.size(); ++t) j["terms"].push_back(term_json(r, t));
+  // docs/fit.md, "Energy": above 1, the fitted model creates light.
+  j["energy"]["max_albedo"] = r.max_albedo;
+  j["energy"]["theta_deg"] = r.max_albedo_theta_deg;
+  j["energy"]["standard_error"] = r.max_albedo_error;
+  j["energy"]["creates_energy"] = creates_energy(r);
   j["starts"] = r.starts;
   j["iterations"] = r.iterations;
   j["seconds"] = r.seconds;

@@ -56,6 +56,13 @@ py::dict fit_result_dict(const fit::FitResult& r) {
   out["out_of_reach"] = r.out_of_reach;
   out["parameters"] = params;
   out["terms"] = terms;
+  // docs/fit.md, "Energy": above 1, the fitted model creates light.
+  py::dict energy;
+  energy["max_albedo"] = r.max_albedo;
+  energy["theta_deg"] = r.max_albedo_theta_deg;
+  energy["standard_error"] = r.max_albedo_error;
+  energy["creates_energy"] = fit::creates_energy(r);
+  out["energy"] = energy;
   out["starts"] = r.starts;
   out["iterations"] = r.iterations;
   out["seconds"] = r.seconds;

@@ -170,6 +170,9 @@ class FitCancelled : public std::runtime_error {
 inline constexpr double kDeadLobeShare = 1e-4;
 inline constexpr double kDeadLobeLoss = 1e-3;
 
+// The incidence angles (degrees) at which a fitted model's directional albedo is reported.
+inline constexpr double kEnergyAngles[] = {0, 30, 60, 80, 85};
+
 struct FitResult {
   Model model;       // parameters at the best start's solution
   std::string spec;  // spec_of(model)
@@ -182,7 +185,12 @@ struct FitResult {
   std::vector<double> albedo_share;  // per term: its share of the sum's albedo, in [0, 1]
   std::vector<double> loss_without;  // per term: the loss of the other terms alone
   std::vector<bool> dead;            // per term: a dead lobe (the rule above)
-  std::size_t samples = 0;           // the samples fitted: within reach and measured
+  // The fitted model's energy: its largest directional albedo, over the channels and θi of
+  // kEnergyAngles, with that θi and the estimate's standard error. A model above 1 reflects more
+  // light than it receives (a renderer gains energy); nothing in a loss forbids it (docs/fit.md,
+  // "Energy").
+  double max_albedo = 0, max_albedo_theta_deg = 0, max_albedo_error = 0;
+  std::size_t samples = 0;  // the samples fitted: within reach and measured
   // Samples left out (docs/fit.md, "Missing and out-of-reach samples"): a target value that is
   // NaN in some channel is missing (an unmeasured bin, a row a lab did not measure); a pair with
   // θi or θo above FitOptions::max_theta is out of reach. The weights of the others are scaled
@@ -192,6 +200,10 @@ struct FitResult {
   int iterations = 0;  // of all starts
   double seconds = 0;
 };
+
+// True when the fitted model's largest albedo (FitResult::max_albedo) exceeds 1 by more than three
+// standard errors.
+bool creates_energy(const FitResult& r);
 
 // Fits `model` to `target` on the layout of options.samples pairs: turned when the model can be
 // anisotropic (can_be_anisotropic), canonical otherwise; missing and out-of-reach samples left
