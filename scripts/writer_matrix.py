@@ -28,7 +28,7 @@ A writer that refuses a source (an anisotropic BRDF in a MERL or RGL file) must 
 status 1 or 2 and a message: the cell says "refused".
 
     /usr/bin/python3 scripts/writer_matrix.py [--small] [--no-commands] [--writers W,W]
-        [--every N] [--halfback BIN] [--python DIR] [--shared DIR] [--csv OUT.csv]
+        [--every N [--offset K]] [--halfback BIN] [--python DIR] [--shared DIR] [--csv OUT.csv]
 
 --small: the CI set (a near-mirror, a white diffuse, a felt, a glossy paint, an RGL file and an
 anisotropic model). Without it: every neural BRDF and RGL file of the shared data. Exit status 1
@@ -284,6 +284,8 @@ def main():
     p.add_argument("--writers", default=",".join(WRITERS),
                    help="comma-separated, of: " + ", ".join(WRITERS))
     p.add_argument("--every", type=int, default=1, help="every Nth source of the set only")
+    p.add_argument("--offset", type=int, default=0,
+                   help="with --every N: the sources at OFFSET, OFFSET + N, ... (0 to N - 1)")
     p.add_argument("--no-commands", action="store_true",
                    help="leave out the CLI readers (info, eval, fit, render, study): the Python "
                         "reader's checks only, about 4x faster")
@@ -297,7 +299,7 @@ def main():
             return 1
         print(f"{args.shared}/data not found: skipped")
         return 77
-    sources = (small_set(args.shared) if args.small else whole_set(args.shared))[::args.every]
+    sources = (small_set(args.shared) if args.small else whole_set(args.shared))[args.offset::args.every]
     writers = args.writers.split(",")
     if any(w not in WRITERS for w in writers):
         p.error(f"--writers: one of {', '.join(WRITERS)}")
