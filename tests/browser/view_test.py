@@ -1639,6 +1639,18 @@ def check_mesh_url_and_export(driver, screenshots):
           f"{after == before}; status {status!r})")
     wait_idle(driver)
     driver.execute_async_script("window.halfback.spheresDone(1).then(arguments[0]);")
+    # Settings a URL may give that the page does not offer: each named, its default shown.
+    got = driver.execute_async_script("""const done = arguments[0];
+        import('/static/mesh.js').then((m) => {
+          const settings = { ...m.MESH_DEFAULTS, mesh: 'file:none.obj', meshLight: 'sun', meshYaw: 500, meshPitch: NaN, meshSize: 77 };
+          const view = new m.MeshView(document.createElement('section'), { meshes: ['embedded:rounded-cube', 'file:cube.obj'],
+            colours: [], label: (s) => s, title: (s) => s, swatch: () => '', onError: () => {}, settings, onSettings: () => {} });
+          done([view.settingsNote, settings]);
+        }).catch((e) => done([e.message, null]));""")
+    note, fixed = got
+    check(fixed == {"mesh": "embedded:rounded-cube", "meshLight": "point", "meshYaw": 35, "meshPitch": 25, "meshSize": 256}
+          and all(w in note for w in ["mesh 'file:none.obj'", "meshLight 'sun'", "meshYaw '500'", "meshPitch 'NaN'", "meshSize '77'"]),
+          f"lit mesh: settings not offered are named and replaced by their defaults ({note!r}, {fixed})")
 
 
 def guarded(driver, check_fn, *args):
