@@ -242,6 +242,7 @@ const updateSlices = coalesced(async () => {
   if (builtKey !== sliceKey()) buildSlices();
   const key = builtKey, list = pairMode() ? [state.a, state.b] : visible().map((v) => v.spec);
   const moving = interactive, n = moving ? dragSide : fullSide();
+  if (moving) coarse.add('slices');
   const t0 = performance.now();
   const batches = [];
   for (let k = 0; k < list.length; k += sliceBatch()) batches.push(list.slice(k, k + sliceBatch()));
@@ -253,7 +254,6 @@ const updateSlices = coalesced(async () => {
   sliceFields = { key, perForm: {} };
   forms.forEach((space, f) => { sliceFields.perForm[space] = list.map((_, b) => fields[b * forms.length + f]); });
   const t1 = performance.now();
-  if (moving) coarse.add('slices');
   drawSlices();
   stats.sliceFetchMs = t1 - t0;  // the request (server and transfer)
   stats.sliceDrawMs = performance.now() - t1;  // colours, isolines, markers
