@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -221,7 +222,11 @@ GBuffer rasterize(const Mesh& mesh, const MeshSettings& s) {
             (1 - (w.y * scale) / kHalfHeight) / 2 * H - 0.5, w.z * scale};
     n[i] = turn(mesh.normals[i]);
   }
-  for (const auto& t : mesh.triangles) {
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (i % 4096 == 0 && s.cancelled && s.cancelled())
+      throw MeshRenderCancelled(
+          fmt::format("mesh render: cancelled after {} of {} triangles", i, mesh.triangles.size()));
+    const auto& t = mesh.triangles[i];
     const V3 &a = p[t[0]], &b = p[t[1]], &c = p[t[2]];
     const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
     if (!(std::abs(area) > 1e-300)) continue;
@@ -250,19 +255,27 @@ GBuffer rasterize(const Mesh& mesh, const MeshSettings& s) {
 }
 
 // The pixels of `image`, each the mean over its k × k positions of what `shade_row` adds for a row
-// of positions (the row's covered positions, in order) — rows in parallel.
+// of positions (the row's covered positions, in order) — rows in parallel, `cancelled` (may be
+// empty) polled before each row of pixels.
 template <class ShadeRow>
-Image shade(const GBuffer& g, int threads, ShadeRow shade_row) {
+Image shade(const GBuffer& g, int threads, const std::function<bool()>& cancelled,
+            ShadeRow shade_row) {
   Image image;
   image.width = g.width;
   image.height = g.height;
   image.rgb.assign(3 * std::size_t(g.width) * std::size_t(g.height), 0.0f);
   const int W = g.width * g.k;
+  std::atomic<bool> stop{false};
+  std::atomic<int> rows{0};
   parallel_for(
       std::size_t(g.height), 1,
       [&](std::size_t begin, std::size_t end) {
         std::vector<Rgb> sum;
         for (std::size_t py = begin; py < end; ++py) {
+          if (stop || (cancelled && cancelled())) {
+            stop = true;
+            return;
+          }
           sum.assign(std::size_t(g.width), Rgb{});
           for (int j = 0; j < g.k; ++j) {
             const std::size_t row = (py * std::size_t(g.k) + std::size_t(j)) * std::size_t(W);
@@ -275,9 +288,13 @@ Image shade(const GBuffer& g, int threads, ShadeRow shade_row) {
             out[1] = float(sum[std::size_t(px)].g * inv);
             out[2] = float(sum[std::size_t(px)].b * inv);
           }
+          ++rows;
         }
       },
       threads);
+  if (stop)
+    throw MeshRenderCancelled(
+        fmt::format("mesh render: cancelled after {} of {} rows", rows.load(), g.height));
   return image;
 }
 
@@ -305,21 +322,22 @@ Image render_mesh_point_light(const Brdf& brdf, const Mesh& mesh, const Vec3<dou
     throw std::invalid_argument("mesh render: the light's direction must be a finite unit vector");
   const GBuffer g = rasterize(mesh, settings);
   const V3 wo{0, 0, 1};
-  return shade(g, settings.threads, [&](std::size_t row, int W, const auto& add) {
-    std::vector<DirPair<double>> pairs;
-    std::vector<int> xs;
-    for (int x = 0; x < W; ++x) {
-      if (!g.covered[row + std::size_t(x)]) continue;
-      const Frame f = shading_frame(g.normal[row + std::size_t(x)]);
-      const DirPair<double> pair{f.to_local(light), f.to_local(wo)};
-      if (!(pair.wi.z > 0 && pair.wo.z > 0)) continue;
-      pairs.push_back(pair);
-      xs.push_back(x);
-    }
-    std::vector<Rgb> rho(pairs.size());
-    brdf.eval_batch(pairs, rho);
-    for (std::size_t i = 0; i < pairs.size(); ++i) add(xs[i], rho[i] * pairs[i].wi.z);
-  });
+  return shade(g, settings.threads, settings.cancelled,
+               [&](std::size_t row, int W, const auto& add) {
+                 std::vector<DirPair<double>> pairs;
+                 std::vector<int> xs;
+                 for (int x = 0; x < W; ++x) {
+                   if (!g.covered[row + std::size_t(x)]) continue;
+                   const Frame f = shading_frame(g.normal[row + std::size_t(x)]);
+                   const DirPair<double> pair{f.to_local(light), f.to_local(wo)};
+                   if (!(pair.wi.z > 0 && pair.wo.z > 0)) continue;
+                   pairs.push_back(pair);
+                   xs.push_back(x);
+                 }
+                 std::vector<Rgb> rho(pairs.size());
+                 brdf.eval_batch(pairs, rho);
+                 for (std::size_t i = 0; i < pairs.size(); ++i) add(xs[i], rho[i] * pairs[i].wi.z);
+               });
 }
 
 Image render_mesh_environment(const Brdf& brdf, const EnvMap& env, const Mesh& mesh,
@@ -327,49 +345,50 @@ Image render_mesh_environment(const Brdf& brdf, const EnvMap& env, const Mesh& m
   const GBuffer g = rasterize(mesh, settings);
   const V3 wo{0, 0, 1};
   const int spp = settings.spp;
-  return shade(g, settings.threads, [&](std::size_t row, int W, const auto& add) {
-    // Every sample of the row's positions, then one batch of ρ.
-    std::vector<DirPair<double>> pairs;
-    std::vector<Rgb> weight;  // L × MIS weight / pdf (× 1/spp)
-    std::vector<int> xs;
-    for (int x = 0; x < W; ++x) {
-      const std::size_t at = row + std::size_t(x);
-      if (!g.covered[at]) continue;
-      const Frame f = shading_frame(g.normal[at]);
-      const V3 o = f.to_local(wo);
-      if (!(o.z > 0)) continue;
-      std::uint64_t state = (settings.seed * 0x2545f4914f6cdd1dull) ^ (std::uint64_t(at) << 1);
-      for (int k = 0; k < spp; ++k) {
-        // A sample of the BRDF's sampler.
-        const BrdfSample b = brdf.sample(o, uniform(state), uniform(state));
-        if (b.pdf > 0 && b.wi.z > 0 && std::isfinite(b.pdf)) {
-          const EnvMap::Lookup l = env.lookup(f.to_world(b.wi));
-          const double w = b.pdf / (b.pdf + l.pdf);
-          pairs.push_back({b.wi, o});
-          weight.push_back(l.radiance * (w / b.pdf / spp));
-          xs.push_back(x);
-        }
-        // A sample of the environment.
-        const EnvMap::Sample e = env.sample(uniform(state), uniform(state));
-        if (e.pdf > 0) {
-          const V3 i = f.to_local(e.dir);
-          if (i.z > 0) {
-            const double pb = brdf.pdf(o, i);
-            const double w = e.pdf / (e.pdf + pb);
-            pairs.push_back({i, o});
-            weight.push_back(e.radiance * (w / e.pdf / spp));
-            xs.push_back(x);
+  return shade(
+      g, settings.threads, settings.cancelled, [&](std::size_t row, int W, const auto& add) {
+        // Every sample of the row's positions, then one batch of ρ.
+        std::vector<DirPair<double>> pairs;
+        std::vector<Rgb> weight;  // L × MIS weight / pdf (× 1/spp)
+        std::vector<int> xs;
+        for (int x = 0; x < W; ++x) {
+          const std::size_t at = row + std::size_t(x);
+          if (!g.covered[at]) continue;
+          const Frame f = shading_frame(g.normal[at]);
+          const V3 o = f.to_local(wo);
+          if (!(o.z > 0)) continue;
+          std::uint64_t state = (settings.seed * 0x2545f4914f6cdd1dull) ^ (std::uint64_t(at) << 1);
+          for (int k = 0; k < spp; ++k) {
+            // A sample of the BRDF's sampler.
+            const BrdfSample b = brdf.sample(o, uniform(state), uniform(state));
+            if (b.pdf > 0 && b.wi.z > 0 && std::isfinite(b.pdf)) {
+              const EnvMap::Lookup l = env.lookup(f.to_world(b.wi));
+              const double w = b.pdf / (b.pdf + l.pdf);
+              pairs.push_back({b.wi, o});
+              weight.push_back(l.radiance * (w / b.pdf / spp));
+              xs.push_back(x);
+            }
+            // A sample of the environment.
+            const EnvMap::Sample e = env.sample(uniform(state), uniform(state));
+            if (e.pdf > 0) {
+              const V3 i = f.to_local(e.dir);
+              if (i.z > 0) {
+                const double pb = brdf.pdf(o, i);
+                const double w = e.pdf / (e.pdf + pb);
+                pairs.push_back({i, o});
+                weight.push_back(e.radiance * (w / e.pdf / spp));
+                xs.push_back(x);
+              }
+            }
           }
         }
-      }
-    }
-    std::vector<Rgb> rho(pairs.size());
-    brdf.eval_batch(pairs, rho);
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-      const Rgb v = rho[i] * pairs[i].wi.z;
-      add(xs[i], Rgb{v.r * weight[i].r, v.g * weight[i].g, v.b * weight[i].b});
-    }
-  });
+        std::vector<Rgb> rho(pairs.size());
+        brdf.eval_batch(pairs, rho);
+        for (std::size_t i = 0; i < pairs.size(); ++i) {
+          const Rgb v = rho[i] * pairs[i].wi.z;
+          add(xs[i], Rgb{v.r * weight[i].r, v.g * weight[i].g, v.b * weight[i].b});
+        }
+      });
 }
 
 }  // namespace halfback::render

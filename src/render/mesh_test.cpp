@@ -132,6 +132,40 @@ TEST(Mesh, ConstantEnvironmentGivesTheAlbedo) {
   EXPECT_NE(other.rgb, image.rgb);
 }
 
+// MeshSettings::cancelled stops a render within it: polled before each row of pixels (and every
+// 4096 triangles), the render throws once it answers true, having shaded no row after that; a
+// poll that never answers true leaves the image as it is without one.
+TEST(Mesh, CancelledStopsTheRenderWithinAnImage) {
+  const Mesh sphere = parse_obj(sphere_obj(48, 24), "sphere");
+  const BrdfPtr brdf = load_brdf("lambert:albedo=0.6");
+  const EnvMap env = EnvMap::constant(Rgb{1, 1, 1});
+  MeshSettings ms;
+  ms.width = ms.height = 64;
+  ms.threads = 1;
+  const Image whole = render_mesh_point_light(*brdf, sphere, {0, 0, 1}, ms);
+  int polls = 0;
+  ms.cancelled = [&polls] { return ++polls > 10; };  // the rasterization's poll, then rows
+  try {
+    render_mesh_point_light(*brdf, sphere, {0, 0, 1}, ms);
+    ADD_FAILURE() << "not cancelled";
+  } catch (const MeshRenderCancelled& e) {
+    EXPECT_NE(std::string(e.what()).find("of 64 rows"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(polls, 11);  // the render stopped at the first poll that said so
+  polls = 0;
+  EXPECT_THROW(render_mesh_environment(*brdf, env, sphere, ms), MeshRenderCancelled);
+  EXPECT_EQ(polls, 11);
+  ms.cancelled = [] { return false; };
+  EXPECT_EQ(render_mesh_point_light(*brdf, sphere, {0, 0, 1}, ms).rgb, whole.rgb);
+  ms.cancelled = [] { return true; };  // at once: in the rasterization
+  try {
+    render_mesh_point_light(*brdf, sphere, {0, 0, 1}, ms);
+    ADD_FAILURE() << "not cancelled";
+  } catch (const MeshRenderCancelled& e) {
+    EXPECT_NE(std::string(e.what()).find("triangles"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Mesh, RefusesBadSettings) {
   const Mesh t = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "t");
   const BrdfPtr brdf = load_brdf("lambert");

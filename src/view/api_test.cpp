@@ -441,12 +441,14 @@ TEST(ViewApi, FitsAreBoundedInSizeAndTime) {
 }
 
 // The single fields have the deadline of every computation: a hemisphere and a slice poll it
-// between blocks of evaluations of ρ, a point-light image at every pixel, and past it the answer
-// is a 503 saying so, soon after the deadline. What is asked here takes about a minute without
-// the poll (here, one thread): a hemisphere or a slice of a sum of 300 He lobes at 512²
-// (55 s), a point-light image of a sum of 36 measured RGL terms at 512² pixels × 16 positions.
-// A client that left stops them before they start. (A slices request polled only between its
-// fields, each as long as the hemisphere; a hemisphere or a point-light image did not poll.)
+// between blocks of evaluations of ρ, a point-light image at every pixel, a mesh image at every
+// row of pixels, and past it the answer is a 503 saying so, soon after the deadline. What is
+// asked here takes about a minute or more without the poll (here, one thread): a hemisphere or a
+// slice of a sum of 300 He lobes at 512² (55 s), a point-light image of a sum of 36 measured RGL
+// terms at 512² pixels × 16 positions, the mesh of the 300 He lobes at 512² pixels × 4
+// positions. A client that left stops them before they start. (A slices request polled only
+// between its fields, each as long as the hemisphere; a hemisphere or a point-light image did not
+// poll; a mesh polled only between its BRDFs' images.)
 TEST(ViewApi, SingleFieldsHaveADeadline) {
   std::string he, rgl;
   for (int k = 0; k < 300; ++k) he += (k ? "+" : "") + std::string("he");
@@ -459,6 +461,7 @@ TEST(ViewApi, SingleFieldsHaveADeadline) {
       {"/api/hemisphere", {{"brdf", he}, {"colour", "rho"}, {"n", "512"}}, "the hemisphere"},
       {"/api/slices", {{"brdf", he}, {"forms", "hybrid"}, {"n", "512"}}, "the slices"},
       {"/api/pointlight", {{"brdf", rgl}, {"size", "512"}, {"spp", "16"}}, "the point-light image"},
+      {"/api/mesh", {{"brdf", he}, {"size", "512"}, {"theta_l", "30"}}, "the mesh"},
   };
   for (const auto& [endpoint, query, what] : requests) {
     // The BRDF loaded (and cached) before the clock starts: one evaluation.
@@ -492,6 +495,12 @@ TEST(ViewApi, SingleFieldsHaveADeadline) {
       api.handle(get("/api/pointlight", {{"brdf", "lambert"}, {"size", "8"}, {"spp", "1"}}));
   ASSERT_EQ(light.status, 200) << light.body;
   EXPECT_EQ(light.body.size(), 8u * 8u * 3u * sizeof(float));
+  for (const char* light_kind : {"point", "env"}) {
+    const Response m =
+        api.handle(get("/api/mesh", {{"brdf", "lambert"}, {"size", "8"}, {"light", light_kind}}));
+    ASSERT_EQ(m.status, 200) << light_kind << ": " << m.body;
+    EXPECT_EQ(m.body.size(), 8u * 8u * 3u * sizeof(float)) << light_kind;
+  }
 }
 
 // One fit at a time: while a long fit runs, another request is answered 503 at once (a quick

@@ -663,12 +663,19 @@ Response mesh_response(const Catalog& catalog, const Request& request, int threa
     const std::string* env_spec = request.param("env");
     env = catalog.environment(env_spec ? std::string_view(*env_spec) : "sky");
   }
+  // The deadline (and the client's leaving) polled at every row of each BRDF's image.
+  s.cancelled = [&budget] { return budget.expired(); };
   std::vector<std::vector<float>> images;
   for (const auto& [spec, brdf] : brdfs) {
     budget.check("the mesh");
-    render::Image image =
-        point ? render::render_mesh_point_light(*brdf, *mesh, dir, s)
-              : render::render_mesh_environment(*catalog.sampled_brdf(spec), *env, *mesh, s);
+    render::Image image;
+    try {
+      image = point ? render::render_mesh_point_light(*brdf, *mesh, dir, s)
+                    : render::render_mesh_environment(*catalog.sampled_brdf(spec), *env, *mesh, s);
+    } catch (const render::MeshRenderCancelled&) {
+      budget.check("the mesh");
+      throw RequestError(503, "the mesh was stopped");
+    }
     images.push_back(std::move(image.rgb));
   }
   budget.check("the mesh");

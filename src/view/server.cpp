@@ -470,7 +470,13 @@ Server::Server(Api& api, int workers) : impl_(std::make_unique<Impl>(api, std::m
     }();
     res.status = r.status;
     for (const auto& [name, value] : r.headers) res.set_header(name.c_str(), value);
-    res.set_content(r.body, r.content_type.c_str());
+    // JSON with its charset: Debian's cpp-httplib, built with brotli, compresses an answer whose
+    // type is exactly one of its list ("application/json" is, this one is not) for a client
+    // that accepts br, at brotli's highest quality — 85 ms of the server's time for the 45 KB
+    // of polar curves of three BRDFs, at each step of a drag of ωo, to save nothing on a
+    // loopback connection. (The page's files, text/*, are still compressed: once per load.)
+    res.set_content(r.body, r.content_type == "application/json" ? "application/json; charset=utf-8"
+                                                                 : r.content_type.c_str());
     return httplib::Server::HandlerResponse::Handled;
   });
 }

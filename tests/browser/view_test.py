@@ -293,19 +293,33 @@ def measure_drag(driver, steps):
     clock. The drag itself is checked above with real mouse events; here the WebDriver round
     trips of each move (~100 ms on the loaded machine) would be measured instead of the page."""
     total = 0.0
+    parts = {}  # the page's stats: each view's request (server and transfer) and drawing, ms
     driver.execute_script("""
         const c = document.getElementById('hemisphere'), r = c.getBoundingClientRect();
         c.dispatchEvent(new MouseEvent('mousedown', {clientX: r.left + r.width * 0.3,
             clientY: r.top + r.height * 0.5, bubbles: true}));""")
+    cpu0, server0 = cpu_seconds(), cpu_seconds(SERVER["pid"])
     for k in range(steps):
-        total += driver.execute_async_script("""
+        t, got = driver.execute_async_script("""
             const [k, done] = arguments;
             const c = document.getElementById('hemisphere'), r = c.getBoundingClientRect();
             const t0 = performance.now();
             c.dispatchEvent(new MouseEvent('mousemove', {clientX: r.left + r.width * (0.2 + 0.01 * (k % 30)),
                 clientY: r.top + r.height * 0.4, bubbles: true}));
-            window.halfback.idle().then(() => done(performance.now() - t0));""", k)
+            window.halfback.idle().then(() => {
+              const s = window.halfback.stats;
+              done([performance.now() - t0, [s.hemiFetchMs, s.hemiDrawMs, s.polarFetchMs, s.polarDrawMs]]);
+            });""", k)
+        total += t
+        for name, v in zip(["hemisphere request", "hemisphere drawing", "polar request", "polar drawing"], got):
+            if v is not None:  # a page without these stats
+                parts[name] = parts.get(name, 0.0) + v
+    cpu, server = cpu_seconds() - cpu0, cpu_seconds(SERVER["pid"]) - server0
     driver.execute_script("window.dispatchEvent(new MouseEvent('mouseup'));")
+    print(f"measure: hemisphere drag update {total / steps:.1f} ms mean: "
+          + ", ".join(f"{name} {v / steps:.1f} ms" for name, v in parts.items())
+          + f"; CPU time per update {1000 * cpu / steps:.1f} ms (server {1000 * server / steps:.1f} ms, "
+          f"browser and test the rest)")
     return 1000 * steps / total
 
 
@@ -756,6 +770,7 @@ def browser_checks(args, base, token, spec):
         driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", hemi)
         before = driver.execute_script("return [window.halfback.state.to, window.halfback.state.po];")
         w = hemi.size["width"]
+        driver.execute_script("performance.setResourceTimingBufferSize(10000); performance.clearResourceTimings();")
         ActionChains(driver).move_to_element_with_offset(hemi, -w // 3, w // 6).click_and_hold() \
             .move_by_offset(w // 10, 0).move_by_offset(w // 10, 0).release().perform()
         wait_idle(driver)
@@ -763,6 +778,20 @@ def browser_checks(args, base, token, spec):
         check(after != before, f"dragging on the hemisphere moves ωo ({before} → {after})")
         time.sleep(0.4)
         wait_idle(driver)
+        # At rest the views a drag drew coarse are drawn again at their resolution (the hemisphere
+        # at its side in device pixels, the polar curves at 181 angles), and the slices, which do
+        # not depend on ωo, are not asked again (they were, a second of server time with three
+        # BRDFs).
+        sizes = driver.execute_script("""const n = (p) => performance.getEntriesByType('resource')
+              .map((e) => new URL(e.name)).filter((u) => u.pathname === p).map((u) => Number(u.searchParams.get('n')));
+            const c = document.getElementById('hemisphere');
+            return [n('/api/hemisphere'), n('/api/polar'), n('/api/slices').length, c.width,
+                    Math.min(512, Math.round(c.getBoundingClientRect().width * (window.devicePixelRatio || 1)))];""")
+        hemi_n, polar_n, slices, canvas_w, side = sizes
+        hemi_n = [n for n in hemi_n if n != 96]  # the lobe's requests (96 × 96) left out
+        check(128 in hemi_n and hemi_n[-1] == side == canvas_w and 91 in polar_n and polar_n[-1] == 181 and slices == 0,
+              f"a drag of ωo: coarse while it moves, refined at rest, the slices not asked again "
+              f"(hemisphere n {hemi_n}, canvas {canvas_w} of {side}; polar n {polar_n}; slices requests {slices})")
         # Hover a slice: the listed numbers against the CLI.
         sl = driver.find_element(By.ID, "slice-halfdiff")
         driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", sl)
@@ -1440,6 +1469,7 @@ def given_brdfs_checks(halfback, screenshots):
             wait_idle(driver)
             guarded(driver, check_one_request_per_view, driver)
             guarded(driver, check_mesh, driver, screenshots)
+            guarded(driver, check_mesh_url_and_export, driver, screenshots)
             for name in ["slices", "hemisphere", "polar", "theta", "lobe", "albedo", "sphere", "mesh"]:
                 panel = driver.find_element(By.ID, f"{name}-panel")
                 driver.execute_script("arguments[0].scrollIntoView({block: 'start'});", panel)
@@ -1558,6 +1588,69 @@ def check_mesh(driver, screenshots):
         const l = document.getElementById('mesh-light'); l.value = 'point'; l.dispatchEvent(new Event('change'));""")
     WebDriverWait(driver, 120).until(lambda d: all(m["passes"] == 1 for m in mesh_state()))
     check(all(m["lit"] > 1000 for m in mesh_state()), "lit mesh: an OBJ under the root is drawn")
+
+
+def check_mesh_url_and_export(driver, screenshots):
+    """The lit mesh's settings (mesh, light, yaw, pitch, size) are in the URL: reloaded, the page
+    shows the same images; its export is a figure titled with them, and its PNG is twice the
+    figure's size (saved as view-three-mesh-export.png)."""
+    import base64
+    import struct
+    driver.execute_script("""const s = document.getElementById('mesh-size'); s.value = '384'; s.dispatchEvent(new Event('change'));""")
+    def images():
+        return driver.execute_script("""return [...document.querySelectorAll('#meshes canvas')].map((c) =>
+            [c.width, c.style.width, Number(c.dataset.passes || 0), c.sum ? Array.from(c.sum.filter((_, k) => k % 97 === 0)) : null]);""")
+    WebDriverWait(driver, 120).until(lambda d: (lambda m: m and all(x[0] == 384 and x[2] == 1 for x in m))(images()))
+    before = images()
+    time.sleep(0.3)  # the fragment is written at most ten times a second
+    url = driver.current_url
+    fragment = urllib.parse.parse_qs(url.split("#", 1)[1])
+    settings = {k: fragment.get(k, [None])[0] for k in ["mesh", "meshLight", "meshYaw", "meshPitch", "meshSize"]}
+    check(settings["mesh"] == "file:cube.obj" and settings["meshLight"] == "point" and settings["meshSize"] == "384"
+          and settings["meshYaw"] not in (None, "35") and settings["meshPitch"] is not None,
+          f"lit mesh: its settings are in the URL ({settings})")
+    got = driver.execute_async_script("""const done = arguments[0];
+        const p = document.getElementById('mesh-panel').getBoundingClientRect();
+        window.halfback.figurePng('mesh').then((png) => done({ png, panel: [p.width, p.height], svg: window.halfback.figure('mesh') }))
+          .catch((e) => done({ error: e.message }));""")
+    check("png" in got, f"lit mesh: the export makes a PNG ({got.get('error')})")
+    if "png" in got:
+        data = base64.b64decode(got["png"].split(",", 1)[1])
+        with open(os.path.join(screenshots, "view-three-mesh-export.png"), "wb") as f:
+            f.write(data)
+        width, height = struct.unpack(">II", data[16:24])
+        svg_w, svg_h = (int(x) for x in re.search(r'<svg[^>]* width="(\d+)" height="(\d+)"', got["svg"]).groups())
+        pw, ph = got["panel"]
+        check(data[:8] == b"\x89PNG\r\n\x1a\n" and (width, height) == (2 * svg_w, 2 * svg_h)
+              and svg_h == math.ceil(ph + 28) and svg_w >= math.ceil(pw) and len(re.findall("<image", got["svg"])) == len(before),
+              f"lit mesh: the PNG export is twice the figure ({width} x {height}; figure {svg_w} x {svg_h}, "
+              f"panel {pw:.0f} x {ph:.0f}, {len(before)} images)")
+        title = re.search(r"<text[^>]*>([^<]*)</text>", got["svg"]).group(1)
+        check("lit mesh cube.obj turned" in title and "point light from ωo" in title and "ilm_l3_37_metallic_rgb.bsdf" in title,
+              f"lit mesh: the figure's title names the mesh, its turn, the light and the BRDFs ({title})")
+    driver.refresh()
+    WebDriverWait(driver, 120).until(lambda d: d.find_element(By.ID, "status").text.startswith("ready"))
+    status = driver.find_element(By.ID, "status").text
+    WebDriverWait(driver, 120).until(lambda d: (lambda m: m and all(x[2] == 1 for x in m))(images()))
+    after = images()
+    shown = driver.execute_script("""return ['mesh-mesh', 'mesh-light', 'mesh-size'].map((id) => document.getElementById(id).value);""")
+    check(after == before and shown == ["file:cube.obj", "point", "384"] and status == "ready",
+          f"lit mesh: the URL reloads to the same images ({shown}, {len(after)} images the same: "
+          f"{after == before}; status {status!r})")
+    wait_idle(driver)
+    driver.execute_async_script("window.halfback.spheresDone(1).then(arguments[0]);")
+    # Settings a URL may give that the page does not offer: each named, its default shown.
+    got = driver.execute_async_script("""const done = arguments[0];
+        import('/static/mesh.js').then((m) => {
+          const settings = { ...m.MESH_DEFAULTS, mesh: 'file:none.obj', meshLight: 'sun', meshYaw: 500, meshPitch: NaN, meshSize: 77 };
+          const view = new m.MeshView(document.createElement('section'), { meshes: ['embedded:rounded-cube', 'file:cube.obj'],
+            colours: [], label: (s) => s, title: (s) => s, swatch: () => '', onError: () => {}, settings, onSettings: () => {} });
+          done([view.settingsNote, settings]);
+        }).catch((e) => done([e.message, null]));""")
+    note, fixed = got
+    check(fixed == {"mesh": "embedded:rounded-cube", "meshLight": "point", "meshYaw": 35, "meshPitch": 25, "meshSize": 256}
+          and all(w in note for w in ["mesh 'file:none.obj'", "meshLight 'sun'", "meshYaw '500'", "meshPitch 'NaN'", "meshSize '77'"]),
+          f"lit mesh: settings not offered are named and replaced by their defaults ({note!r}, {fixed})")
 
 
 def guarded(driver, check_fn, *args):

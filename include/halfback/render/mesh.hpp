@@ -13,6 +13,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -49,19 +51,28 @@ struct MeshSettings {
                            // the environment, weighted by the balance heuristic)
   std::uint64_t seed = 1;  // environment: the image is a function of the seed
   int threads = 0;
+  // Polled before each row of pixels is shaded and every 4096 triangles of the rasterization
+  // (may be empty): once it answers true the render stops and throws MeshRenderCancelled.
+  std::function<bool()> cancelled;
+};
+
+// A mesh render that MeshSettings::cancelled stopped before its image was complete.
+class MeshRenderCancelled : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 // The mesh under a distant light of irradiance 1 from the unit direction `light` in camera space
 // (renderer.hpp's render_point_light): each pixel the mean over its positions of
 // ρ(ωi, ωo) cos θi, 0 where the light or the camera is below the surface, and the background 0.
-// Throws std::invalid_argument for bad settings or light.
+// Throws std::invalid_argument for bad settings or light, MeshRenderCancelled when cancelled.
 Image render_mesh_point_light(const Brdf& brdf, const Mesh& mesh, const Vec3<double>& light,
                               const MeshSettings& settings);
 // The mesh under an environment (its own world frame, renderer.hpp's): each pixel the mean over
 // its positions of an estimate of the reflected radiance from settings.spp samples of the BRDF's
 // sampler (Brdf::sample, its pdf) and as many of the environment's, combined by the balance
 // heuristic; the background 0 (the page draws its own). Passes of other seeds are independent
-// estimates: their mean converges to the radiance.
+// estimates: their mean converges to the radiance. Throws as render_mesh_point_light.
 Image render_mesh_environment(const Brdf& brdf, const EnvMap& env, const Mesh& mesh,
                               const MeshSettings& settings);
 

@@ -6,7 +6,7 @@ import { getJson, getField, getFields, isAbort } from './api.js';
 import * as V from './views.js';
 import { LobeView, lobeMesh } from './lobe.js';
 import * as B from './batch.js';
-import { MeshView } from './mesh.js';
+import { MeshView, MESH_DEFAULTS } from './mesh.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = Math.PI / 180;
@@ -53,6 +53,7 @@ const state = {
   hide: [],  // the BRDFs hidden (their specs): kept, not drawn
   colours: [],  // a colour chosen per place in loaded() ('' or absent: COLOURS)
   polarY: 'rho', theta: 'rho', thetaScale: 'log', lobeOpacity: 0.55, lobeZoom: 1,
+  ...MESH_DEFAULTS,  // the lit mesh's: mesh, meshLight, meshYaw, meshPitch, meshSize (mesh.js)
 };
 const MODES = { b: 'the second', diff: 'the difference', ratio: 'the ratio' };
 let info = null;
@@ -60,6 +61,11 @@ let cursor = null;      // the last /api/point answer
 let pinned = false;
 let interactive = false;  // while dragging: lower resolution
 let refineTimer = 0;
+// The views drawn at a drag's lower resolution, or left as they were (the lobe, the point-lit
+// spheres and the mesh follow ωo at rest only), since the last rest: what the rest refines. A
+// drag of ωo leaves the slices alone (they do not depend on it), a move of the azimuth slider
+// everything but the slices.
+const coarse = new Set();
 let sphereStale = false;  // the sphere waits for the end of a slider's drag
 const pending = new Set();
 const stats = { updates: 0, lastUpdateMs: 0, sliceDraws: 0 };
@@ -236,6 +242,7 @@ const updateSlices = coalesced(async () => {
   if (builtKey !== sliceKey()) buildSlices();
   const key = builtKey, list = pairMode() ? [state.a, state.b] : visible().map((v) => v.spec);
   const moving = interactive, n = moving ? dragSide : fullSide();
+  if (moving) coarse.add('slices');
   const t0 = performance.now();
   const batches = [];
   for (let k = 0; k < list.length; k += sliceBatch()) batches.push(list.slice(k, k + sliceBatch()));
@@ -304,6 +311,7 @@ function pointerOnSlice(e, f, click) {
 const wo = () => [Math.sin(state.to * DEG) * Math.cos(state.po * DEG),
   Math.sin(state.to * DEG) * Math.sin(state.po * DEG), Math.cos(state.to * DEG)];
 let hemiField = null;
+let hemiBarKey = '';  // what the hemisphere's colour bar shows: its range and unit
 // The hemisphere's side on screen (CSS pixels): its panel's width (at most 640); at rest its
 // resolution is that side in device pixels (at most 512).
 let hemiSide = 256;
@@ -337,7 +345,9 @@ function drawHemiMarks() {
 }
 const updateHemisphere = coalesced(async () => {
   const n = interactive ? DRAG : hemiN();
+  if (interactive) coarse.add('hemisphere');
   const common = [['theta_o', state.to], ['phi_o', state.po], ['n', n]];
+  const t0 = performance.now();
   if (state.hemi === 'rho') {
     const fields = await B.fieldsOf(null, '/api/hemisphere', specs(),
       [['colour', 'rho'], ['values', 'luminance'], ...common]);
@@ -345,7 +355,10 @@ const updateHemisphere = coalesced(async () => {
   } else {
     hemiField = { coords: await getField(null, '/api/hemisphere', [['colour', state.hemi], ...common]) };
   }
+  const t1 = performance.now();
   drawHemisphere();
+  stats.hemiFetchMs = t1 - t0;  // the request (server and transfer), in the page's clock
+  stats.hemiDrawMs = performance.now() - t1;
 });
 function drawHemisphere() {
   const canvas = $('hemisphere');
@@ -358,10 +371,17 @@ function drawHemisphere() {
     const scale = V.makeScale([s], mode, 'log');
     V.drawScalar(canvas, s, a.width, a.height, scale, []);
     blackOutside(canvas);
-    $('hemi-colorbar').replaceChildren(V.colourbarSvg(scale, scaleUnit(scale, specLabel(specs()[0]))));
+    // The colour bar again only when its range or unit changed (not at every step of a drag
+    // that leaves them).
+    const unit = scaleUnit(scale, specLabel(specs()[0])), key = `${scale.lo} ${scale.hi} ${scale.eps} ${unit}`;
+    if (hemiBarKey !== key) {
+      hemiBarKey = key;
+      $('hemi-colorbar').replaceChildren(V.colourbarSvg(scale, unit));
+    }
   } else {
     const axes = formInfo(state.hemi).axes;
     V.drawCoordinates(canvas, hemiField.coords, axes);
+    hemiBarKey = '';
     $('hemi-colorbar').textContent = `red: ${plain(axes[0].label)} / its maximum, green: ${plain(axes[1].label)} / its maximum; black: outside the domain`;
   }
   const o = wo();
@@ -535,11 +555,16 @@ let polarCurves = [], polarShown = [], polarThetaO = 45;
 // The polar plot and the plot against θi draw the same curves (/api/polar, one request a BRDF).
 const updatePolar = coalesced(async () => {
   const list = visible(), thetaO = state.to;
+  if (interactive) coarse.add('polar');
+  const t0 = performance.now();
   polarCurves = await B.polarCurves(null, list.map((v) => v.spec),
     [['theta_o', thetaO], ['phi_o', state.po], ['n', interactive ? 91 : 181]]);
   polarShown = list;
   polarThetaO = thetaO;
+  const t1 = performance.now();
   drawPolar();
+  stats.polarFetchMs = t1 - t0;
+  stats.polarDrawMs = performance.now() - t1;
 });
 function drawPolar() {
   const list = polarShown, colours = list.map((v) => palette()[v.b]);
@@ -648,14 +673,15 @@ const updatePointLights = coalesced(async () => {
   });
 });
 const idleFrame = () => new Promise((r) => setTimeout(r, 30));
-// The lit mesh (mesh.js): follows the BRDFs, ωo at rest, the environment and the exposure.
+// The lit mesh (mesh.js): follows the BRDFs, ωo at rest, the environment and the exposure; its
+// own settings are in the state (the URL).
 let meshView = null;
+function setupMesh() {
+  meshView = new MeshView($('mesh-panel'), { meshes: info.meshes, colours: COLOURS, label: specLabel,
+    title: fullSpec, swatch, onError: (m) => setStatus(m, true), settings: state, onSettings: writeHash });
+}
 function updateMesh() {
-  if (!info) return;
-  if (!meshView) {
-    meshView = new MeshView($('mesh-panel'), { meshes: info.meshes, colours: COLOURS, label: specLabel,
-      title: fullSpec, swatch, onError: (m) => setStatus(m, true) });
-  }
+  if (!meshView) return;
   meshView.update({ specs: loaded(), to: state.to, po: state.po, env: state.env, exposure: state.exposure });
 }
 function redrawSpheres() {
@@ -950,6 +976,9 @@ function changed({ slices = true, sphere = true, sliders = false } = {}) {
   if (!interactive) {
     track(updateLobe());
     track(updatePointLights());
+  } else {
+    coarse.add('lobe');
+    coarse.add('pointlights');
   }
   if (sphere === true) {  // a BRDF changed: the views that do not depend on ωo too
     showMore();
@@ -967,11 +996,13 @@ function refineSoon() {
     if (dragging) return refineSoon();
     if (!interactive) return;
     interactive = false;
-    track(updateSlices());
-    track(updateHemisphere());
-    track(updatePolar());
-    track(updateLobe());
-    if (!sphereStale) track(updatePointLights());
+    const refine = new Set(coarse);
+    coarse.clear();
+    if (refine.has('slices')) track(updateSlices());
+    if (refine.has('hemisphere')) track(updateHemisphere());
+    if (refine.has('polar')) track(updatePolar());
+    if (refine.has('lobe')) track(updateLobe());
+    if (refine.has('pointlights') && !sphereStale) track(updatePointLights());
     if (sphereStale) {  // a model's parameters moved: its anisotropy may have changed too
       sphereStale = false;
       restartSphere();
@@ -1185,6 +1216,7 @@ function setup() {
   setupTypedAngles();
   setupLobe();
   setupPolar();
+  setupMesh();
   setupExports();
   setupFit();
 }
@@ -1256,13 +1288,15 @@ function setupExports() {
 }
 // What a figure of the view says above it: the view, the BRDFs, the state that picks the slice.
 function figureTitle(target) {
-  const names = (target === 'hemisphere' || (target === 'slices' && pairMode()) ? specs() : visible().map((v) => v.spec)).map(specLabel);
+  const names = (target === 'hemisphere' || (target === 'slices' && pairMode()) ? specs()
+    : target === 'mesh' ? meshView.view.specs : visible().map((v) => v.spec)).map(specLabel);
   const wo = `θo = ${state.to.toFixed(1)}°, φo = ${state.po.toFixed(1)}°`;
   const what = {
     slices: `slices at the relative azimuth ${state.az}°${$('pose-box').hidden ? '' : `, orientation ${state.pose}°`}`,
     hemisphere: `hemisphere of ωi, ${wo}`, polar: `polar plot of ${state.polarY === 'cos' ? 'ρ cos θi' : 'ρ'}, ${wo}`, lobe: `lobe of ρ(·, ωo), ${wo}`,
     theta: `${state.theta === 'cos' ? 'ρ cos θi' : 'ρ'} against θi (${state.thetaScale} axis), ${wo}`,
     albedo: 'directional albedo', sphere: `lit sphere, environment ${state.env}, exposure ${state.exposure}`,
+    mesh: meshView.title(),
   }[target];
   const shown = state.mode !== 'a' && state.b && (target === 'slices' || target === 'hemisphere')
     ? `${{ b: 'second', diff: 'difference', ratio: 'ratio' }[state.mode]} of ${names.join(' and ')}` : names.join(', ');
@@ -1370,19 +1404,33 @@ function textOf(e) {
   if (e.tagName === 'SELECT') return e.selectedOptions[0]?.textContent || '';
   return [...e.childNodes].map(textOf).join('');
 }
+// The PNG of a view's figure (its SVG drawn at twice the page's size): a promise of the blob.
+function figurePng(target) {
+  const { svg, w, h } = panelFigure(target);
+  return new Promise((resolve, reject) => {
+    const img = new Image(), url = URL.createObjectURL(new Blob([svg], { type: 'image/svg+xml' }));
+    img.onload = () => {
+      URL.revokeObjectURL(url);
+      const c = Object.assign(document.createElement('canvas'), { width: 2 * w, height: 2 * h });
+      c.getContext('2d').drawImage(img, 0, 0, 2 * w, 2 * h);
+      c.toBlob((blob) => (blob ? resolve(blob) : reject(new Error(`the ${target} figure: no PNG`))));
+    };
+    img.onerror = () => { URL.revokeObjectURL(url); reject(new Error(`the ${target} figure: its SVG does not load`)); };
+    img.src = url;
+  });
+}
 function exportView(target, kind) {
-  const name = `halfback-${target}`, { svg, w, h } = panelFigure(target);
-  if (kind === 'SVG') return download(`${name}.svg`, new Blob([svg], { type: 'image/svg+xml' }));
-  const img = new Image();
-  img.onload = () => {  // twice the page's size
-    const c = Object.assign(document.createElement('canvas'), { width: 2 * w, height: 2 * h });
-    c.getContext('2d').drawImage(img, 0, 0, 2 * w, 2 * h);
-    c.toBlob((blob) => download(`${name}.png`, blob));
-  };
-  img.src = URL.createObjectURL(new Blob([svg], { type: 'image/svg+xml' }));
-  return undefined;
+  const name = `halfback-${target}`;
+  if (kind === 'SVG') return download(`${name}.svg`, new Blob([panelFigure(target).svg], { type: 'image/svg+xml' }));
+  return figurePng(target).then((blob) => download(`${name}.png`, blob)).catch((e) => setStatus(e.message, true));
 }
 window.halfback.figure = (target) => panelFigure(target).svg;
+// The PNG the export button downloads, as a data URL (the browser test reads it).
+window.halfback.figurePng = (target) => figurePng(target).then((blob) => new Promise((resolve) => {
+  const reader = new FileReader();
+  reader.onload = () => resolve(reader.result);
+  reader.readAsDataURL(blob);
+}));
 
 // "show" offers the second, the difference and the ratio only with a compare BRDF.
 function syncModes() {
@@ -1436,6 +1484,7 @@ async function main() {
   document.documentElement.style.setProperty('--view', `${viewSize()}px`);
   buildSlices();
   setup();
+  if (meshView.settingsNote) note += `; ${meshView.settingsNote}`;
   showMore();
   layout();
   changed({ sliders: true });
