@@ -36,7 +36,7 @@ struct SamplingMeasure {
   // The mean over ωo of variance / mean² (the squared coefficient of variation: every ωo weighs
   // the same whatever its albedo), and its standard error.
   double relative_variance = 0, relative_variance_error = 0;
-  double seconds_per_sample = 0;  // sampling, evaluating ρ and the pdf, wall time
+  double seconds_per_sample = 0;  // sampling, evaluating ρ and the pdf: the thread's CPU time
 };
 
 // Measures `sampler` (its sample() and pdf()) on ρ of `brdf`. Deterministic numbers for a seed
