@@ -172,13 +172,13 @@ void warn_dead_lobes(const fit::FitResult& r) {
 }
 
 // A warning on stderr when the fitted model reflects more light than it receives.
-void warn_energy(const fit::FitResult& r) {
-  if (fit::creates_energy(r))
+void warn_energy(const fit::FitEnergy& e) {
+  if (e.creates_energy())
     fmt::print(stderr,
                "halfback fit: warning: the fitted model reflects more light than it receives: "
                "directional albedo {:.3f} (± {:.3f}) at θi = {}° (docs/fit.md, \"Energy\"); a "
                "renderer gains energy from it\n",
-               r.max_albedo, r.max_albedo_error, r.max_albedo_theta_deg);
+               e.max_albedo, e.standard_error, e.theta_deg);
 }
 
 int run_fit(const FitCommandOptions& o) {
@@ -211,7 +211,8 @@ int run_fit(const FitCommandOptions& o) {
   } catch (const std::invalid_argument& e) {  // a model with nothing to fit
     throw UsageError(fmt::format("--model: {}", e.what()));
   }
-  out.write(fit::fit_json(r, source_of(o), o.model).dump() + "\n");
+  const fit::FitEnergy energy = fit::fitted_energy(r.spec);
+  out.write(fit::fit_json(r, source_of(o), o.model, energy).dump() + "\n");
   write_emits(emits, r.model);  // every text made before any file is committed
   out.commit();
   for (Emit& e : emits) e.out->commit();
@@ -228,7 +229,7 @@ int run_fit(const FitCommandOptions& o) {
     fmt::print(stderr, "halfback fit: {} material 'halfback_fit' written to {}\n",
                fit::name_of(e.renderer), e.path);
   warn_dead_lobes(r);
-  warn_energy(r);
+  warn_energy(energy);
   return kExitOk;
 }
 

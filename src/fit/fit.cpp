@@ -269,8 +269,19 @@ std::vector<std::string_view> split_terms(std::string_view spec) {
 
 }  // namespace
 
-bool creates_energy(const FitResult& r) {
-  return r.max_albedo > 1 + 3 * r.max_albedo_error;
+FitEnergy fitted_energy(std::string_view spec) {
+  const BrdfPtr model = load_brdf(spec);
+  FitEnergy e;
+  for (const double theta_deg : kEnergyAngles) {
+    const double t = theta_deg * std::numbers::pi / 180;
+    const AlbedoEstimate a =
+        directional_albedo(*model, Vec3<double>{std::sin(t), 0, std::cos(t)}, 256);
+    const double mean[3] = {a.mean.r, a.mean.g, a.mean.b};
+    const double error[3] = {a.standard_error.r, a.standard_error.g, a.standard_error.b};
+    for (int c = 0; c < 3; ++c)
+      if (mean[c] > e.max_albedo) e = {mean[c], theta_deg, error[c]};
+  }
+  return e;
 }
 
 Model parse_model(std::string_view text) {
@@ -1162,24 +1173,6 @@ void report_terms(FitResult& r, const Samples& s, std::span<const Rgb> target, i
   }
 }
 
-// FitResult::max_albedo of the fitted model (256² stratified samples a direction; deterministic).
-void report_energy(FitResult& r) {
-  const BrdfPtr model = load_brdf(r.spec);
-  for (const double theta_deg : kEnergyAngles) {
-    const double t = theta_deg * std::numbers::pi / 180;
-    const AlbedoEstimate a =
-        directional_albedo(*model, Vec3<double>{std::sin(t), 0, std::cos(t)}, 256);
-    const double mean[3] = {a.mean.r, a.mean.g, a.mean.b};
-    const double error[3] = {a.standard_error.r, a.standard_error.g, a.standard_error.b};
-    for (int c = 0; c < 3; ++c)
-      if (mean[c] > r.max_albedo) {
-        r.max_albedo = mean[c];
-        r.max_albedo_theta_deg = theta_deg;
-        r.max_albedo_error = error[c];
-      }
-  }
-}
-
 bool any_fitted(const Model& model) {
   return std::any_of(model.params.begin(), model.params.end(),
                      [](const Param& p) { return p.fitted; });
@@ -1250,7 +1243,6 @@ FitResult fit(const Brdf& target, std::string_view model_spec, const FitOptions&
   r.missing = u.missing;
   r.out_of_reach = u.out_of_reach;
   report_terms(r, u.samples, u.target, o.threads);
-  report_energy(r);
   return r;
 }
 
@@ -1274,7 +1266,6 @@ FitResult fit_at(const Samples& samples, std::span<const Rgb> values, std::strin
   r.missing = u.missing;
   r.out_of_reach = u.out_of_reach;
   report_terms(r, u.samples, u.target, o.threads);
-  report_energy(r);
   return r;
 }
 

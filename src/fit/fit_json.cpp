@@ -39,7 +39,8 @@ Json term_json(const FitResult& r, std::size_t t) {
 
 }  // namespace
 
-Json fit_json(const FitResult& r, std::string_view brdf, std::string_view model) {
+Json fit_json(const FitResult& r, std::string_view brdf, std::string_view model,
+              const FitEnergy& energy) {
   Json j;
   j["brdf"] = valid_utf8(brdf);  // a file name may not be UTF-8
   j["model"] = valid_utf8(model);
@@ -53,10 +54,10 @@ Json fit_json(const FitResult& r, std::string_view brdf, std::string_view model)
   j["terms"] = Json::array();
   for (std::size_t t = 0; t < r.model.terms.size(); ++t) j["terms"].push_back(term_json(r, t));
   // docs/fit.md, "Energy": above 1, the fitted model creates light.
-  j["energy"]["max_albedo"] = r.max_albedo;
-  j["energy"]["theta_deg"] = r.max_albedo_theta_deg;
-  j["energy"]["standard_error"] = r.max_albedo_error;
-  j["energy"]["creates_energy"] = creates_energy(r);
+  j["energy"]["max_albedo"] = energy.max_albedo;
+  j["energy"]["theta_deg"] = energy.theta_deg;
+  j["energy"]["standard_error"] = energy.standard_error;
+  j["energy"]["creates_energy"] = energy.creates_energy();
   j["starts"] = r.starts;
   j["iterations"] = r.iterations;
   j["seconds"] = r.seconds;

@@ -18,6 +18,7 @@ std::string_view fit_parameter_unit(std::string_view model, std::string_view par
 // range), each term's albedo share and whether it is a dead lobe, starts, iterations, seconds.
 // Its strings are well-formed UTF-8 (the specs asked for through valid_utf8), so that dump()
 // cannot throw.
-nlohmann::ordered_json fit_json(const FitResult& r, std::string_view brdf, std::string_view model);
+nlohmann::ordered_json fit_json(const FitResult& r, std::string_view brdf, std::string_view model,
+                                const FitEnergy& energy);
 
 }  // namespace halfback::fit

@@ -57,11 +57,12 @@ py::dict fit_result_dict(const fit::FitResult& r) {
   out["parameters"] = params;
   out["terms"] = terms;
   // docs/fit.md, "Energy": above 1, the fitted model creates light.
+  const fit::FitEnergy e = fit::fitted_energy(r.spec);
   py::dict energy;
-  energy["max_albedo"] = r.max_albedo;
-  energy["theta_deg"] = r.max_albedo_theta_deg;
-  energy["standard_error"] = r.max_albedo_error;
-  energy["creates_energy"] = fit::creates_energy(r);
+  energy["max_albedo"] = e.max_albedo;
+  energy["theta_deg"] = e.theta_deg;
+  energy["standard_error"] = e.standard_error;
+  energy["creates_energy"] = e.creates_energy();
   out["energy"] = energy;
   out["starts"] = r.starts;
   out["iterations"] = r.iterations;

@@ -746,7 +746,7 @@ Response fit_response(const Catalog& catalog, const Request& request, int thread
     throw RequestError(422,
                        fmt::format("'{}' cannot be fitted: {}", spec.substr(0, 128), e.what()));
   }
-  return json(fit::fit_json(result, spec, model));
+  return json(fit::fit_json(result, spec, model, fit::fitted_energy(result.spec)));
 }
 
 }  // namespace halfback::view

@@ -49,13 +49,13 @@ int connect_to(int port) {
   return fd;
 }
 
-// The status line the server writes on `fd` within `seconds` ("" if none, or the connection
-// closed without one).
-std::string status_line(int fd, double seconds) {
+// What the server writes on `fd` until `stop` is in it (empty: until it closes the connection) or
+// `seconds` pass.
+std::string read_until(int fd, double seconds, const std::string& stop = "") {
   std::string answer;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  char buf[4096];
-  while (answer.find("\r\n") == std::string::npos) {
+  char buf[65536];
+  while (stop.empty() || answer.find(stop) == std::string::npos) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
         deadline - std::chrono::steady_clock::now());
     pollfd p{fd, POLLIN, 0};
@@ -64,6 +64,13 @@ std::string status_line(int fd, double seconds) {
     if (n <= 0) break;
     answer.append(buf, std::size_t(n));
   }
+  return answer;
+}
+
+// The status line the server writes on `fd` within `seconds` ("" if none, or the connection
+// closed without one).
+std::string status_line(int fd, double seconds) {
+  const std::string answer = read_until(fd, seconds, "\r\n");
   return answer.substr(0, answer.find("\r\n"));
 }
 
@@ -114,23 +121,6 @@ TEST(ViewServer, APortIsNotShared) {
   for (int k = 0; k < 20; ++k) EXPECT_EQ(get_info(first.port, 5), "HTTP/1.1 200 OK") << k;
 }
 
-// Everything the server writes on `fd` until it closes the connection or `seconds` pass.
-std::string read_all(int fd, double seconds) {
-  std::string answer;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  char buf[65536];
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
-    pollfd p{fd, POLLIN, 0};
-    if (left.count() <= 0 || ::poll(&p, 1, int(left.count())) <= 0) break;
-    const ssize_t n = ::read(fd, buf, sizeof buf);
-    if (n <= 0) break;
-    answer.append(buf, std::size_t(n));
-  }
-  return answer;
-}
-
 // JSON answers are sent as they are, whatever the client accepts: a browser accepts br, and
 // httplib compressed "application/json" with brotli at its highest quality (the 45 KB of polar
 // curves of three BRDFs took 85 ms, at each step of a drag). Their type names the charset.
@@ -145,7 +135,7 @@ TEST(ViewServer, JsonAnswersAreNotCompressed) {
                               "\r\nAccept-Encoding: gzip, deflate, br, zstd\r\n"
                               "Connection: close\r\n\r\n";
   (void)!::write(fd, request.data(), request.size());
-  const std::string answer = read_all(fd, 10);
+  const std::string answer = read_until(fd, 10);
   ::close(fd);
   const std::size_t end = answer.find("\r\n\r\n");
   ASSERT_NE(end, std::string::npos) << answer.substr(0, 200);

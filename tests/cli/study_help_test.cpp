@@ -13,34 +13,18 @@
 
 #include "halfback/study/metric.hpp"
 #include "halfback/study/parts.hpp"
+#include "help_options.hpp"
 #include "support/spawn.hpp"
 #include "support/test_support.hpp"
 
 // A named namespace: the test files are compiled as one unity translation unit.
 namespace halfback::study_help_test {
 
-// The help of each option of a help's "Options:" section, by its names as listed
-// ("--fit-budgets"), its wrapped lines joined.
+// The help of each option of a help's "Options:" section, by its first name ("--fit-budgets").
 std::map<std::string, std::string> option_help(const std::string& help_text) {
   std::map<std::string, std::string> found;
-  std::string last;
-  std::istringstream lines(help_text);
-  bool in_section = false;
-  for (std::string line; std::getline(lines, line);) {
-    if (line.starts_with("Options:")) {
-      in_section = true;
-      continue;
-    }
-    if (!in_section) continue;
-    if (line.empty() || !line.starts_with(" ")) break;
-    if (line.starts_with("  -")) {
-      const std::size_t end = line.find(' ', 2);
-      last = line.substr(2, end - 2);
-      found[last] = end == std::string::npos ? "" : line.substr(end);
-    } else if (!last.empty()) {
-      (found[last] += ' ') += line.substr(line.find_first_not_of(' '));
-    }
-  }
+  for (const test::HelpOption& o : test::help_options(help_text))
+    if (!o.names.empty()) found[o.names.front()] = o.text;
   return found;
 }
 

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "help_options.hpp"
 #include "support/spawn.hpp"
 #include "support/test_support.hpp"
 
@@ -90,29 +91,13 @@ class Vocabulary : public testing::Test {
   // The options of a help's "Options:" section (without -h,--help).
   static std::vector<CliOption> options(const std::string& command, const std::string& help_text) {
     std::vector<CliOption> found;
-    std::istringstream lines(help_text);
-    bool in_section = false;
-    for (std::string line; std::getline(lines, line);) {
-      if (line.starts_with("Options:")) {
-        in_section = true;
-        continue;
-      }
-      if (!in_section) continue;
-      if (line.empty() || !line.starts_with(" ")) break;
-      if (line.starts_with("  -")) {
-        CliOption o;
-        o.command = command;
-        const std::size_t end = line.find(' ', 2);
-        std::istringstream names(line.substr(2, end - 2));
-        for (std::string n; std::getline(names, n, ',');) o.names.push_back(n);
-        if (end != std::string::npos) {
-          o.text = line.substr(line.find_first_not_of(' ', end));
-          o.type = o.text.substr(0, o.text.find(' '));
-        }
-        if (!o.has("--help")) found.push_back(o);
-      } else if (!found.empty()) {  // a description on the next line, or continued
-        (found.back().text += ' ') += line.substr(line.find_first_not_of(' '));
-      }
+    for (test::HelpOption& h : test::help_options(help_text)) {
+      CliOption o;
+      o.command = command;
+      o.names = std::move(h.names);
+      o.text = std::move(h.text);
+      o.type = o.text.substr(0, o.text.find(' '));
+      if (!o.has("--help")) found.push_back(std::move(o));
     }
     return found;
   }

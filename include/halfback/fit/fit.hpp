@@ -185,12 +185,7 @@ struct FitResult {
   std::vector<double> albedo_share;  // per term: its share of the sum's albedo, in [0, 1]
   std::vector<double> loss_without;  // per term: the loss of the other terms alone
   std::vector<bool> dead;            // per term: a dead lobe (the rule above)
-  // The fitted model's energy: its largest directional albedo, over the channels and θi of
-  // kEnergyAngles, with that θi and the estimate's standard error. A model above 1 reflects more
-  // light than it receives (a renderer gains energy); nothing in a loss forbids it (docs/fit.md,
-  // "Energy").
-  double max_albedo = 0, max_albedo_theta_deg = 0, max_albedo_error = 0;
-  std::size_t samples = 0;  // the samples fitted: within reach and measured
+  std::size_t samples = 0;           // the samples fitted: within reach and measured
   // Samples left out (docs/fit.md, "Missing and out-of-reach samples"): a target value that is
   // NaN in some channel is missing (an unmeasured bin, a row a lab did not measure); a pair with
   // θi or θo above FitOptions::max_theta is out of reach. The weights of the others are scaled
@@ -201,9 +196,20 @@ struct FitResult {
   double seconds = 0;
 };
 
-// True when the fitted model's largest albedo (FitResult::max_albedo) exceeds 1 by more than three
-// standard errors.
-bool creates_energy(const FitResult& r);
+// A fitted model's energy: its largest directional albedo, over the channels and θi of
+// kEnergyAngles, with that θi and the estimate's standard error. A model above 1 reflects more
+// light than it receives (a renderer gains energy); nothing in a loss forbids it (docs/fit.md,
+// "Energy"). Computed by those who report a fit (the CLI, the explorer, Python), not by fit():
+// the study fits thousands of times and never reports it.
+struct FitEnergy {
+  double max_albedo = 0, theta_deg = 0, standard_error = 0;
+  // True when max_albedo exceeds 1 by more than three standard errors.
+  bool creates_energy() const { return max_albedo > 1 + 3 * standard_error; }
+};
+
+// The energy of the model `spec` (a fit's FitResult::spec): 256² stratified samples a direction,
+// deterministic.
+FitEnergy fitted_energy(std::string_view spec);
 
 // Fits `model` to `target` on the layout of options.samples pairs: turned when the model can be
 // anisotropic (can_be_anisotropic), canonical otherwise; missing and out-of-reach samples left

@@ -1,0 +1,42 @@
+// The options of a CLI11 help text, for the tests that read `halfback ... --help`.
+#pragma once
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace halfback::test {
+
+struct HelpOption {
+  std::vector<std::string> names;  // as listed in the first column: "-o", "--output", "--out"
+  std::string text;                // the rest of its line and its wrapped lines, joined by spaces
+};
+
+// The options of the help's "Options:" section, in their order (-h,--help included).
+inline std::vector<HelpOption> help_options(const std::string& help_text) {
+  std::vector<HelpOption> found;
+  std::istringstream lines(help_text);
+  bool in_section = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.starts_with("Options:")) {
+      in_section = true;
+      continue;
+    }
+    if (!in_section) continue;
+    if (line.empty() || !line.starts_with(" ")) break;
+    if (line.starts_with("  -")) {
+      HelpOption o;
+      const std::size_t end = line.find(' ', 2);
+      std::istringstream names(line.substr(2, end - 2));
+      for (std::string n; std::getline(names, n, ',');) o.names.push_back(n);
+      const std::size_t text = end == std::string::npos ? end : line.find_first_not_of(' ', end);
+      if (text != std::string::npos) o.text = line.substr(text);
+      found.push_back(std::move(o));
+    } else if (!found.empty()) {  // a description on the next line, or continued
+      (found.back().text += ' ') += line.substr(line.find_first_not_of(' '));
+    }
+  }
+  return found;
+}
+
+}  // namespace halfback::test
