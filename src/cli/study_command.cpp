@@ -1,6 +1,7 @@
 // `halfback study`: the quantitative comparison of the parameterizations on a set of BRDFs
 // (include/halfback/study/, docs/study.md): options to a StudyConfig, progress, the files.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 #include <mutex>
 #include <set>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "command.hpp"
@@ -42,6 +44,20 @@ struct StudyOptions {
   bool resume = false;
   bool quiet = false, full_report = false;  // what goes to stdout (print_written)
 };
+
+// "(default X)", or "(default X; --quick Y)" when --quick changes it: the values the study
+// uses (StudyConfig's and quick_config()'s), so that the help cannot drift from them.
+template <class T>
+std::string defaults(const T& plain, const T& quick) {
+  const auto text = [](const T& v) {
+    if constexpr (std::is_arithmetic_v<T>)
+      return fmt::format("{}", v);
+    else
+      return fmt::format("{}", fmt::join(v, ","));
+  };
+  if (plain == quick) return "(default " + text(plain) + ")";
+  return "(default " + text(plain) + "; --quick " + text(quick) + ")";
+}
 
 // The configuration of the options; a bad value is a usage error.
 study::StudyConfig make_config(const StudyOptions& o) {
@@ -426,6 +442,7 @@ std::string default_studied_names() {
 
 Command register_study(CLI::App& parent) {
   auto o = std::make_shared<StudyOptions>();
+  const study::StudyConfig plain, quick = study::quick_config();
   CLI::App* app = parent.add_subcommand(
       "study",
       "Compare the parameterizations on BRDFs: azimuthal dependence, separability, a virtual "
@@ -456,31 +473,37 @@ Command register_study(CLI::App& parent) {
                   "profiles, computed first and kept in OUT/profiles/); each is measured in the "
                   "regular and the stratified design (--designs is an alias)")
       ->capture_default_str();
-  app->add_flag("--quick", o->settings.quick,
-                "A small study: 24 x 24 x 32 grids, budgets 1000,10000, 20000 test pairs, "
-                "48^2 images");
+  app->add_flag(
+      "--quick", o->settings.quick,
+      fmt::format("A small study: {} x {} x {} grids of the isotropic form ({} of the full "
+                  "form) and each option's --quick value below",
+                  quick.grid.a, quick.grid.b, quick.grid.phi, fmt::join(quick.full_grid, " x ")));
   app->add_option("--budgets", o->budgets,
-                  "Gonio-reflectometer budgets, ascending, comma-separated (default "
-                  "1000,3000,10000,30000,100000)")
+                  "Gonio-reflectometer budgets, ascending, comma-separated " +
+                      defaults(plain.budgets, quick.budgets))
       ->type_name("N,...");
   app->add_option("--budgets-4d", o->budgets_4d,
-                  "Budgets of the 4D gonio-reflectometer of anisotropic BRDFs, comma-separated "
-                  "(default 1000,10000,100000,1000000)")
+                  "Budgets of the 4D gonio-reflectometer of anisotropic BRDFs, comma-separated " +
+                      defaults(plain.budgets_4d, quick.budgets_4d))
       ->type_name("N,...");
-  app->add_option("--test-pairs", o->settings.test_pairs,
-                  "Pairs the reconstructions are checked at (default 200000)")
+  app->add_option(
+         "--test-pairs", o->settings.test_pairs,
+         "Pairs the reconstructions are checked at " + defaults(plain.test_pairs, quick.test_pairs))
       ->check(CLI::Range(std::size_t(100), study::kMaxTestPairs));
   app->add_option("--env", o->environments,
                   "Environments of the image-space error, comma-separated: built-in names "
                   "(default, sky, studio, sunset) or .hdr/.exr files (default: the built-ins)");
   app->add_option("--image-budget", o->settings.image_budget,
-                  "The budget whose reconstructions are rendered (one of --budgets; default "
-                  "10000)");
-  app->add_option("--image-size", o->settings.image_size,
-                  "Width and height of the renderings (default 96)")
+                  fmt::format("The budget whose reconstructions are rendered: one of --budgets "
+                              "(default {}, else the middle budget)",
+                              plain.image_budget));
+  app->add_option(
+         "--image-size", o->settings.image_size,
+         "Width and height of the renderings " + defaults(plain.image_size, quick.image_size))
       ->check(CLI::Range(8, 4096));
-  app->add_option("--image-spp", o->settings.image_spp,
-                  "Samples per pixel of the renderings (default 16)")
+  app->add_option(
+         "--image-spp", o->settings.image_spp,
+         "Samples per pixel of the renderings " + defaults(plain.image_spp, quick.image_spp))
       ->check(CLI::Range(1, 1 << 16));
   app->add_option("--max-theta", o->settings.max_theta,
                   "The gonio-reflectometer's reach: no measurement where a direction is farther "
@@ -500,8 +523,9 @@ Command register_study(CLI::App& parent) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app->add_option("--nielsen-budgets,--nielsen-counts", o->nielsen_counts,
-                  "Measurement budgets of Nielsen's design, ascending, comma-separated (default "
-                  "1,2,5,10,20,40,100; --nielsen-counts is an alias)")
+                  "Measurement budgets of Nielsen's design, ascending, comma-separated; "
+                  "--nielsen-counts is an alias " +
+                      defaults(plain.nielsen_counts, quick.nielsen_counts))
       ->type_name("N,...");
   app->add_option("--nielsen-eta", o->nielsen_eta,
                   "Tikhonov weight of Nielsen's reconstruction (their release's example: 40)")

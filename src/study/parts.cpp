@@ -134,6 +134,12 @@ std::string joined(const std::vector<T>& v) {
 
 }  // namespace
 
+StudyConfig quick_config() {
+  StudyConfig c;
+  apply_quick(c);
+  return c;
+}
+
 StudyConfig make_config(const StudySettings& o) {
   StudyConfig c;
   if (!o.params.empty()) c.params = params_named<std::invalid_argument>(o.params, "--params");

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <map>
 #include <sstream>
@@ -107,6 +108,56 @@ TEST(StudyHelp, MetricOptionsSayTheValuesTheStudyUses) {
     }
   }
   EXPECT_GE(checked, 4u) << "the metrics' options";
+}
+
+// The study's own settings say their values as make_config() resolves them, with and without
+// --quick (the help had them by hand: "--image-spp (default 16)" never said --quick's 8).
+TEST(StudyHelp, SettingsSayTheValuesTheStudyUses) {
+  study::StudySettings settings;
+  settings.designs = {"own"};
+  const study::StudyConfig plain = study::make_config(settings);
+  settings.quick = true;
+  const study::StudyConfig quick = study::make_config(settings);
+
+  test::TempDir dir;
+  const test::Captured ran = test::run_captured(dir.path(), {HALFBACK_CLI_PATH, "study", "--help"});
+  ASSERT_TRUE(ran.started) << ran.error;
+  ASSERT_EQ(ran.status, 0) << ran.err;
+  const std::map<std::string, std::string> help = option_help(ran.out);
+
+  const auto list = [](const std::vector<std::size_t>& v) {
+    std::string s;
+    for (const std::size_t x : v) s += (s.empty() ? "" : ",") + std::to_string(x);
+    return s;
+  };
+  const std::vector<std::array<std::string, 3>> settings_values = {
+      {"--budgets", list(plain.budgets), list(quick.budgets)},
+      {"--budgets-4d", list(plain.budgets_4d), list(quick.budgets_4d)},
+      {"--test-pairs", std::to_string(plain.test_pairs), std::to_string(quick.test_pairs)},
+      {"--image-size", std::to_string(plain.image_size), std::to_string(quick.image_size)},
+      {"--image-spp", std::to_string(plain.image_spp), std::to_string(quick.image_spp)},
+      {"--nielsen-budgets", list(plain.nielsen_counts), list(quick.nielsen_counts)},
+      {"--image-budget", std::to_string(plain.image_budget), std::to_string(quick.image_budget)},
+  };
+  for (const auto& [flag, value, quick_value] : settings_values) {
+    const auto it = help.find(flag);
+    ASSERT_NE(it, help.end()) << flag << " is not in `halfback study --help`";
+    const std::string& line = it->second;
+    EXPECT_TRUE(has_value(line, value) && line.find("default " + value) != std::string::npos)
+        << flag << ": the study's default is " << value << "; the help says: " << line;
+    if (quick_value != value) {
+      EXPECT_NE(line.find("--quick " + quick_value), std::string::npos)
+          << flag << ": --quick gives " << quick_value << "; the help says: " << line;
+    } else {
+      EXPECT_EQ(line.find("--quick"), std::string::npos)
+          << flag << ": --quick leaves it at " << value << "; the help says: " << line;
+    }
+  }
+  // --quick's own help states its grids.
+  const std::string grid = std::to_string(quick.grid.a) + " x " + std::to_string(quick.grid.b) +
+                           " x " + std::to_string(quick.grid.phi);
+  ASSERT_NE(help.find("--quick"), help.end());
+  EXPECT_NE(help.at("--quick").find(grid), std::string::npos) << help.at("--quick");
 }
 
 }  // namespace halfback::study_help_test

@@ -50,6 +50,10 @@ struct StudySettings {
 // the option (--error-space, --spacings, --budgets, ...) and what it accepts.
 StudyConfig make_config(const StudySettings& settings);
 
+// The settings --quick gives before the options given apply (smaller grids, budgets, test pairs and
+// images; each metric's quick values): what `study --help` states beside each default.
+StudyConfig quick_config();
+
 // Whether `config` asks for the learned design (then each BRDF needs the others' profiles).
 bool wants_learned(const StudyConfig& config);
 
