@@ -666,10 +666,15 @@ TEST(ViewApi, SlicesRefuseBadParameters) {
   EXPECT_EQ(slices({{"n", "8"}, {"forms", "spherical,halfdiff,ortho,hybrid"}}).status, 200);
   EXPECT_TRUE(has_error(api.handle(get("/api/slices", {{"forms", "ortho"}})), 400,
                         "missing query parameter 'brdf'"));
-  EXPECT_TRUE(has_error(
-      api.handle(get("/api/slices",
-                     {{"brdf", "arg:0"}, {"brdf", "lambert"}, {"brdf", "arg:0"}, {"n", "8"}})),
-      413, "at most 2"));
+  // Up to kMaxBrdfsPerRequest BRDFs (the page's every shown BRDF in one request), not one more.
+  std::vector<std::pair<std::string, std::string>> many{{"n", "8"}, {"forms", "ortho"}};
+  for (std::size_t k = 0; k < kMaxBrdfsPerRequest; ++k) many.emplace_back("brdf", "lambert");
+  const Response most = api.handle(get("/api/slices", many));
+  ASSERT_EQ(most.status, 200) << most.body;
+  EXPECT_EQ(most.body.size(), kMaxBrdfsPerRequest * 8 * 8 * 3 * sizeof(float));
+  many.emplace_back("brdf", "lambert");
+  EXPECT_TRUE(has_error(api.handle(get("/api/slices", many)), 413,
+                        fmt::format("at most {}", kMaxBrdfsPerRequest)));
   EXPECT_EQ(slices({{"brdf", "arg:7"}}).status, 404);  // the first brdf= is the unknown one
   EXPECT_EQ(api.handle(get("/api/slice", {{"brdf", "arg:0"}, {"form", "ortho"}})).status, 404);
 }

@@ -321,6 +321,7 @@ Response info_response(const Catalog& catalog) {
   limits["spp"] = kMaxRenderSpp;
   limits["fit_samples"] = kMaxFitSamples;
   limits["brdfs"] = kMaxBrdfsPerRequest;
+  limits["slices_bytes"] = kMaxSlicesBytes;
   Json& losses = j["losses"] = Json::array();
   for (const fit::Loss l : fit::kLosses) losses.push_back(fit::name_of(l));
   return json(j);
@@ -358,9 +359,9 @@ Response slices_response(const Catalog& catalog, const Request& request, int thr
   const RhoValues values = values_param(request);
   const std::vector<const std::string*> specs = all_params(request, "brdf");
   if (specs.empty()) throw RequestError(400, "missing query parameter 'brdf'");
-  if (specs.size() > kMaxBrdfsPerSlices)
+  if (specs.size() > kMaxBrdfsPerRequest)
     throw RequestError(413, fmt::format("at most {} brdf= per /api/slices request (got {})",
-                                        kMaxBrdfsPerSlices, specs.size()));
+                                        kMaxBrdfsPerRequest, specs.size()));
   const std::size_t bytes = specs.size() * forms.size() * n * n * channels_of(values) * 4;
   if (bytes > kMaxSlicesBytes)
     throw RequestError(

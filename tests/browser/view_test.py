@@ -1545,6 +1545,21 @@ def check_one_request_per_view(driver):
           and all(n.get(p, 0) < views[p] * shown for p in views),
           f"one request per view for {shown} BRDFs when ωo moves, each naming all of them: "
           f"brdf= per request {per}; requests {n}")
+    # The slices of every BRDF shown: one /api/slices request per update, moving and at rest
+    # (the page before asked one request per two BRDFs).
+    driver.execute_script("performance.clearResourceTimings();")
+    driver.execute_script("""const s = document.getElementById('azimuth');
+        s.value = 40; s.dispatchEvent(new Event('input'));""")
+    wait_idle(driver)
+    time.sleep(0.6)  # the refinement at rest
+    wait_idle(driver)
+    rows = driver.execute_script("""const s = window.halfback.state;
+        if (s.b && s.mode !== 'a') return 2;  // the pair: second, difference or ratio
+        return [s.a, s.b, ...s.more].filter((x) => x && !s.hide.includes(x)).length;""")
+    slices = api_brdfs_per_request(driver, "/api/slices")
+    check(rows >= 2 and slices and all(k == rows for k in slices),
+          f"one /api/slices request per update for the {rows} BRDFs of the slices: "
+          f"brdf= per request {slices}")
 
 
 def check_mesh(driver, screenshots):

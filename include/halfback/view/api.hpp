@@ -49,10 +49,10 @@ inline constexpr double kComputeSeconds = 60;
 inline constexpr int kMaxRenderSide = 512;             // sphere render side
 inline constexpr int kMaxRenderSpp = 64;               // samples per pixel of one pass
 inline constexpr std::size_t kMaxBrdfsPerRequest = 8;  // brdf= repeated in /api/point
-inline constexpr std::size_t kMaxBrdfsPerSlices = 2;   // brdf= repeated in /api/slices
 inline constexpr std::size_t kMaxCachedBrdfs = 32;     // loaded BRDFs kept (least recent dropped)
 // A /api/slices answer: at most the bytes of 8 RGB fields of 512² (25 MB, 24 MiB): BRDFs × forms
-// × n² × channels × 4 above it is a 400.
+// × n² × channels × 4 above it is a 400 (the page asks as many BRDFs a request as fit
+// within it: one request while a slider moves).
 inline constexpr std::size_t kMaxSlicesBytes = 8 * 512 * 512 * 3 * sizeof(float);
 // The lit mesh view (/api/mesh): a mesh file under a root of at most this many bytes; the mesh
 // of the page when it names none.

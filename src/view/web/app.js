@@ -185,8 +185,13 @@ const swatch = (b) => `<span class="swatch-${b}">■</span>`;
 let sliceRows = [];
 let builtKey = '';  // the rows built: sliceKey() when they were built
 const sliceKey = () => (pairMode() ? 'pair' : visible().map((v) => `${v.b}:${v.spec}`).join('|'));
-// /api/slices answers at most this many BRDFs a request: more are asked in requests side by side.
-const sliceBatch = () => (info && info.limits && info.limits.slices_brdfs) || 2;
+// The BRDFs one /api/slices request may ask at n pixels a side: as many as the server's bounds
+// allow (BRDFs a request, bytes an answer); more are asked in requests side by side.
+const sliceBatch = (n) => {
+  const limits = (info && info.limits) || {};
+  const perBrdf = info.forms.length * n * n * 4;  // luminance: one float a pixel
+  return Math.max(1, Math.min(limits.brdfs || 1, Math.floor((limits.slices_bytes || perBrdf) / perBrdf)));
+};
 function buildSlices() {
   const box = $('slices');
   box.replaceChildren();
@@ -236,8 +241,8 @@ window.addEventListener('resize', () => {
 const plain = (label) => label.replace(/_/g, '').replace(/[{}]/g, '');
 
 let sliceFields = {};  // { key: sliceKey() of the request, perForm: { space: [field per row BRDF] } }
-// The forms' slices of every BRDF of the rows (or of the pair), in one request per two BRDFs
-// (/api/slices), side by side.
+// The forms' slices of every BRDF of the rows (or of the pair): one /api/slices request, or
+// several side by side when the answer would exceed the server's bound.
 const updateSlices = coalesced(async () => {
   if (builtKey !== sliceKey()) buildSlices();
   const key = builtKey, list = pairMode() ? [state.a, state.b] : visible().map((v) => v.spec);
@@ -245,7 +250,8 @@ const updateSlices = coalesced(async () => {
   if (moving) coarse.add('slices');
   const t0 = performance.now();
   const batches = [];
-  for (let k = 0; k < list.length; k += sliceBatch()) batches.push(list.slice(k, k + sliceBatch()));
+  const batch = sliceBatch(n);
+  for (let k = 0; k < list.length; k += batch) batches.push(list.slice(k, k + batch));
   const answers = await Promise.all(batches.map((group) => getFields(null, '/api/slices',
     [...group.map((s) => ['brdf', s]), ['azimuth', state.az], ['pose', state.pose], ['n', n], ['values', 'luminance']])));
   if (!answers.length) return;
