@@ -1169,6 +1169,10 @@ def shown_everywhere(driver):
         "slices": driver.execute_script(
             "return [...document.querySelectorAll('#slices .row-name')].map((e) => e.textContent.replace('■', '').trim());"),
         "spheres": len(driver.find_elements(By.CSS_SELECTOR, "#spheres canvas[id^='sphere-']")),
+        # The lit mesh's images: each caption's swatch colour index and name.
+        "mesh": driver.execute_script("""return [...document.querySelectorAll('#meshes figcaption')].map((c) =>
+            [Number((c.querySelector('[class^="swatch-"]') || {className: 'swatch--1'}).className.slice(7)),
+             c.textContent.replace('■', '').trim()]);"""),
     }
 
 
@@ -1178,13 +1182,15 @@ def check_show_hide_solo_colour(driver, names):
     be hidden."""
     every = shown_everywhere(driver)
     check(every["polar"] == names and every["theta"] == names and every["albedo"] == names
-          and every["slices"] == names and every["spheres"] == 3 and all(n in every["lobe"] for n in names),
+          and every["slices"] == names and every["spheres"] == 3 and all(n in every["lobe"] for n in names)
+          and every["mesh"] == [[k, n] for k, n in enumerate(names)],
           f"every view shows the three BRDFs at first ({every})")
     chip(driver, "arg:1", "show").click()
     hidden = shown_everywhere(driver)
     want = [names[0], names[2]]
     check(hidden["polar"] == want and hidden["theta"] == want and hidden["albedo"] == want
           and hidden["slices"] == want and hidden["spheres"] == 2 and names[1] not in hidden["lobe"]
+          and hidden["mesh"] == [[0, names[0]], [2, names[2]]]  # each in its own colour
           and "hide=arg%3A1" in driver.current_url,
           f"hiding the second leaves it out of every view, and the URL says so ({hidden})")
     chip(driver, "arg:1", "show").click()

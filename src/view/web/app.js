@@ -688,7 +688,9 @@ function setupMesh() {
 }
 function updateMesh() {
   if (!meshView) return;
-  meshView.update({ specs: loaded(), to: state.to, po: state.po, env: state.env, exposure: state.exposure });
+  const shown = visible();  // hidden BRDFs leave the mesh too; each keeps its colour
+  meshView.update({ specs: shown.map((v) => v.spec), colours: shown.map((v) => v.b), to: state.to, po: state.po,
+    env: state.env, exposure: state.exposure });
 }
 function redrawSpheres() {
   updateMesh();

@@ -23,7 +23,7 @@ export class MeshView {
     this.o = options;
     this.settings = options.settings;
     this.checkSettings();
-    this.view = { specs: [], to: 45, po: 180, env: 'sky', exposure: 0 };
+    this.view = { specs: [], colours: [], to: 45, po: 180, env: 'sky', exposure: 0 };
     this.generation = 0;
     const head = document.createElement('div');
     head.className = 'panel-head';
@@ -94,12 +94,13 @@ export class MeshView {
     return s;
   }
 
-  // The BRDFs shown, ωo (degrees), the environment and the exposure: restarts when one changes
-  // (the exposure only draws again).
+  // The BRDFs shown (specs, and colours: each one's place in options.colours), ωo (degrees), the
+  // environment and the exposure: restarts when one changes (the exposure only draws again).
   update(view) {
     const before = this.view;
     this.view = { ...before, ...view };
-    const same = before.specs.join('\n') === this.view.specs.join('\n') && before.env === this.view.env &&
+    const same = before.specs.join('\n') === this.view.specs.join('\n') &&
+      before.colours.join() === this.view.colours.join() && before.env === this.view.env &&
       (this.settings.meshLight === 'env' || (before.to === this.view.to && before.po === this.view.po));
     if (same && this.canvases && this.canvases.length === this.view.specs.length) {
       if (before.exposure !== this.view.exposure) this.redraw();
@@ -118,7 +119,7 @@ export class MeshView {
       Object.assign(fig.style, { margin: '0', width: `${this.side}px`, textAlign: 'center' });
       const cap = document.createElement('figcaption');
       cap.style.overflowWrap = 'anywhere';  // a long spec wraps under its image
-      cap.innerHTML = `${this.o.swatch(b)}&nbsp;${escape(this.o.label(spec))}`;
+      cap.innerHTML = `${this.o.swatch(this.view.colours[b] ?? b)}&nbsp;${escape(this.o.label(spec))}`;
       cap.title = this.o.title(spec);
       fig.append(canvas, cap);
       this.figures.append(fig);

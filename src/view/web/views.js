@@ -40,7 +40,34 @@ function percentile(sorted, p) {
   if (!sorted.length) return NaN;
   return sorted[Math.min(sorted.length - 1, Math.round(p * (sorted.length - 1)))];
 }
-const sortedOf = (values) => Float64Array.from(values).sort();
+// The scale's percentiles come from at most this many values, spread evenly over all its fields:
+// they need no more, and sorting every pixel of the 24 slices of three BRDFs took longer than
+// drawing them.
+const SCALE_SAMPLE = 16384;
+// The least step ≥ `from` that shares no factor with any field's length: a stride through an
+// n × n field that is a multiple of n's factors would visit a few columns only (step 96 on
+// 256-wide rows: every 32nd column).
+function coprimeStep(from, fields) {
+  const gcd = (a, b) => (b ? gcd(b, a % b) : a);
+  let step = from;
+  while (step > 1 && fields.some((x) => gcd(step, x.length) !== 1)) ++step;
+  return step;
+}
+// Every step-th value of each field with f(value) finite, mapped by f, sorted; step spreads
+// SCALE_SAMPLE values over all the fields (each gives at least its first value).
+function sortedSample(fields, f) {
+  const total = fields.reduce((n, x) => n + x.length, 0);
+  const step = coprimeStep(Math.max(1, Math.floor(total / SCALE_SAMPLE)), fields);
+  const out = new Float64Array(Math.ceil(total / step) + fields.length);
+  let m = 0;
+  for (const x of fields) {
+    for (let k = 0; k < x.length; k += step) {
+      const t = f(x[k]);
+      if (Number.isFinite(t)) out[m++] = t;
+    }
+  }
+  return out.subarray(0, m).sort();
+}
 
 // A colour scale shared by several fields: transform (value -> t), range [lo, hi], colour map.
 export function makeScale(fields, mode, kind) {
@@ -49,22 +76,12 @@ export function makeScale(fields, mode, kind) {
   // median difference), logarithmic above, so that both small and peak differences show.
   let eps = 1;
   if (mode === 'diff' && kind === 'log') {
-    const abs = [];
-    for (const f of fields) for (let k = 0; k < f.length; k += 7) if (Number.isFinite(f[k])) abs.push(Math.abs(f[k]));
-    eps = Math.max((percentile(sortedOf(abs), 0.5) || 1) / 10, 1e-12);
+    eps = Math.max((percentile(sortedSample(fields, Math.abs), 0.5) || 1) / 10, 1e-12);
   }
   const tf = mode === 'ratio' ? (v) => (v > 0 ? Math.log2(v) : NaN)
     : mode === 'diff' ? (kind === 'log' ? (v) => Math.sign(v) * Math.log10(1 + Math.abs(v) / eps) : (v) => v)
       : kind === 'log' ? (v) => (v > 0 ? Math.log10(v) : NaN) : (v) => v;
-  const sample = [];
-  for (const f of fields) {
-    const step = Math.max(1, Math.floor(f.length / 4000));  // a sample is enough for a range
-    for (let k = 0; k < f.length; k += step) {
-      const t = tf(f[k]);
-      if (Number.isFinite(t)) sample.push(diverge ? Math.abs(t) : t);
-    }
-  }
-  const sorted = sortedOf(sample);
+  const sorted = sortedSample(fields, diverge ? (v) => Math.abs(tf(v)) : tf);
   let lo, hi;
   if (diverge) {
     hi = percentile(sorted, 0.99) || 1;
