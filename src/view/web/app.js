@@ -1311,21 +1311,23 @@ function figureTitle(target) {
   return `halfback view: ${what}; ${shown}`;
 }
 // The panel as an SVG figure: its pictures (canvases), plots and colour bars (SVG) and texts
-// (headings, axis notes, captions, legends) where the page shows them, under a title; controls
-// are left out.
+// (headings, axis notes, captions, legends) where the page shows them, under a title wrapped to
+// the figure's width; controls are left out. The figure is as wide as what it shows (a wide
+// panel's empty right side is left out), at least FIGURE_MIN_WIDTH for its title.
+const FIGURE_MIN_WIDTH = 360;
 function panelFigure(target) {
   const panel = $(`${target}-panel`), box = panel.getBoundingClientRect();
-  const top = 28, parts = [];
-  const at = (e) => { const r = e.getBoundingClientRect(); return { x: r.left - box.left, y: r.top - box.top + top, w: r.width, h: r.height }; };
+  const parts = [];
+  let right = 0;  // the right edge of what the figure shows
+  const at = (e) => { const r = e.getBoundingClientRect(); return { x: r.left - box.left, y: r.top - box.top, w: r.width, h: r.height }; };
   const esc = (t) => t.replace(/[&<>"]/g, (ch) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[ch]));
   const text = (t, x, y, size, colour) => `<text x="${x}" y="${y}" font-family="sans-serif" font-size="${size}" fill="${colour}">${esc(t)}</text>`;
-  const title = figureTitle(target);
-  parts.push(text(title, 8, 18, 13, '#e6e6ea'));
   for (const e of panel.querySelectorAll('canvas, svg, h2, .axis, figcaption, .note, .row-name')) {
     if (e.closest('svg') !== e && e.closest('svg')) continue;  // inside a plot: part of it
     if (e.closest('.panel-head') && e.tagName !== 'H2') continue;  // controls
     const r = at(e);
     if (!r.w || !r.h) continue;
+    right = Math.max(right, r.x + r.w);
     if (e.tagName === 'CANVAS') {
       parts.push(`<image x="${r.x}" y="${r.y}" width="${r.w}" height="${r.h}" preserveAspectRatio="none" href="${e.toDataURL('image/png')}"/>`);
     } else if (e.tagName.toLowerCase() === 'svg') {
@@ -1344,9 +1346,12 @@ function panelFigure(target) {
       });
     }
   }
-  const w = Math.ceil(Math.max(box.width, 16 + 7 * title.length)), h = Math.ceil(box.height + top);
+  const w = Math.ceil(Math.max(Math.min(box.width, right + 8), FIGURE_MIN_WIDTH));
+  const titleLines = wrapRuns([[figureTitle(target), '#e6e6ea']], w - 16, '13px sans-serif');
+  const top = 10 + 18 * titleLines.length, h = Math.ceil(box.height + top);
+  const title = titleLines.map((line, k) => text(line.map(([t]) => t).join(''), 8, 18 + 18 * k, 13, '#e6e6ea'));
   return { svg: `<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="${w}" height="${h}" viewBox="0 0 ${w} ${h}">`
-    + `<rect width="${w}" height="${h}" fill="#202229"/>${parts.join('')}</svg>`, w, h };
+    + `<rect width="${w}" height="${h}" fill="#202229"/>${title.join('')}<g transform="translate(0 ${top})">${parts.join('')}</g></svg>`, w, h };
 }
 // An element's text as runs [text, colour]: a swatch (class swatch-N) in its BRDF's colour.
 function runsOf(e, fill) {
