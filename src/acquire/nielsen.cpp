@@ -427,6 +427,21 @@ void NielsenReconstruction::eval_batch(std::span<const DirPair<double>> pairs,
   }
 }
 
+namespace {
+
+// Whether each channel has a finite value among `values` (what NielsenBasis::solve needs).
+bool every_channel_measured(std::span<const Rgb> values) {
+  bool r = false, g = false, b = false;
+  for (const Rgb& v : values) {
+    r = r || std::isfinite(v.r);
+    g = g || std::isfinite(v.g);
+    b = b || std::isfinite(v.b);
+  }
+  return r && g && b;
+}
+
+}  // namespace
+
 NielsenAcquisition nielsen_acquisition(std::shared_ptr<const NielsenDatabase> database,
                                        const Brdf& brdf, std::span<const std::size_t> counts) {
   if (!brdf.isotropic())
@@ -446,9 +461,13 @@ NielsenAcquisition nielsen_acquisition(std::shared_ptr<const NielsenDatabase> da
   brdf.eval_batch(pairs, values);
   for (std::size_t n : counts) {
     const auto first = std::span(a.directions).first(n);
+    const auto measured = std::span(values).first(n);
+    if (!every_channel_measured(measured)) {
+      a.unmeasured.push_back(n);
+      continue;
+    }
     a.reconstructions.push_back(std::make_shared<NielsenReconstruction>(
-        database, basis.solve(first, std::span(values).first(n), database->options().eta),
-        brdf.name(), n));
+        database, basis.solve(first, measured, database->options().eta), brdf.name(), n));
   }
   return a;
 }

@@ -257,5 +257,34 @@ TEST(Nielsen, RefusesWhatItCannotDo) {
                std::invalid_argument);
 }
 
+// A material without a value at Nielsen's first direction (an ALTA file measured on part of the
+// hemisphere; the whole-data study stopped on one with "no finite measurement"): the count 1 has
+// nothing to solve and gives no reconstruction, the larger count does; a material without any
+// value gives none.
+TEST(Nielsen, ACountWithoutAFiniteMeasurementGivesNoReconstruction) {
+  auto db = std::make_shared<NielsenDatabase>(family(kSpecs), small_grid());
+  const std::size_t first = NielsenBasis(db, {}).directions(1).front();
+  const DirPair<double> at = db->configurations()[first];
+  const auto same = [](const Vec3<double>& a, const Vec3<double>& b) {
+    return std::abs(a.x - b.x) + std::abs(a.y - b.y) + std::abs(a.z - b.z) < 1e-12;
+  };
+  const test::FunctionBrdf partial(
+      [&](const DirPair<double>& p) { return same(p.wi, at.wi) && same(p.wo, at.wo) ? NAN : 0.2; });
+  const std::size_t counts[] = {1, 5};
+  const NielsenAcquisition a = nielsen_acquisition(db, partial, counts);
+  ASSERT_TRUE(a.left_out.empty());
+  ASSERT_EQ(a.directions.front(), first);
+  EXPECT_EQ(a.unmeasured, std::vector<std::size_t>{1});
+  ASSERT_EQ(a.reconstructions.size(), 1u);
+  EXPECT_EQ(a.reconstructions[0]->measurements(), 5u);
+  const Rgb v = a.reconstructions[0]->eval(at);
+  EXPECT_TRUE(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b));
+
+  const test::FunctionBrdf none([](const DirPair<double>&) { return NAN; });
+  const NielsenAcquisition b = nielsen_acquisition(db, none, counts);
+  EXPECT_TRUE(b.reconstructions.empty());
+  EXPECT_EQ(b.unmeasured, (std::vector<std::size_t>{1, 5}));
+}
+
 }  // namespace
 }  // namespace halfback::acquire

@@ -162,7 +162,12 @@ class NielsenReconstruction final : public Brdf {
 struct NielsenAcquisition {
   std::vector<std::size_t> left_out;    // every member like `brdf`
   std::vector<std::size_t> directions;  // the largest count's
+  // One per count that has a finite value of every channel among its measurements, in the order
+  // of the counts (measurements() says which); the others are in `unmeasured`: a BRDF without a
+  // value at its first directions (an ALTA file measured on part of the hemisphere) cannot be
+  // reconstructed from them.
   std::vector<std::shared_ptr<const NielsenReconstruction>> reconstructions;
+  std::vector<std::size_t> unmeasured;
 };
 NielsenAcquisition nielsen_acquisition(std::shared_ptr<const NielsenDatabase> database,
                                        const Brdf& brdf, std::span<const std::size_t> counts);
