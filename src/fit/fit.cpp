@@ -455,10 +455,20 @@ double mean_square(std::span<const double> r) {
   return sum / double(r.size());
 }
 
+bool is_missing(const Rgb& v) {
+  return std::isnan(v.r) || std::isnan(v.g) || std::isnan(v.b);
+}
+
+// loss_value() of the target's measured samples only (defined with usable_samples()).
+double measured_loss_value(std::span<const Rgb> target_rgb, const Brdf& model, Loss loss,
+                           const Samples& samples, int threads);
+
 }  // namespace
 
 double loss_value(std::span<const Rgb> target_rgb, const Brdf& model, Loss loss,
                   const Samples& samples, int threads) {
+  if (std::any_of(target_rgb.begin(), target_rgb.end(), is_missing))
+    return measured_loss_value(target_rgb, model, loss, samples, threads);
   std::vector<Rgb> m(samples.pairs.size());
   eval_all(model, samples, m, threads);
   std::vector<double> r(3 * m.size());
@@ -1062,7 +1072,7 @@ Usable usable_samples(const Samples& s, std::span<const Rgb> t, double max_theta
       ++u.out_of_reach;
       continue;
     }
-    if (std::isnan(t[i].r) || std::isnan(t[i].g) || std::isnan(t[i].b)) {
+    if (is_missing(t[i])) {
       ++u.missing;
       continue;
     }
@@ -1082,6 +1092,12 @@ Usable usable_samples(const Samples& s, std::span<const Rgb> t, double max_theta
     for (double& w : u.samples.weight) w *= scale;
   }
   return u;
+}
+
+double measured_loss_value(std::span<const Rgb> target_rgb, const Brdf& model, Loss loss,
+                           const Samples& samples, int threads) {
+  const Usable u = usable_samples(samples, target_rgb, std::numbers::pi / 2);
+  return loss_value(u.target, model, loss, u.samples, threads);
 }
 
 }  // namespace

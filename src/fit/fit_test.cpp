@@ -247,6 +247,27 @@ TEST(FitSamples, MissingAndOutOfReachAreLeftOutAndCounted) {
   }
 }
 
+// loss_value() leaves a missing target value out as the fit does: the loss of a fit's spec on its
+// holed target is the fit's own loss (the study's fit metric measured such fits on the whole BRDF
+// as NaN, and its table could not be read back), not one number of a hole more.
+TEST(FitLoss, MissingTargetValuesAreLeftOutAsTheFitLeavesThemOut) {
+  const HoledBrdf holed(load_brdf("lambert:albedo=0.3+ggx:alpha=0.2,f0=0.6"));
+  FitOptions o;
+  o.samples = 3000;
+  const FitResult r = fit(holed, "lambert+ggx:alpha=0.35", o);  // α held: a loss above zero
+  ASSERT_GT(r.missing, 500u);
+  ASSERT_GT(r.loss_value, 1e-6);
+  const Samples s = halfdiff_samples(
+      3000, r.layout == kTurnedLayoutName ? Azimuths::turned : Azimuths::canonical);
+  std::vector<Rgb> target(s.pairs.size());
+  for (std::size_t i = 0; i < target.size(); ++i) target[i] = holed.eval(s.pairs[i]);
+  const double again = loss_value(target, *load_brdf(r.spec), o.loss, s, 1);
+  EXPECT_TRUE(std::isfinite(again));
+  EXPECT_NEAR(again, r.loss_value, 1e-9 * r.loss_value);
+  std::vector<Rgb> none(target.size(), Rgb{NAN, NAN, NAN});
+  EXPECT_THROW(loss_value(none, *load_brdf(r.spec), o.loss, s, 1), FitDataError);
+}
+
 TEST(FitLoss, NamesRoundTrip) {
   for (Loss l : kLosses) EXPECT_EQ(parse_loss(name_of(l)), l);
   EXPECT_FALSE(parse_loss("l2").has_value());

@@ -227,7 +227,10 @@ FitResult fit(const Brdf& target, std::string_view model, const FitOptions& opti
 FitResult fit_at(const Samples& samples, std::span<const Rgb> values, std::string_view model,
                  const FitOptions& options = {});
 
-// The loss of `model` against target values `target_rgb` at `samples` (one per pair).
+// The loss of `model` against target values `target_rgb` at `samples` (one per pair). Missing
+// values (NaN in a channel) are left out as fit() leaves them out, the other weights scaled back
+// to mean 1, so that the loss of a fit's spec on its own target is its FitResult::loss_value;
+// throws FitDataError when every value is missing.
 double loss_value(std::span<const Rgb> target_rgb, const Brdf& model, Loss loss,
                   const Samples& samples, int threads = 0);
 
