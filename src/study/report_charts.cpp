@@ -357,6 +357,20 @@ figure::ImageItem difference_item(const render::Image& test, const render::Image
 
 }  // namespace
 
+// The BRDFs of the renderings figure: those rendered, at most kMaxExampleRows of them spread
+// evenly over the results' order (the first and the last kept).
+std::vector<const BrdfResult*> example_rows(const std::vector<BrdfResult>& results,
+                                            std::size_t columns) {
+  std::vector<const BrdfResult*> all;
+  for (const BrdfResult& b : results)
+    if (b.example_images.size() == columns) all.push_back(&b);
+  if (all.size() <= kMaxExampleRows) return all;
+  std::vector<const BrdfResult*> some;
+  for (std::size_t i = 0; i < kMaxExampleRows; ++i)
+    some.push_back(all[(i * (all.size() - 1) + (kMaxExampleRows - 1) / 2) / (kMaxExampleRows - 1)]);
+  return some;
+}
+
 // The renderings of the BRDFs and of their regular-design reconstructions under the first
 // environment, side by side (the same tone mapping for a row), for the eye; under each
 // reconstruction its difference from the BRDF's rendering (difference_item), which shows the
@@ -365,8 +379,10 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
   const std::vector<Space>& params = params_of(results);
   const double cell = 66, gap = 4, label_w = 250, top = 92;
   const std::size_t columns = params.size() + 1;  // the BRDF, then its reconstructions
-  std::size_t rows = 0;
-  for (const BrdfResult& b : results) rows += b.example_images.size() == columns;
+  const std::vector<const BrdfResult*> shown = example_rows(results, columns);
+  std::size_t rendered = 0;
+  for (const BrdfResult& b : results) rendered += b.example_images.size() == columns;
+  const std::size_t rows = shown.size();
   if (rows == 0 || config.environments.empty()) return {};
   figure::Scene sc;
   sc.title = "Renderings of the reconstructions";
@@ -374,8 +390,12 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
       "The BRDF and its reconstructions from {} measurements (regular design), under {}",
       config.image_budget, config.environments.front().label);
   const std::string note = fmt::format(
-      "{} environment samples per pixel, the same in every image: the noise is common to a row.",
-      config.image_spp);
+      "{} environment samples per pixel, the same in every image: the noise is common to a "
+      "row.{}",
+      config.image_spp,
+      rows < rendered
+          ? fmt::format(" {} of the {} BRDFs, spread evenly over the list.", rows, rendered)
+          : "");
   const std::string note2 = fmt::format(
       "Under each reconstruction: |its luminance − the BRDF's| over the BRDF's mean luminance, "
       "black 0, red, yellow, white ≥ {:g} %.",
@@ -399,8 +419,8 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
   for (std::size_t k = 0; k < heads.size(); ++k)
     sc.text({label_w + double(k) * pitch + cell / 2, top - 8}, heads[k], 9, figure::HAlign::centre);
   double y = top;
-  for (const BrdfResult& b : results) {
-    if (b.example_images.size() != columns) continue;
+  for (const BrdfResult* row : shown) {
+    const BrdfResult& b = *row;
     sc.text({label_w - 8, y + cell / 2}, figure::escape_markup(b.label), 8.5, figure::HAlign::right,
             figure::VAlign::middle);
     sc.text({label_w - 8, y + cell + gap + cell / 2}, "difference", 8, figure::HAlign::right,

@@ -137,6 +137,9 @@ struct ReportPlots {
 };
 ReportPlots report_plots(const std::vector<BrdfResult>& results, const StudyConfig& config,
                          const Contents& has, const std::vector<SummaryMetric>& summary);
+// The most BRDFs the renderings figure shows: a whole-data study renders 176, whose rows would
+// make a figure 51 000 pixels tall (above what an image can have).
+inline constexpr std::size_t kMaxExampleRows = 24;
 // The renderings of the BRDFs and of their regular-design reconstructions under the first
 // environment, a column per parameterization (empty when there are none).
 figure::Scene examples_chart(const std::vector<BrdfResult>& results, const StudyConfig& config);

@@ -3,8 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <sstream>
 
 #include "fake_results.hpp"
@@ -114,6 +118,37 @@ TEST(Report, RenderingColumnsFitTheirHeads) {
     EXPECT_GE(heads[k + 1]->at.x - heads[k]->at.x, half_widths) << heads[k + 1]->text;
     EXPECT_GE(images[k + 1] - images[k], heads[k + 1]->at.x - heads[k]->at.x - 1e-9);
   }
+}
+
+// A whole-data study renders every BRDF: the figure shows at most kMaxExampleRows of them, the
+// first and the last among them, spread evenly, and says so (176 rows were 51 040 pixels tall,
+// above an image's 32 767, and the whole report failed after the last BRDF).
+TEST(Report, RenderingsOfManyBrdfsShowASpreadOfThem) {
+  std::vector<BrdfResult> results;
+  const render::Image grey{8, 8, std::vector<float>(8 * 8 * 3, 0.5f)};
+  for (int k = 0; k < 176; ++k) {
+    BrdfResult r = fake(fmt::format("brdf{}", k), true);
+    r.example_images.assign(r.params.size() + 1, grey);
+    results.push_back(std::move(r));
+  }
+  const figure::Scene sc = report::examples_chart(results, config_of_fakes());
+  std::vector<std::string> labels;
+  bool said = false;
+  for (const figure::Item& item : sc.items)
+    if (const auto* t = std::get_if<figure::TextItem>(&item)) {
+      if (t->text.rfind("brdf", 0) == 0) labels.push_back(t->text);
+      said = said || t->text.find("24 of the 176 BRDFs") != std::string::npos;
+    }
+  ASSERT_EQ(labels.size(), report::kMaxExampleRows);
+  EXPECT_EQ(labels.front(), "brdf0");
+  EXPECT_EQ(labels.back(), "brdf175");
+  EXPECT_TRUE(
+      std::is_sorted(labels.begin(), labels.end(), [](const std::string& a, const std::string& b) {
+        return std::stoi(a.substr(4)) < std::stoi(b.substr(4));
+      }));
+  EXPECT_EQ(std::set<std::string>(labels.begin(), labels.end()).size(), labels.size());
+  EXPECT_TRUE(said);
+  EXPECT_LT(sc.height * 2, 32767);
 }
 
 TEST(Report, FilesRepeatTheResults) {
