@@ -1021,7 +1021,7 @@ def check_sphere_export(driver, width):
         box.style.position = 'absolute'; box.style.left = '0'; box.style.top = '0';
         box.innerHTML = window.halfback.figure('sphere');
         document.body.append(box);
-        const texts = [...box.querySelectorAll('svg > text')].filter((t) => t.textContent.trim())
+        const texts = [...box.querySelectorAll('svg > text, svg > g > text')].filter((t) => t.textContent.trim())
           .map((t) => ({ r: t.getBoundingClientRect(), s: t.textContent }));
         const overlaps = [];
         texts.forEach((a, i) => texts.slice(i + 1).forEach((b) => {
@@ -1642,8 +1642,11 @@ def check_mesh_url_and_export(driver, screenshots):
         width, height = struct.unpack(">II", data[16:24])
         svg_w, svg_h = (int(x) for x in re.search(r'<svg[^>]* width="(\d+)" height="(\d+)"', got["svg"]).groups())
         pw, ph = got["panel"]
+        # The figure: the panel's height under a title of one or more lines (10 + 18 px each), as
+        # wide as what it shows (at most the panel, at least 360 px).
         check(data[:8] == b"\x89PNG\r\n\x1a\n" and (width, height) == (2 * svg_w, 2 * svg_h)
-              and svg_h == math.ceil(ph + 28) and svg_w >= math.ceil(pw) and len(re.findall("<image", got["svg"])) == len(before),
+              and any(svg_h == math.ceil(ph + 10 + 18 * k) for k in range(1, 5))
+              and 360 <= svg_w <= math.ceil(pw) and len(re.findall("<image", got["svg"])) == len(before),
               f"lit mesh: the PNG export is twice the figure ({width} x {height}; figure {svg_w} x {svg_h}, "
               f"panel {pw:.0f} x {ph:.0f}, {len(before)} images)")
         title = re.search(r"<text[^>]*>([^<]*)</text>", got["svg"]).group(1)

@@ -186,11 +186,16 @@ let sliceRows = [];
 let builtKey = '';  // the rows built: sliceKey() when they were built
 const sliceKey = () => (pairMode() ? 'pair' : visible().map((v) => `${v.b}:${v.spec}`).join('|'));
 // The BRDFs one /api/slices request may ask at n pixels a side: as many as the server's bounds
-// allow (BRDFs a request, bytes an answer); more are asked in requests side by side.
+// allow (BRDFs a request, bytes an answer) within SLICES_REQUEST_BYTES; more are asked in requests
+// side by side. While a slider moves (n ≤ 128) that is every BRDF shown; at rest (n = 256) four.
+// The server drops a response not read within 10 s: a loaded browser read 8 MB answers in time
+// where a 13 MB one (seven BRDFs at rest) was cut.
+const SLICES_REQUEST_BYTES = 8 << 20;
 const sliceBatch = (n) => {
   const limits = (info && info.limits) || {};
   const perBrdf = info.forms.length * n * n * 4;  // luminance: one float a pixel
-  return Math.max(1, Math.min(limits.brdfs || 1, Math.floor((limits.slices_bytes || perBrdf) / perBrdf)));
+  const bytes = Math.min(limits.slices_bytes || perBrdf, SLICES_REQUEST_BYTES);
+  return Math.max(1, Math.min(limits.brdfs || 1, Math.floor(bytes / perBrdf)));
 };
 function buildSlices() {
   const box = $('slices');
