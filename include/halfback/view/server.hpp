@@ -16,8 +16,9 @@ namespace halfback::view {
 // trickle in: after it, 408 and the connection closed;
 inline constexpr double kRequestHeadSeconds = 4;
 // a response is written within kResponseWriteSeconds of its first byte (the largest, 12 MB of
-// slices, takes milliseconds on loopback): a client that reads slower is dropped;
-inline constexpr double kResponseWriteSeconds = 10;
+// slices or mesh images, takes milliseconds on loopback, but a headless Chromium on a loaded
+// 2-core machine read some in more than 10 s): a client that reads slower is dropped;
+inline constexpr double kResponseWriteSeconds = 30;
 // at most kMaxConnections connections are open at once, whatever their address: a new one at
 // that bound closes the connection that has waited longest for a request head (idle, or
 // trickling one in); when every connection is being answered, the new one is answered 503.

@@ -188,8 +188,8 @@ const sliceKey = () => (pairMode() ? 'pair' : visible().map((v) => `${v.b}:${v.s
 // The BRDFs one /api/slices request may ask at n pixels a side: as many as the server's bounds
 // allow (BRDFs a request, bytes an answer) within SLICES_REQUEST_BYTES; more are asked in requests
 // side by side. While a slider moves (n ≤ 128) that is every BRDF shown; at rest (n = 256) four.
-// The server drops a response not read within 10 s: a loaded browser read 8 MB answers in time
-// where a 13 MB one (seven BRDFs at rest) was cut.
+// The server drops a response not read within its deadline (kResponseWriteSeconds): the smaller
+// the answers, the less a loaded browser risks it.
 const SLICES_REQUEST_BYTES = 8 << 20;
 const sliceBatch = (n) => {
   const limits = (info && info.limits) || {};
