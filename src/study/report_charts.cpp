@@ -357,13 +357,8 @@ figure::ImageItem difference_item(const render::Image& test, const render::Image
 
 }  // namespace
 
-// The BRDFs of the renderings figure: those rendered, at most kMaxExampleRows of them spread
-// evenly over the results' order (the first and the last kept).
-std::vector<const BrdfResult*> example_rows(const std::vector<BrdfResult>& results,
-                                            std::size_t columns) {
-  std::vector<const BrdfResult*> all;
-  for (const BrdfResult& b : results)
-    if (b.example_images.size() == columns) all.push_back(&b);
+// At most kMaxExampleRows of `all`, spread evenly over its order (the first and the last kept).
+std::vector<const BrdfResult*> spread_rows(const std::vector<const BrdfResult*>& all) {
   if (all.size() <= kMaxExampleRows) return all;
   std::vector<const BrdfResult*> some;
   for (std::size_t i = 0; i < kMaxExampleRows; ++i)
@@ -379,9 +374,10 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
   const std::vector<Space>& params = params_of(results);
   const double cell = 66, gap = 4, label_w = 250, top = 92;
   const std::size_t columns = params.size() + 1;  // the BRDF, then its reconstructions
-  const std::vector<const BrdfResult*> shown = example_rows(results, columns);
-  std::size_t rendered = 0;
-  for (const BrdfResult& b : results) rendered += b.example_images.size() == columns;
+  std::vector<const BrdfResult*> rendered;        // the BRDFs with every rendering
+  for (const BrdfResult& b : results)
+    if (b.example_images.size() == columns) rendered.push_back(&b);
+  const std::vector<const BrdfResult*> shown = spread_rows(rendered);
   const std::size_t rows = shown.size();
   if (rows == 0 || config.environments.empty()) return {};
   figure::Scene sc;
@@ -393,8 +389,8 @@ figure::Scene examples_chart(const std::vector<BrdfResult>& results, const Study
       "{} environment samples per pixel, the same in every image: the noise is common to a "
       "row.{}",
       config.image_spp,
-      rows < rendered
-          ? fmt::format(" {} of the {} BRDFs, spread evenly over the list.", rows, rendered)
+      rows < rendered.size()
+          ? fmt::format(" {} of the {} BRDFs, spread evenly over the list.", rows, rendered.size())
           : "");
   const std::string note2 = fmt::format(
       "Under each reconstruction: |its luminance − the BRDF's| over the BRDF's mean luminance, "

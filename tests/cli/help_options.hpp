@@ -3,6 +3,7 @@
 
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace halfback::test {
@@ -12,18 +13,28 @@ struct HelpOption {
   std::string text;                // the rest of its line and its wrapped lines, joined by spaces
 };
 
-// The options of the help's "Options:" section, in their order (-h,--help included).
-inline std::vector<HelpOption> help_options(const std::string& help_text) {
-  std::vector<HelpOption> found;
+// The lines of a help's section — those after the line starting with `heading` ("Options:",
+// "Subcommands:") up to the first empty or unindented line.
+inline std::vector<std::string> section_lines(const std::string& help_text,
+                                              std::string_view heading) {
+  std::vector<std::string> out;
   std::istringstream lines(help_text);
   bool in_section = false;
   for (std::string line; std::getline(lines, line);) {
-    if (line.starts_with("Options:")) {
-      in_section = true;
+    if (!in_section) {
+      in_section = line.starts_with(heading);
       continue;
     }
-    if (!in_section) continue;
     if (line.empty() || !line.starts_with(" ")) break;
+    out.push_back(std::move(line));
+  }
+  return out;
+}
+
+// The options of the help's "Options:" section, in their order (-h,--help included).
+inline std::vector<HelpOption> help_options(const std::string& help_text) {
+  std::vector<HelpOption> found;
+  for (const std::string& line : section_lines(help_text, "Options:")) {
     if (line.starts_with("  -")) {
       HelpOption o;
       const std::size_t end = line.find(' ', 2);

@@ -10,6 +10,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "halfback/study/metric.hpp"
@@ -47,6 +48,27 @@ bool has_value(const std::string& text, const std::string& value) {
   return false;
 }
 
+// The configurations make_config() gives without and with --quick, every metric asked for (so that
+// the options of those off by default have their values too).
+std::pair<study::StudyConfig, study::StudyConfig> configs_with_every_metric() {
+  study::StudySettings settings;
+  settings.designs = {"own"};
+  for (const study::Metric* m : study::study_metrics())
+    if (m->switchable()) settings.metrics.emplace_back(m->name());
+  study::StudyConfig plain = study::make_config(settings);
+  settings.quick = true;
+  return {std::move(plain), study::make_config(settings)};
+}
+
+// The options of `halfback study --help` (empty when it fails: the callers assert on it).
+std::map<std::string, std::string> study_help() {
+  test::TempDir dir;
+  const test::Captured ran = test::run_captured(dir.path(), {HALFBACK_CLI_PATH, "study", "--help"});
+  EXPECT_TRUE(ran.started) << ran.error;
+  EXPECT_EQ(ran.status, 0) << ran.err;
+  return option_help(ran.out);
+}
+
 TEST(StudyHelp, HasValueFindsWholeValuesOnly) {
   EXPECT_TRUE(has_value("(default 64,1024; --quick 64)", "64,1024"));
   EXPECT_TRUE(has_value("default 20.", "20"));
@@ -57,20 +79,9 @@ TEST(StudyHelp, HasValueFindsWholeValuesOnly) {
 }
 
 TEST(StudyHelp, MetricOptionsSayTheValuesTheStudyUses) {
-  // Every metric asked for, so that the options of those off by default have their values too.
-  study::StudySettings settings;
-  settings.designs = {"own"};
-  for (const study::Metric* m : study::study_metrics())
-    if (m->switchable()) settings.metrics.emplace_back(m->name());
-  const study::StudyConfig plain = study::make_config(settings);
-  settings.quick = true;
-  const study::StudyConfig quick = study::make_config(settings);
-
-  test::TempDir dir;
-  const test::Captured ran = test::run_captured(dir.path(), {HALFBACK_CLI_PATH, "study", "--help"});
-  ASSERT_TRUE(ran.started) << ran.error;
-  ASSERT_EQ(ran.status, 0) << ran.err;
-  const std::map<std::string, std::string> help = option_help(ran.out);
+  const auto [plain, quick] = configs_with_every_metric();
+  const std::map<std::string, std::string> help = study_help();
+  ASSERT_FALSE(help.empty()) << "`halfback study --help` has no options";
 
   std::size_t checked = 0;
   for (const study::Metric* m : study::study_metrics()) {
@@ -113,17 +124,9 @@ TEST(StudyHelp, MetricOptionsSayTheValuesTheStudyUses) {
 // The study's own settings say their values as make_config() resolves them, with and without
 // --quick (the help had them by hand: "--image-spp (default 16)" never said --quick's 8).
 TEST(StudyHelp, SettingsSayTheValuesTheStudyUses) {
-  study::StudySettings settings;
-  settings.designs = {"own"};
-  const study::StudyConfig plain = study::make_config(settings);
-  settings.quick = true;
-  const study::StudyConfig quick = study::make_config(settings);
-
-  test::TempDir dir;
-  const test::Captured ran = test::run_captured(dir.path(), {HALFBACK_CLI_PATH, "study", "--help"});
-  ASSERT_TRUE(ran.started) << ran.error;
-  ASSERT_EQ(ran.status, 0) << ran.err;
-  const std::map<std::string, std::string> help = option_help(ran.out);
+  const auto [plain, quick] = configs_with_every_metric();
+  const std::map<std::string, std::string> help = study_help();
+  ASSERT_FALSE(help.empty()) << "`halfback study --help` has no options";
 
   const auto list = [](const std::vector<std::size_t>& v) {
     std::string s;

@@ -71,15 +71,7 @@ class Vocabulary : public testing::Test {
   // The names listed in a help's "Subcommands:" section.
   static std::vector<std::string> subcommands(const std::string& help_text) {
     std::vector<std::string> names;
-    std::istringstream lines(help_text);
-    bool in_section = false;
-    for (std::string line; std::getline(lines, line);) {
-      if (line.starts_with("Subcommands:")) {
-        in_section = true;
-        continue;
-      }
-      if (!in_section) continue;
-      if (line.empty() || !line.starts_with("  ")) break;
+    for (const std::string& line : test::section_lines(help_text, "Subcommands:")) {
       std::istringstream words(line);
       std::string name;
       words >> name;
