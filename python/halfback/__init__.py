@@ -91,8 +91,9 @@ def study_profile(spec, settings=None):
 
 
 def fit(brdf, model, loss="ngan", samples=20000, threads=0, starts=(), max_iterations=200,
-        max_theta=math.pi / 2):
-    return _core.fit(brdf, model, loss, samples, threads, list(starts), max_iterations, max_theta)
+        max_theta=math.pi / 2, energy=True):
+    return _core.fit(brdf, model, loss, samples, threads, list(starts), max_iterations, max_theta,
+                     energy)
 
 
 def fit_loss(brdf, model, loss="ngan", samples=20000, threads=0):

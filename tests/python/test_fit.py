@@ -41,6 +41,18 @@ def test_fit_reports_dead_lobes_inert_parameters_and_the_turned_layout():
         r["loss_value"], rel=1e-12)
 
 
+def test_fit_reports_the_fitted_models_energy_unless_asked_not_to():
+    """energy: the fitted model's largest directional albedo (a Lambert fit: its albedo, at most
+    1 here); energy=False leaves it out (None) and fits the same model."""
+    r = halfback.fit("lambert:albedo=0.2", "lambert", samples=2000)
+    e = r["energy"]
+    assert e["max_albedo"] == pytest.approx(0.2, rel=1e-6)
+    assert e["creates_energy"] is False and e["standard_error"] >= 0
+    assert 0 <= e["theta_deg"] <= 85
+    without = halfback.fit("lambert:albedo=0.2", "lambert", samples=2000, energy=False)
+    assert without["energy"] is None and without["spec"] == r["spec"]
+
+
 def test_fit_errors():
     with pytest.raises(ValueError, match="phong"):
         halfback.fit("ggx", "phong", samples=500)
